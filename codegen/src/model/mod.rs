@@ -1,0 +1,169 @@
+//! The kinematic tree that the derivation works on, independent of any file format.
+//!
+//! A [`Model`] is what is left of a URDF once fixed joints are merged: a list of moving
+//! [`Joint`]s in a fixed order, one rigid [`Body`] per moving joint (the joint's child link with
+//! everything welded to it), and a [`Frame`] for every URDF link so that kinematics can still
+//! address each link by name.
+//!
+//! Conventions:
+//! - the root link is welded to the world; its inertia never matters;
+//! - body `i` is moved by joint `i`; its frame is the child link frame of joint `i`;
+//! - all quantities are in SI units (m, kg, kg m^2, rad).
+
+use nalgebra::{Matrix3, Vector3};
+
+mod build;
+pub use build::{ModelError, ModelOptions, SymbolicParams};
+
+/// A rigid transform: `p_parent = rotation * p_child + translation`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Transform {
+    pub rotation: Matrix3<f64>,
+    pub translation: Vector3<f64>,
+}
+
+impl Transform {
+    pub fn identity() -> Self {
+        Transform { rotation: Matrix3::identity(), translation: Vector3::zeros() }
+    }
+
+    /// `self * other`: first `other`, then `self`.
+    pub fn compose(&self, other: &Transform) -> Transform {
+        Transform {
+            rotation: self.rotation * other.rotation,
+            translation: self.rotation * other.translation + self.translation,
+        }
+    }
+}
+
+/// The kind of a moving joint.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum JointKind {
+    /// Rotation about `axis`, with position limits.
+    Revolute,
+    /// Rotation about `axis` without limits; still one angle (no cos/sin pair as coordinates).
+    Continuous,
+    /// Translation along `axis`.
+    Prismatic,
+}
+
+impl JointKind {
+    pub fn is_revolute(self) -> bool {
+        matches!(self, JointKind::Revolute | JointKind::Continuous)
+    }
+}
+
+/// Position, velocity and effort limits of a joint, as written in the URDF.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct Limits {
+    pub lower: f64,
+    pub upper: f64,
+    pub effort: f64,
+    pub velocity: f64,
+}
+
+/// A mimic relation, kept for information: eomgen treats mimic joints as independent.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Mimic {
+    pub joint: String,
+    pub multiplier: f64,
+    pub offset: f64,
+}
+
+/// A moving joint.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Joint {
+    /// The URDF name.
+    pub name: String,
+    pub kind: JointKind,
+    /// Index of the parent body, `None` when the parent is the root (welded to the world).
+    pub parent: Option<usize>,
+    /// Pose of the joint frame at q = 0 in the parent body's frame (URDF `<origin>`, with any
+    /// fixed joints between the parent body and this joint folded in).
+    pub origin: Transform,
+    /// Unit axis in the joint frame.
+    pub axis: Vector3<f64>,
+    pub limits: Option<Limits>,
+    /// Viscous damping (N m s / rad or N s / m), from `<dynamics damping>`.
+    pub damping: f64,
+    /// Coulomb friction (N m or N), from `<dynamics friction>`.
+    pub friction: f64,
+    pub mimic: Option<Mimic>,
+    /// Whether the translation of `origin` should be a symbol instead of its number.
+    pub symbolic_origin: bool,
+}
+
+/// The rigid body moved by one joint: its child link and every link welded to it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Body {
+    /// The URDF name of the joint's child link.
+    pub name: String,
+    /// Total mass (kg).
+    pub mass: f64,
+    /// Centre of mass in the body frame (m).
+    pub com: Vector3<f64>,
+    /// Rotational inertia about the centre of mass, in body-frame axes (kg m^2), symmetric.
+    pub inertia: Matrix3<f64>,
+    /// The URDF links merged into this body (the child link first).
+    pub merged_links: Vec<String>,
+    /// Whether mass, centre of mass and inertia should be symbols instead of numbers.
+    pub symbolic: bool,
+}
+
+/// Every URDF link, addressable as a frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Frame {
+    /// The URDF link name.
+    pub name: String,
+    /// The body this link is welded to, `None` for the root.
+    pub body: Option<usize>,
+    /// Pose of the link frame in that body's frame (in the world frame for the root).
+    pub placement: Transform,
+}
+
+/// A robot ready for derivation.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Model {
+    /// The URDF `<robot name>`.
+    pub name: String,
+    /// The root link's name.
+    pub root: String,
+    /// Gravity in world axes (m/s^2).
+    pub gravity: Vector3<f64>,
+    /// Moving joints; joint `i` moves body `i`. A parent body always precedes its children.
+    pub joints: Vec<Joint>,
+    pub bodies: Vec<Body>,
+    /// One frame per URDF link, in the URDF's link order.
+    pub frames: Vec<Frame>,
+}
+
+impl Model {
+    /// Degrees of freedom.
+    pub fn dof(&self) -> usize {
+        self.joints.len()
+    }
+
+    /// The chain of joints from the root to joint `i`, root first, `i` last.
+    pub fn path_to_root(&self, i: usize) -> Vec<usize> {
+        let mut path = vec![i];
+        let mut j = i;
+        while let Some(p) = self.joints[j].parent {
+            path.push(p);
+            j = p;
+        }
+        path.reverse();
+        path
+    }
+
+    /// True when joint `a` lies on the path from the root to joint `b` (or `a == b`).
+    pub fn is_ancestor(&self, a: usize, b: usize) -> bool {
+        let mut j = Some(b);
+        while let Some(k) = j {
+            if k == a {
+                return true;
+            }
+            j = self.joints[k].parent;
+        }
+        false
+    }
+}
