@@ -1,0 +1,283 @@
+//! Straight-line programs: the outputs of a graph as a list of temporaries, then outputs.
+//!
+//! Every distinct subexpression reachable from the outputs is computed once. A node used more
+//! than once gets a temporary; a node used once is written inline into its single user (up to a
+//! small nesting depth, so that expressions stay readable and printing never recurses deeply).
+//! Nodes that no output needs are dropped.
+
+use std::fmt;
+
+use super::eval::{powi, sign};
+use super::graph::{Graph, Id, Node, Symbol, SymbolIndex};
+use super::UnboundSymbol;
+
+/// An expression of a straight-line program.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Expr {
+    Const(f64),
+    /// A symbol, by its index in [`Program::symbols`].
+    Input(SymbolIndex),
+    /// An earlier temporary.
+    Temp(usize),
+    /// `constant + sum of coefficient * term`.
+    Add(f64, Vec<(Expr, f64)>),
+    /// Product of `factor ^ exponent`.
+    Mul(Vec<(Expr, i32)>),
+    Sin(Box<Expr>),
+    Cos(Box<Expr>),
+    Sqrt(Box<Expr>),
+    Sign(Box<Expr>),
+}
+
+/// Operation counts of a program, the cost model for generated code.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct OpCount {
+    /// Additions and subtractions.
+    pub add: usize,
+    /// Multiplications (including those of integer powers and coefficients).
+    pub mul: usize,
+    pub div: usize,
+    pub sin: usize,
+    pub cos: usize,
+    pub sqrt: usize,
+    pub sign: usize,
+}
+
+impl OpCount {
+    /// All operations together.
+    pub fn total(&self) -> usize {
+        self.add + self.mul + self.div + self.sin + self.cos + self.sqrt + self.sign
+    }
+}
+
+impl std::ops::AddAssign for OpCount {
+    fn add_assign(&mut self, o: OpCount) {
+        self.add += o.add;
+        self.mul += o.mul;
+        self.div += o.div;
+        self.sin += o.sin;
+        self.cos += o.cos;
+        self.sqrt += o.sqrt;
+        self.sign += o.sign;
+    }
+}
+
+impl fmt::Display for OpCount {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{} mul, {} add, {} div, {} sin, {} cos",
+            self.mul, self.add, self.div, self.sin, self.cos
+        )?;
+        if self.sqrt > 0 {
+            write!(f, ", {} sqrt", self.sqrt)?;
+        }
+        if self.sign > 0 {
+            write!(f, ", {} sign", self.sign)?;
+        }
+        Ok(())
+    }
+}
+
+impl Expr {
+    /// Operations needed to evaluate this expression once its temporaries are known.
+    pub fn ops(&self) -> OpCount {
+        let mut n = OpCount::default();
+        self.count(&mut n);
+        n
+    }
+
+    fn count(&self, n: &mut OpCount) {
+        match self {
+            Expr::Const(_) | Expr::Input(_) | Expr::Temp(_) => {}
+            Expr::Add(c, ts) => {
+                n.add += ts.len() - 1 + usize::from(*c != 0.0);
+                for (t, k) in ts {
+                    n.mul += usize::from(k.abs() != 1.0);
+                    t.count(n);
+                }
+            }
+            Expr::Mul(fs) => {
+                let (mut num, mut den) = (0usize, 0usize);
+                for (f, e) in fs {
+                    n.mul += e.unsigned_abs() as usize - 1;
+                    if *e > 0 {
+                        num += 1;
+                    } else {
+                        den += 1;
+                    }
+                    f.count(n);
+                }
+                n.mul += num.saturating_sub(1) + den.saturating_sub(1);
+                n.div += usize::from(den > 0);
+            }
+            Expr::Sin(a) => {
+                n.sin += 1;
+                a.count(n)
+            }
+            Expr::Cos(a) => {
+                n.cos += 1;
+                a.count(n)
+            }
+            Expr::Sqrt(a) => {
+                n.sqrt += 1;
+                a.count(n)
+            }
+            Expr::Sign(a) => {
+                n.sign += 1;
+                a.count(n)
+            }
+        }
+    }
+
+    fn eval(&self, inputs: &[f64], temps: &[f64]) -> f64 {
+        match self {
+            Expr::Const(c) => *c,
+            Expr::Input(s) => inputs[*s as usize],
+            Expr::Temp(t) => temps[*t],
+            Expr::Add(c, ts) => ts
+                .iter()
+                .fold(*c, |acc, (t, k)| acc + k * t.eval(inputs, temps)),
+            Expr::Mul(fs) => fs
+                .iter()
+                .fold(1.0, |acc, (f, e)| acc * powi(f.eval(inputs, temps), *e)),
+            Expr::Sin(a) => a.eval(inputs, temps).sin(),
+            Expr::Cos(a) => a.eval(inputs, temps).cos(),
+            Expr::Sqrt(a) => a.eval(inputs, temps).sqrt(),
+            Expr::Sign(a) => sign(a.eval(inputs, temps)),
+        }
+    }
+}
+
+/// Temporaries in dependency order, then outputs.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Program {
+    /// `temps[k]` may use inputs and `temps[..k]`.
+    pub temps: Vec<Expr>,
+    pub outputs: Vec<Expr>,
+    /// The graph's symbol table, for naming inputs.
+    pub symbols: Vec<Symbol>,
+}
+
+/// Deepest nesting of single-use nodes written inline.
+const MAX_INLINE_DEPTH: u32 = 4;
+
+impl Program {
+    /// Schedules `outputs` of `graph`.
+    pub fn new(graph: &Graph, outputs: &[Id]) -> Program {
+        let order = graph.reachable(outputs);
+        let slot = |id: Id| order.binary_search(&id).expect("reachable");
+        let mut uses = vec![0u32; order.len()];
+        for &id in &order {
+            for c in graph.node(id).children() {
+                uses[slot(c)] += 1;
+            }
+        }
+        for &o in outputs {
+            uses[slot(o)] += 1;
+        }
+        // For each reachable node: its expression when used (a leaf, a temp, or inline), and
+        // the nesting depth of that inline expression.
+        let mut repr: Vec<Option<(Expr, u32)>> = vec![None; order.len()];
+        let mut temps = Vec::new();
+        for (k, &id) in order.iter().enumerate() {
+            let sub =
+                |c: Id| -> (Expr, u32) { repr[slot(c)].clone().expect("child before parent") };
+            let (e, depth) = match graph.node(id) {
+                Node::Const(c) => (Expr::Const(c.get()), 0),
+                Node::Sym(s) => (Expr::Input(*s), 0),
+                Node::Add(c, ts) => {
+                    let parts: Vec<((Expr, u32), f64)> =
+                        ts.iter().map(|(t, k)| (sub(*t), k.get())).collect();
+                    let d = parts.iter().map(|p| p.0 .1).max().unwrap_or(0) + 1;
+                    (
+                        Expr::Add(
+                            c.get(),
+                            parts.into_iter().map(|((e, _), k)| (e, k)).collect(),
+                        ),
+                        d,
+                    )
+                }
+                Node::Mul(fs) => {
+                    let parts: Vec<((Expr, u32), i32)> =
+                        fs.iter().map(|(f, e)| (sub(*f), *e)).collect();
+                    let d = parts.iter().map(|p| p.0 .1).max().unwrap_or(0) + 1;
+                    (
+                        Expr::Mul(parts.into_iter().map(|((e, _), x)| (e, x)).collect()),
+                        d,
+                    )
+                }
+                Node::Sin(a) => unary(sub(*a), Expr::Sin),
+                Node::Cos(a) => unary(sub(*a), Expr::Cos),
+                Node::Sqrt(a) => unary(sub(*a), Expr::Sqrt),
+                Node::Sign(a) => unary(sub(*a), Expr::Sign),
+            };
+            let is_leaf = depth == 0;
+            repr[k] = Some(if is_leaf || (uses[k] <= 1 && depth <= MAX_INLINE_DEPTH) {
+                (e, depth)
+            } else {
+                temps.push(e);
+                (Expr::Temp(temps.len() - 1), 0)
+            });
+        }
+        let outputs = outputs
+            .iter()
+            .map(|&o| repr[slot(o)].clone().expect("reachable").0)
+            .collect();
+        Program {
+            temps,
+            outputs,
+            symbols: graph.symbols().to_vec(),
+        }
+    }
+
+    /// Operation count of the whole program.
+    pub fn ops(&self) -> OpCount {
+        let mut n = OpCount::default();
+        for e in self.temps.iter().chain(&self.outputs) {
+            n += e.ops();
+        }
+        n
+    }
+
+    /// Runs the program; `value` gives each symbol's number (only symbols the program uses are
+    /// asked for).
+    pub fn eval(
+        &self,
+        mut value: impl FnMut(&Symbol) -> Option<f64>,
+    ) -> Result<Vec<f64>, UnboundSymbol> {
+        let mut used = vec![false; self.symbols.len()];
+        fn mark(e: &Expr, used: &mut [bool]) {
+            match e {
+                Expr::Input(s) => used[*s as usize] = true,
+                Expr::Const(_) | Expr::Temp(_) => {}
+                Expr::Add(_, ts) => ts.iter().for_each(|(t, _)| mark(t, used)),
+                Expr::Mul(fs) => fs.iter().for_each(|(f, _)| mark(f, used)),
+                Expr::Sin(a) | Expr::Cos(a) | Expr::Sqrt(a) | Expr::Sign(a) => mark(a, used),
+            }
+        }
+        for e in self.temps.iter().chain(&self.outputs) {
+            mark(e, &mut used);
+        }
+        let mut inputs = vec![0.0; self.symbols.len()];
+        for (i, s) in self.symbols.iter().enumerate() {
+            if used[i] {
+                inputs[i] = value(s).ok_or_else(|| UnboundSymbol(s.name.clone()))?;
+            }
+        }
+        let mut temps = Vec::with_capacity(self.temps.len());
+        for e in &self.temps {
+            let v = e.eval(&inputs, &temps);
+            temps.push(v);
+        }
+        Ok(self
+            .outputs
+            .iter()
+            .map(|e| e.eval(&inputs, &temps))
+            .collect())
+    }
+}
+
+fn unary((e, d): (Expr, u32), f: fn(Box<Expr>) -> Expr) -> (Expr, u32) {
+    (f(Box::new(e)), d + 1)
+}
