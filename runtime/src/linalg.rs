@@ -1,0 +1,325 @@
+//! Fixed-size, allocation-free, panic-free solvers for symmetric positive definite systems.
+//!
+//! Both factorizations read only the **lower triangle** (`m[i][j]` with `i >= j`) of the
+//! matrix, which is assumed symmetric; the strict upper triangle is ignored. Every pivot is
+//! checked: a pivot that is not finite or not strictly positive stops the factorization with a
+//! [`FactorError`] naming it. Because every input entry of the lower triangle feeds some later
+//! pivot, a NaN or infinity anywhere in the lower triangle is always reported, and a successful
+//! factorization has only finite entries.
+
+use crate::Real;
+use core::fmt;
+
+/// Why a matrix could not be factorized.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum FactorError {
+    /// Pivot `pivot` (0-based row/column index) was zero or negative: the matrix is not
+    /// (numerically) positive definite.
+    NotPositiveDefinite {
+        /// The 0-based index of the offending pivot.
+        pivot: usize,
+    },
+    /// Pivot `pivot` was NaN or infinite: the matrix holds a non-finite value (in row `pivot`
+    /// or an earlier row of its lower triangle), or its factorization overflowed.
+    NonFinite {
+        /// The 0-based index of the offending pivot.
+        pivot: usize,
+    },
+}
+
+impl FactorError {
+    /// The 0-based index of the pivot at which the factorization stopped.
+    pub fn pivot(&self) -> usize {
+        match *self {
+            FactorError::NotPositiveDefinite { pivot } | FactorError::NonFinite { pivot } => pivot,
+        }
+    }
+}
+
+impl fmt::Display for FactorError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            FactorError::NotPositiveDefinite { pivot } => write!(
+                f,
+                "matrix is not positive definite: pivot {pivot} is zero or negative"
+            ),
+            FactorError::NonFinite { pivot } => write!(
+                f,
+                "matrix cannot be factorized: pivot {pivot} is not finite (NaN or infinite input, or overflow)"
+            ),
+        }
+    }
+}
+
+#[cfg(feature = "std")]
+impl std::error::Error for FactorError {}
+
+#[inline(always)]
+fn check_pivot<T: Real>(d: T, pivot: usize) -> Result<(), FactorError> {
+    if !d.is_finite() {
+        Err(FactorError::NonFinite { pivot })
+    } else if d > T::zero() {
+        Ok(())
+    } else {
+        Err(FactorError::NotPositiveDefinite { pivot })
+    }
+}
+
+/// The dot product of the first `len` entries of `a` and `b` (no bounds checks: `zip` and
+/// `take` stop at the shorter length).
+#[inline(always)]
+fn dot_prefix<T: Real, const N: usize>(a: &[T; N], b: &[T; N], len: usize) -> T {
+    let mut s = T::zero();
+    for (x, y) in a.iter().zip(b.iter()).take(len) {
+        s += *x * *y;
+    }
+    s
+}
+
+/// The `L D Lᵀ` factorization of a symmetric positive definite `N×N` matrix, with `L` unit lower
+/// triangular and `D` diagonal.
+///
+/// Needs no square root (a single division per row and one per solve), which makes it the
+/// cheapest choice on microcontrollers; [`solve_spd`] uses it. A positive definite matrix has
+/// all pivots `D_j > 0`; [`Ldlt::new`] fails on the first pivot that is not finite or not
+/// positive.
+///
+/// Only the lower triangle of the input is read; the matrix is assumed symmetric. A NaN or
+/// infinity anywhere in that triangle gives an error ([`FactorError::NonFinite`], unless an
+/// earlier pivot already failed).
+///
+/// ```
+/// use eomgen_runtime::{FactorError, Ldlt};
+///
+/// let m = [[4.0_f64, 2.0], [2.0, 3.0]];
+/// let f = Ldlt::new(m).unwrap();
+/// let x = f.solve(&[6.0, 5.0]);
+/// assert!((x[0] - 1.0).abs() < 1e-12 && (x[1] - 1.0).abs() < 1e-12);
+/// assert_eq!(f.d(), &[4.0, 2.0]);
+///
+/// let singular = [[1.0_f64, 1.0], [1.0, 1.0]];
+/// assert_eq!(Ldlt::new(singular), Err(FactorError::NotPositiveDefinite { pivot: 1 }));
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ldlt<T, const N: usize> {
+    /// Strictly lower part holds `L` (unit diagonal implied); diagonal and upper part unused
+    /// (kept zero).
+    l: [[T; N]; N],
+    /// The pivots `D_j`, all finite and positive.
+    d: [T; N],
+    /// `1 / D_j`.
+    d_inv: [T; N],
+}
+
+impl<T: Real, const N: usize> Ldlt<T, N> {
+    /// Factorizes `m` (lower triangle read). Errors on the first pivot that is not finite or
+    /// not strictly positive.
+    pub fn new(m: [[T; N]; N]) -> Result<Self, FactorError> {
+        let mut l = [[T::zero(); N]; N];
+        let mut d = [T::zero(); N];
+        let mut d_inv = [T::zero(); N];
+        // Work row: w[k] = L[j][k] * D[k] for k < j.
+        let mut w = [T::zero(); N];
+        for j in 0..N {
+            // w = L[j][..j] * D[..j]
+            for ((wk, lk), dk) in w.iter_mut().zip(l[j].iter()).zip(d.iter()).take(j) {
+                *wk = *lk * *dk;
+            }
+            let dj = m[j][j] - dot_prefix(&w, &l[j], j);
+            check_pivot(dj, j)?;
+            let inv = T::one() / dj;
+            d[j] = dj;
+            d_inv[j] = inv;
+            for i in (j + 1)..N {
+                let s = dot_prefix(&l[i], &w, j);
+                l[i][j] = (m[i][j] - s) * inv;
+            }
+        }
+        Ok(Ldlt { l, d, d_inv })
+    }
+
+    /// The unit lower triangular factor `L` (row-major; ones on the diagonal, zeros above).
+    pub fn l(&self) -> [[T; N]; N] {
+        let mut l = self.l;
+        for (i, row) in l.iter_mut().enumerate() {
+            for (j, x) in row.iter_mut().enumerate() {
+                if i == j {
+                    *x = T::one();
+                }
+            }
+        }
+        l
+    }
+
+    /// The diagonal `D` (all entries finite and positive).
+    pub fn d(&self) -> &[T; N] {
+        &self.d
+    }
+
+    /// The determinant of the factorized matrix, `Π D_j` (may overflow to infinity).
+    pub fn determinant(&self) -> T {
+        let mut p = T::one();
+        for x in self.d.iter() {
+            p *= *x;
+        }
+        p
+    }
+
+    /// Overwrites `b` with the solution `x` of `M x = b`.
+    pub fn solve_in_place(&self, b: &mut [T; N]) {
+        // L y = b (forward; unit diagonal)
+        for i in 0..N {
+            let s = dot_prefix(&self.l[i], b, i);
+            b[i] -= s;
+        }
+        // D z = y
+        for (x, inv) in b.iter_mut().zip(self.d_inv.iter()) {
+            *x *= *inv;
+        }
+        // Lᵀ x = z (backward; unit diagonal)
+        for i in (0..N).rev() {
+            let mut s = T::zero();
+            for (row, bk) in self.l.iter().zip(b.iter()).skip(i + 1) {
+                s += row[i] * *bk;
+            }
+            b[i] -= s;
+        }
+    }
+
+    /// The solution `x` of `M x = b`.
+    pub fn solve(&self, b: &[T; N]) -> [T; N] {
+        let mut x = *b;
+        self.solve_in_place(&mut x);
+        x
+    }
+}
+
+/// The Cholesky factorization `M = L Lᵀ` of a symmetric positive definite `N×N` matrix, with `L`
+/// lower triangular with a positive diagonal; like nalgebra's `Cholesky`, but fixed-size,
+/// `no_std` and returning an error instead of panicking.
+///
+/// Costs `N` square roots more than [`Ldlt`]; use it when the factor `L` itself is wanted
+/// (e.g. to draw correlated noise, or for the Cholesky of the mass matrix in operational-space
+/// control). The pivots checked are `L_jj²`.
+///
+/// Only the lower triangle of the input is read; the matrix is assumed symmetric. A NaN or
+/// infinity anywhere in that triangle gives an error ([`FactorError::NonFinite`], unless an
+/// earlier pivot already failed).
+///
+/// ```
+/// use eomgen_runtime::{Cholesky, FactorError};
+///
+/// let m = [[4.0_f64, 2.0], [2.0, 5.0]];
+/// let c = Cholesky::new(m).unwrap();
+/// assert_eq!(c.l(), &[[2.0, 0.0], [1.0, 2.0]]);
+/// assert_eq!(c.solve(&[6.0, 7.0]), [1.0, 1.0]);
+///
+/// let with_nan = [[1.0_f64, 0.0], [f64::NAN, 1.0]];
+/// assert_eq!(Cholesky::new(with_nan), Err(FactorError::NonFinite { pivot: 1 }));
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Cholesky<T, const N: usize> {
+    /// Lower triangular factor, zeros above the diagonal.
+    l: [[T; N]; N],
+    /// `1 / L_jj`.
+    diag_inv: [T; N],
+}
+
+impl<T: Real, const N: usize> Cholesky<T, N> {
+    /// Factorizes `m` (lower triangle read). Errors on the first pivot `L_jj²` that is not
+    /// finite or not strictly positive.
+    pub fn new(m: [[T; N]; N]) -> Result<Self, FactorError> {
+        let mut l = [[T::zero(); N]; N];
+        let mut diag_inv = [T::zero(); N];
+        for j in 0..N {
+            let d = m[j][j] - dot_prefix(&l[j], &l[j], j);
+            check_pivot(d, j)?;
+            let ljj = d.sqrt();
+            let inv = T::one() / ljj;
+            l[j][j] = ljj;
+            diag_inv[j] = inv;
+            for i in (j + 1)..N {
+                let s = dot_prefix(&l[i], &l[j], j);
+                l[i][j] = (m[i][j] - s) * inv;
+            }
+        }
+        Ok(Cholesky { l, diag_inv })
+    }
+
+    /// The lower triangular factor `L` (row-major, zeros above the diagonal).
+    pub fn l(&self) -> &[[T; N]; N] {
+        &self.l
+    }
+
+    /// The determinant of the factorized matrix, `Π L_jj²` (may overflow to infinity).
+    pub fn determinant(&self) -> T {
+        let mut p = T::one();
+        for (j, row) in self.l.iter().enumerate() {
+            if let Some(x) = row.get(j) {
+                p *= *x * *x;
+            }
+        }
+        p
+    }
+
+    /// Overwrites `b` with the solution `x` of `M x = b`.
+    pub fn solve_in_place(&self, b: &mut [T; N]) {
+        // L y = b
+        for i in 0..N {
+            let s = dot_prefix(&self.l[i], b, i);
+            b[i] = (b[i] - s) * self.diag_inv[i];
+        }
+        // Lᵀ x = y
+        for i in (0..N).rev() {
+            let mut s = T::zero();
+            for (row, bk) in self.l.iter().zip(b.iter()).skip(i + 1) {
+                s += row[i] * *bk;
+            }
+            b[i] = (b[i] - s) * self.diag_inv[i];
+        }
+    }
+
+    /// The solution `x` of `M x = b`.
+    pub fn solve(&self, b: &[T; N]) -> [T; N] {
+        let mut x = *b;
+        self.solve_in_place(&mut x);
+        x
+    }
+}
+
+/// Solves `M x = b` for a symmetric positive definite `M` (lower triangle read) with an
+/// [`Ldlt`] factorization.
+///
+/// ```
+/// use eomgen_runtime::{solve_spd, FactorError};
+///
+/// let m = [[2.0_f32, 1.0], [1.0, 2.0]];
+/// let x = solve_spd(&m, &[3.0, 3.0]).unwrap();
+/// assert!((x[0] - 1.0).abs() < 1e-6 && (x[1] - 1.0).abs() < 1e-6);
+///
+/// let indefinite = [[1.0_f32, 0.0], [0.0, -1.0]];
+/// assert_eq!(solve_spd(&indefinite, &[1.0, 1.0]), Err(FactorError::NotPositiveDefinite { pivot: 1 }));
+/// ```
+pub fn solve_spd<T: Real, const N: usize>(
+    m: &[[T; N]; N],
+    b: &[T; N],
+) -> Result<[T; N], FactorError> {
+    Ldlt::new(*m).map(|f| f.solve(b))
+}
+
+/// Like [`solve_spd`], but reports failure as an all-NaN result instead of an error: the form
+/// generated `forward_dynamics` uses, since its signature returns a plain array.
+///
+/// ```
+/// use eomgen_runtime::solve_spd_or_nan;
+///
+/// assert_eq!(solve_spd_or_nan(&[[2.0_f64]], &[1.0]), [0.5]);
+/// assert!(solve_spd_or_nan(&[[0.0_f64]], &[1.0])[0].is_nan());
+/// ```
+#[inline]
+pub fn solve_spd_or_nan<T: Real, const N: usize>(m: &[[T; N]; N], b: &[T; N]) -> [T; N] {
+    match solve_spd(m, b) {
+        Ok(x) => x,
+        Err(_) => [T::nan(); N],
+    }
+}

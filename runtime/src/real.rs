@@ -1,0 +1,202 @@
+//! The scalar trait used by generated code.
+
+use core::fmt::Debug;
+use core::ops::{Add, AddAssign, Div, DivAssign, Mul, MulAssign, Neg, Sub, SubAssign};
+
+/// A real scalar type that generated dynamics code can be instantiated with.
+///
+/// Implemented for [`f32`] (microcontrollers with a single-precision FPU) and [`f64`] (host).
+/// `core` provides no transcendental functions, so the implementations call [`libm`]; on the
+/// host the results may differ from `std`'s in the last bit.
+///
+/// The trait is not sealed: it can be implemented for other scalar types (dual numbers for
+/// automatic differentiation, interval types, ...) as long as they behave like real numbers.
+///
+/// Generated code calls these methods inside long straight-line functions, so the f32/f64
+/// implementations are `#[inline(always)]`.
+///
+/// ```
+/// use eomgen_runtime::Real;
+///
+/// fn pendulum_torque<T: Real>(m: T, l: T, q: T) -> T {
+///     m * T::from_f64(9.81) * l * q.sin()
+/// }
+///
+/// assert!((pendulum_torque(1.0_f64, 1.0, 0.5) - 9.81 * 0.5_f64.sin()).abs() < 1e-12);
+/// assert!((pendulum_torque(1.0_f32, 1.0, 0.5) - 4.703_f32).abs() < 1e-3);
+/// assert_eq!(0.0_f64.signum(), 1.0); // std: +0 has sign +1 ...
+/// assert_eq!(Real::signum(0.0_f64), 0.0); // ... Real: 0 has sign 0
+/// ```
+pub trait Real:
+    Copy
+    + Clone
+    + PartialEq
+    + PartialOrd
+    + Debug
+    + Default
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+    + AddAssign
+    + SubAssign
+    + MulAssign
+    + DivAssign
+    + 'static
+{
+    /// Converts an `f64` (rounding to nearest for `f32`). Generated code writes every numeric
+    /// constant as `T::from_f64(..)`; for `f32` and `f64` this folds to a constant.
+    fn from_f64(v: f64) -> Self;
+    /// Converts to `f64` (exact for `f32` and `f64`).
+    fn to_f64(self) -> f64;
+    /// The additive identity, `0`.
+    fn zero() -> Self;
+    /// The multiplicative identity, `1`.
+    fn one() -> Self;
+    /// A quiet NaN ("not a number"), used to report failures without panicking.
+    fn nan() -> Self;
+    /// The machine epsilon: the difference between 1 and the next larger representable number.
+    fn epsilon() -> Self;
+    /// Sine (argument in radians).
+    fn sin(self) -> Self;
+    /// Cosine (argument in radians).
+    fn cos(self) -> Self;
+    /// Sine and cosine at once, `(sin(self), cos(self))`; cheaper than two calls.
+    fn sin_cos(self) -> (Self, Self);
+    /// Four-quadrant arctangent of `self / x` (`self` is y), in `[-pi, pi]`.
+    fn atan2(self, x: Self) -> Self;
+    /// Square root; NaN for negative arguments.
+    fn sqrt(self) -> Self;
+    /// Absolute value.
+    fn abs(self) -> Self;
+    /// Sign of `self`: `1` if positive, `-1` if negative, and **zero at zero**.
+    ///
+    /// Unlike `f64::signum` (which gives `1.0` for `+0.0` and `-1.0` for `-0.0`), this returns
+    /// `self` unchanged when it is `±0` (or NaN). eomgen uses it for Coulomb friction,
+    /// `tau_f = mu * sign(qd)`, where a joint at rest must get no friction torque.
+    fn signum(self) -> Self;
+    /// `1 / self`.
+    fn recip(self) -> Self;
+    /// The smaller of `self` and `other`; if one of them is NaN, the other is returned.
+    fn min(self, other: Self) -> Self;
+    /// The larger of `self` and `other`; if one of them is NaN, the other is returned.
+    fn max(self, other: Self) -> Self;
+    /// `self * a + b`.
+    ///
+    /// Not guaranteed to be fused (single rounding): the `f32`/`f64` implementations use a plain
+    /// multiply and add, because `libm`'s exact fused version is a slow software routine on
+    /// targets without an FMA instruction (the compiler may still fuse when the target allows).
+    fn mul_add(self, a: Self, b: Self) -> Self;
+    /// `true` unless `self` is infinite or NaN.
+    fn is_finite(self) -> bool;
+}
+
+macro_rules! impl_real {
+    ($t:ty, $sin:path, $cos:path, $sincos:path, $atan2:path, $sqrt:path, $fabs:path,
+     $fmin:path, $fmax:path) => {
+        impl Real for $t {
+            #[inline(always)]
+            fn from_f64(v: f64) -> Self {
+                v as $t
+            }
+            #[inline(always)]
+            fn to_f64(self) -> f64 {
+                self as f64
+            }
+            #[inline(always)]
+            fn zero() -> Self {
+                0.0
+            }
+            #[inline(always)]
+            fn one() -> Self {
+                1.0
+            }
+            #[inline(always)]
+            fn nan() -> Self {
+                <$t>::NAN
+            }
+            #[inline(always)]
+            fn epsilon() -> Self {
+                <$t>::EPSILON
+            }
+            #[inline(always)]
+            fn sin(self) -> Self {
+                $sin(self)
+            }
+            #[inline(always)]
+            fn cos(self) -> Self {
+                $cos(self)
+            }
+            #[inline(always)]
+            fn sin_cos(self) -> (Self, Self) {
+                $sincos(self)
+            }
+            #[inline(always)]
+            fn atan2(self, x: Self) -> Self {
+                $atan2(self, x)
+            }
+            #[inline(always)]
+            fn sqrt(self) -> Self {
+                $sqrt(self)
+            }
+            #[inline(always)]
+            fn abs(self) -> Self {
+                $fabs(self)
+            }
+            #[inline(always)]
+            fn signum(self) -> Self {
+                if self > 0.0 {
+                    1.0
+                } else if self < 0.0 {
+                    -1.0
+                } else {
+                    self
+                }
+            }
+            #[inline(always)]
+            fn recip(self) -> Self {
+                1.0 / self
+            }
+            #[inline(always)]
+            fn min(self, other: Self) -> Self {
+                $fmin(self, other)
+            }
+            #[inline(always)]
+            fn max(self, other: Self) -> Self {
+                $fmax(self, other)
+            }
+            #[inline(always)]
+            fn mul_add(self, a: Self, b: Self) -> Self {
+                self * a + b
+            }
+            #[inline(always)]
+            fn is_finite(self) -> bool {
+                <$t>::is_finite(self)
+            }
+        }
+    };
+}
+
+impl_real!(
+    f32,
+    libm::sinf,
+    libm::cosf,
+    libm::sincosf,
+    libm::atan2f,
+    libm::sqrtf,
+    libm::fabsf,
+    libm::fminf,
+    libm::fmaxf
+);
+impl_real!(
+    f64,
+    libm::sin,
+    libm::cos,
+    libm::sincos,
+    libm::atan2,
+    libm::sqrt,
+    libm::fabs,
+    libm::fmin,
+    libm::fmax
+);
