@@ -8,6 +8,11 @@
 //! [`urdf`] (the only module that sees XML) → [`model`] (kinematic tree, merged fixed links) →
 //! [`kinematics`] and [`dynamics`] (closed-form expressions in the [`cas`]) → emission.
 
+// Matrix code reads best with explicit indices.
+#![allow(clippy::needless_range_loop)]
+
 pub mod cas;
+pub mod dynamics;
+pub mod kinematics;
 pub mod model;
 pub mod urdf;

@@ -1,1 +1,215 @@
-//! placeholder
+//! Workspace-level test support: the Pinocchio reference values of `tests/robots/*.json` and
+//! a tolerance checker that reports every mismatch at once.
+//!
+//! The reference robots and their JSON come from the shared reference set (see
+//! `tests/robots/README.md`): twelve states per robot, computed by Pinocchio 4.1.
+
+#![allow(clippy::needless_range_loop)]
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+use serde_json::Value;
+
+/// The five reference robots.
+pub const ROBOTS: [&str; 5] = [
+    "double_pendulum",
+    "ur5",
+    "panda",
+    "kinova",
+    "allegro_right_hand",
+];
+
+/// Path of a reference robot's URDF.
+pub fn urdf_path(robot: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("robots")
+        .join(format!("{robot}.urdf"))
+}
+
+/// One link frame of a sample.
+#[derive(Clone, Debug)]
+pub struct FrameRef {
+    pub position: Vec<f64>,
+    pub rotation: Vec<Vec<f64>>,
+    /// 6 x N, columns in the reference's joint order.
+    pub jacobian: Vec<Vec<f64>>,
+}
+
+/// One reference state and everything Pinocchio computed there.
+#[derive(Clone, Debug)]
+pub struct Sample {
+    pub q: Vec<f64>,
+    pub qd: Vec<f64>,
+    pub qdd: Vec<f64>,
+    pub tau: Vec<f64>,
+    pub mass_matrix: Vec<Vec<f64>>,
+    pub gravity: Vec<f64>,
+    pub bias: Vec<f64>,
+    pub coriolis_matrix: Vec<Vec<f64>>,
+    pub tau_in: Vec<f64>,
+    pub forward_dynamics: Vec<f64>,
+    pub kinetic_energy: f64,
+    pub potential_energy: f64,
+    pub frames: BTreeMap<String, FrameRef>,
+    pub centrifugal: Option<Vec<Vec<f64>>>,
+    pub coriolis_pairs: Option<Vec<Vec<f64>>>,
+}
+
+/// A robot's reference file.
+#[derive(Clone, Debug)]
+pub struct Reference {
+    pub robot: String,
+    /// Moving joints in the reference's order.
+    pub joints: Vec<String>,
+    pub samples: Vec<Sample>,
+}
+
+fn vec1(v: &Value) -> Vec<f64> {
+    v.as_array()
+        .expect("array")
+        .iter()
+        .map(|x| x.as_f64().expect("number"))
+        .collect()
+}
+
+fn vec2(v: &Value) -> Vec<Vec<f64>> {
+    v.as_array().expect("array").iter().map(vec1).collect()
+}
+
+/// Loads `tests/robots/<robot>.json`.
+pub fn load(robot: &str) -> Reference {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("robots")
+        .join(format!("{robot}.json"));
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let v: Value = serde_json::from_str(&text).expect("valid JSON");
+    let joints = v["joints"]
+        .as_array()
+        .expect("joints")
+        .iter()
+        .map(|j| j.as_str().unwrap().to_string())
+        .collect();
+    let samples = v["samples"]
+        .as_array()
+        .expect("samples")
+        .iter()
+        .map(|s| Sample {
+            q: vec1(&s["q"]),
+            qd: vec1(&s["qd"]),
+            qdd: vec1(&s["qdd"]),
+            tau: vec1(&s["tau"]),
+            mass_matrix: vec2(&s["mass_matrix"]),
+            gravity: vec1(&s["gravity"]),
+            bias: vec1(&s["bias"]),
+            coriolis_matrix: vec2(&s["coriolis_matrix"]),
+            tau_in: vec1(&s["tau_in"]),
+            forward_dynamics: vec1(&s["forward_dynamics"]),
+            kinetic_energy: s["kinetic_energy"].as_f64().unwrap(),
+            potential_energy: s["potential_energy"].as_f64().unwrap(),
+            frames: s["frames"]
+                .as_object()
+                .expect("frames")
+                .iter()
+                .map(|(k, f)| {
+                    let fr = FrameRef {
+                        position: vec1(&f["position"]),
+                        rotation: vec2(&f["rotation"]),
+                        jacobian: vec2(&f["jacobian"]),
+                    };
+                    (k.clone(), fr)
+                })
+                .collect(),
+            centrifugal: s.get("centrifugal").map(vec2),
+            coriolis_pairs: s.get("coriolis_pairs").map(vec2),
+        })
+        .collect();
+    Reference {
+        robot: robot.to_string(),
+        joints,
+        samples,
+    }
+}
+
+/// Maps the reference's joint order onto another order of the same names.
+#[derive(Clone, Debug)]
+pub struct JointMap {
+    /// `ours[k]`: our index of the reference's joint `k`.
+    pub ours: Vec<usize>,
+}
+
+impl JointMap {
+    /// Builds the map; panics when the names differ as sets.
+    pub fn new(reference: &[String], ours: &[&str]) -> JointMap {
+        assert_eq!(reference.len(), ours.len(), "degrees of freedom");
+        let map = reference
+            .iter()
+            .map(|name| {
+                ours.iter()
+                    .position(|o| o == name)
+                    .unwrap_or_else(|| panic!("joint {name} missing"))
+            })
+            .collect();
+        JointMap { ours: map }
+    }
+
+    /// A reference-ordered vector in our order.
+    pub fn to_ours(&self, v: &[f64]) -> Vec<f64> {
+        let mut out = vec![0.0; v.len()];
+        for (k, &i) in self.ours.iter().enumerate() {
+            out[i] = v[k];
+        }
+        out
+    }
+
+    /// Our pair index of the reference's pair `(a, b)`, `a < b`.
+    pub fn pair(&self, a: usize, b: usize) -> usize {
+        let n = self.ours.len();
+        let (j, k) = (
+            self.ours[a].min(self.ours[b]),
+            self.ours[a].max(self.ours[b]),
+        );
+        // Pairs (0,1), (0,2), ..., (0,n-1), (1,2), ...
+        j * n - j * (j + 1) / 2 + (k - j - 1)
+    }
+}
+
+/// Collects mismatches beyond `|a - b| <= tol * max(1, |b|)` and reports them all.
+#[derive(Debug)]
+pub struct Checker {
+    pub tol: f64,
+    pub compared: usize,
+    pub failures: Vec<String>,
+}
+
+impl Checker {
+    pub fn new(tol: f64) -> Checker {
+        Checker {
+            tol,
+            compared: 0,
+            failures: Vec::new(),
+        }
+    }
+
+    /// Compares one number.
+    pub fn check(&mut self, what: impl FnOnce() -> String, got: f64, want: f64) {
+        self.compared += 1;
+        let ok = (got - want).abs() <= self.tol * want.abs().max(1.0);
+        if !ok && self.failures.len() < 40 {
+            self.failures
+                .push(format!("{}: got {got:e}, want {want:e}", what()));
+        }
+    }
+
+    /// Panics with every failure when there was one.
+    pub fn finish(self, context: &str) {
+        assert!(self.compared > 0, "{context}: nothing compared");
+        assert!(
+            self.failures.is_empty(),
+            "{context}: {} mismatches (first {}):\n{}",
+            self.failures.len(),
+            self.failures.len(),
+            self.failures.join("\n")
+        );
+    }
+}

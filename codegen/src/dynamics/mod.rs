@@ -1,0 +1,287 @@
+//! The Lagrangian engine: closed-form M, Craig's B and C, G, the bias, the Coriolis matrix,
+//! energies and frame kinematics of a [`Model`], as expressions in one [`Graph`].
+//!
+//! - `M(q) = sum over bodies of m Jv^T Jv + Jw^T I Jw`, with the Jacobians in body coordinates
+//!   (see [`BodyKinematics`]) and only the joints on a body's path to the root: `M_ij = 0` when
+//!   joints `i` and `j` are not on one path.
+//! - `V = -sum m g.c`, `G = dV/dq`; `T = qd^T M qd / 2`.
+//! - Christoffel symbols `G_ijk = (dM_ij/dq_k + dM_ik/dq_j - dM_jk/dq_i) / 2`; Craig's
+//!   centrifugal matrix `C_ij = G_ijj`, Coriolis matrix `B_i,(jk) = 2 G_ijk` (`j < k`, pairs in
+//!   the order (0,1), (0,2), ..., (1,2), ...), the Coriolis matrix
+//!   `C(q, qd)_ij = sum_k G_ijk qd_k` (so that `dM/dt - 2 C(q, qd)` is skew-symmetric), the
+//!   bias `b = C(q, qd) qd` and `tau = M qdd + b + G`.
+
+use std::time::{Duration, Instant};
+
+use crate::cas::{Graph, Id};
+use crate::kinematics::{
+    const_v3, cross, mat_vec, vec_add, BodyKinematics, Params, WorldKinematics, M3, V3,
+};
+use crate::model::Model;
+
+/// Pose and Jacobian of one URDF link frame.
+#[derive(Clone, Debug)]
+pub struct FrameExprs {
+    /// The URDF link name.
+    pub name: String,
+    /// World from link.
+    pub rotation: M3,
+    pub position: V3,
+    /// 6 x N: rows vx, vy, vz, wx, wy, wz in world axes at the link origin.
+    pub jacobian: Vec<Vec<Id>>,
+}
+
+/// Every derived quantity of a robot, as expressions in [`Derivation::graph`].
+#[derive(Clone, Debug)]
+pub struct Derivation {
+    pub graph: Graph,
+    /// Degrees of freedom.
+    pub dof: usize,
+    /// The joint symbols.
+    pub q: Vec<Id>,
+    pub qd: Vec<Id>,
+    pub qdd: Vec<Id>,
+    /// Symbolic parameters: (name, symbol, URDF value).
+    pub params: Vec<(String, Id, f64)>,
+    /// `M(q)`, full and symmetric (`mass_matrix[i][j]` and `[j][i]` are one node).
+    pub mass_matrix: Vec<Vec<Id>>,
+    /// `G(q)`.
+    pub gravity: Vec<Id>,
+    /// Craig's centrifugal matrix `C(q)`, N x N.
+    pub centrifugal: Vec<Vec<Id>>,
+    /// Craig's Coriolis matrix `B(q)`, N x N(N-1)/2.
+    pub coriolis_pairs: Vec<Vec<Id>>,
+    /// The Christoffel-form Coriolis matrix `C(q, qd)`.
+    pub coriolis_matrix: Vec<Vec<Id>>,
+    /// `b(q, qd) = C(q, qd) qd`: Coriolis and centrifugal, without gravity.
+    pub bias: Vec<Id>,
+    /// `tau = M qdd + b + G`.
+    pub tau: Vec<Id>,
+    pub kinetic_energy: Id,
+    pub potential_energy: Id,
+    /// One per URDF link, in the model's frame order.
+    pub frames: Vec<FrameExprs>,
+    /// How long each stage took.
+    pub timings: Vec<(&'static str, Duration)>,
+}
+
+/// The pairs `(j, k)`, `j < k`, in Craig's order.
+pub fn pairs(n: usize) -> Vec<(usize, usize)> {
+    (0..n)
+        .flat_map(|j| (j + 1..n).map(move |k| (j, k)))
+        .collect()
+}
+
+impl Derivation {
+    /// Derives everything for `model`.
+    pub fn new(model: &Model) -> Derivation {
+        let mut timings = Vec::new();
+        let mut clock = Instant::now();
+        let mut lap = |name: &'static str, timings: &mut Vec<(&'static str, Duration)>| {
+            let now = Instant::now();
+            timings.push((name, now - clock));
+            clock = now;
+        };
+        let mut g = Graph::new();
+        let n = model.dof();
+        let q: Vec<Id> = (0..n).map(|i| g.q(i)).collect();
+        let qd: Vec<Id> = (0..n).map(|i| g.qd(i)).collect();
+        let qdd: Vec<Id> = (0..n).map(|i| g.qdd(i)).collect();
+        let params = Params::new(&mut g, model);
+
+        let world = WorldKinematics::new(&mut g, model, &params, &q);
+        let body = BodyKinematics::new(&mut g, model, &params, &q);
+        lap("kinematics", &mut timings);
+
+        let mass_matrix = mass_matrix(&mut g, model, &params, &body);
+        lap("mass matrix", &mut timings);
+
+        let grav = const_v3(&mut g, &model.gravity);
+        let mut pe_terms = Vec::with_capacity(n);
+        for (b, c) in world.com.iter().enumerate() {
+            let gc = g.dot(&grav, c);
+            let t = g.mul(params.mass[b], gc);
+            pe_terms.push((t, -1.0));
+        }
+        let potential_energy = g.sum(0.0, pe_terms);
+        let gravity: Vec<Id> = q.iter().map(|&qi| g.diff(potential_energy, qi)).collect();
+        let mqd: Vec<Id> = (0..n).map(|i| g.dot(&mass_matrix[i], &qd)).collect();
+        let qd_mqd = g.dot(&qd, &mqd);
+        let kinetic_energy = g.scale(qd_mqd, 0.5);
+        lap("energies and gravity", &mut timings);
+
+        // dM/dq_k for the upper triangle, one memoized pass per joint.
+        let upper: Vec<(usize, usize)> = (0..n).flat_map(|i| (i..n).map(move |j| (i, j))).collect();
+        let roots: Vec<Id> = upper.iter().map(|&(i, j)| mass_matrix[i][j]).collect();
+        let mut dm = vec![vec![vec![g.zero(); n]; n]; n]; // dm[k][i][j] = dM_ij / dq_k
+        for k in 0..n {
+            let d = g.diff_many(&roots, q[k]);
+            for (&(i, j), &e) in upper.iter().zip(&d) {
+                dm[k][i][j] = e;
+                dm[k][j][i] = e;
+            }
+        }
+        // 2 G_ijk = dM_ij/dq_k + dM_ik/dq_j - dM_jk/dq_i
+        let two_christoffel = |g: &mut Graph, i: usize, j: usize, k: usize| -> Id {
+            g.sum(
+                0.0,
+                [(dm[k][i][j], 1.0), (dm[j][i][k], 1.0), (dm[i][j][k], -1.0)],
+            )
+        };
+        let mut centrifugal = vec![vec![g.zero(); n]; n];
+        let mut coriolis_pairs = vec![Vec::new(); n];
+        let mut coriolis_matrix = vec![vec![g.zero(); n]; n];
+        let pair_list = pairs(n);
+        for i in 0..n {
+            for j in 0..n {
+                let c2 = two_christoffel(&mut g, i, j, j);
+                centrifugal[i][j] = g.scale(c2, 0.5);
+            }
+            for &(j, k) in &pair_list {
+                let b = two_christoffel(&mut g, i, j, k);
+                coriolis_pairs[i].push(b);
+            }
+            for j in 0..n {
+                let terms: Vec<(Id, f64)> = (0..n)
+                    .map(|k| {
+                        let c2 = two_christoffel(&mut g, i, j, k);
+                        (g.mul(c2, qd[k]), 0.5)
+                    })
+                    .collect();
+                coriolis_matrix[i][j] = g.sum(0.0, terms);
+            }
+        }
+        // b = B [qd qd] + C [qd^2]: the Craig form shares work with the matrices above.
+        let bias: Vec<Id> = (0..n)
+            .map(|i| {
+                let mut terms = Vec::new();
+                for j in 0..n {
+                    let sq = g.powi(qd[j], 2);
+                    terms.push(g.mul(centrifugal[i][j], sq));
+                }
+                for (p, &(j, k)) in pair_list.iter().enumerate() {
+                    let v = g.mul(qd[j], qd[k]);
+                    terms.push(g.mul(coriolis_pairs[i][p], v));
+                }
+                g.add_all(terms)
+            })
+            .collect();
+        lap("Christoffel symbols", &mut timings);
+
+        let tau: Vec<Id> = (0..n)
+            .map(|i| {
+                let mq = g.dot(&mass_matrix[i], &qdd);
+                g.add_all([mq, bias[i], gravity[i]])
+            })
+            .collect();
+
+        let mut frames = Vec::with_capacity(model.frames.len());
+        for f in &model.frames {
+            let (rotation, position) = world.frame_pose(&mut g, f.body, &f.placement);
+            let jacobian = world.point_jacobian(&mut g, model, f.body, &position);
+            frames.push(FrameExprs {
+                name: f.name.clone(),
+                rotation,
+                position,
+                jacobian,
+            });
+        }
+        lap("frames", &mut timings);
+
+        Derivation {
+            graph: g,
+            dof: n,
+            q,
+            qd,
+            qdd,
+            params: params.symbols,
+            mass_matrix,
+            gravity,
+            centrifugal,
+            coriolis_pairs,
+            coriolis_matrix,
+            bias,
+            tau,
+            kinetic_energy,
+            potential_energy,
+            frames,
+            timings,
+        }
+    }
+
+    /// Lagrange's equations formed directly from `L = T - V`:
+    /// `d/dt (dL/dqd_i) - dL/dq_i`, an independent route to `tau` for cross-checks.
+    pub fn lagrange_equations(&mut self) -> Vec<Id> {
+        let g = &mut self.graph;
+        let lagrangian = g.sub(self.kinetic_energy, self.potential_energy);
+        (0..self.dof)
+            .map(|i| {
+                let p = g.diff(lagrangian, self.qd[i]);
+                let dp = g.time_derivative(p);
+                let dl = g.diff(lagrangian, self.q[i]);
+                g.sub(dp, dl)
+            })
+            .collect()
+    }
+
+    /// The time derivative of the mass matrix, `dM/dt` (in `q` and `qd`).
+    pub fn mass_matrix_derivative(&mut self) -> Vec<Vec<Id>> {
+        let flat: Vec<Id> = self.mass_matrix.iter().flatten().copied().collect();
+        let d = self.graph.time_derivative_many(&flat);
+        d.chunks(self.dof).map(|r| r.to_vec()).collect()
+    }
+}
+
+/// `M_jk = sum_b m_b v_bj . v_bk + u_bj^T I_b u_bk` over bodies `b` below both joints, with
+/// `u` the angular and `v` the linear velocity of `b`'s centre of mass per unit joint rate, in
+/// body coordinates.
+fn mass_matrix(
+    g: &mut Graph,
+    model: &Model,
+    params: &Params,
+    body: &BodyKinematics,
+) -> Vec<Vec<Id>> {
+    let n = model.dof();
+    let mut terms: Vec<Vec<Vec<Id>>> = vec![vec![Vec::new(); n]; n];
+    for b in 0..n {
+        let path = model.path_to_root(b);
+        let m = params.mass[b];
+        let inertia = &params.inertia[b];
+        // Per joint on the path: (u, I u, v).
+        let jac: Vec<(Option<V3>, Option<V3>, V3)> = path
+            .iter()
+            .map(|&j| {
+                let axis = body.axis[b][j].expect("path joint");
+                if model.joints[j].kind.is_revolute() {
+                    let off = body.offset[b][j].expect("path joint");
+                    let r = vec_add(g, &params.com[b], &off);
+                    let v = cross(g, &axis, &r);
+                    let iu = mat_vec(g, inertia, &axis);
+                    (Some(axis), Some(iu), v)
+                } else {
+                    (None, None, axis)
+                }
+            })
+            .collect();
+        for (x, &j) in path.iter().enumerate() {
+            for (y, &k) in path.iter().enumerate().skip(x) {
+                let vv = g.dot(&jac[x].2, &jac[y].2);
+                let lin = g.mul(m, vv);
+                terms[j][k].push(lin);
+                if let (Some(u), Some(iu)) = (jac[x].0, jac[y].1) {
+                    let rot = g.dot(&u, &iu);
+                    terms[j][k].push(rot);
+                }
+            }
+        }
+    }
+    let mut mm = vec![vec![g.zero(); n]; n];
+    for j in 0..n {
+        for k in j..n {
+            let e = g.add_all(std::mem::take(&mut terms[j][k]));
+            mm[j][k] = e;
+            mm[k][j] = e;
+        }
+    }
+    mm
+}
