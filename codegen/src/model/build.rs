@@ -1,7 +1,1048 @@
-//! Building a model (placeholder).
-#[derive(Debug)]
-pub struct ModelError;
-#[derive(Debug, Default)]
-pub struct ModelOptions;
-#[derive(Debug, Default)]
-pub enum SymbolicParams { #[default] None }
+//! Building a [`Model`] from a format-neutral robot description: validation, fixed-joint
+//! merging, joint ordering and the options that shape the result.
+//!
+//! The URDF reader ([`crate::urdf`]) turns XML into a [`RobotDescription`] holding names, poses
+//! and numbers exactly as written; everything else happens here, so that another input format
+//! would only need its own reader.
+//!
+//! The semantics (merging, ordering, validation rules) are documented for users in
+//! [`crate::urdf`].
+
+use std::collections::HashMap;
+
+use nalgebra::{Matrix3, SymmetricEigen, Vector3};
+use thiserror::Error;
+
+use super::{Body, Frame, Joint, JointKind, Limits, Mimic, Model, Transform};
+
+/// Relative tolerance (of the trace) for the positive semi-definiteness and triangle-inequality
+/// checks of rotational inertias.
+const INERTIA_TOLERANCE: f64 = 1e-9;
+
+/// Relative tolerance below which a revolute joint's subtree inertia about its axis counts as
+/// zero (relative to the trace of the subtree inertia about the joint origin).
+const SINGULAR_TOLERANCE: f64 = 1e-12;
+
+/// Options that shape a [`Model`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct ModelOptions {
+    /// Gravity in world axes (m/s^2); `[0, 0, -9.81]` by default.
+    pub gravity: [f64; 3],
+    /// An explicit order of the moving joints, by URDF name (to match a controller's wiring).
+    /// It must list every moving joint exactly once, and a joint's parent joint must come
+    /// before it; otherwise loading fails with [`ModelError::InvalidJointOrder`]. `None` (the
+    /// default) keeps the depth-first order described in [`crate::urdf`].
+    pub joint_order: Option<Vec<String>>,
+    /// Which inertial parameters (and joint offsets) become symbols.
+    pub symbolic: SymbolicParams,
+    /// Also reject rotational inertias that break the triangle inequality (physically
+    /// impossible, but common in vendor files). `false` by default; positive
+    /// semi-definiteness is always required.
+    pub strict_inertia: bool,
+}
+
+impl Default for ModelOptions {
+    fn default() -> Self {
+        ModelOptions {
+            gravity: [0.0, 0.0, -9.81],
+            joint_order: None,
+            symbolic: SymbolicParams::None,
+            strict_inertia: false,
+        }
+    }
+}
+
+/// Which bodies get symbolic inertial parameters ([`Body::symbolic`]) and which joints a
+/// symbolic origin ([`Joint::symbolic_origin`]).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub enum SymbolicParams {
+    /// Every parameter is a number.
+    #[default]
+    None,
+    /// Every body and every joint origin is symbolic.
+    All,
+    /// The bodies containing these URDF links (as child link or as a merged link) are symbolic,
+    /// and so are the origins of the joints moving them. A name that is not a link is an error
+    /// ([`ModelError::UnknownSymbolicLink`]); links welded to the root are accepted and have no
+    /// effect, as the root's inertia never matters.
+    Links(Vec<String>),
+}
+
+/// Why a robot description could not become a [`Model`]. Every message starts with the file
+/// name and names the offending link or joint.
+#[derive(Debug, Error)]
+pub enum ModelError {
+    /// The file could not be read (or is not UTF-8).
+    #[error("{file}: cannot read the file: {source}")]
+    Io {
+        file: String,
+        #[source]
+        source: std::io::Error,
+    },
+    /// The text is not well-formed XML or not a URDF (wrong elements or attributes, numbers
+    /// that do not parse, elements nested too deeply).
+    #[error("{file}: malformed URDF: {message}")]
+    Xml { file: String, message: String },
+    /// The robot has no links at all.
+    #[error("{file}: the robot has no links")]
+    NoLinks { file: String },
+    /// A link or joint has an empty name (counted from 1 in file order).
+    #[error("{file}: {element} number {index} has an empty name")]
+    EmptyName {
+        file: String,
+        element: &'static str,
+        index: usize,
+    },
+    /// Two links have the same name.
+    #[error("{file}: link `{link}` is defined more than once")]
+    DuplicateLink { file: String, link: String },
+    /// Two joints have the same name.
+    #[error("{file}: joint `{joint}` is defined more than once")]
+    DuplicateJoint { file: String, joint: String },
+    /// A floating, planar or spherical joint: not supported yet.
+    #[error(
+        "{file}: joint `{joint}` is {joint_type}, which is not supported \
+         (only revolute, continuous, prismatic and fixed joints are)"
+    )]
+    UnsupportedJoint {
+        file: String,
+        joint: String,
+        joint_type: String,
+    },
+    /// A joint names a parent or child link that does not exist.
+    #[error("{file}: joint `{joint}` has {role} link `{link}`, which does not exist")]
+    MissingLink {
+        file: String,
+        joint: String,
+        /// `"parent"` or `"child"`.
+        role: &'static str,
+        link: String,
+    },
+    /// A link is the child of two joints.
+    #[error(
+        "{file}: link `{link}` has two parents: it is the child of joints `{first}` and `{second}`"
+    )]
+    MultipleParents {
+        file: String,
+        link: String,
+        first: String,
+        second: String,
+    },
+    /// More than one link has no parent joint.
+    #[error("{file}: the robot has several root links (links without a parent joint): `{}`", .roots.join("`, `"))]
+    MultipleRoots { file: String, roots: Vec<String> },
+    /// The joints form a cycle (listed from parent to child; the last link is the parent of the
+    /// first).
+    #[error("{file}: the links `{}` form a cycle", .links.join("` -> `"))]
+    Cycle { file: String, links: Vec<String> },
+    /// A number that matters is NaN or infinite.
+    #[error("{file}: {culprit}: {field} is not a finite number")]
+    NonFinite {
+        file: String,
+        /// The link, joint or option, e.g. ``joint `elbow` ``.
+        culprit: String,
+        field: &'static str,
+    },
+    /// A moving joint's axis is the zero vector.
+    #[error("{file}: joint `{joint}` has a zero axis")]
+    ZeroAxis { file: String, joint: String },
+    /// A link's mass is negative.
+    #[error("{file}: link `{link}` has a negative mass ({mass})")]
+    NegativeMass {
+        file: String,
+        link: String,
+        mass: f64,
+    },
+    /// A link's rotational inertia is not positive semi-definite (a principal moment below
+    /// `-1e-9 * trace`), or, with [`ModelOptions::strict_inertia`], breaks the triangle
+    /// inequality by more than `1e-9 * trace`.
+    #[error("{file}: link `{link}` has an impossible inertia: {reason}")]
+    InvalidInertia {
+        file: String,
+        link: String,
+        reason: String,
+    },
+    /// No revolute, continuous or prismatic joint: nothing to derive.
+    #[error("{file}: the robot has no moving joint (revolute, continuous or prismatic)")]
+    NoMovingJoint { file: String },
+    /// A moving joint whose own diagonal entry of the mass matrix is zero at `q = 0`, so that
+    /// the mass matrix is singular there: for a prismatic joint, the bodies it moves (its
+    /// subtree) have no mass; for a revolute or continuous joint, the subtree's rotational
+    /// inertia about the joint axis at `q = 0`, masses off the axis included, is zero (below
+    /// `1e-12` of the trace of the subtree inertia about the joint origin). This is a necessary
+    /// condition for an invertible mass matrix, not a sufficient one (for example, two
+    /// consecutive coaxial revolute joints whose first body is massless pass the check).
+    #[error(
+        "{file}: joint `{joint}` moves nothing with inertia (its subtree is massless, or for a \
+         revolute joint has no inertia about the axis): the mass matrix would be singular"
+    )]
+    MasslessSubtree { file: String, joint: String },
+    /// [`ModelOptions::joint_order`] names an unknown or fixed joint, repeats or omits a moving
+    /// joint, or puts a joint before its parent joint.
+    #[error("{file}: joint_order: joint `{joint}` {reason}")]
+    InvalidJointOrder {
+        file: String,
+        joint: String,
+        reason: String,
+    },
+    /// [`SymbolicParams::Links`] names a link that does not exist.
+    #[error("{file}: symbolic parameters requested for link `{link}`, which does not exist")]
+    UnknownSymbolicLink { file: String, link: String },
+}
+
+/// A pose as written in a robot description: translation and roll-pitch-yaw angles.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct Pose {
+    pub(crate) xyz: [f64; 3],
+    pub(crate) rpy: [f64; 3],
+}
+
+impl Pose {
+    /// The transform `p_parent = R p_child + xyz` with `R = Rz(yaw) Ry(pitch) Rx(roll)`.
+    pub(crate) fn to_transform(self) -> Transform {
+        Transform {
+            rotation: rpy_to_rotation(self.rpy),
+            translation: Vector3::from(self.xyz),
+        }
+    }
+
+    fn is_finite(&self) -> bool {
+        all_finite(&self.xyz) && all_finite(&self.rpy)
+    }
+}
+
+/// `Rz(yaw) * Ry(pitch) * Rx(roll)`, the URDF convention.
+pub(crate) fn rpy_to_rotation([roll, pitch, yaw]: [f64; 3]) -> Matrix3<f64> {
+    let (sr, cr) = roll.sin_cos();
+    let (sp, cp) = pitch.sin_cos();
+    let (sy, cy) = yaw.sin_cos();
+    Matrix3::new(
+        cy * cp,
+        cy * sp * sr - sy * cr,
+        cy * sp * cr + sy * sr,
+        sy * cp,
+        sy * sp * sr + cy * cr,
+        sy * sp * cr - cy * sr,
+        -sp,
+        cp * sr,
+        cp * cr,
+    )
+}
+
+/// A link's `<inertial>`: mass, centre-of-mass pose and inertia about the centre of mass in
+/// the axes of that pose, as `[ixx, ixy, ixz, iyy, iyz, izz]` (tensor entries, not products of
+/// inertia). All zero for a link without inertial data.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub(crate) struct InertialDescription {
+    pub(crate) origin: Pose,
+    pub(crate) mass: f64,
+    pub(crate) inertia: [f64; 6],
+}
+
+/// A link as written.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct LinkDescription {
+    pub(crate) name: String,
+    pub(crate) inertial: InertialDescription,
+}
+
+/// The type of a joint as written.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) enum JointType {
+    Fixed,
+    Moving(JointKind),
+    /// A type we cannot model yet, by its URDF name (`floating`, `planar`, ...).
+    Unsupported(String),
+}
+
+/// A joint as written.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct JointDescription {
+    pub(crate) name: String,
+    pub(crate) joint_type: JointType,
+    pub(crate) parent: String,
+    pub(crate) child: String,
+    pub(crate) origin: Pose,
+    /// Not normalized; `[1, 0, 0]` when the file gives none.
+    pub(crate) axis: [f64; 3],
+    pub(crate) limits: Option<Limits>,
+    pub(crate) damping: f64,
+    pub(crate) friction: f64,
+    pub(crate) mimic: Option<Mimic>,
+}
+
+/// A robot as written, before any validation.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct RobotDescription {
+    pub(crate) name: String,
+    pub(crate) links: Vec<LinkDescription>,
+    pub(crate) joints: Vec<JointDescription>,
+}
+
+/// Validates `robot` and builds its [`Model`]; `file` names the source in error messages.
+pub(crate) fn build_model(
+    robot: &RobotDescription,
+    file: &str,
+    options: &ModelOptions,
+) -> Result<Model, ModelError> {
+    let tree = Tree::new(robot, file)?;
+    check_numbers(robot, file)?;
+    check_inertias(robot, file, options.strict_inertia)?;
+    if !all_finite(&options.gravity) {
+        return Err(ModelError::NonFinite {
+            file: file.into(),
+            culprit: "options".into(),
+            field: "gravity",
+        });
+    }
+    let mut model = merge(robot, &tree, file, options)?;
+    if model.joints.is_empty() {
+        return Err(ModelError::NoMovingJoint { file: file.into() });
+    }
+    check_singular(&model, file)?;
+    if let Some(order) = &options.joint_order {
+        reorder(&mut model, robot, order, file)?;
+    }
+    mark_symbolic(&mut model, &options.symbolic, file)?;
+    Ok(model)
+}
+
+fn all_finite(v: &[f64]) -> bool {
+    v.iter().all(|x| x.is_finite())
+}
+
+/// The validated structure: link indices per joint, the root and the depth-first joint order.
+struct Tree {
+    /// `(parent link, child link)` of each joint, indices into `robot.links`.
+    ends: Vec<(usize, usize)>,
+    root: usize,
+    /// All joints (fixed ones included), depth first from the root, siblings by name.
+    order: Vec<usize>,
+}
+
+impl Tree {
+    fn new(robot: &RobotDescription, file: &str) -> Result<Tree, ModelError> {
+        if robot.links.is_empty() {
+            return Err(ModelError::NoLinks { file: file.into() });
+        }
+        let mut link_index = HashMap::new();
+        for (i, link) in robot.links.iter().enumerate() {
+            if link.name.is_empty() {
+                return Err(ModelError::EmptyName {
+                    file: file.into(),
+                    element: "link",
+                    index: i + 1,
+                });
+            }
+            if link_index.insert(link.name.as_str(), i).is_some() {
+                return Err(ModelError::DuplicateLink {
+                    file: file.into(),
+                    link: link.name.clone(),
+                });
+            }
+        }
+        let mut joint_names = HashMap::new();
+        for (i, joint) in robot.joints.iter().enumerate() {
+            if joint.name.is_empty() {
+                return Err(ModelError::EmptyName {
+                    file: file.into(),
+                    element: "joint",
+                    index: i + 1,
+                });
+            }
+            if joint_names.insert(joint.name.as_str(), i).is_some() {
+                return Err(ModelError::DuplicateJoint {
+                    file: file.into(),
+                    joint: joint.name.clone(),
+                });
+            }
+        }
+        for joint in &robot.joints {
+            if let JointType::Unsupported(kind) = &joint.joint_type {
+                return Err(ModelError::UnsupportedJoint {
+                    file: file.into(),
+                    joint: joint.name.clone(),
+                    joint_type: kind.clone(),
+                });
+            }
+        }
+        let lookup = |joint: &JointDescription, link: &str, role| {
+            link_index
+                .get(link)
+                .copied()
+                .ok_or_else(|| ModelError::MissingLink {
+                    file: file.into(),
+                    joint: joint.name.clone(),
+                    role,
+                    link: link.into(),
+                })
+        };
+        let mut ends = Vec::with_capacity(robot.joints.len());
+        for joint in &robot.joints {
+            ends.push((
+                lookup(joint, &joint.parent, "parent")?,
+                lookup(joint, &joint.child, "child")?,
+            ));
+        }
+
+        let n = robot.links.len();
+        let mut parent_joint: Vec<Option<usize>> = vec![None; n];
+        let mut children: Vec<Vec<usize>> = vec![Vec::new(); n];
+        for (j, &(parent, child)) in ends.iter().enumerate() {
+            if let Some(first) = parent_joint[child] {
+                return Err(ModelError::MultipleParents {
+                    file: file.into(),
+                    link: robot.links[child].name.clone(),
+                    first: robot.joints[first].name.clone(),
+                    second: robot.joints[j].name.clone(),
+                });
+            }
+            parent_joint[child] = Some(j);
+            children[parent].push(j);
+        }
+        let roots: Vec<usize> = (0..n).filter(|&l| parent_joint[l].is_none()).collect();
+        if roots.len() > 1 {
+            return Err(ModelError::MultipleRoots {
+                file: file.into(),
+                roots: roots.iter().map(|&l| robot.links[l].name.clone()).collect(),
+            });
+        }
+        let cycle_error = |start: usize| ModelError::Cycle {
+            file: file.into(),
+            links: find_cycle(start, &parent_joint, &ends)
+                .into_iter()
+                .map(|l| robot.links[l].name.clone())
+                .collect(),
+        };
+        let Some(&root) = roots.first() else {
+            return Err(cycle_error(0));
+        };
+
+        for list in &mut children {
+            list.sort_by(|&a, &b| robot.joints[a].name.cmp(&robot.joints[b].name));
+        }
+        // Iterative depth-first walk: a long chain must not overflow the stack.
+        let mut visited = vec![false; n];
+        visited[root] = true;
+        let mut order = Vec::with_capacity(robot.joints.len());
+        let mut stack: Vec<usize> = children[root].iter().rev().copied().collect();
+        while let Some(j) = stack.pop() {
+            order.push(j);
+            let child = ends[j].1;
+            visited[child] = true;
+            stack.extend(children[child].iter().rev());
+        }
+        if let Some(unreached) = visited.iter().position(|&v| !v) {
+            return Err(cycle_error(unreached));
+        }
+        Ok(Tree { ends, root, order })
+    }
+}
+
+/// The cycle above `start`, a link unreachable from the root: every link on its chain of
+/// parents has a parent, so the chain loops. Returned from parent to child.
+fn find_cycle(start: usize, parent_joint: &[Option<usize>], ends: &[(usize, usize)]) -> Vec<usize> {
+    let mut chain = Vec::new();
+    let mut seen = HashMap::new();
+    let mut link = start;
+    loop {
+        if let Some(&pos) = seen.get(&link) {
+            let mut cycle = chain.split_off(pos);
+            cycle.reverse();
+            return cycle;
+        }
+        seen.insert(link, chain.len());
+        chain.push(link);
+        match parent_joint[link] {
+            Some(j) => link = ends[j].0,
+            // Unreachable for links cut off from the root; report the chain rather than panic.
+            None => {
+                chain.reverse();
+                return chain;
+            }
+        }
+    }
+}
+
+/// Rejects non-finite numbers wherever they are used, and zero axes.
+fn check_numbers(robot: &RobotDescription, file: &str) -> Result<(), ModelError> {
+    let non_finite = |culprit: String, field| ModelError::NonFinite {
+        file: file.into(),
+        culprit,
+        field,
+    };
+    for link in &robot.links {
+        let culprit = || format!("link `{}`", link.name);
+        let inertial = &link.inertial;
+        if !inertial.origin.is_finite() {
+            return Err(non_finite(culprit(), "inertial origin"));
+        }
+        if !inertial.mass.is_finite() {
+            return Err(non_finite(culprit(), "mass"));
+        }
+        if !all_finite(&inertial.inertia) {
+            return Err(non_finite(culprit(), "inertia"));
+        }
+    }
+    for joint in &robot.joints {
+        let culprit = || format!("joint `{}`", joint.name);
+        if !joint.origin.is_finite() {
+            return Err(non_finite(culprit(), "origin"));
+        }
+        if joint.joint_type == JointType::Fixed {
+            continue;
+        }
+        if !all_finite(&joint.axis) {
+            return Err(non_finite(culprit(), "axis"));
+        }
+        if joint.axis.iter().all(|&x| x == 0.0) {
+            return Err(ModelError::ZeroAxis {
+                file: file.into(),
+                joint: joint.name.clone(),
+            });
+        }
+        // Infinite limits mean "unbounded" (URDF 1.2); NaN means nothing.
+        if let Some(l) = &joint.limits {
+            if [l.lower, l.upper, l.effort, l.velocity]
+                .iter()
+                .any(|x| x.is_nan())
+            {
+                return Err(non_finite(culprit(), "limit"));
+            }
+        }
+        if !joint.damping.is_finite() {
+            return Err(non_finite(culprit(), "damping"));
+        }
+        if !joint.friction.is_finite() {
+            return Err(non_finite(culprit(), "friction"));
+        }
+        if let Some(m) = &joint.mimic {
+            if !(m.multiplier.is_finite() && m.offset.is_finite()) {
+                return Err(non_finite(culprit(), "mimic multiplier or offset"));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Rejects negative masses and impossible rotational inertias (numbers already finite).
+fn check_inertias(robot: &RobotDescription, file: &str, strict: bool) -> Result<(), ModelError> {
+    for link in &robot.links {
+        let inertial = &link.inertial;
+        if inertial.mass < 0.0 {
+            return Err(ModelError::NegativeMass {
+                file: file.into(),
+                link: link.name.clone(),
+                mass: inertial.mass,
+            });
+        }
+        if let Err(reason) = check_inertia(&inertia_matrix(&inertial.inertia), strict) {
+            return Err(ModelError::InvalidInertia {
+                file: file.into(),
+                link: link.name.clone(),
+                reason,
+            });
+        }
+    }
+    Ok(())
+}
+
+fn inertia_matrix(&[ixx, ixy, ixz, iyy, iyz, izz]: &[f64; 6]) -> Matrix3<f64> {
+    Matrix3::new(ixx, ixy, ixz, ixy, iyy, iyz, ixz, iyz, izz)
+}
+
+/// Checks the principal moments of a finite symmetric matrix: non-negative and, if `strict`,
+/// satisfying the triangle inequality, both up to `INERTIA_TOLERANCE * trace`.
+fn check_inertia(inertia: &Matrix3<f64>, strict: bool) -> Result<(), String> {
+    let scale = inertia.amax();
+    if scale == 0.0 {
+        return Ok(());
+    }
+    // Scaling keeps the eigen solver away from overflow; the checks are scale invariant.
+    let scaled = inertia / scale;
+    let Some(eigen) = SymmetricEigen::try_new(scaled, f64::EPSILON, 1000) else {
+        return Err("its principal moments cannot be computed".into());
+    };
+    let mut moments = [
+        eigen.eigenvalues[0],
+        eigen.eigenvalues[1],
+        eigen.eigenvalues[2],
+    ];
+    moments.sort_by(f64::total_cmp);
+    let [a, b, c] = moments;
+    let tolerance = INERTIA_TOLERANCE * (a + b + c).max(0.0);
+    let unscaled = || format!("{:e}, {:e}, {:e}", a * scale, b * scale, c * scale);
+    if a < -tolerance {
+        return Err(format!(
+            "it is not positive semi-definite (principal moments {})",
+            unscaled()
+        ));
+    }
+    if strict && a + b < c - tolerance {
+        return Err(format!(
+            "its principal moments {} break the triangle inequality",
+            unscaled()
+        ));
+    }
+    Ok(())
+}
+
+/// Mass, centre of mass and rotational inertia about the centre of mass, in one frame.
+#[derive(Clone, Debug)]
+struct Inertia {
+    mass: f64,
+    com: Vector3<f64>,
+    inertia: Matrix3<f64>,
+}
+
+impl Inertia {
+    /// A link's inertia expressed in a frame where the link frame has pose `placement`.
+    fn of_link(inertial: &InertialDescription, placement: &Transform) -> Inertia {
+        let frame = placement.compose(&inertial.origin.to_transform());
+        Inertia {
+            mass: inertial.mass,
+            com: frame.translation,
+            inertia: frame.rotation
+                * inertia_matrix(&inertial.inertia)
+                * frame.rotation.transpose(),
+        }
+    }
+
+    /// The same inertia seen from a frame where the current frame has pose `t`.
+    fn transformed(&self, t: &Transform) -> Inertia {
+        Inertia {
+            mass: self.mass,
+            com: t.rotation * self.com + t.translation,
+            inertia: t.rotation * self.inertia * t.rotation.transpose(),
+        }
+    }
+
+    /// The lumped inertia of two rigidly attached parts (same frame). With
+    /// `d = c1 - c2` and `M = m1 + m2`, the inertia about the new centre of mass is
+    /// `I1 + I2 + (m1 m2 / M) (|d|^2 E - d d^T)` (parallel-axis theorem, as in Pinocchio).
+    fn combine(&self, other: &Inertia) -> Inertia {
+        let mass = self.mass + other.mass;
+        let inertia = self.inertia + other.inertia;
+        // Massless parts leave the centre of mass exactly where it was.
+        let (com, inertia) = if mass == 0.0 {
+            (Vector3::zeros(), inertia)
+        } else if other.mass == 0.0 {
+            (self.com, inertia)
+        } else if self.mass == 0.0 {
+            (other.com, inertia)
+        } else {
+            let d = self.com - other.com;
+            (
+                (self.com * self.mass + other.com * other.mass) / mass,
+                inertia + shift(&d) * (self.mass * other.mass / mass),
+            )
+        };
+        Inertia { mass, com, inertia }
+    }
+
+    /// The rotational inertia about the frame origin.
+    fn about_origin(&self) -> Matrix3<f64> {
+        self.inertia + shift(&self.com) * self.mass
+    }
+}
+
+/// `|d|^2 E - d d^T`: the parallel-axis term per unit mass.
+fn shift(d: &Vector3<f64>) -> Matrix3<f64> {
+    Matrix3::identity() * d.norm_squared() - d * d.transpose()
+}
+
+/// Where a link sits: the body it is welded to (`None` for the root) and its pose there.
+#[derive(Clone)]
+struct Attachment {
+    body: Option<usize>,
+    placement: Transform,
+}
+
+/// Walks the tree depth first, creating a body per moving joint and lumping every link welded
+/// through fixed joints into its body.
+fn merge(
+    robot: &RobotDescription,
+    tree: &Tree,
+    file: &str,
+    options: &ModelOptions,
+) -> Result<Model, ModelError> {
+    let mut attach = vec![
+        Attachment {
+            body: None,
+            placement: Transform::identity(),
+        };
+        robot.links.len()
+    ];
+    let mut joints: Vec<Joint> = Vec::new();
+    let mut bodies: Vec<Body> = Vec::new();
+    let mut inertias: Vec<Inertia> = Vec::new();
+    for &j in &tree.order {
+        let joint = &robot.joints[j];
+        let (parent, child) = tree.ends[j];
+        // The walk reaches a joint after its parent link, so `attach[parent]` is final.
+        let above = attach[parent].clone();
+        let placement = above.placement.compose(&joint.origin.to_transform());
+        let child_link = &robot.links[child];
+        match &joint.joint_type {
+            JointType::Moving(kind) => {
+                let b = joints.len();
+                joints.push(Joint {
+                    name: joint.name.clone(),
+                    kind: *kind,
+                    parent: above.body,
+                    origin: placement,
+                    axis: normalized(joint.axis),
+                    limits: joint.limits.clone(),
+                    damping: joint.damping,
+                    friction: joint.friction,
+                    mimic: joint.mimic.clone(),
+                    symbolic_origin: false,
+                });
+                bodies.push(Body {
+                    name: child_link.name.clone(),
+                    mass: 0.0,
+                    com: Vector3::zeros(),
+                    inertia: Matrix3::zeros(),
+                    merged_links: vec![child_link.name.clone()],
+                    symbolic: false,
+                });
+                inertias.push(Inertia::of_link(
+                    &child_link.inertial,
+                    &Transform::identity(),
+                ));
+                attach[child] = Attachment {
+                    body: Some(b),
+                    placement: Transform::identity(),
+                };
+            }
+            JointType::Fixed | JointType::Unsupported(_) => {
+                if let Some(b) = above.body {
+                    bodies[b].merged_links.push(child_link.name.clone());
+                    inertias[b] =
+                        inertias[b].combine(&Inertia::of_link(&child_link.inertial, &placement));
+                }
+                attach[child] = Attachment {
+                    body: above.body,
+                    placement,
+                };
+            }
+        }
+    }
+
+    for (body, inertia) in bodies.iter_mut().zip(inertias) {
+        body.mass = inertia.mass;
+        body.com = if inertia.mass > 0.0 {
+            inertia.com
+        } else {
+            Vector3::zeros()
+        };
+        // Exactly symmetric, whatever the rounding of the rotations.
+        body.inertia = (inertia.inertia + inertia.inertia.transpose()) * 0.5;
+    }
+    let frames: Vec<Frame> = robot
+        .links
+        .iter()
+        .zip(attach)
+        .map(|(link, a)| Frame {
+            name: link.name.clone(),
+            body: a.body,
+            placement: a.placement,
+        })
+        .collect();
+
+    // Finite inputs can still overflow when composed.
+    let non_finite = |culprit: String, field| ModelError::NonFinite {
+        file: file.into(),
+        culprit,
+        field,
+    };
+    let transform_finite =
+        |t: &Transform| all_finite(t.rotation.as_slice()) && all_finite(t.translation.as_slice());
+    for body in &bodies {
+        if !(body.mass.is_finite()
+            && all_finite(body.com.as_slice())
+            && all_finite(body.inertia.as_slice()))
+        {
+            return Err(non_finite(
+                format!("body of link `{}`", body.name),
+                "inertia after merging fixed links",
+            ));
+        }
+    }
+    for joint in &joints {
+        if !transform_finite(&joint.origin) {
+            return Err(non_finite(
+                format!("joint `{}`", joint.name),
+                "origin after merging fixed links",
+            ));
+        }
+    }
+    for frame in &frames {
+        if !transform_finite(&frame.placement) {
+            return Err(non_finite(format!("link `{}`", frame.name), "placement"));
+        }
+    }
+
+    Ok(Model {
+        name: robot.name.clone(),
+        root: robot.links[tree.root].name.clone(),
+        gravity: Vector3::from(options.gravity),
+        joints,
+        bodies,
+        frames,
+    })
+}
+
+/// The unit vector along a finite, non-zero `axis`, scaled first so that tiny or huge
+/// components neither underflow nor overflow.
+fn normalized(axis: [f64; 3]) -> Vector3<f64> {
+    let v = Vector3::from(axis);
+    let v = v / v.amax();
+    v / v.norm()
+}
+
+/// Rejects moving joints whose diagonal entry of the mass matrix is zero at `q = 0` (see
+/// [`ModelError::MasslessSubtree`]).
+fn check_singular(model: &Model, file: &str) -> Result<(), ModelError> {
+    let n = model.joints.len();
+    let mut subtree: Vec<Inertia> = model
+        .bodies
+        .iter()
+        .map(|b| Inertia {
+            mass: b.mass,
+            com: b.com,
+            inertia: b.inertia,
+        })
+        .collect();
+    // Children have larger indices than their parents: accumulate from the leaves.
+    for i in (0..n).rev() {
+        if let Some(p) = model.joints[i].parent {
+            let moved = subtree[i].transformed(&model.joints[i].origin);
+            subtree[p] = subtree[p].combine(&moved);
+        }
+    }
+    for (joint, inertia) in model.joints.iter().zip(&subtree) {
+        let moves_inertia = if joint.kind.is_revolute() {
+            let about = inertia.about_origin();
+            let axial = (joint.axis.transpose() * about * joint.axis)[0];
+            axial > SINGULAR_TOLERANCE * about.trace()
+        } else {
+            inertia.mass > 0.0
+        };
+        if !moves_inertia {
+            return Err(ModelError::MasslessSubtree {
+                file: file.into(),
+                joint: joint.name.clone(),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Applies an explicit joint order (see [`ModelOptions::joint_order`]).
+fn reorder(
+    model: &mut Model,
+    robot: &RobotDescription,
+    order: &[String],
+    file: &str,
+) -> Result<(), ModelError> {
+    let error = |joint: &str, reason: String| ModelError::InvalidJointOrder {
+        file: file.into(),
+        joint: joint.into(),
+        reason,
+    };
+    let n = model.joints.len();
+    let index: HashMap<&str, usize> = model
+        .joints
+        .iter()
+        .enumerate()
+        .map(|(i, j)| (j.name.as_str(), i))
+        .collect();
+    let mut new_index: Vec<Option<usize>> = vec![None; n];
+    for (k, name) in order.iter().enumerate() {
+        let Some(&old) = index.get(name.as_str()) else {
+            let reason = if robot.joints.iter().any(|j| &j.name == name) {
+                "is a fixed joint; list only moving joints"
+            } else {
+                "does not exist"
+            };
+            return Err(error(name, reason.into()));
+        };
+        if new_index[old].is_some() {
+            return Err(error(name, "is listed more than once".into()));
+        }
+        new_index[old] = Some(k);
+    }
+    let mut permutation = Vec::with_capacity(n);
+    for (old, new) in new_index.iter().enumerate() {
+        match new {
+            Some(new) => permutation.push(*new),
+            None => {
+                return Err(error(
+                    &model.joints[old].name,
+                    "is missing (every moving joint must be listed)".into(),
+                ))
+            }
+        }
+    }
+    for (old, joint) in model.joints.iter().enumerate() {
+        if let Some(p) = joint.parent {
+            if permutation[p] > permutation[old] {
+                return Err(error(
+                    &joint.name,
+                    format!(
+                        "comes before its parent joint `{}`; parents must come first",
+                        model.joints[p].name
+                    ),
+                ));
+            }
+        }
+    }
+
+    let mut slots: Vec<Option<(Joint, Body)>> = (0..n).map(|_| None).collect();
+    for (old, (mut joint, body)) in model
+        .joints
+        .drain(..)
+        .zip(model.bodies.drain(..))
+        .enumerate()
+    {
+        joint.parent = joint.parent.map(|p| permutation[p]);
+        slots[permutation[old]] = Some((joint, body));
+    }
+    for (joint, body) in slots.into_iter().flatten() {
+        model.joints.push(joint);
+        model.bodies.push(body);
+    }
+    for frame in &mut model.frames {
+        frame.body = frame.body.map(|b| permutation[b]);
+    }
+    Ok(())
+}
+
+/// Sets [`Body::symbolic`] and [`Joint::symbolic_origin`] as requested.
+fn mark_symbolic(
+    model: &mut Model,
+    symbolic: &SymbolicParams,
+    file: &str,
+) -> Result<(), ModelError> {
+    match symbolic {
+        SymbolicParams::None => {}
+        SymbolicParams::All => {
+            model.bodies.iter_mut().for_each(|b| b.symbolic = true);
+            model
+                .joints
+                .iter_mut()
+                .for_each(|j| j.symbolic_origin = true);
+        }
+        SymbolicParams::Links(links) => {
+            for name in links {
+                let Some(frame) = model.frames.iter().find(|f| &f.name == name) else {
+                    return Err(ModelError::UnknownSymbolicLink {
+                        file: file.into(),
+                        link: name.clone(),
+                    });
+                };
+                if let Some(b) = frame.body {
+                    model.bodies[b].symbolic = true;
+                    model.joints[b].symbolic_origin = true;
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rot_x(a: f64) -> Matrix3<f64> {
+        let (s, c) = a.sin_cos();
+        Matrix3::new(1.0, 0.0, 0.0, 0.0, c, -s, 0.0, s, c)
+    }
+    fn rot_y(a: f64) -> Matrix3<f64> {
+        let (s, c) = a.sin_cos();
+        Matrix3::new(c, 0.0, s, 0.0, 1.0, 0.0, -s, 0.0, c)
+    }
+    fn rot_z(a: f64) -> Matrix3<f64> {
+        let (s, c) = a.sin_cos();
+        Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0)
+    }
+
+    #[test]
+    fn rpy_is_z_then_y_then_x() {
+        let (r, p, y) = (0.3, -1.1, 2.5);
+        let expected = rot_z(y) * rot_y(p) * rot_x(r);
+        assert!((rpy_to_rotation([r, p, y]) - expected).amax() < 1e-15);
+    }
+
+    #[test]
+    fn combine_matches_sum_about_a_common_point() {
+        let a = Inertia {
+            mass: 2.0,
+            com: Vector3::new(0.1, -0.2, 0.3),
+            inertia: Matrix3::new(0.3, 0.01, 0.0, 0.01, 0.2, 0.02, 0.0, 0.02, 0.25),
+        };
+        let b = Inertia {
+            mass: 0.5,
+            com: Vector3::new(-0.4, 0.0, 1.0),
+            inertia: Matrix3::from_diagonal(&Vector3::new(0.01, 0.02, 0.03)),
+        };
+        let c = a.combine(&b);
+        assert_eq!(c.mass, 2.5);
+        assert!((c.com - (a.com * 2.0 + b.com * 0.5) / 2.5).amax() < 1e-15);
+        // Inertia about the frame origin is additive.
+        assert!((c.about_origin() - (a.about_origin() + b.about_origin())).amax() < 1e-14);
+    }
+
+    #[test]
+    fn combine_of_massless_parts_keeps_rotational_inertia() {
+        let a = Inertia {
+            mass: 0.0,
+            com: Vector3::new(1.0, 2.0, 3.0),
+            inertia: Matrix3::identity(),
+        };
+        let c = a.combine(&a);
+        assert_eq!(c.mass, 0.0);
+        assert_eq!(c.com, Vector3::zeros());
+        assert_eq!(c.inertia, Matrix3::identity() * 2.0);
+    }
+
+    #[test]
+    fn inertia_checks() {
+        let diag = |a, b, c| Matrix3::from_diagonal(&Vector3::new(a, b, c));
+        assert!(check_inertia(&Matrix3::zeros(), true).is_ok());
+        assert!(check_inertia(&diag(1.0, 1.0, 2.0), true).is_ok()); // flat plate: equality
+        assert!(check_inertia(&diag(0.0, 1.0, 1.0), true).is_ok()); // thin rod
+        assert!(check_inertia(&diag(-1e-3, 1.0, 1.0), false).is_err());
+        assert!(check_inertia(&diag(1.0, 1.0, 2.1), false).is_ok());
+        assert!(check_inertia(&diag(1.0, 1.0, 2.1), true).is_err());
+        // Within tolerance.
+        assert!(check_inertia(&diag(-1e-12, 1.0, 1.0), true).is_ok());
+        assert!(check_inertia(&diag(1.0, 1.0, 2.0 + 1e-12), true).is_ok());
+        // Huge but finite: no overflow inside the eigen solver.
+        assert!(check_inertia(&diag(1e307, 1e308, 1e308), true).is_ok());
+        // Indefinite off-diagonal case: eigenvalues 1 +- 2.
+        assert!(check_inertia(
+            &Matrix3::new(1.0, 2.0, 0.0, 2.0, 1.0, 0.0, 0.0, 0.0, 1.0),
+            false
+        )
+        .is_err());
+    }
+
+    #[test]
+    fn normalized_handles_extreme_axes() {
+        assert_eq!(normalized([0.0, 0.0, 5e-324]), Vector3::new(0.0, 0.0, 1.0));
+        assert_eq!(normalized([1e308, 0.0, 0.0]), Vector3::new(1.0, 0.0, 0.0));
+        let v = normalized([1e308, 1e308, 0.0]);
+        assert!((v.norm() - 1.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn cycle_is_found_from_a_hanging_link() {
+        // Links 0 -> 1 -> 2 -> 1 (a cycle) with 3 hanging below 2.
+        let ends = [(1, 2), (2, 1), (2, 3)];
+        let parent_joint = [None, Some(1), Some(0), Some(2)];
+        assert_eq!(find_cycle(3, &parent_joint, &ends), vec![1, 2]);
+    }
+}

@@ -14,6 +14,11 @@ use nalgebra::{Matrix3, Vector3};
 
 mod build;
 pub use build::{ModelError, ModelOptions, SymbolicParams};
+// The format-neutral description that readers (`crate::urdf`) fill in.
+pub(crate) use build::{
+    build_model, InertialDescription, JointDescription, JointType, LinkDescription, Pose,
+    RobotDescription,
+};
 
 /// A rigid transform: `p_parent = rotation * p_child + translation`.
 #[derive(Clone, Debug, PartialEq)]
@@ -24,7 +29,10 @@ pub struct Transform {
 
 impl Transform {
     pub fn identity() -> Self {
-        Transform { rotation: Matrix3::identity(), translation: Vector3::zeros() }
+        Transform {
+            rotation: Matrix3::identity(),
+            translation: Vector3::zeros(),
+        }
     }
 
     /// `self * other`: first `other`, then `self`.
