@@ -2,17 +2,77 @@
 //!
 //! eomgen reads a robot's URDF, derives its rigid-body dynamics with its own small computer
 //! algebra system ([`cas`]) and emits allocation-free `no_std` Rust that the
-//! `eomgen-runtime` crate supports.
+//! `eomgen-runtime` crate supports. Most users need only [`Builder`], from a build script.
 //!
 //! The pipeline, one module per stage:
 //! [`urdf`] (the only module that sees XML) → [`model`] (kinematic tree, merged fixed links) →
-//! [`kinematics`] and [`dynamics`] (closed-form expressions in the [`cas`]) → emission.
+//! [`kinematics`] and [`dynamics`] (closed-form expressions in the [`cas`]) → [`emit`] (Rust).
 
 // Matrix code reads best with explicit indices.
 #![allow(clippy::needless_range_loop)]
 
+use std::path::{Path, PathBuf};
+
+mod builder;
 pub mod cas;
 pub mod dynamics;
+pub mod emit;
 pub mod kinematics;
 pub mod model;
 pub mod urdf;
+
+pub use builder::Builder;
+pub use model::{ModelError, ModelOptions, SymbolicParams};
+
+/// Everything that can go wrong between a URDF and a written module.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// The URDF is unreadable or describes no valid robot.
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    /// Writing the output failed.
+    #[error("{path}: {source}")]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    /// `compile()` outside a build script, without `out_dir`.
+    #[error("OUT_DIR is not set: call compile() from a build script, or set Builder::out_dir")]
+    NoOutDir,
+    /// A user-chosen name that is not a valid identifier of its kind.
+    #[error(
+        "invalid {what} `{name}`: use an UpperCamelCase type name or a snake_case module name"
+    )]
+    InvalidName { what: &'static str, name: String },
+    /// Generated tokens failed to parse: a bug in eomgen.
+    #[error("internal error while emitting code (please report): {0}")]
+    Emit(String),
+}
+
+/// Writes `bytes` to `path` unless the file already holds exactly them, through a temporary file
+/// and a rename, so that readers never see a partial file and an unchanged file keeps its
+/// modification time (no needless rebuilds).
+pub fn write_if_changed(path: &Path, bytes: &[u8]) -> Result<bool, Error> {
+    if std::fs::read(path).is_ok_and(|old| old == bytes) {
+        return Ok(false);
+    }
+    let io = |source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
+    std::fs::write(&tmp, bytes).map_err(io)?;
+    std::fs::rename(&tmp, path).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        io(e)
+    })?;
+    Ok(true)
+}
