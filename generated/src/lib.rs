@@ -1,1 +1,33 @@
-//! placeholder
+//! eomgen's checked-in output for the five reference robots, a `#![no_std]` crate.
+//!
+//! Each module is generated from the URDF of the same name in `robots/`. Do not edit them:
+//! `tests/golden.rs` regenerates every file in memory and fails on any difference; refresh
+//! them with `EOMGEN_BLESS=1 cargo test -p eomgen-generated --test golden`.
+//!
+//! ```
+//! use eomgen_generated::panda::{Panda, PandaLink};
+//! use eomgen_runtime::Dynamics;
+//! let robot = Panda::<f64>::default();
+//! let q = [0.0; 9];
+//! let m = robot.mass_matrix(&q);
+//! assert!(m[0][0] > 0.0);
+//! let hand = robot.link_pose(PandaLink::PandaHand, &q);
+//! assert!(hand.translation[2] > 0.5);
+//! ```
+
+#![no_std]
+
+pub mod allegro_right_hand;
+pub mod double_pendulum;
+pub mod kinova;
+pub mod panda;
+pub mod ur5;
+
+/// The robots of this crate: (module, type name, URDF file in `robots/`).
+pub const ROBOTS: [(&str, &str, &str); 5] = [
+    ("double_pendulum", "DoublePendulum", "double_pendulum.urdf"),
+    ("ur5", "Ur5", "ur5.urdf"),
+    ("panda", "Panda", "panda.urdf"),
+    ("kinova", "Kinova", "kinova.urdf"),
+    ("allegro_right_hand", "AllegroRightHand", "allegro_right_hand.urdf"),
+];
