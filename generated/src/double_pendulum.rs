@@ -47,7 +47,8 @@ impl DoublePendulumLink {
     clippy::neg_multiply,
     clippy::double_parens,
     clippy::identity_op,
-    clippy::needless_range_loop
+    clippy::needless_range_loop,
+    clippy::let_and_return
 )]
 impl<T: ::eomgen_runtime::Real> DoublePendulum<T> {
     /// Number of joint coordinates.
@@ -90,6 +91,81 @@ impl<T: ::eomgen_runtime::Real> DoublePendulum<T> {
             ],
             [T::zero()],
         ]
+    }
+    /// Forward dynamics `qdd = M(q)^-1 (tau - b(q, qd) - G(q))`, or which pivot of the
+    /// `L^T D L` factorization of M(q) was not positive (a non-physical model or
+    /// non-finite input); see `Dynamics::forward_dynamics` for the operation count.
+    pub fn try_forward_dynamics(
+        &self,
+        q: &[T; 2],
+        qd: &[T; 2],
+        tau: &[T; 2],
+    ) -> ::core::result::Result<[T; 2], ::eomgen_runtime::FactorError> {
+        let o: [T; 4] = {
+            let (s0, c0) = q[0].sin_cos();
+            let (s1, c1) = q[1].sin_cos();
+            let t0 = s0;
+            let t1 = c0;
+            let t2 = s1;
+            let t3 = c1;
+            let t4 = t1 * t3;
+            let t5 = t0 * t2;
+            let t6 = t1 * t2;
+            let t7 = t0 * t3;
+            let t8 = t2 * (-T::from_f64(0.1) * t3 - T::from_f64(0.10088));
+            let t9 = t3 * (T::from_f64(0.1) * t2 + T::from_f64(0.00000000019371));
+            let t10 = qd[0] * qd[0]
+                * (-T::from_f64(0.033238000000000004) * t8
+                    - T::from_f64(0.033238000000000004) * t9);
+            let t11 = T::from_f64(0.0000000014126230823060105) * t2
+                + T::from_f64(0.7356637062775817) * t3 + T::one();
+            let t12 = T::from_f64(0.000000000012877065959999999) * t2
+                + T::from_f64(0.006706098880000001) * t3
+                + T::from_f64(0.008636227908704868)
+                - (T::from_f64(0.0000000000064385329799999996) * t2
+                    + T::from_f64(0.0033530494400000003) * t3
+                    + T::from_f64(0.004557856275072)) * t11;
+            let t13 = T::from_f64(0.42040052957160007) * t0
+                + T::from_f64(0.0000000006316200853380001) * t5
+                + T::from_f64(0.328934150064) * t6 + T::from_f64(0.328934150064) * t7
+                + tau[0] - T::from_f64(0.0000056915273546100005) * t1
+                - T::from_f64(0.0000000006316200853380001) * t4
+                - qd[1] * qd[1]
+                    * (T::from_f64(0.000000000006438532980000001) * t3
+                        - T::from_f64(0.00335304944) * t2)
+                - qd[0] * qd[1]
+                    * (T::from_f64(0.06647600000000001) * t8
+                        + T::from_f64(0.06647600000000001) * t9)
+                - (T::from_f64(0.0000000006316200853380001) * t5
+                    + T::from_f64(0.328934150064) * t6 + T::from_f64(0.328934150064) * t7
+                    + tau[1] - T::from_f64(0.0000000006316200853380001) * t4 - t10)
+                    * t11;
+            [
+                t13 / t12,
+                T::from_f64(0.00000013857832437421965) * t5
+                    + T::from_f64(72.16860958583077) * t6
+                    + T::from_f64(72.16860958583077) * t7
+                    + T::from_f64(219.4013895236754) * tau[1]
+                    - T::from_f64(0.00000013857832437421965) * t4
+                    - T::from_f64(219.4013895236754) * t10 - t11 * t13 / t12,
+                t12,
+                T::from_f64(0.004557856275072),
+            ]
+        };
+        let pivots = [o[2], o[3]];
+        for (pivot, d) in pivots.iter().enumerate() {
+            if !d.is_finite() {
+                return Err(::eomgen_runtime::FactorError::NonFinite {
+                    pivot,
+                });
+            }
+            if *d <= T::zero() {
+                return Err(::eomgen_runtime::FactorError::NotPositiveDefinite {
+                    pivot,
+                });
+            }
+        }
+        Ok([o[0], o[1]])
     }
     /// Pose of a link frame in the world (root) frame.
     pub fn link_pose(
@@ -235,35 +311,30 @@ impl<T: ::eomgen_runtime::Real> DoublePendulum<T> {
     clippy::neg_multiply,
     clippy::double_parens,
     clippy::identity_op,
-    clippy::needless_range_loop
+    clippy::needless_range_loop,
+    clippy::let_and_return
 )]
 impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 2> for DoublePendulum<T> {
     const JOINT_NAMES: [&'static str; 2] = ["joint1", "joint2"];
-    /// Operations: 8 mul, 6 add, 0 div, 1 sin, 1 cos.
+    /// Route: composite-rigid-body algorithm.
+    /// Operations: 4 mul, 4 add, 0 div, 1 sin, 1 cos.
     fn mass_matrix(&self, q: &[T; 2]) -> [[T; 2]; 2] {
         let (s1, c1) = q[1].sin_cos();
         let t0 = s1;
         let t1 = c1;
-        let t2 = T::from_f64(0.000000000006438532980000001) * t0
-            + T::from_f64(0.00335304944) * t1 + T::from_f64(0.004557856275072);
+        let t2 = T::from_f64(0.0000000000064385329799999996) * t0
+            + T::from_f64(0.0033530494400000003) * t1 + T::from_f64(0.004557856275072);
         [
             [
-                T::from_f64(0.33238)
-                    * {
-                        let b = -T::from_f64(0.1) * t1 - T::from_f64(0.10088);
-                        b * b
-                    }
-                    + T::from_f64(0.33238)
-                        * {
-                            let b = T::from_f64(0.1) * t0
-                                + T::from_f64(0.00000000019371);
-                            b * b
-                        } + T::from_f64(0.0019298716336328685),
+                T::from_f64(0.000000000012877065959999999) * t0
+                    + T::from_f64(0.006706098880000001) * t1
+                    + T::from_f64(0.008636227908704868),
                 t2,
             ],
             [t2, T::from_f64(0.004557856275072)],
         ]
     }
+    /// Route: closed-form Lagrangian expressions.
     /// Operations: 14 mul, 8 add, 0 div, 2 sin, 2 cos.
     fn gravity(&self, q: &[T; 2]) -> [T; 2] {
         let (s0, c0) = q[0].sin_cos();
@@ -287,6 +358,7 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 2> for DoublePendu
                 - T::from_f64(0.328934150064) * t6 - T::from_f64(0.328934150064) * t7,
         ]
     }
+    /// Route: closed-form Lagrangian expressions.
     /// Operations: 16 mul, 6 add, 0 div, 1 sin, 1 cos.
     fn bias(&self, q: &[T; 2], qd: &[T; 2]) -> [T; 2] {
         let (s1, c1) = q[1].sin_cos();
@@ -331,6 +403,7 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 2> for DoublePendu
             ],
         ]
     }
+    /// Route: closed-form Lagrangian expressions.
     /// Operations: 40 mul, 24 add, 0 div, 2 sin, 2 cos.
     fn inverse_dynamics(&self, q: &[T; 2], qd: &[T; 2], qdd: &[T; 2]) -> [T; 2] {
         let (s0, c0) = q[0].sin_cos();
@@ -373,83 +446,32 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 2> for DoublePendu
                 - T::from_f64(0.328934150064) * t6 - T::from_f64(0.328934150064) * t7,
         ]
     }
-    /// Operations: 43 mul, 20 add, 2 div, 2 sin, 2 cos (M and b + G, then an LDL^T solve).
-    /// Returns NaN in every entry when M(q) is not positive definite (it cannot be for a valid model).
+    /// Route: M and b + G as in `mass_matrix` and `bias`, then an unrolled L^T D L solve without fill-in.
+    /// Operations: 45 mul, 32 add, 2 div, 2 sin, 2 cos.
+    ///
+    /// Returns NaN in every entry when M(q) is not positive definite (it cannot be for a valid
+    /// model and finite inputs); `try_forward_dynamics` says which pivot failed.
     fn forward_dynamics(&self, q: &[T; 2], qd: &[T; 2], tau: &[T; 2]) -> [T; 2] {
-        let o: [T; 2 * 2 + 2] = {
-            let (s0, c0) = q[0].sin_cos();
-            let (s1, c1) = q[1].sin_cos();
-            let t0 = s0;
-            let t1 = c0;
-            let t2 = s1;
-            let t3 = c1;
-            let t4 = t1 * t3;
-            let t5 = t0 * t2;
-            let t6 = t1 * t2;
-            let t7 = t0 * t3;
-            let t8 = T::from_f64(0.1) * t2 + T::from_f64(0.00000000019371);
-            let t9 = -T::from_f64(0.1) * t3 - T::from_f64(0.10088);
-            let t10 = T::from_f64(0.000000000006438532980000001) * t2
-                + T::from_f64(0.00335304944) * t3 + T::from_f64(0.004557856275072);
-            let t11 = t2 * t9;
-            let t12 = t3 * t8;
-            [
-                T::from_f64(0.33238) * t9 * t9 + T::from_f64(0.33238) * t8 * t8
-                    + T::from_f64(0.0019298716336328685),
-                t10,
-                t10,
-                T::from_f64(0.004557856275072),
-                T::from_f64(0.0000056915273546100005) * t1
-                    + T::from_f64(0.0000000006316200853380001) * t4
-                    + qd[1] * qd[1]
-                        * (T::from_f64(0.000000000006438532980000001) * t3
-                            - T::from_f64(0.00335304944) * t2)
-                    + qd[0] * qd[1]
-                        * (T::from_f64(0.06647600000000001) * t11
-                            + T::from_f64(0.06647600000000001) * t12)
-                    - T::from_f64(0.42040052957160007) * t0
-                    - T::from_f64(0.0000000006316200853380001) * t5
-                    - T::from_f64(0.328934150064) * t6
-                    - T::from_f64(0.328934150064) * t7,
-                T::from_f64(0.0000000006316200853380001) * t4
-                    + qd[0] * qd[0]
-                        * (-T::from_f64(0.033238000000000004) * t11
-                            - T::from_f64(0.033238000000000004) * t12)
-                    - T::from_f64(0.0000000006316200853380001) * t5
-                    - T::from_f64(0.328934150064) * t6 - T::from_f64(0.328934150064) * t7,
-            ]
-        };
-        let mut m = [[T::zero(); 2]; 2];
-        let mut rhs = [T::zero(); 2];
-        for i in 0..2 {
-            for j in 0..2 {
-                m[i][j] = o[i * 2 + j];
-            }
-            rhs[i] = tau[i] - o[2 * 2 + i];
+        match self.try_forward_dynamics(q, qd, tau) {
+            Ok(qdd) => qdd,
+            Err(_) => [T::nan(); 2],
         }
-        ::eomgen_runtime::solve_spd_or_nan(&m, &rhs)
     }
-    /// Operations: 16 mul, 9 add, 0 div, 1 sin, 1 cos.
+    /// Operations: 12 mul, 7 add, 0 div, 1 sin, 1 cos.
     fn kinetic_energy(&self, q: &[T; 2], qd: &[T; 2]) -> T {
         let (s1, c1) = q[1].sin_cos();
         let t0 = s1;
         let t1 = c1;
-        let t2 = T::from_f64(0.000000000006438532980000001) * t0
-            + T::from_f64(0.00335304944) * t1 + T::from_f64(0.004557856275072);
-        let t3 = qd[0]
-            * (T::from_f64(0.33238)
-                * {
-                    let b = -T::from_f64(0.1) * t1 - T::from_f64(0.10088);
-                    b * b
-                }
-                + T::from_f64(0.33238)
-                    * {
-                        let b = T::from_f64(0.1) * t0 + T::from_f64(0.00000000019371);
-                        b * b
-                    } + T::from_f64(0.0019298716336328685)) + qd[1] * t2;
-        T::from_f64(0.5) * qd[0] * t3
+        let t2 = T::from_f64(0.0000000000064385329799999996) * t0
+            + T::from_f64(0.0033530494400000003) * t1 + T::from_f64(0.004557856275072);
+        let t3 = T::from_f64(0.5) * qd[0]
+            * (qd[0]
+                * (T::from_f64(0.000000000012877065959999999) * t0
+                    + T::from_f64(0.006706098880000001) * t1
+                    + T::from_f64(0.008636227908704868)) + qd[1] * t2)
             + T::from_f64(0.5) * qd[1]
-                * (T::from_f64(0.004557856275072) * qd[1] + qd[0] * t2)
+                * (T::from_f64(0.004557856275072) * qd[1] + qd[0] * t2);
+        t3
     }
     /// Operations: 10 mul, 6 add, 0 div, 2 sin, 2 cos.
     fn potential_energy(&self, q: &[T; 2]) -> T {

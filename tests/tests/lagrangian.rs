@@ -20,7 +20,7 @@ fn run(p: &Program, q: &[f64], qd: &[f64], qdd: &[f64]) -> Vec<f64> {
         SymbolKind::Q(i) => Some(q[i]),
         SymbolKind::Qd(i) => Some(qd[i]),
         SymbolKind::Qdd(i) => Some(qdd[i]),
-        SymbolKind::Param => None,
+        SymbolKind::Tau(_) | SymbolKind::Param => None,
     })
     .expect("numeric model")
 }
@@ -275,6 +275,59 @@ fn physics_identities_hold_at_random_states() {
             let v0 = run(&p, &q, &zero, &qdd);
             for i in 0..n * n {
                 c.check(|| format!("{robot} C(q, 0)[{i}]"), v0[c_at + i], 0.0);
+            }
+        }
+        c.finish(robot);
+    }
+}
+
+#[test]
+fn recursive_algorithms_agree_with_the_lagrangian_route() {
+    let mut rng = Lcg(11);
+    for robot in ROBOTS {
+        let (_, d) = derive(robot);
+        let n = d.dof;
+        let r = &d.recursive;
+        let mut l = Layout {
+            outputs: Vec::new(),
+        };
+        let pairs: [(&str, Vec<Id>, Vec<Id>); 4] = [
+            (
+                "M",
+                d.mass_matrix.iter().flatten().copied().collect(),
+                r.mass_matrix.iter().flatten().copied().collect(),
+            ),
+            ("G", d.gravity.clone(), r.gravity.clone()),
+            ("b", d.bias.clone(), r.bias.clone()),
+            ("tau", d.tau.clone(), r.tau.clone()),
+        ];
+        let at: Vec<(usize, usize)> = pairs
+            .iter()
+            .map(|(_, a, b)| (l.push(a.iter().copied()), l.push(b.iter().copied())))
+            .collect();
+        let bg_at = l.push(r.bias_and_gravity.iter().copied());
+        let b_at = at[2].0;
+        let g_at = at[1].0;
+        let p = Program::new(&d.graph, &l.outputs);
+        let mut c = Checker::new(1e-10);
+        for _ in 0..5 {
+            let (q, qd, qdd) = (rng.vec(n, 2.0), rng.vec(n, 2.0), rng.vec(n, 2.0));
+            let v = run(&p, &q, &qd, &qdd);
+            for ((name, a, _), &(ia, ib)) in pairs.iter().zip(&at) {
+                for k in 0..a.len() {
+                    c.check(
+                        || format!("{robot} {name}[{k}]: recursive vs Lagrangian"),
+                        v[ib + k],
+                        v[ia + k],
+                    );
+                }
+            }
+            for i in 0..n {
+                c.check(
+                    || format!("{robot} b+G[{i}]"),
+                    v[bg_at + i],
+                    v[b_at + i] + v[g_at + i],
+                );
             }
         }
         c.finish(robot);

@@ -61,7 +61,9 @@ pub enum SymbolKind {
     Qd(usize),
     /// Joint acceleration `qdd_i`.
     Qdd(usize),
-    /// Any other named quantity: a mass, a length, an input torque.
+    /// Joint effort `tau_i` (an input of forward dynamics).
+    Tau(usize),
+    /// Any other named quantity: a mass, a length, an offset.
     Param,
 }
 
@@ -331,6 +333,11 @@ impl Graph {
     /// Joint acceleration `qdd_i`, printed `qdd{i+1}`.
     pub fn qdd(&mut self, i: usize) -> Id {
         self.symbol(&format!("qdd{}", i + 1), SymbolKind::Qdd(i))
+    }
+
+    /// Joint effort `tau_i`, printed `tau{i+1}`.
+    pub fn tau(&mut self, i: usize) -> Id {
+        self.symbol(&format!("tau{}", i + 1), SymbolKind::Tau(i))
     }
 
     /// A named parameter.

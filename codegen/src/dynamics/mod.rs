@@ -11,9 +11,11 @@
 //!   `C(q, qd)_ij = sum_k G_ijk qd_k` (so that `dM/dt - 2 C(q, qd)` is skew-symmetric), the
 //!   bias `b = C(q, qd) qd` and `tau = M qdd + b + G`.
 
+pub mod newton_euler;
+
 use std::time::{Duration, Instant};
 
-use crate::cas::{Graph, Id};
+use crate::cas::{Graph, Id, Program};
 use crate::kinematics::{
     const_v3, cross, mat_vec, vec_add, BodyKinematics, Params, WorldKinematics, M3, V3,
 };
@@ -61,8 +63,72 @@ pub struct Derivation {
     pub potential_energy: Id,
     /// One per URDF link, in the model's frame order.
     pub frames: Vec<FrameExprs>,
+    /// The same quantities by the recursive algorithms.
+    pub recursive: Recursive,
+    /// For each function of generated code, the cheaper of the two routes.
+    pub fast: Fast,
     /// How long each stage took.
     pub timings: Vec<(&'static str, Duration)>,
+}
+
+/// `M`, `G`, `b` and `tau` by the customized symbolic recursive algorithms
+/// ([`newton_euler`]): equal to the Lagrangian forms, but far fewer operations.
+#[derive(Clone, Debug)]
+pub struct Recursive {
+    /// By the composite-rigid-body algorithm.
+    pub mass_matrix: Vec<Vec<Id>>,
+    /// By Newton-Euler with zero velocity and acceleration.
+    pub gravity: Vec<Id>,
+    /// By Newton-Euler with zero acceleration and no gravity.
+    pub bias: Vec<Id>,
+    /// `b + G` in one recursion (what forward dynamics needs).
+    pub bias_and_gravity: Vec<Id>,
+    /// Full inverse dynamics.
+    pub tau: Vec<Id>,
+}
+
+/// Which derivation a fast form comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Route {
+    /// The closed-form Lagrangian expressions.
+    Lagrangian,
+    /// Newton-Euler or the composite-rigid-body algorithm.
+    Recursive,
+}
+
+impl Route {
+    /// A short description for documentation.
+    pub fn describe(self, recursive: &str) -> String {
+        match self {
+            Route::Lagrangian => "closed-form Lagrangian expressions".to_string(),
+            Route::Recursive => recursive.to_string(),
+        }
+    }
+}
+
+/// The forms generated code evaluates: per quantity, whichever route needs fewer operations.
+#[derive(Clone, Debug)]
+pub struct Fast {
+    pub mass_matrix: (Route, Vec<Vec<Id>>),
+    pub gravity: (Route, Vec<Id>),
+    pub bias: (Route, Vec<Id>),
+    pub tau: (Route, Vec<Id>),
+    pub kinetic_energy: Id,
+    /// Joint efforts as symbols `tau_i` (inputs of forward dynamics).
+    pub tau_in: Vec<Id>,
+    /// `qdd = M^-1 (tau_in - b - G)`, with an unrolled sparse `L^T D L` solve.
+    pub forward_dynamics: Vec<Id>,
+    /// The pivots `D` of that factorization, all positive when `M` is positive definite.
+    pub pivots: Vec<Id>,
+}
+
+fn cheaper<T: Clone>(g: &Graph, a: &T, b: &T, ids: impl Fn(&T) -> Vec<Id>) -> (Route, T) {
+    let cost = |x: &T| Program::new(g, &ids(x)).ops().total();
+    if cost(b) < cost(a) {
+        (Route::Recursive, b.clone())
+    } else {
+        (Route::Lagrangian, a.clone())
+    }
 }
 
 /// The pairs `(j, k)`, `j < k`, in Craig's order.
@@ -188,6 +254,79 @@ impl Derivation {
         }
         lap("frames", &mut timings);
 
+        let lm = newton_euler::LocalModel::new(&mut g, model, &params, &q);
+        let gv = Some(grav);
+        use newton_euler::Terms;
+        let (qd_s, qdd_s) = (Some(qd.as_slice()), Some(qdd.as_slice()));
+        let recursive = Recursive {
+            mass_matrix: newton_euler::crba(&mut g, &lm),
+            gravity: newton_euler::rnea(
+                &mut g,
+                &lm,
+                Terms {
+                    qd: None,
+                    qdd: None,
+                    gravity: gv,
+                },
+            ),
+            bias: newton_euler::rnea(
+                &mut g,
+                &lm,
+                Terms {
+                    qd: qd_s,
+                    qdd: None,
+                    gravity: None,
+                },
+            ),
+            bias_and_gravity: newton_euler::rnea(
+                &mut g,
+                &lm,
+                Terms {
+                    qd: qd_s,
+                    qdd: None,
+                    gravity: gv,
+                },
+            ),
+            tau: newton_euler::rnea(
+                &mut g,
+                &lm,
+                Terms {
+                    qd: qd_s,
+                    qdd: qdd_s,
+                    gravity: gv,
+                },
+            ),
+        };
+        lap("recursive algorithms", &mut timings);
+
+        let flat = |m: &Vec<Vec<Id>>| -> Vec<Id> { m.iter().flatten().copied().collect() };
+        let vec = |v: &Vec<Id>| v.clone();
+        let mm = cheaper(&g, &mass_matrix, &recursive.mass_matrix, flat);
+        let gr = cheaper(&g, &gravity, &recursive.gravity, vec);
+        let bi = cheaper(&g, &bias, &recursive.bias, vec);
+        let tq = cheaper(&g, &tau, &recursive.tau, vec);
+        // h = b + G: one recursion, or the sum of the cheaper closed forms.
+        let lag_h: Vec<Id> = (0..n).map(|i| g.add(bi.1[i], gr.1[i])).collect();
+        let (_, h) = cheaper(&g, &lag_h, &recursive.bias_and_gravity, vec);
+        let tau_in: Vec<Id> = (0..n).map(|i| g.tau(i)).collect();
+        let rhs: Vec<Id> = (0..n).map(|i| g.sub(tau_in[i], h[i])).collect();
+        let parents: Vec<Option<usize>> = model.joints.iter().map(|j| j.parent).collect();
+        let (forward_dynamics, pivots) = newton_euler::ltdl_solve(&mut g, &parents, &mm.1, &rhs);
+        let mqd_fast: Vec<Id> = (0..n).map(|i| g.dot(&mm.1[i], &qd)).collect();
+        let t2 = g.dot(&qd, &mqd_fast);
+        let kinetic_energy_fast = g.scale(t2, 0.5);
+        let fast = Fast {
+            mass_matrix: mm,
+            gravity: gr,
+            bias: bi,
+            tau: tq,
+            kinetic_energy: kinetic_energy_fast,
+            tau_in,
+            forward_dynamics,
+            pivots,
+        };
+        lap("fast forms", &mut timings);
+
         Derivation {
             graph: g,
             dof: n,
@@ -205,6 +344,8 @@ impl Derivation {
             kinetic_energy,
             potential_energy,
             frames,
+            recursive,
+            fast,
             timings,
         }
     }

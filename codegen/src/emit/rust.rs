@@ -8,7 +8,7 @@ use quote::{format_ident, quote};
 
 use super::names::{snake, upper_camel, Scope};
 use crate::cas::{Expr, Id, OpCount, Program, Symbol, SymbolKind};
-use crate::dynamics::Derivation;
+use crate::dynamics::{Derivation, Route};
 use crate::model::Model;
 
 /// What the emitted file is called and says about itself.
@@ -91,6 +91,10 @@ impl Ctx<'_> {
             (SymbolKind::Qd(i), None) => {
                 let i = idx(i);
                 quote!(qd[#i])
+            }
+            (SymbolKind::Tau(i), None) => {
+                let i = idx(i);
+                quote!(tau[#i])
             }
             (SymbolKind::Qdd(i), None) => {
                 let i = idx(i);
@@ -392,14 +396,19 @@ pub fn emit_tokens(
         (b, ops_line(&ops))
     };
 
+    let f = &d.fast;
+    let route = |r: Route, rec: &str| format!("Route: {}.", r.describe(rec));
     let (mm, mm_ops) = func(
         "mass_matrix",
-        flat(&d.mass_matrix),
+        flat(&f.mass_matrix.1),
         Shape::Matrix(n, n),
         &mut counts,
     );
-    let (gr, gr_ops) = func("gravity", d.gravity.clone(), Shape::Vector, &mut counts);
-    let (bi, bi_ops) = func("bias", d.bias.clone(), Shape::Vector, &mut counts);
+    let mm_route = route(f.mass_matrix.0, "composite-rigid-body algorithm");
+    let (gr, gr_ops) = func("gravity", f.gravity.1.clone(), Shape::Vector, &mut counts);
+    let gr_route = route(f.gravity.0, "Newton-Euler");
+    let (bi, bi_ops) = func("bias", f.bias.1.clone(), Shape::Vector, &mut counts);
+    let bi_route = route(f.bias.0, "Newton-Euler");
     let (cm, cm_ops) = func(
         "coriolis_matrix",
         flat(&d.coriolis_matrix),
@@ -408,13 +417,14 @@ pub fn emit_tokens(
     );
     let (id, id_ops) = func(
         "inverse_dynamics",
-        d.tau.clone(),
+        f.tau.1.clone(),
         Shape::Vector,
         &mut counts,
     );
+    let id_route = route(f.tau.0, "Newton-Euler");
     let (ke, ke_ops) = func(
         "kinetic_energy",
-        vec![d.kinetic_energy],
+        vec![f.kinetic_energy],
         Shape::Scalar,
         &mut counts,
     );
@@ -437,27 +447,24 @@ pub fn emit_tokens(
         Shape::Matrix(n, np),
         &mut counts,
     );
-    // Forward dynamics: M and h = b + G in one program, then an LDL^T solve.
-    let mut fd_outputs = flat(&d.mass_matrix);
-    let mut g = d.graph.clone();
-    let h: Vec<Id> = (0..n).map(|i| g.add(d.bias[i], d.gravity[i])).collect();
-    fd_outputs.extend(&h);
-    let fd_d = Derivation {
-        graph: g,
-        ..d.clone()
-    };
-    let (fd_body, fd_ops) = {
-        let program = Program::new(&fd_d.graph, &fd_outputs);
-        let mut ops = program.ops();
-        ops.mul += n * n * (n + 3) / 6 + n * n; // LDL^T factor and solve, roughly
-        ops.div += n;
-        let (b, _) = body(&fd_d, &cx, &fd_outputs, Shape::Vector);
-        counts.push(("forward_dynamics".into(), ops));
-        (
-            b,
-            format!("Operations: {ops} (M and b + G, then an LDL^T solve)."),
-        )
-    };
+    // Forward dynamics: M and h = b + G, then the unrolled sparse L^T D L solve, all in one
+    // program; the pivots come out too, to report a mass matrix that is not positive definite.
+    let mut fd_outputs = f.forward_dynamics.clone();
+    fd_outputs.extend(&f.pivots);
+    let (fd_body, fd_ops) = func("forward_dynamics", fd_outputs, Shape::Vector, &mut counts);
+    let fd_len = Literal::usize_unsuffixed(2 * n);
+    let fd_x: Vec<TokenStream> = (0..n)
+        .map(|i| {
+            let i = Literal::usize_unsuffixed(i);
+            quote!(o[#i])
+        })
+        .collect();
+    let fd_pivots: Vec<TokenStream> = (0..n)
+        .map(|i| {
+            let i = Literal::usize_unsuffixed(n + i);
+            quote!(o[#i])
+        })
+        .collect();
 
     // Links.
     let mut link_scope = Scope::with_reserved(&["ALL"]);
@@ -499,14 +506,17 @@ pub fn emit_tokens(
         "The URDF links of [`{}`], one variant per link.",
         opts.type_name
     )]);
-    let mm_doc = doc(&[mm_ops]);
-    let gr_doc = doc(&[gr_ops]);
-    let bi_doc = doc(&[bi_ops]);
+    let mm_doc = doc(&[mm_route, mm_ops]);
+    let gr_doc = doc(&[gr_route, gr_ops]);
+    let bi_doc = doc(&[bi_route, bi_ops]);
     let cm_doc = doc(&[cm_ops]);
-    let id_doc = doc(&[id_ops]);
+    let id_doc = doc(&[id_route, id_ops]);
     let fd_doc = doc(&[
+        "Route: M and b + G as in `mass_matrix` and `bias`, then an unrolled L^T D L solve without fill-in.".into(),
         fd_ops,
-        "Returns NaN in every entry when M(q) is not positive definite (it cannot be for a valid model).".into(),
+        String::new(),
+        "Returns NaN in every entry when M(q) is not positive definite (it cannot be for a valid".into(),
+        "model and finite inputs); `try_forward_dynamics` says which pivot failed.".into(),
     ]);
     let ke_doc = doc(&[ke_ops]);
     let pe_doc = doc(&[pe_ops]);
@@ -558,7 +568,7 @@ pub fn emit_tokens(
             }
         }
 
-        #[allow(unused_variables, clippy::approx_constant, clippy::excessive_precision, clippy::unreadable_literal, clippy::neg_multiply, clippy::double_parens, clippy::identity_op, clippy::needless_range_loop)]
+        #[allow(unused_variables, clippy::approx_constant, clippy::excessive_precision, clippy::unreadable_literal, clippy::neg_multiply, clippy::double_parens, clippy::identity_op, clippy::needless_range_loop, clippy::let_and_return)]
         impl<T: ::eomgen_runtime::Real> #ty<T> {
             /// Number of joint coordinates.
             pub const DOF: usize = #n;
@@ -568,6 +578,23 @@ pub fn emit_tokens(
 
             #cp_doc
             pub fn coriolis_pairs(&self, q: &[T; #n]) -> [[T; #np]; #n] { #cp }
+
+            /// Forward dynamics `qdd = M(q)^-1 (tau - b(q, qd) - G(q))`, or which pivot of the
+            /// `L^T D L` factorization of M(q) was not positive (a non-physical model or
+            /// non-finite input); see `Dynamics::forward_dynamics` for the operation count.
+            pub fn try_forward_dynamics(&self, q: &[T; #n], qd: &[T; #n], tau: &[T; #n]) -> ::core::result::Result<[T; #n], ::eomgen_runtime::FactorError> {
+                let o: [T; #fd_len] = { #fd_body };
+                let pivots = [#(#fd_pivots),*];
+                for (pivot, d) in pivots.iter().enumerate() {
+                    if !d.is_finite() {
+                        return Err(::eomgen_runtime::FactorError::NonFinite { pivot });
+                    }
+                    if *d <= T::zero() {
+                        return Err(::eomgen_runtime::FactorError::NotPositiveDefinite { pivot });
+                    }
+                }
+                Ok([#(#fd_x),*])
+            }
 
             /// Pose of a link frame in the world (root) frame.
             pub fn link_pose(&self, link: #link_ty, q: &[T; #n]) -> ::eomgen_runtime::Pose<T> {
@@ -580,7 +607,7 @@ pub fn emit_tokens(
             }
         }
 
-        #[allow(unused_variables, clippy::approx_constant, clippy::excessive_precision, clippy::unreadable_literal, clippy::neg_multiply, clippy::double_parens, clippy::identity_op, clippy::needless_range_loop)]
+        #[allow(unused_variables, clippy::approx_constant, clippy::excessive_precision, clippy::unreadable_literal, clippy::neg_multiply, clippy::double_parens, clippy::identity_op, clippy::needless_range_loop, clippy::let_and_return)]
         impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, #n> for #ty<T> {
             const JOINT_NAMES: [&'static str; #n] = [#(#joint_names),*];
 
@@ -601,16 +628,10 @@ pub fn emit_tokens(
 
             #fd_doc
             fn forward_dynamics(&self, q: &[T; #n], qd: &[T; #n], tau: &[T; #n]) -> [T; #n] {
-                let o: [T; #n * #n + #n] = { #fd_body };
-                let mut m = [[T::zero(); #n]; #n];
-                let mut rhs = [T::zero(); #n];
-                for i in 0..#n {
-                    for j in 0..#n {
-                        m[i][j] = o[i * #n + j];
-                    }
-                    rhs[i] = tau[i] - o[#n * #n + i];
+                match self.try_forward_dynamics(q, qd, tau) {
+                    Ok(qdd) => qdd,
+                    Err(_) => [T::nan(); #n],
                 }
-                ::eomgen_runtime::solve_spd_or_nan(&m, &rhs)
             }
 
             #ke_doc
