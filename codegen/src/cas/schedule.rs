@@ -5,6 +5,7 @@
 //! small nesting depth, so that expressions stay readable and printing never recurses deeply).
 //! Nodes that no output needs are dropped.
 
+use std::collections::HashMap;
 use std::fmt;
 
 use super::eval::{powi, sign};
@@ -176,6 +177,21 @@ impl Program {
         for &o in outputs {
             uses[slot(o)] += 1;
         }
+        // Denominators shared by several products get one reciprocal temporary: a division
+        // costs as much as ten multiplications.
+        let den_key = |fs: &[(Id, i32)]| -> Vec<(Id, i32)> {
+            fs.iter().filter(|f| f.1 < 0).copied().collect()
+        };
+        let mut den_uses: HashMap<Vec<(Id, i32)>, usize> = HashMap::new();
+        for &id in &order {
+            if let Node::Mul(fs) = graph.node(id) {
+                let key = den_key(fs);
+                if !key.is_empty() && key.len() < fs.len() {
+                    *den_uses.entry(key).or_insert(0) += 1;
+                }
+            }
+        }
+        let mut recips: HashMap<Vec<(Id, i32)>, usize> = HashMap::new();
         // For each reachable node: its expression when used (a leaf, a temp, or inline), and
         // the nesting depth of that inline expression.
         let mut repr: Vec<Option<(Expr, u32)>> = vec![None; order.len()];
@@ -195,6 +211,29 @@ impl Program {
                             c.get(),
                             parts.into_iter().map(|((e, _), k)| (e, k)).collect(),
                         ),
+                        d,
+                    )
+                }
+                Node::Mul(fs) if den_uses.get(&den_key(fs)).is_some_and(|&u| u >= 2) => {
+                    let key = den_key(fs);
+                    let r = match recips.get(&key) {
+                        Some(&r) => r,
+                        None => {
+                            let den = key.iter().map(|(f, e)| (sub(*f).0, *e)).collect();
+                            temps.push(Expr::Mul(den));
+                            recips.insert(key, temps.len() - 1);
+                            temps.len() - 1
+                        }
+                    };
+                    let mut parts: Vec<((Expr, u32), i32)> = fs
+                        .iter()
+                        .filter(|f| f.1 > 0)
+                        .map(|(f, e)| (sub(*f), *e))
+                        .collect();
+                    parts.push(((Expr::Temp(r), 0), 1));
+                    let d = parts.iter().map(|p| p.0 .1).max().unwrap_or(0) + 1;
+                    (
+                        Expr::Mul(parts.into_iter().map(|((e, _), x)| (e, x)).collect()),
                         d,
                     )
                 }

@@ -113,6 +113,13 @@ pub struct Fast {
     pub gravity: (Route, Vec<Id>),
     pub bias: (Route, Vec<Id>),
     pub tau: (Route, Vec<Id>),
+    /// `C(q, qd)`: Christoffel symbols, or half the velocity gradient of the Newton-Euler
+    /// bias (`C = 1/2 db/dqd`, exact because `G_ijk = G_ikj`).
+    pub coriolis_matrix: (Route, Vec<Vec<Id>>),
+    /// Craig's `C(q)`: Christoffel symbols, or `1/2 d^2 b_i / dqd_j^2`.
+    pub centrifugal: (Route, Vec<Vec<Id>>),
+    /// Craig's `B(q)`: Christoffel symbols, or `d^2 b_i / dqd_j dqd_k`.
+    pub coriolis_pairs: (Route, Vec<Vec<Id>>),
     pub kinetic_energy: Id,
     /// Joint efforts as symbols `tau_i` (inputs of forward dynamics).
     pub tau_in: Vec<Id>,
@@ -312,6 +319,28 @@ impl Derivation {
         let rhs: Vec<Id> = (0..n).map(|i| g.sub(tau_in[i], h[i])).collect();
         let parents: Vec<Option<usize>> = model.joints.iter().map(|j| j.parent).collect();
         let (forward_dynamics, pivots) = newton_euler::ltdl_solve(&mut g, &parents, &mm.1, &rhs);
+        // Velocity derivatives of the Newton-Euler bias: C = 1/2 db/dqd, and Craig's forms from
+        // the second derivatives (b is quadratic in qd).
+        let db: Vec<Vec<Id>> = (0..n)
+            .map(|j| g.diff_many(&recursive.bias, qd[j]))
+            .collect();
+        let c_rec: Vec<Vec<Id>> = (0..n)
+            .map(|i| (0..n).map(|j| g.scale(db[j][i], 0.5)).collect())
+            .collect();
+        let mut cf_rec = vec![vec![g.zero(); n]; n];
+        let mut cp_rec = vec![Vec::new(); n];
+        for i in 0..n {
+            for j in 0..n {
+                let d2 = g.diff(db[j][i], qd[j]);
+                cf_rec[i][j] = g.scale(d2, 0.5);
+            }
+            for &(j, k) in &pair_list {
+                cp_rec[i].push(g.diff(db[j][i], qd[k]));
+            }
+        }
+        let cm = cheaper(&g, &coriolis_matrix, &c_rec, flat);
+        let cf = cheaper(&g, &centrifugal, &cf_rec, flat);
+        let cp = cheaper(&g, &coriolis_pairs, &cp_rec, flat);
         let mqd_fast: Vec<Id> = (0..n).map(|i| g.dot(&mm.1[i], &qd)).collect();
         let t2 = g.dot(&qd, &mqd_fast);
         let kinetic_energy_fast = g.scale(t2, 0.5);
@@ -320,6 +349,9 @@ impl Derivation {
             gravity: gr,
             bias: bi,
             tau: tq,
+            coriolis_matrix: cm,
+            centrifugal: cf,
+            coriolis_pairs: cp,
             kinetic_energy: kinetic_energy_fast,
             tau_in,
             forward_dynamics,

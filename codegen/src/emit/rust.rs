@@ -411,7 +411,7 @@ pub fn emit_tokens(
     let bi_route = route(f.bias.0, "Newton-Euler");
     let (cm, cm_ops) = func(
         "coriolis_matrix",
-        flat(&d.coriolis_matrix),
+        flat(&f.coriolis_matrix.1),
         Shape::Matrix(n, n),
         &mut counts,
     );
@@ -437,13 +437,13 @@ pub fn emit_tokens(
     let np = n * n.saturating_sub(1) / 2;
     let (cf, cf_ops) = func(
         "centrifugal",
-        flat(&d.centrifugal),
+        flat(&f.centrifugal.1),
         Shape::Matrix(n, n),
         &mut counts,
     );
     let (cp, cp_ops) = func(
         "coriolis_pairs",
-        flat(&d.coriolis_pairs),
+        flat(&f.coriolis_pairs.1),
         Shape::Matrix(n, np),
         &mut counts,
     );
@@ -509,7 +509,13 @@ pub fn emit_tokens(
     let mm_doc = doc(&[mm_route, mm_ops]);
     let gr_doc = doc(&[gr_route, gr_ops]);
     let bi_doc = doc(&[bi_route, bi_ops]);
-    let cm_doc = doc(&[cm_ops]);
+    let cm_doc = doc(&[
+        route(
+            f.coriolis_matrix.0,
+            "half the velocity gradient of the Newton-Euler bias",
+        ),
+        cm_ops,
+    ]);
     let id_doc = doc(&[id_route, id_ops]);
     let fd_doc = doc(&[
         "Route: M and b + G as in `mass_matrix` and `bias`, then an unrolled L^T D L solve without fill-in.".into(),
@@ -523,11 +529,16 @@ pub fn emit_tokens(
     let cf_doc = doc(&[
         "Craig's centrifugal matrix C(q): `b = B(q) [qd qd] + C(q) [qd^2]`.".into(),
         String::new(),
+        route(
+            f.centrifugal.0,
+            "second velocity derivatives of the Newton-Euler bias",
+        ),
         cf_ops,
     ]);
     let cp_doc = doc(&[
         format!("Craig's Coriolis matrix B(q), N x N(N-1)/2 = {n} x {np}, columns for qd_j qd_k with j < k in the order (0,1), (0,2), ..., (1,2), ..."),
         String::new(),
+        route(f.coriolis_pairs.0, "second velocity derivatives of the Newton-Euler bias"),
         cp_ops,
     ]);
 
