@@ -19,6 +19,7 @@ pub mod dynamics;
 pub mod emit;
 pub mod kinematics;
 pub mod model;
+pub mod report;
 pub mod urdf;
 
 pub use builder::Builder;

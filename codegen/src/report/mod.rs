@@ -1,0 +1,808 @@
+//! Equations for people: the derived quantities of a robot as plain text, LaTeX or Markdown.
+//!
+//! Two forms:
+//! - [`Form::Expanded`]: each entry is one formula, expanded and simplified with the
+//!   trigonometric identities of [`Graph::expand_trig`], with textbook short names
+//!   (`s1 = sin(q1)`, `c12 = cos(q1 + q2)`) explained in a legend. Readable for small robots;
+//!   a term whose expansion exceeds [`ShowOptions::max_terms`] falls back to the program form,
+//!   with a note.
+//! - [`Form::Program`]: the closed-form expressions as a straight-line program, shared
+//!   temporaries `t0, t1, ...` first, then the entries. Compact enough for large robots.
+//!
+//! Output is deterministic: it depends only on the model and the options.
+//!
+//! ```
+//! use eomgen::report::{render, Form, Format, ShowOptions, Term};
+//! let urdf = r#"<robot name="pendulum">
+//!   <link name="base"/>
+//!   <link name="arm">
+//!     <inertial>
+//!       <origin xyz="0 0 -0.5"/> <mass value="2"/>
+//!       <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.001"/>
+//!     </inertial>
+//!   </link>
+//!   <joint name="swing" type="continuous">
+//!     <parent link="base"/> <child link="arm"/> <axis xyz="0 1 0"/>
+//!   </joint>
+//! </robot>"#;
+//! let model = eomgen::urdf::load_str(urdf, "pendulum.urdf", &Default::default()).unwrap();
+//! let d = eomgen::dynamics::Derivation::new(&model);
+//! let opts = ShowOptions { terms: vec![Term::MassMatrix, Term::Gravity], ..Default::default() };
+//! let text = render(&model, &d, &opts).unwrap();
+//! assert!(text.contains("M11 = 0.51\n"));
+//! assert!(text.contains("G1 = 9.81*s1\n"));
+//! assert!(text.contains("s1 = sin(q1)"));
+//! ```
+
+mod trig;
+
+use std::collections::BTreeSet;
+use std::fmt::Write as _;
+
+use crate::cas::{format_number, Graph, Id, Node, Program, Style, SymbolKind, Syntax};
+use crate::dynamics::{pairs, Derivation};
+use crate::model::{JointKind, Model};
+
+/// A derived quantity that can be printed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Term {
+    /// `M(q)`, printed as its upper triangle.
+    MassMatrix,
+    /// Craig's Coriolis matrix `B(q)`, N x N(N-1)/2.
+    CoriolisPairs,
+    /// Craig's centrifugal matrix `C(q)`, N x N.
+    Centrifugal,
+    /// `G(q)`.
+    Gravity,
+    /// `b(q, qd)`: Coriolis and centrifugal terms without gravity.
+    Bias,
+    /// The Christoffel-form Coriolis matrix `C(q, qd)`.
+    CoriolisMatrix,
+    /// `tau = M qdd + b + G`.
+    Tau,
+    /// Kinetic energy `T`.
+    KineticEnergy,
+    /// Potential energy `V`.
+    PotentialEnergy,
+}
+
+impl Term {
+    /// Every term, in print order.
+    pub const ALL: [Term; 9] = [
+        Term::MassMatrix,
+        Term::CoriolisPairs,
+        Term::Centrifugal,
+        Term::Gravity,
+        Term::Bias,
+        Term::CoriolisMatrix,
+        Term::Tau,
+        Term::KineticEnergy,
+        Term::PotentialEnergy,
+    ];
+
+    /// The command-line name: `M`, `B`, `C`, `G`, `b`, `coriolis`, `tau`, `T`, `V`.
+    pub fn label(self) -> &'static str {
+        match self {
+            Term::MassMatrix => "M",
+            Term::CoriolisPairs => "B",
+            Term::Centrifugal => "C",
+            Term::Gravity => "G",
+            Term::Bias => "b",
+            Term::CoriolisMatrix => "coriolis",
+            Term::Tau => "tau",
+            Term::KineticEnergy => "T",
+            Term::PotentialEnergy => "V",
+        }
+    }
+
+    /// Parses a [`Term::label`] (case matters: `B` and `b` differ) or a long name such as
+    /// `mass_matrix`, `coriolis_pairs`, `centrifugal`, `gravity`, `bias`, `coriolis_matrix`,
+    /// `kinetic_energy`, `potential_energy`.
+    pub fn parse(s: &str) -> Option<Term> {
+        let long = [
+            "mass_matrix",
+            "coriolis_pairs",
+            "centrifugal",
+            "gravity",
+            "bias",
+            "coriolis_matrix",
+            "tau",
+            "kinetic_energy",
+            "potential_energy",
+        ];
+        Term::ALL
+            .iter()
+            .zip(long)
+            .find(|(t, l)| t.label() == s || *l == s)
+            .map(|(t, _)| *t)
+    }
+
+    /// Heading and the sentence that defines the term.
+    fn title(self) -> (&'static str, &'static str) {
+        match self {
+            Term::MassMatrix => (
+                "Mass matrix M(q)",
+                "Symmetric: entries below the diagonal are not shown.",
+            ),
+            Term::CoriolisPairs => (
+                "Craig's Coriolis matrix B(q)",
+                "B_i,jk multiplies qd_j qd_k (j < k): b = B(q) [qd qd] + C(q) [qd^2].",
+            ),
+            Term::Centrifugal => ("Craig's centrifugal matrix C(q)", "C_ij multiplies qd_j^2."),
+            Term::Gravity => ("Gravity G(q) = dV/dq", ""),
+            Term::Bias => (
+                "Bias b(q, qd) = B(q) [qd qd] + C(q) [qd^2]",
+                "Coriolis and centrifugal terms, without gravity.",
+            ),
+            Term::CoriolisMatrix => (
+                "Coriolis matrix C(q, qd), Christoffel form",
+                "Cqd_ij = sum_k Gamma_ijk qd_k: b = C(q, qd) qd, and dM/dt - 2 C(q, qd) is \
+                 skew-symmetric.",
+            ),
+            Term::Tau => ("Inverse dynamics tau = M(q) qdd + b(q, qd) + G(q)", ""),
+            Term::KineticEnergy => ("Kinetic energy T = qd^T M(q) qd / 2", ""),
+            Term::PotentialEnergy => ("Potential energy V = -sum over bodies of m g.c", ""),
+        }
+    }
+}
+
+/// The output language.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Format {
+    /// Plain text: `M11 = 2*m_link2*c2 + ...`.
+    #[default]
+    Text,
+    /// LaTeX `aligned` blocks, with `%` comments for headings.
+    Latex,
+    /// Markdown with LaTeX display math (`$$`), as GitHub renders it.
+    Markdown,
+}
+
+/// How entries are written.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Form {
+    /// One simplified formula per entry.
+    #[default]
+    Expanded,
+    /// Shared temporaries, then the entries.
+    Program,
+}
+
+/// What [`render`] prints.
+#[derive(Clone, Debug)]
+pub struct ShowOptions {
+    /// The terms, printed in this order.
+    pub terms: Vec<Term>,
+    /// One entry only, 1-based: `[i, j]` for matrices (for `B`, `[i, column]` or `[i, j, k]`
+    /// with the pair `j < k`), `[i]` for vectors. Needs exactly one term; not for `T` and `V`.
+    pub entry: Option<Vec<usize>>,
+    pub format: Format,
+    pub form: Form,
+    /// Significant digits of numbers; `None` prints the shortest text that reads back exactly.
+    pub digits: Option<usize>,
+    /// Most terms an expansion may reach before the term falls back to the program form.
+    pub max_terms: usize,
+    /// The URDF's name for the heading (a file name, not a path, keeps output portable).
+    pub source: Option<String>,
+}
+
+impl Default for ShowOptions {
+    /// Every term, plain text, expanded, 6 significant digits, at most 100 terms per entry.
+    fn default() -> Self {
+        ShowOptions {
+            terms: Term::ALL.to_vec(),
+            entry: None,
+            format: Format::Text,
+            form: Form::Expanded,
+            digits: Some(6),
+            max_terms: 100,
+            source: None,
+        }
+    }
+}
+
+/// Why [`render`] could not print.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum ReportError {
+    /// `entry` does not name an entry of the term.
+    #[error("entry {entry} {reason}")]
+    InvalidEntry { entry: String, reason: String },
+}
+
+/// In an expanded numeric entry, terms below this fraction of the entry's largest coefficient
+/// are rounding noise (from rotations like `rpy="0 0 1.5708"`) and are not printed.
+pub const NOISE: f64 = 1e-12;
+
+/// Every entry of a term: 0-based indices (`[i, j, k]` for `B`) and expression.
+fn all_entries(d: &Derivation, term: Term) -> Vec<(Vec<usize>, Id)> {
+    let n = d.dof;
+    let square = |m: &Vec<Vec<Id>>, upper: bool| -> Vec<(Vec<usize>, Id)> {
+        (0..n)
+            .flat_map(|i| {
+                let from = if upper { i } else { 0 };
+                (from..n).map(move |j| (vec![i, j], m[i][j]))
+            })
+            .collect()
+    };
+    let vector = |v: &Vec<Id>| -> Vec<(Vec<usize>, Id)> {
+        v.iter().enumerate().map(|(i, &e)| (vec![i], e)).collect()
+    };
+    match term {
+        Term::MassMatrix => square(&d.mass_matrix, true),
+        Term::Centrifugal => square(&d.centrifugal, false),
+        Term::CoriolisMatrix => square(&d.coriolis_matrix, false),
+        Term::CoriolisPairs => {
+            let pl = pairs(n);
+            (0..n)
+                .flat_map(|i| {
+                    pl.iter()
+                        .enumerate()
+                        .map(move |(p, &(j, k))| (vec![i, j, k], d.coriolis_pairs[i][p]))
+                })
+                .collect()
+        }
+        Term::Gravity => vector(&d.gravity),
+        Term::Bias => vector(&d.bias),
+        Term::Tau => vector(&d.tau),
+        Term::KineticEnergy => vec![(vec![], d.kinetic_energy)],
+        Term::PotentialEnergy => vec![(vec![], d.potential_energy)],
+    }
+}
+
+/// The one entry named by a 1-based `entry`.
+fn one_entry(d: &Derivation, term: Term, entry: &[usize]) -> Result<(Vec<usize>, Id), ReportError> {
+    let n = d.dof;
+    let text = entry
+        .iter()
+        .map(|i| i.to_string())
+        .collect::<Vec<_>>()
+        .join(",");
+    let err = |reason: String| ReportError::InvalidEntry {
+        entry: text.clone(),
+        reason,
+    };
+    let np = n * n.saturating_sub(1) / 2;
+    let in_range = |i: usize, len: usize| (1..=len).contains(&i);
+    let idx: Vec<usize> = entry.iter().map(|i| i.wrapping_sub(1)).collect();
+    match (term, entry) {
+        (Term::KineticEnergy | Term::PotentialEnergy, _) => Err(err(format!(
+            "given, but {} is a scalar: leave out --entry",
+            term.label()
+        ))),
+        (Term::Gravity | Term::Bias | Term::Tau, &[i]) if in_range(i, n) => {
+            let v = match term {
+                Term::Gravity => &d.gravity,
+                Term::Bias => &d.bias,
+                _ => &d.tau,
+            };
+            Ok((idx.clone(), v[idx[0]]))
+        }
+        (Term::Gravity | Term::Bias | Term::Tau, _) => Err(err(format!(
+            "is not an entry of {}: give one index from 1 to {n}",
+            term.label()
+        ))),
+        (Term::MassMatrix | Term::Centrifugal | Term::CoriolisMatrix, &[i, j])
+            if in_range(i, n) && in_range(j, n) =>
+        {
+            let m = match term {
+                Term::MassMatrix => &d.mass_matrix,
+                Term::Centrifugal => &d.centrifugal,
+                _ => &d.coriolis_matrix,
+            };
+            Ok((idx.clone(), m[idx[0]][idx[1]]))
+        }
+        (Term::MassMatrix | Term::Centrifugal | Term::CoriolisMatrix, _) => Err(err(format!(
+            "is not an entry of {}: give I,J with both from 1 to {n}",
+            term.label()
+        ))),
+        (Term::CoriolisPairs, &[i, p]) if in_range(i, n) && in_range(p, np) => {
+            let (j, k) = pairs(n)[p - 1];
+            Ok((vec![i - 1, j, k], d.coriolis_pairs[i - 1][p - 1]))
+        }
+        (Term::CoriolisPairs, &[i, j, k])
+            if in_range(i, n) && in_range(j, n) && in_range(k, n) && j != k =>
+        {
+            let (j, k) = (j.min(k) - 1, j.max(k) - 1);
+            let p = pairs(n).iter().position(|&x| x == (j, k)).expect("a pair");
+            Ok((vec![i - 1, j, k], d.coriolis_pairs[i - 1][p]))
+        }
+        (Term::CoriolisPairs, _) => Err(err(format!(
+            "is not an entry of B: give I,P (row 1 to {n}, column 1 to {np}) or I,J,K (the \
+             pair J < K)"
+        ))),
+    }
+}
+
+/// The printed name of an entry: `M12`, `B1_23`, `G1`, `tau2`, `T` (text) or `M_{12}` (LaTeX);
+/// with more than 9 joints, matrix indices are separated (`M1,12`).
+fn entry_name(term: Term, idx: &[usize], dof: usize, syntax: Syntax) -> String {
+    let latex = syntax == Syntax::Latex;
+    let compact = dof <= 9;
+    let one = |i: usize| (i + 1).to_string();
+    let pair = |a: usize, b: usize| {
+        if compact {
+            format!("{}{}", a + 1, b + 1)
+        } else {
+            format!("{},{}", a + 1, b + 1)
+        }
+    };
+    let base = match (term, latex) {
+        (Term::MassMatrix, _) => "M",
+        (Term::CoriolisPairs, _) => "B",
+        (Term::Centrifugal, _) => "C",
+        (Term::CoriolisMatrix, false) => "Cqd",
+        (Term::CoriolisMatrix, true) => "C^{\\dot{q}}",
+        (Term::Gravity, _) => "G",
+        (Term::Bias, _) => "b",
+        (Term::Tau, false) => "tau",
+        (Term::Tau, true) => "\\tau",
+        (Term::KineticEnergy, _) => "T",
+        (Term::PotentialEnergy, _) => "V",
+    };
+    let sub = match idx {
+        [] => return base.to_string(),
+        [i] => one(*i),
+        [i, j] => pair(*i, *j),
+        [i, j, k] => {
+            if compact && !latex {
+                format!("{}_{}{}", i + 1, j + 1, k + 1)
+            } else if compact {
+                format!("{},{}{}", i + 1, j + 1, k + 1)
+            } else {
+                format!("{},({},{})", i + 1, j + 1, k + 1)
+            }
+        }
+        _ => unreachable!("entries have at most three indices"),
+    };
+    if latex {
+        format!("{base}_{{{sub}}}")
+    } else {
+        format!("{base}{sub}")
+    }
+}
+
+/// True when `e` contains a parameter symbol.
+fn has_param(g: &Graph, e: Id) -> bool {
+    g.reachable(&[e]).iter().any(|&id| match g.node(id) {
+        Node::Sym(s) => g.symbols()[*s as usize].kind == SymbolKind::Param,
+        _ => false,
+    })
+}
+
+/// Drops the numeric terms of an expanded sum that are below [`NOISE`] times its largest
+/// numeric coefficient. Returns the new expression and how many terms went.
+fn drop_noise(g: &mut Graph, e: Id) -> (Id, usize) {
+    let (c, ts) = match g.node(e) {
+        Node::Add(c, ts) => (c.get(), ts.to_vec()),
+        _ => return (e, 0),
+    };
+    let numeric: Vec<bool> = ts.iter().map(|(t, _)| !has_param(g, *t)).collect();
+    let scale = ts
+        .iter()
+        .zip(&numeric)
+        .filter(|(_, &n)| n)
+        .map(|((_, k), _)| k.get().abs())
+        .fold(c.abs(), f64::max);
+    let tol = NOISE * scale;
+    let mut dropped = 0;
+    let mut kept = Vec::with_capacity(ts.len());
+    for ((t, k), &n) in ts.iter().zip(&numeric) {
+        if n && k.get().abs() < tol {
+            dropped += 1;
+        } else {
+            kept.push((*t, k.get()));
+        }
+    }
+    let c = if c != 0.0 && c.abs() < tol {
+        dropped += 1;
+        0.0
+    } else {
+        c
+    };
+    if dropped == 0 {
+        return (e, 0);
+    }
+    (g.sum(c, kept), dropped)
+}
+
+/// One printed term.
+struct Section {
+    term: Term,
+    /// Expanded entries (name, expression), or the program form.
+    body: Body,
+    notes: Vec<String>,
+}
+
+enum Body {
+    Expanded(Vec<(String, Id)>),
+    Program(Vec<String>, Vec<Id>),
+}
+
+impl Section {
+    fn roots(&self) -> Vec<Id> {
+        match &self.body {
+            Body::Expanded(v) => v.iter().map(|x| x.1).collect(),
+            Body::Program(_, ids) => ids.clone(),
+        }
+    }
+}
+
+/// Builds one section: selects entries, expands them or schedules a program.
+fn section(
+    g: &mut Graph,
+    d: &Derivation,
+    term: Term,
+    opts: &ShowOptions,
+    syntax: Syntax,
+    dropped: &mut usize,
+) -> Result<Section, ReportError> {
+    let single = opts.entry.is_some();
+    let entries = match &opts.entry {
+        Some(e) => vec![one_entry(d, term, e)?],
+        None => all_entries(d, term),
+    };
+    let mut notes = Vec::new();
+    let (_, definition) = term.title();
+    // A single entry of M needs no word on its symmetry.
+    let skip = definition.is_empty() || (single && term == Term::MassMatrix);
+    if !skip {
+        notes.push(definition.to_string());
+    }
+    let name = |idx: &[usize]| entry_name(term, idx, d.dof, syntax);
+    let structural: Vec<(Vec<usize>, Id)> = entries
+        .into_iter()
+        .filter(|(_, e)| single || g.as_const(*e) != Some(0.0))
+        .collect();
+    let mut omitted_zero = !single && structural.len() < all_entries(d, term).len();
+    let mut body = None;
+    if opts.form == Form::Expanded {
+        let mut out = Vec::with_capacity(structural.len());
+        let mut noise = 0;
+        let mut too_large = None;
+        for (idx, e) in &structural {
+            let Ok(x) = g.expand_trig(*e, opts.max_terms) else {
+                too_large = Some(entry_name(term, idx, d.dof, Syntax::Text));
+                break;
+            };
+            let (x, k) = drop_noise(g, x);
+            noise += k;
+            if single || g.as_const(x) != Some(0.0) {
+                out.push((name(idx), x));
+            } else {
+                omitted_zero = true;
+            }
+        }
+        match too_large {
+            None => {
+                *dropped += noise;
+                body = Some(Body::Expanded(out));
+            }
+            Some(culprit) => notes.push(format!(
+                "Program form: the expansion of {culprit} exceeds {} terms.",
+                opts.max_terms
+            )),
+        }
+    }
+    let body = match body {
+        Some(b) => b,
+        None => {
+            let names = structural.iter().map(|(idx, _)| name(idx)).collect();
+            let ids = structural.iter().map(|x| x.1).collect();
+            Body::Program(names, ids)
+        }
+    };
+    let empty = match &body {
+        Body::Expanded(v) => v.is_empty(),
+        Body::Program(_, ids) => ids.is_empty(),
+    };
+    if empty {
+        notes.push("Every entry is 0.".to_string());
+    } else if omitted_zero {
+        notes.push("Entries not listed are 0.".to_string());
+    }
+    Ok(Section { term, body, notes })
+}
+
+/// What a parameter symbol stands for, from its name (see [`crate::kinematics::Params`]).
+fn describe_param(name: &str) -> String {
+    let Some((head, owner)) = name.split_once('_') else {
+        return "a parameter".to_string();
+    };
+    match head {
+        "m" => format!("mass of body {owner}"),
+        "cx" | "cy" | "cz" => format!(
+            "centre of mass of body {owner}, {} coordinate in its frame",
+            &head[1..]
+        ),
+        h if h.starts_with('I') && h.len() == 3 => {
+            format!("inertia {h} of body {owner} about its centre of mass, in its frame")
+        }
+        "x" | "y" | "z" => {
+            format!("origin of joint {owner} in its parent's frame, {head} coordinate")
+        }
+        _ => "a parameter".to_string(),
+    }
+}
+
+fn kind_name(k: JointKind) -> &'static str {
+    match k {
+        JointKind::Revolute => "revolute",
+        JointKind::Continuous => "continuous",
+        JointKind::Prismatic => "prismatic",
+    }
+}
+
+/// A vector as `(1, 0, 0)`.
+fn vec3(v: &nalgebra::Vector3<f64>, digits: Option<usize>) -> String {
+    format!(
+        "({}, {}, {})",
+        format_number(v[0], digits),
+        format_number(v[1], digits),
+        format_number(v[2], digits)
+    )
+}
+
+/// Prints the chosen terms of a derived robot.
+///
+/// The heading lists the joints (`q1` is the first joint of the model's order); then each
+/// term, under a heading with its definition; then a legend of the short names and symbolic
+/// parameters used. Entries that are structurally 0 are not listed (a note says so), unless
+/// [`ShowOptions::entry`] asks for one.
+///
+/// Fails only when [`ShowOptions::entry`] names no entry of the term (or is given with other
+/// than exactly one term).
+pub fn render(model: &Model, d: &Derivation, opts: &ShowOptions) -> Result<String, ReportError> {
+    if opts.entry.is_some() && opts.terms.len() != 1 {
+        return Err(ReportError::InvalidEntry {
+            entry: opts
+                .entry
+                .iter()
+                .flatten()
+                .map(|i| i.to_string())
+                .collect::<Vec<_>>()
+                .join(","),
+            reason: "needs exactly one term".to_string(),
+        });
+    }
+    let syntax = match opts.format {
+        Format::Text => Syntax::Text,
+        Format::Latex | Format::Markdown => Syntax::Latex,
+    };
+    let style = Style {
+        syntax,
+        digits: opts.digits,
+    };
+    let mut g = d.graph.clone();
+    let mut dropped = 0;
+    let mut sections = Vec::with_capacity(opts.terms.len());
+    for &term in &opts.terms {
+        sections.push(section(&mut g, d, term, opts, syntax, &mut dropped)?);
+    }
+    let expanded_roots: Vec<Id> = sections
+        .iter()
+        .filter(|s| matches!(s.body, Body::Expanded(_)))
+        .flat_map(|s| s.roots())
+        .collect();
+    let short = trig::short_names(&g, &expanded_roots, style, d.dof <= 9);
+    let all_roots: Vec<Id> = sections.iter().flat_map(|s| s.roots()).collect();
+    let used: BTreeSet<Id> = g.reachable(&all_roots).into_iter().collect();
+    let params: Vec<(String, String, f64)> = d
+        .params
+        .iter()
+        .filter(|p| used.contains(&p.1))
+        .map(|(name, id, v)| (g.print(*id, style), describe_param(name), *v))
+        .collect();
+    let uses_rates = used.iter().any(|&id| match g.node(id) {
+        Node::Sym(s) => matches!(
+            g.symbols()[*s as usize].kind,
+            SymbolKind::Qd(_) | SymbolKind::Qdd(_)
+        ),
+        _ => false,
+    });
+
+    // The formulas of each section, as `(name, formula)` lines in the document's syntax.
+    let bodies: Vec<Vec<(String, String)>> = sections
+        .iter()
+        .map(|s| match &s.body {
+            Body::Expanded(v) => v
+                .iter()
+                .map(|(name, e)| (name.clone(), trig::shorten(&g.print(*e, style), &short)))
+                .collect(),
+            Body::Program(names, ids) => {
+                let text = Program::new(&g, ids).print(names, style);
+                let sep = if syntax == Syntax::Latex {
+                    " &= "
+                } else {
+                    " = "
+                };
+                text.lines()
+                    .map(|l| {
+                        let l = l.trim_end_matches(" \\\\");
+                        match l.split_once(sep) {
+                            Some((a, b)) => (a.to_string(), b.to_string()),
+                            None => (String::new(), l.to_string()),
+                        }
+                    })
+                    .collect()
+            }
+        })
+        .collect();
+
+    let source = opts.source.as_deref().unwrap_or("URDF");
+    let numbers = match opts.digits {
+        Some(k) => format!("{k} significant digits"),
+        None => "shortest exact decimals".to_string(),
+    };
+    let mut intro = vec![format!(
+        "{} ({source}): {} degrees of freedom, gravity {} m/s^2.",
+        model.name,
+        d.dof,
+        vec3(&model.gravity, opts.digits)
+    )];
+    intro.push(if params.is_empty() {
+        format!("Numbers are the URDF's values, printed with {numbers}.")
+    } else {
+        format!(
+            "Symbolic parameters are listed in the legend; other numbers are the URDF's \
+             values, printed with {numbers}."
+        )
+    });
+    if dropped > 0 {
+        intro.push(format!(
+            "Expanded entries omit {dropped} numeric term(s) below {NOISE:e} times the largest \
+             of their entry (rounding noise; --form program shows every term)."
+        ));
+    }
+    let joints: Vec<(String, String)> = model
+        .joints
+        .iter()
+        .enumerate()
+        .map(|(i, j)| {
+            let q = g.print(d.q[i], style);
+            let what = format!(
+                "{}, {} about {}",
+                j.name,
+                kind_name(j.kind),
+                vec3(&j.axis, opts.digits)
+            );
+            (q, what)
+        })
+        .collect();
+    let legend: Vec<(String, String)> = short
+        .iter()
+        .map(|s| (s.short().to_string(), s.meaning.clone()))
+        .collect();
+    let mut legend_text: Vec<(String, String)> = Vec::new();
+    if uses_rates {
+        legend_text.push((
+            "qd_i, qdd_i".into(),
+            "velocity and acceleration of q_i".into(),
+        ));
+    }
+    for (sym, what, v) in &params {
+        legend_text.push((
+            sym.clone(),
+            format!("{what} (URDF value {})", format_number(*v, None)),
+        ));
+    }
+
+    let mut out = String::new();
+    match opts.format {
+        Format::Text => {
+            for l in &intro {
+                let _ = writeln!(out, "{l}");
+            }
+            let _ = writeln!(out, "Joints:");
+            for (q, what) in &joints {
+                let _ = writeln!(out, "  {q}: {what}");
+            }
+            for (s, body) in sections.iter().zip(&bodies) {
+                let _ = writeln!(out, "\n{}:", s.term.title().0);
+                for n in &s.notes {
+                    let _ = writeln!(out, "  ({n})");
+                }
+                for (name, f) in body {
+                    let _ = writeln!(out, "  {name} = {f}");
+                }
+            }
+            if !legend.is_empty() || !legend_text.is_empty() {
+                let _ = writeln!(out, "\nLegend:");
+                for (a, b) in &legend {
+                    let _ = writeln!(out, "  {a} = {b}");
+                }
+                for (a, b) in &legend_text {
+                    let _ = writeln!(out, "  {a}: {b}");
+                }
+            }
+        }
+        Format::Latex => {
+            for l in &intro {
+                let _ = writeln!(out, "% {l}");
+            }
+            let _ = writeln!(out, "% Joints:");
+            for (q, what) in &joints {
+                let _ = writeln!(out, "%   {q}: {what}");
+            }
+            for (s, body) in sections.iter().zip(&bodies) {
+                let _ = writeln!(out, "\n% {}", s.term.title().0);
+                for n in &s.notes {
+                    let _ = writeln!(out, "% {n}");
+                }
+                aligned(&mut out, body);
+            }
+            if !legend.is_empty() || !legend_text.is_empty() {
+                let _ = writeln!(out, "\n% Legend");
+                for (a, b) in &legend_text {
+                    let _ = writeln!(out, "% {a}: {b}");
+                }
+                if !legend.is_empty() {
+                    aligned(&mut out, &legend);
+                }
+            }
+        }
+        Format::Markdown => {
+            let _ = writeln!(out, "# {}: equations of motion\n", md_escape(&model.name));
+            for l in &intro {
+                let _ = writeln!(out, "{}", md_escape(l));
+            }
+            let _ = writeln!(out, "\n| coordinate | joint |\n| --- | --- |");
+            for (q, what) in &joints {
+                let _ = writeln!(out, "| ${q}$ | {} |", md_escape(what));
+            }
+            for (s, body) in sections.iter().zip(&bodies) {
+                let _ = writeln!(out, "\n## {}\n", s.term.title().0);
+                for n in &s.notes {
+                    let _ = writeln!(out, "{}\n", md_escape(n));
+                }
+                if !body.is_empty() {
+                    let _ = writeln!(out, "$$");
+                    aligned(&mut out, body);
+                    let _ = writeln!(out, "$$");
+                }
+            }
+            if !legend.is_empty() || !legend_text.is_empty() {
+                let _ = writeln!(out, "\n## Legend\n\n| symbol | meaning |\n| --- | --- |");
+                for (a, b) in &legend {
+                    let _ = writeln!(out, "| ${a}$ | ${b}$ |");
+                }
+                for (a, b) in &legend_text {
+                    let a = if a.starts_with("qd_i") {
+                        "$\\dot{q}_i$, $\\ddot{q}_i$".to_string()
+                    } else {
+                        format!("${a}$")
+                    };
+                    let _ = writeln!(out, "| {a} | {} |", md_escape(b));
+                }
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// An `aligned` block of `name &= formula` lines.
+fn aligned(out: &mut String, lines: &[(String, String)]) {
+    let _ = writeln!(out, "\\begin{{aligned}}");
+    for (k, (a, b)) in lines.iter().enumerate() {
+        let end = if k + 1 < lines.len() { " \\\\" } else { "" };
+        let _ = writeln!(out, "{a} &= {b}{end}");
+    }
+    let _ = writeln!(out, "\\end{{aligned}}");
+}
+
+/// Escapes what Markdown would interpret in prose and table cells: `|`, `*`, backticks,
+/// backslashes, `<`, and `_` unless it sits inside a word (`qd_j` stays readable).
+fn md_escape(s: &str) -> String {
+    let chars: Vec<char> = s.chars().collect();
+    let mut out = String::with_capacity(s.len());
+    for (k, &c) in chars.iter().enumerate() {
+        let inside_word = k > 0
+            && chars[k - 1].is_alphanumeric()
+            && chars.get(k + 1).is_some_and(|n| n.is_alphanumeric());
+        let special = matches!(c, '|' | '*' | '`' | '\\' | '<') || (c == '_' && !inside_word);
+        if special {
+            out.push('\\');
+        }
+        out.push(c);
+    }
+    out
+}
