@@ -1,0 +1,158 @@
+//! `eomgen info`: the kinematic tree, masses, operation counts and timings.
+
+use std::fmt::Write as _;
+use std::time::Duration;
+
+use eomgen::cas::format_number;
+use eomgen::dynamics::Derivation;
+use eomgen::emit::Generated;
+use eomgen::model::{JointKind, Model};
+
+fn kind(k: JointKind) -> &'static str {
+    match k {
+        JointKind::Revolute => "revolute",
+        JointKind::Continuous => "continuous",
+        JointKind::Prismatic => "prismatic",
+    }
+}
+
+fn vec3(v: &nalgebra::Vector3<f64>) -> String {
+    let f = |x: f64| format_number(x, Some(6));
+    format!("({}, {}, {})", f(v[0]), f(v[1]), f(v[2]))
+}
+
+fn ms(d: Duration) -> String {
+    format!("{:.1} ms", d.as_secs_f64() * 1e3)
+}
+
+/// The report. `load` and `emit` are the times of reading the URDF and of emitting code.
+pub fn print(
+    model: &Model,
+    d: &Derivation,
+    generated: &Generated,
+    source: &str,
+    load: Duration,
+    emit: Duration,
+) -> String {
+    let mut out = String::new();
+    let total_mass: f64 = model.bodies.iter().map(|b| b.mass).sum();
+    let _ = writeln!(out, "robot: {} ({source})", model.name);
+    let _ = writeln!(out, "degrees of freedom: {}", model.dof());
+    let _ = writeln!(
+        out,
+        "moving mass: {} kg in {} bodies",
+        format_number(total_mass, Some(6)),
+        model.bodies.len()
+    );
+    let _ = writeln!(out, "gravity: {} m/s^2", vec3(&model.gravity));
+
+    // The tree, depth first with an explicit stack (no recursion on user input).
+    let _ = writeln!(
+        out,
+        "\ntree (coordinate, joint: type about its axis in the joint frame -> body, mass):"
+    );
+    let welded: Vec<&str> = model
+        .frames
+        .iter()
+        .filter(|f| f.body.is_none() && f.name != model.root)
+        .map(|f| f.name.as_str())
+        .collect();
+    let _ = write!(out, "{}", model.root);
+    if !welded.is_empty() {
+        let _ = write!(out, " (welded: {})", welded.join(", "));
+    }
+    out.push('\n');
+    let children = |parent: Option<usize>| -> Vec<usize> {
+        (0..model.dof())
+            .filter(|&j| model.joints[j].parent == parent)
+            .collect()
+    };
+    // (joint, prefix of its line, whether it is the last child)
+    let mut stack: Vec<(usize, String, bool)> = Vec::new();
+    let push = |stack: &mut Vec<(usize, String, bool)>, kids: Vec<usize>, prefix: &str| {
+        for (k, &j) in kids.iter().enumerate().rev() {
+            stack.push((j, prefix.to_string(), k + 1 == kids.len()));
+        }
+    };
+    push(&mut stack, children(None), "");
+    while let Some((j, prefix, last)) = stack.pop() {
+        let joint = &model.joints[j];
+        let body = &model.bodies[j];
+        let _ = write!(
+            out,
+            "{prefix}{} q{} {}: {} about {} -> {}, {} kg",
+            if last { "└──" } else { "├──" },
+            j + 1,
+            joint.name,
+            kind(joint.kind),
+            vec3(&joint.axis),
+            body.name,
+            format_number(body.mass, Some(6))
+        );
+        let merged: Vec<&str> = body
+            .merged_links
+            .iter()
+            .skip(1)
+            .map(|s| s.as_str())
+            .collect();
+        if !merged.is_empty() {
+            let _ = write!(out, " (merged: {})", merged.join(", "));
+        }
+        if let Some(m) = &joint.mimic {
+            let _ = write!(
+                out,
+                " (mimics {} x {} + {}, treated as independent)",
+                m.joint,
+                format_number(m.multiplier, Some(6)),
+                format_number(m.offset, Some(6))
+            );
+        }
+        out.push('\n');
+        let deeper = format!("{prefix}{}", if last { "    " } else { "│   " });
+        push(&mut stack, children(Some(j)), &deeper);
+    }
+
+    let _ = writeln!(out, "\njoint limits (lower, upper, effort, velocity):");
+    for (i, j) in model.joints.iter().enumerate() {
+        let limits = match &j.limits {
+            Some(l) => format!(
+                "{}, {}, {}, {}",
+                format_number(l.lower, Some(6)),
+                format_number(l.upper, Some(6)),
+                format_number(l.effort, Some(6)),
+                format_number(l.velocity, Some(6))
+            ),
+            None => "none".to_string(),
+        };
+        let _ = writeln!(out, "  q{} {}: {limits}", i + 1, j.name);
+    }
+
+    let _ = writeln!(out, "\noperations per call of each generated function:");
+    let width = generated
+        .op_counts
+        .iter()
+        .map(|(n, _)| n.len())
+        .max()
+        .unwrap_or(0);
+    for (name, ops) in &generated.op_counts {
+        let _ = writeln!(out, "  {name:width$}  {:>7} total: {ops}", ops.total());
+    }
+
+    let derive: Duration = d.timings.iter().map(|t| t.1).sum();
+    let stages: Vec<String> = d
+        .timings
+        .iter()
+        .map(|(n, t)| format!("{n} {}", ms(*t)))
+        .collect();
+    let _ = writeln!(out, "\ntimes:");
+    let _ = writeln!(out, "  reading the URDF: {}", ms(load));
+    let _ = writeln!(
+        out,
+        "  derivation: {} ({}); expression graph: {} nodes",
+        ms(derive),
+        stages.join(", "),
+        d.graph.len()
+    );
+    let _ = writeln!(out, "  code generation: {}", ms(emit));
+    out
+}

@@ -1,0 +1,446 @@
+//! The `eomgen` command line (clap): `generate`, `show`, `info`, `eval`.
+//!
+//! Exit codes: 0 on success, 1 on bad input (one line on stderr, starting with
+//! `eomgen: error:`), 2 on bad usage (clap's message). Nothing panics visibly: a panic would be
+//! a bug, and is reported as one line too.
+
+mod eval;
+mod info;
+mod progress;
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Instant;
+
+use clap::builder::PossibleValuesParser;
+use clap::{Args, CommandFactory, Parser, Subcommand, ValueEnum};
+
+use eomgen::dynamics::Derivation;
+use eomgen::model::Model;
+use eomgen::report::{self, Form, Format, ShowOptions, Term};
+use eomgen::{Builder, ModelOptions, SymbolicParams};
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "eomgen",
+    version,
+    about = "Symbolic equations of motion for robots: URDF in, no_std Rust and readable equations out",
+    long_about = "Symbolic equations of motion for robots: URDF in, no_std Rust and readable \
+                  equations out.\n\nJoint coordinates q1, q2, ... follow the model's joint order: \
+                  depth first from the root, the child joints of a link sorted by name \
+                  (Pinocchio's order), unless --joint-order says otherwise. SI units throughout.\n\n\
+                  Exit status: 0 on success, 1 on bad input (a message on stderr), 2 on bad usage."
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Writes the Rust module for a robot (to stdout without -o), as a build script would.
+    Generate(GenerateArgs),
+    /// Prints the equations of motion for people: text, LaTeX or Markdown.
+    Show(ShowArgs),
+    /// Prints the kinematic tree, masses, operation counts and derivation time.
+    Info(InfoArgs),
+    /// Evaluates M, b, G, tau and the forward dynamics at one state, to check a model quickly.
+    Eval(EvalArgs),
+}
+
+/// Options shared by every command that loads a model.
+#[derive(Args, Debug)]
+struct ModelArgs {
+    /// Gravity in world axes, m/s^2.
+    #[arg(
+        long,
+        value_name = "X,Y,Z",
+        default_value = "0,0,-9.81",
+        allow_hyphen_values = true,
+        value_parser = parse_vec3
+    )]
+    gravity: [f64; 3],
+    /// The order of the moving joints, by URDF name, every moving joint once, parents first
+    /// [default: depth first, children by joint name]
+    #[arg(long, value_name = "A,B,...", value_delimiter = ',')]
+    joint_order: Option<Vec<String>>,
+}
+
+impl ModelArgs {
+    fn options(&self, symbolic: &Option<Vec<String>>) -> ModelOptions {
+        ModelOptions {
+            gravity: self.gravity,
+            joint_order: self.joint_order.clone(),
+            symbolic: match symbolic {
+                None => SymbolicParams::None,
+                Some(v) if v.is_empty() => SymbolicParams::All,
+                Some(v) => SymbolicParams::Links(v.clone()),
+            },
+            ..ModelOptions::default()
+        }
+    }
+}
+
+#[derive(Args, Debug)]
+struct GenerateArgs {
+    /// The robot's URDF file.
+    urdf: PathBuf,
+    /// Write the module to this file (only if its content changed) instead of stdout.
+    #[arg(short, long, value_name = "FILE")]
+    output: Option<PathBuf>,
+    /// The generated type, UpperCamelCase [default: the robot name in UpperCamelCase]
+    #[arg(long, value_name = "T")]
+    type_name: Option<String>,
+    /// The module name, snake_case, used in the banner [default: the robot name in snake_case]
+    #[arg(long, value_name = "M")]
+    module_name: Option<String>,
+    /// Keep masses, centres of mass, inertias and joint offsets as fields of the generated
+    /// struct (Default holds the URDF's values): of every link, or of the links listed.
+    #[arg(long, value_name = "LINK,...", num_args = 0..=1, value_delimiter = ',')]
+    symbolic: Option<Vec<String>>,
+    #[command(flatten)]
+    model: ModelArgs,
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+enum FormatArg {
+    Text,
+    Latex,
+    Markdown,
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+enum FormArg {
+    /// Each entry as one simplified formula, with short names (s1, c12) in a legend.
+    Expanded,
+    /// Shared temporaries, then the entries: for large robots.
+    Program,
+}
+
+const TERMS: [&str; 10] = ["M", "B", "C", "G", "b", "coriolis", "tau", "T", "V", "all"];
+
+#[derive(Args, Debug)]
+struct ShowArgs {
+    /// The robot's URDF file.
+    urdf: PathBuf,
+    /// What to print, one or several separated by commas: M (mass matrix), B (Craig's
+    /// Coriolis matrix), C (Craig's centrifugal matrix), G (gravity), b (bias), coriolis
+    /// (Coriolis matrix C(q, qd)), tau (inverse dynamics), T and V (energies), or all.
+    #[arg(
+        long,
+        value_name = "TERM",
+        default_value = "all",
+        value_delimiter = ',',
+        value_parser = PossibleValuesParser::new(TERMS),
+        hide_possible_values = true
+    )]
+    term: Vec<String>,
+    /// One entry of the term, 1-based: I,J for matrices (for B: I,COLUMN or I,J,K with the
+    /// pair J < K), I for vectors.
+    #[arg(long, value_name = "I,J", value_parser = parse_indices)]
+    entry: Option<Indices>,
+    /// Output language.
+    #[arg(long, value_enum, default_value_t = FormatArg::Text)]
+    format: FormatArg,
+    /// Keep masses, centres of mass, inertias and link lengths as named symbols instead of the
+    /// URDF's numbers: of every link, or of the links listed (put the URDF first, or write
+    /// --symbolic=LINK,...).
+    #[arg(long, value_name = "LINK,...", num_args = 0..=1, value_delimiter = ',')]
+    symbolic: Option<Vec<String>>,
+    /// Significant digits of numbers; 0 prints the shortest exact decimals.
+    #[arg(long, value_name = "N", default_value_t = 6)]
+    digits: usize,
+    /// How entries are written.
+    #[arg(long, value_enum, default_value_t = FormArg::Expanded)]
+    form: FormArg,
+    /// In expanded form, a term whose expansion exceeds N terms is shown in program form.
+    #[arg(long, value_name = "N", default_value_t = 100)]
+    max_terms: usize,
+    #[command(flatten)]
+    model: ModelArgs,
+}
+
+#[derive(Args, Debug)]
+struct InfoArgs {
+    /// The robot's URDF file.
+    urdf: PathBuf,
+    #[command(flatten)]
+    model: ModelArgs,
+}
+
+#[derive(Args, Debug)]
+struct EvalArgs {
+    /// The robot's URDF file.
+    urdf: PathBuf,
+    /// Joint positions (rad or m), one per joint, separated by commas.
+    #[arg(long, value_name = "Q1,Q2,...", allow_hyphen_values = true, value_parser = parse_numbers)]
+    q: Numbers,
+    /// Joint velocities [default: 0]
+    #[arg(long, value_name = "QD1,...", allow_hyphen_values = true, value_parser = parse_numbers)]
+    qd: Option<Numbers>,
+    /// Joint accelerations for the inverse dynamics [default: 0]
+    #[arg(long, value_name = "QDD1,...", allow_hyphen_values = true, value_parser = parse_numbers)]
+    qdd: Option<Numbers>,
+    /// Joint torques (N m) or forces (N) for the forward dynamics [default: 0]
+    #[arg(long, value_name = "TAU1,...", allow_hyphen_values = true, value_parser = parse_numbers)]
+    tau: Option<Numbers>,
+    /// Significant digits of numbers; 0 (the default) prints the shortest exact decimals.
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    digits: usize,
+    #[command(flatten)]
+    model: ModelArgs,
+}
+
+/// A list of numbers from the command line.
+#[derive(Clone, Debug)]
+struct Numbers(Vec<f64>);
+
+/// A list of 1-based indices.
+#[derive(Clone, Debug)]
+struct Indices(Vec<usize>);
+
+fn parse_numbers(s: &str) -> Result<Numbers, String> {
+    let items: Vec<&str> = s
+        .split(|c: char| c == ',' || c.is_whitespace())
+        .filter(|t| !t.is_empty())
+        .collect();
+    if items.is_empty() {
+        return Err("expected numbers separated by commas".into());
+    }
+    items
+        .iter()
+        .map(|t| match t.parse::<f64>() {
+            Ok(v) if v.is_finite() => Ok(v),
+            _ => Err(format!("`{t}` is not a finite number")),
+        })
+        .collect::<Result<Vec<f64>, String>>()
+        .map(Numbers)
+}
+
+fn parse_vec3(s: &str) -> Result<[f64; 3], String> {
+    let v = parse_numbers(s)?.0;
+    <[f64; 3]>::try_from(v.as_slice()).map_err(|_| format!("expected 3 numbers, got {}", v.len()))
+}
+
+fn parse_indices(s: &str) -> Result<Indices, String> {
+    let items: Result<Vec<usize>, String> = s
+        .split(',')
+        .map(|t| match t.trim().parse::<usize>() {
+            Ok(i) if i >= 1 => Ok(i),
+            _ => Err(format!("`{t}` is not an index (1, 2, ...)")),
+        })
+        .collect();
+    let items = items?;
+    if items.len() > 3 {
+        return Err("expected at most 3 indices".into());
+    }
+    Ok(Indices(items))
+}
+
+/// A failure to report on stderr with exit status 1.
+struct Failure(String);
+
+impl<E: std::fmt::Display> From<E> for Failure {
+    fn from(e: E) -> Failure {
+        Failure(e.to_string())
+    }
+}
+
+/// Entry point of the binary.
+pub fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(c) => c,
+        Err(e) => {
+            let _ = e.print();
+            return ExitCode::from(e.exit_code().clamp(0, 255) as u8);
+        }
+    };
+    // A panic is a bug: report it in one line, without a backtrace.
+    std::panic::set_hook(Box::new(|_| {}));
+    let result = std::panic::catch_unwind(|| run(cli)).unwrap_or_else(|payload| {
+        let what = payload
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| payload.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "unknown panic".into());
+        Err(Failure(format!("internal error: {what} (please report)")))
+    });
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(Failure(message)) => {
+            // Exactly one line, whatever the underlying message looks like.
+            let line = message.split_whitespace().collect::<Vec<_>>().join(" ");
+            let _ = writeln!(std::io::stderr(), "eomgen: error: {line}");
+            ExitCode::from(1)
+        }
+    }
+}
+
+/// Writes to stdout; a closed pipe (`eomgen show ... | head`) is not an error.
+fn emit(text: &str) -> Result<(), Failure> {
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|_| out.flush()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+            Err(Failure(format!("cannot write to stdout: {e}")))
+        }
+        _ => Ok(()),
+    }
+}
+
+/// The file name of a path, for headings (never a full path of this machine).
+fn file_name(p: &Path) -> String {
+    p.file_name()
+        .map(|f| f.to_string_lossy().into_owned())
+        .unwrap_or_else(|| p.display().to_string())
+}
+
+fn load(urdf: &Path, options: &ModelOptions) -> Result<Model, Failure> {
+    Ok(eomgen::urdf::load_file(urdf, options)?)
+}
+
+fn derive(model: &Model) -> Derivation {
+    let label = format!(
+        "deriving the equations of {} ({} joints)",
+        model.name,
+        model.dof()
+    );
+    progress::run(&label, || Derivation::new(model))
+}
+
+fn run(cli: Cli) -> Result<(), Failure> {
+    match cli.command {
+        Command::Generate(a) => generate(a),
+        Command::Show(a) => show(a),
+        Command::Info(a) => info_cmd(a),
+        Command::Eval(a) => eval_cmd(a),
+    }
+}
+
+fn generate(a: GenerateArgs) -> Result<(), Failure> {
+    let mut b = Builder::new(&a.urdf).model_options(a.model.options(&a.symbolic));
+    if let Some(t) = &a.type_name {
+        b = b.type_name(t);
+    }
+    if let Some(m) = &a.module_name {
+        b = b.module_name(m);
+    }
+    // Fail fast on bad input, before a long derivation.
+    let model = b.model()?;
+    let label = format!(
+        "deriving and emitting {} ({} joints)",
+        model.name,
+        model.dof()
+    );
+    let (generated, _, _) = progress::run(&label, || b.generate_with_report())?;
+    match &a.output {
+        Some(path) => {
+            eomgen::write_if_changed(path, generated.source.as_bytes())?;
+            Ok(())
+        }
+        None => emit(&generated.source),
+    }
+}
+
+fn show(a: ShowArgs) -> Result<(), Failure> {
+    let mut terms = Vec::new();
+    for t in &a.term {
+        match Term::parse(t) {
+            Some(t) => terms.push(t),
+            None => terms.extend(Term::ALL),
+        }
+    }
+    // Each term once, in the order asked.
+    let mut seen = Vec::new();
+    terms.retain(|t| {
+        let new = !seen.contains(t);
+        seen.push(*t);
+        new
+    });
+    if a.entry.is_some() && terms.len() != 1 {
+        Cli::command()
+            .error(
+                clap::error::ErrorKind::ArgumentConflict,
+                "--entry needs exactly one --term (M, B, C, G, b, coriolis or tau)",
+            )
+            .exit();
+    }
+    let model = load(&a.urdf, &a.model.options(&a.symbolic))?;
+    let d = derive(&model);
+    let opts = ShowOptions {
+        terms,
+        entry: a.entry.map(|e| e.0),
+        format: match a.format {
+            FormatArg::Text => Format::Text,
+            FormatArg::Latex => Format::Latex,
+            FormatArg::Markdown => Format::Markdown,
+        },
+        form: match a.form {
+            FormArg::Expanded => Form::Expanded,
+            FormArg::Program => Form::Program,
+        },
+        digits: (a.digits > 0).then_some(a.digits),
+        max_terms: a.max_terms,
+        source: Some(file_name(&a.urdf)),
+    };
+    let text = progress::run("printing the equations", || {
+        report::render(&model, &d, &opts)
+    })?;
+    emit(&text)
+}
+
+fn info_cmd(a: InfoArgs) -> Result<(), Failure> {
+    let b = Builder::new(&a.urdf).model_options(a.model.options(&None));
+    let start = Instant::now();
+    let model = b.model()?;
+    let load = start.elapsed();
+    let label = format!(
+        "deriving and emitting {} ({} joints)",
+        model.name,
+        model.dof()
+    );
+    let start = Instant::now();
+    let (generated, model, d) = progress::run(&label, || b.generate_with_report())?;
+    let derive: std::time::Duration = d.timings.iter().map(|t| t.1).sum();
+    let emit_time = start.elapsed().saturating_sub(derive + load);
+    emit(&info::print(
+        &model,
+        &d,
+        &generated,
+        &file_name(&a.urdf),
+        load,
+        emit_time,
+    ))
+}
+
+fn eval_cmd(a: EvalArgs) -> Result<(), Failure> {
+    let model = load(&a.urdf, &a.model.options(&None))?;
+    let n = model.dof();
+    let joints = model
+        .joints
+        .iter()
+        .map(|j| j.name.as_str())
+        .collect::<Vec<_>>()
+        .join(", ");
+    let check = |flag: &str, v: Option<Numbers>| -> Result<Vec<f64>, Failure> {
+        match v {
+            None => Ok(vec![0.0; n]),
+            Some(Numbers(v)) if v.len() == n => Ok(v),
+            Some(Numbers(v)) => Err(Failure(format!(
+                "{flag} has {} value(s), but {} has {n} joint(s): {joints}",
+                v.len(),
+                model.name
+            ))),
+        }
+    };
+    let state = eval::State {
+        q: check("--q", Some(a.q))?,
+        qd: check("--qd", a.qd)?,
+        qdd: check("--qdd", a.qdd)?,
+        tau: check("--tau", a.tau)?,
+    };
+    let d = derive(&model);
+    let values = eval::evaluate(&model, &d, &state).map_err(Failure)?;
+    let digits = (a.digits > 0).then_some(a.digits);
+    emit(&eval::print(&model, &state, &values, digits))
+}
