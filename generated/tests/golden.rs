@@ -50,3 +50,69 @@ fn checked_in_code_is_what_eomgen_generates() {
     }
     assert!(stale.is_empty(), "generated code is stale; refresh with `{REFRESH}`\n\n{}", stale.join("\n"));
 }
+
+/// The readable equations in `equations/` (M, B, C and G): expanded formulas for the double
+/// pendulum (text and Markdown), shared temporaries then entries for the larger robots. Each
+/// file is what the `eomgen show` command in its first line prints.
+#[test]
+fn checked_in_equations_are_what_eomgen_prints() {
+    use eomgen::report::{render, Form, Format, ShowOptions, Term};
+    let bless = std::env::var_os("EOMGEN_BLESS").is_some();
+    let mut stale = Vec::new();
+    for (module, _, urdf) in ROBOTS {
+        let model = eomgen::urdf::load_file(root().join("robots").join(urdf), &Default::default())
+            .unwrap_or_else(|e| panic!("{urdf}: {e}"));
+        let derivation = eomgen::dynamics::Derivation::new(&model);
+        let (form, flag, formats) = if module == "double_pendulum" {
+            (Form::Expanded, "", &[Format::Text, Format::Markdown][..])
+        } else {
+            (Form::Program, " --form program", &[Format::Text][..])
+        };
+        for &format in formats {
+            let opts = ShowOptions {
+                terms: vec![
+                    Term::MassMatrix,
+                    Term::CoriolisPairs,
+                    Term::Centrifugal,
+                    Term::Gravity,
+                ],
+                format,
+                form,
+                source: Some(urdf.to_string()),
+                ..Default::default()
+            };
+            let text = render(&model, &derivation, &opts).unwrap_or_else(|e| panic!("{urdf}: {e}"));
+            let (ext, format_flag) = match format {
+                Format::Markdown => ("md", " --format markdown"),
+                _ => ("txt", ""),
+            };
+            let banner = format!(
+                "Printed by `eomgen show robots/{urdf} --term M,B,C,G{flag}{format_flag}`. Do not \
+                 edit: refresh with `{REFRESH}`."
+            );
+            let generated = match format {
+                Format::Markdown => format!("<!-- {banner} -->\n\n{text}"),
+                _ => format!("{banner}\n\n{text}"),
+            };
+            let path = root().join("equations").join(format!("{module}.{ext}"));
+            let current = std::fs::read_to_string(&path).unwrap_or_default();
+            if current != generated {
+                if bless {
+                    std::fs::create_dir_all(root().join("equations")).unwrap();
+                    eomgen::write_if_changed(&path, generated.as_bytes()).unwrap();
+                } else {
+                    stale.push(format!(
+                        "{}:\n{}",
+                        path.display(),
+                        diff(&current, &generated)
+                    ));
+                }
+            }
+        }
+    }
+    assert!(
+        stale.is_empty(),
+        "equations are stale; refresh with `{REFRESH}`\n\n{}",
+        stale.join("\n")
+    );
+}
