@@ -6,7 +6,8 @@
 //!
 //! The pipeline, one module per stage:
 //! [`urdf`] (the only module that sees XML) → [`model`] (kinematic tree, merged fixed links) →
-//! [`kinematics`] and [`dynamics`] (closed-form expressions in the [`cas`]) → [`emit`] (Rust).
+//! [`kinematics`] and [`dynamics`] (closed-form expressions in the [`cas`]) → [`emit`] (Rust),
+//! or [`report`] (equations for people: text, LaTeX, Markdown; the `eomgen show` command).
 
 // Matrix code reads best with explicit indices.
 #![allow(clippy::needless_range_loop)]

@@ -176,7 +176,9 @@ pub struct ShowOptions {
     /// One entry only, 1-based: `[i, j]` for matrices (for `B`, `[i, column]` or `[i, j, k]`
     /// with the pair `j < k`), `[i]` for vectors. Needs exactly one term; not for `T` and `V`.
     pub entry: Option<Vec<usize>>,
+    /// Plain text, LaTeX or Markdown.
     pub format: Format,
+    /// Expanded formulas or a straight-line program.
     pub form: Form,
     /// Significant digits of numbers; `None` prints the shortest text that reads back exactly.
     pub digits: Option<usize>,
