@@ -1,9 +1,11 @@
 //! Forward kinematics in the CAS: poses of bodies and link frames, joint axes, Jacobians.
 //!
 //! Each joint angle enters through exactly one `sin`/`cos` pair. Constant rotations (URDF
-//! origins) fold into the products, and their entries within `1e-14` of 0 or ±1 are snapped,
-//! so that the zeros of a robot's geometry (`rpy = "0 0 1.5708"` and the like) vanish from the
-//! expressions instead of carrying `6e-17` terms through every product.
+//! origins and axes) fold into the products, and their entries within `1e-9` of 0 or ±1 are
+//! snapped, so that the zeros of a robot's geometry vanish from the expressions instead of
+//! carrying tiny terms through every product: `rpy = "1.570796325 0 0"` (pi/2 to nine
+//! decimals, as exporters write it) has a cosine of `4.9e-12`, which is meant as 0. The change
+//! to any result is of the order of 1e-9 relative, below the precision URDF numbers carry.
 
 use nalgebra::{Matrix3, Vector3};
 
@@ -17,7 +19,7 @@ pub type M3 = [[Id; 3]; 3];
 
 /// Snaps rotation-matrix entries that are 0 or ±1 up to rounding.
 pub fn snap(v: f64) -> f64 {
-    const EPS: f64 = 1e-14;
+    const EPS: f64 = 1e-9;
     for target in [0.0, 1.0, -1.0] {
         if (v - target).abs() < EPS {
             return target;

@@ -56,24 +56,21 @@ impl<T: ::eomgen_runtime::Real> DoublePendulum<T> {
     /// Craig's centrifugal matrix C(q): `b = B(q) [qd qd] + C(q) [qd^2]`.
     ///
     /// Route: closed-form Lagrangian expressions.
-    /// Operations: 8 mul, 4 add, 0 div, 1 sin, 1 cos.
+    /// Operations: 7 mul, 4 add, 0 div, 1 sin, 1 cos.
     pub fn centrifugal(&self, q: &[T; 2]) -> [[T; 2]; 2] {
         let (s1, c1) = q[1].sin_cos();
         let t0 = s1;
         let t1 = c1;
+        let t2 = -T::from_f64(0.033238000000000004)
+            * (t0 * (-T::from_f64(0.1) * t1 - T::from_f64(0.10088))
+                + t1 * (T::from_f64(0.1) * t0 + T::from_f64(0.00000000019371)));
         [
             [
                 T::zero(),
                 T::from_f64(0.000000000006438532980000001) * t1
                     - T::from_f64(0.00335304944) * t0,
             ],
-            [
-                -T::from_f64(0.033238000000000004) * t0
-                    * (-T::from_f64(0.1) * t1 - T::from_f64(0.10088))
-                    - T::from_f64(0.033238000000000004) * t1
-                        * (T::from_f64(0.1) * t0 + T::from_f64(0.00000000019371)),
-                T::zero(),
-            ],
+            [t2, T::zero()],
         ]
     }
     /// Craig's Coriolis matrix B(q), N x N(N-1)/2 = 2 x 1, columns for qd_j qd_k with j < k in the order (0,1), (0,2), ..., (1,2), ...
@@ -112,9 +109,7 @@ impl<T: ::eomgen_runtime::Real> DoublePendulum<T> {
             let t7 = t0 * t3;
             let t8 = t2 * (-T::from_f64(0.1) * t3 - T::from_f64(0.10088));
             let t9 = t3 * (T::from_f64(0.1) * t2 + T::from_f64(0.00000000019371));
-            let t10 = qd[0] * qd[0]
-                * (-T::from_f64(0.033238000000000004) * t8
-                    - T::from_f64(0.033238000000000004) * t9);
+            let t10 = qd[0] * qd[0] * (-T::from_f64(0.033238000000000004) * (t8 + t9));
             let t11 = T::from_f64(0.0000000014126230823060105) * t2
                 + T::from_f64(0.7356637062775817) * t3 + T::one();
             let t12 = T::from_f64(0.000000000012877065959999999) * t2
@@ -124,29 +119,21 @@ impl<T: ::eomgen_runtime::Real> DoublePendulum<T> {
                     + T::from_f64(0.0033530494400000003) * t3
                     + T::from_f64(0.004557856275072)) * t11;
             let t13 = T::from_f64(0.42040052957160007) * t0
-                + T::from_f64(0.0000000006316200853380001) * t5
-                + T::from_f64(0.328934150064) * t6 + T::from_f64(0.328934150064) * t7
-                + tau[0] - T::from_f64(0.0000056915273546100005) * t1
-                - T::from_f64(0.0000000006316200853380001) * t4
+                + T::from_f64(0.0000000006316200853380001) * (t5 - t4)
+                + T::from_f64(0.328934150064) * (t6 + t7) + tau[0]
+                - T::from_f64(0.0000056915273546100005) * t1
                 - qd[1] * qd[1]
                     * (T::from_f64(0.000000000006438532980000001) * t3
                         - T::from_f64(0.00335304944) * t2)
-                - qd[0] * qd[1]
-                    * (T::from_f64(0.06647600000000001) * t8
-                        + T::from_f64(0.06647600000000001) * t9)
-                - (T::from_f64(0.0000000006316200853380001) * t5
-                    + T::from_f64(0.328934150064) * t6 + T::from_f64(0.328934150064) * t7
-                    + tau[1] - T::from_f64(0.0000000006316200853380001) * t4 - t10)
-                    * t11;
+                - qd[0] * qd[1] * (T::from_f64(0.06647600000000001) * (t8 + t9))
+                - (T::from_f64(0.0000000006316200853380001) * (t5 - t4)
+                    + T::from_f64(0.328934150064) * (t6 + t7) + tau[1] - t10) * t11;
             let t14 = T::one() / t12;
             [
                 t13 * t14,
-                T::from_f64(0.00000013857832437421965) * t5
-                    + T::from_f64(72.16860958583077) * t6
-                    + T::from_f64(72.16860958583077) * t7
-                    + T::from_f64(219.4013895236754) * tau[1]
-                    - T::from_f64(0.00000013857832437421965) * t4
-                    - T::from_f64(219.4013895236754) * t10 - t11 * t13 * t14,
+                T::from_f64(0.00000013857832437421965) * (t5 - t4)
+                    + T::from_f64(72.16860958583077) * (t6 + t7)
+                    + T::from_f64(219.4013895236754) * (tau[1] - t10) - t11 * t13 * t14,
                 t12,
                 T::from_f64(0.004557856275072),
             ]
@@ -334,7 +321,7 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 2> for DoublePendu
         ]
     }
     /// Route: closed-form Lagrangian expressions.
-    /// Operations: 14 mul, 8 add, 0 div, 2 sin, 2 cos.
+    /// Operations: 10 mul, 8 add, 0 div, 2 sin, 2 cos.
     fn gravity(&self, q: &[T; 2]) -> [T; 2] {
         let (s0, c0) = q[0].sin_cos();
         let (s1, c1) = q[1].sin_cos();
@@ -348,63 +335,47 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 2> for DoublePendu
         let t7 = t0 * t3;
         [
             T::from_f64(0.0000056915273546100005) * t1
-                + T::from_f64(0.0000000006316200853380001) * t4
+                + T::from_f64(0.0000000006316200853380001) * (t4 - t5)
                 - T::from_f64(0.42040052957160007) * t0
-                - T::from_f64(0.0000000006316200853380001) * t5
-                - T::from_f64(0.328934150064) * t6 - T::from_f64(0.328934150064) * t7,
-            T::from_f64(0.0000000006316200853380001) * t4
-                - T::from_f64(0.0000000006316200853380001) * t5
-                - T::from_f64(0.328934150064) * t6 - T::from_f64(0.328934150064) * t7,
+                - T::from_f64(0.328934150064) * (t6 + t7),
+            T::from_f64(0.0000000006316200853380001) * (t4 - t5)
+                - T::from_f64(0.328934150064) * (t6 + t7),
         ]
     }
     /// Route: closed-form Lagrangian expressions.
-    /// Operations: 16 mul, 6 add, 0 div, 1 sin, 1 cos.
+    /// Operations: 14 mul, 6 add, 0 div, 1 sin, 1 cos.
     fn bias(&self, q: &[T; 2], qd: &[T; 2]) -> [T; 2] {
         let (s1, c1) = q[1].sin_cos();
         let t0 = s1;
         let t1 = c1;
         let t2 = t0 * (-T::from_f64(0.1) * t1 - T::from_f64(0.10088));
         let t3 = t1 * (T::from_f64(0.1) * t0 + T::from_f64(0.00000000019371));
-        [
-            qd[1] * qd[1]
-                * (T::from_f64(0.000000000006438532980000001) * t1
-                    - T::from_f64(0.00335304944) * t0)
-                + qd[0] * qd[1]
-                    * (T::from_f64(0.06647600000000001) * t2
-                        + T::from_f64(0.06647600000000001) * t3),
-            qd[0] * qd[0]
-                * (-T::from_f64(0.033238000000000004) * t2
-                    - T::from_f64(0.033238000000000004) * t3),
-        ]
+        let t4 = qd[1] * qd[1]
+            * (T::from_f64(0.000000000006438532980000001) * t1
+                - T::from_f64(0.00335304944) * t0)
+            + qd[0] * qd[1] * (T::from_f64(0.06647600000000001) * (t2 + t3));
+        [t4, qd[0] * qd[0] * (-T::from_f64(0.033238000000000004) * (t2 + t3))]
     }
     /// Route: closed-form Lagrangian expressions.
-    /// Operations: 18 mul, 6 add, 0 div, 1 sin, 1 cos.
+    /// Operations: 15 mul, 6 add, 0 div, 1 sin, 1 cos.
     fn coriolis_matrix(&self, q: &[T; 2], qd: &[T; 2]) -> [[T; 2]; 2] {
         let (s1, c1) = q[1].sin_cos();
         let t0 = s1;
         let t1 = c1;
         let t2 = t0 * (-T::from_f64(0.1) * t1 - T::from_f64(0.10088));
         let t3 = t1 * (T::from_f64(0.1) * t0 + T::from_f64(0.00000000019371));
-        let t4 = T::from_f64(0.06647600000000001) * t2
-            + T::from_f64(0.06647600000000001) * t3;
-        [
-            [
-                T::from_f64(0.5) * qd[1] * t4,
-                T::from_f64(0.5) * qd[0] * t4
-                    + T::from_f64(0.5) * qd[1]
-                        * (T::from_f64(0.000000000012877065960000002) * t1
-                            - T::from_f64(0.00670609888) * t0),
-            ],
-            [
-                T::from_f64(0.5) * qd[0]
-                    * (-T::from_f64(0.06647600000000001) * t2
-                        - T::from_f64(0.06647600000000001) * t3),
-                T::zero(),
-            ],
-        ]
+        let t4 = T::from_f64(0.06647600000000001) * (t2 + t3);
+        let t5 = T::from_f64(0.5)
+            * (qd[0] * t4
+                + qd[1]
+                    * (T::from_f64(0.000000000012877065960000002) * t1
+                        - T::from_f64(0.00670609888) * t0));
+        let t6 = T::from_f64(0.5) * qd[0]
+            * (-T::from_f64(0.06647600000000001) * (t2 + t3));
+        [[T::from_f64(0.5) * qd[1] * t4, t5], [t6, T::zero()]]
     }
-    /// Route: closed-form Lagrangian expressions.
-    /// Operations: 40 mul, 24 add, 0 div, 2 sin, 2 cos.
+    /// Route: Newton-Euler.
+    /// Operations: 29 mul, 27 add, 0 div, 2 sin, 2 cos.
     fn inverse_dynamics(&self, q: &[T; 2], qd: &[T; 2], qdd: &[T; 2]) -> [T; 2] {
         let (s0, c0) = q[0].sin_cos();
         let (s1, c1) = q[1].sin_cos();
@@ -412,42 +383,34 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 2> for DoublePendu
         let t1 = c0;
         let t2 = s1;
         let t3 = c1;
-        let t4 = t1 * t3;
-        let t5 = t0 * t2;
-        let t6 = t1 * t2;
-        let t7 = t0 * t3;
-        let t8 = T::from_f64(0.1) * t2 + T::from_f64(0.00000000019371);
-        let t9 = -T::from_f64(0.1) * t3 - T::from_f64(0.10088);
-        let t10 = T::from_f64(0.000000000006438532980000001) * t2
-            + T::from_f64(0.00335304944) * t3 + T::from_f64(0.004557856275072);
-        let t11 = t2 * t9;
-        let t12 = t3 * t8;
+        let t4 = qd[0] + qd[1];
+        let t5 = T::from_f64(9.81) * t1 - T::from_f64(0.1) * qd[0] * qd[0];
+        let t6 = t2 * t5;
+        let t7 = t3 * t5;
+        let t8 = T::from_f64(9.81) * t0 - T::from_f64(0.1) * qdd[0];
+        let t9 = t3 * t8;
+        let t10 = t2 * t8;
+        let t11 = T::from_f64(0.33238) * (t6 + t9)
+            - T::from_f64(0.0335304944) * (qdd[0] + qdd[1])
+            - t4 * (T::from_f64(0.0000000000643853298) * (qd[0] + qd[1]));
+        let t12 = T::from_f64(0.0000000000643853298) * (qdd[0] + qdd[1])
+            + t4 * (-T::from_f64(0.0335304944) * (qd[0] + qd[1]))
+            + T::from_f64(0.33238) * (t7 - t10);
         [
-            T::from_f64(0.0000056915273546100005) * t1
-                + T::from_f64(0.0000000006316200853380001) * t4
-                + qd[1] * qd[1]
-                    * (T::from_f64(0.000000000006438532980000001) * t3
-                        - T::from_f64(0.00335304944) * t2)
-                + qd[0] * qd[1]
-                    * (T::from_f64(0.06647600000000001) * t11
-                        + T::from_f64(0.06647600000000001) * t12)
-                + qdd[0]
-                    * (T::from_f64(0.33238) * t9 * t9 + T::from_f64(0.33238) * t8 * t8
-                        + T::from_f64(0.0019298716336328685)) + qdd[1] * t10
-                - T::from_f64(0.42040052957160007) * t0
-                - T::from_f64(0.0000000006316200853380001) * t5
-                - T::from_f64(0.328934150064) * t6 - T::from_f64(0.328934150064) * t7,
-            T::from_f64(0.004557856275072) * qdd[1]
-                + T::from_f64(0.0000000006316200853380001) * t4
-                + qd[0] * qd[0]
-                    * (-T::from_f64(0.033238000000000004) * t11
-                        - T::from_f64(0.033238000000000004) * t12) + qdd[0] * t10
-                - T::from_f64(0.0000000006316200853380001) * t5
-                - T::from_f64(0.328934150064) * t6 - T::from_f64(0.328934150064) * t7,
+            T::from_f64(0.005312427908704868) * qdd[0]
+                + T::from_f64(0.004557856275072) * qdd[1]
+                + T::from_f64(0.00000569152735461) * t1
+                + T::from_f64(0.0000000000643853298) * (t7 - t10)
+                + T::from_f64(0.1) * (t2 * t12 - t3 * t11)
+                - T::from_f64(0.0943357495716) * t0
+                - T::from_f64(0.0335304944) * (t6 + t9),
+            T::from_f64(0.004557856275072) * (qdd[0] + qdd[1])
+                + T::from_f64(0.0000000000643853298) * (t7 - t10)
+                - T::from_f64(0.0335304944) * (t6 + t9),
         ]
     }
     /// Route: M and b + G as in `mass_matrix` and `bias`, then an unrolled L^T D L solve without fill-in.
-    /// Operations: 47 mul, 32 add, 1 div, 2 sin, 2 cos.
+    /// Operations: 38 mul, 32 add, 1 div, 2 sin, 2 cos.
     ///
     /// Returns NaN in every entry when M(q) is not positive definite (it cannot be for a valid
     /// model and finite inputs); `try_forward_dynamics` says which pivot failed.
@@ -457,23 +420,23 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 2> for DoublePendu
             Err(_) => [T::nan(); 2],
         }
     }
-    /// Operations: 12 mul, 7 add, 0 div, 1 sin, 1 cos.
+    /// Operations: 11 mul, 7 add, 0 div, 1 sin, 1 cos.
     fn kinetic_energy(&self, q: &[T; 2], qd: &[T; 2]) -> T {
         let (s1, c1) = q[1].sin_cos();
         let t0 = s1;
         let t1 = c1;
         let t2 = T::from_f64(0.0000000000064385329799999996) * t0
             + T::from_f64(0.0033530494400000003) * t1 + T::from_f64(0.004557856275072);
-        let t3 = T::from_f64(0.5) * qd[0]
-            * (qd[0]
-                * (T::from_f64(0.000000000012877065959999999) * t0
-                    + T::from_f64(0.006706098880000001) * t1
-                    + T::from_f64(0.008636227908704868)) + qd[1] * t2)
-            + T::from_f64(0.5) * qd[1]
-                * (T::from_f64(0.004557856275072) * qd[1] + qd[0] * t2);
-        t3
+        let t3 = qd[0]
+            * (T::from_f64(0.000000000012877065959999999) * t0
+                + T::from_f64(0.006706098880000001) * t1
+                + T::from_f64(0.008636227908704868)) + qd[1] * t2;
+        let t4 = T::from_f64(0.5)
+            * (qd[0] * t3
+                + qd[1] * (T::from_f64(0.004557856275072) * qd[1] + qd[0] * t2));
+        t4
     }
-    /// Operations: 10 mul, 6 add, 0 div, 2 sin, 2 cos.
+    /// Operations: 8 mul, 6 add, 0 div, 2 sin, 2 cos.
     fn potential_energy(&self, q: &[T; 2]) -> T {
         let (s0, c0) = q[0].sin_cos();
         let (s1, c1) = q[1].sin_cos();
@@ -483,9 +446,8 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 2> for DoublePendu
         let t3 = c1;
         T::from_f64(0.0000056915273546100005) * t0
             + T::from_f64(0.42040052957160007) * t1
-            + T::from_f64(0.328934150064) * t1 * t3
-            + T::from_f64(0.0000000006316200853380001) * t1 * t2
-            + T::from_f64(0.0000000006316200853380001) * t0 * t3
-            + T::from_f64(0.20580742350000003) - T::from_f64(0.328934150064) * t0 * t2
+            + T::from_f64(0.328934150064) * (t1 * t3 - t0 * t2)
+            + T::from_f64(0.0000000006316200853380001) * (t1 * t2 + t0 * t3)
+            + T::from_f64(0.20580742350000003)
     }
 }

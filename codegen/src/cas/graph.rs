@@ -168,6 +168,9 @@ impl Hasher for FxHasher {
 pub struct Limits {
     /// Most nodes a graph may hold.
     pub max_nodes: usize,
+    /// Sums and products with more children than this are not flattened into their parents
+    /// (they stay one term or factor), which keeps building linear in the graph's size.
+    pub max_flatten: usize,
 }
 
 impl Default for Limits {
@@ -175,6 +178,7 @@ impl Default for Limits {
         // About 3 GB of nodes at the worst; a 48-joint arm needs a few million.
         Limits {
             max_nodes: 50_000_000,
+            max_flatten: 128,
         }
     }
 }
@@ -364,7 +368,9 @@ impl Graph {
             }
             match &self.nodes[id.index()] {
                 Node::Const(v) => c += k * v.get(),
-                Node::Add(c2, ts) => {
+                // A large child sum stays one term: flattening it into every parent would make
+                // building quadratic in its size.
+                Node::Add(c2, ts) if ts.len() <= self.limits.max_flatten => {
                     c += k * c2.get();
                     flat.extend(ts.iter().map(|&(t, kt)| (t, k * kt.get())));
                 }
@@ -399,7 +405,9 @@ impl Graph {
             }
             match &self.nodes[id.index()] {
                 Node::Const(v) => coef *= v.get().powi(e),
-                Node::Mul(fs) => work.extend(fs.iter().map(|&(f, fe)| (f, fe * e))),
+                Node::Mul(fs) if fs.len() <= self.limits.max_flatten => {
+                    work.extend(fs.iter().map(|&(f, fe)| (f, fe * e)))
+                }
                 // A scaled term k * t: pull k into the coefficient.
                 Node::Add(c0, ts) if c0.get() == 0.0 && ts.len() == 1 => {
                     coef *= ts[0].1.get().powi(e);

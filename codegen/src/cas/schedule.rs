@@ -207,11 +207,11 @@ impl Program {
                         ts.iter().map(|(t, k)| (sub(*t), k.get())).collect();
                     let d = parts.iter().map(|p| p.0 .1).max().unwrap_or(0) + 1;
                     (
-                        Expr::Add(
+                        factor_coefficients(
                             c.get(),
                             parts.into_iter().map(|((e, _), k)| (e, k)).collect(),
                         ),
-                        d,
+                        d + 1,
                     )
                 }
                 Node::Mul(fs) if den_uses.get(&den_key(fs)).is_some_and(|&u| u >= 2) => {
@@ -315,6 +315,38 @@ impl Program {
             .map(|e| e.eval(&inputs, &temps))
             .collect())
     }
+}
+
+/// `k a + k b - k c` -> `k (a + b - c)`: terms whose coefficients share a magnitude get it
+/// once, saving a multiplication per term. Groups keep the order of their first term.
+fn factor_coefficients(constant: f64, terms: Vec<(Expr, f64)>) -> Expr {
+    let mut groups: Vec<(f64, Vec<(Expr, f64)>)> = Vec::new();
+    for (e, k) in terms {
+        let mag = k.abs();
+        let unit = if k < 0.0 { -1.0 } else { 1.0 };
+        match groups.iter_mut().find(|g| g.0 == mag) {
+            Some(g) => g.1.push((e, unit)),
+            None => groups.push((mag, vec![(e, unit)])),
+        }
+    }
+    let mut out = Vec::with_capacity(groups.len());
+    for (mag, mut members) in groups {
+        if members.len() == 1 || mag == 1.0 {
+            out.extend(members.into_iter().map(|(e, u)| (e, u * mag)));
+        } else {
+            // Lead with a positive term where possible, so the inner sum needs no negation.
+            let sign = if members.iter().all(|m| m.1 < 0.0) {
+                -1.0
+            } else {
+                1.0
+            };
+            for m in members.iter_mut() {
+                m.1 *= sign;
+            }
+            out.push((Expr::Add(0.0, members), sign * mag));
+        }
+    }
+    Expr::Add(constant, out)
 }
 
 fn unary((e, d): (Expr, u32), f: fn(Box<Expr>) -> Expr) -> (Expr, u32) {

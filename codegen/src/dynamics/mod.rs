@@ -327,15 +327,18 @@ impl Derivation {
         let c_rec: Vec<Vec<Id>> = (0..n)
             .map(|i| (0..n).map(|j| g.scale(db[j][i], 0.5)).collect())
             .collect();
+        // d2[k][j][i] = d^2 b_i / dqd_j dqd_k, one memoized pass per k over every first derivative.
+        let db_flat: Vec<Id> = db.iter().flatten().copied().collect();
+        let d2: Vec<Vec<Id>> = (0..n).map(|k| g.diff_many(&db_flat, qd[k])).collect();
+        let second = |k: usize, j: usize, i: usize| d2[k][j * n + i];
         let mut cf_rec = vec![vec![g.zero(); n]; n];
         let mut cp_rec = vec![Vec::new(); n];
         for i in 0..n {
             for j in 0..n {
-                let d2 = g.diff(db[j][i], qd[j]);
-                cf_rec[i][j] = g.scale(d2, 0.5);
+                cf_rec[i][j] = g.scale(second(j, j, i), 0.5);
             }
             for &(j, k) in &pair_list {
-                cp_rec[i].push(g.diff(db[j][i], qd[k]));
+                cp_rec[i].push(second(k, j, i));
             }
         }
         let cm = cheaper(&g, &coriolis_matrix, &c_rec, flat);
