@@ -1202,7 +1202,7 @@ fn check_invariants(model: &Model) {
     assert!(model.dof() > 0);
     assert_eq!(model.bodies.len(), model.dof());
     for (i, joint) in model.joints.iter().enumerate() {
-        assert!(joint.parent.map_or(true, |p| p < i));
+        assert!(joint.parent.is_none_or(|p| p < i));
         assert!((joint.axis.norm() - 1.0).abs() < 1e-12);
         assert!(joint.origin.rotation.iter().all(|x| x.is_finite()));
         assert!(joint.origin.translation.iter().all(|x| x.is_finite()));

@@ -17,10 +17,16 @@
 
 #![no_std]
 
+// Formatted by eomgen (prettyplease), not rustfmt: the golden test compares bytes.
+#[rustfmt::skip]
 pub mod allegro_right_hand;
+#[rustfmt::skip]
 pub mod double_pendulum;
+#[rustfmt::skip]
 pub mod kinova;
+#[rustfmt::skip]
 pub mod panda;
+#[rustfmt::skip]
 pub mod ur5;
 
 /// The robots of this crate: (module, type name, URDF file in `robots/`).
@@ -29,5 +35,9 @@ pub const ROBOTS: [(&str, &str, &str); 5] = [
     ("ur5", "Ur5", "ur5.urdf"),
     ("panda", "Panda", "panda.urdf"),
     ("kinova", "Kinova", "kinova.urdf"),
-    ("allegro_right_hand", "AllegroRightHand", "allegro_right_hand.urdf"),
+    (
+        "allegro_right_hand",
+        "AllegroRightHand",
+        "allegro_right_hand.urdf",
+    ),
 ];

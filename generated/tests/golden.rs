@@ -14,8 +14,17 @@ fn root() -> PathBuf {
 /// The first differing lines, with a little context.
 fn diff(old: &str, new: &str) -> String {
     let (a, b): (Vec<&str>, Vec<&str>) = (old.lines().collect(), new.lines().collect());
-    let first = a.iter().zip(&b).position(|(x, y)| x != y).unwrap_or(a.len().min(b.len()));
-    let mut out = format!("first difference at line {} ({} lines checked in, {} generated)\n", first + 1, a.len(), b.len());
+    let first = a
+        .iter()
+        .zip(&b)
+        .position(|(x, y)| x != y)
+        .unwrap_or(a.len().min(b.len()));
+    let mut out = format!(
+        "first difference at line {} ({} lines checked in, {} generated)\n",
+        first + 1,
+        a.len(),
+        b.len()
+    );
     for k in first.saturating_sub(2)..(first + 5) {
         if let Some(x) = a.get(k) {
             out.push_str(&format!("- {x}\n"));
@@ -44,11 +53,19 @@ fn checked_in_code_is_what_eomgen_generates() {
             if bless {
                 eomgen::write_if_changed(&path, generated.as_bytes()).unwrap();
             } else {
-                stale.push(format!("{}:\n{}", path.display(), diff(&current, &generated)));
+                stale.push(format!(
+                    "{}:\n{}",
+                    path.display(),
+                    diff(&current, &generated)
+                ));
             }
         }
     }
-    assert!(stale.is_empty(), "generated code is stale; refresh with `{REFRESH}`\n\n{}", stale.join("\n"));
+    assert!(
+        stale.is_empty(),
+        "generated code is stale; refresh with `{REFRESH}`\n\n{}",
+        stale.join("\n")
+    );
 }
 
 /// The readable equations in `equations/` (M, B, C and G): expanded formulas for the double
