@@ -11,6 +11,11 @@
 //! - [`Pose`]: a rigid transform (world from link) as returned by the generated `link_pose`;
 //! - fixed-size, allocation-free and panic-free solvers for symmetric positive definite systems
 //!   ([`Ldlt`], [`Cholesky`], [`solve_spd`], [`solve_spd_or_nan`]) used by forward dynamics;
+//! - simulation over any [`Dynamics`] (module [`sim`]): [`State`], semi-implicit Euler and RK4
+//!   steps, a [`Simulator`] loop with a torque callback;
+//! - control (module [`control`]): PD with gravity compensation ([`PdGravity`]),
+//!   [`ComputedTorque`], the Jacobian-transpose map [`wrench_to_torque`], velocity and force
+//!   manipulability [`Ellipsoid`]s and the [`SymmetricEigen`] solver behind them;
 //! - with the `nalgebra` feature, conversions between the plain arrays used here and nalgebra's
 //!   fixed-size types (module `nalgebra_support`).
 //!
@@ -47,15 +52,23 @@
 #[cfg(feature = "std")]
 extern crate std;
 
+pub mod control;
 mod dynamics;
 mod linalg;
 mod pose;
 mod real;
+pub mod sim;
 
 #[cfg(feature = "nalgebra")]
 pub mod nalgebra_support;
 
+pub use control::{
+    wrench_to_torque, ComputedTorque, Ellipsoid, PdGravity, Setpoint, SymmetricEigen,
+};
 pub use dynamics::Dynamics;
 pub use linalg::{solve_spd, solve_spd_or_nan, Cholesky, FactorError, Ldlt};
 pub use pose::Pose;
 pub use real::Real;
+pub use sim::{
+    rk4_step, rk4_step_closed_loop, semi_implicit_euler_step, Integrator, Simulator, State,
+};
