@@ -13,6 +13,7 @@
 use nalgebra::{Matrix3, Vector3};
 
 mod build;
+pub mod shapes;
 pub use build::{ModelError, ModelOptions, SymbolicParams};
 // The format-neutral description that readers (`crate::urdf`) fill in.
 pub(crate) use build::{
