@@ -1,6 +1,9 @@
 //! The symbolic core: one test per simplification rule, property tests against a direct
 //! evaluation of random expression trees, and a two-process determinism check.
 
+#[path = "support/child.rs"]
+mod child;
+
 use eomgen::cas::{Graph, Id, Node, Program, Style, Syntax};
 use proptest::prelude::*;
 
@@ -504,29 +507,14 @@ fn determinism_sample() -> String {
 
 #[test]
 fn determinism_child() {
-    if std::env::var_os("EOMGEN_DETERMINISM_CHILD").is_some() {
-        println!("<<<{}>>>", determinism_sample());
+    if child::is_child() {
+        child::emit(&determinism_sample());
     }
 }
 
 #[test]
 fn printing_is_byte_identical_across_processes() {
-    let run = || {
-        let out = std::process::Command::new(std::env::current_exe().unwrap())
-            .args([
-                "--exact",
-                "determinism_child",
-                "--nocapture",
-                "--test-threads=1",
-            ])
-            .env("EOMGEN_DETERMINISM_CHILD", "1")
-            .output()
-            .unwrap();
-        let text = String::from_utf8(out.stdout).unwrap();
-        let start = text.find("<<<").expect("child printed") + 3;
-        let end = text.find(">>>").unwrap();
-        text[start..end].to_string()
-    };
+    let run = || child::run_child("determinism_child");
     let (a, b) = (run(), run());
     assert!(!a.is_empty());
     assert_eq!(a, b);

@@ -1,5 +1,8 @@
 //! The same URDF and options give byte-identical output in separate processes.
 
+#[path = "support/child.rs"]
+mod child;
+
 use std::path::PathBuf;
 
 const ROBOTS: [&str; 5] = [
@@ -35,28 +38,14 @@ fn generate_all() -> String {
 
 #[test]
 fn child_process_generates() {
-    if std::env::var_os("EOMGEN_DETERMINISM_CHILD").is_some() {
-        print!("<<<{}>>>", generate_all());
+    if child::is_child() {
+        child::emit(&generate_all());
     }
 }
 
 #[test]
 fn every_reference_robot_generates_identical_bytes_in_two_processes() {
-    let run = || {
-        let out = std::process::Command::new(std::env::current_exe().unwrap())
-            .args([
-                "--exact",
-                "child_process_generates",
-                "--nocapture",
-                "--test-threads=1",
-            ])
-            .env("EOMGEN_DETERMINISM_CHILD", "1")
-            .output()
-            .unwrap();
-        let text = String::from_utf8(out.stdout).unwrap();
-        let start = text.find("<<<").expect("child printed") + 3;
-        text[start..text.find(">>>").unwrap()].to_string()
-    };
+    let run = || child::run_child("child_process_generates");
     let (a, b) = (run(), run());
     assert_eq!(a.lines().count(), ROBOTS.len());
     assert_eq!(a, b);
