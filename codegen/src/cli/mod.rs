@@ -1,4 +1,4 @@
-//! The `eomgen` command line (clap): `generate`, `show`, `info`, `eval`.
+//! The `eomgen` command line (clap): `generate`, `show`, `info`, `eval`, `simulate`.
 //!
 //! Exit codes: 0 on success, 1 on bad input (one line on stderr, starting with
 //! `eomgen: error:`), 2 on bad usage (clap's message). Nothing panics visibly: a panic would be
@@ -7,6 +7,7 @@
 mod eval;
 mod info;
 mod progress;
+mod simulate;
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -47,6 +48,8 @@ enum Command {
     Info(InfoArgs),
     /// Evaluates M, b, G, tau and the forward dynamics at one state, to check a model quickly.
     Eval(EvalArgs),
+    /// Integrates the motion (RK4, through the CAS interpreter) and writes the trajectory as CSV.
+    Simulate(SimulateArgs),
 }
 
 /// Options shared by every command that loads a model.
@@ -192,6 +195,55 @@ struct EvalArgs {
     model: ModelArgs,
 }
 
+#[derive(Clone, Copy, Debug, ValueEnum)]
+enum ControllerArg {
+    /// No effort: the robot moves under gravity alone.
+    None,
+    /// tau = G(q) + Kp (target - q) - Kd qd (pure gravity compensation with the default zero gains).
+    GravityComp,
+    /// Computed torque to the target, critically damped at --omega.
+    ComputedTorque,
+}
+
+#[derive(Args, Debug)]
+struct SimulateArgs {
+    /// The robot's URDF file.
+    urdf: PathBuf,
+    /// Simulated time (s).
+    #[arg(long, value_name = "S", default_value_t = 1.0)]
+    duration: f64,
+    /// Time step (s).
+    #[arg(long, value_name = "H", default_value_t = 1e-3)]
+    dt: f64,
+    /// Initial joint positions [default: 0]
+    #[arg(long, value_name = "Q1,Q2,...", allow_hyphen_values = true, value_parser = parse_numbers)]
+    q0: Option<Numbers>,
+    /// Initial joint velocities [default: 0]
+    #[arg(long, value_name = "QD1,...", allow_hyphen_values = true, value_parser = parse_numbers)]
+    qd0: Option<Numbers>,
+    /// Target joint positions of the controller [default: the initial positions]
+    #[arg(long, value_name = "Q1,...", allow_hyphen_values = true, value_parser = parse_numbers)]
+    target: Option<Numbers>,
+    /// The controller closing the loop.
+    #[arg(long, value_enum, default_value_t = ControllerArg::None)]
+    controller: ControllerArg,
+    /// Proportional gain of gravity-comp (N m/rad or N/m).
+    #[arg(long, value_name = "KP", default_value_t = 0.0)]
+    kp: f64,
+    /// Derivative gain of gravity-comp (N m s/rad or N s/m).
+    #[arg(long, value_name = "KD", default_value_t = 0.0)]
+    kd: f64,
+    /// Bandwidth of computed-torque (rad/s): Kp = omega^2, Kd = 2 omega.
+    #[arg(long, value_name = "RAD_PER_S", default_value_t = 10.0)]
+    omega: f64,
+    /// Writes the CSV (t, q_*, qd_*, tau_* per joint) to FILE and a summary to stdout, instead
+    /// of the CSV to stdout.
+    #[arg(long, value_name = "FILE")]
+    csv: Option<PathBuf>,
+    #[command(flatten)]
+    model: ModelArgs,
+}
+
 /// A list of numbers from the command line.
 #[derive(Clone, Debug)]
 struct Numbers(Vec<f64>);
@@ -314,6 +366,7 @@ fn run(cli: Cli) -> Result<(), Failure> {
         Command::Show(a) => show(a),
         Command::Info(a) => info_cmd(a),
         Command::Eval(a) => eval_cmd(a),
+        Command::Simulate(a) => simulate_cmd(a),
     }
 }
 
@@ -443,4 +496,46 @@ fn eval_cmd(a: EvalArgs) -> Result<(), Failure> {
     let values = eval::evaluate(&model, &d, &state).map_err(Failure)?;
     let digits = (a.digits > 0).then_some(a.digits);
     emit(&eval::print(&model, &state, &values, digits))
+}
+
+fn simulate_cmd(a: SimulateArgs) -> Result<(), Failure> {
+    let model = load(&a.urdf, &a.model.options(&None))?;
+    let n = model.dof();
+    let check = |flag: &str, v: Option<Numbers>, default: &[f64]| -> Result<Vec<f64>, Failure> {
+        match v {
+            None => Ok(default.to_vec()),
+            Some(Numbers(v)) if v.len() == n => Ok(v),
+            Some(Numbers(v)) => Err(Failure(format!(
+                "{flag} has {} value(s), but {} has {n} joint(s)",
+                v.len(),
+                model.name
+            ))),
+        }
+    };
+    let q0 = check("--q0", a.q0, &vec![0.0; n])?;
+    let options = simulate::Options {
+        duration: a.duration,
+        dt: a.dt,
+        qd0: check("--qd0", a.qd0, &vec![0.0; n])?,
+        target: check("--target", a.target, &q0)?,
+        q0,
+        controller: match a.controller {
+            ControllerArg::None => simulate::Controller::None,
+            ControllerArg::GravityComp => simulate::Controller::GravityComp,
+            ControllerArg::ComputedTorque => simulate::Controller::ComputedTorque,
+        },
+        kp: a.kp,
+        kd: a.kd,
+        omega: a.omega,
+    };
+    let d = derive(&model);
+    let outcome = simulate::run(&model, &d, &options).map_err(Failure)?;
+    match &a.csv {
+        Some(path) => {
+            std::fs::write(path, &outcome.csv)
+                .map_err(|e| Failure(format!("cannot write {}: {e}", path.display())))?;
+            emit(&outcome.summary)
+        }
+        None => emit(&outcome.csv),
+    }
 }

@@ -1,0 +1,198 @@
+//! `eomgen simulate`: integrates the equation of motion with RK4, evaluating M, b and G through
+//! the CAS interpreter (the command line cannot compile the generated code), and writes the
+//! trajectory as CSV.
+//!
+//! The integrator and controllers mirror the runtime's (`rk4_step_closed_loop`, `PdGravity`,
+//! `ComputedTorque` in `eomgen_runtime`), written again for a joint count known only at run
+//! time; the controller is re-evaluated at every RK4 stage (a continuous-time controller).
+
+use std::fmt::Write as _;
+
+use eomgen::dynamics::Derivation;
+use eomgen::model::Model;
+
+use super::eval;
+
+/// The controller closing the loop.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Controller {
+    /// No effort: the robot moves under gravity alone.
+    None,
+    /// PD to the target with gravity compensation, `tau = Kp (q* - q) - Kd qd + G(q)`; with
+    /// zero gains (the default) pure gravity compensation.
+    GravityComp,
+    /// Computed torque to the target, `tau = M (Kp e - Kd qd) + b + G`: critically damped
+    /// at `omega` rad/s.
+    ComputedTorque,
+}
+
+/// What to simulate.
+pub struct Options {
+    pub duration: f64,
+    pub dt: f64,
+    pub q0: Vec<f64>,
+    pub qd0: Vec<f64>,
+    pub target: Vec<f64>,
+    pub controller: Controller,
+    /// Proportional and derivative gains for `GravityComp` (N m/rad, N m s/rad).
+    pub kp: f64,
+    pub kd: f64,
+    /// Bandwidth of `ComputedTorque` (rad/s).
+    pub omega: f64,
+}
+
+/// The result: the CSV text and a one-paragraph summary.
+pub struct Outcome {
+    pub csv: String,
+    pub summary: String,
+}
+
+/// M, b, G and the energies at `(q, qd)`.
+fn terms(model: &Model, d: &Derivation, q: &[f64], qd: &[f64]) -> Result<eval::Values, String> {
+    let n = q.len();
+    eval::evaluate(
+        model,
+        d,
+        &eval::State {
+            q: q.to_vec(),
+            qd: qd.to_vec(),
+            qdd: vec![0.0; n],
+            tau: vec![0.0; n],
+        },
+    )
+}
+
+/// The controller's effort and the resulting acceleration at `(q, qd)`.
+fn step_eval(
+    model: &Model,
+    d: &Derivation,
+    o: &Options,
+    q: &[f64],
+    qd: &[f64],
+) -> Result<(Vec<f64>, Vec<f64>), String> {
+    let n = q.len();
+    let v = terms(model, d, q, qd)?;
+    let tau: Vec<f64> = match o.controller {
+        Controller::None => vec![0.0; n],
+        Controller::GravityComp => (0..n)
+            .map(|i| o.kp * (o.target[i] - q[i]) - o.kd * qd[i] + v.gravity[i])
+            .collect(),
+        Controller::ComputedTorque => {
+            let (kp, kd) = (o.omega * o.omega, 2.0 * o.omega);
+            let a: Vec<f64> = (0..n)
+                .map(|i| kp * (o.target[i] - q[i]) - kd * qd[i])
+                .collect();
+            (0..n)
+                .map(|i| {
+                    (0..n).map(|j| v.mass_matrix[i][j] * a[j]).sum::<f64>()
+                        + v.bias[i]
+                        + v.gravity[i]
+                })
+                .collect()
+        }
+    };
+    let rhs: Vec<f64> = (0..n).map(|i| tau[i] - v.bias[i] - v.gravity[i]).collect();
+    let qdd = eval::cholesky_solve(&v.mass_matrix, &rhs).map_err(|k| {
+        format!(
+            "{}: the mass matrix is not positive definite during the simulation (pivot {} of \
+             {n}); the state diverged or the inertias are wrong",
+            model.name,
+            k + 1
+        )
+    })?;
+    Ok((tau, qdd))
+}
+
+fn axpy(a: &[f64], h: f64, b: &[f64]) -> Vec<f64> {
+    a.iter().zip(b).map(|(x, y)| x + h * y).collect()
+}
+
+fn row(out: &mut String, t: f64, q: &[f64], qd: &[f64], tau: &[f64]) {
+    let _ = write!(out, "{t}");
+    for x in q.iter().chain(qd).chain(tau) {
+        let _ = write!(out, ",{x}");
+    }
+    out.push('\n');
+}
+
+/// Runs the simulation: `round(duration / dt)` RK4 steps.
+pub fn run(model: &Model, d: &Derivation, o: &Options) -> Result<Outcome, String> {
+    let valid = o.dt > 0.0 && o.dt.is_finite() && o.duration >= 0.0 && o.duration.is_finite();
+    if !valid {
+        return Err("--dt must be positive and --duration non-negative".into());
+    }
+    let steps = (o.duration / o.dt).round();
+    if steps > 1e8 {
+        return Err(format!(
+            "{steps} steps: choose a larger --dt or a shorter --duration"
+        ));
+    }
+    let steps = steps as u64;
+    let names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
+    let mut csv = String::from("t");
+    for prefix in ["q", "qd", "tau"] {
+        for name in &names {
+            let _ = write!(csv, ",{prefix}_{name}");
+        }
+    }
+    csv.push('\n');
+    let (mut q, mut qd) = (o.q0.clone(), o.qd0.clone());
+    let e = |q: &[f64], qd: &[f64]| -> Result<f64, String> {
+        let v = terms(model, d, q, qd)?;
+        Ok(v.kinetic_energy + v.potential_energy)
+    };
+    let e0 = e(&q, &qd)?;
+    let h = o.dt;
+    for k in 0..steps {
+        let t = k as f64 * h;
+        let (tau, a1) = step_eval(model, d, o, &q, &qd)?;
+        row(&mut csv, t, &q, &qd, &tau);
+        let v1 = qd.clone();
+        let (q2, v2) = (axpy(&q, h / 2.0, &v1), axpy(&qd, h / 2.0, &a1));
+        let (_, a2) = step_eval(model, d, o, &q2, &v2)?;
+        let (q3, v3) = (axpy(&q, h / 2.0, &v2), axpy(&qd, h / 2.0, &a2));
+        let (_, a3) = step_eval(model, d, o, &q3, &v3)?;
+        let (q4, v4) = (axpy(&q, h, &v3), axpy(&qd, h, &a3));
+        let (_, a4) = step_eval(model, d, o, &q4, &v4)?;
+        for i in 0..q.len() {
+            q[i] += h / 6.0 * (v1[i] + 2.0 * (v2[i] + v3[i]) + v4[i]);
+            qd[i] += h / 6.0 * (a1[i] + 2.0 * (a2[i] + a3[i]) + a4[i]);
+        }
+        if q.iter().chain(&qd).any(|x| !x.is_finite()) {
+            return Err(format!(
+                "the simulation diverged at t = {}; try a smaller --dt",
+                t + h
+            ));
+        }
+    }
+    let (tau, _) = step_eval(model, d, o, &q, &qd)?;
+    let t_end = steps as f64 * h;
+    row(&mut csv, t_end, &q, &qd, &tau);
+    let e_end = e(&q, &qd)?;
+    let fmt = |v: &[f64]| {
+        v.iter()
+            .map(|x| format!("{x:.6}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let mut summary = format!(
+        "{}: {} RK4 steps of {h} s to t = {t_end} s\nq  = [{}]\nqd = [{}]\n",
+        model.name,
+        steps,
+        fmt(&q),
+        fmt(&qd)
+    );
+    if o.controller == Controller::None {
+        let _ = writeln!(
+            summary,
+            "energy: {e0:.9e} J at t = 0, {e_end:.9e} J at the end (change {:.3e} J)",
+            e_end - e0
+        );
+    } else {
+        let err = (0..q.len())
+            .map(|i| (q[i] - o.target[i]).abs())
+            .fold(0.0, f64::max);
+        let _ = writeln!(summary, "max |q - target| at the end: {err:.3e}");
+    }
+    Ok(Outcome { csv, summary })
+}

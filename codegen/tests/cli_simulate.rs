@@ -1,0 +1,145 @@
+//! `eomgen simulate`: CSV layout, energy conservation without a controller, the closed-loop
+//! error of computed torque against its analytical decay, and input errors.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn workspace() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("the workspace holds codegen/")
+        .to_path_buf()
+}
+
+/// Runs the binary from the workspace root.
+fn eomgen(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_eomgen"))
+        .args(args)
+        .current_dir(workspace())
+        .output()
+        .expect("the binary runs")
+}
+
+#[track_caller]
+fn ok(args: &[&str]) -> String {
+    let out = eomgen(args);
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).expect("UTF-8")
+}
+
+fn rows(csv: &str) -> Vec<Vec<f64>> {
+    csv.lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|x| x.parse().expect("number")).collect())
+        .collect()
+}
+
+#[test]
+fn passive_double_pendulum_csv_and_energy() {
+    let csv = ok(&[
+        "simulate",
+        "tests/robots/double_pendulum.urdf",
+        "--duration",
+        "0.5",
+        "--dt",
+        "1e-3",
+        "--q0",
+        "1.8,1.2",
+        "--qd0",
+        "1,2",
+    ]);
+    let header = csv.lines().next().unwrap();
+    assert_eq!(
+        header,
+        "t,q_joint1,q_joint2,qd_joint1,qd_joint2,tau_joint1,tau_joint2"
+    );
+    let r = rows(&csv);
+    assert_eq!(r.len(), 501, "initial state and one row per step");
+    assert_eq!(r[0], vec![0.0, 1.8, 1.2, 1.0, 2.0, 0.0, 0.0]);
+    assert!((r[500][0] - 0.5).abs() < 1e-12);
+    // The summary reports the energy change; RK4 at 1 ms keeps it tiny.
+    let dir = std::env::temp_dir().join(format!("eomgen-sim-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("dp.csv");
+    let summary = ok(&[
+        "simulate",
+        "tests/robots/double_pendulum.urdf",
+        "--duration",
+        "0.5",
+        "--q0",
+        "1.8,1.2",
+        "--qd0",
+        "1,2",
+        "--csv",
+        file.to_str().unwrap(),
+    ]);
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), csv);
+    let change: f64 = summary
+        .split("(change ")
+        .nth(1)
+        .and_then(|s| s.split(' ').next())
+        .expect("energy change in the summary")
+        .parse()
+        .unwrap();
+    assert!(change.abs() < 1e-7, "{summary}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn computed_torque_error_decays_as_critically_damped() {
+    // From rest 0.2 rad off the target: e(t) = e0 (1 + w t) exp(-w t) in every joint.
+    let csv = ok(&[
+        "simulate",
+        "tests/robots/ur5.urdf",
+        "--duration",
+        "0.6",
+        "--q0",
+        "0.1,-1.2,1.4,-1,-1.5,0.3",
+        "--target",
+        "0.3,-1,1.2,-0.8,-1.3,0.5",
+        "--controller",
+        "computed-torque",
+        "--omega",
+        "10",
+    ]);
+    let target = [0.3, -1.0, 1.2, -0.8, -1.3, 0.5];
+    for r in rows(&csv).iter().step_by(100) {
+        let t = r[0];
+        let want = 0.2 * (1.0 + 10.0 * t) * (-10.0 * t).exp();
+        for i in 0..6 {
+            let e = (target[i] - r[1 + i]).abs();
+            assert!((e - want).abs() < 1e-9, "t = {t}, joint {i}: {e} vs {want}");
+        }
+    }
+}
+
+#[test]
+fn gravity_compensation_holds_still_and_bad_input_fails() {
+    let csv = ok(&[
+        "simulate",
+        "tests/robots/ur5.urdf",
+        "--duration",
+        "0.2",
+        "--q0",
+        "0.1,-1.2,1.4,-1,-1.5,0.3",
+        "--controller",
+        "gravity-comp",
+    ]);
+    let last = rows(&csv).pop().unwrap();
+    for (i, q) in [0.1, -1.2, 1.4, -1.0, -1.5, 0.3].iter().enumerate() {
+        assert!((last[1 + i] - q).abs() < 1e-12);
+    }
+    let out = eomgen(&["simulate", "tests/robots/ur5.urdf", "--q0", "1,2"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.starts_with("eomgen: error: --q0 has 2 value(s)"),
+        "{err}"
+    );
+    let out = eomgen(&["simulate", "tests/robots/ur5.urdf", "--dt", "0"]);
+    assert_eq!(out.status.code(), Some(1));
+}
