@@ -321,12 +321,16 @@ impl Program {
 /// once, saving a multiplication per term. Groups keep the order of their first term.
 fn factor_coefficients(constant: f64, terms: Vec<(Expr, f64)>) -> Expr {
     let mut groups: Vec<(f64, Vec<(Expr, f64)>)> = Vec::new();
+    let mut index: HashMap<u64, usize> = HashMap::with_capacity(terms.len());
     for (e, k) in terms {
         let mag = k.abs();
         let unit = if k < 0.0 { -1.0 } else { 1.0 };
-        match groups.iter_mut().find(|g| g.0 == mag) {
-            Some(g) => g.1.push((e, unit)),
-            None => groups.push((mag, vec![(e, unit)])),
+        match index.get(&mag.to_bits()) {
+            Some(&g) => groups[g].1.push((e, unit)),
+            None => {
+                index.insert(mag.to_bits(), groups.len());
+                groups.push((mag, vec![(e, unit)]));
+            }
         }
     }
     let mut out = Vec::with_capacity(groups.len());
