@@ -240,6 +240,9 @@ struct SimulateArgs {
     /// of the CSV to stdout.
     #[arg(long, value_name = "FILE")]
     csv: Option<PathBuf>,
+    /// Also writes an SVG plot of the joint positions against time to FILE.
+    #[arg(long, value_name = "FILE.svg")]
+    plot: Option<PathBuf>,
     #[command(flatten)]
     model: ModelArgs,
 }
@@ -530,6 +533,13 @@ fn simulate_cmd(a: SimulateArgs) -> Result<(), Failure> {
     };
     let d = derive(&model);
     let outcome = simulate::run(&model, &d, &options).map_err(Failure)?;
+    if let Some(path) = &a.plot {
+        let names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
+        let title = format!("{}: joint positions", model.name);
+        let svg = simulate::svg(&title, &names, &outcome.times, &outcome.positions);
+        std::fs::write(path, svg)
+            .map_err(|e| Failure(format!("cannot write {}: {e}", path.display())))?;
+    }
     match &a.csv {
         Some(path) => {
             std::fs::write(path, &outcome.csv)
