@@ -16,6 +16,8 @@
 //! - control (module [`control`]): PD with gravity compensation ([`PdGravity`]),
 //!   [`ComputedTorque`], the Jacobian-transpose map [`wrench_to_torque`], velocity and force
 //!   manipulability [`Ellipsoid`]s and the [`SymmetricEigen`] solver behind them;
+//! - [`WithJointEffects`]: rotor inertia (armature), viscous and Coulomb joint friction added
+//!   to any [`Dynamics`];
 //! - with the `nalgebra` feature, conversions between the plain arrays used here and nalgebra's
 //!   fixed-size types (module `nalgebra_support`).
 //!
@@ -54,6 +56,7 @@ extern crate std;
 
 pub mod control;
 mod dynamics;
+mod joint_effects;
 mod linalg;
 mod pose;
 mod real;
@@ -66,6 +69,7 @@ pub use control::{
     wrench_to_torque, ComputedTorque, Ellipsoid, PdGravity, Setpoint, SymmetricEigen,
 };
 pub use dynamics::Dynamics;
+pub use joint_effects::WithJointEffects;
 pub use linalg::{solve_spd, solve_spd_or_nan, Cholesky, FactorError, Ldlt};
 pub use pose::Pose;
 pub use real::Real;

@@ -10,7 +10,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use eomgen_runtime::{
     wrench_to_torque, ComputedTorque, Dynamics, Ellipsoid, Integrator, PdGravity, Setpoint,
-    Simulator, State,
+    Simulator, State, WithJointEffects,
 };
 use eomgen_tests::robots::double_pendulum::DoublePendulum;
 use eomgen_tests::robots::panda::{Panda, PandaLink};
@@ -329,4 +329,69 @@ fn simulation_and_control_do_not_allocate() {
     }
     COUNTING.with(|c| c.set(false));
     assert_eq!(ALLOCATIONS.load(Ordering::SeqCst) - before, 0);
+}
+
+/// Armature and friction: on the ur5, inverse and forward dynamics stay inverse to each other,
+/// the mass matrix gains the armature on its diagonal and inverse dynamics the friction; a
+/// damped passive double pendulum loses energy at the rate `qdᵀ K qd`.
+#[test]
+fn armature_and_friction() {
+    let robot = WithJointEffects {
+        robot: Ur5::<f64>::default(),
+        armature: [0.5, 0.5, 0.4, 0.1, 0.1, 0.1],
+        viscous: [2.0, 2.0, 1.0, 0.5, 0.5, 0.5],
+        coulomb: [1.0, 1.0, 0.8, 0.3, 0.3, 0.3],
+    };
+    let (q, qd, qdd) = (
+        [0.3, -1.0, 1.2, -0.4, 0.8, 0.1],
+        [0.5, -0.2, 0.9, 1.1, -0.7, 0.3],
+        [1.0, -2.0, 0.5, 0.0, 3.0, -1.0],
+    );
+    let tau = robot.inverse_dynamics(&q, &qd, &qdd);
+    let back = robot.forward_dynamics(&q, &qd, &tau);
+    for i in 0..6 {
+        assert!((back[i] - qdd[i]).abs() < 1e-9, "joint {i}");
+    }
+    let (m, m0) = (robot.mass_matrix(&q), robot.robot.mass_matrix(&q));
+    for i in 0..6 {
+        for j in 0..6 {
+            let extra = if i == j { robot.armature[i] } else { 0.0 };
+            assert!((m[i][j] - m0[i][j] - extra).abs() < 1e-15);
+        }
+    }
+    let plain = robot.robot.inverse_dynamics(&q, &qd, &qdd);
+    for i in 0..6 {
+        let want = plain[i]
+            + robot.armature[i] * qdd[i]
+            + robot.viscous[i] * qd[i]
+            + robot.coulomb[i] * qd[i].signum();
+        assert!((tau[i] - want).abs() < 1e-12);
+    }
+
+    let damped = WithJointEffects {
+        robot: DoublePendulum::<f64>::default(),
+        armature: [1e-3, 1e-3],
+        viscous: [2e-3, 1e-3],
+        coulomb: [0.0, 0.0],
+    };
+    let mut sim = Simulator::new(
+        &damped,
+        Integrator::Rk4,
+        State::new([1.8, 1.2], [1.0, 2.0]),
+        1e-4,
+    );
+    let mut e = sim.state.energy(&damped);
+    for _ in 0..2000 {
+        let qd = sim.state.qd;
+        sim.step(&[0.0; 2]);
+        let e_next = sim.state.energy(&damped);
+        let qd_mid: [f64; 2] = core::array::from_fn(|i| 0.5 * (qd[i] + sim.state.qd[i]));
+        // dE/dt = -qdᵀ K qd, to the order of the step.
+        let rate = -(0..2)
+            .map(|i| damped.viscous[i] * qd_mid[i] * qd_mid[i])
+            .sum::<f64>();
+        assert!(e_next <= e + 1e-12);
+        assert!(((e_next - e) / 1e-4 - rate).abs() < 1e-3 * rate.abs().max(1e-3));
+        e = e_next;
+    }
 }
