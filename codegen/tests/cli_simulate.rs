@@ -203,3 +203,80 @@ fn plot_has_one_trajectory_per_joint() {
             .all(|&(x, y)| (0.0..=900.0).contains(&x) && (0.0..=480.0).contains(&y)));
     }
 }
+
+/// `--friction` applies the URDF's `<dynamics damping friction>`: the double pendulum's
+/// energy then drops, and computed torque on the allegro hand (damping and Coulomb friction on
+/// every joint) compensates it exactly, so the error still decays as `(1 + w t) exp(-w t)`.
+#[test]
+fn friction_dissipates_and_computed_torque_compensates_it() {
+    let change = |extra: &[&str]| -> f64 {
+        let dir = std::env::temp_dir().join(format!(
+            "eomgen-fric-{}-{}",
+            std::process::id(),
+            extra.len()
+        ));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("dp.csv");
+        let mut args = vec![
+            "simulate",
+            "tests/robots/double_pendulum.urdf",
+            "--duration",
+            "0.5",
+            "--q0",
+            "1.8,1.2",
+            "--qd0",
+            "1,2",
+            "--csv",
+            file.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let summary = ok(&args);
+        std::fs::remove_dir_all(&dir).unwrap();
+        summary
+            .split("(change ")
+            .nth(1)
+            .and_then(|s| s.split(' ').next())
+            .unwrap()
+            .parse()
+            .unwrap()
+    };
+    let (free, damped) = (change(&[]), change(&["--friction"]));
+    assert!(free.abs() < 1e-7 && damped < -1e-3, "{free} {damped}");
+
+    let q0 = "0.1,0.2,0.3,0.2,1.0,0.3,0.2,0.1,0.0,0.3,0.2,0.1,0.0,0.3,0.2,0.1";
+    let target: Vec<f64> = q0
+        .split(',')
+        .map(|x| x.parse::<f64>().unwrap() + 0.1)
+        .collect();
+    let target_arg = target
+        .iter()
+        .map(|x| x.to_string())
+        .collect::<Vec<_>>()
+        .join(",");
+    let csv = ok(&[
+        "simulate",
+        "tests/robots/allegro_right_hand.urdf",
+        "--duration",
+        "0.3",
+        "--q0",
+        q0,
+        "--target",
+        &target_arg,
+        "--controller",
+        "computed-torque",
+        "--omega",
+        "10",
+        "--friction",
+    ]);
+    for r in rows(&csv).iter().step_by(100) {
+        let want = 0.1 * (1.0 + 10.0 * r[0]) * (-10.0 * r[0]).exp();
+        for i in 0..16 {
+            let e = (target[i] - r[1 + i]).abs();
+            assert!(
+                (e - want).abs() < 1e-8,
+                "t = {}, joint {i}: {e} vs {want}",
+                r[0]
+            );
+        }
+    }
+}

@@ -240,6 +240,10 @@ struct SimulateArgs {
     /// of the CSV to stdout.
     #[arg(long, value_name = "FILE")]
     csv: Option<PathBuf>,
+    /// Applies the URDF's joint friction, <dynamics damping friction> (viscous and Coulomb,
+    /// no stiction); computed-torque compensates it.
+    #[arg(long)]
+    friction: bool,
     /// Also writes an SVG plot of the joint positions against time to FILE.
     #[arg(long, value_name = "FILE.svg")]
     plot: Option<PathBuf>,
@@ -530,6 +534,7 @@ fn simulate_cmd(a: SimulateArgs) -> Result<(), Failure> {
         kp: a.kp,
         kd: a.kd,
         omega: a.omega,
+        friction: a.friction,
     };
     let d = derive(&model);
     let outcome = simulate::run(&model, &d, &options).map_err(Failure)?;

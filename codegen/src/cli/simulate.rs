@@ -39,6 +39,9 @@ pub struct Options {
     pub kd: f64,
     /// Bandwidth of `ComputedTorque` (rad/s).
     pub omega: f64,
+    /// Whether the joints feel the URDF's `<dynamics damping friction>` (viscous and
+    /// Coulomb); computed torque then compensates it.
+    pub friction: bool,
 }
 
 /// The result: the CSV text, a one-paragraph summary and the joint trajectories.
@@ -75,6 +78,23 @@ fn step_eval(
 ) -> Result<(Vec<f64>, Vec<f64>), String> {
     let n = q.len();
     let v = terms(model, d, q, qd)?;
+    // The effort friction takes, `damping qd + friction sign(qd)` (none at rest: no stiction).
+    let friction: Vec<f64> = (0..n)
+        .map(|i| {
+            if !o.friction {
+                return 0.0;
+            }
+            let j = &model.joints[i];
+            let sign = if qd[i] > 0.0 {
+                1.0
+            } else if qd[i] < 0.0 {
+                -1.0
+            } else {
+                0.0
+            };
+            j.damping * qd[i] + j.friction * sign
+        })
+        .collect();
     let tau: Vec<f64> = match o.controller {
         Controller::None => vec![0.0; n],
         Controller::GravityComp => (0..n)
@@ -90,11 +110,14 @@ fn step_eval(
                     (0..n).map(|j| v.mass_matrix[i][j] * a[j]).sum::<f64>()
                         + v.bias[i]
                         + v.gravity[i]
+                        + friction[i]
                 })
                 .collect()
         }
     };
-    let rhs: Vec<f64> = (0..n).map(|i| tau[i] - v.bias[i] - v.gravity[i]).collect();
+    let rhs: Vec<f64> = (0..n)
+        .map(|i| tau[i] - v.bias[i] - v.gravity[i] - friction[i])
+        .collect();
     let qdd = eval::cholesky_solve(&v.mass_matrix, &rhs).map_err(|k| {
         format!(
             "{}: the mass matrix is not positive definite during the simulation (pivot {} of \
