@@ -49,7 +49,13 @@ pub struct Builder {
     out_dir: Option<PathBuf>,
     regenerate: Option<String>,
     options: ModelOptions,
+    max_dof: usize,
 }
+
+/// Robots with more joints than this are refused unless [`Builder::max_dof`] raises the limit:
+/// Craig's Coriolis matrix has N^2 (N-1) / 2 entries, and a 48-joint chain already takes about a
+/// minute and gigabytes of memory to derive.
+pub const DEFAULT_MAX_DOF: usize = 40;
 
 fn is_identifier(s: &str, upper: bool) -> bool {
     let candidate = if upper {
@@ -71,6 +77,7 @@ impl Builder {
             out_dir: None,
             regenerate: None,
             options: ModelOptions::default(),
+            max_dof: DEFAULT_MAX_DOF,
         }
     }
 
@@ -118,6 +125,12 @@ impl Builder {
         self
     }
 
+    /// The most degrees of freedom accepted (default [`DEFAULT_MAX_DOF`]).
+    pub fn max_dof(mut self, limit: usize) -> Builder {
+        self.max_dof = limit;
+        self
+    }
+
     /// The "Regenerate:" line of the banner.
     pub fn regenerate_hint(mut self, hint: &str) -> Builder {
         self.regenerate = Some(hint.to_string());
@@ -156,6 +169,15 @@ impl Builder {
     /// Derives and emits, returning the source and the operation counts.
     pub fn generate_with_report(&self) -> Result<(Generated, Model, Derivation), Error> {
         let model = self.model()?;
+        if model.dof() > self.max_dof {
+            return Err(Error::Limit {
+                file: self.urdf.display().to_string(),
+                what: "degrees of freedom",
+                value: model.dof(),
+                limit: self.max_dof,
+                raise: "Builder::max_dof",
+            });
+        }
         let (type_name, _) = self.names(&model)?;
         let derivation = Derivation::new(&model);
         let source_name = self

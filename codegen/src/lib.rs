@@ -23,7 +23,7 @@ pub mod model;
 pub mod report;
 pub mod urdf;
 
-pub use builder::Builder;
+pub use builder::{Builder, DEFAULT_MAX_DOF};
 pub use model::{ModelError, ModelOptions, SymbolicParams};
 
 /// Everything that can go wrong between a URDF and a written module.
@@ -46,6 +46,15 @@ pub enum Error {
         "invalid {what} `{name}`: use an UpperCamelCase type name or a snake_case module name"
     )]
     InvalidName { what: &'static str, name: String },
+    /// The robot is beyond a limit of the generator.
+    #[error("{file}: {value} {what} exceed the limit of {limit} (raise it with {raise})")]
+    Limit {
+        file: String,
+        what: &'static str,
+        value: usize,
+        limit: usize,
+        raise: &'static str,
+    },
     /// Generated tokens failed to parse: a bug in eomgen.
     #[error("internal error while emitting code (please report): {0}")]
     Emit(String),
