@@ -237,3 +237,52 @@ pub mod robots {
         include!(concat!(env!("OUT_DIR"), "/allegro_right_hand.rs"));
     }
 }
+
+/// A global allocator that counts this thread's allocations, to prove code allocation-free.
+///
+/// A test binary installs it with
+/// `#[global_allocator] static GLOBAL: Counting = Counting;` and measures with
+/// [`alloc_counter::allocations`].
+pub mod alloc_counter {
+    use std::alloc::{GlobalAlloc, Layout, System};
+    use std::cell::Cell;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
+    /// Forwards to the system allocator and counts, on threads that are measuring.
+    pub struct Counting;
+
+    static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+    thread_local! {
+        // Only this thread's allocations count: the test harness allocates on its own threads.
+        static COUNTING: Cell<bool> = const { Cell::new(false) };
+    }
+
+    // SAFETY: forwards every call unchanged to the system allocator; only counts.
+    unsafe impl GlobalAlloc for Counting {
+        unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+            if COUNTING.with(Cell::get) {
+                ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+            }
+            unsafe { System.alloc(layout) }
+        }
+        unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+            unsafe { System.dealloc(ptr, layout) }
+        }
+        unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+            if COUNTING.with(Cell::get) {
+                ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+            }
+            unsafe { System.realloc(ptr, layout, new_size) }
+        }
+    }
+
+    /// Allocations made by `f` on this thread (needs [`Counting`] as the global allocator).
+    pub fn allocations(f: impl FnOnce()) -> usize {
+        let before = ALLOCATIONS.load(Ordering::SeqCst);
+        COUNTING.with(|c| c.set(true));
+        f();
+        COUNTING.with(|c| c.set(false));
+        ALLOCATIONS.load(Ordering::SeqCst) - before
+    }
+}

@@ -3,10 +3,9 @@
 
 #![allow(clippy::needless_range_loop)] // index loops read like the formulas
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
 use std::hint::black_box;
-use std::sync::atomic::{AtomicUsize, Ordering};
+
+use eomgen_tests::alloc_counter::{allocations, Counting};
 
 use eomgen_runtime::{
     wrench_to_torque, ComputedTorque, Dynamics, Ellipsoid, Integrator, PdGravity, Setpoint,
@@ -272,34 +271,6 @@ fn ur5_computed_torque_in_f32() {
     assert!(err < 1e-4, "f32 error {err:e}");
 }
 
-struct Counting;
-
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
-
-thread_local! {
-    // Only this thread's allocations count: the test harness allocates on its own threads.
-    static COUNTING: Cell<bool> = const { Cell::new(false) };
-}
-
-// SAFETY: forwards every call unchanged to the system allocator; only counts.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        if COUNTING.with(Cell::get) {
-            ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
-        }
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        if COUNTING.with(Cell::get) {
-            ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
-        }
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
-
 #[global_allocator]
 static GLOBAL: Counting = Counting;
 
@@ -313,9 +284,7 @@ fn simulation_and_control_do_not_allocate() {
         kp: [50.0; 9],
         kd: [5.0; 9],
     };
-    let before = ALLOCATIONS.load(Ordering::SeqCst);
-    COUNTING.with(|c| c.set(true));
-    {
+    let made = allocations(|| {
         let mut sim = Simulator::new(&robot, Integrator::Rk4, State::at_rest(target.q), 1e-3);
         sim.run(5, |_t, s| ct.torque(&robot, s, &target));
         sim.run_continuous(5, |_t, s| pd.torque(&robot, s, &target));
@@ -326,9 +295,8 @@ fn simulation_and_control_do_not_allocate() {
         black_box(Ellipsoid::force_translational(black_box(&jac)));
         black_box(wrench_to_torque(&jac, &[1.0; 6]));
         black_box(sim.state);
-    }
-    COUNTING.with(|c| c.set(false));
-    assert_eq!(ALLOCATIONS.load(Ordering::SeqCst) - before, 0);
+    });
+    assert_eq!(made, 0);
 }
 
 /// Armature and friction: on the ur5, inverse and forward dynamics stay inverse to each other,

@@ -3,7 +3,7 @@
 //! Output depends only on the expressions, never on hash order or on the order in which the
 //! graph was built: the terms of a sum are sorted by a key made from their printed text.
 
-use super::graph::{Graph, Id, Node, SymbolKind};
+use super::graph::{Graph, Id, Node, Symbol, SymbolKind};
 use super::schedule::{Expr, Program};
 
 /// The output language.
@@ -265,17 +265,21 @@ fn latex_symbol(name: &str) -> String {
     }
 }
 
+/// Each symbol's printed name in the given syntax.
+fn symbol_names(symbols: &[Symbol], syntax: Syntax) -> Vec<String> {
+    symbols
+        .iter()
+        .map(|s| match syntax {
+            Syntax::Text => s.name.clone(),
+            Syntax::Latex => latex_symbol(&s.name),
+        })
+        .collect()
+}
+
 impl Graph {
     /// Prints one expression.
     pub fn print(&self, e: Id, style: Style) -> String {
-        let names: Vec<String> = self
-            .symbols()
-            .iter()
-            .map(|s| match style.syntax {
-                Syntax::Text => s.name.clone(),
-                Syntax::Latex => latex_symbol(&s.name),
-            })
-            .collect();
+        let names = symbol_names(self.symbols(), style.syntax);
         let lookup = |s: u32| names[s as usize].clone();
         let p = Printer {
             style,
@@ -331,14 +335,7 @@ impl Program {
     /// Prints a program as `name = expression` lines: temporaries `t0, t1, ...`, then the outputs
     /// under the given names.
     pub fn print(&self, output_names: &[String], style: Style) -> String {
-        let names: Vec<String> = self
-            .symbols
-            .iter()
-            .map(|s| match style.syntax {
-                Syntax::Text => s.name.clone(),
-                Syntax::Latex => latex_symbol(&s.name),
-            })
-            .collect();
+        let names = symbol_names(&self.symbols, style.syntax);
         let lookup = |s: u32| names[s as usize].clone();
         let p = Printer {
             style,
