@@ -291,7 +291,7 @@ fn recursive_algorithms_agree_with_the_lagrangian_route() {
         let mut l = Layout {
             outputs: Vec::new(),
         };
-        let pairs: [(&str, Vec<Id>, Vec<Id>); 4] = [
+        let pairs: [(&str, Vec<Id>, Vec<Id>); 5] = [
             (
                 "M",
                 d.mass_matrix.iter().flatten().copied().collect(),
@@ -300,6 +300,11 @@ fn recursive_algorithms_agree_with_the_lagrangian_route() {
             ("G", d.gravity.clone(), r.gravity.clone()),
             ("b", d.bias.clone(), r.bias.clone()),
             ("tau", d.tau.clone(), r.tau.clone()),
+            (
+                "C(q, qd)",
+                d.coriolis_matrix.iter().flatten().copied().collect(),
+                r.coriolis_matrix.iter().flatten().copied().collect(),
+            ),
         ];
         let at: Vec<(usize, usize)> = pairs
             .iter()

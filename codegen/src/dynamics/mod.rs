@@ -85,6 +85,9 @@ pub struct Recursive {
     pub bias_and_gravity: Vec<Id>,
     /// Full inverse dynamics.
     pub tau: Vec<Id>,
+    /// `C(q, qd)` by Echeandia and Wensing's `O(N^2)` recursion
+    /// ([`newton_euler::coriolis`]).
+    pub coriolis_matrix: Vec<Vec<Id>>,
 }
 
 /// Which derivation a fast form comes from.
@@ -113,8 +116,7 @@ pub struct Fast {
     pub gravity: (Route, Vec<Id>),
     pub bias: (Route, Vec<Id>),
     pub tau: (Route, Vec<Id>),
-    /// `C(q, qd)`: Christoffel symbols, or half the velocity gradient of the Newton-Euler
-    /// bias (`C = 1/2 db/dqd`, exact because `G_ijk = G_ikj`).
+    /// `C(q, qd)`: Christoffel symbols, or Echeandia and Wensing's `O(N^2)` recursion.
     pub coriolis_matrix: (Route, Vec<Vec<Id>>),
     /// Craig's `C(q)`: Christoffel symbols, or `1/2 d^2 b_i / dqd_j^2`.
     pub centrifugal: (Route, Vec<Vec<Id>>),
@@ -303,6 +305,7 @@ impl Derivation {
                     gravity: gv,
                 },
             ),
+            coriolis_matrix: newton_euler::coriolis(&mut g, &lm, &qd),
         };
         lap("recursive algorithms", &mut timings);
 
@@ -319,13 +322,10 @@ impl Derivation {
         let rhs: Vec<Id> = (0..n).map(|i| g.sub(tau_in[i], h[i])).collect();
         let parents: Vec<Option<usize>> = model.joints.iter().map(|j| j.parent).collect();
         let (forward_dynamics, pivots) = newton_euler::ltdl_solve(&mut g, &parents, &mm.1, &rhs);
-        // Velocity derivatives of the Newton-Euler bias: C = 1/2 db/dqd, and Craig's forms from
-        // the second derivatives (b is quadratic in qd).
+        // Craig's forms from second velocity derivatives of the Newton-Euler bias (b is quadratic
+        // in qd).
         let db: Vec<Vec<Id>> = (0..n)
             .map(|j| g.diff_many(&recursive.bias, qd[j]))
-            .collect();
-        let c_rec: Vec<Vec<Id>> = (0..n)
-            .map(|i| (0..n).map(|j| g.scale(db[j][i], 0.5)).collect())
             .collect();
         // d2[k][j][i] = d^2 b_i / dqd_j dqd_k, one memoized pass per k over every first derivative.
         let db_flat: Vec<Id> = db.iter().flatten().copied().collect();
@@ -341,7 +341,7 @@ impl Derivation {
                 cp_rec[i].push(second(k, j, i));
             }
         }
-        let cm = cheaper(&g, &coriolis_matrix, &c_rec, flat);
+        let cm = cheaper(&g, &coriolis_matrix, &recursive.coriolis_matrix, flat);
         let cf = cheaper(&g, &centrifugal, &cf_rec, flat);
         let cp = cheaper(&g, &coriolis_pairs, &cp_rec, flat);
         let mqd_fast: Vec<Id> = (0..n).map(|i| g.dot(&mm.1[i], &qd)).collect();

@@ -12,7 +12,7 @@
 use crate::cas::{Graph, Id};
 use crate::kinematics::{
     axis_rotation, const_m3, const_v3, cross, mat_mul, mat_t_vec, mat_vec, vec_add, vec_scale,
-    Params, M3, V3,
+    vec_sub, Params, M3, V3,
 };
 use crate::model::{JointKind, Model};
 
@@ -227,77 +227,293 @@ fn transfer(g: &mut Graph, lm: &LocalModel, c: usize, f: &V3, n: &V3) -> (V3, V3
     (fp, vec_add(g, &np, &tf))
 }
 
-/// Composite-rigid-body algorithm: the upper triangle of `M(q)` (mirrored into a full matrix).
-pub fn crba(g: &mut Graph, lm: &LocalModel) -> Vec<Vec<Id>> {
+/// Mass, first moment and rotational inertia of each composite body (a body and everything
+/// below it), about the body origin in body axes.
+struct Composite {
+    mass: Vec<Id>,
+    h: Vec<V3>,
+    j: Vec<M3>,
+}
+
+/// Moves a body's inertia parameters `(m, h, J)` about its origin (in its axes) to the parent's
+/// origin and axes: `J_O = R J R^T - m [t]^2 - [t][R h] - [R h][t]`, `h_O = R h + m t`. With
+/// `m = None` the same map moves the time derivative of an inertia (whose mass part is zero).
+fn inertia_to_parent(
+    g: &mut Graph,
+    lm: &LocalModel,
+    c: usize,
+    m: Option<Id>,
+    h: &V3,
+    j: &M3,
+) -> (V3, M3) {
+    let r = lm.rotation[c];
+    let t = lm.translation[c];
+    let rh = mat_vec(g, &r, h);
+    let rj = mat_mul(g, &r, j);
+    let rt = transpose(&r);
+    let rjr = mat_mul(g, &rj, &rt);
+    let th = skew_mul(g, &t, &rh);
+    let ht = skew_mul(g, &rh, &t);
+    let tt = skew_mul(g, &t, &t);
+    // The result is symmetric: build the upper triangle and mirror it, as the two triangles
+    // would be different expressions of one value.
+    let mut out = [[g.zero(); 3]; 3];
+    for a in 0..3 {
+        for b in a..3 {
+            let mtt = match m {
+                Some(m) => g.mul(m, tt[a][b]),
+                None => g.zero(),
+            };
+            out[a][b] = g.sum(
+                0.0,
+                [
+                    (rjr[a][b], 1.0),
+                    (mtt, -1.0),
+                    (th[a][b], -1.0),
+                    (ht[a][b], -1.0),
+                ],
+            );
+            out[b][a] = out[a][b];
+        }
+    }
+    let h_o = match m {
+        Some(m) => {
+            let mt = vec_scale(g, &t, m);
+            vec_add(g, &rh, &mt)
+        }
+        None => rh,
+    };
+    (h_o, out)
+}
+
+fn composites(g: &mut Graph, lm: &LocalModel) -> Composite {
     let n = lm.dof();
     let children = lm.children();
-    // Composite mass, first moment and inertia about each body origin, leaves first.
     let mut mass = lm.mass.clone();
     let mut h = lm.first_moment.clone();
     let mut jm = lm.inertia.clone();
     for i in (0..n).rev() {
         for &c in &children[i] {
-            let r = lm.rotation[c];
-            let t = lm.translation[c];
-            // Child's composite about its origin -> about the parent origin, parent axes:
-            // J_O = R J R^T - m [t]^2 - [t][R h] - [R h][t];  h_O = R h + m t.
-            let rh = mat_vec(g, &r, &h[c]);
-            let rj = mat_mul(g, &r, &jm[c]);
-            let rt = transpose(&r);
-            let rjr = mat_mul(g, &rj, &rt);
-            let mt = vec_scale(g, &t, mass[c]);
-            let tt = skew_mul(g, &t, &t);
-            let th = skew_mul(g, &t, &rh);
-            let ht = skew_mul(g, &rh, &t);
-            for a in 0..3 {
-                for b in 0..3 {
-                    let mtt = g.mul(mass[c], tt[a][b]);
-                    jm[i][a][b] = g.sum(
-                        0.0,
-                        [
-                            (jm[i][a][b], 1.0),
-                            (rjr[a][b], 1.0),
-                            (mtt, -1.0),
-                            (th[a][b], -1.0),
-                            (ht[a][b], -1.0),
-                        ],
-                    );
-                }
-            }
-            h[i] = [0, 1, 2].map(|k| g.add_all([h[i][k], rh[k], mt[k]]));
+            let (hc, jc) = inertia_to_parent(g, lm, c, Some(mass[c]), &h[c], &jm[c]);
+            jm[i] = mat_add(g, &jm[i], &jc);
+            h[i] = vec_add(g, &h[i], &hc);
             mass[i] = g.add(mass[i], mass[c]);
         }
     }
+    Composite { mass, h, j: jm }
+}
+
+/// A spatial vector in body axes: (angular, linear) for motion, (moment about the body
+/// origin, force) for force.
+type Spatial = (V3, V3);
+
+/// The motion subspace of joint `i` in its body axes: `(a, 0)` revolute, `(0, a)` prismatic.
+fn subspace(g: &Graph, lm: &LocalModel, i: usize) -> Spatial {
+    let zero = [g.zero(); 3];
+    if lm.revolute[i] {
+        (lm.axis[i], zero)
+    } else {
+        (zero, lm.axis[i])
+    }
+}
+
+/// The momentum-like product `I v` for inertia parameters `(m, h, J)` about the origin:
+/// moment `J w + h x u`, force `w x h + m u` (with `m = None` for an inertia derivative).
+fn inertia_times(g: &mut Graph, m: Option<Id>, h: &V3, j: &M3, v: &Spatial) -> Spatial {
+    let (w, u) = v;
+    let jw = mat_vec(g, j, w);
+    let hu = cross(g, h, u);
+    let wh = cross(g, w, h);
+    let moment = vec_add(g, &jw, &hu);
+    let force = match m {
+        Some(m) => {
+            let mu = vec_scale(g, u, m);
+            vec_add(g, &wh, &mu)
+        }
+        None => wh,
+    };
+    (moment, force)
+}
+
+fn spatial_dot(g: &mut Graph, a: &Spatial, b: &Spatial) -> Id {
+    let x = g.dot(&a.0, &b.0);
+    let y = g.dot(&a.1, &b.1);
+    g.add(x, y)
+}
+
+/// Composite-rigid-body algorithm: the upper triangle of `M(q)` (mirrored into a full matrix).
+pub fn crba(g: &mut Graph, lm: &LocalModel) -> Vec<Vec<Id>> {
+    let n = lm.dof();
+    let comp = composites(g, lm);
     let mut m = vec![vec![g.zero(); n]; n];
     for i in 0..n {
-        let a = lm.axis[i];
         // Force and moment on composite body i for a unit rate of joint i.
-        let (mut f, mut nm) = if lm.revolute[i] {
-            (cross(g, &a, &h[i]), mat_vec(g, &jm[i], &a))
-        } else {
-            (vec_scale(g, &a, mass[i]), cross(g, &h[i], &a))
-        };
-        m[i][i] = if lm.revolute[i] {
-            g.dot(&a, &nm)
-        } else {
-            g.dot(&a, &f)
-        };
+        let s = subspace(g, lm, i);
+        let (mut nm, mut f) = inertia_times(g, Some(comp.mass[i]), &comp.h[i], &comp.j[i], &s);
+        m[i][i] = spatial_dot(g, &s, &(nm, f));
         let mut j = i;
         while let Some(p) = lm.parent[j] {
-            let (fp, np) = transfer(g, lm, j, &f, &nm);
-            f = fp;
-            nm = np;
-            let e = if lm.revolute[p] {
-                g.dot(&lm.axis[p], &nm)
-            } else {
-                g.dot(&lm.axis[p], &f)
-            };
+            (f, nm) = transfer(g, lm, j, &f, &nm);
+            let sp = subspace(g, lm, p);
+            let e = spatial_dot(g, &sp, &(nm, f));
             m[p][i] = e;
             m[i][p] = e;
             j = p;
         }
     }
     m
+}
+
+/// The Christoffel-consistent Coriolis matrix `C(q, qd)` in `O(N^2)`, after Echeandia and
+/// Wensing's recursive algorithm (the one behind Pinocchio's `computeCoriolisMatrix`), in body
+/// axes.
+///
+/// With `S_i` the joint subspaces, `v_k` the body velocities, `I_k` the inertias and
+/// `B_k = 1/2 ((v_k x*) I_k - I_k (v_k x) + (I_k v_k) xbar*)`, the matrix is
+/// `C = sum_k J_k^T (I_k dJ_k/dt + B_k J_k)`. Summed over a subtree, with `I^C` the composite
+/// inertia, `dI^C/dt` its time derivative and `H^C` the composite momentum, joint `j` needs
+/// three force-like vectors:
+/// `f1 = I^C dS_j/dt + 1/2 dI^C/dt S_j + 1/2 S_j x* H^C` (so `B^C S_j`'s symmetric half is
+/// `1/2 dI^C/dt S_j` and its skew half `1/2 S_j x* H^C`), `f2 = I^C S_j` and
+/// `f3 = (B^C)^T S_j = 1/2 dI^C/dt S_j - 1/2 S_j x* H^C`. Then for every `i` on the path from
+/// `j` to the root, `C_ij = S_i . f1` and `C_ji = dS_i/dt . f2 + S_i . f3`, with the vectors
+/// moved to body `i`'s axes.
+pub fn coriolis(g: &mut Graph, lm: &LocalModel, qd: &[Id]) -> Vec<Vec<Id>> {
+    let n = lm.dof();
+    let zero = [g.zero(); 3];
+    // Body velocities (angular, origin) and the joint subspaces' time derivatives.
+    let mut vel: Vec<Spatial> = Vec::with_capacity(n);
+    let mut sdot: Vec<Spatial> = Vec::with_capacity(n);
+    for i in 0..n {
+        let (wp, up) = match lm.parent[i] {
+            Some(p) => vel[p],
+            None => (zero, zero),
+        };
+        let r = &lm.rotation[i];
+        let wt = cross(g, &wp, &lm.translation[i]);
+        let ut = vec_add(g, &up, &wt);
+        let u = mat_t_vec(g, r, &ut);
+        let w = mat_t_vec(g, r, &wp);
+        let a = lm.axis[i];
+        let aq = vec_scale(g, &a, qd[i]);
+        // dS/dt = v x S, and S x S = 0 lets the parent's velocity stand in for the body's.
+        if lm.revolute[i] {
+            let wa = cross(g, &w, &a);
+            let ua = cross(g, &u, &a);
+            sdot.push((wa, ua));
+            let wi = vec_add(g, &w, &aq);
+            vel.push((wi, u));
+        } else {
+            let wa = cross(g, &w, &a);
+            sdot.push((zero, wa));
+            let ui = vec_add(g, &u, &aq);
+            vel.push((w, ui));
+        }
+    }
+    // Per body, both halved (with halved inertia parameters, so that no product by 1/2 is
+    // left for run time): the momentum H = I v, and dI/dt's parameters: dh/dt (the linear
+    // momentum) and dJ/dt = [w]J - J[w] + 2 (h.u) 1 - u h^T - h u^T.
+    let mut mom: Vec<Spatial> = Vec::with_capacity(n);
+    let mut dj: Vec<M3> = Vec::with_capacity(n);
+    for k in 0..n {
+        let (w, u) = vel[k];
+        let m = g.scale(lm.mass[k], 0.5);
+        let h = lm.first_moment[k].map(|x| g.scale(x, 0.5));
+        let j = lm.inertia[k].map(|row| row.map(|x| g.scale(x, 0.5)));
+        mom.push(inertia_times(g, Some(m), &h, &j, &(w, u)));
+        let hu = g.dot(&h, &u);
+        let wj = skew_times(g, &w, &j);
+        let mut d = [[g.zero(); 3]; 3];
+        for a in 0..3 {
+            for b in a..3 {
+                // ([w]J)_ab - (J[w])_ab = ([w]J)_ab + ([w]J)_ba, as J is symmetric.
+                let uh = g.mul(u[a], h[b]);
+                let hu_ab = g.mul(h[a], u[b]);
+                let mut terms = vec![(wj[a][b], 1.0), (wj[b][a], 1.0), (uh, -1.0), (hu_ab, -1.0)];
+                if a == b {
+                    terms.push((hu, 2.0));
+                }
+                d[a][b] = g.sum(0.0, terms);
+                d[b][a] = d[a][b];
+            }
+        }
+        dj.push(d);
+    }
+    // Composites, leaves first: inertia, and the halved derivative and momentum.
+    let comp = composites(g, lm);
+    let children = lm.children();
+    let mut dh: Vec<V3> = mom.iter().map(|m| m.1).collect();
+    for i in (0..n).rev() {
+        for &c in &children[i] {
+            let (dhc, djc) = inertia_to_parent(g, lm, c, None, &dh[c], &dj[c]);
+            dj[i] = mat_add(g, &dj[i], &djc);
+            dh[i] = vec_add(g, &dh[i], &dhc);
+            let (f, nm) = transfer(g, lm, c, &mom[c].1, &mom[c].0);
+            mom[i] = (vec_add(g, &mom[i].0, &nm), vec_add(g, &mom[i].1, &f));
+        }
+    }
+    let mut c = vec![vec![g.zero(); n]; n];
+    for j in 0..n {
+        let s = subspace(g, lm, j);
+        let ic = (Some(comp.mass[j]), comp.h[j], comp.j[j]);
+        let f2 = inertia_times(g, ic.0, &ic.1, &ic.2, &s);
+        let isd = inertia_times(g, ic.0, &ic.1, &ic.2, &sdot[j]);
+        let dis = inertia_times(g, None, &dh[j], &dj[j], &s);
+        let sh = cross_force(g, &s, &mom[j]);
+        let sym = spatial_add(g, &isd, &dis);
+        let mut f1 = spatial_add(g, &sym, &sh);
+        let mut f2 = f2;
+        let mut f3 = spatial_sub(g, &dis, &sh);
+        c[j][j] = spatial_dot(g, &s, &f1);
+        let mut k = j;
+        while let Some(i) = lm.parent[k] {
+            f1 = transfer_spatial(g, lm, k, &f1);
+            f2 = transfer_spatial(g, lm, k, &f2);
+            f3 = transfer_spatial(g, lm, k, &f3);
+            let si = subspace(g, lm, i);
+            c[i][j] = spatial_dot(g, &si, &f1);
+            let a = spatial_dot(g, &sdot[i], &f2);
+            let b = spatial_dot(g, &si, &f3);
+            c[j][i] = g.add(a, b);
+            k = i;
+        }
+    }
+    c
+}
+
+/// `v x* f` for a motion `v` and a force `f`: `(w x n + u x f, w x f)`.
+fn cross_force(g: &mut Graph, v: &Spatial, f: &Spatial) -> Spatial {
+    let wn = cross(g, &v.0, &f.0);
+    let uf = cross(g, &v.1, &f.1);
+    let wf = cross(g, &v.0, &f.1);
+    (vec_add(g, &wn, &uf), wf)
+}
+
+fn spatial_add(g: &mut Graph, a: &Spatial, b: &Spatial) -> Spatial {
+    (vec_add(g, &a.0, &b.0), vec_add(g, &a.1, &b.1))
+}
+
+fn spatial_sub(g: &mut Graph, a: &Spatial, b: &Spatial) -> Spatial {
+    (vec_sub(g, &a.0, &b.0), vec_sub(g, &a.1, &b.1))
+}
+
+/// A (moment, force) pair of body `c` moved to its parent (see [`transfer`]).
+fn transfer_spatial(g: &mut Graph, lm: &LocalModel, c: usize, f: &Spatial) -> Spatial {
+    let (fp, np) = transfer(g, lm, c, &f.1, &f.0);
+    (np, fp)
+}
+
+fn mat_add(g: &mut Graph, a: &M3, b: &M3) -> M3 {
+    [0, 1, 2].map(|r| [0, 1, 2].map(|c| g.add(a[r][c], b[r][c])))
+}
+
+/// `[w] J`: the cross-product matrix of `w` times `J`.
+fn skew_times(g: &mut Graph, w: &V3, j: &M3) -> M3 {
+    let cols = [0, 1, 2].map(|c| {
+        let col = [j[0][c], j[1][c], j[2][c]];
+        cross(g, w, &col)
+    });
+    [0, 1, 2].map(|r| [0, 1, 2].map(|c| cols[c][r]))
 }
 
 fn transpose(r: &M3) -> M3 {

@@ -512,7 +512,7 @@ pub fn emit_tokens(
     let cm_doc = doc(&[
         route(
             f.coriolis_matrix.0,
-            "half the velocity gradient of the Newton-Euler bias",
+            "Echeandia and Wensing's O(N^2) recursion on composite inertias and momenta",
         ),
         cm_ops,
     ]);
