@@ -463,6 +463,36 @@ fn programs_compute_each_subexpression_once_and_count_operations() {
 }
 
 #[test]
+fn a_scaled_copy_of_a_sum_reuses_the_sum() {
+    let mut g = Graph::new();
+    let (a, b, c, d) = (g.q(0), g.q(1), g.q(2), g.q(3));
+    let ab = g.mul(a, b);
+    // u = ab + c - d; the graph distributes 2.5 into the terms of the second sum.
+    let u = g.sum(0.0, [(ab, 1.0), (c, 1.0), (d, -1.0)]);
+    let su = g.scale(u, 2.5);
+    let v = g.add(su, a); // 2.5 ab + 2.5 c - 2.5 d + a
+                          // Made before the unit sum it matches (negated): -3 ab - 3 c + 3 d + b.
+    let w = g.sum(0.0, [(ab, -3.0), (c, -3.0), (d, 3.0), (b, 1.0)]);
+    let x = g.mul(u, a);
+    let outputs = [w, v, x];
+    let p = Program::new(&g, &outputs);
+    let n = p.ops();
+    // u: 2 adds and ab's product; v and w: one scale and one add each; x: one product.
+    assert_eq!((n.add, n.mul), (4, 4), "{}", p.print(&[], Style::default()));
+    let at = [0.3, -1.2, 0.7, 2.1];
+    let got = p
+        .eval(|s| match s.kind {
+            eomgen::cas::SymbolKind::Q(i) => at.get(i).copied(),
+            _ => None,
+        })
+        .unwrap();
+    let want = eval(&g, &outputs, &at);
+    for (x, y) in got.iter().zip(&want) {
+        assert!(close(*x, *y, 1e-14), "{got:?} {want:?}");
+    }
+}
+
+#[test]
 fn numbers_print_shortest_or_to_digits() {
     use eomgen::cas::format_number;
     assert_eq!(format_number(2.0, None), "2");

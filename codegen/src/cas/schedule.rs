@@ -168,10 +168,47 @@ impl Program {
     pub fn new(graph: &Graph, outputs: &[Id]) -> Program {
         let order = graph.reachable(outputs);
         let slot = |id: Id| order.binary_search(&id).expect("reachable");
-        let mut uses = vec![0u32; order.len()];
+        // Sums that are unit combinations, `a + b - c`: a later sum that holds the same terms
+        // with one coefficient magnitude, `k a + k b - k c` (the graph distributes constant
+        // factors into sums), reuses them as `k t` instead of adding the terms again.
+        let mut unit_sums: HashMap<Vec<(Id, bool)>, (Id, f64)> = HashMap::new();
         for &id in &order {
-            for c in graph.node(id).children() {
-                uses[slot(c)] += 1;
+            if let Node::Add(c, ts) = graph.node(id) {
+                if c.get() == 0.0 && ts.len() >= 2 && ts.iter().all(|t| t.1.get().abs() == 1.0) {
+                    let (key, sign) = unit_key(ts.iter().map(|t| (t.0, t.1.get())));
+                    unit_sums.entry(key).or_insert((id, sign));
+                }
+            }
+        }
+        let terms_of = |id: Id, ts: &[(Id, super::graph::Num)]| -> Vec<(Id, f64)> {
+            reuse_unit_sums(id, ts.iter().map(|t| (t.0, t.1.get())), &unit_sums)
+        };
+        let mut uses = vec![0u32; order.len()];
+        // Scheduling order: by `Id` (children first), except that a reused unit sum created
+        // after its user moves just before it (its terms are the user's children).
+        let mut visit: Vec<usize> = Vec::with_capacity(order.len());
+        let mut placed = vec![false; order.len()];
+        for (k, &id) in order.iter().enumerate() {
+            match graph.node(id) {
+                Node::Add(_, ts) => {
+                    for (c, _) in terms_of(id, ts) {
+                        let sc = slot(c);
+                        uses[sc] += 1;
+                        if sc > k && !placed[sc] {
+                            placed[sc] = true;
+                            visit.push(sc);
+                        }
+                    }
+                }
+                node => {
+                    for c in node.children() {
+                        uses[slot(c)] += 1;
+                    }
+                }
+            }
+            if !placed[k] {
+                placed[k] = true;
+                visit.push(k);
             }
         }
         for &o in outputs {
@@ -196,15 +233,18 @@ impl Program {
         // the nesting depth of that inline expression.
         let mut repr: Vec<Option<(Expr, u32)>> = vec![None; order.len()];
         let mut temps = Vec::new();
-        for (k, &id) in order.iter().enumerate() {
+        for k in visit {
+            let id = order[k];
             let sub =
                 |c: Id| -> (Expr, u32) { repr[slot(c)].clone().expect("child before parent") };
             let (e, depth) = match graph.node(id) {
                 Node::Const(c) => (Expr::Const(c.get()), 0),
                 Node::Sym(s) => (Expr::Input(*s), 0),
                 Node::Add(c, ts) => {
-                    let parts: Vec<((Expr, u32), f64)> =
-                        ts.iter().map(|(t, k)| (sub(*t), k.get())).collect();
+                    let parts: Vec<((Expr, u32), f64)> = terms_of(id, ts)
+                        .into_iter()
+                        .map(|(t, k)| (sub(t), k))
+                        .collect();
                     let d = parts.iter().map(|p| p.0 .1).max().unwrap_or(0) + 1;
                     (
                         factor_coefficients(
@@ -315,6 +355,53 @@ impl Program {
             .map(|e| e.eval(&inputs, &temps))
             .collect())
     }
+}
+
+/// The terms of a unit sum with its first coefficient made positive, and the sign that undoes
+/// it.
+fn unit_key(terms: impl Iterator<Item = (Id, f64)>) -> (Vec<(Id, bool)>, f64) {
+    let terms: Vec<(Id, f64)> = terms.collect();
+    let sign = if terms[0].1 < 0.0 { -1.0 } else { 1.0 };
+    let key = terms.iter().map(|&(t, k)| (t, k * sign > 0.0)).collect();
+    (key, sign)
+}
+
+/// The terms of sum `id` with every group of two or more terms of one coefficient magnitude
+/// that equals an earlier unit sum replaced by that sum: `k a + k b + c` -> `k t + c`.
+fn reuse_unit_sums(
+    id: Id,
+    terms: impl Iterator<Item = (Id, f64)>,
+    unit_sums: &HashMap<Vec<(Id, bool)>, (Id, f64)>,
+) -> Vec<(Id, f64)> {
+    let terms: Vec<(Id, f64)> = terms.collect();
+    let mut mags: Vec<f64> = Vec::new();
+    for &(_, k) in &terms {
+        if !mags.contains(&k.abs()) {
+            mags.push(k.abs());
+        }
+    }
+    if mags.len() == terms.len() {
+        return terms;
+    }
+    let mut out = Vec::with_capacity(terms.len());
+    for mag in mags {
+        let group: Vec<(Id, f64)> = terms
+            .iter()
+            .filter(|t| t.1.abs() == mag)
+            .map(|&(t, k)| (t, k / mag))
+            .collect();
+        if group.len() >= 2 {
+            let (key, sign) = unit_key(group.iter().copied());
+            if let Some(&(u, u_sign)) = unit_sums.get(&key) {
+                if u != id {
+                    out.push((u, mag * sign * u_sign));
+                    continue;
+                }
+            }
+        }
+        out.extend(group.into_iter().map(|(t, k)| (t, k * mag)));
+    }
+    out
 }
 
 /// `k a + k b - k c` -> `k (a + b - c)`: terms whose coefficients share a magnitude get it
