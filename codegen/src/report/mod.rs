@@ -578,7 +578,21 @@ pub fn render(model: &Model, d: &Derivation, opts: &ShowOptions) -> Result<Strin
     let mut dropped = 0;
     let mut sections = Vec::with_capacity(opts.terms.len());
     for &term in &opts.terms {
-        sections.push(section(&mut g, d, term, opts, syntax, &mut dropped)?);
+        let mut s = section(&mut g, d, term, opts, syntax, &mut dropped)?;
+        if term == Term::Tau && model.include_friction {
+            let sign = if model.coulomb_smoothing > 0.0 {
+                format!(
+                    "qd_i / sqrt(qd_i^2 + {}^2)",
+                    format_number(model.coulomb_smoothing, opts.digits)
+                )
+            } else {
+                "sign(qd_i)".to_string()
+            };
+            s.notes.push(format!(
+                "Plus the joint friction F_i = damping_i qd_i + friction_i {sign}."
+            ));
+        }
+        sections.push(s);
     }
     let expanded_roots: Vec<Id> = sections
         .iter()
@@ -661,12 +675,27 @@ pub fn render(model: &Model, d: &Derivation, opts: &ShowOptions) -> Result<Strin
         .enumerate()
         .map(|(i, j)| {
             let q = g.print(d.q[i], style);
-            let what = format!(
+            let mut what = format!(
                 "{}, {} about {}",
                 j.name,
                 kind_name(j.kind),
                 vec3(&j.axis, opts.digits)
             );
+            if j.armature != 0.0 {
+                let _ = write!(
+                    what,
+                    ", rotor inertia {}",
+                    format_number(j.armature, opts.digits)
+                );
+            }
+            if model.include_friction {
+                let _ = write!(
+                    what,
+                    ", damping {}, friction {}",
+                    format_number(j.damping, opts.digits),
+                    format_number(j.friction, opts.digits)
+                );
+            }
             (q, what)
         })
         .collect();
