@@ -572,6 +572,16 @@ fn command_line_flags_and_warnings() {
     assert!(stdout.contains("inverse dynamics tau = M qdd + b + G + F"));
     // M22 = fore about the elbow, 0.01 + 1 * 0.15^2 = 0.0325, plus 0.1.
     assert!(stdout.contains(", 0.1325]"), "{stdout}");
+    // info lists the effects per joint.
+    let out = run(&["info", urdf, "--armature", "shoulder=0.2"]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains(
+            "joint effects (damping, Coulomb friction, rotor inertia; friction left out of the \
+             dynamics without --friction):\n  q1 shoulder: 0.5, 0.2, 0.2\n  q2 elbow: 0.1, 0.05, 0\n"
+        ),
+        "{stdout}"
+    );
     // Bad values: exit 1 naming the joint, or 2 for malformed flags.
     let out = run(&["generate", urdf, "--armature", "wrist=0.1"]);
     assert_eq!(out.status.code(), Some(1));
