@@ -592,3 +592,54 @@ fn command_line_flags_and_warnings() {
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("density must be positive"));
 }
+
+#[test]
+fn symbolic_parameters_include_the_joint_effects() {
+    use eomgen::SymbolicParams;
+    let source = eomgen::Builder::new(fixture())
+        .inertia_from_collision(1000.0)
+        .symbolic(SymbolicParams::All)
+        .friction(true)
+        .armature([("shoulder", 0.2)])
+        .generate()
+        .unwrap();
+    for field in [
+        "/// `Ia_shoulder` (armature option value 0.2).\n    pub ia_shoulder: T,",
+        "/// `damping_elbow` (URDF value 0.1).\n    pub damping_elbow: T,",
+        "/// `friction_shoulder` (URDF value 0.2).\n    pub friction_shoulder: T,",
+    ] {
+        assert!(source.contains(field), "missing {field}");
+    }
+    // Zero rotor inertia stays a structural zero, not a field.
+    assert!(!source.contains("ia_elbow"));
+    // The symbolic derivation at the default values is the numeric one.
+    let o = options(|o| {
+        o.symbolic = SymbolicParams::All;
+        o.friction = true;
+        o.armature = vec![("shoulder".into(), 0.2)];
+    });
+    let symbolic = Derivation::new(&load(&o));
+    let numeric = Derivation::new(&load(&ModelOptions {
+        symbolic: SymbolicParams::None,
+        ..o
+    }));
+    let s = &states(2)[3];
+    let value = |d: &Derivation, ids: &[Id]| {
+        Program::new(&d.graph, ids)
+            .eval(|sym| match sym.kind {
+                SymbolKind::Q(i) => Some(s.q[i]),
+                SymbolKind::Qd(i) => Some(s.qd[i]),
+                SymbolKind::Qdd(i) => Some(s.qdd[i]),
+                SymbolKind::Param => d.params.iter().find(|p| p.0 == sym.name).map(|p| p.2),
+                SymbolKind::Tau(_) => None,
+            })
+            .unwrap()
+    };
+    let (a, b) = (
+        value(&symbolic, &symbolic.fast.tau.1),
+        value(&numeric, &numeric.fast.tau.1),
+    );
+    for i in 0..2 {
+        assert!(close(a[i], b[i], 1e-13), "{a:?} vs {b:?}");
+    }
+}

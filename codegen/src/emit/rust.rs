@@ -378,7 +378,12 @@ pub fn emit_tokens(
     for (name, id, value) in &d.params {
         let sym = d.graph.as_symbol(*id).expect("parameter symbol");
         let f = format_ident!("{}", field_scope.claim(snake(name, "p")));
-        let docline = format!(" `{}` (URDF value {}).", name.replace('`', "'"), value);
+        let docline = format!(
+            " `{}` ({} {}).",
+            name.replace('`', "'"),
+            crate::report::value_source(name),
+            value
+        );
         field_defs.push(quote!(#[doc = #docline] pub #f: T,));
         let l = lit(*value);
         field_defaults.push(quote!(#f: #l,));

@@ -522,7 +522,19 @@ fn describe_param(name: &str) -> String {
         "x" | "y" | "z" => {
             format!("origin of joint {owner} in its parent's frame, {head} coordinate")
         }
+        "Ia" => format!("rotor inertia (armature) of joint {owner}"),
+        "damping" => format!("viscous damping of joint {owner}"),
+        "friction" => format!("Coulomb friction of joint {owner}"),
         _ => "a parameter".to_string(),
+    }
+}
+
+/// Where a parameter's default value comes from: the URDF, or an option for rotor inertia.
+pub(crate) fn value_source(name: &str) -> &'static str {
+    if name.starts_with("Ia_") {
+        "armature option value"
+    } else {
+        "URDF value"
     }
 }
 
@@ -602,11 +614,19 @@ pub fn render(model: &Model, d: &Derivation, opts: &ShowOptions) -> Result<Strin
     let short = trig::short_names(&g, &expanded_roots, style, d.dof <= 9);
     let all_roots: Vec<Id> = sections.iter().flat_map(|s| s.roots()).collect();
     let used: BTreeSet<Id> = g.reachable(&all_roots).into_iter().collect();
-    let params: Vec<(String, String, f64)> = d
+    let params: Vec<(String, String)> = d
         .params
         .iter()
         .filter(|p| used.contains(&p.1))
-        .map(|(name, id, v)| (g.print(*id, style), describe_param(name), *v))
+        .map(|(name, id, v)| {
+            let what = format!(
+                "{} ({} {})",
+                describe_param(name),
+                value_source(name),
+                format_number(*v, None)
+            );
+            (g.print(*id, style), what)
+        })
         .collect();
     let uses_rates = used.iter().any(|&id| match g.node(id) {
         Node::Sym(s) => matches!(
@@ -710,11 +730,8 @@ pub fn render(model: &Model, d: &Derivation, opts: &ShowOptions) -> Result<Strin
             "velocity and acceleration of q_i".into(),
         ));
     }
-    for (sym, what, v) in &params {
-        legend_text.push((
-            sym.clone(),
-            format!("{what} (URDF value {})", format_number(*v, None)),
-        ));
+    for (sym, what) in &params {
+        legend_text.push((sym.clone(), what.clone()));
     }
 
     let mut out = String::new();
