@@ -1,4 +1,5 @@
-//! Generates the reference robots exactly as a user's build script would.
+//! Generates the reference robots exactly as a user's build script would, and a small arm
+//! with joint friction, rotor inertia and an inertia filled from its collision box.
 
 fn main() {
     for (file, module, ty) in [
@@ -21,5 +22,47 @@ fn main() {
             .type_name(ty)
             .compile()
             .unwrap();
+    }
+    joint_effects();
+}
+
+/// `fixtures/joint_effects.urdf` three ways: rigid only, with friction and armature, and with
+/// smoothed Coulomb friction. Its upper arm's inertia comes from its collision box; the two
+/// warnings that produces (the filled link and a mesh-only one) are expected, so they are
+/// checked here instead of printed by `compile()` on every build.
+fn joint_effects() {
+    let urdf = "fixtures/joint_effects.urdf";
+    println!("cargo:rerun-if-changed={urdf}");
+    let out_dir = std::path::PathBuf::from(std::env::var_os("OUT_DIR").unwrap());
+    let base = || {
+        eomgen::Builder::new(urdf)
+            .inertia_from_collision(1000.0)
+            .armature([("shoulder", 0.2), ("elbow", 0.05)])
+    };
+    for (module, ty, builder) in [
+        (
+            "joint_effects",
+            "JointEffects",
+            eomgen::Builder::new(urdf).inertia_from_collision(1000.0),
+        ),
+        (
+            "joint_effects_full",
+            "JointEffectsFull",
+            base().friction(true),
+        ),
+        (
+            "joint_effects_smooth",
+            "JointEffectsSmooth",
+            base().friction(true).coulomb_smoothing(0.05),
+        ),
+    ] {
+        let (generated, model, _) = builder.type_name(ty).generate_with_report().unwrap();
+        let warned: Vec<String> = model.warnings.iter().map(|w| w.to_string()).collect();
+        assert!(
+            warned.len() == 2 && warned[0].contains("`upper`") && warned[1].contains("`camera`"),
+            "unexpected warnings: {warned:?}"
+        );
+        let path = out_dir.join(format!("{module}.rs"));
+        eomgen::write_if_changed(&path, generated.source.as_bytes()).unwrap();
     }
 }

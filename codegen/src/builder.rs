@@ -119,6 +119,56 @@ impl Builder {
         self
     }
 
+    /// Rotor inertia (armature) per joint, by URDF name: kg m^2 for a revolute joint (gear
+    /// ratio squared times the rotor's inertia), kg for a prismatic one. Added to the mass
+    /// matrix's diagonal, so it is part of `mass_matrix`, `inverse_dynamics`,
+    /// `forward_dynamics` and `kinetic_energy`. Calls add up; an unknown or fixed joint, or a
+    /// negative or non-finite value, fails generation with an error naming the joint.
+    ///
+    /// ```no_run
+    /// eomgen::Builder::new("robots/panda.urdf")
+    ///     .armature([("panda_joint1", 0.1), ("panda_joint2", 0.1)])
+    ///     .compile()
+    ///     .unwrap();
+    /// ```
+    pub fn armature<S: Into<String>>(
+        mut self,
+        joints: impl IntoIterator<Item = (S, f64)>,
+    ) -> Builder {
+        self.options
+            .armature
+            .extend(joints.into_iter().map(|(name, value)| (name.into(), value)));
+        self
+    }
+
+    /// Includes the joint friction of the URDF's `<dynamics damping friction>` in the generated
+    /// `inverse_dynamics` and `forward_dynamics` (`tau = M qdd + b + G + F(qd)`, with
+    /// `F_i = damping_i qd_i + friction_i sign(qd_i)`), and generates `friction(qd)` giving
+    /// `F`. Off by default.
+    pub fn friction(mut self, include: bool) -> Builder {
+        self.options.friction = include;
+        self
+    }
+
+    /// With [`Builder::friction`], smooths the Coulomb term's `sign(qd)` into
+    /// `qd / sqrt(qd^2 + eps^2)` with `eps` this velocity (rad/s or m/s), for integrators
+    /// that dislike discontinuities; 0 (the default) keeps the exact sign.
+    pub fn coulomb_smoothing(mut self, eps: f64) -> Builder {
+        self.options.coulomb_smoothing = eps;
+        self
+    }
+
+    /// Fills the inertia of links without `<inertial>` from their `<collision>` boxes,
+    /// cylinders and spheres, of uniform `density` (kg/m^3; 1000 for water, 2700 for
+    /// aluminium). Each filled link, and each that has only meshes to offer, is reported as a
+    /// warning: [`Builder::compile`] prints it as `cargo:warning=`, and the model returned by
+    /// [`Builder::model`] lists it in [`Model::warnings`]. See
+    /// [`ModelOptions::inertia_from_collision`].
+    pub fn inertia_from_collision(mut self, density: f64) -> Builder {
+        self.options.inertia_from_collision = Some(density);
+        self
+    }
+
     /// All model options at once.
     pub fn model_options(mut self, options: ModelOptions) -> Builder {
         self.options = options;
@@ -203,7 +253,8 @@ impl Builder {
     }
 
     /// Writes `<out_dir>/<module_name>.rs` when its content changed, and tells cargo to rerun
-    /// the build script when the URDF changes. Returns the path written.
+    /// the build script when the URDF changes; prints each of the model's warnings
+    /// ([`Model::warnings`]) as `cargo:warning=`. Returns the path written.
     pub fn compile(&self) -> Result<PathBuf, Error> {
         println!("cargo:rerun-if-changed={}", self.urdf.display());
         let out_dir = match &self.out_dir {
@@ -213,6 +264,11 @@ impl Builder {
                 .ok_or(Error::NoOutDir)?,
         };
         let (generated, model, _) = self.generate_with_report()?;
+        for warning in &model.warnings {
+            // One line each: cargo shows a warning per `cargo:warning=` line.
+            let line = warning.to_string().replace(['\n', '\r'], " ");
+            println!("cargo:warning={line}");
+        }
         let (_, module_name) = self.names(&model)?;
         let path = out_dir.join(format!("{module_name}.rs"));
         crate::write_if_changed(&path, generated.source.as_bytes())?;

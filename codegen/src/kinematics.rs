@@ -37,6 +37,12 @@ pub struct Params {
     pub inertia: Vec<M3>,
     /// Per joint: translation of the joint origin in the parent body frame.
     pub origin: Vec<V3>,
+    /// Per joint: rotor inertia (armature), added to the mass matrix's diagonal.
+    pub armature: Vec<Id>,
+    /// Per joint: viscous damping and Coulomb friction coefficients (zero unless the model
+    /// includes friction).
+    pub damping: Vec<Id>,
+    pub coulomb: Vec<Id>,
     /// Every symbolic parameter: (symbol name, node, the URDF's value), in creation order.
     pub symbols: Vec<(String, Id, f64)>,
 }
@@ -86,11 +92,28 @@ impl Params {
             origin
                 .push([0, 1, 2].map(|k| value(g, s, format!("{}_{n}", ["x", "y", "z"][k]), t[k])));
         }
+        // Joint parameters after every geometric one, so that adding them leaves the order of
+        // existing fields alone; zero values stay structural zeros.
+        let (mut armature, mut damping, mut coulomb) = (vec![], vec![], vec![]);
+        for j in &model.joints {
+            let (s, n) = (j.symbolic_origin, &j.name);
+            armature.push(value(g, s, format!("Ia_{n}"), j.armature));
+            let (d, f) = if model.include_friction {
+                (j.damping, j.friction)
+            } else {
+                (0.0, 0.0)
+            };
+            damping.push(value(g, s, format!("damping_{n}"), d));
+            coulomb.push(value(g, s, format!("friction_{n}"), f));
+        }
         Params {
             mass,
             com,
             inertia,
             origin,
+            armature,
+            damping,
+            coulomb,
             symbols,
         }
     }

@@ -25,7 +25,10 @@
 //!   unless [`ModelOptions::joint_order`] gives an explicit order. A parent joint always comes
 //!   before its children.
 //! - Mimic joints are independent joints, as in Pinocchio; the [`Mimic`]
-//!   relation is kept for information only. Limits and `<dynamics damping friction>` are kept.
+//!   relation is kept for information only. Limits and `<dynamics damping friction>` are kept
+//!   (the friction enters the dynamics only with [`ModelOptions::friction`]).
+//! - `<collision>` boxes, cylinders and spheres give a link without `<inertial>` its inertia
+//!   only with [`ModelOptions::inertia_from_collision`]; otherwise such a link is massless.
 //!
 //! # Validation
 //!
@@ -83,9 +86,10 @@
 
 use std::path::Path;
 
+use crate::model::shapes::Shape;
 use crate::model::{
-    build_model, InertialDescription, JointDescription, JointKind, JointType, Limits,
-    LinkDescription, Mimic, Model, ModelError, ModelOptions, Pose, RobotDescription,
+    build_model, CollisionDescription, InertialDescription, JointDescription, JointKind, JointType,
+    Limits, LinkDescription, Mimic, Model, ModelError, ModelOptions, Pose, RobotDescription,
 };
 
 /// The deepest element nesting accepted. URDFs need about 5 levels (robot, link, visual,
@@ -125,6 +129,27 @@ fn describe(robot: &urdf_rs::Robot) -> RobotDescription {
         .map(|link| {
             let i = &link.inertial;
             let t = &i.inertia;
+            let collisions = link
+                .collision
+                .iter()
+                .map(|c| {
+                    use urdf_rs::Geometry as G;
+                    let geometry = match &c.geometry {
+                        G::Box { size } => Ok(Shape::Box { size: size.0 }),
+                        G::Cylinder { radius, length } => Ok(Shape::Cylinder {
+                            radius: *radius,
+                            length: *length,
+                        }),
+                        G::Sphere { radius } => Ok(Shape::Sphere { radius: *radius }),
+                        G::Capsule { .. } => Err("capsule"),
+                        G::Mesh { .. } => Err("mesh"),
+                    };
+                    CollisionDescription {
+                        origin: pose(&c.origin),
+                        geometry,
+                    }
+                })
+                .collect();
             LinkDescription {
                 name: link.name.clone(),
                 inertial: InertialDescription {
@@ -132,6 +157,7 @@ fn describe(robot: &urdf_rs::Robot) -> RobotDescription {
                     mass: i.mass.value,
                     inertia: [t.ixx, t.ixy, t.ixz, t.iyy, t.iyz, t.izz],
                 },
+                collisions,
             }
         })
         .collect();

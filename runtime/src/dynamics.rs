@@ -23,6 +23,14 @@
 ///   gravity vector and `c_i` the centre of mass of link `i` in the world frame; it is zero when
 ///   every centre of mass is at the origin of the world frame.
 ///
+/// Generated with joint friction (`eomgen::Builder::friction`), [`inverse_dynamics`] and
+/// [`forward_dynamics`] also include the friction effort `F(qd)`:
+/// `M qdd + C qd + g + F(qd) = tau`; generated with rotor inertia (`Builder::armature`), `M`
+/// includes it. [`WithJointEffects`](crate::WithJointEffects) adds both at run time instead.
+///
+/// [`inverse_dynamics`]: Dynamics::inverse_dynamics
+/// [`forward_dynamics`]: Dynamics::forward_dynamics
+///
 /// Implementations are allocation-free and must not panic; non-finite inputs give non-finite
 /// outputs.
 ///

@@ -236,6 +236,18 @@ pub mod robots {
     pub mod allegro_right_hand {
         include!(concat!(env!("OUT_DIR"), "/allegro_right_hand.rs"));
     }
+    /// `fixtures/joint_effects.urdf`, rigid body only (upper arm filled at 1000 kg/m^3).
+    pub mod joint_effects {
+        include!(concat!(env!("OUT_DIR"), "/joint_effects.rs"));
+    }
+    /// The same with joint friction and rotor inertia (shoulder 0.2, elbow 0.05 kg m^2).
+    pub mod joint_effects_full {
+        include!(concat!(env!("OUT_DIR"), "/joint_effects_full.rs"));
+    }
+    /// The same with Coulomb friction smoothed below 0.05 rad/s.
+    pub mod joint_effects_smooth {
+        include!(concat!(env!("OUT_DIR"), "/joint_effects_smooth.rs"));
+    }
 }
 
 /// A global allocator that counts this thread's allocations, to prove code allocation-free.

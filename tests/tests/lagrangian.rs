@@ -25,6 +25,18 @@ fn run(p: &Program, q: &[f64], qd: &[f64], qdd: &[f64]) -> Vec<f64> {
     .expect("numeric model")
 }
 
+/// Evaluates `outputs` with the joint efforts `tau` too (inputs of forward dynamics).
+fn run_with_tau(p: &Program, q: &[f64], qd: &[f64], qdd: &[f64], tau: &[f64]) -> Vec<f64> {
+    p.eval(|s| match s.kind {
+        SymbolKind::Q(i) => Some(q[i]),
+        SymbolKind::Qd(i) => Some(qd[i]),
+        SymbolKind::Qdd(i) => Some(qdd[i]),
+        SymbolKind::Tau(i) => Some(tau[i]),
+        SymbolKind::Param => None,
+    })
+    .expect("numeric model")
+}
+
 /// Lays out every quantity in one output list, remembering where each starts.
 struct Layout {
     outputs: Vec<Id>,
@@ -283,9 +295,35 @@ fn physics_identities_hold_at_random_states() {
 
 #[test]
 fn recursive_algorithms_agree_with_the_lagrangian_route() {
+    routes_agree(|_| ModelOptions::default());
+}
+
+/// The same with rotor inertia on every joint (0.1 + 0.01 i) and the URDFs' joint friction
+/// (the Allegro hand has damping and Coulomb friction on every joint), smoothed: the fast
+/// forms too, and forward dynamics inverting them.
+#[test]
+fn routes_agree_with_armature_and_friction() {
+    routes_agree(|model| ModelOptions {
+        armature: model
+            .joints
+            .iter()
+            .enumerate()
+            .map(|(i, j)| (j.name.clone(), 0.1 + 0.01 * i as f64))
+            .collect(),
+        friction: true,
+        coulomb_smoothing: 0.01,
+        ..ModelOptions::default()
+    });
+}
+
+/// Compares the Lagrangian and recursive routes, and the emitted fast forms, at random states
+/// for the options `options(model with default options)` give.
+fn routes_agree(options: impl Fn(&eomgen::model::Model) -> ModelOptions) {
     let mut rng = Lcg(11);
     for robot in ROBOTS {
-        let (_, d) = derive(robot);
+        let (plain, _) = derive(robot);
+        let model = eomgen::urdf::load_file(urdf_path(robot), &options(&plain)).expect("loads");
+        let d = Derivation::new(&model);
         let n = d.dof;
         let r = &d.recursive;
         let mut l = Layout {
@@ -311,13 +349,39 @@ fn recursive_algorithms_agree_with_the_lagrangian_route() {
             .map(|(_, a, b)| (l.push(a.iter().copied()), l.push(b.iter().copied())))
             .collect();
         let bg_at = l.push(r.bias_and_gravity.iter().copied());
+        let fast_m_at = l.push(d.fast.mass_matrix.1.iter().flatten().copied());
+        let fast_tau_at = l.push(d.fast.tau.1.iter().copied());
+        let fd_at = l.push(d.fast.forward_dynamics.iter().copied());
         let b_at = at[2].0;
         let g_at = at[1].0;
         let p = Program::new(&d.graph, &l.outputs);
         let mut c = Checker::new(1e-10);
         for _ in 0..5 {
             let (q, qd, qdd) = (rng.vec(n, 2.0), rng.vec(n, 2.0), rng.vec(n, 2.0));
-            let v = run(&p, &q, &qd, &qdd);
+            let v = run_with_tau(&p, &q, &qd, &qdd, &vec![0.0; n]);
+            // Forward dynamics with tau_in = the Lagrangian tau gives qdd back.
+            let tau_in = v[at[3].0..at[3].0 + n].to_vec();
+            let v_fd = run_with_tau(&p, &q, &qd, &qdd, &tau_in);
+            for i in 0..n {
+                c.check(
+                    || format!("{robot} fast M/tau[{i}]"),
+                    v[fast_tau_at + i],
+                    v[at[3].0 + i],
+                );
+                c.check(
+                    || format!("{robot} forward(inverse)[{i}]"),
+                    v_fd[fd_at + i],
+                    qdd[i],
+                );
+                for j in 0..n {
+                    let k = i * n + j;
+                    c.check(
+                        || format!("{robot} fast M[{k}]"),
+                        v[fast_m_at + k],
+                        v[at[0].0 + k],
+                    );
+                }
+            }
             for ((name, a, _), &(ia, ib)) in pairs.iter().zip(&at) {
                 for k in 0..a.len() {
                     c.check(

@@ -5,7 +5,10 @@ use std::hint::black_box;
 use eomgen_tests::alloc_counter::{allocations, Counting};
 
 use eomgen_runtime::Dynamics;
-use eomgen_tests::robots::{allegro_right_hand, double_pendulum, kinova, panda, ur5};
+use eomgen_tests::robots::{
+    allegro_right_hand, double_pendulum, joint_effects_full, joint_effects_smooth, kinova, panda,
+    ur5,
+};
 
 #[global_allocator]
 static GLOBAL: Counting = Counting;
@@ -52,4 +55,19 @@ fn generated_functions_never_allocate() {
         f64
     );
     exercise!(panda, Panda, PandaLink, 9, f32);
+    // With friction and rotor inertia, and the friction term itself.
+    exercise!(
+        joint_effects_full,
+        JointEffectsFull,
+        JointEffectsFullLink,
+        2,
+        f64
+    );
+    let smooth = joint_effects_smooth::JointEffectsSmooth::<f32>::default();
+    let full = joint_effects_full::JointEffectsFull::<f64>::default();
+    let a = allocations(|| {
+        black_box(smooth.friction(black_box(&[0.1, -0.2])));
+        black_box(full.friction(black_box(&[0.1, 0.0])));
+    });
+    assert_eq!(a, 0);
 }

@@ -20,6 +20,8 @@ pub struct Values {
     pub bias: Vec<f64>,
     pub gravity: Vec<f64>,
     pub tau: Vec<f64>,
+    /// The joint friction effort `F(qd)`, zero unless the model includes friction.
+    pub friction: Vec<f64>,
     pub qdd: Vec<f64>,
     pub kinetic_energy: f64,
     pub potential_energy: f64,
@@ -62,6 +64,7 @@ pub fn evaluate(model: &Model, d: &Derivation, s: &State) -> Result<Values, Stri
     outputs.extend(&d.bias);
     outputs.extend(&d.gravity);
     outputs.extend(&d.tau);
+    outputs.extend(&d.friction);
     outputs.push(d.kinetic_energy);
     outputs.push(d.potential_energy);
     let v = d
@@ -80,7 +83,10 @@ pub fn evaluate(model: &Model, d: &Derivation, s: &State) -> Result<Values, Stri
     let bias = v[n * n..n * n + n].to_vec();
     let gravity = v[n * n + n..n * n + 2 * n].to_vec();
     let tau = v[n * n + 2 * n..n * n + 3 * n].to_vec();
-    let rhs: Vec<f64> = (0..n).map(|i| s.tau[i] - bias[i] - gravity[i]).collect();
+    let friction = v[n * n + 3 * n..n * n + 4 * n].to_vec();
+    let rhs: Vec<f64> = (0..n)
+        .map(|i| s.tau[i] - bias[i] - gravity[i] - friction[i])
+        .collect();
     let qdd = cholesky_solve(&mass_matrix, &rhs).map_err(|k| {
         format!(
             "{}: the mass matrix is not positive definite at this state (pivot {} of {n}, joint \
@@ -95,9 +101,10 @@ pub fn evaluate(model: &Model, d: &Derivation, s: &State) -> Result<Values, Stri
         bias,
         gravity,
         tau,
+        friction,
         qdd,
-        kinetic_energy: v[n * n + 3 * n],
-        potential_energy: v[n * n + 3 * n + 1],
+        kinetic_energy: v[n * n + 4 * n],
+        potential_energy: v[n * n + 4 * n + 1],
     })
 }
 
@@ -127,14 +134,21 @@ pub fn print(model: &Model, s: &State, v: &Values, digits: Option<usize>) -> Str
     }
     let _ = writeln!(out, "bias b(q, qd) = {}", list(&v.bias, digits));
     let _ = writeln!(out, "gravity G(q) = {}", list(&v.gravity, digits));
+    let f = if model.include_friction {
+        let _ = writeln!(out, "friction F(qd) = {}", list(&v.friction, digits));
+        " + F"
+    } else {
+        ""
+    };
     let _ = writeln!(
         out,
-        "inverse dynamics tau = M qdd + b + G = {}",
+        "inverse dynamics tau = M qdd + b + G{f} = {}",
         list(&v.tau, digits)
     );
+    let f = if model.include_friction { " - F" } else { "" };
     let _ = writeln!(
         out,
-        "forward dynamics qdd = M^-1 (tau_in - b - G) = {}",
+        "forward dynamics qdd = M^-1 (tau_in - b - G{f}) = {}",
         list(&v.qdd, digits)
     );
     let _ = writeln!(

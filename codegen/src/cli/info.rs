@@ -127,6 +127,33 @@ pub fn print(
         let _ = writeln!(out, "  q{} {}: {limits}", i + 1, j.name);
     }
 
+    let has_effects = model
+        .joints
+        .iter()
+        .any(|j| j.damping != 0.0 || j.friction != 0.0 || j.armature != 0.0);
+    if has_effects {
+        let included = if model.include_friction {
+            "friction included in the dynamics"
+        } else {
+            "friction left out of the dynamics without --friction"
+        };
+        let _ = writeln!(
+            out,
+            "\njoint effects (damping, Coulomb friction, rotor inertia; {included}):"
+        );
+        for (i, j) in model.joints.iter().enumerate() {
+            let _ = writeln!(
+                out,
+                "  q{} {}: {}, {}, {}",
+                i + 1,
+                j.name,
+                format_number(j.damping, Some(6)),
+                format_number(j.friction, Some(6)),
+                format_number(j.armature, Some(6))
+            );
+        }
+    }
+
     let _ = writeln!(out, "\noperations per call of each generated function:");
     let width = generated
         .op_counts

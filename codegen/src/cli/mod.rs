@@ -68,6 +68,27 @@ struct ModelArgs {
     /// [default: depth first, children by joint name]
     #[arg(long, value_name = "A,B,...", value_delimiter = ',')]
     joint_order: Option<Vec<String>>,
+    /// Rotor inertia (armature) added to the mass matrix's diagonal, per joint: kg m^2
+    /// (revolute) or kg (prismatic).
+    #[arg(long, value_name = "JOINT=VALUE,...", value_delimiter = ',', value_parser = parse_armature)]
+    armature: Vec<(String, f64)>,
+    /// Includes the URDF's joint friction, <dynamics damping friction>, in the inverse and
+    /// forward dynamics: tau = M qdd + b + G + damping qd + friction sign(qd) (no stiction).
+    #[arg(long)]
+    friction: bool,
+    /// With --friction, replaces sign(qd) by qd / sqrt(qd^2 + EPS^2) (EPS in rad/s or m/s)
+    /// [default: 0, the exact sign]
+    #[arg(
+        long,
+        value_name = "EPS",
+        default_value_t = 0.0,
+        allow_hyphen_values = true
+    )]
+    coulomb_smoothing: f64,
+    /// Fills links without <inertial> from their <collision> boxes, cylinders and spheres, of
+    /// this uniform density (kg/m^3); each filled link is reported on stderr.
+    #[arg(long, value_name = "KG_PER_M3", allow_hyphen_values = true)]
+    density: Option<f64>,
 }
 
 impl ModelArgs {
@@ -80,8 +101,22 @@ impl ModelArgs {
                 Some(v) if v.is_empty() => SymbolicParams::All,
                 Some(v) => SymbolicParams::Links(v.clone()),
             },
+            armature: self.armature.clone(),
+            friction: self.friction,
+            coulomb_smoothing: self.coulomb_smoothing,
+            inertia_from_collision: self.density,
             ..ModelOptions::default()
         }
+    }
+}
+
+fn parse_armature(s: &str) -> Result<(String, f64), String> {
+    let Some((joint, value)) = s.split_once('=') else {
+        return Err(format!("expected JOINT=VALUE, got `{s}`"));
+    };
+    match value.trim().parse::<f64>() {
+        Ok(v) => Ok((joint.trim().to_string(), v)),
+        Err(_) => Err(format!("`{value}` is not a number")),
     }
 }
 
@@ -240,10 +275,6 @@ struct SimulateArgs {
     /// of the CSV to stdout.
     #[arg(long, value_name = "FILE")]
     csv: Option<PathBuf>,
-    /// Applies the URDF's joint friction, <dynamics damping friction> (viscous and Coulomb,
-    /// no stiction); computed-torque compensates it.
-    #[arg(long)]
-    friction: bool,
     /// Also writes an SVG plot of the joint positions against time to FILE.
     #[arg(long, value_name = "FILE.svg")]
     plot: Option<PathBuf>,
@@ -355,7 +386,21 @@ fn file_name(p: &Path) -> String {
 }
 
 fn load(urdf: &Path, options: &ModelOptions) -> Result<Model, Failure> {
-    Ok(eomgen::urdf::load_file(urdf, options)?)
+    let model = eomgen::urdf::load_file(urdf, options)?;
+    warn(&model);
+    Ok(model)
+}
+
+/// Prints the model's warnings on stderr, one line each.
+fn warn(model: &Model) {
+    for w in &model.warnings {
+        let line = w
+            .to_string()
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .join(" ");
+        let _ = writeln!(std::io::stderr(), "eomgen: warning: {line}");
+    }
 }
 
 fn derive(model: &Model) -> Derivation {
@@ -387,6 +432,7 @@ fn generate(a: GenerateArgs) -> Result<(), Failure> {
     }
     // Fail fast on bad input, before a long derivation.
     let model = b.model()?;
+    warn(&model);
     let label = format!(
         "deriving and emitting {} ({} joints)",
         model.name,
@@ -454,6 +500,7 @@ fn info_cmd(a: InfoArgs) -> Result<(), Failure> {
     let start = Instant::now();
     let model = b.model()?;
     let load = start.elapsed();
+    warn(&model);
     let label = format!(
         "deriving and emitting {} ({} joints)",
         model.name,
@@ -534,7 +581,6 @@ fn simulate_cmd(a: SimulateArgs) -> Result<(), Failure> {
         kp: a.kp,
         kd: a.kd,
         omega: a.omega,
-        friction: a.friction,
     };
     let d = derive(&model);
     let outcome = simulate::run(&model, &d, &options).map_err(Failure)?;

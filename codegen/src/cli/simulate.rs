@@ -39,9 +39,6 @@ pub struct Options {
     pub kd: f64,
     /// Bandwidth of `ComputedTorque` (rad/s).
     pub omega: f64,
-    /// Whether the joints feel the URDF's `<dynamics damping friction>` (viscous and
-    /// Coulomb); computed torque then compensates it.
-    pub friction: bool,
 }
 
 /// The result: the CSV text, a one-paragraph summary and the joint trajectories.
@@ -78,23 +75,8 @@ fn step_eval(
 ) -> Result<(Vec<f64>, Vec<f64>), String> {
     let n = q.len();
     let v = terms(model, d, q, qd)?;
-    // The effort friction takes, `damping qd + friction sign(qd)` (none at rest: no stiction).
-    let friction: Vec<f64> = (0..n)
-        .map(|i| {
-            if !o.friction {
-                return 0.0;
-            }
-            let j = &model.joints[i];
-            let sign = if qd[i] > 0.0 {
-                1.0
-            } else if qd[i] < 0.0 {
-                -1.0
-            } else {
-                0.0
-            };
-            j.damping * qd[i] + j.friction * sign
-        })
-        .collect();
+    // The effort friction takes (zero unless the model includes it, `--friction`).
+    let friction = &v.friction;
     let tau: Vec<f64> = match o.controller {
         Controller::None => vec![0.0; n],
         Controller::GravityComp => (0..n)

@@ -9,7 +9,9 @@
 //!   centrifugal matrix `C_ij = G_ijj`, Coriolis matrix `B_i,(jk) = 2 G_ijk` (`j < k`, pairs in
 //!   the order (0,1), (0,2), ..., (1,2), ...), the Coriolis matrix
 //!   `C(q, qd)_ij = sum_k G_ijk qd_k` (so that `dM/dt - 2 C(q, qd)` is skew-symmetric), the
-//!   bias `b = C(q, qd) qd` and `tau = M qdd + b + G`.
+//!   bias `b = C(q, qd) qd` and `tau = M qdd + b + G + F(qd)`.
+//! - Rotor inertia (armature) adds to `M`'s diagonal; joint friction `F(qd)` (when the model
+//!   includes it) adds to `tau` and enters forward dynamics, but not `b`.
 
 pub mod newton_euler;
 
@@ -57,8 +59,13 @@ pub struct Derivation {
     pub coriolis_matrix: Vec<Vec<Id>>,
     /// `b(q, qd) = C(q, qd) qd`: Coriolis and centrifugal, without gravity.
     pub bias: Vec<Id>,
-    /// `tau = M qdd + b + G`.
+    /// `tau = M qdd + b + G + F(qd)` (`F` only when the model includes friction).
     pub tau: Vec<Id>,
+    /// The joint friction effort `F(qd)`, per joint `damping qd + friction s(qd)` with `s`
+    /// the sign or its smoothed form ([`Model::coulomb_smoothing`]): what the actuators must
+    /// supply against friction, whose torque on the joints is `-F`. All zero unless
+    /// [`Model::include_friction`].
+    pub friction: Vec<Id>,
     pub kinetic_energy: Id,
     pub potential_energy: Id,
     /// One per URDF link, in the model's frame order.
@@ -83,7 +90,7 @@ pub struct Recursive {
     pub bias: Vec<Id>,
     /// `b + G` in one recursion (what forward dynamics needs).
     pub bias_and_gravity: Vec<Id>,
-    /// Full inverse dynamics.
+    /// Full inverse dynamics, friction included when the model includes it.
     pub tau: Vec<Id>,
     /// `C(q, qd)` by Echeandia and Wensing's `O(N^2)` recursion
     /// ([`newton_euler::coriolis`]).
@@ -125,7 +132,7 @@ pub struct Fast {
     pub kinetic_energy: Id,
     /// Joint efforts as symbols `tau_i` (inputs of forward dynamics).
     pub tau_in: Vec<Id>,
-    /// `qdd = M^-1 (tau_in - b - G)`, with an unrolled sparse `L^T D L` solve.
+    /// `qdd = M^-1 (tau_in - b - G - F)`, with an unrolled sparse `L^T D L` solve.
     pub forward_dynamics: Vec<Id>,
     /// The pivots `D` of that factorization, all positive when `M` is positive definite.
     pub pivots: Vec<Id>,
@@ -243,10 +250,11 @@ impl Derivation {
             .collect();
         lap("Christoffel symbols", &mut timings);
 
+        let friction = joint_friction(&mut g, model, &params, &qd);
         let tau: Vec<Id> = (0..n)
             .map(|i| {
                 let mq = g.dot(&mass_matrix[i], &qdd);
-                g.add_all([mq, bias[i], gravity[i]])
+                g.add_all([mq, bias[i], gravity[i], friction[i]])
             })
             .collect();
 
@@ -307,6 +315,12 @@ impl Derivation {
             ),
             coriolis_matrix: newton_euler::coriolis(&mut g, &lm, &qd),
         };
+        let recursive = Recursive {
+            tau: (0..n)
+                .map(|i| g.add(recursive.tau[i], friction[i]))
+                .collect(),
+            ..recursive
+        };
         lap("recursive algorithms", &mut timings);
 
         let flat = |m: &Vec<Vec<Id>>| -> Vec<Id> { m.iter().flatten().copied().collect() };
@@ -318,6 +332,7 @@ impl Derivation {
         // h = b + G: one recursion, or the sum of the cheaper closed forms.
         let lag_h: Vec<Id> = (0..n).map(|i| g.add(bi.1[i], gr.1[i])).collect();
         let (_, h) = cheaper(&g, &lag_h, &recursive.bias_and_gravity, vec);
+        let h: Vec<Id> = (0..n).map(|i| g.add(h[i], friction[i])).collect();
         let tau_in: Vec<Id> = (0..n).map(|i| g.tau(i)).collect();
         let rhs: Vec<Id> = (0..n).map(|i| g.sub(tau_in[i], h[i])).collect();
         let parents: Vec<Option<usize>> = model.joints.iter().map(|j| j.parent).collect();
@@ -376,6 +391,7 @@ impl Derivation {
             coriolis_matrix,
             bias,
             tau,
+            friction,
             kinetic_energy,
             potential_energy,
             frames,
@@ -386,7 +402,8 @@ impl Derivation {
     }
 
     /// Lagrange's equations formed directly from `L = T - V`:
-    /// `d/dt (dL/dqd_i) - dL/dq_i`, an independent route to `tau` for cross-checks.
+    /// `d/dt (dL/dqd_i) - dL/dq_i + F_i`, an independent route to `tau` for cross-checks (the
+    /// friction `F` is a non-conservative generalized force, zero unless included).
     pub fn lagrange_equations(&mut self) -> Vec<Id> {
         let g = &mut self.graph;
         let lagrangian = g.sub(self.kinetic_energy, self.potential_energy);
@@ -395,7 +412,7 @@ impl Derivation {
                 let p = g.diff(lagrangian, self.qd[i]);
                 let dp = g.time_derivative(p);
                 let dl = g.diff(lagrangian, self.q[i]);
-                g.sub(dp, dl)
+                g.sum(0.0, [(dp, 1.0), (dl, -1.0), (self.friction[i], 1.0)])
             })
             .collect()
     }
@@ -406,6 +423,31 @@ impl Derivation {
         let d = self.graph.time_derivative_many(&flat);
         d.chunks(self.dof).map(|r| r.to_vec()).collect()
     }
+}
+
+/// The joint friction effort `F_i = damping_i qd_i + coulomb_i s(qd_i)`, with `s = sign` or,
+/// for a smoothing velocity `eps > 0`, `s(v) = v / sqrt(v^2 + eps^2)`; zeros unless the model
+/// includes friction.
+fn joint_friction(g: &mut Graph, model: &Model, params: &Params, qd: &[Id]) -> Vec<Id> {
+    let eps = model.coulomb_smoothing;
+    (0..model.dof())
+        .map(|i| {
+            if !model.include_friction {
+                return g.zero();
+            }
+            let viscous = g.mul(params.damping[i], qd[i]);
+            let s = if eps > 0.0 {
+                let v2 = g.powi(qd[i], 2);
+                let r = g.sum(eps * eps, [(v2, 1.0)]);
+                let root = g.sqrt(r);
+                g.div(qd[i], root)
+            } else {
+                g.sign(qd[i])
+            };
+            let coulomb = g.mul(params.coulomb[i], s);
+            g.add(viscous, coulomb)
+        })
+        .collect()
 }
 
 /// `M_jk = sum_b m_b v_bj . v_bk + u_bj^T I_b u_bk` over bodies `b` below both joints, with
@@ -450,6 +492,9 @@ fn mass_matrix(
                 }
             }
         }
+    }
+    for j in 0..n {
+        terms[j][j].push(params.armature[j]);
     }
     let mut mm = vec![vec![g.zero(); n]; n];
     for j in 0..n {

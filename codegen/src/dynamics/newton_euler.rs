@@ -32,6 +32,8 @@ pub struct LocalModel {
     pub first_moment: Vec<V3>,
     /// Rotational inertia about the body origin, `I_c + m (|c|^2 1 - c c^T)`.
     pub inertia: Vec<M3>,
+    /// Rotor inertia of each joint: `M_ii += armature_i`, `tau_i += armature_i qdd_i`.
+    pub armature: Vec<Id>,
 }
 
 impl LocalModel {
@@ -46,6 +48,7 @@ impl LocalModel {
             mass: params.mass.clone(),
             first_moment: Vec::with_capacity(n),
             inertia: Vec::with_capacity(n),
+            armature: params.armature.clone(),
         };
         for (i, joint) in model.joints.iter().enumerate() {
             let ro = const_m3(g, &joint.origin.rotation);
@@ -214,6 +217,11 @@ pub fn rnea(g: &mut Graph, lm: &LocalModel, terms: Terms<'_>) -> Vec<Id> {
         } else {
             g.dot(&lm.axis[i], &force[i])
         };
+        // The rotor, spun up by the joint alone (its gyroscopic terms are neglected).
+        if let Some(qdd) = terms.qdd {
+            let rotor = g.mul(lm.armature[i], qdd[i]);
+            tau[i] = g.add(tau[i], rotor);
+        }
     }
     tau
 }
@@ -350,7 +358,8 @@ pub fn crba(g: &mut Graph, lm: &LocalModel) -> Vec<Vec<Id>> {
         // Force and moment on composite body i for a unit rate of joint i.
         let s = subspace(g, lm, i);
         let (mut nm, mut f) = inertia_times(g, Some(comp.mass[i]), &comp.h[i], &comp.j[i], &s);
-        m[i][i] = spatial_dot(g, &s, &(nm, f));
+        let own = spatial_dot(g, &s, &(nm, f));
+        m[i][i] = g.add(own, lm.armature[i]);
         let mut j = i;
         while let Some(p) = lm.parent[j] {
             (f, nm) = transfer(g, lm, j, &f, &nm);

@@ -378,7 +378,12 @@ pub fn emit_tokens(
     for (name, id, value) in &d.params {
         let sym = d.graph.as_symbol(*id).expect("parameter symbol");
         let f = format_ident!("{}", field_scope.claim(snake(name, "p")));
-        let docline = format!(" `{}` (URDF value {}).", name.replace('`', "'"), value);
+        let docline = format!(
+            " `{}` ({} {}).",
+            name.replace('`', "'"),
+            crate::report::value_source(name),
+            value
+        );
         field_defs.push(quote!(#[doc = #docline] pub #f: T,));
         let l = lit(*value);
         field_defaults.push(quote!(#f: #l,));
@@ -506,7 +511,6 @@ pub fn emit_tokens(
         "The URDF links of [`{}`], one variant per link.",
         opts.type_name
     )]);
-    let mm_doc = doc(&[mm_route, mm_ops]);
     let gr_doc = doc(&[gr_route, gr_ops]);
     let bi_doc = doc(&[bi_route, bi_ops]);
     let cm_doc = doc(&[
@@ -516,15 +520,67 @@ pub fn emit_tokens(
         ),
         cm_ops,
     ]);
-    let id_doc = doc(&[id_route, id_ops]);
-    let fd_doc = doc(&[
-        "Route: M and b + G as in `mass_matrix` and `bias`, then an unrolled L^T D L solve without fill-in.".into(),
-        fd_ops,
-        String::new(),
-        "Returns NaN in every entry when M(q) is not positive definite (it cannot be for a valid".into(),
-        "model and finite inputs); `try_forward_dynamics` says which pivot failed.".into(),
-    ]);
-    let ke_doc = doc(&[ke_ops]);
+    // Joint effects change the meaning of some functions: say so where they apply.
+    let friction_note = |what: &str| -> Vec<String> {
+        if model.include_friction {
+            vec![
+                String::new(),
+                format!(
+                    "{what} the joint friction F(qd) of [`{}::friction`].",
+                    opts.type_name
+                ),
+            ]
+        } else {
+            Vec::new()
+        }
+    };
+    let armature: Vec<String> = model
+        .joints
+        .iter()
+        .filter(|j| j.armature != 0.0)
+        .map(|j| format!("`{}` {}", j.name.replace('`', "'"), j.armature))
+        .collect();
+    let armature_note = |what: &str| -> Vec<String> {
+        if armature.is_empty() {
+            Vec::new()
+        } else {
+            vec![
+                String::new(),
+                format!("{what} rotor inertia (armature): {}.", armature.join(", ")),
+            ]
+        }
+    };
+    let with_notes = |mut lines: Vec<String>, notes: &[Vec<String>]| {
+        for n in notes {
+            lines.extend(n.iter().cloned());
+        }
+        doc(&lines)
+    };
+    let mm_doc = with_notes(
+        vec![mm_route, mm_ops],
+        &[armature_note("The diagonal includes")],
+    );
+    let id_doc = with_notes(
+        vec![id_route, id_ops],
+        &[
+            friction_note("`tau = M qdd + b + G + F(qd)`: includes"),
+            armature_note("M includes"),
+        ],
+    );
+    let fd_doc = with_notes(
+        vec![
+            "Route: M and b + G as in `mass_matrix` and `bias`, then an unrolled L^T D L solve without fill-in.".into(),
+            fd_ops,
+            String::new(),
+            "Returns NaN in every entry when M(q) is not positive definite (it cannot be for a valid".into(),
+            "model and finite inputs); `try_forward_dynamics` says which pivot failed.".into(),
+        ],
+        &[
+            friction_note("`qdd = M^-1 (tau - b - G - F(qd))`: includes"),
+            armature_note("M includes"),
+        ],
+    );
+    let ke_doc = with_notes(vec![ke_ops], &[armature_note("Includes the")]);
     let pe_doc = doc(&[pe_ops]);
     let cf_doc = doc(&[
         "Craig's centrifugal matrix C(q): `b = B(q) [qd qd] + C(q) [qd^2]`.".into(),
@@ -542,6 +598,46 @@ pub fn emit_tokens(
         cp_ops,
     ]);
 
+    let friction_fn = if model.include_friction {
+        let (fr, fr_ops) = func("friction", d.friction.clone(), Shape::Vector, &mut counts);
+        let smoothing = if model.coulomb_smoothing > 0.0 {
+            format!(
+                "`s(v) = v / sqrt(v^2 + eps^2)`, the sign smoothed below `eps = {}` (rad/s or m/s)",
+                model.coulomb_smoothing
+            )
+        } else {
+            "`s(v) = sign(v)`, 0 at rest (no stiction)".to_string()
+        };
+        let coefficients: Vec<String> = model
+            .joints
+            .iter()
+            .map(|j| {
+                format!(
+                    "`{}`: damping {}, friction {}",
+                    j.name.replace('`', "'"),
+                    j.damping,
+                    j.friction
+                )
+            })
+            .collect();
+        let fr_doc = doc(&[
+            "Joint friction effort `F(qd)`, per joint `damping qd + friction s(qd)` from the URDF's".into(),
+            format!("`<dynamics damping friction>`, with {smoothing}."),
+            "The effort the actuators must supply against friction (the joints feel `-F`); it is".into(),
+            "part of `inverse_dynamics` and `forward_dynamics`, not of `bias`.".into(),
+            String::new(),
+            format!("Coefficients: {}.", coefficients.join("; ")),
+            String::new(),
+            fr_ops,
+        ]);
+        let nn = Literal::usize_unsuffixed(n);
+        quote! {
+            #fr_doc
+            pub fn friction(&self, qd: &[T; #nn]) -> [T; #nn] { #fr }
+        }
+    } else {
+        TokenStream::new()
+    };
     let (n, np, nlinks) = (
         Literal::usize_unsuffixed(n),
         Literal::usize_unsuffixed(np),
@@ -606,6 +702,8 @@ pub fn emit_tokens(
                 }
                 Ok([#(#fd_x),*])
             }
+
+            #friction_fn
 
             /// Pose of a link frame in the world (root) frame.
             pub fn link_pose(&self, link: #link_ty, q: &[T; #n]) -> ::eomgen_runtime::Pose<T> {

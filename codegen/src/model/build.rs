@@ -13,6 +13,7 @@ use std::collections::HashMap;
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 use thiserror::Error;
 
+use super::shapes::{mass_properties, Shape};
 use super::{Body, Frame, Joint, JointKind, Limits, Mimic, Model, Transform};
 
 /// Relative tolerance (of the trace) for the positive semi-definiteness and triangle-inequality
@@ -39,6 +40,32 @@ pub struct ModelOptions {
     /// impossible, but common in vendor files). `false` by default; positive
     /// semi-definiteness is always required.
     pub strict_inertia: bool,
+    /// Rotor inertia (armature) per moving joint, by URDF name: kg m^2 for a revolute joint
+    /// (the reflected rotor inertia, gear ratio squared times the rotor's inertia), kg for a
+    /// prismatic one. Added to the joint's diagonal entry of the mass matrix, hence to the
+    /// inverse and forward dynamics and the kinetic energy. A name listed twice adds up. An
+    /// unknown or fixed joint, or a negative or non-finite value, is
+    /// [`ModelError::InvalidArmature`]. Empty by default.
+    pub armature: Vec<(String, f64)>,
+    /// Includes the joint friction of the URDF's `<dynamics damping friction>` in the inverse
+    /// and forward dynamics: the joints feel `-(damping qd + friction sign(qd))`, so that
+    /// `tau = M qdd + b + G + damping qd + friction sign(qd)`. `false` by default.
+    pub friction: bool,
+    /// With [`ModelOptions::friction`], replaces `sign(qd)` in the Coulomb term by the smooth
+    /// `qd / sqrt(qd^2 + eps^2)` with `eps` this velocity (rad/s or m/s), so that integrators
+    /// do not step across a discontinuity. 0 (the default) keeps the exact sign
+    /// (`sign(0) = 0`). Must be finite and non-negative ([`ModelError::InvalidOption`]).
+    pub coulomb_smoothing: f64,
+    /// Fills the inertia of links without `<inertial>` (urdf-rs reads a missing one as all
+    /// zeros, so a link whose mass and inertia are all zero counts as missing) from their
+    /// `<collision>` boxes, cylinders and spheres, made of a uniform material of this density
+    /// (kg/m^3), each placed by its `<origin>` (overlaps count twice). Every filled link gets a
+    /// [`ModelWarning::InertiaFromCollision`]; a link whose collision geometry has no such
+    /// primitive (only meshes or capsules) stays massless with a
+    /// [`ModelWarning::NoCollisionPrimitive`]. Links welded to the root are skipped (their
+    /// inertia never matters). `None` (the default) leaves such links massless. The density
+    /// must be positive and finite ([`ModelError::InvalidOption`]).
+    pub inertia_from_collision: Option<f64>,
 }
 
 impl Default for ModelOptions {
@@ -48,7 +75,61 @@ impl Default for ModelOptions {
             joint_order: None,
             symbolic: SymbolicParams::None,
             strict_inertia: false,
+            armature: Vec::new(),
+            friction: false,
+            coulomb_smoothing: 0.0,
+            inertia_from_collision: None,
         }
+    }
+}
+
+/// Something loading had to guess or leave out; the model is usable, but a person should
+/// check it. Every message starts with the file name and names the link.
+#[derive(Clone, Debug, PartialEq, Error)]
+pub enum ModelWarning {
+    /// A link without `<inertial>` got its mass, centre of mass and inertia from its
+    /// `<collision>` primitives ([`ModelOptions::inertia_from_collision`]).
+    #[error(
+        "{file}: link `{link}` has no <inertial>: mass {} kg, centre of mass and inertia \
+         computed from {primitives} <collision> primitive(s) at a density of {density} \
+         kg/m^3{}",
+        crate::cas::format_number(*.mass, Some(6)),
+        ignored_note(.ignored)
+    )]
+    InertiaFromCollision {
+        file: String,
+        link: String,
+        /// The computed mass (kg).
+        mass: f64,
+        /// Boxes, cylinders and spheres used.
+        primitives: usize,
+        density: f64,
+        /// Collision geometry that could not be used (`mesh`, `capsule`).
+        ignored: Vec<String>,
+    },
+    /// A link without `<inertial>` whose `<collision>` geometry has no box, cylinder or
+    /// sphere: it stays massless.
+    #[error(
+        "{file}: link `{link}` has no <inertial>, and its <collision> geometry ({}) has no \
+         box, cylinder or sphere to compute one from: the link stays massless",
+        .ignored.join(", ")
+    )]
+    NoCollisionPrimitive {
+        file: String,
+        link: String,
+        /// The collision geometry found (`mesh`, `capsule`).
+        ignored: Vec<String>,
+    },
+}
+
+fn ignored_note(ignored: &[String]) -> String {
+    if ignored.is_empty() {
+        String::new()
+    } else {
+        format!(
+            " (ignored, as it cannot be weighed: {})",
+            ignored.join(", ")
+        )
     }
 }
 
@@ -171,7 +252,8 @@ pub enum ModelError {
     /// inertia about the joint axis at `q = 0`, masses off the axis included, is zero (below
     /// `1e-12` of the trace of the subtree inertia about the joint origin). This is a necessary
     /// condition for an invertible mass matrix, not a sufficient one (for example, two
-    /// consecutive coaxial revolute joints whose first body is massless pass the check).
+    /// consecutive coaxial revolute joints whose first body is massless pass the check). A
+    /// joint with rotor inertia ([`ModelOptions::armature`]) always passes.
     #[error(
         "{file}: joint `{joint}` moves nothing with inertia (its subtree is massless, or for a \
          revolute joint has no inertia about the axis): the mass matrix would be singular"
@@ -188,6 +270,29 @@ pub enum ModelError {
     /// [`SymbolicParams::Links`] names a link that does not exist.
     #[error("{file}: symbolic parameters requested for link `{link}`, which does not exist")]
     UnknownSymbolicLink { file: String, link: String },
+    /// [`ModelOptions::armature`] names a joint that does not exist or is fixed, or gives a
+    /// negative or non-finite value.
+    #[error("{file}: armature: joint `{joint}` {reason}")]
+    InvalidArmature {
+        file: String,
+        joint: String,
+        reason: String,
+    },
+    /// A numeric option is out of its range (for example a density that is not positive).
+    #[error("{file}: option {option}: {reason}")]
+    InvalidOption {
+        file: String,
+        option: &'static str,
+        reason: String,
+    },
+    /// A collision primitive needed to fill a link's inertia has a negative or non-finite size
+    /// or pose.
+    #[error("{file}: link `{link}` has an invalid <collision> {reason}")]
+    InvalidCollision {
+        file: String,
+        link: String,
+        reason: String,
+    },
 }
 
 /// A pose as written in a robot description: translation and roll-pitch-yaw angles.
@@ -239,11 +344,20 @@ pub(crate) struct InertialDescription {
     pub(crate) inertia: [f64; 6],
 }
 
+/// One `<collision>` element as written: its pose in the link frame and its geometry, a
+/// primitive that can be weighed or the name of one that cannot (`mesh`, `capsule`).
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct CollisionDescription {
+    pub(crate) origin: Pose,
+    pub(crate) geometry: Result<Shape, &'static str>,
+}
+
 /// A link as written.
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) struct LinkDescription {
     pub(crate) name: String,
     pub(crate) inertial: InertialDescription,
+    pub(crate) collisions: Vec<CollisionDescription>,
 }
 
 /// The type of a joint as written.
@@ -287,7 +401,33 @@ pub(crate) fn build_model(
 ) -> Result<Model, ModelError> {
     let tree = Tree::new(robot, file)?;
     check_numbers(robot, file)?;
+    check_options(options, file)?;
+    let mut warnings = Vec::new();
+    let filled;
+    let robot = match options.inertia_from_collision {
+        Some(density) => {
+            filled = fill_inertias(robot, &tree, density, file, &mut warnings)?;
+            &filled
+        }
+        None => robot,
+    };
     check_inertias(robot, file, options.strict_inertia)?;
+    let mut model = merge(robot, &tree, file, options)?;
+    model.warnings = warnings;
+    if model.joints.is_empty() {
+        return Err(ModelError::NoMovingJoint { file: file.into() });
+    }
+    set_armature(&mut model, robot, &options.armature, file)?;
+    check_singular(&model, file)?;
+    if let Some(order) = &options.joint_order {
+        reorder(&mut model, robot, order, file)?;
+    }
+    mark_symbolic(&mut model, &options.symbolic, file)?;
+    Ok(model)
+}
+
+/// Rejects option values out of range.
+fn check_options(options: &ModelOptions, file: &str) -> Result<(), ModelError> {
     if !all_finite(&options.gravity) {
         return Err(ModelError::NonFinite {
             file: file.into(),
@@ -295,16 +435,158 @@ pub(crate) fn build_model(
             field: "gravity",
         });
     }
-    let mut model = merge(robot, &tree, file, options)?;
-    if model.joints.is_empty() {
-        return Err(ModelError::NoMovingJoint { file: file.into() });
+    let invalid = |option, reason: String| ModelError::InvalidOption {
+        file: file.into(),
+        option,
+        reason,
+    };
+    let s = options.coulomb_smoothing;
+    if !(s.is_finite() && s >= 0.0) {
+        return Err(invalid(
+            "coulomb_smoothing",
+            format!("the velocity must be finite and non-negative, not {s}"),
+        ));
     }
-    check_singular(&model, file)?;
-    if let Some(order) = &options.joint_order {
-        reorder(&mut model, robot, order, file)?;
+    if let Some(rho) = options.inertia_from_collision {
+        if !(rho.is_finite() && rho > 0.0) {
+            return Err(invalid(
+                "inertia_from_collision",
+                format!("the density must be positive and finite, not {rho} kg/m^3"),
+            ));
+        }
     }
-    mark_symbolic(&mut model, &options.symbolic, file)?;
-    Ok(model)
+    Ok(())
+}
+
+/// Sets [`Joint::armature`] from [`ModelOptions::armature`].
+fn set_armature(
+    model: &mut Model,
+    robot: &RobotDescription,
+    armature: &[(String, f64)],
+    file: &str,
+) -> Result<(), ModelError> {
+    for (name, value) in armature {
+        let error = |reason: String| ModelError::InvalidArmature {
+            file: file.into(),
+            joint: name.clone(),
+            reason,
+        };
+        let Some(joint) = model.joints.iter_mut().find(|j| &j.name == name) else {
+            return Err(error(
+                if robot.joints.iter().any(|j| &j.name == name) {
+                    "is a fixed joint: only moving joints have rotor inertia"
+                } else {
+                    "does not exist"
+                }
+                .into(),
+            ));
+        };
+        if !value.is_finite() {
+            return Err(error(format!("has a non-finite value ({value})")));
+        }
+        if *value < 0.0 {
+            return Err(error(format!("has a negative value ({value})")));
+        }
+        joint.armature += value;
+    }
+    Ok(())
+}
+
+/// The robot with the inertia of every link that lacks one (and moves) computed from its
+/// collision primitives, warning about each.
+fn fill_inertias(
+    robot: &RobotDescription,
+    tree: &Tree,
+    density: f64,
+    file: &str,
+    warnings: &mut Vec<ModelWarning>,
+) -> Result<RobotDescription, ModelError> {
+    // Links welded to the root (through fixed joints only) never move: skip them.
+    let mut welded = vec![false; robot.links.len()];
+    welded[tree.root] = true;
+    for &j in &tree.order {
+        let (parent, child) = tree.ends[j];
+        welded[child] = welded[parent] && robot.joints[j].joint_type == JointType::Fixed;
+    }
+    let mut filled = robot.clone();
+    for (link, welded) in filled.links.iter_mut().zip(welded) {
+        let missing = link.inertial.mass == 0.0 && link.inertial.inertia.iter().all(|&x| x == 0.0);
+        if welded || !missing || link.collisions.is_empty() {
+            continue;
+        }
+        let invalid = |reason: String| ModelError::InvalidCollision {
+            file: file.into(),
+            link: link.name.clone(),
+            reason,
+        };
+        let mut parts = Vec::new();
+        let mut ignored = Vec::new();
+        for c in &link.collisions {
+            match c.geometry {
+                Ok(shape) => {
+                    let sizes: Vec<f64> = match shape {
+                        Shape::Box { size } => size.to_vec(),
+                        Shape::Cylinder { radius, length } => vec![radius, length],
+                        Shape::Sphere { radius } => vec![radius],
+                        Shape::Rod { length } => vec![length],
+                    };
+                    if !sizes.iter().all(|x| x.is_finite() && *x >= 0.0) {
+                        return Err(invalid(format!(
+                            "geometry: sizes must be finite and non-negative, not {sizes:?}"
+                        )));
+                    }
+                    if !c.origin.is_finite() {
+                        return Err(invalid("origin: not finite".into()));
+                    }
+                    parts.push((shape, c.origin.to_transform()));
+                }
+                Err(kind) => ignored.push(kind.to_string()),
+            }
+        }
+        match mass_properties(&parts, density) {
+            Some(p) => {
+                let i = (p.inertia + p.inertia.transpose()) * 0.5;
+                link.inertial = InertialDescription {
+                    origin: Pose {
+                        xyz: p.com.into(),
+                        rpy: [0.0; 3],
+                    },
+                    mass: p.mass,
+                    inertia: [
+                        i[(0, 0)],
+                        i[(0, 1)],
+                        i[(0, 2)],
+                        i[(1, 1)],
+                        i[(1, 2)],
+                        i[(2, 2)],
+                    ],
+                };
+                warnings.push(ModelWarning::InertiaFromCollision {
+                    file: file.into(),
+                    link: link.name.clone(),
+                    mass: p.mass,
+                    primitives: parts.len(),
+                    density,
+                    ignored,
+                });
+            }
+            None if parts.is_empty() => warnings.push(ModelWarning::NoCollisionPrimitive {
+                file: file.into(),
+                link: link.name.clone(),
+                ignored,
+            }),
+            // Primitives of zero volume: nothing to weigh either.
+            None => {
+                ignored.extend(parts.iter().map(|_| "primitive of zero volume".to_string()));
+                warnings.push(ModelWarning::NoCollisionPrimitive {
+                    file: file.into(),
+                    link: link.name.clone(),
+                    ignored,
+                })
+            }
+        }
+    }
+    Ok(filled)
 }
 
 fn all_finite(v: &[f64]) -> bool {
@@ -695,6 +977,7 @@ fn merge(
                     limits: joint.limits.clone(),
                     damping: joint.damping,
                     friction: joint.friction,
+                    armature: 0.0,
                     mimic: joint.mimic.clone(),
                     symbolic_origin: false,
                 });
@@ -790,6 +1073,9 @@ fn merge(
         joints,
         bodies,
         frames,
+        include_friction: options.friction,
+        coulomb_smoothing: options.coulomb_smoothing,
+        warnings: Vec::new(),
     })
 }
 
@@ -829,6 +1115,8 @@ fn check_singular(model: &Model, file: &str) -> Result<(), ModelError> {
         } else {
             inertia.mass > 0.0
         };
+        // Rotor inertia alone makes the diagonal entry positive.
+        let moves_inertia = moves_inertia || joint.armature > 0.0;
         if !moves_inertia {
             return Err(ModelError::MasslessSubtree {
                 file: file.into(),

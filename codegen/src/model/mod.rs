@@ -14,11 +14,11 @@ use nalgebra::{Matrix3, Vector3};
 
 mod build;
 pub mod shapes;
-pub use build::{ModelError, ModelOptions, SymbolicParams};
+pub use build::{ModelError, ModelOptions, ModelWarning, SymbolicParams};
 // The format-neutral description that readers (`crate::urdf`) fill in.
 pub(crate) use build::{
-    build_model, InertialDescription, JointDescription, JointType, LinkDescription, Pose,
-    RobotDescription,
+    build_model, CollisionDescription, InertialDescription, JointDescription, JointType,
+    LinkDescription, Pose, RobotDescription,
 };
 
 /// A rigid transform: `p_parent = rotation * p_child + translation`.
@@ -97,6 +97,9 @@ pub struct Joint {
     pub damping: f64,
     /// Coulomb friction (N m or N), from `<dynamics friction>`.
     pub friction: f64,
+    /// Rotor inertia (armature, kg m^2 or kg) added to this joint's diagonal entry of the mass
+    /// matrix, from [`ModelOptions::armature`]; 0 unless set.
+    pub armature: f64,
     pub mimic: Option<Mimic>,
     /// Whether the translation of `origin` should be a symbol instead of its number.
     pub symbolic_origin: bool,
@@ -144,6 +147,14 @@ pub struct Model {
     pub bodies: Vec<Body>,
     /// One frame per URDF link, in the URDF's link order.
     pub frames: Vec<Frame>,
+    /// Whether the joint friction (`damping qd + friction sign(qd)` per joint) is part of the
+    /// inverse and forward dynamics ([`ModelOptions::friction`]).
+    pub include_friction: bool,
+    /// The velocity (rad/s or m/s) below which Coulomb friction is smoothed
+    /// ([`ModelOptions::coulomb_smoothing`]); 0 for the exact sign.
+    pub coulomb_smoothing: f64,
+    /// What loading had to guess, for the user to check (see [`ModelWarning`]).
+    pub warnings: Vec<ModelWarning>,
 }
 
 impl Model {

@@ -522,7 +522,19 @@ fn describe_param(name: &str) -> String {
         "x" | "y" | "z" => {
             format!("origin of joint {owner} in its parent's frame, {head} coordinate")
         }
+        "Ia" => format!("rotor inertia (armature) of joint {owner}"),
+        "damping" => format!("viscous damping of joint {owner}"),
+        "friction" => format!("Coulomb friction of joint {owner}"),
         _ => "a parameter".to_string(),
+    }
+}
+
+/// Where a parameter's default value comes from: the URDF, or an option for rotor inertia.
+pub(crate) fn value_source(name: &str) -> &'static str {
+    if name.starts_with("Ia_") {
+        "armature option value"
+    } else {
+        "URDF value"
     }
 }
 
@@ -578,7 +590,21 @@ pub fn render(model: &Model, d: &Derivation, opts: &ShowOptions) -> Result<Strin
     let mut dropped = 0;
     let mut sections = Vec::with_capacity(opts.terms.len());
     for &term in &opts.terms {
-        sections.push(section(&mut g, d, term, opts, syntax, &mut dropped)?);
+        let mut s = section(&mut g, d, term, opts, syntax, &mut dropped)?;
+        if term == Term::Tau && model.include_friction {
+            let sign = if model.coulomb_smoothing > 0.0 {
+                format!(
+                    "qd_i / sqrt(qd_i^2 + {}^2)",
+                    format_number(model.coulomb_smoothing, opts.digits)
+                )
+            } else {
+                "sign(qd_i)".to_string()
+            };
+            s.notes.push(format!(
+                "Plus the joint friction F_i = damping_i qd_i + friction_i {sign}."
+            ));
+        }
+        sections.push(s);
     }
     let expanded_roots: Vec<Id> = sections
         .iter()
@@ -588,11 +614,19 @@ pub fn render(model: &Model, d: &Derivation, opts: &ShowOptions) -> Result<Strin
     let short = trig::short_names(&g, &expanded_roots, style, d.dof <= 9);
     let all_roots: Vec<Id> = sections.iter().flat_map(|s| s.roots()).collect();
     let used: BTreeSet<Id> = g.reachable(&all_roots).into_iter().collect();
-    let params: Vec<(String, String, f64)> = d
+    let params: Vec<(String, String)> = d
         .params
         .iter()
         .filter(|p| used.contains(&p.1))
-        .map(|(name, id, v)| (g.print(*id, style), describe_param(name), *v))
+        .map(|(name, id, v)| {
+            let what = format!(
+                "{} ({} {})",
+                describe_param(name),
+                value_source(name),
+                format_number(*v, None)
+            );
+            (g.print(*id, style), what)
+        })
         .collect();
     let uses_rates = used.iter().any(|&id| match g.node(id) {
         Node::Sym(s) => matches!(
@@ -661,12 +695,27 @@ pub fn render(model: &Model, d: &Derivation, opts: &ShowOptions) -> Result<Strin
         .enumerate()
         .map(|(i, j)| {
             let q = g.print(d.q[i], style);
-            let what = format!(
+            let mut what = format!(
                 "{}, {} about {}",
                 j.name,
                 kind_name(j.kind),
                 vec3(&j.axis, opts.digits)
             );
+            if j.armature != 0.0 {
+                let _ = write!(
+                    what,
+                    ", rotor inertia {}",
+                    format_number(j.armature, opts.digits)
+                );
+            }
+            if model.include_friction {
+                let _ = write!(
+                    what,
+                    ", damping {}, friction {}",
+                    format_number(j.damping, opts.digits),
+                    format_number(j.friction, opts.digits)
+                );
+            }
             (q, what)
         })
         .collect();
@@ -681,11 +730,8 @@ pub fn render(model: &Model, d: &Derivation, opts: &ShowOptions) -> Result<Strin
             "velocity and acceleration of q_i".into(),
         ));
     }
-    for (sym, what, v) in &params {
-        legend_text.push((
-            sym.clone(),
-            format!("{what} (URDF value {})", format_number(*v, None)),
-        ));
+    for (sym, what) in &params {
+        legend_text.push((sym.clone(), what.clone()));
     }
 
     let mut out = String::new();
