@@ -4,7 +4,7 @@
 #[path = "support/child.rs"]
 mod child;
 
-use eomgen::cas::{Graph, Id, Node, Program, Style, Syntax};
+use eomgen::cas::{Graph, Id, Node, Order, Program, Style, Syntax};
 use proptest::prelude::*;
 
 const NVARS: usize = 3;
@@ -175,9 +175,15 @@ proptest! {
         let all: Vec<Id> = outs.iter().chain(&d).copied().collect();
         let want = eval(&g, &all, &x);
         let p = Program::new(&g, &all);
-        let got = p.eval(|s| match s.kind { eomgen::cas::SymbolKind::Q(i) => x.get(i).copied(), _ => None }).unwrap();
-        for (a, b) in got.iter().zip(&want) {
-            prop_assert!(a == b || (a.is_nan() && b.is_nan()) || close(*a, *b, 1e-12), "{} vs {}", a, b);
+        let levels = Program::ordered(&g, &all, Order::Levels);
+        // The same operations, in another order.
+        prop_assert_eq!(p.ops(), levels.ops());
+        prop_assert_eq!(p.temps.len(), levels.temps.len());
+        for p in [p, levels] {
+            let got = p.eval(|s| match s.kind { eomgen::cas::SymbolKind::Q(i) => x.get(i).copied(), _ => None }).unwrap();
+            for (a, b) in got.iter().zip(&want) {
+                prop_assert!(a == b || (a.is_nan() && b.is_nan()) || close(*a, *b, 1e-12), "{} vs {}", a, b);
+            }
         }
     }
 
@@ -490,6 +496,51 @@ fn a_scaled_copy_of_a_sum_reuses_the_sum() {
     for (x, y) in got.iter().zip(&want) {
         assert!(close(*x, *y, 1e-14), "{got:?} {want:?}");
     }
+    // A sum that holds u's terms among others adds u once: ab + c - d + 2 b -> u + 2 b.
+    let y = g.sum(0.0, [(ab, 1.0), (c, 1.0), (d, -1.0), (b, 2.0)]);
+    let p = Program::new(&g, &[y, x]);
+    let n = p.ops();
+    assert_eq!((n.add, n.mul), (3, 3), "{}", p.print(&[], Style::default()));
+}
+
+#[test]
+fn level_order_interleaves_independent_chains() {
+    let mut g = Graph::new();
+    // Two chains x -> x^2 y -> (x^2 y)^2 y ..., each step used twice so that it is a temporary.
+    let chain = |g: &mut Graph, x: Id, y: Id| -> Vec<Id> {
+        let mut v = vec![x];
+        for _ in 0..4 {
+            let last = *v.last().unwrap();
+            let sq = g.mul(last, last);
+            let next = g.mul(sq, y);
+            let shifted = g.add(next, last);
+            v.push(shifted);
+        }
+        v
+    };
+    let (x0, x1, y) = (g.q(0), g.q(1), g.q(2));
+    let a = chain(&mut g, x0, y);
+    let b = chain(&mut g, x1, y);
+    let outputs = [a[4], b[4]];
+    let names = ["a".to_string(), "b".to_string()];
+    let created = Program::new(&g, &outputs).print(&names, Style::default());
+    let levels = Program::ordered(&g, &outputs, Order::Levels).print(&names, Style::default());
+    // Which chain each temporary belongs to: chain a reads q1 or a temporary of chain a.
+    let chains = |text: &str| -> Vec<bool> {
+        let mut of_a: Vec<bool> = Vec::new();
+        for line in text.lines().filter(|l| l.starts_with('t')) {
+            let (_, rhs) = line.split_once(" = ").unwrap();
+            let reads_a = rhs.contains("q1")
+                || (0..of_a.len()).any(|t| of_a[t] && rhs.contains(&format!("t{t}")));
+            of_a.push(reads_a);
+        }
+        of_a
+    };
+    // Creation order finishes chain a before it starts b; level order alternates.
+    let (created, levels) = (chains(&created), chains(&levels));
+    assert_eq!(created.len(), 6);
+    assert_eq!(created, [true, true, true, false, false, false]);
+    assert_eq!(levels, [true, false, true, false, true, false]);
 }
 
 #[test]

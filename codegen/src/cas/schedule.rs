@@ -163,52 +163,75 @@ pub struct Program {
 /// Deepest nesting of single-use nodes written inline.
 const MAX_INLINE_DEPTH: u32 = 4;
 
+/// The order of a program's temporaries (the operations are the same either way).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Order {
+    /// As the expressions were built: each step of a derivation stays together, for reading.
+    #[default]
+    Creation,
+    /// By level (the longest path from the inputs), then creation: independent chains are
+    /// interleaved, so that an out-of-order processor finds work while a long dependency chain
+    /// (a force carried up a kinematic chain, say) waits on its previous step. For generated
+    /// code.
+    Levels,
+}
+
 impl Program {
-    /// Schedules `outputs` of `graph`.
+    /// Schedules `outputs` of `graph` in creation order.
     pub fn new(graph: &Graph, outputs: &[Id]) -> Program {
+        Program::ordered(graph, outputs, Order::Creation)
+    }
+
+    /// Schedules `outputs` of `graph` with its temporaries in `order`.
+    pub fn ordered(graph: &Graph, outputs: &[Id], order_by: Order) -> Program {
         let order = graph.reachable(outputs);
         let slot = |id: Id| order.binary_search(&id).expect("reachable");
-        // Sums that are unit combinations, `a + b - c`: a later sum that holds the same terms
-        // with one coefficient magnitude, `k a + k b - k c` (the graph distributes constant
-        // factors into sums), reuses them as `k t` instead of adding the terms again.
-        let mut unit_sums: HashMap<Vec<(Id, bool)>, (Id, f64)> = HashMap::new();
-        for &id in &order {
-            if let Node::Add(c, ts) = graph.node(id) {
-                if c.get() == 0.0 && ts.len() >= 2 && ts.iter().all(|t| t.1.get().abs() == 1.0) {
-                    let (key, sign) = unit_key(ts.iter().map(|t| (t.0, t.1.get())));
-                    unit_sums.entry(key).or_insert((id, sign));
-                }
+        // Sums that are unit combinations, `a + b - c`, are reused by other sums that hold the
+        // same terms with one coefficient magnitude: `k a + k b - k c + d` (the graph
+        // distributes constant factors into sums and flattens sums into sums) becomes
+        // `k t + d`, saving the additions.
+        let units = UnitSums::new(graph, &order);
+        let plans: Vec<Option<Vec<(Id, f64)>>> = order
+            .iter()
+            .map(|&id| match graph.node(id) {
+                Node::Add(_, ts) => Some(units.plan(id, ts.iter().map(|t| (t.0, t.1.get())))),
+                _ => None,
+            })
+            .collect();
+        let kids = |k: usize| -> Vec<Id> {
+            match &plans[k] {
+                Some(terms) => terms.iter().map(|t| t.0).collect(),
+                None => graph.node(order[k]).children().collect(),
             }
-        }
-        let terms_of = |id: Id, ts: &[(Id, super::graph::Num)]| -> Vec<(Id, f64)> {
-            reuse_unit_sums(id, ts.iter().map(|t| (t.0, t.1.get())), &unit_sums)
         };
         let mut uses = vec![0u32; order.len()];
+        for k in 0..order.len() {
+            for c in kids(k) {
+                uses[slot(c)] += 1;
+            }
+        }
         // Scheduling order: by `Id` (children first), except that a reused unit sum created
-        // after its user moves just before it (its terms are the user's children).
+        // after its user moves just before it, after whatever it reuses in turn.
         let mut visit: Vec<usize> = Vec::with_capacity(order.len());
         let mut placed = vec![false; order.len()];
-        for (k, &id) in order.iter().enumerate() {
-            match graph.node(id) {
-                Node::Add(_, ts) => {
-                    for (c, _) in terms_of(id, ts) {
-                        let sc = slot(c);
-                        uses[sc] += 1;
-                        if sc > k && !placed[sc] {
-                            placed[sc] = true;
-                            visit.push(sc);
-                        }
+        for k in 0..order.len() {
+            let mut stack = vec![(k, false)];
+            while let Some((j, ready)) = stack.pop() {
+                if placed[j] {
+                    continue;
+                }
+                if ready {
+                    placed[j] = true;
+                    visit.push(j);
+                    continue;
+                }
+                stack.push((j, true));
+                for c in kids(j) {
+                    let sc = slot(c);
+                    if !placed[sc] {
+                        stack.push((sc, false));
                     }
                 }
-                node => {
-                    for c in node.children() {
-                        uses[slot(c)] += 1;
-                    }
-                }
-            }
-            if !placed[k] {
-                placed[k] = true;
-                visit.push(k);
             }
         }
         for &o in outputs {
@@ -233,6 +256,16 @@ impl Program {
         // the nesting depth of that inline expression.
         let mut repr: Vec<Option<(Expr, u32)>> = vec![None; order.len()];
         let mut temps = Vec::new();
+        if order_by == Order::Levels {
+            let mut level = vec![0u32; order.len()];
+            let mut position = vec![0usize; order.len()];
+            for (p, &k) in visit.iter().enumerate() {
+                let deepest = kids(k).iter().map(|&c| level[slot(c)]).max();
+                level[k] = deepest.map_or(0, |l| l + 1);
+                position[k] = p;
+            }
+            visit.sort_by_key(|&k| (level[k], position[k]));
+        }
         for k in visit {
             let id = order[k];
             let sub =
@@ -240,10 +273,11 @@ impl Program {
             let (e, depth) = match graph.node(id) {
                 Node::Const(c) => (Expr::Const(c.get()), 0),
                 Node::Sym(s) => (Expr::Input(*s), 0),
-                Node::Add(c, ts) => {
-                    let parts: Vec<((Expr, u32), f64)> = terms_of(id, ts)
-                        .into_iter()
-                        .map(|(t, k)| (sub(t), k))
+                Node::Add(c, _) => {
+                    let parts: Vec<((Expr, u32), f64)> = plans[k]
+                        .iter()
+                        .flatten()
+                        .map(|&(t, k)| (sub(t), k))
                         .collect();
                     let d = parts.iter().map(|p| p.0 .1).max().unwrap_or(0) + 1;
                     (
@@ -357,51 +391,126 @@ impl Program {
     }
 }
 
-/// The terms of a unit sum with its first coefficient made positive, and the sign that undoes
-/// it.
-fn unit_key(terms: impl Iterator<Item = (Id, f64)>) -> (Vec<(Id, bool)>, f64) {
-    let terms: Vec<(Id, f64)> = terms.collect();
-    let sign = if terms[0].1 < 0.0 { -1.0 } else { 1.0 };
-    let key = terms.iter().map(|&(t, k)| (t, k * sign > 0.0)).collect();
-    (key, sign)
+/// The reachable unit sums of a program: constant 0, coefficients +-1, two or more terms.
+struct UnitSums {
+    /// By their terms with the first coefficient made positive: (sum, the sign undoing that).
+    exact: HashMap<Vec<(Id, bool)>, (Id, f64)>,
+    /// Each sum's terms with unit coefficients.
+    terms: Vec<(Id, Vec<(Id, f64)>)>,
+    /// For each term, the sums (indices into `terms`) that hold it, at most
+    /// `MAX_CANDIDATES` of them.
+    by_term: HashMap<Id, Vec<usize>>,
 }
 
-/// The terms of sum `id` with every group of two or more terms of one coefficient magnitude
-/// that equals an earlier unit sum replaced by that sum: `k a + k b + c` -> `k t + c`.
-fn reuse_unit_sums(
-    id: Id,
-    terms: impl Iterator<Item = (Id, f64)>,
-    unit_sums: &HashMap<Vec<(Id, bool)>, (Id, f64)>,
-) -> Vec<(Id, f64)> {
-    let terms: Vec<(Id, f64)> = terms.collect();
-    let mut mags: Vec<f64> = Vec::new();
-    for &(_, k) in &terms {
-        if !mags.contains(&k.abs()) {
-            mags.push(k.abs());
-        }
-    }
-    if mags.len() == terms.len() {
-        return terms;
-    }
-    let mut out = Vec::with_capacity(terms.len());
-    for mag in mags {
-        let group: Vec<(Id, f64)> = terms
-            .iter()
-            .filter(|t| t.1.abs() == mag)
-            .map(|&(t, k)| (t, k / mag))
-            .collect();
-        if group.len() >= 2 {
-            let (key, sign) = unit_key(group.iter().copied());
-            if let Some(&(u, u_sign)) = unit_sums.get(&key) {
-                if u != id {
-                    out.push((u, mag * sign * u_sign));
-                    continue;
+/// Sums looked at per term when searching for a reusable part of a sum, which bounds the
+/// search on graphs where one term appears in thousands of sums.
+const MAX_CANDIDATES: usize = 32;
+
+impl UnitSums {
+    fn new(graph: &Graph, order: &[Id]) -> UnitSums {
+        let mut u = UnitSums {
+            exact: HashMap::new(),
+            terms: Vec::new(),
+            by_term: HashMap::new(),
+        };
+        for &id in order {
+            if let Node::Add(c, ts) = graph.node(id) {
+                if c.get() == 0.0 && ts.len() >= 2 && ts.iter().all(|t| t.1.get().abs() == 1.0) {
+                    let terms: Vec<(Id, f64)> = ts.iter().map(|t| (t.0, t.1.get())).collect();
+                    let (key, sign) = unit_key(&terms);
+                    u.exact.entry(key).or_insert((id, sign));
+                    for &(t, _) in &terms {
+                        let list = u.by_term.entry(t).or_default();
+                        if list.len() < MAX_CANDIDATES {
+                            list.push(u.terms.len());
+                        }
+                    }
+                    u.terms.push((id, terms));
                 }
             }
         }
-        out.extend(group.into_iter().map(|(t, k)| (t, k * mag)));
+        u
     }
-    out
+
+    /// The terms of sum `id` with unit sums standing in for terms they hold: per group of terms
+    /// of one coefficient magnitude, the whole group if it is a unit sum, else the largest unit
+    /// sums inside it, one after another.
+    fn plan(&self, id: Id, terms: impl Iterator<Item = (Id, f64)>) -> Vec<(Id, f64)> {
+        let terms: Vec<(Id, f64)> = terms.collect();
+        let mut mags: Vec<f64> = Vec::new();
+        for &(_, k) in &terms {
+            if !mags.contains(&k.abs()) {
+                mags.push(k.abs());
+            }
+        }
+        let mut out = Vec::with_capacity(terms.len());
+        for mag in mags {
+            // The group as unit terms, in `Id` order (as the node keeps them).
+            let mut group: Vec<(Id, f64)> = terms
+                .iter()
+                .filter(|t| t.1.abs() == mag)
+                .map(|&(t, k)| (t, k / mag))
+                .collect();
+            while group.len() >= 2 {
+                let found = match self.exact.get(&unit_key(&group).0) {
+                    Some(&(u, _)) if u != id => Some(u),
+                    _ => self.largest_inside(id, &group),
+                };
+                let Some(u) = found else { break };
+                // The sign relating the group's terms to the unit sum's.
+                let u_terms = &self.terms[self.index_of(u)].1;
+                let first = u_terms[0];
+                let g_first = group.iter().find(|t| t.0 == first.0).expect("inside").1;
+                let sign = g_first * first.1;
+                group.retain(|t| u_terms.binary_search_by_key(&t.0, |x| x.0).is_err());
+                out.push((u, mag * sign));
+            }
+            out.extend(group.into_iter().map(|(t, k)| (t, k * mag)));
+        }
+        out
+    }
+
+    fn index_of(&self, u: Id) -> usize {
+        self.terms
+            .binary_search_by_key(&u, |t| t.0)
+            .expect("a unit sum")
+    }
+
+    /// The largest unit sum other than `id` whose terms all lie in `group` with the same
+    /// relative signs (ties: the earliest), if any.
+    fn largest_inside(&self, id: Id, group: &[(Id, f64)]) -> Option<Id> {
+        let sign_in_group = |t: Id| -> Option<f64> {
+            group
+                .binary_search_by_key(&t, |x| x.0)
+                .ok()
+                .map(|i| group[i].1)
+        };
+        let mut best: Option<(usize, Id)> = None;
+        for &(t, _) in group {
+            for &i in self.by_term.get(&t).into_iter().flatten() {
+                let (u, ref ut) = self.terms[i];
+                if u == id || ut.len() >= group.len() || best.is_some_and(|b| b.0 >= ut.len()) {
+                    continue;
+                }
+                let Some(s0) = sign_in_group(ut[0].0) else {
+                    continue;
+                };
+                let rel = s0 * ut[0].1;
+                if ut.iter().all(|&(x, k)| sign_in_group(x) == Some(rel * k)) {
+                    best = Some((ut.len(), u));
+                }
+            }
+        }
+        best.map(|b| b.1)
+    }
+}
+
+/// The terms of a unit sum with its first coefficient made positive, and the sign that undoes
+/// it.
+fn unit_key(terms: &[(Id, f64)]) -> (Vec<(Id, bool)>, f64) {
+    let sign = if terms[0].1 < 0.0 { -1.0 } else { 1.0 };
+    let key = terms.iter().map(|&(t, k)| (t, k * sign > 0.0)).collect();
+    (key, sign)
 }
 
 /// `k a + k b - k c` -> `k (a + b - c)`: terms whose coefficients share a magnitude get it

@@ -7,7 +7,7 @@ use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote};
 
 use super::names::{snake, upper_camel, Scope};
-use crate::cas::{Expr, Id, OpCount, Program, Symbol, SymbolKind};
+use crate::cas::{Expr, Id, OpCount, Order, Program, Symbol, SymbolKind};
 use crate::dynamics::{Derivation, Route};
 use crate::model::Model;
 
@@ -278,7 +278,7 @@ const LET_CHUNK: usize = 64;
 
 /// Straight-line body computing `outputs` in the given shape, and its operation count.
 fn body(d: &Derivation, cx: &Ctx<'_>, outputs: &[Id], shape: Shape) -> (TokenStream, OpCount) {
-    let program = Program::new(&d.graph, outputs);
+    let program = Program::ordered(&d.graph, outputs, Order::Levels);
     let mut trig = BTreeSet::new();
     // Temporaries go in chunks: `let (t0, .., t63) = { let t0 = ..; ..; (t0, .., t63) };`.
     // Every `let` opens a lexical scope nested in the previous one, and LLVM's debug-info
