@@ -5,7 +5,7 @@
 //! - [`eval`]: numeric evaluation;
 //! - [`simplify`]: expansion and trigonometric identities, for readable equations;
 //! - [`schedule`]: straight-line programs (temporaries, outputs, operation counts);
-//! - [`print`]: plain text and LaTeX.
+//! - [`mod@print`]: plain text and LaTeX.
 //!
 //! ```
 //! use eomgen::cas::{Graph, Style};
