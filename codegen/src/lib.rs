@@ -23,7 +23,7 @@ pub mod model;
 pub mod report;
 pub mod urdf;
 
-pub use builder::{Builder, DEFAULT_MAX_DOF};
+pub use builder::{Builder, DEFAULT_MAX_DOF, DEFAULT_MAX_GRAPH_NODES};
 pub use model::{ModelError, ModelOptions, SymbolicParams};
 
 /// Everything that can go wrong between a URDF and a written module.

@@ -68,6 +68,13 @@ struct ModelArgs {
     /// [default: depth first, children by joint name]
     #[arg(long, value_name = "A,B,...", value_delimiter = ',')]
     joint_order: Option<Vec<String>>,
+    /// Refuse robots with more degrees of freedom than this.
+    #[arg(long, value_name = "N", default_value_t = eomgen::DEFAULT_MAX_DOF)]
+    max_dof: usize,
+    /// Refuse robots whose derivation needs more expression graph nodes than this (each takes
+    /// some 60 bytes).
+    #[arg(long, value_name = "N", default_value_t = eomgen::DEFAULT_MAX_GRAPH_NODES)]
+    max_graph_nodes: usize,
 }
 
 impl ModelArgs {
@@ -82,6 +89,40 @@ impl ModelArgs {
             },
             ..ModelOptions::default()
         }
+    }
+
+    /// A builder for `urdf` with these options and limits.
+    fn builder(&self, urdf: &Path, symbolic: &Option<Vec<String>>) -> Builder {
+        Builder::new(urdf)
+            .model_options(self.options(symbolic))
+            .max_dof(self.max_dof)
+            .max_graph_nodes(self.max_graph_nodes)
+    }
+}
+
+/// A library error, with the command-line flag that raises a limit instead of the Builder
+/// option.
+fn cli_error(e: eomgen::Error) -> Failure {
+    match e {
+        eomgen::Error::Limit {
+            file,
+            what,
+            value,
+            limit,
+            raise,
+        } => eomgen::Error::Limit {
+            file,
+            what,
+            value,
+            limit,
+            raise: match raise {
+                "Builder::max_dof" => "--max-dof",
+                "Builder::max_graph_nodes" => "--max-graph-nodes",
+                other => other,
+            },
+        }
+        .into(),
+        e => e.into(),
     }
 }
 
@@ -354,17 +395,14 @@ fn file_name(p: &Path) -> String {
         .unwrap_or_else(|| p.display().to_string())
 }
 
-fn load(urdf: &Path, options: &ModelOptions) -> Result<Model, Failure> {
-    Ok(eomgen::urdf::load_file(urdf, options)?)
-}
-
-fn derive(model: &Model) -> Derivation {
+/// Derives within the limits of `b` (degrees of freedom, graph size).
+fn derive(b: &Builder, model: &Model) -> Result<Derivation, Failure> {
     let label = format!(
         "deriving the equations of {} ({} joints)",
         model.name,
         model.dof()
     );
-    progress::run(&label, || Derivation::new(model))
+    progress::run(&label, || b.derive(model)).map_err(cli_error)
 }
 
 fn run(cli: Cli) -> Result<(), Failure> {
@@ -378,7 +416,7 @@ fn run(cli: Cli) -> Result<(), Failure> {
 }
 
 fn generate(a: GenerateArgs) -> Result<(), Failure> {
-    let mut b = Builder::new(&a.urdf).model_options(a.model.options(&a.symbolic));
+    let mut b = a.model.builder(&a.urdf, &a.symbolic);
     if let Some(t) = &a.type_name {
         b = b.type_name(t);
     }
@@ -392,7 +430,8 @@ fn generate(a: GenerateArgs) -> Result<(), Failure> {
         model.name,
         model.dof()
     );
-    let (generated, _, _) = progress::run(&label, || b.generate_with_report())?;
+    let (generated, _, _) =
+        progress::run(&label, || b.generate_with_report()).map_err(cli_error)?;
     match &a.output {
         Some(path) => {
             eomgen::write_if_changed(path, generated.source.as_bytes())?;
@@ -425,8 +464,9 @@ fn show(a: ShowArgs) -> Result<(), Failure> {
             )
             .exit();
     }
-    let model = load(&a.urdf, &a.model.options(&a.symbolic))?;
-    let d = derive(&model);
+    let b = a.model.builder(&a.urdf, &a.symbolic);
+    let model = b.model()?;
+    let d = derive(&b, &model)?;
     let opts = ShowOptions {
         terms,
         entry: a.entry.map(|e| e.0),
@@ -450,7 +490,7 @@ fn show(a: ShowArgs) -> Result<(), Failure> {
 }
 
 fn info_cmd(a: InfoArgs) -> Result<(), Failure> {
-    let b = Builder::new(&a.urdf).model_options(a.model.options(&None));
+    let b = a.model.builder(&a.urdf, &None);
     let start = Instant::now();
     let model = b.model()?;
     let load = start.elapsed();
@@ -460,7 +500,8 @@ fn info_cmd(a: InfoArgs) -> Result<(), Failure> {
         model.dof()
     );
     let start = Instant::now();
-    let (generated, model, d) = progress::run(&label, || b.generate_with_report())?;
+    let (generated, model, d) =
+        progress::run(&label, || b.generate_with_report()).map_err(cli_error)?;
     let derive: std::time::Duration = d.timings.iter().map(|t| t.1).sum();
     let emit_time = start.elapsed().saturating_sub(derive + load);
     emit(&info::print(
@@ -474,7 +515,8 @@ fn info_cmd(a: InfoArgs) -> Result<(), Failure> {
 }
 
 fn eval_cmd(a: EvalArgs) -> Result<(), Failure> {
-    let model = load(&a.urdf, &a.model.options(&None))?;
+    let b = a.model.builder(&a.urdf, &None);
+    let model = b.model()?;
     let n = model.dof();
     let joints = model
         .joints
@@ -499,14 +541,15 @@ fn eval_cmd(a: EvalArgs) -> Result<(), Failure> {
         qdd: check("--qdd", a.qdd)?,
         tau: check("--tau", a.tau)?,
     };
-    let d = derive(&model);
+    let d = derive(&b, &model)?;
     let values = eval::evaluate(&model, &d, &state).map_err(Failure)?;
     let digits = (a.digits > 0).then_some(a.digits);
     emit(&eval::print(&model, &state, &values, digits))
 }
 
 fn simulate_cmd(a: SimulateArgs) -> Result<(), Failure> {
-    let model = load(&a.urdf, &a.model.options(&None))?;
+    let b = a.model.builder(&a.urdf, &None);
+    let model = b.model()?;
     let n = model.dof();
     let check = |flag: &str, v: Option<Numbers>, default: &[f64]| -> Result<Vec<f64>, Failure> {
         match v {
@@ -536,7 +579,7 @@ fn simulate_cmd(a: SimulateArgs) -> Result<(), Failure> {
         omega: a.omega,
         friction: a.friction,
     };
-    let d = derive(&model);
+    let d = derive(&b, &model)?;
     let outcome = simulate::run(&model, &d, &options).map_err(Failure)?;
     if let Some(path) = &a.plot {
         let names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
