@@ -874,7 +874,7 @@ fn error_non_finite_numbers() {
         model.joints[0].limits.as_ref().unwrap().upper,
         f64::INFINITY
     );
-    // Finite numbers whose composition overflows.
+    // Finite numbers so large that their composition would overflow.
     let far = r#"<origin xyz="1e308 0 0"/>"#;
     let text = robot(&[
         link("base"),
@@ -889,8 +889,8 @@ fn error_non_finite_numbers() {
             r#"<joint name="fb" type="fixed">{far}<parent link="a"/><child link="b"/></joint>"#
         ),
     ]);
-    let err = bad(&text, &["`l1`"]);
-    assert!(matches!(err, ModelError::NonFinite { .. }), "{err}");
+    let err = bad(&text, &["joint `fa`", "origin holds 1e308"]);
+    assert!(matches!(err, ModelError::OutOfRange { .. }), "{err}");
     // A non-finite gravity option.
     let options = ModelOptions {
         gravity: [0.0, 0.0, f64::NAN],

@@ -584,20 +584,24 @@ impl Graph {
     }
 
     /// Ids of every node reachable from `roots`, ascending (so children before parents).
+    ///
+    /// Costs time in proportion to the nodes reached, not to the size of the graph: a robot
+    /// with thousands of links asks for thousands of small programs from one big graph.
     pub fn reachable(&self, roots: &[Id]) -> Vec<Id> {
-        let mut seen = vec![false; self.nodes.len()];
+        // Children precede parents: nothing reachable lies above the highest root.
+        let top = roots.iter().map(|r| r.index() + 1).max().unwrap_or(0);
+        let mut seen = vec![false; top];
+        let mut found = Vec::new();
         let mut stack: Vec<Id> = roots.to_vec();
         while let Some(id) = stack.pop() {
             if std::mem::replace(&mut seen[id.index()], true) {
                 continue;
             }
+            found.push(id);
             stack.extend(self.node(id).children().filter(|c| !seen[c.index()]));
         }
-        seen.iter()
-            .enumerate()
-            .filter(|(_, &s)| s)
-            .map(|(i, _)| Id(i as u32))
-            .collect()
+        found.sort_unstable();
+        found
     }
 
     /// True when `e` contains the symbol node `x`.

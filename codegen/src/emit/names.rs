@@ -77,6 +77,23 @@ pub fn snake(name: &str, fallback: &str) -> String {
     finish(s, fallback)
 }
 
+/// `text` made safe for a comment (doc comments included): control characters other than tab
+/// (newlines, carriage returns) and the bidirectional-text controls that rustc refuses in
+/// comments (`text_direction_codepoint_in_comment`, deny by default) are written as escapes
+/// such as `\u{202e}`; everything else, `*/` included, is harmless in a line comment.
+pub fn comment_text(text: &str) -> String {
+    let bidi = |c: char| matches!(c, '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}');
+    text.chars()
+        .map(|c| {
+            if (c.is_control() && c != '\t') || bidi(c) {
+                format!("\\u{{{:x}}}", c as u32)
+            } else {
+                c.to_string()
+            }
+        })
+        .collect()
+}
+
 /// Hands out identifiers unique within one scope, suffixing `_2`, `_3`, ... on collision.
 #[derive(Default)]
 pub struct Scope {
@@ -119,6 +136,14 @@ mod tests {
         assert_eq!(snake("Panda Arm", "robot"), "panda_arm");
         assert_eq!(snake("fn", "robot"), "fn_");
         assert_eq!(snake("9lives", "robot"), "robot9lives");
+    }
+
+    #[test]
+    fn comment_text_escapes_what_rustc_refuses_in_comments() {
+        assert_eq!(comment_text("a */ b\tc"), "a */ b\tc");
+        assert_eq!(comment_text("a\nb\rc"), "a\\u{a}b\\u{d}c");
+        assert_eq!(comment_text("x\u{202e}y\u{2066}"), "x\\u{202e}y\\u{2066}");
+        assert_eq!(comment_text("日本語 é"), "日本語 é");
     }
 
     #[test]

@@ -6,7 +6,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote};
 
-use super::names::{snake, upper_camel, Scope};
+use super::names::{comment_text, snake, upper_camel, Scope};
 use crate::cas::{Expr, Id, OpCount, Program, Symbol, SymbolKind};
 use crate::dynamics::{Derivation, Route};
 use crate::model::Model;
@@ -349,7 +349,7 @@ fn body(d: &Derivation, cx: &Ctx<'_>, outputs: &[Id], shape: Shape) -> (TokenStr
 
 fn doc(lines: &[String]) -> TokenStream {
     let attrs = lines.iter().map(|l| {
-        let text = format!(" {l}");
+        let text = format!(" {}", comment_text(l));
         quote!(#[doc = #text])
     });
     quote!(#(#attrs)*)
@@ -378,7 +378,11 @@ pub fn emit_tokens(
     for (name, id, value) in &d.params {
         let sym = d.graph.as_symbol(*id).expect("parameter symbol");
         let f = format_ident!("{}", field_scope.claim(snake(name, "p")));
-        let docline = format!(" `{}` (URDF value {}).", name.replace('`', "'"), value);
+        let docline = format!(
+            " `{}` (URDF value {}).",
+            comment_text(&name.replace('`', "'")),
+            value
+        );
         field_defs.push(quote!(#[doc = #docline] pub #f: T,));
         let l = lit(*value);
         field_defaults.push(quote!(#f: #l,));
