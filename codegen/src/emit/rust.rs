@@ -597,6 +597,9 @@ pub fn emit_tokens(
             /// Forward dynamics `qdd = M(q)^-1 (tau - b(q, qd) - G(q))`, or which pivot of the
             /// `L^T D L` factorization of M(q) was not positive (a non-physical model or
             /// non-finite input); see `Dynamics::forward_dynamics` for the operation count.
+            /// `Ok` holds only finite numbers: a non-finite component `i` of the solution (from
+            /// a non-finite `qd` or `tau`, or a `q` that leaves M(q) finite) is reported as
+            /// `FactorError::NonFinite { pivot: i }`.
             pub fn try_forward_dynamics(&self, q: &[T; #n], qd: &[T; #n], tau: &[T; #n]) -> ::core::result::Result<[T; #n], ::eomgen_runtime::FactorError> {
                 let o: [T; #fd_len] = { #fd_body };
                 let pivots = [#(#fd_pivots),*];
@@ -608,7 +611,13 @@ pub fn emit_tokens(
                         return Err(::eomgen_runtime::FactorError::NotPositiveDefinite { pivot });
                     }
                 }
-                Ok([#(#fd_x),*])
+                let qdd = [#(#fd_x),*];
+                for (pivot, x) in qdd.iter().enumerate() {
+                    if !x.is_finite() {
+                        return Err(::eomgen_runtime::FactorError::NonFinite { pivot });
+                    }
+                }
+                Ok(qdd)
             }
 
             /// Pose of a link frame in the world (root) frame.
