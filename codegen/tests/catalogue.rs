@@ -441,6 +441,11 @@ fn catalogue() -> Vec<(&'static str, String, Expect)> {
             },
             Error(&["form a cycle", "4992 more"]),
         ),
+        (
+            "terminal_escapes",
+            robot(&[link("b\u{9b}31mX\u{202e}"), link("b\u{9b}31mX\u{202e}")]),
+            Error(&["is defined more than once"]),
+        ),
         // Hostile but legal names.
         ("hostile_names", fixture("names.urdf"), Code),
         (
@@ -699,6 +704,7 @@ fn the_cli_prints_one_line_and_exits_1_on_catalogue_cases() {
         "massless_subtree",
         "floating_joint",
         "revolute_chain_10000",
+        "terminal_escapes",
     ];
     for name in picked {
         let (_, text, _) = cases.iter().find(|c| c.0 == name).unwrap();
@@ -712,6 +718,14 @@ fn the_cli_prints_one_line_and_exits_1_on_catalogue_cases() {
             "{name}: {stderr}"
         );
         assert!(!stderr.contains("internal error"), "{name}: {stderr}");
+        // Names cannot drive the terminal: no control or bidirectional-text characters.
+        assert!(
+            !stderr
+                .trim_end_matches('\n')
+                .chars()
+                .any(|c| c.is_control() || ('\u{202a}'..='\u{202e}').contains(&c)),
+            "{name}: {stderr:?}"
+        );
     }
     // The CLI names its own flag for the limit.
     let (_, chain, _) = cases

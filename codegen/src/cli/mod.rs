@@ -369,8 +369,10 @@ pub fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(Failure(message)) => {
-            // Exactly one line, whatever the underlying message looks like.
+            // Exactly one line, whatever the underlying message looks like, and no control or
+            // bidirectional-text characters from names in the URDF reach the terminal.
             let line = message.split_whitespace().collect::<Vec<_>>().join(" ");
+            let line = eomgen::emit::names::comment_text(&line);
             let _ = writeln!(std::io::stderr(), "eomgen: error: {line}");
             ExitCode::from(1)
         }
