@@ -65,13 +65,16 @@ pub const DEFAULT_MAX_DOF: usize = 40;
 /// the worst; a 40-joint chain needs a few million.
 pub const DEFAULT_MAX_GRAPH_NODES: usize = crate::cas::graph::DEFAULT_MAX_NODES;
 
+/// Type names the generated code cannot take: `T` is its generic parameter.
+const RESERVED_TYPE_NAMES: &[&str] = &["T"];
+
 fn is_identifier(s: &str, upper: bool) -> bool {
     let candidate = if upper {
         upper_camel(s, "X")
     } else {
         snake(s, "x")
     };
-    !s.is_empty() && candidate == s
+    !s.is_empty() && candidate == s && !(upper && RESERVED_TYPE_NAMES.contains(&s))
 }
 
 impl Builder {
@@ -119,7 +122,8 @@ impl Builder {
         self
     }
 
-    /// The generated type; default: the robot name in UpperCamelCase. The link enum is
+    /// The generated type; default: the robot name in UpperCamelCase (`TRobot` for a robot
+    /// called `t`: `T` is the generated code's type parameter). The link enum is
     /// `<type_name>Link`.
     pub fn type_name(mut self, name: &str) -> Builder {
         self.type_name = Some(name.to_string());
@@ -196,7 +200,10 @@ impl Builder {
                     name: t.clone(),
                 })
             }
-            None => upper_camel(&model.name, "Robot"),
+            None => match upper_camel(&model.name, "Robot") {
+                t if RESERVED_TYPE_NAMES.contains(&t.as_str()) => format!("{t}Robot"),
+                t => t,
+            },
         };
         let module_name = match &self.module_name {
             Some(m) if is_identifier(m, false) => m.clone(),

@@ -630,6 +630,21 @@ fn hostile_names_stay_data_with_symbolic_parameters() {
 }
 
 #[test]
+fn a_robot_called_t_does_not_take_the_type_parameter_name() {
+    // `pub struct T<T = f64>` would not compile.
+    let urdf = arm("", link("tip")).replace("name=\"r\"", "name=\"t\"");
+    let source = eomgen::Builder::from_urdf_str(&urdf, "t.urdf")
+        .generate()
+        .unwrap();
+    assert!(source.contains("pub struct TRobot<T = f64>"));
+    let err = eomgen::Builder::from_urdf_str(&urdf, "t.urdf")
+        .type_name("T")
+        .generate()
+        .unwrap_err();
+    assert!(matches!(err, eomgen::Error::InvalidName { .. }), "{err}");
+}
+
+#[test]
 fn case_names_are_unique() {
     let mut names: Vec<&str> = catalogue().iter().map(|c| c.0).collect();
     names.sort_unstable();
