@@ -487,6 +487,14 @@ fn show(a: ShowArgs) -> Result<(), Failure> {
     };
     let text = progress::run("printing the equations", || {
         report::render(&model, &d, &opts)
+    })
+    .map_err(|e| match e {
+        report::ReportError::GraphFull(full) => Failure(format!(
+            "{}: {full} while expanding the equations for print: raise it with \
+             --max-graph-nodes, or print with --form program",
+            a.urdf.display()
+        )),
+        e => e.into(),
     })?;
     emit(&text)
 }
