@@ -464,6 +464,30 @@ fn catalogue() -> Vec<(&'static str, String, Expect)> {
             Code,
         ),
         (
+            "colliding_names_10000",
+            {
+                // 10,000 names that all sanitize to `L` (words are alphanumeric runs), welded
+                // to the base of a one-joint arm.
+                let punct: Vec<char> = "!#$%()*+,-./:;=?@[]^_{|}~".chars().collect();
+                let name = |mut i: usize| {
+                    let mut s = String::from("l");
+                    for _ in 0..3 {
+                        s.push(punct[i % punct.len()]);
+                        i /= punct.len();
+                    }
+                    s
+                };
+                let mut parts = vec![link("base"), link("tip")];
+                parts.push(joint("j", "revolute", "base", "tip", ""));
+                for i in 0..10_000 {
+                    parts.push(format!("<link name=\"{}\"/>", name(i)));
+                    parts.push(joint(&format!("w{i}"), "fixed", "base", &name(i), ""));
+                }
+                robot(&parts)
+            },
+            Code,
+        ),
+        (
             "keyword_names",
             robot(&[
                 link("self"),
@@ -552,7 +576,9 @@ fn run(case: &str, text: &str, expect: &Expect) -> Result<(), String> {
         format!("{case}: panicked: {what}")
     })?;
     let elapsed = start.elapsed();
-    if elapsed > Duration::from_secs(10) {
+    // The largest cases take about 4 s; names colliding after sanitizing used to take
+    // quadratic time.
+    if elapsed > Duration::from_secs(8) {
         return Err(format!("{case}: took {elapsed:?}"));
     }
     match (outcome, expect) {

@@ -4,7 +4,7 @@
 //! punctuation, quotes or non-ASCII letters. Only the identifiers made here and string literals
 //! escaped by `proc_macro2` reach generated code, so no name can break or inject into it.
 
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 
 /// Words that cannot be identifiers (strict and reserved keywords of every edition).
 const KEYWORDS: &[&str] = &[
@@ -98,6 +98,9 @@ pub fn comment_text(text: &str) -> String {
 #[derive(Default)]
 pub struct Scope {
     taken: BTreeSet<String>,
+    /// Per identifier that collided, the first suffix not yet tried: thousands of names that
+    /// sanitize alike (`l!`, `l#`, ...) cost linear time, not quadratic.
+    next_suffix: BTreeMap<String, usize>,
 }
 
 impl Scope {
@@ -105,6 +108,7 @@ impl Scope {
     pub fn with_reserved(reserved: &[&str]) -> Scope {
         Scope {
             taken: reserved.iter().map(|s| s.to_string()).collect(),
+            next_suffix: BTreeMap::new(),
         }
     }
 
@@ -113,10 +117,15 @@ impl Scope {
         if self.taken.insert(ident.clone()) {
             return ident;
         }
-        (2..)
-            .map(|k| format!("{ident}_{k}"))
-            .find(|c| self.taken.insert(c.clone()))
-            .expect("an unused suffix exists")
+        // Suffixes below `first` were taken, and taken names stay taken: same result as
+        // trying from 2.
+        let first = self.next_suffix.get(&ident).copied().unwrap_or(2);
+        let (k, claimed) = (first..)
+            .map(|k| (k, format!("{ident}_{k}")))
+            .find(|(_, c)| self.taken.insert(c.clone()))
+            .expect("an unused suffix exists");
+        self.next_suffix.insert(ident, k + 1);
+        claimed
     }
 }
 
@@ -153,5 +162,11 @@ mod tests {
         assert_eq!(s.claim("A".into()), "A");
         assert_eq!(s.claim("A".into()), "A_2");
         assert_eq!(s.claim("A".into()), "A_3");
+        // A suffixed name taken directly is skipped later.
+        assert_eq!(s.claim("B_2".into()), "B_2");
+        assert_eq!(s.claim("B".into()), "B");
+        assert_eq!(s.claim("B".into()), "B_3");
+        assert_eq!(s.claim("A_4".into()), "A_4");
+        assert_eq!(s.claim("A".into()), "A_5");
     }
 }
