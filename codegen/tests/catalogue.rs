@@ -768,6 +768,35 @@ fn the_cli_prints_one_line_and_exits_1_on_catalogue_cases() {
             "{name}: {stderr:?}"
         );
     }
+    // Names printed on stdout cannot drive the terminal either.
+    let dir = std::env::temp_dir().join(format!("eomgen-catalogue-{}", std::process::id()));
+    let path = dir.join("escapes.urdf");
+    let name = "tip\u{9b}2J\u{85}\u{202e}x";
+    let text = robot(&[
+        link("base"),
+        link(name),
+        joint(name, "revolute", "base", name, ""),
+    ]);
+    std::fs::write(&path, text).unwrap();
+    for command in ["info", "show", "generate"] {
+        let out = Command::new(env!("CARGO_BIN_EXE_eomgen"))
+            .arg(command)
+            .arg(&path)
+            .output()
+            .unwrap();
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            out.status.success(),
+            "{command}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(
+            !stdout
+                .chars()
+                .any(|c| (c.is_control() && c != '\n') || ('\u{202a}'..='\u{202e}').contains(&c)),
+            "{command}: {stdout:?}"
+        );
+    }
     // The CLI names its own flag for the limit.
     let (_, chain, _) = cases
         .iter()

@@ -372,7 +372,7 @@ pub fn main() -> ExitCode {
             // Exactly one line, whatever the underlying message looks like, and no control or
             // bidirectional-text characters from names in the URDF reach the terminal.
             let line = message.split_whitespace().collect::<Vec<_>>().join(" ");
-            let line = eomgen::emit::names::comment_text(&line);
+            let line = terminal_safe(&line);
             let _ = writeln!(std::io::stderr(), "eomgen: error: {line}");
             ExitCode::from(1)
         }
@@ -380,8 +380,18 @@ pub fn main() -> ExitCode {
 }
 
 /// Writes to stdout; a closed pipe (`eomgen show ... | head`) is not an error.
+/// Control characters other than newline and tab, and bidirectional-text controls, from names
+/// in a URDF must not drive the terminal: each is written as an escape such as `\u{1b}`.
+fn terminal_safe(text: &str) -> String {
+    text.split('\n')
+        .map(eomgen::emit::names::comment_text)
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
 fn emit(text: &str) -> Result<(), Failure> {
     let mut out = std::io::stdout().lock();
+    let text = terminal_safe(text);
     match out.write_all(text.as_bytes()).and_then(|_| out.flush()) {
         Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
             Err(Failure(format!("cannot write to stdout: {e}")))
