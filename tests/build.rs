@@ -1,5 +1,6 @@
-//! Generates the reference robots exactly as a user's build script would, and a small arm
-//! with joint friction, rotor inertia and an inertia filled from its collision box.
+//! Generates the reference robots exactly as a user's build script would, a small arm with
+//! joint friction, rotor inertia and an inertia filled from its collision box, and two
+//! bad-input robots.
 
 fn main() {
     for (file, module, ty) in [
@@ -15,6 +16,14 @@ fn main() {
             "robots/allegro_right_hand.urdf",
             "allegro_right_hand",
             "AllegroRightHand",
+        ),
+        // Bad-input robots: an ill-conditioned mass matrix, and names that try to break out
+        // of comments and strings (compiled for real here, with rustc's default lints).
+        ("urdf/light_tip.urdf", "light_tip", "LightTip"),
+        (
+            "../codegen/tests/urdf/hostile/names.urdf",
+            "hostile_names",
+            "HostileNames",
         ),
     ] {
         eomgen::Builder::new(file)

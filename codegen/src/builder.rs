@@ -3,6 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::cas::Limits;
 use crate::dynamics::Derivation;
 use crate::emit::names::{snake, upper_camel};
 use crate::emit::{self, EmitOptions, Generated};
@@ -44,12 +45,15 @@ use crate::Error;
 #[derive(Clone, Debug)]
 pub struct Builder {
     urdf: PathBuf,
+    /// The URDF's text, for [`Builder::from_urdf_str`]; `None` reads the file `urdf`.
+    text: Option<String>,
     module_name: Option<String>,
     type_name: Option<String>,
     out_dir: Option<PathBuf>,
     regenerate: Option<String>,
     options: ModelOptions,
     max_dof: usize,
+    max_graph_nodes: usize,
 }
 
 /// Robots with more joints than this are refused unless [`Builder::max_dof`] raises the limit:
@@ -57,13 +61,20 @@ pub struct Builder {
 /// minute and gigabytes of memory to derive.
 pub const DEFAULT_MAX_DOF: usize = 40;
 
+/// The default of [`Builder::max_graph_nodes`]: 50 million expression nodes, a few gigabytes at
+/// the worst; a 40-joint chain needs a few million.
+pub const DEFAULT_MAX_GRAPH_NODES: usize = crate::cas::graph::DEFAULT_MAX_NODES;
+
+/// Type names the generated code cannot take: `T` is its generic parameter.
+const RESERVED_TYPE_NAMES: &[&str] = &["T"];
+
 fn is_identifier(s: &str, upper: bool) -> bool {
     let candidate = if upper {
         upper_camel(s, "X")
     } else {
         snake(s, "x")
     };
-    !s.is_empty() && candidate == s
+    !s.is_empty() && candidate == s && !(upper && RESERVED_TYPE_NAMES.contains(&s))
 }
 
 impl Builder {
@@ -72,12 +83,36 @@ impl Builder {
     pub fn new(urdf: impl AsRef<Path>) -> Builder {
         Builder {
             urdf: urdf.as_ref().to_path_buf(),
+            text: None,
             module_name: None,
             type_name: None,
             out_dir: None,
             regenerate: None,
             options: ModelOptions::default(),
             max_dof: DEFAULT_MAX_DOF,
+            max_graph_nodes: DEFAULT_MAX_GRAPH_NODES,
+        }
+    }
+
+    /// Generation for a URDF given as text; `name` stands for the file in error messages and
+    /// in the generated banner (a file name such as `"robot.urdf"`, no directories).
+    /// [`Builder::compile`] then prints no `cargo:rerun-if-changed` line.
+    ///
+    /// ```
+    /// let urdf = r#"<robot name="pendulum"><link name="base"/>
+    ///   <link name="arm"><inertial><origin xyz="0 0 -0.5"/><mass value="1"/>
+    ///   <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.001"/></inertial></link>
+    ///   <joint name="swing" type="continuous"><parent link="base"/><child link="arm"/>
+    ///   <axis xyz="0 1 0"/></joint></robot>"#;
+    /// let source = eomgen::Builder::from_urdf_str(urdf, "pendulum.urdf").generate().unwrap();
+    /// assert!(source.contains("pub struct Pendulum<T = f64>"));
+    /// let err = eomgen::Builder::from_urdf_str("<robot/>", "empty.urdf").generate().unwrap_err();
+    /// assert_eq!(err.to_string(), "empty.urdf: the robot has no links");
+    /// ```
+    pub fn from_urdf_str(text: &str, name: &str) -> Builder {
+        Builder {
+            text: Some(text.to_string()),
+            ..Builder::new(name)
         }
     }
 
@@ -87,7 +122,8 @@ impl Builder {
         self
     }
 
-    /// The generated type; default: the robot name in UpperCamelCase. The link enum is
+    /// The generated type; default: the robot name in UpperCamelCase (`TRobot` for a robot
+    /// called `t`: `T` is the generated code's type parameter). The link enum is
     /// `<type_name>Link`.
     pub fn type_name(mut self, name: &str) -> Builder {
         self.type_name = Some(name.to_string());
@@ -181,6 +217,14 @@ impl Builder {
         self
     }
 
+    /// The most nodes the expression graph of the derivation may hold (default
+    /// [`DEFAULT_MAX_GRAPH_NODES`]); a robot that needs more is refused with
+    /// [`Error::Limit`] instead of exhausting memory. Each node takes some 60 bytes.
+    pub fn max_graph_nodes(mut self, limit: usize) -> Builder {
+        self.max_graph_nodes = limit;
+        self
+    }
+
     /// The "Regenerate:" line of the banner.
     pub fn regenerate_hint(mut self, hint: &str) -> Builder {
         self.regenerate = Some(hint.to_string());
@@ -189,7 +233,12 @@ impl Builder {
 
     /// Loads the model.
     pub fn model(&self) -> Result<Model, Error> {
-        Ok(crate::urdf::load_file(&self.urdf, &self.options)?)
+        Ok(match &self.text {
+            Some(text) => {
+                crate::urdf::load_str(text, &self.urdf.display().to_string(), &self.options)?
+            }
+            None => crate::urdf::load_file(&self.urdf, &self.options)?,
+        })
     }
 
     fn names(&self, model: &Model) -> Result<(String, String), Error> {
@@ -201,7 +250,10 @@ impl Builder {
                     name: t.clone(),
                 })
             }
-            None => upper_camel(&model.name, "Robot"),
+            None => match upper_camel(&model.name, "Robot") {
+                t if RESERVED_TYPE_NAMES.contains(&t.as_str()) => format!("{t}Robot"),
+                t => t,
+            },
         };
         let module_name = match &self.module_name {
             Some(m) if is_identifier(m, false) => m.clone(),
@@ -216,20 +268,37 @@ impl Builder {
         Ok((type_name, module_name))
     }
 
-    /// Derives and emits, returning the source and the operation counts.
-    pub fn generate_with_report(&self) -> Result<(Generated, Model, Derivation), Error> {
-        let model = self.model()?;
+    /// Derives the equations of `model` (usually from [`Builder::model`]) within the limits
+    /// of [`Builder::max_dof`] and [`Builder::max_graph_nodes`].
+    pub fn derive(&self, model: &Model) -> Result<Derivation, Error> {
+        let file = self.urdf.display().to_string();
         if model.dof() > self.max_dof {
             return Err(Error::Limit {
-                file: self.urdf.display().to_string(),
+                file,
                 what: "degrees of freedom",
                 value: model.dof(),
                 limit: self.max_dof,
                 raise: "Builder::max_dof",
             });
         }
+        let limits = Limits {
+            max_nodes: self.max_graph_nodes,
+            ..Limits::default()
+        };
+        Derivation::try_new(model, limits).map_err(|e| Error::Limit {
+            file,
+            what: "expression graph nodes (or more)",
+            value: e.nodes,
+            limit: e.max_nodes,
+            raise: "Builder::max_graph_nodes",
+        })
+    }
+
+    /// Derives and emits, returning the source and the operation counts.
+    pub fn generate_with_report(&self) -> Result<(Generated, Model, Derivation), Error> {
+        let model = self.model()?;
         let (type_name, _) = self.names(&model)?;
-        let derivation = Derivation::new(&model);
+        let derivation = self.derive(&model)?;
         let source_name = self
             .urdf
             .file_name()
@@ -256,7 +325,9 @@ impl Builder {
     /// the build script when the URDF changes; prints each of the model's warnings
     /// ([`Model::warnings`]) as `cargo:warning=`. Returns the path written.
     pub fn compile(&self) -> Result<PathBuf, Error> {
-        println!("cargo:rerun-if-changed={}", self.urdf.display());
+        if self.text.is_none() {
+            println!("cargo:rerun-if-changed={}", self.urdf.display());
+        }
         let out_dir = match &self.out_dir {
             Some(d) => d.clone(),
             None => std::env::var_os("OUT_DIR")

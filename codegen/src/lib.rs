@@ -23,7 +23,7 @@ pub mod model;
 pub mod report;
 pub mod urdf;
 
-pub use builder::{Builder, DEFAULT_MAX_DOF};
+pub use builder::{Builder, DEFAULT_MAX_DOF, DEFAULT_MAX_GRAPH_NODES};
 pub use model::{ModelError, ModelOptions, SymbolicParams};
 
 /// Everything that can go wrong between a URDF and a written module.
@@ -80,10 +80,12 @@ pub fn write_if_changed(path: &Path, bytes: &[u8]) -> Result<bool, Error> {
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
     let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
-    std::fs::write(&tmp, bytes).map_err(io)?;
-    std::fs::rename(&tmp, path).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        io(e)
-    })?;
+    // On any failure (a full disk mid-write, a directory in the way), no temporary file stays.
+    std::fs::write(&tmp, bytes)
+        .and_then(|_| std::fs::rename(&tmp, path))
+        .map_err(|e| {
+            let _ = std::fs::remove_file(&tmp);
+            io(e)
+        })?;
     Ok(true)
 }

@@ -36,3 +36,96 @@ fn robots_beyond_the_joint_limit_are_refused_with_the_way_to_raise_it() {
         .generate()
         .is_ok());
 }
+
+#[test]
+fn derivations_beyond_the_graph_limit_are_refused_with_the_way_to_raise_it() {
+    for robot in ["ur5", "panda"] {
+        let err = eomgen::Builder::new(urdf(robot))
+            .max_graph_nodes(5_000)
+            .generate()
+            .unwrap_err();
+        let msg = err.to_string();
+        match err {
+            eomgen::Error::Limit {
+                value,
+                limit: 5_000,
+                raise: "Builder::max_graph_nodes",
+                ..
+            } => assert!(value > 5_000, "{msg}"),
+            _ => panic!("{robot}: not the graph limit: {msg}"),
+        }
+        assert!(
+            msg.contains(&format!("{robot}.urdf")) && msg.contains("expression graph nodes"),
+            "{msg}"
+        );
+    }
+    // The same robot passes with room to spare, and its output does not depend on the limit.
+    let roomy = eomgen::Builder::new(urdf("ur5"))
+        .max_graph_nodes(2_000_000)
+        .generate()
+        .unwrap();
+    assert_eq!(roomy, eomgen::Builder::new(urdf("ur5")).generate().unwrap());
+}
+
+#[test]
+fn a_full_graph_stops_growing_and_reports_instead_of_panicking() {
+    use eomgen::cas::{Graph, Limits};
+    for max_nodes in [0, 1, 2, 3, 50] {
+        let mut g = Graph::with_limits(Limits {
+            max_nodes,
+            ..Limits::default()
+        });
+        let x = g.q(0);
+        let mut e = x;
+        for k in 0..200 {
+            let s = g.sin(e);
+            let c = g.constant(k as f64 + 0.5);
+            e = g.add(s, c);
+        }
+        // 0 and 1 always exist; nothing beyond the limit was stored.
+        assert!(g.len() <= max_nodes.max(2), "{max_nodes}: {}", g.len());
+        let full = g.check().unwrap_err();
+        assert_eq!(full.max_nodes, max_nodes);
+        assert!(full.nodes > max_nodes, "{full:?}");
+    }
+    let mut g = Graph::new();
+    let x = g.q(0);
+    g.sin(x);
+    assert!(g.check().is_ok());
+}
+
+#[test]
+fn show_names_the_graph_limit_when_expansion_fills_the_graph() {
+    // Just enough nodes for the derivation, not for the expansion.
+    let builder = eomgen::Builder::new(urdf("double_pendulum"));
+    let derived = builder.derive(&builder.model().unwrap()).unwrap();
+    let limit = (derived.graph.len() + 2).to_string();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_eomgen"))
+        .arg("show")
+        .arg(urdf("double_pendulum"))
+        .args(["--max-graph-nodes", &limit])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(
+        stderr.contains("double_pendulum.urdf")
+            && stderr.contains(&format!("limit of {limit} nodes"))
+            && stderr.contains("while expanding the equations")
+            && stderr.contains("--max-graph-nodes"),
+        "{stderr}"
+    );
+    // In program form nothing is expanded: the same limit suffices.
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_eomgen"))
+        .arg("show")
+        .arg(urdf("double_pendulum"))
+        .args(["--max-graph-nodes", &limit, "--form", "program"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}

@@ -4427,6 +4427,9 @@ impl<T: ::eomgen_runtime::Real> AllegroRightHand<T> {
     /// Forward dynamics `qdd = M(q)^-1 (tau - b(q, qd) - G(q))`, or which pivot of the
     /// `L^T D L` factorization of M(q) was not positive (a non-physical model or
     /// non-finite input); see `Dynamics::forward_dynamics` for the operation count.
+    /// `Ok` holds only finite numbers: a non-finite component `i` of the solution (from
+    /// a non-finite `qd` or `tau`, or a `q` that leaves M(q) finite) is reported as
+    /// `FactorError::NonFinite { pivot: i }`.
     pub fn try_forward_dynamics(
         &self,
         q: &[T; 16],
@@ -6348,7 +6351,7 @@ impl<T: ::eomgen_runtime::Real> AllegroRightHand<T> {
                 });
             }
         }
-        Ok([
+        let qdd = [
             o[0],
             o[1],
             o[2],
@@ -6365,7 +6368,15 @@ impl<T: ::eomgen_runtime::Real> AllegroRightHand<T> {
             o[13],
             o[14],
             o[15],
-        ])
+        ];
+        for (pivot, x) in qdd.iter().enumerate() {
+            if !x.is_finite() {
+                return Err(::eomgen_runtime::FactorError::NonFinite {
+                    pivot,
+                });
+            }
+        }
+        Ok(qdd)
     }
     /// Pose of a link frame in the world (root) frame.
     pub fn link_pose(

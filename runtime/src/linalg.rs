@@ -20,7 +20,9 @@ pub enum FactorError {
         pivot: usize,
     },
     /// Pivot `pivot` was NaN or infinite: the matrix holds a non-finite value (in row `pivot`
-    /// or an earlier row of its lower triangle), or its factorization overflowed.
+    /// or an earlier row of its lower triangle), or its factorization overflowed. From a
+    /// generated `try_forward_dynamics`, also: component `pivot` of the solution is not finite
+    /// (a non-finite right-hand side).
     NonFinite {
         /// The 0-based index of the offending pivot.
         pivot: usize,

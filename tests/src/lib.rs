@@ -248,6 +248,15 @@ pub mod robots {
     pub mod joint_effects_smooth {
         include!(concat!(env!("OUT_DIR"), "/joint_effects_smooth.rs"));
     }
+    /// `urdf/light_tip.urdf`: a 1e-12 kg last link, an ill-conditioned mass matrix.
+    pub mod light_tip {
+        include!(concat!(env!("OUT_DIR"), "/light_tip.rs"));
+    }
+    /// `codegen/tests/urdf/hostile/names.urdf`: link and joint names that try to break out of
+    /// comments and string literals; compiling this module is the test.
+    pub mod hostile_names {
+        include!(concat!(env!("OUT_DIR"), "/hostile_names.rs"));
+    }
 }
 
 /// A global allocator that counts this thread's allocations, to prove code allocation-free.

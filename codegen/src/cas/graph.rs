@@ -163,10 +163,15 @@ impl Hasher for FxHasher {
     }
 }
 
+/// The default of [`Limits::max_nodes`].
+pub const DEFAULT_MAX_NODES: usize = 50_000_000;
+
 /// Limits that keep a runaway derivation from exhausting memory.
 #[derive(Clone, Copy, Debug)]
 pub struct Limits {
-    /// Most nodes a graph may hold.
+    /// Most nodes a graph may hold (at least 2: the constants 0 and 1 are always there, and
+    /// never more than `u32::MAX`). A graph that is full stops growing instead of panicking:
+    /// see [`Graph::check`].
     pub max_nodes: usize,
     /// Sums and products with more children than this are not flattened into their parents
     /// (they stay one term or factor), which keeps building linear in the graph's size.
@@ -177,10 +182,20 @@ impl Default for Limits {
     fn default() -> Self {
         // About 3 GB of nodes at the worst; a 48-joint arm needs a few million.
         Limits {
-            max_nodes: 50_000_000,
+            max_nodes: DEFAULT_MAX_NODES,
             max_flatten: 128,
         }
     }
+}
+
+/// A graph ran into [`Limits::max_nodes`]: the expressions built since are wrong.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("the expression graph needs more than its limit of {max_nodes} nodes ({nodes} requested)")]
+pub struct GraphFull {
+    /// The limit in force.
+    pub max_nodes: usize,
+    /// The nodes held plus the nodes refused: a lower bound of what the work needed.
+    pub nodes: usize,
 }
 
 /// The arena of interned nodes and the symbol table.
@@ -190,6 +205,8 @@ pub struct Graph {
     memo: HashTable<Id>,
     symbols: Vec<Symbol>,
     limits: Limits,
+    /// Nodes that could not be created because the graph was full.
+    refused: usize,
 }
 
 impl Default for Graph {
@@ -226,10 +243,19 @@ impl Graph {
             memo: HashTable::new(),
             symbols: Vec::new(),
             limits,
+            refused: 0,
         };
-        // 0 and 1 first: they are the most common children.
-        g.constant(0.0);
-        g.constant(1.0);
+        // 0 and 1 first, whatever the limit: they are the most common children, and a full
+        // graph answers with 0.
+        for v in [0.0, 1.0] {
+            let node = Node::Const(Num::new(v));
+            let h = hash_node(&node);
+            let id = Id(g.nodes.len() as u32);
+            g.nodes.push(node);
+            let nodes = &g.nodes;
+            g.memo
+                .insert_unique(h, id, |&i| hash_node(&nodes[i.index()]));
+        }
         g
     }
 
@@ -258,22 +284,35 @@ impl Graph {
         self.limits
     }
 
-    /// Interns a node that is already canonical.
+    /// `Err` once the graph has run into [`Limits::max_nodes`].
     ///
-    /// # Panics
-    /// When the graph would exceed [`Limits::max_nodes`]; callers that take user input check
-    /// [`Graph::len`] against the limit between stages and report an error instead.
+    /// A full graph never panics and never grows: every node it cannot create is replaced by
+    /// the constant 0, so that work in progress finishes quickly, but with wrong results. Long
+    /// computations call this between steps and give up on `Err`; nothing built since the
+    /// limit was hit may be used.
+    pub fn check(&self) -> Result<(), GraphFull> {
+        if self.refused == 0 {
+            Ok(())
+        } else {
+            Err(GraphFull {
+                max_nodes: self.limits.max_nodes,
+                nodes: self.nodes.len().saturating_add(self.refused),
+            })
+        }
+    }
+
+    /// Interns a node that is already canonical; in a full graph, answers the constant 0 for
+    /// a new node (see [`Graph::check`]).
     fn intern(&mut self, node: Node) -> Id {
         let h = hash_node(&node);
         let nodes = &self.nodes;
         if let Some(&id) = self.memo.find(h, |&id| nodes[id.index()] == node) {
             return id;
         }
-        assert!(
-            self.nodes.len() < self.limits.max_nodes && self.nodes.len() < u32::MAX as usize,
-            "expression graph limit of {} nodes exceeded",
-            self.limits.max_nodes
-        );
+        if self.nodes.len() >= self.limits.max_nodes.min(u32::MAX as usize) {
+            self.refused = self.refused.saturating_add(1);
+            return self.zero();
+        }
         let id = Id(self.nodes.len() as u32);
         self.nodes.push(node);
         let nodes = &self.nodes;
@@ -545,20 +584,24 @@ impl Graph {
     }
 
     /// Ids of every node reachable from `roots`, ascending (so children before parents).
+    ///
+    /// Costs time in proportion to the nodes reached, not to the size of the graph: a robot
+    /// with thousands of links asks for thousands of small programs from one big graph.
     pub fn reachable(&self, roots: &[Id]) -> Vec<Id> {
-        let mut seen = vec![false; self.nodes.len()];
+        // Children precede parents: nothing reachable lies above the highest root.
+        let top = roots.iter().map(|r| r.index() + 1).max().unwrap_or(0);
+        let mut seen = vec![false; top];
+        let mut found = Vec::new();
         let mut stack: Vec<Id> = roots.to_vec();
         while let Some(id) = stack.pop() {
             if std::mem::replace(&mut seen[id.index()], true) {
                 continue;
             }
+            found.push(id);
             stack.extend(self.node(id).children().filter(|c| !seen[c.index()]));
         }
-        seen.iter()
-            .enumerate()
-            .filter(|(_, &s)| s)
-            .map(|(i, _)| Id(i as u32))
-            .collect()
+        found.sort_unstable();
+        found
     }
 
     /// True when `e` contains the symbol node `x`.

@@ -89,6 +89,13 @@ struct ModelArgs {
     /// this uniform density (kg/m^3); each filled link is reported on stderr.
     #[arg(long, value_name = "KG_PER_M3", allow_hyphen_values = true)]
     density: Option<f64>,
+    /// Refuse robots with more degrees of freedom than this.
+    #[arg(long, value_name = "N", default_value_t = eomgen::DEFAULT_MAX_DOF)]
+    max_dof: usize,
+    /// Refuse robots whose derivation needs more expression graph nodes than this (each takes
+    /// some 60 bytes).
+    #[arg(long, value_name = "N", default_value_t = eomgen::DEFAULT_MAX_GRAPH_NODES)]
+    max_graph_nodes: usize,
 }
 
 impl ModelArgs {
@@ -107,6 +114,40 @@ impl ModelArgs {
             inertia_from_collision: self.density,
             ..ModelOptions::default()
         }
+    }
+
+    /// A builder for `urdf` with these options and limits.
+    fn builder(&self, urdf: &Path, symbolic: &Option<Vec<String>>) -> Builder {
+        Builder::new(urdf)
+            .model_options(self.options(symbolic))
+            .max_dof(self.max_dof)
+            .max_graph_nodes(self.max_graph_nodes)
+    }
+}
+
+/// A library error, with the command-line flag that raises a limit instead of the Builder
+/// option.
+fn cli_error(e: eomgen::Error) -> Failure {
+    match e {
+        eomgen::Error::Limit {
+            file,
+            what,
+            value,
+            limit,
+            raise,
+        } => eomgen::Error::Limit {
+            file,
+            what,
+            value,
+            limit,
+            raise: match raise {
+                "Builder::max_dof" => "--max-dof",
+                "Builder::max_graph_nodes" => "--max-graph-nodes",
+                other => other,
+            },
+        }
+        .into(),
+        e => e.into(),
     }
 }
 
@@ -359,8 +400,10 @@ pub fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(Failure(message)) => {
-            // Exactly one line, whatever the underlying message looks like.
+            // Exactly one line, whatever the underlying message looks like, and no control or
+            // bidirectional-text characters from names in the URDF reach the terminal.
             let line = message.split_whitespace().collect::<Vec<_>>().join(" ");
+            let line = terminal_safe(&line);
             let _ = writeln!(std::io::stderr(), "eomgen: error: {line}");
             ExitCode::from(1)
         }
@@ -368,8 +411,18 @@ pub fn main() -> ExitCode {
 }
 
 /// Writes to stdout; a closed pipe (`eomgen show ... | head`) is not an error.
+/// Control characters other than newline and tab, and bidirectional-text controls, from names
+/// in a URDF must not drive the terminal: each is written as an escape such as `\u{1b}`.
+fn terminal_safe(text: &str) -> String {
+    text.split('\n')
+        .map(eomgen::emit::names::comment_text)
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
 fn emit(text: &str) -> Result<(), Failure> {
     let mut out = std::io::stdout().lock();
+    let text = terminal_safe(text);
     match out.write_all(text.as_bytes()).and_then(|_| out.flush()) {
         Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
             Err(Failure(format!("cannot write to stdout: {e}")))
@@ -385,12 +438,6 @@ fn file_name(p: &Path) -> String {
         .unwrap_or_else(|| p.display().to_string())
 }
 
-fn load(urdf: &Path, options: &ModelOptions) -> Result<Model, Failure> {
-    let model = eomgen::urdf::load_file(urdf, options)?;
-    warn(&model);
-    Ok(model)
-}
-
 /// Prints the model's warnings on stderr, one line each.
 fn warn(model: &Model) {
     for w in &model.warnings {
@@ -403,13 +450,14 @@ fn warn(model: &Model) {
     }
 }
 
-fn derive(model: &Model) -> Derivation {
+/// Derives within the limits of `b` (degrees of freedom, graph size).
+fn derive(b: &Builder, model: &Model) -> Result<Derivation, Failure> {
     let label = format!(
         "deriving the equations of {} ({} joints)",
         model.name,
         model.dof()
     );
-    progress::run(&label, || Derivation::new(model))
+    progress::run(&label, || b.derive(model)).map_err(cli_error)
 }
 
 fn run(cli: Cli) -> Result<(), Failure> {
@@ -423,7 +471,7 @@ fn run(cli: Cli) -> Result<(), Failure> {
 }
 
 fn generate(a: GenerateArgs) -> Result<(), Failure> {
-    let mut b = Builder::new(&a.urdf).model_options(a.model.options(&a.symbolic));
+    let mut b = a.model.builder(&a.urdf, &a.symbolic);
     if let Some(t) = &a.type_name {
         b = b.type_name(t);
     }
@@ -438,7 +486,8 @@ fn generate(a: GenerateArgs) -> Result<(), Failure> {
         model.name,
         model.dof()
     );
-    let (generated, _, _) = progress::run(&label, || b.generate_with_report())?;
+    let (generated, _, _) =
+        progress::run(&label, || b.generate_with_report()).map_err(cli_error)?;
     match &a.output {
         Some(path) => {
             eomgen::write_if_changed(path, generated.source.as_bytes())?;
@@ -471,8 +520,9 @@ fn show(a: ShowArgs) -> Result<(), Failure> {
             )
             .exit();
     }
-    let model = load(&a.urdf, &a.model.options(&a.symbolic))?;
-    let d = derive(&model);
+    let b = a.model.builder(&a.urdf, &a.symbolic);
+    let model = b.model()?;
+    let d = derive(&b, &model)?;
     let opts = ShowOptions {
         terms,
         entry: a.entry.map(|e| e.0),
@@ -491,12 +541,20 @@ fn show(a: ShowArgs) -> Result<(), Failure> {
     };
     let text = progress::run("printing the equations", || {
         report::render(&model, &d, &opts)
+    })
+    .map_err(|e| match e {
+        report::ReportError::GraphFull(full) => Failure(format!(
+            "{}: {full} while expanding the equations for print: raise it with \
+             --max-graph-nodes, or print with --form program",
+            a.urdf.display()
+        )),
+        e => e.into(),
     })?;
     emit(&text)
 }
 
 fn info_cmd(a: InfoArgs) -> Result<(), Failure> {
-    let b = Builder::new(&a.urdf).model_options(a.model.options(&None));
+    let b = a.model.builder(&a.urdf, &None);
     let start = Instant::now();
     let model = b.model()?;
     let load = start.elapsed();
@@ -507,7 +565,8 @@ fn info_cmd(a: InfoArgs) -> Result<(), Failure> {
         model.dof()
     );
     let start = Instant::now();
-    let (generated, model, d) = progress::run(&label, || b.generate_with_report())?;
+    let (generated, model, d) =
+        progress::run(&label, || b.generate_with_report()).map_err(cli_error)?;
     let derive: std::time::Duration = d.timings.iter().map(|t| t.1).sum();
     let emit_time = start.elapsed().saturating_sub(derive + load);
     emit(&info::print(
@@ -521,7 +580,8 @@ fn info_cmd(a: InfoArgs) -> Result<(), Failure> {
 }
 
 fn eval_cmd(a: EvalArgs) -> Result<(), Failure> {
-    let model = load(&a.urdf, &a.model.options(&None))?;
+    let b = a.model.builder(&a.urdf, &None);
+    let model = b.model()?;
     let n = model.dof();
     let joints = model
         .joints
@@ -546,14 +606,15 @@ fn eval_cmd(a: EvalArgs) -> Result<(), Failure> {
         qdd: check("--qdd", a.qdd)?,
         tau: check("--tau", a.tau)?,
     };
-    let d = derive(&model);
+    let d = derive(&b, &model)?;
     let values = eval::evaluate(&model, &d, &state).map_err(Failure)?;
     let digits = (a.digits > 0).then_some(a.digits);
     emit(&eval::print(&model, &state, &values, digits))
 }
 
 fn simulate_cmd(a: SimulateArgs) -> Result<(), Failure> {
-    let model = load(&a.urdf, &a.model.options(&None))?;
+    let b = a.model.builder(&a.urdf, &None);
+    let model = b.model()?;
     let n = model.dof();
     let check = |flag: &str, v: Option<Numbers>, default: &[f64]| -> Result<Vec<f64>, Failure> {
         match v {
@@ -582,7 +643,7 @@ fn simulate_cmd(a: SimulateArgs) -> Result<(), Failure> {
         kd: a.kd,
         omega: a.omega,
     };
-    let d = derive(&model);
+    let d = derive(&b, &model)?;
     let outcome = simulate::run(&model, &d, &options).map_err(Failure)?;
     if let Some(path) = &a.plot {
         let names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();

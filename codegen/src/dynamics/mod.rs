@@ -17,7 +17,7 @@ pub mod newton_euler;
 
 use std::time::{Duration, Instant};
 
-use crate::cas::{Graph, Id, Program};
+use crate::cas::{Graph, GraphFull, Id, Limits, Program};
 use crate::kinematics::{
     const_v3, cross, mat_vec, vec_add, BodyKinematics, Params, WorldKinematics, M3, V3,
 };
@@ -155,8 +155,20 @@ pub fn pairs(n: usize) -> Vec<(usize, usize)> {
 }
 
 impl Derivation {
-    /// Derives everything for `model`.
+    /// Derives everything for `model`, with the default [`Limits`].
+    ///
+    /// # Panics
+    /// When the expression graph exceeds [`Limits::max_nodes`] (only robots far beyond the
+    /// default limit of degrees of freedom of [`Builder`](crate::Builder) get there); use
+    /// [`Derivation::try_new`] to get an error instead.
     pub fn new(model: &Model) -> Derivation {
+        Derivation::try_new(model, Limits::default()).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    /// Derives everything for `model` in a graph with the given limits, or fails as soon as
+    /// the graph is full (checked after every stage and every joint's step within a stage, so
+    /// that a robot too large for the limit costs little time and at most the limit's memory).
+    pub fn try_new(model: &Model, limits: Limits) -> Result<Derivation, GraphFull> {
         let mut timings = Vec::new();
         let mut clock = Instant::now();
         let mut lap = |name: &'static str, timings: &mut Vec<(&'static str, Duration)>| {
@@ -164,7 +176,7 @@ impl Derivation {
             timings.push((name, now - clock));
             clock = now;
         };
-        let mut g = Graph::new();
+        let mut g = Graph::with_limits(limits);
         let n = model.dof();
         let q: Vec<Id> = (0..n).map(|i| g.q(i)).collect();
         let qd: Vec<Id> = (0..n).map(|i| g.qd(i)).collect();
@@ -172,10 +184,12 @@ impl Derivation {
         let params = Params::new(&mut g, model);
 
         let world = WorldKinematics::new(&mut g, model, &params, &q);
+        g.check()?;
         let body = BodyKinematics::new(&mut g, model, &params, &q);
+        g.check()?;
         lap("kinematics", &mut timings);
 
-        let mass_matrix = mass_matrix(&mut g, model, &params, &body);
+        let mass_matrix = mass_matrix(&mut g, model, &params, &body)?;
         lap("mass matrix", &mut timings);
 
         let grav = const_v3(&mut g, &model.gravity);
@@ -190,6 +204,7 @@ impl Derivation {
         let mqd: Vec<Id> = (0..n).map(|i| g.dot(&mass_matrix[i], &qd)).collect();
         let qd_mqd = g.dot(&qd, &mqd);
         let kinetic_energy = g.scale(qd_mqd, 0.5);
+        g.check()?;
         lap("energies and gravity", &mut timings);
 
         // dM/dq_k for the upper triangle, one memoized pass per joint.
@@ -202,6 +217,7 @@ impl Derivation {
                 dm[k][i][j] = e;
                 dm[k][j][i] = e;
             }
+            g.check()?;
         }
         // 2 G_ijk = dM_ij/dq_k + dM_ik/dq_j - dM_jk/dq_i
         let two_christoffel = |g: &mut Graph, i: usize, j: usize, k: usize| -> Id {
@@ -232,6 +248,7 @@ impl Derivation {
                     .collect();
                 coriolis_matrix[i][j] = g.sum(0.0, terms);
             }
+            g.check()?;
         }
         // b = B [qd qd] + C [qd^2]: the Craig form shares work with the matrices above.
         let bias: Vec<Id> = (0..n)
@@ -248,6 +265,7 @@ impl Derivation {
                 g.add_all(terms)
             })
             .collect();
+        g.check()?;
         lap("Christoffel symbols", &mut timings);
 
         let friction = joint_friction(&mut g, model, &params, &qd);
@@ -268,53 +286,30 @@ impl Derivation {
                 position,
                 jacobian,
             });
+            g.check()?;
         }
         lap("frames", &mut timings);
 
         let lm = newton_euler::LocalModel::new(&mut g, model, &params, &q);
+        g.check()?;
         let gv = Some(grav);
         use newton_euler::Terms;
         let (qd_s, qdd_s) = (Some(qd.as_slice()), Some(qdd.as_slice()));
+        let crba = newton_euler::crba(&mut g, &lm);
+        g.check()?;
+        let rnea = |g: &mut Graph, qd, qdd, gravity| {
+            let r = newton_euler::rnea(g, &lm, Terms { qd, qdd, gravity });
+            g.check().map(|_| r)
+        };
         let recursive = Recursive {
-            mass_matrix: newton_euler::crba(&mut g, &lm),
-            gravity: newton_euler::rnea(
-                &mut g,
-                &lm,
-                Terms {
-                    qd: None,
-                    qdd: None,
-                    gravity: gv,
-                },
-            ),
-            bias: newton_euler::rnea(
-                &mut g,
-                &lm,
-                Terms {
-                    qd: qd_s,
-                    qdd: None,
-                    gravity: None,
-                },
-            ),
-            bias_and_gravity: newton_euler::rnea(
-                &mut g,
-                &lm,
-                Terms {
-                    qd: qd_s,
-                    qdd: None,
-                    gravity: gv,
-                },
-            ),
-            tau: newton_euler::rnea(
-                &mut g,
-                &lm,
-                Terms {
-                    qd: qd_s,
-                    qdd: qdd_s,
-                    gravity: gv,
-                },
-            ),
+            mass_matrix: crba,
+            gravity: rnea(&mut g, None, None, gv)?,
+            bias: rnea(&mut g, qd_s, None, None)?,
+            bias_and_gravity: rnea(&mut g, qd_s, None, gv)?,
+            tau: rnea(&mut g, qd_s, qdd_s, gv)?,
             coriolis_matrix: newton_euler::coriolis(&mut g, &lm, &qd),
         };
+        g.check()?;
         let recursive = Recursive {
             tau: (0..n)
                 .map(|i| g.add(recursive.tau[i], friction[i]))
@@ -339,12 +334,18 @@ impl Derivation {
         let (forward_dynamics, pivots) = newton_euler::ltdl_solve(&mut g, &parents, &mm.1, &rhs);
         // Craig's forms from second velocity derivatives of the Newton-Euler bias (b is quadratic
         // in qd).
-        let db: Vec<Vec<Id>> = (0..n)
-            .map(|j| g.diff_many(&recursive.bias, qd[j]))
-            .collect();
+        let mut db: Vec<Vec<Id>> = Vec::with_capacity(n);
+        for j in 0..n {
+            db.push(g.diff_many(&recursive.bias, qd[j]));
+            g.check()?;
+        }
         // d2[k][j][i] = d^2 b_i / dqd_j dqd_k, one memoized pass per k over every first derivative.
         let db_flat: Vec<Id> = db.iter().flatten().copied().collect();
-        let d2: Vec<Vec<Id>> = (0..n).map(|k| g.diff_many(&db_flat, qd[k])).collect();
+        let mut d2: Vec<Vec<Id>> = Vec::with_capacity(n);
+        for k in 0..n {
+            d2.push(g.diff_many(&db_flat, qd[k]));
+            g.check()?;
+        }
         let second = |k: usize, j: usize, i: usize| d2[k][j * n + i];
         let mut cf_rec = vec![vec![g.zero(); n]; n];
         let mut cp_rec = vec![Vec::new(); n];
@@ -375,9 +376,10 @@ impl Derivation {
             forward_dynamics,
             pivots,
         };
+        g.check()?;
         lap("fast forms", &mut timings);
 
-        Derivation {
+        Ok(Derivation {
             graph: g,
             dof: n,
             q,
@@ -398,7 +400,7 @@ impl Derivation {
             recursive,
             fast,
             timings,
-        }
+        })
     }
 
     /// Lagrange's equations formed directly from `L = T - V`:
@@ -458,7 +460,7 @@ fn mass_matrix(
     model: &Model,
     params: &Params,
     body: &BodyKinematics,
-) -> Vec<Vec<Id>> {
+) -> Result<Vec<Vec<Id>>, GraphFull> {
     let n = model.dof();
     let mut terms: Vec<Vec<Vec<Id>>> = vec![vec![Vec::new(); n]; n];
     for b in 0..n {
@@ -492,6 +494,7 @@ fn mass_matrix(
                 }
             }
         }
+        g.check()?;
     }
     for j in 0..n {
         terms[j][j].push(params.armature[j]);
@@ -504,5 +507,5 @@ fn mass_matrix(
             mm[k][j] = e;
         }
     }
-    mm
+    Ok(mm)
 }

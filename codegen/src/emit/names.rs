@@ -4,7 +4,7 @@
 //! punctuation, quotes or non-ASCII letters. Only the identifiers made here and string literals
 //! escaped by `proc_macro2` reach generated code, so no name can break or inject into it.
 
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 
 /// Words that cannot be identifiers (strict and reserved keywords of every edition).
 const KEYWORDS: &[&str] = &[
@@ -77,10 +77,30 @@ pub fn snake(name: &str, fallback: &str) -> String {
     finish(s, fallback)
 }
 
+/// `text` made safe for a comment (doc comments included): control characters other than tab
+/// (newlines, carriage returns) and the bidirectional-text controls that rustc refuses in
+/// comments (`text_direction_codepoint_in_comment`, deny by default) are written as escapes
+/// such as `\u{202e}`; everything else, `*/` included, is harmless in a line comment.
+pub fn comment_text(text: &str) -> String {
+    let bidi = |c: char| matches!(c, '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}');
+    text.chars()
+        .map(|c| {
+            if (c.is_control() && c != '\t') || bidi(c) {
+                format!("\\u{{{:x}}}", c as u32)
+            } else {
+                c.to_string()
+            }
+        })
+        .collect()
+}
+
 /// Hands out identifiers unique within one scope, suffixing `_2`, `_3`, ... on collision.
 #[derive(Default)]
 pub struct Scope {
     taken: BTreeSet<String>,
+    /// Per identifier that collided, the first suffix not yet tried: thousands of names that
+    /// sanitize alike (`l!`, `l#`, ...) cost linear time, not quadratic.
+    next_suffix: BTreeMap<String, usize>,
 }
 
 impl Scope {
@@ -88,6 +108,7 @@ impl Scope {
     pub fn with_reserved(reserved: &[&str]) -> Scope {
         Scope {
             taken: reserved.iter().map(|s| s.to_string()).collect(),
+            next_suffix: BTreeMap::new(),
         }
     }
 
@@ -96,10 +117,15 @@ impl Scope {
         if self.taken.insert(ident.clone()) {
             return ident;
         }
-        (2..)
-            .map(|k| format!("{ident}_{k}"))
-            .find(|c| self.taken.insert(c.clone()))
-            .expect("an unused suffix exists")
+        // Suffixes below `first` were taken, and taken names stay taken: same result as
+        // trying from 2.
+        let first = self.next_suffix.get(&ident).copied().unwrap_or(2);
+        let (k, claimed) = (first..)
+            .map(|k| (k, format!("{ident}_{k}")))
+            .find(|(_, c)| self.taken.insert(c.clone()))
+            .expect("an unused suffix exists");
+        self.next_suffix.insert(ident, k + 1);
+        claimed
     }
 }
 
@@ -122,11 +148,25 @@ mod tests {
     }
 
     #[test]
+    fn comment_text_escapes_what_rustc_refuses_in_comments() {
+        assert_eq!(comment_text("a */ b\tc"), "a */ b\tc");
+        assert_eq!(comment_text("a\nb\rc"), "a\\u{a}b\\u{d}c");
+        assert_eq!(comment_text("x\u{202e}y\u{2066}"), "x\\u{202e}y\\u{2066}");
+        assert_eq!(comment_text("日本語 é"), "日本語 é");
+    }
+
+    #[test]
     fn collisions_get_suffixes() {
         let mut s = Scope::with_reserved(&["Link"]);
         assert_eq!(s.claim("Link".into()), "Link_2");
         assert_eq!(s.claim("A".into()), "A");
         assert_eq!(s.claim("A".into()), "A_2");
         assert_eq!(s.claim("A".into()), "A_3");
+        // A suffixed name taken directly is skipped later.
+        assert_eq!(s.claim("B_2".into()), "B_2");
+        assert_eq!(s.claim("B".into()), "B");
+        assert_eq!(s.claim("B".into()), "B_3");
+        assert_eq!(s.claim("A_4".into()), "A_4");
+        assert_eq!(s.claim("A".into()), "A_5");
     }
 }

@@ -6,7 +6,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote};
 
-use super::names::{snake, upper_camel, Scope};
+use super::names::{comment_text, snake, upper_camel, Scope};
 use crate::cas::{Expr, Id, OpCount, Order, Program, Symbol, SymbolKind};
 use crate::dynamics::{Derivation, Route};
 use crate::model::Model;
@@ -349,7 +349,7 @@ fn body(d: &Derivation, cx: &Ctx<'_>, outputs: &[Id], shape: Shape) -> (TokenStr
 
 fn doc(lines: &[String]) -> TokenStream {
     let attrs = lines.iter().map(|l| {
-        let text = format!(" {l}");
+        let text = format!(" {}", comment_text(l));
         quote!(#[doc = #text])
     });
     quote!(#(#attrs)*)
@@ -380,7 +380,7 @@ pub fn emit_tokens(
         let f = format_ident!("{}", field_scope.claim(snake(name, "p")));
         let docline = format!(
             " `{}` ({} {}).",
-            name.replace('`', "'"),
+            comment_text(&name.replace('`', "'")),
             crate::report::value_source(name),
             value
         );
@@ -689,6 +689,9 @@ pub fn emit_tokens(
             /// Forward dynamics `qdd = M(q)^-1 (tau - b(q, qd) - G(q))`, or which pivot of the
             /// `L^T D L` factorization of M(q) was not positive (a non-physical model or
             /// non-finite input); see `Dynamics::forward_dynamics` for the operation count.
+            /// `Ok` holds only finite numbers: a non-finite component `i` of the solution (from
+            /// a non-finite `qd` or `tau`, or a `q` that leaves M(q) finite) is reported as
+            /// `FactorError::NonFinite { pivot: i }`.
             pub fn try_forward_dynamics(&self, q: &[T; #n], qd: &[T; #n], tau: &[T; #n]) -> ::core::result::Result<[T; #n], ::eomgen_runtime::FactorError> {
                 let o: [T; #fd_len] = { #fd_body };
                 let pivots = [#(#fd_pivots),*];
@@ -700,7 +703,13 @@ pub fn emit_tokens(
                         return Err(::eomgen_runtime::FactorError::NotPositiveDefinite { pivot });
                     }
                 }
-                Ok([#(#fd_x),*])
+                let qdd = [#(#fd_x),*];
+                for (pivot, x) in qdd.iter().enumerate() {
+                    if !x.is_finite() {
+                        return Err(::eomgen_runtime::FactorError::NonFinite { pivot });
+                    }
+                }
+                Ok(qdd)
             }
 
             #friction_fn

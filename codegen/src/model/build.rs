@@ -20,6 +20,12 @@ use super::{Body, Frame, Joint, JointKind, Limits, Mimic, Model, Transform};
 /// checks of rotational inertias.
 const INERTIA_TOLERANCE: f64 = 1e-9;
 
+/// The largest magnitude accepted for a number that enters the equations (lengths, angles,
+/// masses, inertias, damping, friction, gravity). Far beyond any robot in SI units, and small
+/// enough that the products in the equations (a mass times a squared length, summed over
+/// thousands of links) stay far from overflowing.
+pub const MAX_MAGNITUDE: f64 = 1e15;
+
 /// Relative tolerance below which a revolute joint's subtree inertia about its axis counts as
 /// zero (relative to the trace of the subtree inertia about the joint origin).
 const SINGULAR_TOLERANCE: f64 = 1e-12;
@@ -210,11 +216,11 @@ pub enum ModelError {
         second: String,
     },
     /// More than one link has no parent joint.
-    #[error("{file}: the robot has several root links (links without a parent joint): `{}`", .roots.join("`, `"))]
+    #[error("{file}: the robot has several root links (links without a parent joint): {}", name_list(.roots, ", "))]
     MultipleRoots { file: String, roots: Vec<String> },
     /// The joints form a cycle (listed from parent to child; the last link is the parent of the
     /// first).
-    #[error("{file}: the links `{}` form a cycle", .links.join("` -> `"))]
+    #[error("{file}: the links {} form a cycle", name_list(.links, " -> "))]
     Cycle { file: String, links: Vec<String> },
     /// A number that matters is NaN or infinite.
     #[error("{file}: {culprit}: {field} is not a finite number")]
@@ -223,6 +229,17 @@ pub enum ModelError {
         /// The link, joint or option, e.g. ``joint `elbow` ``.
         culprit: String,
         field: &'static str,
+    },
+    /// A number that matters is finite but larger in magnitude than [`MAX_MAGNITUDE`].
+    #[error(
+        "{file}: {culprit}: {field} holds {value:e}, beyond the largest magnitude accepted (1e15)"
+    )]
+    OutOfRange {
+        file: String,
+        /// The link, joint or option, e.g. ``joint `elbow` ``.
+        culprit: String,
+        field: &'static str,
+        value: f64,
     },
     /// A moving joint's axis is the zero vector.
     #[error("{file}: joint `{joint}` has a zero axis")]
@@ -293,6 +310,23 @@ pub enum ModelError {
         link: String,
         reason: String,
     },
+}
+
+/// At most this many names in one message.
+const MAX_NAMES_SHOWN: usize = 8;
+
+/// `` `a`, `b`, `c` `` (with `separator`), the first [`MAX_NAMES_SHOWN`] names of a long list
+/// followed by how many more there are, so that a message stays one readable line.
+fn name_list(names: &[String], separator: &str) -> String {
+    let mut shown: Vec<String> = names
+        .iter()
+        .take(MAX_NAMES_SHOWN)
+        .map(|n| format!("`{n}`"))
+        .collect();
+    if names.len() > MAX_NAMES_SHOWN {
+        shown.push(format!("... ({} more)", names.len() - MAX_NAMES_SHOWN));
+    }
+    shown.join(separator)
 }
 
 /// A pose as written in a robot description: translation and roll-pitch-yaw angles.
@@ -407,6 +441,8 @@ pub(crate) fn build_model(
     let robot = match options.inertia_from_collision {
         Some(density) => {
             filled = fill_inertias(robot, &tree, density, file, &mut warnings)?;
+            // Huge primitives give huge masses.
+            check_numbers(&filled, file)?;
             &filled
         }
         None => robot,
@@ -433,6 +469,14 @@ fn check_options(options: &ModelOptions, file: &str) -> Result<(), ModelError> {
             file: file.into(),
             culprit: "options".into(),
             field: "gravity",
+        });
+    }
+    if let Some(&value) = options.gravity.iter().find(|x| x.abs() > MAX_MAGNITUDE) {
+        return Err(ModelError::OutOfRange {
+            file: file.into(),
+            culprit: "options".into(),
+            field: "gravity",
+            value,
         });
     }
     let invalid = |option, reason: String| ModelError::InvalidOption {
@@ -746,34 +790,43 @@ fn find_cycle(start: usize, parent_joint: &[Option<usize>], ends: &[(usize, usiz
     }
 }
 
-/// Rejects non-finite numbers wherever they are used, and zero axes.
+/// Rejects non-finite and out-of-range numbers wherever they are used, and zero axes.
 fn check_numbers(robot: &RobotDescription, file: &str) -> Result<(), ModelError> {
     let non_finite = |culprit: String, field| ModelError::NonFinite {
         file: file.into(),
         culprit,
         field,
     };
+    // Finite and within MAX_MAGNITUDE; `culprit` is built only on failure.
+    let check = |culprit: &dyn Fn() -> String, field, values: &[f64]| {
+        if !all_finite(values) {
+            return Err(non_finite(culprit(), field));
+        }
+        match values.iter().find(|x| x.abs() > MAX_MAGNITUDE) {
+            Some(&value) => Err(ModelError::OutOfRange {
+                file: file.into(),
+                culprit: culprit(),
+                field,
+                value,
+            }),
+            None => Ok(()),
+        }
+    };
+    let pose = |p: &Pose| [p.xyz, p.rpy].concat();
     for link in &robot.links {
         let culprit = || format!("link `{}`", link.name);
         let inertial = &link.inertial;
-        if !inertial.origin.is_finite() {
-            return Err(non_finite(culprit(), "inertial origin"));
-        }
-        if !inertial.mass.is_finite() {
-            return Err(non_finite(culprit(), "mass"));
-        }
-        if !all_finite(&inertial.inertia) {
-            return Err(non_finite(culprit(), "inertia"));
-        }
+        check(&culprit, "inertial origin", &pose(&inertial.origin))?;
+        check(&culprit, "mass", &[inertial.mass])?;
+        check(&culprit, "inertia", &inertial.inertia)?;
     }
     for joint in &robot.joints {
         let culprit = || format!("joint `{}`", joint.name);
-        if !joint.origin.is_finite() {
-            return Err(non_finite(culprit(), "origin"));
-        }
+        check(&culprit, "origin", &pose(&joint.origin))?;
         if joint.joint_type == JointType::Fixed {
             continue;
         }
+        // The axis is normalized: only its direction matters.
         if !all_finite(&joint.axis) {
             return Err(non_finite(culprit(), "axis"));
         }
@@ -792,12 +845,8 @@ fn check_numbers(robot: &RobotDescription, file: &str) -> Result<(), ModelError>
                 return Err(non_finite(culprit(), "limit"));
             }
         }
-        if !joint.damping.is_finite() {
-            return Err(non_finite(culprit(), "damping"));
-        }
-        if !joint.friction.is_finite() {
-            return Err(non_finite(culprit(), "friction"));
-        }
+        check(&culprit, "damping", &[joint.damping])?;
+        check(&culprit, "friction", &[joint.friction])?;
         if let Some(m) = &joint.mimic {
             if !(m.multiplier.is_finite() && m.offset.is_finite()) {
                 return Err(non_finite(culprit(), "mimic multiplier or offset"));

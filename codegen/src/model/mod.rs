@@ -14,7 +14,7 @@ use nalgebra::{Matrix3, Vector3};
 
 mod build;
 pub mod shapes;
-pub use build::{ModelError, ModelOptions, ModelWarning, SymbolicParams};
+pub use build::{ModelError, ModelOptions, ModelWarning, SymbolicParams, MAX_MAGNITUDE};
 // The format-neutral description that readers (`crate::urdf`) fill in.
 pub(crate) use build::{
     build_model, CollisionDescription, InertialDescription, JointDescription, JointType,

@@ -209,6 +209,9 @@ pub enum ReportError {
     /// `entry` does not name an entry of the term.
     #[error("entry {entry} {reason}")]
     InvalidEntry { entry: String, reason: String },
+    /// Expanding the equations for print ran into the expression graph's node limit.
+    #[error("{0} while expanding the equations for print: try --form program")]
+    GraphFull(#[from] crate::cas::GraphFull),
 }
 
 /// In an expanded numeric entry, terms below this fraction of the entry's largest coefficient
@@ -563,8 +566,9 @@ fn vec3(v: &nalgebra::Vector3<f64>, digits: Option<usize>) -> String {
 /// parameters used. Entries that are structurally 0 are not listed (a note says so), unless
 /// [`ShowOptions::entry`] asks for one.
 ///
-/// Fails only when [`ShowOptions::entry`] names no entry of the term (or is given with other
-/// than exactly one term).
+/// Fails when [`ShowOptions::entry`] names no entry of the term (or is given with other than
+/// exactly one term), and when expanding the entries for print fills the expression graph
+/// ([`ReportError::GraphFull`]).
 pub fn render(model: &Model, d: &Derivation, opts: &ShowOptions) -> Result<String, ReportError> {
     if opts.entry.is_some() && opts.terms.len() != 1 {
         return Err(ReportError::InvalidEntry {
@@ -605,6 +609,7 @@ pub fn render(model: &Model, d: &Derivation, opts: &ShowOptions) -> Result<Strin
             ));
         }
         sections.push(s);
+        g.check()?;
     }
     let expanded_roots: Vec<Id> = sections
         .iter()
