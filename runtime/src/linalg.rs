@@ -47,7 +47,7 @@ impl fmt::Display for FactorError {
             ),
             FactorError::NonFinite { pivot } => write!(
                 f,
-                "matrix cannot be factorized: pivot {pivot} is not finite (NaN or infinite input, or overflow)"
+                "pivot or solution component {pivot} is not finite (NaN or infinite input, or overflow)"
             ),
         }
     }
