@@ -81,8 +81,9 @@
 //!   names.
 //! - The XML tree is handled recursively, so deeply nested elements would overflow the stack
 //!   (an abort, not a panic): we refuse nesting deeper than [`MAX_DEPTH`] before parsing.
-//! - We found no input that makes it panic (fuzzed with mutated URDFs, including namespaces,
-//!   entities, CDATA and comments).
+//! - It panics when an element declares the reserved prefix `xmlns` (`xmlns:xmlns="..."`,
+//!   found by fuzzing): we refuse that before parsing, and report any other panic of the parser
+//!   as malformed XML.
 
 use std::path::Path;
 
@@ -113,7 +114,18 @@ pub fn load_str(text: &str, origin: &str, options: &ModelOptions) -> Result<Mode
         message,
     };
     check_depth(text).map_err(xml_error)?;
-    let robot = urdf_rs::read_from_string(text).map_err(|e| xml_error(e.to_string()))?;
+    // A panic inside the parser is its bug, but for our caller it is bad input all the same.
+    let robot = match std::panic::catch_unwind(|| urdf_rs::read_from_string(text)) {
+        Ok(parsed) => parsed.map_err(|e| xml_error(e.to_string()))?,
+        Err(panic) => {
+            let what = panic
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| panic.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "unknown".into());
+            return Err(xml_error(format!("the URDF parser failed ({what})")));
+        }
+    };
     build_model(&describe(&robot), origin, options)
 }
 
@@ -212,11 +224,13 @@ fn describe(robot: &urdf_rs::Robot) -> RobotDescription {
     }
 }
 
-/// Refuses element nesting deeper than [`MAX_DEPTH`].
+/// Refuses element nesting deeper than [`MAX_DEPTH`], and a declaration of the reserved
+/// `xmlns` prefix (`xmlns:xmlns="..."`), which XML forbids and which makes urdf-rs's
+/// re-serialization of the tree panic (found by fuzzing).
 ///
 /// A transcription of the tokenizer of the XML parser that urdf-rs uses (RustyXML), reduced to
-/// element starts and ends so that it sees exactly the nesting that parser builds. Where that
-/// parser reports an error we stop: it never gets further.
+/// element starts and ends and attribute names, so that it sees exactly what that parser
+/// builds. Where that parser reports an error we stop: it never gets further.
 fn check_depth(text: &str) -> Result<(), String> {
     #[derive(Clone, Copy)]
     enum State {
@@ -247,8 +261,9 @@ fn check_depth(text: &str) -> Result<(), String> {
     let is_space = |c: u8| matches!(c, b' ' | b'\t' | b'\r' | b'\n');
     let mut depth = 0usize;
     let mut state = Outside;
+    let mut attr_start = 0;
     // Bytes rather than chars: non-ASCII characters never play a role in any state.
-    for &c in text.as_bytes() {
+    for (i, &c) in text.as_bytes().iter().enumerate() {
         let mut opened = false;
         state = match (state, c) {
             (Outside, b'<') => TagOpened,
@@ -271,8 +286,18 @@ fn check_depth(text: &str) -> Result<(), String> {
             (TagName, c) if is_space(c) => InTag,
             (TagName, _) => TagName,
             (InTag, c) if is_space(c) => InTag,
-            (InTag, _) => AttrName(false),
-            (AttrName(_), b'=') => ExpectDelimiter,
+            (InTag, _) => {
+                attr_start = i;
+                AttrName(false)
+            }
+            (AttrName(_), b'=') => {
+                if text[attr_start..i].trim_end() == "xmlns:xmlns" {
+                    return Err(
+                        "the reserved prefix `xmlns` cannot be declared (`xmlns:xmlns`)".into(),
+                    );
+                }
+                ExpectDelimiter
+            }
             (AttrName(_), c) if is_space(c) => AttrName(true),
             (AttrName(false), _) => AttrName(false),
             (AttrName(true), _) => return Ok(()),

@@ -130,6 +130,14 @@ fn catalogue() -> Vec<(&'static str, String, Expect)> {
             Error(&["malformed URDF", "entity"]),
         ),
         (
+            "xmlns_prefix_declared",
+            robot(&[link("base")]).replace(
+                "<robot name=\"r\">",
+                "<robot name=\"r\" xmlns:xmlns=\"http://www.ros.org/wiki/xacro\">",
+            ),
+            Error(&["malformed URDF", "xmlns:xmlns"]),
+        ),
+        (
             "deep_nesting",
             format!("<robot name=\"r\">{}", "<link>".repeat(100_000)),
             Error(&["malformed URDF", "nested more than 100 levels"]),
