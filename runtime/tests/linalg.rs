@@ -288,7 +288,9 @@ fn errors_display_and_name_the_pivot() {
     );
     let e = FactorError::NonFinite { pivot: 0 };
     assert_eq!(e.pivot(), 0);
-    assert!(e.to_string().contains("pivot or solution component 0 is not finite"));
+    assert!(e
+        .to_string()
+        .contains("pivot or solution component 0 is not finite"));
 }
 
 #[test]
