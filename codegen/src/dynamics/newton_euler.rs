@@ -357,14 +357,14 @@ pub fn crba(g: &mut Graph, lm: &LocalModel) -> Vec<Vec<Id>> {
     for i in 0..n {
         // Force and moment on composite body i for a unit rate of joint i.
         let s = subspace(g, lm, i);
-        let (mut nm, mut f) = inertia_times(g, Some(comp.mass[i]), &comp.h[i], &comp.j[i], &s);
-        let own = spatial_dot(g, &s, &(nm, f));
+        let mut force = inertia_times(g, Some(comp.mass[i]), &comp.h[i], &comp.j[i], &s);
+        let own = spatial_dot(g, &s, &force);
         m[i][i] = g.add(own, lm.armature[i]);
         let mut j = i;
         while let Some(p) = lm.parent[j] {
-            (f, nm) = transfer(g, lm, j, &f, &nm);
+            force = transfer_spatial(g, lm, j, &force);
             let sp = subspace(g, lm, p);
-            let e = spatial_dot(g, &sp, &(nm, f));
+            let e = spatial_dot(g, &sp, &force);
             m[p][i] = e;
             m[i][p] = e;
             j = p;
@@ -457,21 +457,20 @@ pub fn coriolis(g: &mut Graph, lm: &LocalModel, qd: &[Id]) -> Vec<Vec<Id>> {
             let (dhc, djc) = inertia_to_parent(g, lm, c, None, &dh[c], &dj[c]);
             dj[i] = mat_add(g, &dj[i], &djc);
             dh[i] = vec_add(g, &dh[i], &dhc);
-            let (f, nm) = transfer(g, lm, c, &mom[c].1, &mom[c].0);
-            mom[i] = (vec_add(g, &mom[i].0, &nm), vec_add(g, &mom[i].1, &f));
+            let moved = transfer_spatial(g, lm, c, &mom[c]);
+            mom[i] = spatial_add(g, &mom[i], &moved);
         }
     }
     let mut c = vec![vec![g.zero(); n]; n];
     for j in 0..n {
         let s = subspace(g, lm, j);
-        let ic = (Some(comp.mass[j]), comp.h[j], comp.j[j]);
-        let f2 = inertia_times(g, ic.0, &ic.1, &ic.2, &s);
-        let isd = inertia_times(g, ic.0, &ic.1, &ic.2, &sdot[j]);
+        let (m, h, jc) = (Some(comp.mass[j]), &comp.h[j], &comp.j[j]);
+        let mut f2 = inertia_times(g, m, h, jc, &s);
+        let isd = inertia_times(g, m, h, jc, &sdot[j]);
         let dis = inertia_times(g, None, &dh[j], &dj[j], &s);
         let sh = cross_force(g, &s, &mom[j]);
         let sym = spatial_add(g, &isd, &dis);
         let mut f1 = spatial_add(g, &sym, &sh);
-        let mut f2 = f2;
         let mut f3 = spatial_sub(g, &dis, &sh);
         c[j][j] = spatial_dot(g, &s, &f1);
         let mut k = j;
