@@ -53,43 +53,9 @@ impl DoublePendulumLink {
 impl<T: ::eomgen_runtime::Real> DoublePendulum<T> {
     /// Number of joint coordinates.
     pub const DOF: usize = 2;
-    /// Craig's centrifugal matrix C(q): `b = B(q) [qd qd] + C(q) [qd^2]`.
-    ///
-    /// Route: closed-form Lagrangian expressions.
-    /// Operations: 7 mul, 4 add, 0 div, 1 sin, 1 cos.
-    pub fn centrifugal(&self, q: &[T; 2]) -> [[T; 2]; 2] {
-        let (s1, c1) = q[1].sin_cos();
-        let t0 = s1;
-        let t1 = c1;
-        let t2 = -T::from_f64(0.033238000000000004)
-            * (t0 * (-T::from_f64(0.1) * t1 - T::from_f64(0.10088))
-                + t1 * (T::from_f64(0.1) * t0 + T::from_f64(0.00000000019371)));
-        [
-            [
-                T::zero(),
-                T::from_f64(0.000000000006438532980000001) * t1
-                    - T::from_f64(0.00335304944) * t0,
-            ],
-            [t2, T::zero()],
-        ]
-    }
-    /// Craig's Coriolis matrix B(q), N x N(N-1)/2 = 2 x 1, columns for qd_j qd_k with j < k in the order (0,1), (0,2), ..., (1,2), ...
-    ///
-    /// Route: second velocity derivatives of the Newton-Euler bias.
-    /// Operations: 2 mul, 1 add, 0 div, 1 sin, 1 cos.
-    pub fn coriolis_pairs(&self, q: &[T; 2]) -> [[T; 1]; 2] {
-        let (s1, c1) = q[1].sin_cos();
-        [
-            [
-                T::from_f64(0.000000000012877065959999999) * c1
-                    - T::from_f64(0.006706098880000001) * s1,
-            ],
-            [T::zero()],
-        ]
-    }
     /// Forward dynamics `qdd = M(q)^-1 (tau - b(q, qd) - G(q))`, or which pivot of the
     /// `L^T D L` factorization of M(q) was not positive (a non-physical model or
-    /// non-finite input); see `Dynamics::forward_dynamics` for the operation count.
+    /// non-finite input); see `forward_dynamics` for the operation count.
     /// `Ok` holds only finite numbers: a non-finite component `i` of the solution (from
     /// a non-finite `qd` or `tau`, or a `q` that leaves M(q) finite) is reported as
     /// `FactorError::NonFinite { pivot: i }`.
@@ -164,40 +130,79 @@ impl<T: ::eomgen_runtime::Real> DoublePendulum<T> {
         }
         Ok(qdd)
     }
+    /// Craig's centrifugal matrix C(q): `b = B(q) [qd qd] + C(q) [qd^2]`.
+    ///
+    /// Route: closed-form Lagrangian expressions.
+    /// Operations: 7 mul, 4 add, 0 div, 1 sin, 1 cos.
+    pub fn centrifugal(&self, q: &[T; 2]) -> [[T; 2]; 2] {
+        let (s1, c1) = q[1].sin_cos();
+        let t0 = s1;
+        let t1 = c1;
+        let t2 = -T::from_f64(0.033238000000000004)
+            * (t0 * (-T::from_f64(0.1) * t1 - T::from_f64(0.10088))
+                + t1 * (T::from_f64(0.1) * t0 + T::from_f64(0.00000000019371)));
+        [
+            [
+                T::zero(),
+                T::from_f64(0.000000000006438532980000001) * t1
+                    - T::from_f64(0.00335304944) * t0,
+            ],
+            [t2, T::zero()],
+        ]
+    }
+    /// Craig's Coriolis matrix B(q), N x N(N-1)/2 = 2 x 1, columns for qd_j qd_k with j < k in the order (0,1), (0,2), ..., (1,2), ...
+    ///
+    /// Route: second velocity derivatives of the Newton-Euler bias.
+    /// Operations: 2 mul, 1 add, 0 div, 1 sin, 1 cos.
+    pub fn coriolis_pairs(&self, q: &[T; 2]) -> [[T; 1]; 2] {
+        let (s1, c1) = q[1].sin_cos();
+        [
+            [
+                T::from_f64(0.000000000012877065959999999) * c1
+                    - T::from_f64(0.006706098880000001) * s1,
+            ],
+            [T::zero()],
+        ]
+    }
     /// Pose of a link frame in the world (root) frame.
+    ///
+    /// Route: each joint's transform composed along the link's chain from the root.
     pub fn link_pose(
         &self,
         link: DoublePendulumLink,
         q: &[T; 2],
     ) -> ::eomgen_runtime::Pose<T> {
-        match link {
-            DoublePendulumLink::BaseLink => {
-                let o = {
-                    [
-                        T::zero(),
-                        T::zero(),
-                        T::zero(),
-                        T::one(),
-                        T::zero(),
-                        T::zero(),
-                        T::zero(),
-                        T::one(),
-                        T::zero(),
-                        T::zero(),
-                        T::zero(),
-                        T::one(),
-                    ]
-                };
-                ::eomgen_runtime::Pose {
-                    translation: [o[0], o[1], o[2]],
-                    rotation: [
-                        [o[3], o[4], o[5]],
-                        [o[6], o[7], o[8]],
-                        [o[9], o[10], o[11]],
-                    ],
-                }
-            }
-            DoublePendulumLink::Link1 => {
+        let (path, placement) = Self::link_frame(link);
+        ::eomgen_runtime::tree::chain_pose(path, |j| self.joint_transform(j, q))
+            .compose(&placement)
+    }
+    /// The 6 x N Jacobian of a link frame: rows vx, vy, vz, wx, wy, wz in world axes, at the link origin.
+    ///
+    /// Route: joint axes and origins along the link's chain, from the same transforms as `link_pose`.
+    pub fn link_jacobian(&self, link: DoublePendulumLink, q: &[T; 2]) -> [[T; 2]; 6] {
+        let (path, placement) = Self::link_frame(link);
+        ::eomgen_runtime::tree::chain_jacobian(
+            path,
+            &Self::TREE_JOINTS,
+            |j| self.joint_transform(j, q),
+            &placement,
+        )
+    }
+    /// Each joint's axis (in the frame of the body it moves) and motion.
+    const TREE_JOINTS: [::eomgen_runtime::tree::TreeJoint; 2] = [
+        ::eomgen_runtime::tree::TreeJoint {
+            axis: [1.0, 0.0, 0.0],
+            motion: ::eomgen_runtime::tree::Motion::Rotation,
+        },
+        ::eomgen_runtime::tree::TreeJoint {
+            axis: [1.0, 0.0, 0.0],
+            motion: ::eomgen_runtime::tree::Motion::Rotation,
+        },
+    ];
+    /// The pose of body `j` in its parent body's frame.
+    fn joint_transform(&self, j: usize, q: &[T; 2]) -> ::eomgen_runtime::Pose<T> {
+        match j {
+            0 => {
                 let o = {
                     let (s0, c0) = q[0].sin_cos();
                     let t0 = s0;
@@ -226,29 +231,24 @@ impl<T: ::eomgen_runtime::Real> DoublePendulum<T> {
                     ],
                 }
             }
-            DoublePendulumLink::Link2 => {
+            1 => {
                 let o = {
-                    let (s0, c0) = q[0].sin_cos();
                     let (s1, c1) = q[1].sin_cos();
-                    let t0 = s0;
-                    let t1 = c0;
-                    let t2 = s1;
-                    let t3 = c1;
-                    let t4 = t1 * t3 - t0 * t2;
-                    let t5 = -t1 * t2 - t0 * t3;
+                    let t0 = s1;
+                    let t1 = c1;
                     [
-                        T::from_f64(0.0290872),
-                        -T::from_f64(0.1) * t0,
-                        T::from_f64(0.1) * t1 + T::from_f64(0.035),
+                        T::from_f64(0.023),
+                        T::zero(),
+                        T::from_f64(0.1),
                         T::one(),
                         T::zero(),
                         T::zero(),
                         T::zero(),
-                        t4,
-                        t5,
+                        t1,
+                        -t0,
                         T::zero(),
-                        -t5,
-                        t4,
+                        t0,
+                        t1,
                     ]
                 };
                 ::eomgen_runtime::Pose {
@@ -260,41 +260,52 @@ impl<T: ::eomgen_runtime::Real> DoublePendulum<T> {
                     ],
                 }
             }
+            _ => ::eomgen_runtime::Pose::identity(),
         }
     }
-    /// The 6 x N Jacobian of a link frame: rows vx, vy, vz, wx, wy, wz in world axes, at the link origin.
-    pub fn link_jacobian(&self, link: DoublePendulumLink, q: &[T; 2]) -> [[T; 2]; 6] {
+    /// A link's chain of joints from the root and its placement in the last body.
+    fn link_frame(
+        link: DoublePendulumLink,
+    ) -> (&'static [usize], ::eomgen_runtime::Pose<T>) {
         match link {
             DoublePendulumLink::BaseLink => {
-                [
-                    [T::zero(), T::zero()],
-                    [T::zero(), T::zero()],
-                    [T::zero(), T::zero()],
-                    [T::zero(), T::zero()],
-                    [T::zero(), T::zero()],
-                    [T::zero(), T::zero()],
-                ]
+                (
+                    &[],
+                    ::eomgen_runtime::Pose {
+                        translation: [T::zero(), T::zero(), T::zero()],
+                        rotation: [
+                            [T::one(), T::zero(), T::zero()],
+                            [T::zero(), T::one(), T::zero()],
+                            [T::zero(), T::zero(), T::one()],
+                        ],
+                    },
+                )
             }
             DoublePendulumLink::Link1 => {
-                [
-                    [T::zero(), T::zero()],
-                    [T::zero(), T::zero()],
-                    [T::zero(), T::zero()],
-                    [T::one(), T::zero()],
-                    [T::zero(), T::zero()],
-                    [T::zero(), T::zero()],
-                ]
+                (
+                    &[0],
+                    ::eomgen_runtime::Pose {
+                        translation: [T::zero(), T::zero(), T::zero()],
+                        rotation: [
+                            [T::one(), T::zero(), T::zero()],
+                            [T::zero(), T::one(), T::zero()],
+                            [T::zero(), T::zero(), T::one()],
+                        ],
+                    },
+                )
             }
             DoublePendulumLink::Link2 => {
-                let (s0, c0) = q[0].sin_cos();
-                [
-                    [T::zero(), T::zero()],
-                    [-T::from_f64(0.1) * c0, T::zero()],
-                    [-T::from_f64(0.1) * s0, T::zero()],
-                    [T::one(), T::one()],
-                    [T::zero(), T::zero()],
-                    [T::zero(), T::zero()],
-                ]
+                (
+                    &[0, 1],
+                    ::eomgen_runtime::Pose {
+                        translation: [T::zero(), T::zero(), T::zero()],
+                        rotation: [
+                            [T::one(), T::zero(), T::zero()],
+                            [T::zero(), T::one(), T::zero()],
+                            [T::zero(), T::zero(), T::one()],
+                        ],
+                    },
+                )
             }
         }
     }
@@ -312,6 +323,8 @@ impl<T: ::eomgen_runtime::Real> DoublePendulum<T> {
 )]
 impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 2> for DoublePendulum<T> {
     const JOINT_NAMES: [&'static str; 2] = ["joint1", "joint2"];
+    /// The joint-space mass matrix M(q), symmetric positive definite.
+    ///
     /// Route: composite-rigid-body algorithm.
     /// Operations: 4 mul, 4 add, 0 div, 1 sin, 1 cos.
     fn mass_matrix(&self, q: &[T; 2]) -> [[T; 2]; 2] {
@@ -330,6 +343,8 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 2> for DoublePendu
             [t2, T::from_f64(0.004557856275072)],
         ]
     }
+    /// The generalized gravity force G(q) = dV/dq.
+    ///
     /// Route: closed-form Lagrangian expressions.
     /// Operations: 10 mul, 8 add, 0 div, 2 sin, 2 cos.
     fn gravity(&self, q: &[T; 2]) -> [T; 2] {
@@ -352,6 +367,8 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 2> for DoublePendu
                 - T::from_f64(0.328934150064) * (t6 + t7),
         ]
     }
+    /// The Coriolis and centrifugal effort b(q, qd) = C(q, qd) qd, without gravity.
+    ///
     /// Route: closed-form Lagrangian expressions.
     /// Operations: 14 mul, 6 add, 0 div, 1 sin, 1 cos.
     fn bias(&self, q: &[T; 2], qd: &[T; 2]) -> [T; 2] {
@@ -366,6 +383,8 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 2> for DoublePendu
             + qd[0] * qd[1] * (T::from_f64(0.06647600000000001) * (t2 + t3));
         [t4, qd[0] * qd[0] * (-T::from_f64(0.033238000000000004) * (t2 + t3))]
     }
+    /// The Christoffel-form Coriolis matrix C(q, qd): C qd = b, dM/dt - 2C skew-symmetric.
+    ///
     /// Route: closed-form Lagrangian expressions.
     /// Operations: 15 mul, 6 add, 0 div, 1 sin, 1 cos.
     fn coriolis_matrix(&self, q: &[T; 2], qd: &[T; 2]) -> [[T; 2]; 2] {
@@ -384,6 +403,8 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 2> for DoublePendu
             * (-T::from_f64(0.06647600000000001) * (t2 + t3));
         [[T::from_f64(0.5) * qd[1] * t4, t5], [t6, T::zero()]]
     }
+    /// Inverse dynamics: tau = M(q) qdd + b(q, qd) + G(q).
+    ///
     /// Route: Newton-Euler.
     /// Operations: 29 mul, 25 add, 0 div, 2 sin, 2 cos.
     fn inverse_dynamics(&self, q: &[T; 2], qd: &[T; 2], qdd: &[T; 2]) -> [T; 2] {
@@ -418,17 +439,22 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 2> for DoublePendu
                 - T::from_f64(0.0335304944) * (t7 + t9),
         ]
     }
-    /// Route: M and b + G as in `mass_matrix` and `bias`, then an unrolled L^T D L solve without fill-in.
-    /// Operations: 38 mul, 32 add, 1 div, 2 sin, 2 cos.
+    /// Forward dynamics: qdd = M(q)^-1 (tau - b(q, qd) - G(q)).
     ///
     /// Returns NaN in every entry when M(q) is not positive definite (it cannot be for a valid
     /// model and finite inputs); `try_forward_dynamics` says which pivot failed.
+    ///
+    /// Route: M and b + G as in `mass_matrix` and `bias`, then an unrolled L^T D L solve without fill-in.
+    /// Operations: 38 mul, 32 add, 1 div, 2 sin, 2 cos.
     fn forward_dynamics(&self, q: &[T; 2], qd: &[T; 2], tau: &[T; 2]) -> [T; 2] {
         match self.try_forward_dynamics(q, qd, tau) {
             Ok(qdd) => qdd,
             Err(_) => [T::nan(); 2],
         }
     }
+    /// The kinetic energy T = qd^T M(q) qd / 2.
+    ///
+    /// Route: the quadratic form of `mass_matrix`.
     /// Operations: 11 mul, 7 add, 0 div, 1 sin, 1 cos.
     fn kinetic_energy(&self, q: &[T; 2], qd: &[T; 2]) -> T {
         let (s1, c1) = q[1].sin_cos();
@@ -445,6 +471,9 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 2> for DoublePendu
                 + qd[1] * (T::from_f64(0.004557856275072) * qd[1] + qd[0] * t2));
         t4
     }
+    /// The gravitational potential energy V = -sum m g.c, zero with every centre of mass at the origin.
+    ///
+    /// Route: centres of mass by forward kinematics.
     /// Operations: 8 mul, 6 add, 0 div, 2 sin, 2 cos.
     fn potential_energy(&self, q: &[T; 2]) -> T {
         let (s0, c0) = q[0].sin_cos();

@@ -16,6 +16,8 @@
 //! - control (module [`control`]): PD with gravity compensation ([`PdGravity`]),
 //!   [`ComputedTorque`], the Jacobian-transpose map [`wrench_to_torque`], velocity and force
 //!   manipulability [`Ellipsoid`]s and the [`SymmetricEigen`] solver behind them;
+//! - kernels that generated code loops over (module [`tree`]): poses and Jacobians along a
+//!   kinematic chain, Craig's `B(q)` and `C(q)` from the Christoffel-form Coriolis matrix;
 //! - [`WithJointEffects`]: rotor inertia (armature), viscous and Coulomb joint friction added
 //!   to any [`Dynamics`];
 //! - with the `nalgebra` feature, conversions between the plain arrays used here and nalgebra's
@@ -61,6 +63,7 @@ mod linalg;
 mod pose;
 mod real;
 pub mod sim;
+pub mod tree;
 
 #[cfg(feature = "nalgebra")]
 pub mod nalgebra_support;

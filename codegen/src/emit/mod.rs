@@ -3,6 +3,8 @@
 //! Code is built as tokens with `quote`, parsed into a `syn::File` (which also proves it is
 //! valid Rust) and formatted with `prettyplease`, so output never depends on a user's rustfmt.
 
+mod body;
+mod expr;
 pub mod names;
 mod rust;
 

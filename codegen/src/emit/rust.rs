@@ -1,15 +1,22 @@
-//! Rust source for one robot: a generic struct, its `Dynamics` implementation and link
-//! kinematics, as straight-line, allocation-free, panic-free code over `eomgen_runtime::Real`.
+//! Rust source for one robot: a generic struct with one inherent method per quantity of the
+//! derivation's catalogue, the runtime's `Dynamics` trait delegating to them, and the link
+//! enum with the tables link kinematics walks.
+//!
+//! One emitter method per generated item, as prost-build's code generator does it: the
+//! parameter fields, the link enum, each kind of [`Evaluation`], the trait implementation.
 
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::BTreeMap;
 
 use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote};
 
+use super::body::body;
+use super::expr::{lit, Ctx};
 use super::names::{comment_text, snake, upper_camel, Scope};
-use crate::cas::{Expr, Id, OpCount, Order, Program, Symbol, SymbolKind};
-use crate::dynamics::{Derivation, Route};
-use crate::model::Model;
+use crate::cas::{Graph, Id, OpCount};
+use crate::dynamics::{Craig, Derivation, Evaluation, Home, Input, Quantity, Shape};
+use crate::kinematics::snap;
+use crate::model::{Model, Transform};
 
 /// What the emitted file is called and says about itself.
 #[derive(Clone, Debug)]
@@ -22,329 +29,9 @@ pub struct EmitOptions {
     pub regenerate: String,
 }
 
-/// How a function's outputs are laid out.
-enum Shape {
-    Scalar,
-    Vector,
-    /// Rows x columns, row-major.
-    Matrix(usize, usize),
-}
-
-/// Turns program expressions into tokens.
-struct Ctx<'a> {
-    symbols: &'a [Symbol],
-    /// Parameter symbol index -> struct field.
-    fields: &'a BTreeMap<u32, Ident>,
-}
-
-/// Tokens of an expression and whether it is a sum (needs parentheses inside a product).
-struct Tok {
-    ts: TokenStream,
-    sum: bool,
-    /// A plain name or literal call, cheap to repeat.
-    atom: bool,
-}
-
-fn lit(v: f64) -> TokenStream {
-    if v.is_nan() {
-        return quote!(T::nan());
-    }
-    if v.is_infinite() {
-        return if v > 0.0 {
-            quote!(T::from_f64(f64::INFINITY))
-        } else {
-            quote!(T::from_f64(f64::NEG_INFINITY))
-        };
-    }
-    if v == 0.0 {
-        return quote!(T::zero());
-    }
-    if v == 1.0 {
-        return quote!(T::one());
-    }
-    let l = Literal::f64_unsuffixed(v.abs());
-    if v < 0.0 {
-        quote!((-T::from_f64(#l)))
-    } else {
-        quote!(T::from_f64(#l))
-    }
-}
-
-impl Ctx<'_> {
-    fn input(&self, s: u32, trig: &mut BTreeSet<(usize, bool)>, sin: Option<bool>) -> TokenStream {
-        let sym = &self.symbols[s as usize];
-        let idx = |i: usize| Literal::usize_unsuffixed(i);
-        match (sym.kind, sin) {
-            (SymbolKind::Q(i), Some(is_sin)) => {
-                trig.insert((i, is_sin));
-                let name = if is_sin {
-                    format_ident!("s{}", i)
-                } else {
-                    format_ident!("c{}", i)
-                };
-                quote!(#name)
-            }
-            (SymbolKind::Q(i), None) => {
-                let i = idx(i);
-                quote!(q[#i])
-            }
-            (SymbolKind::Qd(i), None) => {
-                let i = idx(i);
-                quote!(qd[#i])
-            }
-            (SymbolKind::Tau(i), None) => {
-                let i = idx(i);
-                quote!(tau[#i])
-            }
-            (SymbolKind::Qdd(i), None) => {
-                let i = idx(i);
-                quote!(qdd[#i])
-            }
-            (SymbolKind::Param, None) => {
-                let f = &self.fields[&s];
-                quote!(self.#f)
-            }
-            (_, Some(is_sin)) => {
-                let inner = self.input(s, trig, None);
-                if is_sin {
-                    quote!(#inner.sin())
-                } else {
-                    quote!(#inner.cos())
-                }
-            }
-        }
-    }
-
-    fn expr(&self, e: &Expr, trig: &mut BTreeSet<(usize, bool)>) -> Tok {
-        match e {
-            Expr::Const(c) => Tok {
-                ts: lit(*c),
-                sum: false,
-                atom: true,
-            },
-            Expr::Input(s) => Tok {
-                ts: self.input(*s, trig, None),
-                sum: false,
-                atom: true,
-            },
-            Expr::Temp(t) => {
-                let name = format_ident!("t{}", t);
-                Tok {
-                    ts: quote!(#name),
-                    sum: false,
-                    atom: true,
-                }
-            }
-            Expr::Sin(a) | Expr::Cos(a) => {
-                let is_sin = matches!(e, Expr::Sin(_));
-                if let Expr::Input(s) = **a {
-                    return Tok {
-                        ts: self.input(s, trig, Some(is_sin)),
-                        sum: false,
-                        atom: true,
-                    };
-                }
-                let inner = self.paren(a, trig);
-                let ts = if is_sin {
-                    quote!(#inner.sin())
-                } else {
-                    quote!(#inner.cos())
-                };
-                Tok {
-                    ts,
-                    sum: false,
-                    atom: false,
-                }
-            }
-            Expr::Sqrt(a) => {
-                let inner = self.paren(a, trig);
-                Tok {
-                    ts: quote!(#inner.sqrt()),
-                    sum: false,
-                    atom: false,
-                }
-            }
-            Expr::Sign(a) => {
-                let inner = self.paren(a, trig);
-                Tok {
-                    ts: quote!(#inner.signum()),
-                    sum: false,
-                    atom: false,
-                }
-            }
-            Expr::Add(c, terms) => {
-                // Positive terms first, so that the sum starts without a negation when it can.
-                let mut parts: Vec<(bool, TokenStream)> = Vec::new();
-                for (t, k) in terms {
-                    let tt = self.expr(t, trig);
-                    let body = if k.abs() == 1.0 {
-                        tt.ts
-                    } else {
-                        let coef = lit(k.abs());
-                        let inner = if tt.sum { paren(tt.ts) } else { tt.ts };
-                        quote!(#coef * #inner)
-                    };
-                    parts.push((*k < 0.0, body));
-                }
-                if *c != 0.0 {
-                    parts.push((*c < 0.0, lit(c.abs())));
-                }
-                parts.sort_by_key(|p| p.0);
-                let mut ts = TokenStream::new();
-                for (i, (neg, body)) in parts.into_iter().enumerate() {
-                    ts = match (i, neg) {
-                        (0, false) => body,
-                        (0, true) => quote!(-#body),
-                        (_, false) => quote!(#ts + #body),
-                        (_, true) => quote!(#ts - #body),
-                    };
-                }
-                Tok {
-                    ts,
-                    sum: true,
-                    atom: false,
-                }
-            }
-            Expr::Mul(factors) => {
-                let mut num: Vec<TokenStream> = Vec::new();
-                let mut den: Vec<TokenStream> = Vec::new();
-                for (f, x) in factors {
-                    let ft = self.expr(f, trig);
-                    let raw = ft.ts.clone();
-                    let base = if ft.sum { paren(ft.ts) } else { ft.ts };
-                    let n = x.unsigned_abs() as usize;
-                    let power = if n == 1 {
-                        base
-                    } else if ft.atom {
-                        join_mul(std::iter::repeat_n(base, n).collect())
-                    } else {
-                        // Evaluate a compound base once.
-                        let prod = join_mul(std::iter::repeat_n(quote!(b), n).collect());
-                        quote!({ let b = #raw; #prod })
-                    };
-                    if *x > 0 {
-                        num.push(power);
-                    } else {
-                        den.push(power);
-                    }
-                }
-                let n = if num.is_empty() {
-                    quote!(T::one())
-                } else {
-                    join_mul(num)
-                };
-                let ts = match den.len() {
-                    0 => n,
-                    1 => {
-                        let d = &den[0];
-                        quote!(#n / #d)
-                    }
-                    _ => {
-                        let d = join_mul(den);
-                        quote!(#n / (#d))
-                    }
-                };
-                Tok {
-                    ts,
-                    sum: false,
-                    atom: false,
-                }
-            }
-        }
-    }
-
-    fn paren(&self, e: &Expr, trig: &mut BTreeSet<(usize, bool)>) -> TokenStream {
-        let t = self.expr(e, trig);
-        if t.atom {
-            t.ts
-        } else {
-            paren(t.ts)
-        }
-    }
-}
-
-fn paren(ts: TokenStream) -> TokenStream {
-    quote!((#ts))
-}
-
-fn join_mul(items: Vec<TokenStream>) -> TokenStream {
-    let mut it = items.into_iter();
-    let first = it.next().unwrap_or_else(|| quote!(T::one()));
-    it.fold(first, |acc, x| quote!(#acc * #x))
-}
-
-/// Temporaries per chunk of `let`s (see `body`).
-const LET_CHUNK: usize = 64;
-
-/// Straight-line body computing `outputs` in the given shape, and its operation count.
-fn body(d: &Derivation, cx: &Ctx<'_>, outputs: &[Id], shape: Shape) -> (TokenStream, OpCount) {
-    let program = Program::ordered(&d.graph, outputs, Order::Levels);
-    let mut trig = BTreeSet::new();
-    // Temporaries go in chunks: `let (t0, .., t63) = { let t0 = ..; ..; (t0, .., t63) };`.
-    // Every `let` opens a lexical scope nested in the previous one, and LLVM's debug-info
-    // writer recurses once per level: a few thousand plain `let`s in one function overflow
-    // rustc's stack in debug builds. Chunking bounds the depth at chunks + chunk size.
-    let defs: Vec<(Ident, TokenStream)> = program
-        .temps
-        .iter()
-        .enumerate()
-        .map(|(k, e)| (format_ident!("t{}", k), cx.expr(e, &mut trig).ts))
-        .collect();
-    let temps: Vec<TokenStream> = if defs.len() <= LET_CHUNK {
-        defs.iter()
-            .map(|(name, v)| quote!(let #name = #v;))
-            .collect()
-    } else {
-        defs.chunks(LET_CHUNK)
-            .map(|chunk| {
-                let names: Vec<&Ident> = chunk.iter().map(|(n, _)| n).collect();
-                let lets = chunk.iter().map(|(name, v)| quote!(let #name = #v;));
-                quote!(let (#(#names),*,) = { #(#lets)* (#(#names),*,) };)
-            })
-            .collect()
-    };
-    let outs: Vec<TokenStream> = program
-        .outputs
-        .iter()
-        .map(|e| cx.expr(e, &mut trig).ts)
-        .collect();
-    let ops = program.ops();
-    // One sin_cos per joint angle, computed up front.
-    let joints: BTreeSet<usize> = trig.iter().map(|t| t.0).collect();
-    let pre: Vec<TokenStream> = joints
-        .iter()
-        .map(|&i| {
-            let (s, c) = (format_ident!("s{}", i), format_ident!("c{}", i));
-            let (has_sin, has_cos) = (trig.contains(&(i, true)), trig.contains(&(i, false)));
-            let i = Literal::usize_unsuffixed(i);
-            match (has_sin, has_cos) {
-                (true, true) => quote!(let (#s, #c) = q[#i].sin_cos();),
-                (true, false) => quote!(let #s = q[#i].sin();),
-                _ => quote!(let #c = q[#i].cos();),
-            }
-        })
-        .collect();
-    let result = match shape {
-        Shape::Scalar => outs[0].clone(),
-        Shape::Vector => quote!([#(#outs),*]),
-        Shape::Matrix(_, cols) => {
-            let rows: Vec<TokenStream> = outs
-                .chunks(cols.max(1))
-                .map(|r| quote!([#(#r),*]))
-                .collect();
-            if cols == 0 {
-                let n = match shape {
-                    Shape::Matrix(r, _) => r,
-                    _ => 0,
-                };
-                let empty = std::iter::repeat_n(quote!([]), n);
-                quote!([#(#empty),*])
-            } else {
-                quote!([#(#rows),*])
-            }
-        }
-    };
-    (quote!(#(#pre)* #(#temps)* #result), ops)
+/// The lints generated code may trip: long literals, `x * -1.0` and the like.
+fn allow_lints() -> TokenStream {
+    quote!(#[allow(unused_variables, clippy::approx_constant, clippy::excessive_precision, clippy::unreadable_literal, clippy::neg_multiply, clippy::double_parens, clippy::identity_op, clippy::needless_range_loop, clippy::let_and_return)])
 }
 
 fn doc(lines: &[String]) -> TokenStream {
@@ -355,346 +42,343 @@ fn doc(lines: &[String]) -> TokenStream {
     quote!(#(#attrs)*)
 }
 
-fn ops_line(ops: &OpCount) -> String {
-    format!("Operations: {ops}.")
+fn usize_lit(n: usize) -> Literal {
+    Literal::usize_unsuffixed(n)
 }
 
-/// Emits the whole file (unformatted tokens; see [`super::format`]).
-pub fn emit_tokens(
-    model: &Model,
-    d: &Derivation,
-    opts: &EmitOptions,
-) -> (TokenStream, Vec<(String, OpCount)>) {
-    let n = d.dof;
-    let ty = format_ident!("{}", opts.type_name);
-    let link_ty = format_ident!("{}Link", opts.type_name);
-    let mut counts = Vec::new();
+/// The parameters of a derivation as struct fields: definitions, defaults, and the map from
+/// parameter symbol to field for expressions.
+struct Fields {
+    defs: Vec<TokenStream>,
+    defaults: Vec<TokenStream>,
+    by_symbol: BTreeMap<u32, Ident>,
+}
 
-    // Parameters become fields.
-    let mut field_scope = Scope::with_reserved(&["_marker"]);
-    let mut fields = BTreeMap::new();
-    let mut field_defs = Vec::new();
-    let mut field_defaults = Vec::new();
+fn fields(d: &Derivation) -> Fields {
+    let mut scope = Scope::with_reserved(&["_marker"]);
+    let mut f = Fields {
+        defs: Vec::new(),
+        defaults: Vec::new(),
+        by_symbol: BTreeMap::new(),
+    };
     for (name, id, value) in &d.params {
         let sym = d.graph.as_symbol(*id).expect("parameter symbol");
-        let f = format_ident!("{}", field_scope.claim(snake(name, "p")));
+        let field = format_ident!("{}", scope.claim(snake(name, "p")));
         let docline = format!(
             " `{}` ({} {}).",
             comment_text(&name.replace('`', "'")),
             crate::report::value_source(name),
             value
         );
-        field_defs.push(quote!(#[doc = #docline] pub #f: T,));
+        f.defs.push(quote!(#[doc = #docline] pub #field: T,));
         let l = lit(*value);
-        field_defaults.push(quote!(#f: #l,));
-        fields.insert(sym, f);
+        f.defaults.push(quote!(#field: #l,));
+        f.by_symbol.insert(sym, field);
     }
-    let cx = Ctx {
-        symbols: d.graph.symbols(),
-        fields: &fields,
-    };
+    f
+}
 
-    let flat = |m: &Vec<Vec<Id>>| -> Vec<Id> { m.iter().flatten().copied().collect() };
-    let func = |name: &str, outputs: Vec<Id>, shape: Shape, counts: &mut Vec<(String, OpCount)>| {
-        let (b, ops) = body(d, &cx, &outputs, shape);
-        counts.push((name.to_string(), ops));
-        (b, ops_line(&ops))
-    };
+struct Emitter<'a> {
+    model: &'a Model,
+    graph: &'a Graph,
+    quantities: &'a [Quantity],
+    cx: Ctx<'a>,
+    ty: Ident,
+    link_ty: Ident,
+    n: Literal,
+    /// Whether every `Dynamics` method is generated, so that the trait is implemented (and
+    /// its methods live there rather than in the inherent impl).
+    in_trait: bool,
+    /// `try_forward_dynamics`, which stays inherent when `forward_dynamics` is the trait's.
+    try_forward_dynamics: TokenStream,
+    counts: Vec<(String, OpCount)>,
+}
 
-    let f = &d.fast;
-    let route = |r: Route, rec: &str| format!("Route: {}.", r.describe(rec));
-    let (mm, mm_ops) = func(
-        "mass_matrix",
-        flat(&f.mass_matrix.1),
-        Shape::Matrix(n, n),
-        &mut counts,
-    );
-    let mm_route = route(f.mass_matrix.0, "composite-rigid-body algorithm");
-    let (gr, gr_ops) = func("gravity", f.gravity.1.clone(), Shape::Vector, &mut counts);
-    let gr_route = route(f.gravity.0, "Newton-Euler");
-    let (bi, bi_ops) = func("bias", f.bias.1.clone(), Shape::Vector, &mut counts);
-    let bi_route = route(f.bias.0, "Newton-Euler");
-    let (cm, cm_ops) = func(
-        "coriolis_matrix",
-        flat(&f.coriolis_matrix.1),
-        Shape::Matrix(n, n),
-        &mut counts,
-    );
-    let (id, id_ops) = func(
-        "inverse_dynamics",
-        f.tau.1.clone(),
-        Shape::Vector,
-        &mut counts,
-    );
-    let id_route = route(f.tau.0, "Newton-Euler");
-    let (ke, ke_ops) = func(
-        "kinetic_energy",
-        vec![f.kinetic_energy],
-        Shape::Scalar,
-        &mut counts,
-    );
-    let (pe, pe_ops) = func(
-        "potential_energy",
-        vec![d.potential_energy],
-        Shape::Scalar,
-        &mut counts,
-    );
-    let np = n * n.saturating_sub(1) / 2;
-    let (cf, cf_ops) = func(
-        "centrifugal",
-        flat(&f.centrifugal.1),
-        Shape::Matrix(n, n),
-        &mut counts,
-    );
-    let (cp, cp_ops) = func(
-        "coriolis_pairs",
-        flat(&f.coriolis_pairs.1),
-        Shape::Matrix(n, np),
-        &mut counts,
-    );
-    // Forward dynamics: M and h = b + G, then the unrolled sparse L^T D L solve, all in one
-    // program; the pivots come out too, to report a mass matrix that is not positive definite.
-    let mut fd_outputs = f.forward_dynamics.clone();
-    fd_outputs.extend(&f.pivots);
-    let (fd_body, fd_ops) = func("forward_dynamics", fd_outputs, Shape::Vector, &mut counts);
-    let fd_len = Literal::usize_unsuffixed(2 * n);
-    let fd_x: Vec<TokenStream> = (0..n)
-        .map(|i| {
-            let i = Literal::usize_unsuffixed(i);
-            quote!(o[#i])
-        })
-        .collect();
-    let fd_pivots: Vec<TokenStream> = (0..n)
-        .map(|i| {
-            let i = Literal::usize_unsuffixed(n + i);
-            quote!(o[#i])
-        })
-        .collect();
+/// How many methods the runtime's `Dynamics` trait has.
+const TRAIT_METHODS: usize = 8;
 
-    // Links.
-    let mut link_scope = Scope::with_reserved(&["ALL"]);
-    let variants: Vec<Ident> = d
-        .frames
-        .iter()
-        .map(|f| format_ident!("{}", link_scope.claim(upper_camel(&f.name, "Link"))))
-        .collect();
-    let link_names: Vec<Literal> = d.frames.iter().map(|f| Literal::string(&f.name)).collect();
-    let nlinks = variants.len();
-    let mut pose_arms = Vec::new();
-    let mut jac_arms = Vec::new();
-    for (f, v) in d.frames.iter().zip(&variants) {
-        let mut outs: Vec<Id> = f.position.to_vec();
-        outs.extend(f.rotation.iter().flatten());
-        let (pb, _) = body(d, &cx, &outs, Shape::Vector);
-        pose_arms.push(quote!(#link_ty::#v => { let o = { #pb }; ::eomgen_runtime::Pose { translation: [o[0], o[1], o[2]], rotation: [[o[3], o[4], o[5]], [o[6], o[7], o[8]], [o[9], o[10], o[11]]] } }));
-        let (jb, _) = body(d, &cx, &flat(&f.jacobian), Shape::Matrix(6, n));
-        jac_arms.push(quote!(#link_ty::#v => { #jb }));
-    }
-
-    let joint_names: Vec<Literal> = model
-        .joints
-        .iter()
-        .map(|j| Literal::string(&j.name))
-        .collect();
-    let type_doc = doc(&[
-        format!(
-            "Rigid-body dynamics of `{}` ({} joints), generated by eomgen.",
-            model.name.replace('`', "'"),
-            n
-        ),
-        String::new(),
-        "Generic over the scalar type (`f64` by default, `f32` for single-precision firmware)."
-            .into(),
-        "`Default` holds the URDF's parameter values.".into(),
-    ]);
-    let link_doc = doc(&[format!(
-        "The URDF links of [`{}`], one variant per link.",
-        opts.type_name
-    )]);
-    let gr_doc = doc(&[gr_route, gr_ops]);
-    let bi_doc = doc(&[bi_route, bi_ops]);
-    let cm_doc = doc(&[
-        route(
-            f.coriolis_matrix.0,
-            "Echeandia and Wensing's O(N^2) recursion on composite inertias and momenta",
-        ),
-        cm_ops,
-    ]);
-    // Joint effects change the meaning of some functions: say so where they apply.
-    let friction_note = |what: &str| -> Vec<String> {
-        if model.include_friction {
-            vec![
-                String::new(),
-                format!(
-                    "{what} the joint friction F(qd) of [`{}::friction`].",
-                    opts.type_name
-                ),
-            ]
-        } else {
-            Vec::new()
-        }
-    };
-    let armature: Vec<String> = model
-        .joints
-        .iter()
-        .filter(|j| j.armature != 0.0)
-        .map(|j| format!("`{}` {}", j.name.replace('`', "'"), j.armature))
-        .collect();
-    let armature_note = |what: &str| -> Vec<String> {
-        if armature.is_empty() {
-            Vec::new()
-        } else {
-            vec![
-                String::new(),
-                format!("{what} rotor inertia (armature): {}.", armature.join(", ")),
-            ]
-        }
-    };
-    let with_notes = |mut lines: Vec<String>, notes: &[Vec<String>]| {
-        for n in notes {
-            lines.extend(n.iter().cloned());
-        }
-        doc(&lines)
-    };
-    let mm_doc = with_notes(
-        vec![mm_route, mm_ops],
-        &[armature_note("The diagonal includes")],
-    );
-    let id_doc = with_notes(
-        vec![id_route, id_ops],
-        &[
-            friction_note("`tau = M qdd + b + G + F(qd)`: includes"),
-            armature_note("M includes"),
-        ],
-    );
-    let fd_doc = with_notes(
-        vec![
-            "Route: M and b + G as in `mass_matrix` and `bias`, then an unrolled L^T D L solve without fill-in.".into(),
-            fd_ops,
-            String::new(),
-            "Returns NaN in every entry when M(q) is not positive definite (it cannot be for a valid".into(),
-            "model and finite inputs); `try_forward_dynamics` says which pivot failed.".into(),
-        ],
-        &[
-            friction_note("`qdd = M^-1 (tau - b - G - F(qd))`: includes"),
-            armature_note("M includes"),
-        ],
-    );
-    let ke_doc = with_notes(vec![ke_ops], &[armature_note("Includes the")]);
-    let pe_doc = doc(&[pe_ops]);
-    let cf_doc = doc(&[
-        "Craig's centrifugal matrix C(q): `b = B(q) [qd qd] + C(q) [qd^2]`.".into(),
-        String::new(),
-        route(
-            f.centrifugal.0,
-            "second velocity derivatives of the Newton-Euler bias",
-        ),
-        cf_ops,
-    ]);
-    let cp_doc = doc(&[
-        format!("Craig's Coriolis matrix B(q), N x N(N-1)/2 = {n} x {np}, columns for qd_j qd_k with j < k in the order (0,1), (0,2), ..., (1,2), ..."),
-        String::new(),
-        route(f.coriolis_pairs.0, "second velocity derivatives of the Newton-Euler bias"),
-        cp_ops,
-    ]);
-
-    let friction_fn = if model.include_friction {
-        let (fr, fr_ops) = func("friction", d.friction.clone(), Shape::Vector, &mut counts);
-        let smoothing = if model.coulomb_smoothing > 0.0 {
-            format!(
-                "`s(v) = v / sqrt(v^2 + eps^2)`, the sign smoothed below `eps = {}` (rad/s or m/s)",
-                model.coulomb_smoothing
-            )
-        } else {
-            "`s(v) = sign(v)`, 0 at rest (no stiction)".to_string()
-        };
-        let coefficients: Vec<String> = model
-            .joints
+/// Emits the whole file (unformatted tokens; see [`super::format`]) and the operation count of
+/// each straight-line function.
+pub fn emit_tokens(
+    model: &Model,
+    d: &Derivation,
+    opts: &EmitOptions,
+) -> (TokenStream, Vec<(String, OpCount)>) {
+    let fields = fields(d);
+    let mut e = Emitter {
+        model,
+        graph: &d.graph,
+        quantities: &d.quantities,
+        cx: Ctx {
+            symbols: d.graph.symbols(),
+            fields: &fields.by_symbol,
+        },
+        ty: format_ident!("{}", opts.type_name),
+        link_ty: format_ident!("{}Link", opts.type_name),
+        n: usize_lit(d.dof),
+        in_trait: d
+            .quantities
             .iter()
-            .map(|j| {
-                format!(
-                    "`{}`: damping {}, friction {}",
-                    j.name.replace('`', "'"),
-                    j.damping,
-                    j.friction
-                )
-            })
-            .collect();
-        let fr_doc = doc(&[
-            "Joint friction effort `F(qd)`, per joint `damping qd + friction s(qd)` from the URDF's".into(),
-            format!("`<dynamics damping friction>`, with {smoothing}."),
-            "The effort the actuators must supply against friction (the joints feel `-F`); it is".into(),
-            "part of `inverse_dynamics` and `forward_dynamics`, not of `bias`.".into(),
-            String::new(),
-            format!("Coefficients: {}.", coefficients.join("; ")),
-            String::new(),
-            fr_ops,
-        ]);
-        let nn = Literal::usize_unsuffixed(n);
-        quote! {
-            #fr_doc
-            pub fn friction(&self, qd: &[T; #nn]) -> [T; #nn] { #fr }
-        }
-    } else {
-        TokenStream::new()
+            .filter(|q| q.home == Home::Dynamics)
+            .count()
+            == TRAIT_METHODS,
+        try_forward_dynamics: TokenStream::new(),
+        counts: Vec::new(),
     };
-    let (n, np, nlinks) = (
-        Literal::usize_unsuffixed(n),
-        Literal::usize_unsuffixed(np),
-        Literal::usize_unsuffixed(nlinks),
-    );
-    let tokens = quote! {
-        #type_doc
-        #[derive(Clone, Copy, Debug, PartialEq)]
-        pub struct #ty<T = f64> {
-            #(#field_defs)*
-            _marker: ::core::marker::PhantomData<T>,
-        }
+    let tokens = e.file(&fields, d);
+    (tokens, e.counts)
+}
 
-        impl<T: ::eomgen_runtime::Real> ::core::default::Default for #ty<T> {
-            fn default() -> Self {
-                #ty { #(#field_defaults)* _marker: ::core::marker::PhantomData }
+impl Emitter<'_> {
+    fn has_frames(&self) -> bool {
+        self.quantities
+            .iter()
+            .any(|q| matches!(q.eval, Evaluation::LinkPose | Evaluation::LinkJacobian))
+    }
+
+    fn file(&mut self, fields: &Fields, d: &Derivation) -> TokenStream {
+        let strukt = self.struct_def(fields);
+        let links = if self.has_frames() {
+            self.link_enum()
+        } else {
+            TokenStream::new()
+        };
+        let quantities = self.quantities;
+        let mut methods = Vec::new();
+        let mut trait_methods = Vec::new();
+        for q in quantities {
+            let tokens = self.quantity_fn(q);
+            if self.in_trait && q.home == Home::Dynamics {
+                trait_methods.push(tokens);
+            } else {
+                methods.push(tokens);
             }
         }
-
-        #link_doc
-        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-        pub enum #link_ty {
-            #(#variants),*
+        let frames = if self.has_frames() {
+            self.frame_support(d)
+        } else {
+            TokenStream::new()
+        };
+        let trait_impl = self.trait_impl(&trait_methods);
+        let (ty, n, allow) = (&self.ty, &self.n, allow_lints());
+        let try_fd = &self.try_forward_dynamics;
+        quote! {
+            #strukt
+            #links
+            #allow
+            impl<T: ::eomgen_runtime::Real> #ty<T> {
+                /// Number of joint coordinates.
+                pub const DOF: usize = #n;
+                #try_fd
+                #(#methods)*
+                #frames
+            }
+            #allow
+            #trait_impl
         }
+    }
 
-        impl #link_ty {
-            /// Every link, in URDF order.
-            pub const ALL: [#link_ty; #nlinks] = [#(#link_ty::#variants),*];
+    /// `pub` in the inherent impl; nothing in the trait's.
+    fn vis(&self, q: &Quantity) -> TokenStream {
+        if self.in_trait && q.home == Home::Dynamics {
+            TokenStream::new()
+        } else {
+            quote!(pub)
+        }
+    }
 
-            /// The URDF name of the link.
-            pub const fn name(self) -> &'static str {
-                match self {
-                    #(#link_ty::#variants => #link_names),*
+    fn struct_def(&self, fields: &Fields) -> TokenStream {
+        let type_doc = doc(&[
+            format!(
+                "Rigid-body dynamics of `{}` ({} joints), generated by eomgen.",
+                self.model.name.replace('`', "'"),
+                self.model.dof()
+            ),
+            String::new(),
+            "Generic over the scalar type (`f64` by default, `f32` for single-precision firmware)."
+                .into(),
+            "`Default` holds the URDF's parameter values.".into(),
+        ]);
+        let (ty, defs, defaults) = (&self.ty, &fields.defs, &fields.defaults);
+        quote! {
+            #type_doc
+            #[derive(Clone, Copy, Debug, PartialEq)]
+            pub struct #ty<T = f64> {
+                #(#defs)*
+                _marker: ::core::marker::PhantomData<T>,
+            }
+
+            impl<T: ::eomgen_runtime::Real> ::core::default::Default for #ty<T> {
+                fn default() -> Self {
+                    #ty { #(#defaults)* _marker: ::core::marker::PhantomData }
                 }
             }
         }
+    }
 
-        #[allow(unused_variables, clippy::approx_constant, clippy::excessive_precision, clippy::unreadable_literal, clippy::neg_multiply, clippy::double_parens, clippy::identity_op, clippy::needless_range_loop, clippy::let_and_return)]
-        impl<T: ::eomgen_runtime::Real> #ty<T> {
-            /// Number of joint coordinates.
-            pub const DOF: usize = #n;
+    /// The link enum's variant names, in URDF order.
+    fn link_variants(&self) -> Vec<Ident> {
+        let mut scope = Scope::with_reserved(&["ALL"]);
+        self.model
+            .frames
+            .iter()
+            .map(|f| format_ident!("{}", scope.claim(upper_camel(&f.name, "Link"))))
+            .collect()
+    }
 
-            #cf_doc
-            pub fn centrifugal(&self, q: &[T; #n]) -> [[T; #n]; #n] { #cf }
+    fn link_enum(&self) -> TokenStream {
+        let variants = self.link_variants();
+        let names = self.model.frames.iter().map(|f| Literal::string(&f.name));
+        let count = usize_lit(variants.len());
+        let link_ty = &self.link_ty;
+        let link_doc = doc(&[format!(
+            "The URDF links of [`{}`], one variant per link.",
+            self.ty
+        )]);
+        quote! {
+            #link_doc
+            #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+            pub enum #link_ty {
+                #(#variants),*
+            }
 
-            #cp_doc
-            pub fn coriolis_pairs(&self, q: &[T; #n]) -> [[T; #np]; #n] { #cp }
+            impl #link_ty {
+                /// Every link, in URDF order.
+                pub const ALL: [#link_ty; #count] = [#(#link_ty::#variants),*];
 
+                /// The URDF name of the link.
+                pub const fn name(self) -> &'static str {
+                    match self {
+                        #(#link_ty::#variants => #names),*
+                    }
+                }
+            }
+        }
+    }
+
+    /// The arguments `q: &[T; N], ...` of a quantity.
+    fn args(&self, inputs: &[Input]) -> Vec<TokenStream> {
+        let n = &self.n;
+        inputs
+            .iter()
+            .map(|i| {
+                let name = format_ident!("{}", i.name());
+                quote!(#name: &[T; #n])
+            })
+            .collect()
+    }
+
+    fn return_type(shape: Shape) -> TokenStream {
+        match shape {
+            Shape::Scalar => quote!(T),
+            Shape::Vector(n) => {
+                let n = usize_lit(n);
+                quote!([T; #n])
+            }
+            Shape::Matrix(r, c) => {
+                let (r, c) = (usize_lit(r), usize_lit(c));
+                quote!([[T; #c]; #r])
+            }
+        }
+    }
+
+    /// Straight-line code for `outputs`, counted under `name`.
+    fn straight(&mut self, name: &str, outputs: &[Id], shape: Shape) -> (TokenStream, OpCount) {
+        let (b, ops) = body(self.graph, &self.cx, outputs, shape);
+        self.counts.push((name.to_string(), ops));
+        (b, ops)
+    }
+
+    fn quantity_doc(q: &Quantity, ops: Option<OpCount>) -> TokenStream {
+        let mut lines = q.doc.clone();
+        lines.push(String::new());
+        lines.push(q.route.clone());
+        if let Some(ops) = ops {
+            lines.push(format!("Operations: {ops}."));
+        }
+        doc(&lines)
+    }
+
+    fn quantity_fn(&mut self, q: &Quantity) -> TokenStream {
+        match &q.eval {
+            Evaluation::Exprs(ids) => self.exprs_fn(q, ids),
+            Evaluation::CraigColumns(which) => self.craig_fn(q, *which),
+            Evaluation::ForwardDynamics {
+                accelerations,
+                pivots,
+            } => self.forward_dynamics_fns(q, accelerations, pivots),
+            Evaluation::LinkPose => self.link_pose_fn(q),
+            Evaluation::LinkJacobian => self.link_jacobian_fn(q),
+        }
+    }
+
+    fn exprs_fn(&mut self, q: &Quantity, ids: &[Id]) -> TokenStream {
+        let (b, ops) = self.straight(q.name, ids, q.shape);
+        let docs = Self::quantity_doc(q, Some(ops));
+        let (name, args, ret) = (
+            format_ident!("{}", q.name),
+            self.args(q.inputs),
+            Self::return_type(q.shape),
+        );
+        let vis = self.vis(q);
+        quote! {
+            #docs
+            #vis fn #name(&self, #(#args),*) -> #ret { #b }
+        }
+    }
+
+    /// Craig's `C(q)` or `B(q)` from `N` Christoffel columns of `coriolis_matrix`.
+    fn craig_fn(&mut self, q: &Quantity, which: Craig) -> TokenStream {
+        let docs = Self::quantity_doc(q, None);
+        let (name, ret, n) = (
+            format_ident!("{}", q.name),
+            Self::return_type(q.shape),
+            &self.n,
+        );
+        let coriolis = if self.in_trait {
+            quote!(<Self as ::eomgen_runtime::Dynamics<T, #n>>::coriolis_matrix)
+        } else {
+            quote!(Self::coriolis_matrix)
+        };
+        let kernel = match which {
+            Craig::Centrifugal => quote!(centrifugal_from_coriolis),
+            Craig::CoriolisPairs => quote!(coriolis_pairs_from_coriolis),
+        };
+        quote! {
+            #docs
+            pub fn #name(&self, q: &[T; #n]) -> #ret {
+                ::eomgen_runtime::tree::#kernel(|v: &[T; #n]| #coriolis(self, q, v))
+            }
+        }
+    }
+
+    /// `try_forward_dynamics`, which reports a failed pivot, and `forward_dynamics`, which
+    /// gives NaN then.
+    fn forward_dynamics_fns(&mut self, q: &Quantity, acc: &[Id], piv: &[Id]) -> TokenStream {
+        let dof = acc.len();
+        let outputs: Vec<Id> = acc.iter().chain(piv).copied().collect();
+        let (b, ops) = self.straight(q.name, &outputs, Shape::Vector(2 * dof));
+        let docs = Self::quantity_doc(q, Some(ops));
+        let len = usize_lit(2 * dof);
+        let x = (0..dof).map(|i| {
+            let i = usize_lit(i);
+            quote!(o[#i])
+        });
+        let pivots = (0..dof).map(|i| {
+            let i = usize_lit(dof + i);
+            quote!(o[#i])
+        });
+        let (n, vis) = (&self.n, self.vis(q));
+        let try_fd = quote! {
             /// Forward dynamics `qdd = M(q)^-1 (tau - b(q, qd) - G(q))`, or which pivot of the
             /// `L^T D L` factorization of M(q) was not positive (a non-physical model or
-            /// non-finite input); see `Dynamics::forward_dynamics` for the operation count.
+            /// non-finite input); see `forward_dynamics` for the operation count.
             /// `Ok` holds only finite numbers: a non-finite component `i` of the solution (from
             /// a non-finite `qd` or `tau`, or a `q` that leaves M(q) finite) is reported as
             /// `FactorError::NonFinite { pivot: i }`.
             pub fn try_forward_dynamics(&self, q: &[T; #n], qd: &[T; #n], tau: &[T; #n]) -> ::core::result::Result<[T; #n], ::eomgen_runtime::FactorError> {
-                let o: [T; #fd_len] = { #fd_body };
-                let pivots = [#(#fd_pivots),*];
+                let o: [T; #len] = { #b };
+                let pivots = [#(#pivots),*];
                 for (pivot, d) in pivots.iter().enumerate() {
                     if !d.is_finite() {
                         return Err(::eomgen_runtime::FactorError::NonFinite { pivot });
@@ -703,7 +387,7 @@ pub fn emit_tokens(
                         return Err(::eomgen_runtime::FactorError::NotPositiveDefinite { pivot });
                     }
                 }
-                let qdd = [#(#fd_x),*];
+                let qdd = [#(#x),*];
                 for (pivot, x) in qdd.iter().enumerate() {
                     if !x.is_finite() {
                         return Err(::eomgen_runtime::FactorError::NonFinite { pivot });
@@ -711,53 +395,144 @@ pub fn emit_tokens(
                 }
                 Ok(qdd)
             }
-
-            #friction_fn
-
-            /// Pose of a link frame in the world (root) frame.
-            pub fn link_pose(&self, link: #link_ty, q: &[T; #n]) -> ::eomgen_runtime::Pose<T> {
-                match link { #(#pose_arms)* }
-            }
-
-            /// The 6 x N Jacobian of a link frame: rows vx, vy, vz, wx, wy, wz in world axes, at the link origin.
-            pub fn link_jacobian(&self, link: #link_ty, q: &[T; #n]) -> [[T; #n]; 6] {
-                match link { #(#jac_arms)* }
-            }
-        }
-
-        #[allow(unused_variables, clippy::approx_constant, clippy::excessive_precision, clippy::unreadable_literal, clippy::neg_multiply, clippy::double_parens, clippy::identity_op, clippy::needless_range_loop, clippy::let_and_return)]
-        impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, #n> for #ty<T> {
-            const JOINT_NAMES: [&'static str; #n] = [#(#joint_names),*];
-
-            #mm_doc
-            fn mass_matrix(&self, q: &[T; #n]) -> [[T; #n]; #n] { #mm }
-
-            #gr_doc
-            fn gravity(&self, q: &[T; #n]) -> [T; #n] { #gr }
-
-            #bi_doc
-            fn bias(&self, q: &[T; #n], qd: &[T; #n]) -> [T; #n] { #bi }
-
-            #cm_doc
-            fn coriolis_matrix(&self, q: &[T; #n], qd: &[T; #n]) -> [[T; #n]; #n] { #cm }
-
-            #id_doc
-            fn inverse_dynamics(&self, q: &[T; #n], qd: &[T; #n], qdd: &[T; #n]) -> [T; #n] { #id }
-
-            #fd_doc
-            fn forward_dynamics(&self, q: &[T; #n], qd: &[T; #n], tau: &[T; #n]) -> [T; #n] {
+        };
+        self.try_forward_dynamics = try_fd;
+        quote! {
+            #docs
+            #vis fn forward_dynamics(&self, q: &[T; #n], qd: &[T; #n], tau: &[T; #n]) -> [T; #n] {
                 match self.try_forward_dynamics(q, qd, tau) {
                     Ok(qdd) => qdd,
                     Err(_) => [T::nan(); #n],
                 }
             }
-
-            #ke_doc
-            fn kinetic_energy(&self, q: &[T; #n], qd: &[T; #n]) -> T { #ke }
-
-            #pe_doc
-            fn potential_energy(&self, q: &[T; #n]) -> T { #pe }
         }
-    };
-    (tokens, counts)
+    }
+
+    fn link_pose_fn(&mut self, q: &Quantity) -> TokenStream {
+        let docs = Self::quantity_doc(q, None);
+        let (link_ty, n) = (&self.link_ty, &self.n);
+        quote! {
+            #docs
+            pub fn link_pose(&self, link: #link_ty, q: &[T; #n]) -> ::eomgen_runtime::Pose<T> {
+                let (path, placement) = Self::link_frame(link);
+                ::eomgen_runtime::tree::chain_pose(path, |j| self.joint_transform(j, q)).compose(&placement)
+            }
+        }
+    }
+
+    fn link_jacobian_fn(&mut self, q: &Quantity) -> TokenStream {
+        let docs = Self::quantity_doc(q, None);
+        let (link_ty, n) = (&self.link_ty, &self.n);
+        quote! {
+            #docs
+            pub fn link_jacobian(&self, link: #link_ty, q: &[T; #n]) -> [[T; #n]; 6] {
+                let (path, placement) = Self::link_frame(link);
+                ::eomgen_runtime::tree::chain_jacobian(path, &Self::TREE_JOINTS, |j| self.joint_transform(j, q), &placement)
+            }
+        }
+    }
+
+    /// What link kinematics walks: each joint's transform as straight-line code, the joint
+    /// axes, and per link its chain from the root and its placement in its body.
+    fn frame_support(&mut self, d: &Derivation) -> TokenStream {
+        let n = &self.n;
+        let arms: Vec<TokenStream> = d
+            .joint_transforms
+            .iter()
+            .enumerate()
+            .map(|(j, t)| {
+                let mut outs: Vec<Id> = t.translation.to_vec();
+                outs.extend(t.rotation.iter().flatten());
+                let (b, _) = body(self.graph, &self.cx, &outs, Shape::Vector(12));
+                let j = usize_lit(j);
+                quote!(#j => { let o = { #b }; ::eomgen_runtime::Pose { translation: [o[0], o[1], o[2]], rotation: [[o[3], o[4], o[5]], [o[6], o[7], o[8]], [o[9], o[10], o[11]]] } })
+            })
+            .collect();
+        let joints = self.model.joints.iter().map(|j| {
+            let axis = j.axis.map(snap);
+            let [x, y, z] = [0, 1, 2].map(|k| f64_literal(axis[k]));
+            let motion = if j.kind.is_revolute() {
+                quote!(Rotation)
+            } else {
+                quote!(Translation)
+            };
+            quote!(::eomgen_runtime::tree::TreeJoint { axis: [#x, #y, #z], motion: ::eomgen_runtime::tree::Motion::#motion })
+        });
+        let link_arms = self.link_frame_arms();
+        let link_ty = &self.link_ty;
+        quote! {
+            /// Each joint's axis (in the frame of the body it moves) and motion.
+            const TREE_JOINTS: [::eomgen_runtime::tree::TreeJoint; #n] = [#(#joints),*];
+
+            /// The pose of body `j` in its parent body's frame.
+            fn joint_transform(&self, j: usize, q: &[T; #n]) -> ::eomgen_runtime::Pose<T> {
+                match j {
+                    #(#arms)*
+                    _ => ::eomgen_runtime::Pose::identity(),
+                }
+            }
+
+            /// A link's chain of joints from the root and its placement in the last body.
+            fn link_frame(link: #link_ty) -> (&'static [usize], ::eomgen_runtime::Pose<T>) {
+                match link { #(#link_arms)* }
+            }
+        }
+    }
+
+    fn link_frame_arms(&self) -> Vec<TokenStream> {
+        let link_ty = &self.link_ty;
+        self.model
+            .frames
+            .iter()
+            .zip(self.link_variants())
+            .map(|(f, v)| {
+                let path: Vec<Literal> = match f.body {
+                    Some(b) => self
+                        .model
+                        .path_to_root(b)
+                        .into_iter()
+                        .map(usize_lit)
+                        .collect(),
+                    None => Vec::new(),
+                };
+                let pose = constant_pose(&f.placement);
+                quote!(#link_ty::#v => (&[#(#path),*], #pose),)
+            })
+            .collect()
+    }
+
+    /// `impl Dynamics` with its methods, when every one of them is generated.
+    fn trait_impl(&self, methods: &[TokenStream]) -> TokenStream {
+        if !self.in_trait {
+            return TokenStream::new();
+        }
+        let names = self.model.joints.iter().map(|j| Literal::string(&j.name));
+        let (ty, n) = (&self.ty, &self.n);
+        quote! {
+            impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, #n> for #ty<T> {
+                const JOINT_NAMES: [&'static str; #n] = [#(#names),*];
+                #(#methods)*
+            }
+        }
+    }
+}
+
+/// A constant pose as `Pose { .. }` with `T::from_f64` literals (rotation entries snapped).
+fn constant_pose(t: &Transform) -> TokenStream {
+    let tr = (0..3).map(|k| lit(t.translation[k]));
+    let rows = (0..3).map(|r| {
+        let row = (0..3).map(|c| lit(snap(t.rotation[(r, c)])));
+        quote!([#(#row),*])
+    });
+    quote!(::eomgen_runtime::Pose { translation: [#(#tr),*], rotation: [#(#rows),*] })
+}
+
+/// An `f64` literal, negative ones as a negation.
+fn f64_literal(v: f64) -> TokenStream {
+    let l = Literal::f64_unsuffixed(v.abs());
+    if v < 0.0 {
+        quote!(-#l)
+    } else {
+        quote!(#l)
+    }
 }

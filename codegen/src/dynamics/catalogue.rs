@@ -1,0 +1,171 @@
+//! The catalogue of generated quantities: one [`Quantity`] per generated function, with its
+//! name, arguments, result shape, documentation, route and expressions.
+//!
+//! Emission ([`crate::emit`]), `eomgen eval` and the tests loop over the catalogue, so adding a
+//! quantity is one entry here (in [`catalogue`]) plus the function that derives its
+//! expressions. See `docs/architecture.md`.
+
+use crate::cas::{Graph, Id, OpCount, Program};
+
+/// An argument of a generated function: a vector of joint-space values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Input {
+    /// Joint positions `q`.
+    Q,
+    /// Joint velocities `qd`.
+    Qd,
+    /// Joint accelerations `qdd`.
+    Qdd,
+    /// Joint efforts `tau`.
+    Tau,
+}
+
+impl Input {
+    /// The argument's name in generated code.
+    pub fn name(self) -> &'static str {
+        match self {
+            Input::Q => "q",
+            Input::Qd => "qd",
+            Input::Qdd => "qdd",
+            Input::Tau => "tau",
+        }
+    }
+}
+
+/// The shape of a quantity's value.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Shape {
+    /// One number.
+    Scalar,
+    /// A vector of this length.
+    Vector(usize),
+    /// Rows x columns, row-major.
+    Matrix(usize, usize),
+}
+
+impl Shape {
+    /// How many numbers the value holds.
+    pub fn len(self) -> usize {
+        match self {
+            Shape::Scalar => 1,
+            Shape::Vector(n) => n,
+            Shape::Matrix(r, c) => r * c,
+        }
+    }
+
+    /// True for an empty vector or matrix.
+    pub fn is_empty(self) -> bool {
+        self.len() == 0
+    }
+}
+
+/// Where a generated function lives.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Home {
+    /// A method of the runtime's `Dynamics` trait (and an inherent method of the same name).
+    Dynamics,
+    /// An inherent method of the generated type only.
+    Inherent,
+}
+
+/// Craig's two velocity-product matrices.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Craig {
+    /// Centrifugal `C(q)`, N x N.
+    Centrifugal,
+    /// Coriolis `B(q)`, N x N(N-1)/2.
+    CoriolisPairs,
+}
+
+/// How generated code evaluates a quantity.
+#[derive(Clone, Debug)]
+pub enum Evaluation {
+    /// Straight-line code for these expressions (row-major for a matrix).
+    Exprs(Vec<Id>),
+    /// A loop over the `N` Christoffel columns `C(q, e_k)` of `coriolis_matrix`: a few lines of
+    /// code instead of `N^3 / 2` flattened entries, for robots where flattening does not pay.
+    CraigColumns(Craig),
+    /// `qdd = M^-1 (tau - b - G - F)` by an unrolled sparse `L^T D L` solve: the accelerations
+    /// and the factorization's pivots (checked at run time).
+    ForwardDynamics {
+        accelerations: Vec<Id>,
+        pivots: Vec<Id>,
+    },
+    /// A link frame's world pose: per-joint transforms composed along the link's chain.
+    LinkPose,
+    /// A link frame's 6 x N Jacobian, from the same per-joint transforms.
+    LinkJacobian,
+}
+
+/// One generated function.
+#[derive(Clone, Debug)]
+pub struct Quantity {
+    /// The function's name in generated code (and in `Builder::quantities`).
+    pub name: &'static str,
+    /// Its joint-space arguments, in order.
+    pub inputs: &'static [Input],
+    /// The result's shape.
+    pub shape: Shape,
+    /// The trait or the inherent impl.
+    pub home: Home,
+    /// What it is: documentation lines, the first a one-line summary.
+    pub doc: Vec<String>,
+    /// How it is computed, one sentence.
+    pub route: String,
+    /// The expressions, or the kernel, generated code evaluates.
+    pub eval: Evaluation,
+}
+
+impl Quantity {
+    /// The expressions a straight-line body evaluates (for a forward dynamics, the
+    /// accelerations and then the pivots); empty for loop kernels.
+    pub fn exprs(&self) -> Vec<Id> {
+        match &self.eval {
+            Evaluation::Exprs(e) => e.clone(),
+            Evaluation::ForwardDynamics {
+                accelerations,
+                pivots,
+            } => accelerations.iter().chain(pivots).copied().collect(),
+            _ => Vec::new(),
+        }
+    }
+
+    /// The operation count of its straight-line body (zero for loop kernels).
+    pub fn ops(&self, g: &Graph) -> OpCount {
+        Program::new(g, &self.exprs()).ops()
+    }
+
+    /// Quantities whose generated code this one calls.
+    pub fn needs(&self) -> &'static [&'static str] {
+        match self.eval {
+            Evaluation::CraigColumns(_) => &["coriolis_matrix"],
+            _ => &[],
+        }
+    }
+}
+
+/// The names of a catalogue, in order.
+pub fn names(quantities: &[Quantity]) -> Vec<&'static str> {
+    quantities.iter().map(|q| q.name).collect()
+}
+
+/// Keeps the quantities named in `wanted` and those they need, in catalogue order; `Err` with
+/// the first unknown name.
+pub fn select(quantities: Vec<Quantity>, wanted: &[String]) -> Result<Vec<Quantity>, String> {
+    if let Some(bad) = wanted
+        .iter()
+        .find(|w| !quantities.iter().any(|q| q.name == w.as_str()))
+    {
+        return Err(bad.clone());
+    }
+    let mut keep: Vec<&str> = wanted.iter().map(String::as_str).collect();
+    for q in &quantities {
+        if keep.contains(&q.name) {
+            keep.extend(q.needs());
+        }
+    }
+    Ok(quantities
+        .into_iter()
+        .filter(|q| keep.contains(&q.name))
+        .collect())
+}

@@ -1,0 +1,327 @@
+//! The catalogue's entries: what each generated function is, how it is computed, and its
+//! expressions. One function per quantity; [`catalogue`] lists them in file order.
+
+use super::catalogue::{Craig, Evaluation, Home, Input, Quantity, Shape};
+use super::{flat, Derivation, Route};
+use crate::cas::{Graph, Id, Program};
+use crate::model::Model;
+
+/// Flattened Craig forms are generated when their straight-line code is at most this many
+/// operations; beyond, a loop over the columns of `C(q, qd)` costs `N` evaluations of it but
+/// almost no code (Craig's `B` of a 9-joint arm is half of the flattened file).
+pub const CRAIG_FLAT_MAX_OPS: usize = 3000;
+
+const Q: &[Input] = &[Input::Q];
+const Q_QD: &[Input] = &[Input::Q, Input::Qd];
+const QD: &[Input] = &[Input::Qd];
+
+/// Every quantity generated code can evaluate for `model`, in file order.
+pub fn catalogue(model: &Model, d: &Derivation) -> Vec<Quantity> {
+    let notes = Notes::new(model);
+    let mut out = vec![
+        mass_matrix(d, &notes),
+        gravity(d),
+        bias(d),
+        coriolis_matrix(d),
+        inverse_dynamics(d, &notes),
+        forward_dynamics(d, &notes),
+        kinetic_energy(d, &notes),
+        potential_energy(d),
+        craig(d, Craig::Centrifugal),
+        craig(d, Craig::CoriolisPairs),
+    ];
+    if model.include_friction {
+        out.push(friction(model, d));
+    }
+    out.push(link_pose());
+    out.push(link_jacobian(d.dof));
+    out
+}
+
+/// Remarks about joint effects that change what some functions mean.
+struct Notes {
+    friction: bool,
+    armature: Vec<String>,
+}
+
+impl Notes {
+    fn new(model: &Model) -> Notes {
+        Notes {
+            friction: model.include_friction,
+            armature: model
+                .joints
+                .iter()
+                .filter(|j| j.armature != 0.0)
+                .map(|j| format!("`{}` {}", j.name.replace('`', "'"), j.armature))
+                .collect(),
+        }
+    }
+
+    fn friction(&self, what: &str) -> Vec<String> {
+        if self.friction {
+            vec![
+                String::new(),
+                format!("{what} the joint friction F(qd) of `friction`."),
+            ]
+        } else {
+            Vec::new()
+        }
+    }
+
+    fn armature(&self, what: &str) -> Vec<String> {
+        if self.armature.is_empty() {
+            Vec::new()
+        } else {
+            let list = self.armature.join(", ");
+            vec![
+                String::new(),
+                format!("{what} rotor inertia (armature): {list}."),
+            ]
+        }
+    }
+}
+
+fn route(r: Route, recursive: &str) -> String {
+    format!("Route: {}.", r.describe(recursive))
+}
+
+fn lines(parts: &[&[String]]) -> Vec<String> {
+    parts.iter().flat_map(|p| p.iter().cloned()).collect()
+}
+
+fn mass_matrix(d: &Derivation, notes: &Notes) -> Quantity {
+    let (r, m) = &d.fast.mass_matrix;
+    Quantity {
+        name: "mass_matrix",
+        inputs: Q,
+        shape: Shape::Matrix(d.dof, d.dof),
+        home: Home::Dynamics,
+        doc: lines(&[
+            &["The joint-space mass matrix M(q), symmetric positive definite.".into()],
+            &notes.armature("The diagonal includes"),
+        ]),
+        route: route(*r, "composite-rigid-body algorithm"),
+        eval: Evaluation::Exprs(flat(m)),
+    }
+}
+
+fn gravity(d: &Derivation) -> Quantity {
+    let (r, v) = &d.fast.gravity;
+    Quantity {
+        name: "gravity",
+        inputs: Q,
+        shape: Shape::Vector(d.dof),
+        home: Home::Dynamics,
+        doc: vec!["The generalized gravity force G(q) = dV/dq.".into()],
+        route: route(*r, "Newton-Euler"),
+        eval: Evaluation::Exprs(v.clone()),
+    }
+}
+
+fn bias(d: &Derivation) -> Quantity {
+    let (r, v) = &d.fast.bias;
+    Quantity {
+        name: "bias",
+        inputs: Q_QD,
+        shape: Shape::Vector(d.dof),
+        home: Home::Dynamics,
+        doc: vec![
+            "The Coriolis and centrifugal effort b(q, qd) = C(q, qd) qd, without gravity.".into(),
+        ],
+        route: route(*r, "Newton-Euler"),
+        eval: Evaluation::Exprs(v.clone()),
+    }
+}
+
+fn coriolis_matrix(d: &Derivation) -> Quantity {
+    let (r, m) = &d.fast.coriolis_matrix;
+    Quantity {
+        name: "coriolis_matrix",
+        inputs: Q_QD,
+        shape: Shape::Matrix(d.dof, d.dof),
+        home: Home::Dynamics,
+        doc: vec![
+            "The Christoffel-form Coriolis matrix C(q, qd): C qd = b, dM/dt - 2C skew-symmetric."
+                .into(),
+        ],
+        route: route(
+            *r,
+            "Echeandia and Wensing's O(N^2) recursion on composite inertias and momenta",
+        ),
+        eval: Evaluation::Exprs(flat(m)),
+    }
+}
+
+fn inverse_dynamics(d: &Derivation, notes: &Notes) -> Quantity {
+    let (r, v) = &d.fast.tau;
+    Quantity {
+        name: "inverse_dynamics",
+        inputs: &[Input::Q, Input::Qd, Input::Qdd],
+        shape: Shape::Vector(d.dof),
+        home: Home::Dynamics,
+        doc: lines(&[
+            &["Inverse dynamics: tau = M(q) qdd + b(q, qd) + G(q).".into()],
+            &notes.friction("`tau = M qdd + b + G + F(qd)`: includes"),
+            &notes.armature("M includes"),
+        ]),
+        route: route(*r, "Newton-Euler"),
+        eval: Evaluation::Exprs(v.clone()),
+    }
+}
+
+fn forward_dynamics(d: &Derivation, notes: &Notes) -> Quantity {
+    Quantity {
+        name: "forward_dynamics",
+        inputs: &[Input::Q, Input::Qd, Input::Tau],
+        shape: Shape::Vector(d.dof),
+        home: Home::Dynamics,
+        doc: lines(&[
+            &[
+                "Forward dynamics: qdd = M(q)^-1 (tau - b(q, qd) - G(q)).".into(),
+                String::new(),
+                "Returns NaN in every entry when M(q) is not positive definite (it cannot be for a valid".into(),
+                "model and finite inputs); `try_forward_dynamics` says which pivot failed.".into(),
+            ],
+            &notes.friction("`qdd = M^-1 (tau - b - G - F(qd))`: includes"),
+            &notes.armature("M includes"),
+        ]),
+        route: "Route: M and b + G as in `mass_matrix` and `bias`, then an unrolled L^T D L solve without fill-in.".into(),
+        eval: Evaluation::ForwardDynamics {
+            accelerations: d.fast.forward_dynamics.clone(),
+            pivots: d.fast.pivots.clone(),
+        },
+    }
+}
+
+fn kinetic_energy(d: &Derivation, notes: &Notes) -> Quantity {
+    Quantity {
+        name: "kinetic_energy",
+        inputs: Q_QD,
+        shape: Shape::Scalar,
+        home: Home::Dynamics,
+        doc: lines(&[
+            &["The kinetic energy T = qd^T M(q) qd / 2.".into()],
+            &notes.armature("Includes the"),
+        ]),
+        route: "Route: the quadratic form of `mass_matrix`.".into(),
+        eval: Evaluation::Exprs(vec![d.fast.kinetic_energy]),
+    }
+}
+
+fn potential_energy(d: &Derivation) -> Quantity {
+    Quantity {
+        name: "potential_energy",
+        inputs: Q,
+        shape: Shape::Scalar,
+        home: Home::Dynamics,
+        doc: vec!["The gravitational potential energy V = -sum m g.c, zero with every centre of mass at the origin.".into()],
+        route: "Route: centres of mass by forward kinematics.".into(),
+        eval: Evaluation::Exprs(vec![d.potential_energy]),
+    }
+}
+
+/// Flattened when the straight-line code is small, else a loop over Christoffel columns.
+fn craig(d: &Derivation, which: Craig) -> Quantity {
+    let n = d.dof;
+    let np = n * n.saturating_sub(1) / 2;
+    let (name, shape, flat_form, doc) = match which {
+        Craig::Centrifugal => (
+            "centrifugal",
+            Shape::Matrix(n, n),
+            &d.fast.centrifugal,
+            "Craig's centrifugal matrix C(q): `b = B(q) [qd qd] + C(q) [qd^2]`.".to_string(),
+        ),
+        Craig::CoriolisPairs => (
+            "coriolis_pairs",
+            Shape::Matrix(n, np),
+            &d.fast.coriolis_pairs,
+            format!("Craig's Coriolis matrix B(q), N x N(N-1)/2 = {n} x {np}, columns for qd_j qd_k with j < k in the order (0,1), (0,2), ..., (1,2), ..."),
+        ),
+    };
+    let small = flat_form
+        .as_ref()
+        .filter(|(_, m)| ops(&d.graph, &flat(m)) <= CRAIG_FLAT_MAX_OPS);
+    let (route_line, eval) = match small {
+        Some((r, m)) => (
+            route(*r, "second velocity derivatives of the Newton-Euler bias"),
+            Evaluation::Exprs(flat(m)),
+        ),
+        None => (
+            format!("Route: Christoffel symbols Gamma_ijk = C(q, e_k)_ij from {n} evaluations of `coriolis_matrix`."),
+            Evaluation::CraigColumns(which),
+        ),
+    };
+    Quantity {
+        name,
+        inputs: Q,
+        shape,
+        home: Home::Inherent,
+        doc: vec![doc],
+        route: route_line,
+        eval,
+    }
+}
+
+fn ops(g: &Graph, outputs: &[Id]) -> usize {
+    Program::new(g, outputs).ops().total()
+}
+
+fn friction(model: &Model, d: &Derivation) -> Quantity {
+    let smoothing = if model.coulomb_smoothing > 0.0 {
+        format!(
+            "`s(v) = v / sqrt(v^2 + eps^2)`, the sign smoothed below `eps = {}` (rad/s or m/s)",
+            model.coulomb_smoothing
+        )
+    } else {
+        "`s(v) = sign(v)`, 0 at rest (no stiction)".to_string()
+    };
+    let coefficients: Vec<String> = model
+        .joints
+        .iter()
+        .map(|j| {
+            let name = j.name.replace('`', "'");
+            format!("`{name}`: damping {}, friction {}", j.damping, j.friction)
+        })
+        .collect();
+    Quantity {
+        name: "friction",
+        inputs: QD,
+        shape: Shape::Vector(d.dof),
+        home: Home::Inherent,
+        doc: vec![
+            "Joint friction effort `F(qd)`, per joint `damping qd + friction s(qd)` from the URDF's".into(),
+            format!("`<dynamics damping friction>`, with {smoothing}."),
+            "The effort the actuators must supply against friction (the joints feel `-F`); it is".into(),
+            "part of `inverse_dynamics` and `forward_dynamics`, not of `bias`.".into(),
+            String::new(),
+            format!("Coefficients: {}.", coefficients.join("; ")),
+        ],
+        route: "Route: per joint, from the joint's velocity alone.".into(),
+        eval: Evaluation::Exprs(d.friction.clone()),
+    }
+}
+
+fn link_pose() -> Quantity {
+    Quantity {
+        name: "link_pose",
+        inputs: Q,
+        shape: Shape::Vector(12),
+        home: Home::Inherent,
+        doc: vec!["Pose of a link frame in the world (root) frame.".into()],
+        route: "Route: each joint's transform composed along the link's chain from the root."
+            .into(),
+        eval: Evaluation::LinkPose,
+    }
+}
+
+fn link_jacobian(n: usize) -> Quantity {
+    Quantity {
+        name: "link_jacobian",
+        inputs: Q,
+        shape: Shape::Matrix(6, n),
+        home: Home::Inherent,
+        doc: vec!["The 6 x N Jacobian of a link frame: rows vx, vy, vz, wx, wy, wz in world axes, at the link origin.".into()],
+        route: "Route: joint axes and origins along the link's chain, from the same transforms as `link_pose`.".into(),
+        eval: Evaluation::LinkJacobian,
+    }
+}

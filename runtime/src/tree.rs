@@ -1,0 +1,169 @@
+//! Compact kernels that generated code loops over where flattening every entry does not pay:
+//! poses and Jacobians along a kinematic chain, and Craig's `B(q)` and `C(q)` from the columns
+//! of the Christoffel-form Coriolis matrix.
+//!
+//! Generated code supplies what is specific to the robot (each joint's transform as
+//! straight-line code, the joint axes, the chains from the root); the loops here are the same
+//! for every robot, so a 48-joint robot costs no more code than its joints.
+
+use crate::{Pose, Real};
+
+/// How a joint moves its body, for Jacobian columns.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Motion {
+    /// Rotation about the axis (revolute and continuous joints).
+    Rotation,
+    /// Translation along the axis (prismatic joints).
+    Translation,
+}
+
+/// A moving joint as the tree kernels see it: its unit axis in its body's frame and how it
+/// moves.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TreeJoint {
+    /// The joint axis in the frame of the body it moves (the child link frame).
+    pub axis: [f64; 3],
+    /// Rotation or translation about that axis.
+    pub motion: Motion,
+}
+
+/// The world pose of the body at the end of `path` (joint indices from the root), composing
+/// `transform(j)`, the pose of body `j` in its parent's frame, along the chain.
+///
+/// ```
+/// use eomgen_runtime::{tree::chain_pose, Pose};
+/// // two joints, each 1 m along x from its parent
+/// let step = |_j: usize| Pose::from_translation([1.0_f64, 0.0, 0.0]);
+/// assert_eq!(chain_pose(&[0, 1], step).translation, [2.0, 0.0, 0.0]);
+/// ```
+#[inline]
+pub fn chain_pose<T: Real>(path: &[usize], transform: impl Fn(usize) -> Pose<T>) -> Pose<T> {
+    let mut pose = Pose::identity();
+    for &j in path {
+        pose = pose.compose(&transform(j));
+    }
+    pose
+}
+
+fn cross<T: Real>(a: &[T; 3], b: &[T; 3]) -> [T; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// The 6 x N Jacobian (rows vx, vy, vz, wx, wy, wz in world axes) of a frame at `placement` in
+/// the body at the end of `path`, with `transform(j)` the pose of body `j` in its parent's
+/// frame. Columns of joints off the path are zero.
+///
+/// ```
+/// use eomgen_runtime::tree::{chain_jacobian, Motion, TreeJoint};
+/// use eomgen_runtime::Pose;
+/// // one revolute joint about z, the frame 1 m along the body's x axis
+/// let joints = [TreeJoint { axis: [0.0, 0.0, 1.0], motion: Motion::Rotation }];
+/// let tip = Pose::from_translation([1.0_f64, 0.0, 0.0]);
+/// let j = chain_jacobian(&[0], &joints, |_| Pose::identity(), &tip);
+/// assert_eq!(j, [[0.0], [1.0], [0.0], [0.0], [0.0], [1.0]]);
+/// ```
+pub fn chain_jacobian<T: Real, const N: usize>(
+    path: &[usize],
+    joints: &[TreeJoint; N],
+    transform: impl Fn(usize) -> Pose<T>,
+    placement: &Pose<T>,
+) -> [[T; N]; 6] {
+    let mut bodies = [Pose::identity(); N];
+    let mut pose = Pose::identity();
+    for (k, &j) in path.iter().enumerate().take(N) {
+        pose = pose.compose(&transform(j));
+        bodies[k] = pose;
+    }
+    let point = pose.transform_point(&placement.translation);
+    let mut jac = [[T::zero(); N]; 6];
+    for (k, &j) in path.iter().enumerate().take(N) {
+        let Some(joint) = joints.get(j) else { continue };
+        let a = joint.axis.map(T::from_f64);
+        let z = bodies[k].transform_vector(&a);
+        let (lin, ang) = match joint.motion {
+            Motion::Rotation => {
+                let o = bodies[k].translation;
+                let r = [point[0] - o[0], point[1] - o[1], point[2] - o[2]];
+                (cross(&z, &r), z)
+            }
+            Motion::Translation => (z, [T::zero(); 3]),
+        };
+        for r in 0..3 {
+            jac[r][j] = lin[r];
+            jac[3 + r][j] = ang[r];
+        }
+    }
+    jac
+}
+
+/// The column of the pair `(j, k)`, `j < k`, in Craig's order (0,1), (0,2), ..., (1,2), ...
+#[inline]
+pub const fn pair_index(n: usize, j: usize, k: usize) -> usize {
+    j * n - j * (j + 1) / 2 + (k - j - 1)
+}
+
+/// Craig's centrifugal matrix `C(q)` from the Christoffel-form Coriolis matrix:
+/// `C_ij = Gamma_ijj = C(q, e_j)_ij`, with `coriolis(v)` the Coriolis matrix at velocity `v`
+/// (linear in `v`). Costs `N` evaluations of `coriolis`.
+///
+/// ```
+/// use eomgen_runtime::tree::centrifugal_from_coriolis;
+/// // a 1-joint system with C(q, qd) = [[2 qd]]: Gamma_000 = 2
+/// let c = centrifugal_from_coriolis(|v: &[f64; 1]| [[2.0 * v[0]]]);
+/// assert_eq!(c, [[2.0]]);
+/// ```
+pub fn centrifugal_from_coriolis<T: Real, const N: usize>(
+    coriolis: impl Fn(&[T; N]) -> [[T; N]; N],
+) -> [[T; N]; N] {
+    let mut out = [[T::zero(); N]; N];
+    let mut e = [T::zero(); N];
+    for j in 0..N {
+        e[j] = T::one();
+        let c = coriolis(&e);
+        e[j] = T::zero();
+        for i in 0..N {
+            out[i][j] = c[i][j];
+        }
+    }
+    out
+}
+
+/// Craig's Coriolis matrix `B(q)` (`N x P`, `P = N (N - 1) / 2`, pairs in
+/// [`pair_index`] order) from the Christoffel-form Coriolis matrix:
+/// `B_i,(j,k) = Gamma_ijk + Gamma_ikj` with `Gamma_ijk = C(q, e_k)_ij`. Costs `N` evaluations
+/// of `coriolis`. `P` must be `N (N - 1) / 2`; other entries stay zero.
+///
+/// ```
+/// use eomgen_runtime::tree::coriolis_pairs_from_coriolis;
+/// // C(q, qd) = [[qd1, qd0], [0, 0]]: b_0 = 2 qd0 qd1, so B_0,(0,1) = 2
+/// let b = coriolis_pairs_from_coriolis::<f64, 2, 1>(|v| [[v[1], v[0]], [0.0, 0.0]]);
+/// assert_eq!(b, [[2.0], [0.0]]);
+/// ```
+pub fn coriolis_pairs_from_coriolis<T: Real, const N: usize, const P: usize>(
+    coriolis: impl Fn(&[T; N]) -> [[T; N]; N],
+) -> [[T; P]; N] {
+    let mut out = [[T::zero(); P]; N];
+    let mut e = [T::zero(); N];
+    for k in 0..N {
+        e[k] = T::one();
+        let c = coriolis(&e);
+        e[k] = T::zero();
+        for (i, row) in out.iter_mut().enumerate() {
+            for (a, &gamma) in c[i].iter().enumerate() {
+                let p = match a.cmp(&k) {
+                    core::cmp::Ordering::Less => pair_index(N, a, k),
+                    core::cmp::Ordering::Greater => pair_index(N, k, a),
+                    core::cmp::Ordering::Equal => continue,
+                };
+                if let Some(x) = row.get_mut(p) {
+                    *x += gamma;
+                }
+            }
+        }
+    }
+    out
+}
