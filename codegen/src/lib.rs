@@ -6,7 +6,8 @@
 //!
 //! The pipeline, one module per stage:
 //! [`urdf`] (the only module that sees XML) → [`model`] (kinematic tree, merged fixed links) →
-//! [`kinematics`] and [`dynamics`] (closed-form expressions in the [`cas`]) → [`emit`] (Rust),
+//! [`kinematics`] and [`dynamics`] (closed-form expressions in the [`cas`], with [`spatial`]
+//! algebra) → [`emit`] (Rust),
 //! or [`report`] (equations for people: text, LaTeX, Markdown; the `eomgen show` command).
 
 // Matrix code reads best with explicit indices.
@@ -21,6 +22,7 @@ pub mod emit;
 pub mod kinematics;
 pub mod model;
 pub mod report;
+pub mod spatial;
 pub mod urdf;
 
 pub use builder::{Builder, DEFAULT_MAX_DOF, DEFAULT_MAX_GRAPH_NODES};

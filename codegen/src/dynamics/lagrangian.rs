@@ -13,8 +13,9 @@
 //!   bias `b = C(q, qd) qd`.
 
 use crate::cas::{Graph, GraphFull, Id};
-use crate::kinematics::{cross, mat_vec, vec_add, BodyKinematics, Params, WorldKinematics, V3};
+use crate::kinematics::{BodyKinematics, Params, WorldKinematics};
 use crate::model::Model;
+use crate::spatial::{cross, mat_vec, vec_add, V3};
 
 /// The pairs `(j, k)`, `j < k`, in Craig's order.
 pub fn pairs(n: usize) -> Vec<(usize, usize)> {

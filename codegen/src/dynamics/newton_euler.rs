@@ -10,11 +10,12 @@
 //! to the centre of mass).
 
 use crate::cas::{Graph, Id};
-use crate::kinematics::{
-    axis_rotation, const_m3, const_v3, cross, mat_mul, mat_t_vec, mat_vec, vec_add, vec_scale,
-    vec_sub, Params, M3, V3,
+use crate::kinematics::{joint, Params};
+use crate::model::Model;
+use crate::spatial::{
+    cross, cross_force, mat_add, mat_mul, mat_t_vec, mat_vec, skew_mul, skew_times, spatial_add,
+    spatial_dot, spatial_sub, transpose, vec_add, vec_scale, Spatial, M3, V3,
 };
-use crate::model::{JointKind, Model};
 
 /// Each body's placement relative to its parent and its inertia about its own origin.
 #[derive(Clone, Debug)]
@@ -25,7 +26,10 @@ pub struct LocalModel {
     pub translation: Vec<V3>,
     /// Joint axis in body coordinates.
     pub axis: Vec<V3>,
+    /// Whether the joint rotates its body (its subspace has an angular part).
     pub revolute: Vec<bool>,
+    /// The joint's motion subspace in body axes (one column per joint coordinate).
+    pub subspace: Vec<Spatial>,
     pub parent: Vec<Option<usize>>,
     pub mass: Vec<Id>,
     /// First moment `m c`.
@@ -44,6 +48,7 @@ impl LocalModel {
             translation: Vec::with_capacity(n),
             axis: Vec::with_capacity(n),
             revolute: Vec::with_capacity(n),
+            subspace: Vec::with_capacity(n),
             parent: Vec::with_capacity(n),
             mass: params.mass.clone(),
             first_moment: Vec::with_capacity(n),
@@ -51,23 +56,14 @@ impl LocalModel {
             armature: params.armature.clone(),
         };
         for (i, joint) in model.joints.iter().enumerate() {
-            let ro = const_m3(g, &joint.origin.rotation);
-            let a = const_v3(g, &joint.axis);
-            let (rot, trans) = match joint.kind {
-                JointKind::Revolute | JointKind::Continuous => {
-                    let rj = axis_rotation(g, &joint.axis, q[i]);
-                    (mat_mul(g, &ro, &rj), params.origin[i])
-                }
-                JointKind::Prismatic => {
-                    let ra = mat_vec(g, &ro, &a);
-                    let slide = vec_scale(g, &ra, q[i]);
-                    (ro, vec_add(g, &params.origin[i], &slide))
-                }
-            };
-            lm.rotation.push(rot);
-            lm.translation.push(trans);
-            lm.axis.push(a);
-            lm.revolute.push(joint.kind.is_revolute());
+            let placed = joint::body_in_parent(g, joint, &params.origin[i], &q[i..i + 1]);
+            let s = joint::subspace(g, joint);
+            let zero = [g.zero(); 3];
+            lm.rotation.push(placed.rotation);
+            lm.translation.push(placed.translation);
+            lm.axis.push(joint::axis(g, joint));
+            lm.revolute.push(s[0].0 != zero);
+            lm.subspace.push(s[0]);
             lm.parent.push(joint.parent);
             let m = params.mass[i];
             let c = params.com[i];
@@ -311,18 +307,9 @@ fn composites(g: &mut Graph, lm: &LocalModel) -> Composite {
     Composite { mass, h, j: jm }
 }
 
-/// A spatial vector in body axes: (angular, linear) for motion, (moment about the body
-/// origin, force) for force.
-type Spatial = (V3, V3);
-
-/// The motion subspace of joint `i` in its body axes: `(a, 0)` revolute, `(0, a)` prismatic.
-fn subspace(g: &Graph, lm: &LocalModel, i: usize) -> Spatial {
-    let zero = [g.zero(); 3];
-    if lm.revolute[i] {
-        (lm.axis[i], zero)
-    } else {
-        (zero, lm.axis[i])
-    }
+/// The motion subspace of joint `i` in its body axes (see [`joint::subspace`]).
+fn subspace(lm: &LocalModel, i: usize) -> Spatial {
+    lm.subspace[i]
 }
 
 /// The momentum-like product `I v` for inertia parameters `(m, h, J)` about the origin:
@@ -343,12 +330,6 @@ fn inertia_times(g: &mut Graph, m: Option<Id>, h: &V3, j: &M3, v: &Spatial) -> S
     (moment, force)
 }
 
-fn spatial_dot(g: &mut Graph, a: &Spatial, b: &Spatial) -> Id {
-    let x = g.dot(&a.0, &b.0);
-    let y = g.dot(&a.1, &b.1);
-    g.add(x, y)
-}
-
 /// Composite-rigid-body algorithm: the upper triangle of `M(q)` (mirrored into a full matrix).
 pub fn crba(g: &mut Graph, lm: &LocalModel) -> Vec<Vec<Id>> {
     let n = lm.dof();
@@ -356,14 +337,14 @@ pub fn crba(g: &mut Graph, lm: &LocalModel) -> Vec<Vec<Id>> {
     let mut m = vec![vec![g.zero(); n]; n];
     for i in 0..n {
         // Force and moment on composite body i for a unit rate of joint i.
-        let s = subspace(g, lm, i);
+        let s = subspace(lm, i);
         let mut force = inertia_times(g, Some(comp.mass[i]), &comp.h[i], &comp.j[i], &s);
         let own = spatial_dot(g, &s, &force);
         m[i][i] = g.add(own, lm.armature[i]);
         let mut j = i;
         while let Some(p) = lm.parent[j] {
             force = transfer_spatial(g, lm, j, &force);
-            let sp = subspace(g, lm, p);
+            let sp = subspace(lm, p);
             let e = spatial_dot(g, &sp, &force);
             m[p][i] = e;
             m[i][p] = e;
@@ -463,7 +444,7 @@ pub fn coriolis(g: &mut Graph, lm: &LocalModel, qd: &[Id]) -> Vec<Vec<Id>> {
     }
     let mut c = vec![vec![g.zero(); n]; n];
     for j in 0..n {
-        let s = subspace(g, lm, j);
+        let s = subspace(lm, j);
         let (m, h, jc) = (Some(comp.mass[j]), &comp.h[j], &comp.j[j]);
         let mut f2 = inertia_times(g, m, h, jc, &s);
         let isd = inertia_times(g, m, h, jc, &sdot[j]);
@@ -478,7 +459,7 @@ pub fn coriolis(g: &mut Graph, lm: &LocalModel, qd: &[Id]) -> Vec<Vec<Id>> {
             f1 = transfer_spatial(g, lm, k, &f1);
             f2 = transfer_spatial(g, lm, k, &f2);
             f3 = transfer_spatial(g, lm, k, &f3);
-            let si = subspace(g, lm, i);
+            let si = subspace(lm, i);
             c[i][j] = spatial_dot(g, &si, &f1);
             let a = spatial_dot(g, &sdot[i], &f2);
             let b = spatial_dot(g, &si, &f3);
@@ -489,56 +470,10 @@ pub fn coriolis(g: &mut Graph, lm: &LocalModel, qd: &[Id]) -> Vec<Vec<Id>> {
     c
 }
 
-/// `v x* f` for a motion `v` and a force `f`: `(w x n + u x f, w x f)`.
-fn cross_force(g: &mut Graph, v: &Spatial, f: &Spatial) -> Spatial {
-    let wn = cross(g, &v.0, &f.0);
-    let uf = cross(g, &v.1, &f.1);
-    let wf = cross(g, &v.0, &f.1);
-    (vec_add(g, &wn, &uf), wf)
-}
-
-fn spatial_add(g: &mut Graph, a: &Spatial, b: &Spatial) -> Spatial {
-    (vec_add(g, &a.0, &b.0), vec_add(g, &a.1, &b.1))
-}
-
-fn spatial_sub(g: &mut Graph, a: &Spatial, b: &Spatial) -> Spatial {
-    (vec_sub(g, &a.0, &b.0), vec_sub(g, &a.1, &b.1))
-}
-
 /// A (moment, force) pair of body `c` moved to its parent (see [`transfer`]).
 fn transfer_spatial(g: &mut Graph, lm: &LocalModel, c: usize, f: &Spatial) -> Spatial {
     let (fp, np) = transfer(g, lm, c, &f.1, &f.0);
     (np, fp)
-}
-
-fn mat_add(g: &mut Graph, a: &M3, b: &M3) -> M3 {
-    [0, 1, 2].map(|r| [0, 1, 2].map(|c| g.add(a[r][c], b[r][c])))
-}
-
-/// `[w] J`: the cross-product matrix of `w` times `J`.
-fn skew_times(g: &mut Graph, w: &V3, j: &M3) -> M3 {
-    let cols = [0, 1, 2].map(|c| {
-        let col = [j[0][c], j[1][c], j[2][c]];
-        cross(g, w, &col)
-    });
-    [0, 1, 2].map(|r| [0, 1, 2].map(|c| cols[c][r]))
-}
-
-fn transpose(r: &M3) -> M3 {
-    [0, 1, 2].map(|a| [0, 1, 2].map(|b| r[b][a]))
-}
-
-/// `[a] [b]` for cross-product matrices: `[a][b] v = a x (b x v)`, which is `b a^T - (a.b) 1`.
-fn skew_mul(g: &mut Graph, a: &V3, b: &V3) -> M3 {
-    let ab = g.dot(a, b);
-    let mut out = [[g.zero(); 3]; 3];
-    for r in 0..3 {
-        for c in 0..3 {
-            let ba = g.mul(b[r], a[c]);
-            out[r][c] = if r == c { g.sub(ba, ab) } else { ba };
-        }
-    }
-    out
 }
 
 /// Solves `M x = rhs` symbolically by Featherstone's `L^T D L` factorization in reverse joint

@@ -1,0 +1,114 @@
+//! The joint model: how each kind of joint places its body, as expressions in its
+//! coordinates.
+//!
+//! A moving joint places its body (the child link frame) in its parent body's frame in two
+//! steps: its constant origin (the URDF `<origin>`, fixed joints folded in), then its motion in
+//! the joint frame, a function of the joint's `nq` position coordinates. Its velocity enters
+//! through the motion subspace `S`, `nv` spatial columns in body axes. Kinematics, the
+//! recursive algorithms and the Lagrangian route all ask this module, so that a new kind of
+//! joint (a free-flying base: nq 7, nv 6) is one more arm in each function here, not a new
+//! branch in every algorithm.
+//!
+//! | kind | nq | nv | motion in the joint frame | subspace `S` (angular; linear) |
+//! |---|---|---|---|---|
+//! | revolute, continuous | 1 | 1 | rotation by `q` about `a` | `(a; 0)` |
+//! | prismatic | 1 | 1 | translation by `q a` | `(0; a)` |
+//!
+//! Revolute and prismatic joints integrate as `q + v dt`; a continuous joint's coordinate is
+//! its angle.
+
+use crate::cas::{Graph, Id};
+use crate::model::{Joint, JointKind};
+use crate::spatial::{
+    const_m3, const_v3, mat_mul, mat_vec, snap, vec_add, vec_scale, Spatial, M3, V3,
+};
+
+/// A rigid placement as expressions: `p_outer = rotation p_inner + translation`.
+#[derive(Clone, Copy, Debug)]
+pub struct Placement {
+    pub rotation: M3,
+    pub translation: V3,
+}
+
+/// The joint's constant origin in its parent body's frame: the URDF rotation (snapped) and
+/// `translation`, which may hold symbols.
+pub fn origin(g: &mut Graph, joint: &Joint, translation: &V3) -> Placement {
+    Placement {
+        rotation: const_m3(g, &joint.origin.rotation),
+        translation: *translation,
+    }
+}
+
+/// The unit axis in the joint (and body) frame, snapped.
+pub fn axis(g: &mut Graph, joint: &Joint) -> V3 {
+    const_v3(g, &joint.axis)
+}
+
+/// The body's placement in the joint frame, for the joint's position coordinates `q`
+/// (`joint.kind.nq()` of them).
+pub fn motion(g: &mut Graph, joint: &Joint, q: &[Id]) -> Placement {
+    let zero = [g.zero(); 3];
+    match joint.kind {
+        JointKind::Revolute | JointKind::Continuous => Placement {
+            rotation: axis_rotation(g, &joint.axis, q[0]),
+            translation: zero,
+        },
+        JointKind::Prismatic => {
+            let a = axis(g, joint);
+            Placement {
+                rotation: identity(g),
+                translation: vec_scale(g, &a, q[0]),
+            }
+        }
+    }
+}
+
+/// The body's placement in its parent body's frame: origin, then motion.
+pub fn body_in_parent(g: &mut Graph, joint: &Joint, translation: &V3, q: &[Id]) -> Placement {
+    let o = origin(g, joint, translation);
+    let m = motion(g, joint, q);
+    compose(g, &o, &m)
+}
+
+/// `outer ∘ inner`.
+pub fn compose(g: &mut Graph, outer: &Placement, inner: &Placement) -> Placement {
+    let rotation = mat_mul(g, &outer.rotation, &inner.rotation);
+    let moved = mat_vec(g, &outer.rotation, &inner.translation);
+    Placement {
+        rotation,
+        translation: vec_add(g, &outer.translation, &moved),
+    }
+}
+
+/// The motion subspace: `nv` spatial columns (angular; linear) in body axes.
+pub fn subspace(g: &mut Graph, joint: &Joint) -> Vec<Spatial> {
+    let a = axis(g, joint);
+    let zero = [g.zero(); 3];
+    match joint.kind {
+        JointKind::Revolute | JointKind::Continuous => vec![(a, zero)],
+        JointKind::Prismatic => vec![(zero, a)],
+    }
+}
+
+fn identity(g: &mut Graph) -> M3 {
+    let (o, z) = (g.one(), g.zero());
+    [[o, z, z], [z, o, z], [z, z, o]]
+}
+
+/// Rotation by angle `q` about the unit axis `a` (Rodrigues: `I + s K + (1 - c) K^2`), with one
+/// `sin`/`cos` pair of `q`.
+pub fn axis_rotation(g: &mut Graph, a: &nalgebra::Vector3<f64>, q: Id) -> M3 {
+    let (s, c) = (g.sin(q), g.cos(q));
+    let one_minus_c = g.sum(1.0, [(c, -1.0)]);
+    let a = [snap(a[0]), snap(a[1]), snap(a[2])];
+    let k = [[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]];
+    let mut out = [[g.zero(); 3]; 3];
+    for r in 0..3 {
+        for col in 0..3 {
+            let k2: f64 = (0..3).map(|m| k[r][m] * k[m][col]).sum();
+            let id = if r == col { 1.0 } else { 0.0 };
+            out[r][col] = g.sum(id, [(s, k[r][col]), (one_minus_c, k2)]);
+        }
+    }
+    out
+}
