@@ -33,6 +33,14 @@ fn main() {
             .unwrap();
     }
     joint_effects();
+    // What a firmware that needs inverse dynamics alone generates (plus Craig's B, which
+    // brings the Coriolis matrix it loops over).
+    eomgen::Builder::new("robots/panda.urdf")
+        .module_name("panda_selected")
+        .type_name("PandaSelected")
+        .quantities(["inverse_dynamics", "gravity", "coriolis_pairs"])
+        .compile()
+        .unwrap();
 }
 
 /// `fixtures/joint_effects.urdf` three ways: rigid only, with friction and armature, and with

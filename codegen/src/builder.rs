@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::cas::Limits;
-use crate::dynamics::Derivation;
+use crate::dynamics::{catalogue, Derivation};
 use crate::emit::names::{snake, upper_camel};
 use crate::emit::{self, EmitOptions, Generated};
 use crate::model::{Model, ModelOptions, SymbolicParams};
@@ -54,6 +54,8 @@ pub struct Builder {
     options: ModelOptions,
     max_dof: usize,
     max_graph_nodes: usize,
+    /// The quantities to generate, by name; `None` for all of them.
+    quantities: Option<Vec<String>>,
 }
 
 /// Robots with more joints than this are refused unless [`Builder::max_dof`] raises the limit:
@@ -91,6 +93,7 @@ impl Builder {
             options: ModelOptions::default(),
             max_dof: DEFAULT_MAX_DOF,
             max_graph_nodes: DEFAULT_MAX_GRAPH_NODES,
+            quantities: None,
         }
     }
 
@@ -225,6 +228,41 @@ impl Builder {
         self
     }
 
+    /// Generates only the named functions (and those they call), for a firmware that needs
+    /// inverse dynamics alone, say; by default every one is generated. The names are those of
+    /// the generated methods: `mass_matrix`, `gravity`, `bias`, `coriolis_matrix`,
+    /// `inverse_dynamics`, `forward_dynamics` (with `try_forward_dynamics`), `kinetic_energy`,
+    /// `potential_energy`, `centrifugal`, `coriolis_pairs`, `friction` (with
+    /// [`Builder::friction`]), `link_pose` and `link_jacobian`. An unknown name fails generation
+    /// with [`Error::UnknownQuantity`].
+    ///
+    /// The `Dynamics` trait is implemented when all its eight methods are selected; otherwise
+    /// the selected ones are inherent methods of the generated type. Craig's `centrifugal` and
+    /// `coriolis_pairs` may call `coriolis_matrix`, which then comes along.
+    ///
+    /// ```
+    /// # let urdf = r#"<robot name="pendulum"><link name="base"/>
+    /// #   <link name="arm"><inertial><origin xyz="0 0 -0.5"/><mass value="1"/>
+    /// #   <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.001"/></inertial></link>
+    /// #   <joint name="swing" type="continuous"><parent link="base"/><child link="arm"/>
+    /// #   <axis xyz="0 1 0"/></joint></robot>"#;
+    /// let source = eomgen::Builder::from_urdf_str(urdf, "pendulum.urdf")
+    ///     .quantities(["inverse_dynamics", "gravity"])
+    ///     .generate()
+    ///     .unwrap();
+    /// assert!(source.contains("pub fn inverse_dynamics("));
+    /// assert!(!source.contains("fn mass_matrix("));
+    /// let err = eomgen::Builder::from_urdf_str(urdf, "pendulum.urdf")
+    ///     .quantities(["mass_matrx"])
+    ///     .generate()
+    ///     .unwrap_err();
+    /// assert!(err.to_string().contains("unknown quantity `mass_matrx`"));
+    /// ```
+    pub fn quantities<S: Into<String>>(mut self, names: impl IntoIterator<Item = S>) -> Builder {
+        self.quantities = Some(names.into_iter().map(Into::into).collect());
+        self
+    }
+
     /// The "Regenerate:" line of the banner.
     pub fn regenerate_hint(mut self, hint: &str) -> Builder {
         self.regenerate = Some(hint.to_string());
@@ -285,13 +323,20 @@ impl Builder {
             max_nodes: self.max_graph_nodes,
             ..Limits::default()
         };
-        Derivation::try_new(model, limits).map_err(|e| Error::Limit {
-            file,
+        let mut d = Derivation::try_new(model, limits).map_err(|e| Error::Limit {
+            file: file.clone(),
             what: "expression graph nodes (or more)",
             value: e.nodes,
             limit: e.max_nodes,
             raise: "Builder::max_graph_nodes",
-        })
+        })?;
+        if let Some(wanted) = &self.quantities {
+            let all = std::mem::take(&mut d.quantities);
+            let known = catalogue::names(&all).join(", ");
+            d.quantities = catalogue::select(all, wanted)
+                .map_err(|name| Error::UnknownQuantity { file, name, known })?;
+        }
+        Ok(d)
     }
 
     /// Derives and emits, returning the source and the operation counts.

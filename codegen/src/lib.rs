@@ -57,6 +57,13 @@ pub enum Error {
         limit: usize,
         raise: &'static str,
     },
+    /// [`Builder::quantities`] named something eomgen does not generate.
+    #[error("{file}: unknown quantity `{name}` (known: {known})")]
+    UnknownQuantity {
+        file: String,
+        name: String,
+        known: String,
+    },
     /// Generated tokens failed to parse: a bug in eomgen.
     #[error("internal error while emitting code (please report): {0}")]
     Emit(String),

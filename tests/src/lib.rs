@@ -252,6 +252,11 @@ pub mod robots {
     pub mod light_tip {
         include!(concat!(env!("OUT_DIR"), "/light_tip.rs"));
     }
+    /// `panda.urdf` with only `inverse_dynamics`, `gravity` and `coriolis_pairs` selected
+    /// (`Builder::quantities`): no `Dynamics` implementation, inherent methods only.
+    pub mod panda_selected {
+        include!(concat!(env!("OUT_DIR"), "/panda_selected.rs"));
+    }
     /// `codegen/tests/urdf/hostile/names.urdf`: link and joint names that try to break out of
     /// comments and string literals; compiling this module is the test.
     pub mod hostile_names {

@@ -178,6 +178,10 @@ struct GenerateArgs {
     /// struct (Default holds the URDF's values): of every link, or of the links listed.
     #[arg(long, value_name = "LINK,...", num_args = 0..=1, value_delimiter = ',')]
     symbolic: Option<Vec<String>>,
+    /// Generate only these functions (and those they call), e.g. inverse_dynamics,gravity
+    /// [default: all]
+    #[arg(long, value_name = "NAME,...", value_delimiter = ',')]
+    only: Option<Vec<String>>,
     #[command(flatten)]
     model: ModelArgs,
 }
@@ -477,6 +481,9 @@ fn generate(a: GenerateArgs) -> Result<(), Failure> {
     }
     if let Some(m) = &a.module_name {
         b = b.module_name(m);
+    }
+    if let Some(only) = &a.only {
+        b = b.quantities(only);
     }
     // Fail fast on bad input, before a long derivation.
     let model = b.model()?;

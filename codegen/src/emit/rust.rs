@@ -162,6 +162,16 @@ impl Emitter<'_> {
         let trait_impl = self.trait_impl(&trait_methods);
         let (ty, n, allow) = (&self.ty, &self.n, allow_lints());
         let try_fd = &self.try_forward_dynamics;
+        // Without the trait, the joint order still has to be said.
+        let joint_names = if self.in_trait {
+            TokenStream::new()
+        } else {
+            let names = self.model.joints.iter().map(|j| Literal::string(&j.name));
+            quote! {
+                /// The URDF names of the joint coordinates, in the order of every array.
+                pub const JOINT_NAMES: [&'static str; #n] = [#(#names),*];
+            }
+        };
         quote! {
             #strukt
             #links
@@ -169,11 +179,11 @@ impl Emitter<'_> {
             impl<T: ::eomgen_runtime::Real> #ty<T> {
                 /// Number of joint coordinates.
                 pub const DOF: usize = #n;
+                #joint_names
                 #try_fd
                 #(#methods)*
                 #frames
             }
-            #allow
             #trait_impl
         }
     }
@@ -507,8 +517,9 @@ impl Emitter<'_> {
             return TokenStream::new();
         }
         let names = self.model.joints.iter().map(|j| Literal::string(&j.name));
-        let (ty, n) = (&self.ty, &self.n);
+        let (ty, n, allow) = (&self.ty, &self.n, allow_lints());
         quote! {
+            #allow
             impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, #n> for #ty<T> {
                 const JOINT_NAMES: [&'static str; #n] = [#(#names),*];
                 #(#methods)*
