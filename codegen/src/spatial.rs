@@ -142,3 +142,16 @@ pub fn skew_mul(g: &mut Graph, a: &V3, b: &V3) -> M3 {
     }
     out
 }
+
+/// `v x m` for motions `v = (w, u)` and `m = (a, b)`: `(w x a, w x b + u x a)`.
+pub fn motion_cross(g: &mut Graph, v: &Spatial, m: &Spatial) -> Spatial {
+    let wa = cross(g, &v.0, &m.0);
+    let wb = cross(g, &v.0, &m.1);
+    let ua = cross(g, &v.1, &m.0);
+    (wa, vec_add(g, &wb, &ua))
+}
+
+/// `k s` for an expression `k`.
+pub fn spatial_scale(g: &mut Graph, s: &Spatial, k: Id) -> Spatial {
+    (vec_scale(g, &s.0, k), vec_scale(g, &s.1, k))
+}

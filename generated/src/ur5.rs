@@ -3512,8 +3512,8 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
             let t35 = t5 * t32;
             let t36 = t3 * t34;
             let t37 = t2 * t34;
-            let t38 = -t33;
-            let t39 = T::from_f64(0.425) * t20 - T::from_f64(0.39225) * t32;
+            let t38 = T::from_f64(0.425) * t20 - T::from_f64(0.39225) * t32;
+            let t39 = -t33;
             let t40 = t6 * t7 * t27 - T::from_f64(0.12999255384415) * t6 * t7;
             let t41 = T::from_f64(0.12999255384415) * t6 * t6 + t7 * t7 * t27
                 + T::from_f64(0.123341033631);
@@ -3523,17 +3523,17 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
             let t45 = -t4 * t32 - t5 * t33;
             let t46 = t4 * t33 - t35;
             let t47 = t37 - T::from_f64(0.016149999999999998) * t22;
-            let t48 = T::from_f64(0.016149999999999998) * t22 - t37;
-            let t49 = T::from_f64(0.39225) * (qd[1] + qd[2])
+            let t48 = T::from_f64(0.39225) * (qd[1] + qd[2])
                 + T::from_f64(0.016149999999999998) * t24 + t36;
-            let t50 = t6 * t39;
-            let t51 = t7 * t39;
+            let t49 = t6 * t38;
+            let t50 = t7 * t38;
+            let t51 = T::from_f64(0.016149999999999998) * t22 - t37;
             let t52 = qd[4] - t46;
-            let t53 = t4 * t49;
+            let t53 = t4 * t48;
             let t54 = t5 * t47;
-            let t55 = t5 * t49;
+            let t55 = t5 * t48;
             let t56 = t4 * t47;
-            let t57 = t19 * t48;
+            let t57 = t19 * t51;
             let t58 = t5 * (T::from_f64(0.016149999999999998) * t24 + t36);
             let t59 = t40 * t46;
             let t60 = t28 * t45;
@@ -3688,7 +3688,7 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
             let t76 = t7 * t69;
             let t77 = t6 * t69;
             let t78 = T::from_f64(0.008342763427299999) * (t66 + qd[5]);
-            let t79 = t63 * t38;
+            let t79 = t63 * t39;
             let t80 = t8 * t9 * t66;
             let t81 = -T::from_f64(0.00697606230375) * t5 - t5 * t62 - t4 * t42;
             let t82 = t5 * t42 + T::from_f64(0.5956519516747499)
@@ -3697,14 +3697,14 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
                 - t5 * (-T::from_f64(0.016685526854599998) * t18 - t5 * t41)
                 - t4 * (-T::from_f64(0.016685526854599998) * t17 - t4 * t29);
             let t84 = t3 * t71;
-            let t85 = T::from_f64(0.09465) * t66 + t76 + t50;
+            let t85 = T::from_f64(0.09465) * t66 + t76 + t49;
             let t86 = T::from_f64(0.0085682365727) * (t74 - t67);
             let t87 = T::from_f64(0.016911) * (t75 + t68);
             let t88 = T::from_f64(0.008342763427299999) * (t67 - t74);
             let t89 = t8 * t9 * t78;
             let t90 = t8 * t8 * t78;
             let t91 = t9 * t9 * t78;
-            let t92 = T::from_f64(0.70345) * (t51 - t77)
+            let t92 = T::from_f64(0.70345) * (t50 - t77)
                 - T::from_f64(0.0088923675) * t65;
             let t93 = t71 * t32;
             let t94 = -T::from_f64(0.0002254731454000014) * (t75 + t68);
@@ -3728,7 +3728,7 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
             let t111 = t99 + t2 * t83;
             let t112 = T::from_f64(0.09395) * (t9 * t85 - t8 * t70);
             let t113 = T::from_f64(0.09395) * (t8 * t85 + t9 * t70);
-            let t114 = T::from_f64(0.0088923675) * (t77 - t51) + t100
+            let t114 = T::from_f64(0.0088923675) * (t77 - t50) + t100
                 - T::from_f64(0.053281959650625) * t65;
             let t115 = qd[0] * t0
                 * (T::from_f64(0.0021288327795) * t16 + T::from_f64(0.1197) * t30 + t72
@@ -3880,7 +3880,7 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
         ) = {
             let t128 = t7
                 * (T::from_f64(0.056428040349375) * t65
-                    + T::from_f64(0.0088923675) * (t77 - t51) + t101 + t102);
+                    + T::from_f64(0.0088923675) * (t77 - t50) + t101 + t102);
             let t129 = t7 * t117;
             let t130 = t6 * t119;
             let t131 = t6 * t121;
@@ -3892,18 +3892,18 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
             let t135 = T::from_f64(0.1893) * (t126 - t125);
             let t136 = T::from_f64(0.0541236222345) * t66 + t91
                 - T::from_f64(0.09465) * (t123 + t124) - t90;
-            let t137 = T::from_f64(0.6095) * (t76 + t50) + t123 + t124;
+            let t137 = T::from_f64(0.6095) * (t76 + t49) + t123 + t124;
             let t138 = T::from_f64(0.056683500000000005) * t45
                 + T::from_f64(1.219) * (t55 - t56) + t126 - t125;
             let t139 = T::from_f64(0.18789999999999996) * (t56 - t55)
                 + T::from_f64(2.0) * (t126 - t125)
                 - T::from_f64(0.017474700000000003) * t45;
-            let t140 = T::from_f64(0.017784735) * (t76 + t50) + t91 + t27 * t66
+            let t140 = T::from_f64(0.017784735) * (t76 + t49) + t91 + t27 * t66
                 - T::from_f64(0.0085682365727) * qd[5]
                 - T::from_f64(0.01003099210370001) * t66
                 - T::from_f64(0.1893) * (t123 + t124) - t90;
             let t141 = T::from_f64(2.0) * (t123 + t124) - T::from_f64(0.017784735) * t66
-                - T::from_f64(0.18789999999999996) * (t76 + t50);
+                - T::from_f64(0.18789999999999996) * (t76 + t49);
             let t142 = t7 * t109 - t6 * t117;
             let t143 = t118 + t129 + qd[0] * t0 * (t3 * t43 + t2 * t44)
                 - qd[0] * t1 * (t3 * t44 - t2 * t43);
@@ -4177,7 +4177,7 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
                     * (T::from_f64(0.1197) * t31 + t84 + T::from_f64(0.19371331275000003)
                         - T::from_f64(0.0021288327795) * t12 - t73)
                 - T::from_f64(0.7845) * (t180 + t154);
-            let t220 = T::from_f64(0.1308417) * t37 + t184 + t81 * t38 + t83 * t32
+            let t220 = T::from_f64(0.1308417) * t37 + t184 + t81 * t39 + t83 * t32
                 - T::from_f64(0.00006559345499998481) * t22
                 - T::from_f64(0.0020475000000000076) * t23 - t207 - t183 - t185;
             let t221 = T::from_f64(0.37713872974349993) * t32 + t185
@@ -4197,7 +4197,7 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
             let t233 = t2 * t217;
             let t234 = t3 * t218;
             let t235 = T::from_f64(0.00006559345499999999) * t24
-                + T::from_f64(0.1308417) * t36 + t217 + t82 * t38 + t81 * t32
+                + T::from_f64(0.1308417) * t36 + t217 + t82 * t39 + t81 * t32
                 - T::from_f64(0.0020475) * t25 - t186 - t187;
             let t236 = t217 + t186 + t187 - T::from_f64(0.0020475) * t33;
             let t237 = -t5 * (-t182 - t5 * t188) - t4 * (-t181 - t4 * t159);
@@ -4247,7 +4247,7 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
             let t249 = -t1 * (t3 * t226 + t2 * t227) - t0 * (t3 * t227 - t2 * t226);
             let t250 = T::from_f64(0.13585) * (t0 * t222 - t1 * t223)
                 - t1
-                    * (T::from_f64(0.425) * t19 * t38 + t3 * t235 + t2 * t220
+                    * (T::from_f64(0.425) * t19 * t39 + t3 * t235 + t2 * t220
                         - T::from_f64(0.007558512375) * t35 - T::from_f64(0.1197) * t223)
                 - t0 * (T::from_f64(0.1197) * t222 + t3 * t220 - t2 * t235);
             let t251 = -t1 * (t3 * t236 + t2 * t221) - t0 * (t3 * t221 - t2 * t236);
@@ -4364,7 +4364,7 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
                 t249,
                 t202,
                 t177 + t178 + t79 + t64 * t32
-                    - T::from_f64(0.017784735) * (t58 + t4 * t48),
+                    - T::from_f64(0.017784735) * (t58 + t4 * t51),
                 T::from_f64(0.017784735) * (t56 - t55) + t177 + t178 + t59 + t60,
                 t169,
                 t130,
@@ -4372,7 +4372,7 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
             [
                 t230,
                 t143,
-                t118 + t129 + t43 * t38 + t44 * t32,
+                t118 + t129 + t43 * t39 + t44 * t32,
                 T::from_f64(0.016685526854599998) * t61 + t118 + t129 + t26 * t45,
                 T::from_f64(0.016685526854599998) * t80 - T::from_f64(2.0) * t89,
                 t120,
@@ -4380,7 +4380,7 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
             [
                 t206,
                 t148,
-                t131 + T::from_f64(0.0171364731454) * (t4 * t6 * t38 + t5 * t6 * t32),
+                t131 + T::from_f64(0.0171364731454) * (t4 * t6 * t39 + t5 * t6 * t32),
                 t131 - T::from_f64(0.0171364731454) * t6 * t46,
                 t122 - T::from_f64(0.0171364731454) * t65,
                 T::zero(),
@@ -4877,282 +4877,90 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
     }
     /// The kinetic energy T = qd^T M(q) qd / 2.
     ///
-    /// Route: the quadratic form of `mass_matrix`.
-    /// Operations: 199 mul, 137 add, 0 div, 5 sin, 5 cos.
+    /// Route: a sum over body velocities, O(N).
+    /// Operations: 108 mul, 57 add, 0 div, 5 sin, 5 cos.
     fn kinetic_energy(&self, q: &[T; 6], qd: &[T; 6]) -> T {
         let (s1, c1) = q[1].sin_cos();
         let (s2, c2) = q[2].sin_cos();
         let (s3, c3) = q[3].sin_cos();
         let (s4, c4) = q[4].sin_cos();
         let (s5, c5) = q[5].sin_cos();
-        let (
-            t0,
-            t1,
-            t2,
-            t3,
-            t4,
-            t5,
-            t6,
-            t7,
-            t8,
-            t9,
-            t10,
-            t11,
-            t12,
-            t13,
-            t14,
-            t15,
-            t16,
-            t17,
-            t18,
-            t19,
-            t20,
-            t21,
-            t22,
-            t23,
-            t24,
-            t25,
-            t26,
-            t27,
-            t28,
-            t29,
-            t30,
-            t31,
-            t32,
-            t33,
-            t34,
-            t35,
-            t36,
-            t37,
-            t38,
-            t39,
-            t40,
-            t41,
-            t42,
-            t43,
-            t44,
-            t45,
-            t46,
-            t47,
-            t48,
-            t49,
-            t50,
-            t51,
-            t52,
-            t53,
-            t54,
-            t55,
-            t56,
-            t57,
-            t58,
-            t59,
-            t60,
-            t61,
-            t62,
-            t63,
-        ) = {
-            let t0 = s1;
-            let t1 = c1;
-            let t2 = s2;
-            let t3 = c2;
-            let t4 = s3;
-            let t5 = c3;
-            let t6 = s4;
-            let t7 = c4;
-            let t8 = s5;
-            let t9 = c5;
-            let t10 = t2 * t4;
-            let t11 = t2 * t5;
-            let t12 = t7 * t7;
-            let t13 = t8 * t8;
-            let t14 = t9 * t9;
-            let t15 = qd[4] * t6 * t8 * t9;
-            let t16 = qd[5] * t7;
-            let t17 = t3 * t4;
-            let t18 = t3 * t5;
-            let t19 = t5 * t7 * t8 * t9;
-            let t20 = t4 * t7 * t8 * t9;
-            let t21 = T::from_f64(1.598759275) - T::from_f64(0.017784735) * t4;
-            let t22 = T::from_f64(0.0171364731454) * t13 + T::from_f64(0.033822) * t14
-                + T::from_f64(0.21942);
-            let t23 = T::from_f64(0.033822) * t13 + T::from_f64(0.0171364731454) * t14
-                + T::from_f64(0.11285608069875);
-            let t24 = T::from_f64(0.016685526854599998) * t6 * t8 * t9
-                - T::from_f64(0.0016539803549999999);
-            let t25 = T::from_f64(0.0171364731454) * t13 + T::from_f64(0.033822) * t14
-                + T::from_f64(0.4510082781);
-            let t26 = t2 * t21;
-            let t27 = t3 * t21;
-            let t28 = t6 * t6 * t23;
-            let t29 = t6 * t7 * t23 - T::from_f64(0.12999255384415) * t6 * t7;
-            let t30 = T::from_f64(0.12999255384415) * t6 * t6 + t7 * t7 * t23
-                + T::from_f64(0.123341033631);
-            let t31 = t5 * t25 - T::from_f64(0.016685526854599998) * t20;
-            let t32 = t1 * (-T::from_f64(0.017784735) * t18 - t26);
-            let t33 = T::from_f64(0.12999255384415) * t12 + t28
-                + T::from_f64(0.425) * t27 + T::from_f64(0.70682470720575)
-                - T::from_f64(0.0139521246075) * t4 - T::from_f64(0.007558512375) * t11;
-            let t34 = T::from_f64(0.12999255384415) * t12 + t28
-                + T::from_f64(0.111172755531) - T::from_f64(0.00697606230375) * t4;
-            let t35 = T::from_f64(0.12999255384415) * t12 + t28
-                + T::from_f64(0.111172755531) - T::from_f64(0.00697606230375) * t4
-                - T::from_f64(0.007558512375) * (t11 + t17);
-            let t36 = t5 * t22 - T::from_f64(0.016685526854599998) * t20;
-            let t37 = -T::from_f64(0.016685526854599998) * t19 - t4 * t22;
-            let t38 = -t1
-                * (T::from_f64(0.0171364731454) * (t3 * t4 * t6 + t2 * t5 * t6))
-                - t0 * (T::from_f64(0.0171364731454) * (t3 * t5 * t6 - t2 * t4 * t6));
-            let t39 = T::from_f64(0.016685526854599998) * t19 - t4 * t30;
-            let t40 = t5 * t24 - t4 * t29;
-            let t41 = -t5 * t29 - t4 * t24;
-            let t42 = t41 - T::from_f64(0.051322656825);
-            let t43 = t3 * t40;
-            let t44 = t2 * t40;
-            let t45 = -T::from_f64(0.00697606230375) * t5 - t5 * t39 - t4 * t31;
-            let t46 = t5 * t31 + T::from_f64(0.5956519516747499)
-                - T::from_f64(0.0139521246075) * t4 - t4 * t39;
-            let t47 = T::from_f64(0.004095)
-                - t5 * (-T::from_f64(0.016685526854599998) * t20 - t5 * t30)
-                - t4 * (-T::from_f64(0.016685526854599998) * t19 - t4 * t25);
-            let t48 = t3 * t42;
-            let t49 = -t1 * (t3 * t36 + t2 * t37) - t0 * (t3 * t37 - t2 * t36);
-            let t50 = t2 * t45;
-            let t51 = t3 * t45;
-            let t52 = t3 * t46 + t50;
-            let t53 = t51 + t2 * t47;
-            let t54 = t1
-                * (T::from_f64(0.0021288327795) * t18 + T::from_f64(0.1197) * t26 + t43
-                    + t2 * t42);
-            let t55 = T::from_f64(0.13585)
-                * (t0 * (-T::from_f64(0.017784735) * (t11 + t17))
-                    - t1 * (T::from_f64(0.017784735) * (t10 - t18)))
-                - t1 * (T::from_f64(0.0021288327795) * (t18 - t10) + t43 + t2 * t41)
-                - t0 * (t3 * t41 - T::from_f64(0.0021288327795) * (t11 + t17) - t44);
-            let t56 = T::from_f64(0.13585)
-                * (t0 * (t27 + T::from_f64(4.4329225) - T::from_f64(0.017784735) * t11)
-                    - t32) - t54
-                - t0
-                    * (T::from_f64(0.1197) * t27 + t48 + T::from_f64(0.19371331275000003)
-                        - T::from_f64(0.0021288327795) * t11 - t44);
-            let t57 = T::from_f64(0.13585)
-                * (t0 * (t27 - T::from_f64(0.017784735) * t11) - t32) - t54
-                - t0
-                    * (T::from_f64(0.1197) * t27 + t48
-                        - T::from_f64(0.0021288327795) * t11 - t44);
-            let t58 = t3 * t53 - T::from_f64(0.007558512375) * t18
-                - T::from_f64(0.425) * t26 - t2 * t52;
-            let t59 = t3 * (t3 * t47 - t50) + T::from_f64(0.054004433300999945)
-                - t2 * (t51 - t2 * t46);
-            let t60 = T::from_f64(0.016685526854599998) * t15
-                + T::from_f64(0.0171364731454) * t16 + qd[0] * t55 + qd[1] * t35
-                + qd[2] * t34
-                + qd[3]
-                    * (T::from_f64(0.12999255384415) * t12 + t28
-                        + T::from_f64(0.111172755531));
-            let t61 = T::from_f64(0.016685526854599998) * t15
-                + T::from_f64(0.0171364731454) * t16 + qd[0] * t56
-                + qd[1]
-                    * (T::from_f64(0.12999255384415) * t12 + t28
-                        + T::from_f64(0.85) * t27 + T::from_f64(2.47695164561575)
-                        - T::from_f64(0.0139521246075) * t4
-                        - T::from_f64(0.01511702475) * t11) + qd[2] * t33 + qd[3] * t35;
-            let t62 = T::from_f64(0.016685526854599998) * t15
-                + T::from_f64(0.0171364731454) * t16 + qd[0] * t57 + qd[1] * t33
-                + qd[2]
-                    * (T::from_f64(0.12999255384415) * t12 + t28
-                        + T::from_f64(0.70682470720575)
-                        - T::from_f64(0.0139521246075) * t4) + qd[3] * t34;
-            let t63 = -t0 * t58
-                - t1
-                    * (T::from_f64(0.85) * t27 + t3 * t52 + t2 * t53
-                        + T::from_f64(1.809023971711)
-                        - T::from_f64(0.01511702475) * t11);
-            (
-                t0,
-                t1,
-                t2,
-                t3,
-                t4,
-                t5,
-                t6,
-                t7,
-                t8,
-                t9,
-                t10,
-                t11,
-                t12,
-                t13,
-                t14,
-                t15,
-                t16,
-                t17,
-                t18,
-                t19,
-                t20,
-                t21,
-                t22,
-                t23,
-                t24,
-                t25,
-                t26,
-                t27,
-                t28,
-                t29,
-                t30,
-                t31,
-                t32,
-                t33,
-                t34,
-                t35,
-                t36,
-                t37,
-                t38,
-                t39,
-                t40,
-                t41,
-                t42,
-                t43,
-                t44,
-                t45,
-                t46,
-                t47,
-                t48,
-                t49,
-                t50,
-                t51,
-                t52,
-                t53,
-                t54,
-                t55,
-                t56,
-                t57,
-                t58,
-                t59,
-                t60,
-                t61,
-                t62,
-                t63,
-            )
-        };
-        let (t64, t65) = {
-            let t64 = T::from_f64(0.12816210104175002) - t1 * t63
-                - t0 * (-t1 * t58 - t0 * t59);
-            let t65 = T::from_f64(0.5)
-                * (qd[0]
-                    * (qd[0] * t64 + qd[1] * t56 + qd[2] * t57 + qd[3] * t55
-                        + qd[4] * t49 + qd[5] * t38) + qd[1] * t61 + qd[2] * t62
-                    + qd[3] * t60
-                    + qd[4]
-                        * (T::from_f64(0.016685526854599998)
-                            * (qd[1] * t6 * t8 * t9 + qd[2] * t6 * t8 * t9
-                                + qd[3] * t6 * t8 * t9) + qd[4] * t22 + qd[0] * t49)
-                    + qd[5]
-                        * (T::from_f64(0.0171364731454)
-                            * (qd[5] + qd[1] * t7 + qd[2] * t7 + qd[3] * t7)
-                            + qd[0] * t38));
-            (t64, t65)
-        };
-        t65
+        let t0 = s1;
+        let t1 = c1;
+        let t2 = s2;
+        let t3 = c2;
+        let t4 = s3;
+        let t5 = c3;
+        let t6 = s4;
+        let t7 = c4;
+        let t8 = s5;
+        let t9 = c5;
+        let t10 = qd[1] + qd[2];
+        let t11 = qd[0] * t1 * t3;
+        let t12 = qd[0] * t1 * t2;
+        let t13 = t10 + qd[3];
+        let t14 = qd[0] * t0 * t2 - t11;
+        let t15 = -t12 - qd[0] * t0 * t3;
+        let t16 = T::from_f64(0.425) * qd[1]
+            + T::from_f64(0.016149999999999998) * qd[0] * t0;
+        let t17 = t3 * t16;
+        let t18 = T::from_f64(0.425) * qd[0] * t1 - T::from_f64(0.39225) * t14;
+        let t19 = -t4 * t14 - t5 * t15;
+        let t20 = t5 * t14 - t4 * t15;
+        let t21 = T::from_f64(0.016149999999999998) * t12 + t17;
+        let t22 = t2 * t16 - T::from_f64(0.016149999999999998) * t11;
+        let t23 = T::from_f64(0.39225) * t10 + T::from_f64(0.016149999999999998) * t12
+            + t17;
+        let t24 = t20 + qd[4];
+        let t25 = t7 * t19 + t6 * t13;
+        let t26 = t7 * t13 - t6 * t19;
+        let t27 = -t4 * t23 - t5 * t22;
+        let t28 = t5 * t23 - t4 * t22;
+        let t29 = t26 + qd[5];
+        let t30 = t27 - T::from_f64(0.093) * t20;
+        let t31 = T::from_f64(0.093) * t19 + t28;
+        let t32 = t9 * t25 - t8 * t24;
+        let t33 = t8 * t25 + t9 * t24;
+        let t34 = t7 * t30 + t6 * t18;
+        let t35 = t7 * t18 - t6 * t30;
+        let t36 = T::from_f64(0.09465) * t26 + t34;
+        let t37 = T::from_f64(0.00333) * qd[0] * qd[0]
+            + T::from_f64(0.44245093795500007) * qd[1] * qd[1]
+            + T::from_f64(0.31925293400000004) * qd[0] * qd[1] * t0
+            + T::from_f64(0.72535921667625) * qd[0] * qd[0] * t1 * t1
+            + T::from_f64(0.08500104122125) * qd[0] * qd[0] * t0 * t0
+            + T::from_f64(1.1375) * (t21 * t21 + t22 * t22)
+            + (T::from_f64(0.56875) * t10) * t21
+            + T::from_f64(0.425) * qd[0] * t1 * (-T::from_f64(0.56875) * t14)
+            + T::from_f64(0.5)
+                * (t14 * (T::from_f64(0.19163081355599998) * t14)
+                    + t10 * (T::from_f64(0.19163081355599998) * t10)
+                    + t15 * (T::from_f64(0.004095) * t15)
+                    + t19 * (T::from_f64(0.111172755531) * t19)
+                    + t13 * (T::from_f64(0.111172755531) * t13)
+                    + t20 * (T::from_f64(0.21942) * t20)
+                    + t25 * (T::from_f64(0.111172755531) * t25)
+                    + t26 * (T::from_f64(0.111172755531) * t26)
+                    + t24 * (T::from_f64(0.21942) * t24)
+                    + t32 * (T::from_f64(0.0171364731454) * t32)
+                    + t29 * (T::from_f64(0.0171364731454) * t29)
+                    + t33 * (T::from_f64(0.033822) * t33))
+            + T::from_f64(0.6095)
+                * (t27 * t27 + t18 * t18 + t28 * t28 + t34 * t34 + t35 * t35 + t31 * t31)
+            + T::from_f64(0.09395)
+                * ({
+                    let b = t9 * t36 - t8 * t31;
+                    b * b
+                }
+                    + {
+                        let b = t35 - T::from_f64(0.09465) * t25;
+                        b * b
+                    }
+                    + {
+                        let b = t8 * t36 + t9 * t31;
+                        b * b
+                    });
+        t37
     }
     /// The gravitational potential energy V = -sum m g.c, zero with every centre of mass at the origin.
     ///

@@ -108,6 +108,8 @@ pub struct Recursive {
     /// `C(q, qd)` by Echeandia and Wensing's `O(N^2)` recursion
     /// ([`newton_euler::coriolis`]).
     pub coriolis_matrix: Vec<Vec<Id>>,
+    /// `T` from body velocities ([`newton_euler::kinetic_energy`]).
+    pub kinetic_energy: Id,
 }
 
 /// Which derivation a fast form comes from.
@@ -145,6 +147,8 @@ pub struct Fast {
     /// Craig's `B(q)` likewise (Christoffel symbols, or `d^2 b_i / dqd_j dqd_k`).
     pub coriolis_pairs: Option<(Route, Vec<Vec<Id>>)>,
     pub kinetic_energy: Id,
+    /// Whether `kinetic_energy` is `qd^T M qd / 2` or the sum over body velocities.
+    pub kinetic_energy_route: Route,
     /// Joint efforts as symbols `tau_i` (inputs of forward dynamics).
     pub tau_in: Vec<Id>,
     /// `qdd = M^-1 (tau_in - b - G - F)`, with an unrolled sparse `L^T D L` solve.
@@ -372,6 +376,7 @@ fn recursive(
     let bias_and_gravity = rnea(g, qd_s, None, gv)?;
     let tau = rnea(g, qd_s, qdd_s, gv)?;
     let coriolis_matrix = newton_euler::coriolis(g, lm, qd);
+    let kinetic_energy = newton_euler::kinetic_energy(g, lm, qd);
     g.check()?;
     let tau = tau
         .iter()
@@ -385,6 +390,7 @@ fn recursive(
         bias_and_gravity,
         tau,
         coriolis_matrix,
+        kinetic_energy,
     })
 }
 
@@ -428,7 +434,9 @@ fn fast_forms(
     } else {
         (None, None)
     };
-    let kinetic_energy = lagrangian::quadratic_form(g, &mm.1, qd);
+    let quadratic = lagrangian::quadratic_form(g, &mm.1, qd);
+    let (kinetic_energy_route, ke) = cheaper(g, &vec![quadratic], &vec![rec.kinetic_energy], vec);
+    let kinetic_energy = ke[0];
     g.check()?;
     Ok(Fast {
         mass_matrix: mm,
@@ -439,6 +447,7 @@ fn fast_forms(
         centrifugal,
         coriolis_pairs,
         kinetic_energy,
+        kinetic_energy_route,
         tau_in,
         forward_dynamics,
         pivots,

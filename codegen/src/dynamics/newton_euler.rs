@@ -13,8 +13,9 @@ use crate::cas::{Graph, Id};
 use crate::kinematics::{joint, Params};
 use crate::model::Model;
 use crate::spatial::{
-    cross, cross_force, mat_add, mat_mul, mat_t_vec, mat_vec, skew_mul, skew_times, spatial_add,
-    spatial_dot, spatial_sub, transpose, vec_add, vec_scale, Spatial, M3, V3,
+    cross, cross_force, mat_add, mat_mul, mat_t_vec, mat_vec, motion_cross, skew_mul, skew_times,
+    spatial_add, spatial_dot, spatial_scale, spatial_sub, transpose, vec_add, vec_scale, Spatial,
+    M3, V3,
 };
 
 /// Each body's placement relative to its parent and its inertia about its own origin.
@@ -354,6 +355,56 @@ pub fn crba(g: &mut Graph, lm: &LocalModel) -> Vec<Vec<Id>> {
     m
 }
 
+/// A body's velocity and its parent's, both in the body's axes (angular, then the velocity of
+/// the body origin).
+#[derive(Clone, Copy, Debug)]
+pub struct Velocity {
+    /// The parent body's velocity, moved to this body's frame.
+    pub parent: Spatial,
+    /// This body's: the parent's plus `S qd`.
+    pub body: Spatial,
+}
+
+/// Every body's velocity, from the root out.
+pub fn velocities(g: &mut Graph, lm: &LocalModel, qd: &[Id]) -> Vec<Velocity> {
+    let zero = [g.zero(); 3];
+    let mut out: Vec<Velocity> = Vec::with_capacity(lm.dof());
+    for i in 0..lm.dof() {
+        let (wp, up) = match lm.parent[i] {
+            Some(p) => out[p].body,
+            None => (zero, zero),
+        };
+        let r = &lm.rotation[i];
+        let wt = cross(g, &wp, &lm.translation[i]);
+        let ut = vec_add(g, &up, &wt);
+        let parent = (mat_t_vec(g, r, &wp), mat_t_vec(g, r, &ut));
+        let sq = spatial_scale(g, &subspace(lm, i), qd[i]);
+        let body = spatial_add(g, &parent, &sq);
+        out.push(Velocity { parent, body });
+    }
+    out
+}
+
+/// The kinetic energy `T = 1/2 sum_b (m u.u + 2 u.(w x h) + w.J w)` over body velocities
+/// `(w, u)` (origin velocity `u`), with the first moment `h` and the inertia `J` about the body
+/// origin: `O(N)` where `qd^T M qd / 2` is `O(N^2)`. Rotor inertia adds `Ia qd^2 / 2`.
+pub fn kinetic_energy(g: &mut Graph, lm: &LocalModel, qd: &[Id]) -> Id {
+    let vel = velocities(g, lm, qd);
+    let mut terms = Vec::with_capacity(3 * lm.dof());
+    for (i, v) in vel.iter().enumerate() {
+        let (w, u) = v.body;
+        let uu = g.dot(&u, &u);
+        terms.push((g.mul(lm.mass[i], uu), 0.5));
+        let wh = cross(g, &w, &lm.first_moment[i]);
+        terms.push((g.dot(&u, &wh), 1.0));
+        let jw = mat_vec(g, &lm.inertia[i], &w);
+        terms.push((g.dot(&w, &jw), 0.5));
+        let q2 = g.powi(qd[i], 2);
+        terms.push((g.mul(lm.armature[i], q2), 0.5));
+    }
+    g.sum(0.0, terms)
+}
+
 /// The Christoffel-consistent Coriolis matrix `C(q, qd)` in `O(N^2)`, after Echeandia and
 /// Wensing's recursive algorithm (the one behind Pinocchio's `computeCoriolisMatrix`), in body
 /// axes.
@@ -370,36 +421,13 @@ pub fn crba(g: &mut Graph, lm: &LocalModel) -> Vec<Vec<Id>> {
 /// moved to body `i`'s axes.
 pub fn coriolis(g: &mut Graph, lm: &LocalModel, qd: &[Id]) -> Vec<Vec<Id>> {
     let n = lm.dof();
-    let zero = [g.zero(); 3];
-    // Body velocities (angular, origin) and the joint subspaces' time derivatives.
-    let mut vel: Vec<Spatial> = Vec::with_capacity(n);
-    let mut sdot: Vec<Spatial> = Vec::with_capacity(n);
-    for i in 0..n {
-        let (wp, up) = match lm.parent[i] {
-            Some(p) => vel[p],
-            None => (zero, zero),
-        };
-        let r = &lm.rotation[i];
-        let wt = cross(g, &wp, &lm.translation[i]);
-        let ut = vec_add(g, &up, &wt);
-        let u = mat_t_vec(g, r, &ut);
-        let w = mat_t_vec(g, r, &wp);
-        let a = lm.axis[i];
-        let aq = vec_scale(g, &a, qd[i]);
-        // dS/dt = v x S, and S x S = 0 lets the parent's velocity stand in for the body's.
-        if lm.revolute[i] {
-            let wa = cross(g, &w, &a);
-            let ua = cross(g, &u, &a);
-            sdot.push((wa, ua));
-            let wi = vec_add(g, &w, &aq);
-            vel.push((wi, u));
-        } else {
-            let wa = cross(g, &w, &a);
-            sdot.push((zero, wa));
-            let ui = vec_add(g, &u, &aq);
-            vel.push((w, ui));
-        }
-    }
+    // Body velocities (angular, origin) and the joint subspaces' time derivatives:
+    // dS/dt = v x S, and S x S = 0 lets the parent's velocity stand in for the body's.
+    let moved = velocities(g, lm, qd);
+    let vel: Vec<Spatial> = moved.iter().map(|m| m.body).collect();
+    let sdot: Vec<Spatial> = (0..n)
+        .map(|i| motion_cross(g, &moved[i].parent, &subspace(lm, i)))
+        .collect();
     // Per body, both halved (with halved inertia parameters, so that no product by 1/2 is
     // left for run time): the momentum H = I v, and dI/dt's parameters: dh/dt (the linear
     // momentum) and dJ/dt = [w]J - J[w] + 2 (h.u) 1 - u h^T - h u^T.

@@ -203,7 +203,10 @@ fn kinetic_energy(d: &Derivation, notes: &Notes) -> Quantity {
             &["The kinetic energy T = qd^T M(q) qd / 2.".into()],
             &notes.armature("Includes the"),
         ]),
-        route: "Route: the quadratic form of `mass_matrix`.".into(),
+        route: match d.fast.kinetic_energy_route {
+            Route::Lagrangian => "Route: the quadratic form of `mass_matrix`.".into(),
+            Route::Recursive => "Route: a sum over body velocities, O(N).".into(),
+        },
         eval: Evaluation::Exprs(vec![d.fast.kinetic_energy]),
     }
 }
