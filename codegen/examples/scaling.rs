@@ -1,7 +1,10 @@
 //! How generation time and the operation counts of each generated function grow with the number
 //! of joints, on a synthetic serial chain (see `tests/support/chain.rs`).
 //!
-//!     cargo run --release -p eomgen --example scaling -- [--min 2] [--max 24] [--out docs/scaling.md]
+//!     cargo run --release -p eomgen --example scaling -- [--min 2] [--max 24] [--step 1] \
+//!         [--out docs/scaling.md] [--keep DIR]
+//!
+//! `--keep DIR` writes the chains' URDFs to DIR and leaves them there (for `scripts/build-cost`).
 //!
 //! Prints a Markdown document (to `--out`, or to stdout); progress goes to stderr.
 
@@ -170,38 +173,70 @@ fn render(rows: &[Row], functions: &[String], stages: &[&'static str]) -> String
     s
 }
 
-fn parse_args() -> Result<(usize, usize, Option<String>), String> {
-    let (mut min, mut max, mut out) = (2, 24, None);
+/// The command line.
+struct Options {
+    min: usize,
+    max: usize,
+    step: usize,
+    out: Option<String>,
+    keep: Option<String>,
+}
+
+fn parse_args() -> Result<Options, String> {
+    let mut o = Options {
+        min: 2,
+        max: 24,
+        step: 1,
+        out: None,
+        keep: None,
+    };
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         let mut value = || args.next().ok_or(format!("{a} needs a value"));
+        let number = |v: String| v.parse::<usize>().map_err(|e| format!("{a}: {e}"));
         match a.as_str() {
-            "--min" => min = value()?.parse().map_err(|e| format!("--min: {e}"))?,
-            "--max" => max = value()?.parse().map_err(|e| format!("--max: {e}"))?,
-            "--out" => out = Some(value()?),
+            "--min" => o.min = number(value()?)?,
+            "--max" => o.max = number(value()?)?,
+            "--step" => o.step = number(value()?)?,
+            "--out" => o.out = Some(value()?),
+            "--keep" => o.keep = Some(value()?),
             "-h" | "--help" => {
-                return Err("usage: scaling [--min N] [--max N] [--out FILE.md]".into())
+                return Err(
+                    "usage: scaling [--min N] [--max N] [--step N] [--out FILE.md] [--keep DIR]"
+                        .into(),
+                )
             }
             _ => return Err(format!("unknown argument {a} (try --help)")),
         }
     }
-    if min < 1 || min > max {
-        return Err(format!("need 1 <= --min <= --max, got {min} and {max}"));
+    if o.min < 1 || o.min > o.max || o.step < 1 {
+        return Err(format!(
+            "need 1 <= --min <= --max and --step >= 1, got {}, {} and {}",
+            o.min, o.max, o.step
+        ));
     }
-    Ok((min, max, out))
+    Ok(o)
 }
 
 fn main() -> ExitCode {
-    let (min, max, out) = match parse_args() {
+    let opts = match parse_args() {
         Ok(a) => a,
         Err(e) => {
             eprintln!("{e}");
             return ExitCode::from(2);
         }
     };
-    let dir = std::env::temp_dir().join(format!("eomgen-scaling-{}", std::process::id()));
+    let dir = match &opts.keep {
+        Some(d) => std::path::PathBuf::from(d),
+        None => std::env::temp_dir().join(format!("eomgen-scaling-{}", std::process::id())),
+    };
+    let cleanup = |dir: &std::path::Path| {
+        if opts.keep.is_none() {
+            let _ = std::fs::remove_dir_all(dir);
+        }
+    };
     let mut rows = Vec::new();
-    for n in min..=max {
+    for n in (opts.min..=opts.max).step_by(opts.step) {
         eprint!("n = {n} ... ");
         match measure(&dir, n) {
             Ok(r) => {
@@ -210,12 +245,12 @@ fn main() -> ExitCode {
             }
             Err(e) => {
                 eprintln!("failed: {e}");
-                let _ = std::fs::remove_dir_all(&dir);
+                cleanup(&dir);
                 return ExitCode::FAILURE;
             }
         }
     }
-    let _ = std::fs::remove_dir_all(&dir);
+    cleanup(&dir);
 
     // Functions and stages in the order the generator reports them, whatever they are.
     let mut functions: Vec<String> = Vec::new();
@@ -233,7 +268,7 @@ fn main() -> ExitCode {
         }
     }
     let doc = render(&rows, &functions, &stages);
-    match out {
+    match opts.out {
         Some(path) => {
             if let Err(e) = std::fs::write(&path, doc) {
                 eprintln!("{path}: {e}");

@@ -61,7 +61,7 @@ pub struct Builder {
 /// Robots with more joints than this are refused unless [`Builder::max_dof`] raises the limit:
 /// Craig's Coriolis matrix has N^2 (N-1) / 2 entries, and a 48-joint chain already takes about a
 /// minute and gigabytes of memory to derive.
-pub const DEFAULT_MAX_DOF: usize = 40;
+pub const DEFAULT_MAX_DOF: usize = 64;
 
 /// The default of [`Builder::max_graph_nodes`]: 50 million expression nodes, a few gigabytes at
 /// the worst; a 40-joint chain needs a few million.

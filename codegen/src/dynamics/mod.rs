@@ -161,6 +161,10 @@ pub struct Fast {
 /// `N^2 (N-1) / 2` entries.
 pub const CRAIG_FLAT_MAX_DOF: usize = 12;
 
+/// Robots with a chain of more joints than this take the recursive route for `b`, `tau` and
+/// `C(q, qd)` without comparing it with the Christoffel forms.
+pub const CLOSED_FORM_MAX_DEPTH: usize = 12;
+
 fn cheaper<T: Clone>(g: &Graph, a: &T, b: &T, ids: impl Fn(&T) -> Vec<Id>) -> (Route, T) {
     let cost = |x: &T| Program::new(g, &ids(x)).ops().total();
     if cost(b) < cost(a) {
@@ -409,8 +413,23 @@ fn fast_forms(
     let fl = |m: &Vec<Vec<Id>>| flat(m);
     let mm = cheaper(g, &closed.mass_matrix.to_vec(), &rec.mass_matrix, fl);
     let gr = cheaper(g, &closed.gravity.to_vec(), &rec.gravity, vec);
-    let bi = cheaper(g, &closed.bias.to_vec(), &rec.bias, vec);
-    let tq = cheaper(g, &closed.tau.to_vec(), &rec.tau, vec);
+    // On chains longer than a dozen joints the Christoffel forms of b, tau and C(q, qd) are
+    // never the cheaper ones, and merely costing them (scheduling millions of nodes) took most
+    // of a 64-joint chain's generation time. (A branched hand of short fingers keeps them.)
+    let depth = (0..n)
+        .map(|i| model.path_to_root(i).len())
+        .max()
+        .unwrap_or(0);
+    let small = depth <= CLOSED_FORM_MAX_DEPTH;
+    let choose = |g: &Graph, closed: &[Id], recursive: &Vec<Id>| {
+        if small {
+            cheaper(g, &closed.to_vec(), recursive, vec)
+        } else {
+            (Route::Recursive, recursive.clone())
+        }
+    };
+    let bi = choose(g, closed.bias, &rec.bias);
+    let tq = choose(g, closed.tau, &rec.tau);
     // h = b + G: one recursion, or the sum of the cheaper closed forms.
     let lag_h: Vec<Id> = (0..n).map(|i| g.add(bi.1[i], gr.1[i])).collect();
     let (_, h) = cheaper(g, &lag_h, &rec.bias_and_gravity, vec);
@@ -419,12 +438,16 @@ fn fast_forms(
     let rhs: Vec<Id> = (0..n).map(|i| g.sub(tau_in[i], h[i])).collect();
     let parents: Vec<Option<usize>> = model.joints.iter().map(|j| j.parent).collect();
     let (forward_dynamics, pivots) = newton_euler::ltdl_solve(g, &parents, &mm.1, &rhs);
-    let cm = cheaper(
-        g,
-        &closed.coriolis_matrix.to_vec(),
-        &rec.coriolis_matrix,
-        fl,
-    );
+    let cm = if small {
+        cheaper(
+            g,
+            &closed.coriolis_matrix.to_vec(),
+            &rec.coriolis_matrix,
+            fl,
+        )
+    } else {
+        (Route::Recursive, rec.coriolis_matrix.clone())
+    };
     let (centrifugal, coriolis_pairs) = if n <= CRAIG_FLAT_MAX_DOF {
         let (cf, cp) = craig_from_bias(g, &rec.bias, qd)?;
         (
