@@ -167,6 +167,10 @@ fn describe(
     let doc = xml::parse(text).map_err(|issue| format_error(vec![issue], 0))?;
     let mut report = report::Report::new(&doc);
     let robot = robot::read(&doc, &mut report);
+    // In file order.
+    for list in [&mut report.errors, &mut report.warnings] {
+        list.sort_by_key(|i| (i.line, i.column));
+    }
     let markup = |issue| ModelWarning::Markup {
         file: file.into(),
         issue,
