@@ -4,7 +4,9 @@
 //! `eomgen: error:`), 2 on bad usage (clap's message). Nothing panics visibly: a panic would be
 //! a bug, and is reported as one line too.
 
+mod conditioning;
 mod eval;
+mod floating_base;
 mod info;
 mod progress;
 mod simulate;
@@ -454,14 +456,16 @@ fn load(b: &Builder) -> Result<Model, Failure> {
     Ok(model?)
 }
 
-/// Prints warnings on stderr, one line each.
+/// Prints the model's warnings on stderr, one line each.
 fn warn(warnings: &[eomgen::model::ModelWarning]) {
+    warn_lines(warnings.iter().map(|w| w.to_string()));
+}
+
+/// Prints warnings on stderr, one line each.
+fn warn_lines(warnings: impl IntoIterator<Item = String>) {
     for w in warnings {
-        let line = w
-            .to_string()
-            .split_whitespace()
-            .collect::<Vec<_>>()
-            .join(" ");
+        let line = w.split_whitespace().collect::<Vec<_>>().join(" ");
+        let line = terminal_safe(&line);
         let _ = writeln!(std::io::stderr(), "eomgen: warning: {line}");
     }
 }
@@ -583,6 +587,7 @@ fn info_cmd(a: InfoArgs) -> Result<(), Failure> {
         progress::run(&label, || b.generate_with_report()).map_err(cli_error)?;
     let derive: std::time::Duration = d.timings.iter().map(|t| t.1).sum();
     let emit_time = start.elapsed().saturating_sub(derive + load_time);
+    warn_lines(conditioning::sampled_warnings(&model, &d));
     emit(&info::print(
         &model,
         &d,
@@ -622,6 +627,11 @@ fn eval_cmd(a: EvalArgs) -> Result<(), Failure> {
     };
     let d = derive(&b, &model)?;
     let values = eval::evaluate(&model, &d, &state).map_err(Failure)?;
+    warn_lines(conditioning::warning(
+        &model,
+        &values.mass_matrix,
+        "at this state",
+    ));
     let digits = (a.digits > 0).then_some(a.digits);
     emit(&eval::print(&model, &state, &values, digits))
 }
