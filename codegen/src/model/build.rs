@@ -65,7 +65,7 @@ pub struct ModelOptions {
     /// do not step across a discontinuity. 0 (the default) keeps the exact sign
     /// (`sign(0) = 0`). Must be finite and non-negative ([`ModelError::InvalidOption`]).
     pub coulomb_smoothing: f64,
-    /// Fills the inertia of links without `<inertial>` (urdf-rs reads a missing one as all
+    /// Fills the inertia of links without `<inertial>` (a missing one is described as all
     /// zeros, so a link whose mass and inertia are all zero counts as missing) from their
     /// `<collision>` boxes, cylinders and spheres, made of a uniform material of this density
     /// (kg/m^3), each placed by its `<origin>` (overlaps count twice). Every filled link gets a
@@ -1244,7 +1244,7 @@ fn massless_hint(
     )
 }
 
-/// Whether a link has no inertial data: all zero, as urdf-rs used to read a missing one.
+/// Whether a link has no inertial data: all zero, as a missing one is described.
 fn is_missing(inertial: &InertialDescription) -> bool {
     inertial.mass == 0.0 && inertial.inertia.iter().all(|&x| x == 0.0)
 }

@@ -55,7 +55,8 @@ pub(super) fn read(node: Node, report: &mut Report) -> Option<JointDescription> 
         child: child?.to_string(),
         origin,
         axis: axis?,
-        // An all-zero <limit> limits nothing, as before (urdf-rs could not tell it from none).
+        // An all-zero <limit> limits nothing, as with the former reader (urdf-rs), which
+        // could not tell it from none.
         limits: limits.flatten().filter(|l| {
             [l.lower, l.upper, l.effort, l.velocity]
                 .iter()

@@ -1,6 +1,7 @@
 //! URDF reading: the only module that sees XML.
 //!
-//! [`load_file`] and [`load_str`] parse a URDF with the `urdf-rs` crate, turn it into a
+//! [`load_file`] and [`load_str`] parse a URDF (XML through the `roxmltree` crate, every
+//! element and attribute read here, with its place in the file), turn it into a
 //! format-neutral description and build the [`Model`] from it (fixed joints merged, joints
 //! ordered, everything validated), shaped by [`ModelOptions`].
 //!
