@@ -7,7 +7,7 @@ use crate::cas::Limits;
 use crate::dynamics::{catalogue, Derivation};
 use crate::emit::names::{snake, upper_camel};
 use crate::emit::{self, EmitOptions, Generated};
-use crate::model::{Model, ModelOptions, SymbolicParams};
+use crate::model::{Model, ModelOptions, ModelWarning, SymbolicParams};
 use crate::Error;
 
 /// Configures and runs code generation for one robot.
@@ -208,6 +208,15 @@ impl Builder {
         self
     }
 
+    /// Repairs the rotational inertia of a moving body that is not positive semi-definite or
+    /// breaks the triangle inequality, instead of refusing the robot: like MuJoCo's
+    /// `balanceinertia`, its principal moments are set to their mean. Each repair is a warning
+    /// saying what changed. Off by default. See [`ModelOptions::repair_inertia`].
+    pub fn repair_inertia(mut self, repair: bool) -> Builder {
+        self.options.repair_inertia = repair;
+        self
+    }
+
     /// All model options at once.
     pub fn model_options(mut self, options: ModelOptions) -> Builder {
         self.options = options;
@@ -271,12 +280,21 @@ impl Builder {
 
     /// Loads the model.
     pub fn model(&self) -> Result<Model, Error> {
-        Ok(match &self.text {
-            Some(text) => {
-                crate::urdf::load_str(text, &self.urdf.display().to_string(), &self.options)?
-            }
-            None => crate::urdf::load_file(&self.urdf, &self.options)?,
-        })
+        self.model_with_warnings().0
+    }
+
+    /// Loads the model, and returns its warnings whether loading succeeds or not (on success
+    /// they are also in [`Model::warnings`]), so that a refusal can show what led to it.
+    pub fn model_with_warnings(&self) -> (Result<Model, Error>, Vec<ModelWarning>) {
+        let (model, warnings) = match &self.text {
+            Some(text) => crate::urdf::load_str_with_warnings(
+                text,
+                &self.urdf.display().to_string(),
+                &self.options,
+            ),
+            None => crate::urdf::load_file_with_warnings(&self.urdf, &self.options),
+        };
+        (model.map_err(Error::from), warnings)
     }
 
     fn names(&self, model: &Model) -> Result<(String, String), Error> {

@@ -81,32 +81,35 @@ fn fixture(name: &str) -> String {
 enum Expect {
     /// An error whose message contains every one of these (besides the file name).
     Error(&'static [&'static str]),
+    /// A format error: the message starts with `file:line:column: ` and contains every one of
+    /// these.
+    Located(&'static [&'static str]),
     /// Generated code (checked by [`check_safe_source`]).
     Code,
 }
-use Expect::{Code, Error};
+use Expect::{Code, Error, Located};
 
 /// The catalogue: a name (also the file name in messages), the URDF text and the outcome.
 fn catalogue() -> Vec<(&'static str, String, Expect)> {
     let nan_origin = r#"xyz="0 0 0.1""#;
     vec![
         // Not a URDF at all.
-        ("empty", String::new(), Error(&["malformed URDF"])),
-        ("blank", " \n\t ".into(), Error(&["malformed URDF"])),
+        ("empty", String::new(), Located(&["no XML element"])),
+        ("blank", " \n\t ".into(), Located(&["no XML element"])),
         (
             "not_xml",
             "robot: {name: r}".into(),
-            Error(&["malformed URDF"]),
+            Located(&["not well-formed XML"]),
         ),
         (
             "truncated",
             robot(&[link("base")])[..40].into(),
-            Error(&["malformed URDF"]),
+            Located(&["2:24: ", "truncated"]),
         ),
         (
             "binary",
             "\u{0}\u{1}<\u{7f}>\u{fffd}".into(),
-            Error(&["malformed URDF"]),
+            Located(&["1:1: ", "not well-formed XML"]),
         ),
         (
             "no_links",
@@ -122,25 +125,36 @@ fn catalogue() -> Vec<(&'static str, String, Expect)> {
         (
             "billion_laughs",
             fixture("billion_laughs.urdf"),
-            Error(&["malformed URDF"]),
+            Located(&["2:1: ", "document type declarations"]),
         ),
         (
             "external_entity",
             fixture("external_entity.urdf"),
-            Error(&["malformed URDF", "entity"]),
+            Located(&["2:1: ", "entities are not accepted"]),
         ),
         (
+            // Made the former XML parser panic; harmless to this one.
             "xmlns_prefix_declared",
             robot(&[link("base")]).replace(
                 "<robot name=\"r\">",
                 "<robot name=\"r\" xmlns:xmlns=\"http://www.ros.org/wiki/xacro\">",
             ),
-            Error(&["malformed URDF", "xmlns:xmlns"]),
+            Error(&["no moving joint"]),
         ),
         (
+            // Unclosed: the parser's tokenizer would recurse 100,000 levels deep.
             "deep_nesting",
             format!("<robot name=\"r\">{}", "<link>".repeat(100_000)),
-            Error(&["malformed URDF", "nested more than 100 levels"]),
+            Located(&["1:611: ", "nested more than 100 levels"]),
+        ),
+        (
+            "deep_nesting_closed",
+            format!(
+                "<robot name=\"r\">{}{}</robot>",
+                "<gazebo>".repeat(100_000),
+                "</gazebo>".repeat(100_000)
+            ),
+            Located(&["1:809: ", "nested more than 100 levels"]),
         ),
         // Numbers.
         (
@@ -205,13 +219,13 @@ fn catalogue() -> Vec<(&'static str, String, Expect)> {
         (
             "not_a_number",
             arm("", link_with("tip", nan_origin, "heavy", UNIT)),
-            Error(&["malformed URDF"]),
+            Located(&["link `tip`: <mass value>: `heavy` is not a number"]),
         ),
         // Missing pieces.
         (
             "link_without_name",
             robot(&[link("base"), "<link/>".into()]),
-            Error(&["malformed URDF"]),
+            Located(&["<link> has no `name` attribute"]),
         ),
         (
             "joint_without_type",
@@ -220,7 +234,7 @@ fn catalogue() -> Vec<(&'static str, String, Expect)> {
                 link("tip"),
                 r#"<joint name="j"><parent link="base"/><child link="tip"/></joint>"#.into(),
             ]),
-            Error(&["malformed URDF"]),
+            Located(&["joint `j`: <joint> has no `type` attribute"]),
         ),
         (
             "joint_without_child",
@@ -229,12 +243,12 @@ fn catalogue() -> Vec<(&'static str, String, Expect)> {
                 link("tip"),
                 r#"<joint name="j" type="revolute"><parent link="base"/></joint>"#.into(),
             ]),
-            Error(&["malformed URDF"]),
+            Located(&["joint `j`: <joint> has no <child>"]),
         ),
         (
             "mass_without_value",
             arm("", link("tip").replace(r#"<mass value="1"/>"#, "<mass/>")),
-            Error(&["malformed URDF"]),
+            Located(&["link `tip`: <mass> has no `value` attribute"]),
         ),
         (
             "empty_joint_name",
@@ -348,6 +362,28 @@ fn catalogue() -> Vec<(&'static str, String, Expect)> {
             Error(&["link `tip` has an impossible inertia"]),
         ),
         (
+            "triangle_inequality",
+            arm(
+                "",
+                link_with("tip", nan_origin, "1", ["1", "0", "0", "1", "0", "2.5"]),
+            ),
+            Error(&[
+                "link `tip`",
+                "triangle inequality 2.5 <= 1 + 1",
+                "--repair-inertia",
+            ]),
+        ),
+        (
+            "conflicting_axes",
+            arm(r#"<axis xyz="0 1 0"/><axis xyz="0 0 1"/>"#, link("tip")),
+            Located(&["joint `shoulder`: a second <axis> with different content"]),
+        ),
+        (
+            "short_vector",
+            arm(r#"<origin xyz="0 1"/>"#, link("tip")),
+            Located(&["joint `shoulder`: <origin xyz>: `0 1` holds 2 number(s)"]),
+        ),
+        (
             "massless_subtree",
             robot(&[
                 link("base"),
@@ -403,7 +439,7 @@ fn catalogue() -> Vec<(&'static str, String, Expect)> {
                 link("tip"),
                 joint("j", "hinge", "base", "tip", ""),
             ]),
-            Error(&["malformed URDF", "hinge"]),
+            Located(&["joint `j`: unknown joint type `hinge`"]),
         ),
         // Size.
         (
@@ -568,6 +604,17 @@ impl Clock {
     }
 }
 
+/// Whether `msg` starts with `file:line:column: `.
+fn starts_with_place(msg: &str, file: &str) -> bool {
+    let Some(rest) = msg.strip_prefix(&format!("{file}:")) else {
+        return false;
+    };
+    let mut parts = rest.splitn(3, ':');
+    let number =
+        |p: Option<&str>| p.is_some_and(|p| !p.is_empty() && p.bytes().all(|b| b.is_ascii_digit()));
+    number(parts.next()) && number(parts.next()) && parts.next().is_some_and(|r| r.starts_with(' '))
+}
+
 /// Runs one case in-process; `Err` describes what went wrong.
 fn run(case: &str, text: &str, expect: &Expect) -> Result<(), String> {
     let file = format!("{case}.urdf");
@@ -590,9 +637,16 @@ fn run(case: &str, text: &str, expect: &Expect) -> Result<(), String> {
         return Err(format!("{case}: took {elapsed:?}"));
     }
     match (outcome, expect) {
-        (Err(e), Error(parts)) => {
+        (Err(e), Error(parts) | Located(parts)) => {
             let msg = e.to_string();
-            if !msg.starts_with(&format!("{file}: ")) {
+            let located = matches!(expect, Located(_));
+            if located != starts_with_place(&msg, &file) {
+                return Err(format!(
+                    "{case}: message should start with the file{}: {msg}",
+                    if located { ":line:column" } else { " alone" }
+                ));
+            }
+            if !located && !msg.starts_with(&format!("{file}: ")) {
                 return Err(format!(
                     "{case}: message does not start with the file: {msg}"
                 ));
@@ -606,7 +660,9 @@ fn run(case: &str, text: &str, expect: &Expect) -> Result<(), String> {
             }
         }
         (Ok(source), Code) => check_safe_source(case, &source),
-        (Ok(_), Error(parts)) => Err(format!("{case}: generated code, expected error {parts:?}")),
+        (Ok(_), Error(parts) | Located(parts)) => {
+            Err(format!("{case}: generated code, expected error {parts:?}"))
+        }
         (Err(e), Code) => Err(format!("{case}: expected code, got: {e}")),
     }
 }

@@ -605,14 +605,14 @@ const PLANAR: &str = r#"<robot name="planar_two_link">
     <inertial>
       <origin xyz="0.4 0 0"/>
       <mass value="2"/>
-      <inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0.1"/>
+      <inertia ixx="0.05" ixy="0" ixz="0" iyy="0.05" iyz="0" izz="0.1"/>
     </inertial>
   </link>
   <link name="link2">
     <inertial>
       <origin xyz="0.3 0 0"/>
       <mass value="1.5"/>
-      <inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0.05"/>
+      <inertia ixx="0.025" ixy="0" ixz="0" iyy="0.025" iyz="0" izz="0.05"/>
     </inertial>
   </link>
   <joint name="joint1" type="continuous">
@@ -734,7 +734,10 @@ fn textbook_planar_two_link_arm() {
     ];
     let mut symbols: Vec<&str> = d.params.iter().map(|p| p.0.as_str()).collect();
     symbols.sort_unstable();
-    let mut expected = names.to_vec();
+    // The links are flat discs (a possible inertia needs Ixx + Iyy >= Izz); rotating about z
+    // only, their Ixx and Iyy never enter the equations.
+    let discs = ["Ixx_link1", "Iyy_link1", "Ixx_link2", "Iyy_link2"];
+    let mut expected = [names.as_slice(), &discs].concat();
     expected.sort_unstable();
     assert_eq!(symbols, expected);
 
@@ -768,7 +771,11 @@ fn textbook_planar_two_link_arm() {
                 SymbolKind::Q(i) => Some(q[i]),
                 SymbolKind::Qd(i) => Some(qd[i]),
                 SymbolKind::Qdd(i) => Some(qdd[i]),
-                SymbolKind::Param => names.iter().position(|n| *n == s.name).map(|k| p[k]),
+                SymbolKind::Param => names
+                    .iter()
+                    .position(|n| *n == s.name)
+                    .map(|k| p[k])
+                    .or_else(|| discs.contains(&s.name.as_str()).then_some(0.05)),
                 #[allow(unreachable_patterns)]
                 _ => None,
             })

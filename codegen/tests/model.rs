@@ -6,7 +6,8 @@ use std::collections::HashSet;
 use std::path::PathBuf;
 
 use eomgen::model::{
-    JointKind, Limits, Mimic, Model, ModelError, ModelOptions, SymbolicParams, Transform,
+    JointKind, Limits, Mimic, Model, ModelError, ModelOptions, ModelWarning, SymbolicParams,
+    Transform,
 };
 use eomgen::urdf::{load_file, load_str};
 use nalgebra::{Matrix3, Rotation3, Unit, Vector3};
@@ -272,20 +273,14 @@ fn reference_robots_match_pinocchio_kinematics_and_energies() {
 }
 
 #[test]
-fn allegro_loads_despite_impossible_fingertip_inertias_unless_strict() {
+fn allegro_loads_as_its_impossible_fingertips_merge_into_possible_bodies() {
+    // The fingertip links alone break the triangle inequality by 11 %; each is welded to a
+    // finger link, and the merged bodies are possible.
     let path = robots_dir().join("allegro_right_hand.urdf");
-    let strict = ModelOptions {
-        strict_inertia: true,
-        ..ModelOptions::default()
-    };
-    let err = load_file(&path, &strict).unwrap_err();
-    assert!(matches!(err, ModelError::InvalidInertia { .. }), "{err}");
-    let message = err.to_string();
-    assert!(
-        message.contains("link_3.0") && message.contains("triangle"),
-        "{message}"
-    );
-    assert!(message.contains("allegro_right_hand.urdf"), "{message}");
+    let model = load_file(&path, &ModelOptions::default()).unwrap();
+    let tip = model.bodies.iter().find(|b| b.name == "link_3.0").unwrap();
+    assert_eq!(tip.merged_links, ["link_3.0", "link_3.0_tip"]);
+    assert!(model.warnings.is_empty(), "{:?}", model.warnings);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -649,7 +644,7 @@ fn error_malformed_xml() {
         r#"<robot name="test"><link name="a"><inertial><mass value="heavy"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link></robot>"#,
     ] {
         let err = bad(text, &[]);
-        assert!(matches!(err, ModelError::Xml { .. }), "{err}");
+        assert!(matches!(err, ModelError::Format { .. }), "{err}");
     }
 }
 
@@ -663,7 +658,7 @@ fn error_nesting_too_deep_is_refused_without_overflowing_the_stack() {
         "</gazebo>".repeat(depth)
     ));
     let err = bad(&robot(&parts), &["nested"]);
-    assert!(matches!(err, ModelError::Xml { .. }), "{err}");
+    assert!(matches!(err, ModelError::Format { .. }), "{err}");
     // Moderate nesting of unknown elements is fine.
     let mut parts = valid();
     parts.push(format!(
@@ -904,9 +899,21 @@ fn error_non_finite_numbers() {
 #[test]
 fn error_negative_mass() {
     let text = robot(&valid()).replacen(r#"<mass value="1"/>"#, r#"<mass value="-1"/>"#, 2);
-    // The first negative mass in file order is reported: base's.
-    let err = bad(&text, &["`base`", "-1"]);
+    // The moving body's is an error; base's, welded to the world, only a warning.
+    let err = bad(&text, &["`l1`", "-1"]);
     assert!(matches!(err, ModelError::NegativeMass { .. }), "{err}");
+    let (_, warnings) = eomgen::urdf::load_str_with_warnings(&text, FILE, &Default::default());
+    assert!(
+        matches!(&warnings[..], [ModelWarning::WeldedInertia { link, .. }] if link == "base"),
+        "{warnings:?}"
+    );
+    let base_only = robot(&valid()).replacen(r#"<mass value="1"/>"#, r#"<mass value="-1"/>"#, 1);
+    let model = load(&base_only).unwrap();
+    let message = model.warnings[0].to_string();
+    assert!(
+        message.contains("`base` is welded to the world") && message.contains("negative (-1)"),
+        "{message}"
+    );
 }
 
 #[test]
@@ -927,24 +934,87 @@ fn error_inertia_not_positive_semi_definite() {
 }
 
 #[test]
-fn error_inertia_breaking_the_triangle_inequality_when_strict() {
-    // 1 + 1 < 2.5: impossible, but only rejected with `strict_inertia`.
+fn error_inertia_breaking_the_triangle_inequality_unless_repaired() {
+    // 1 + 1 < 2.5: impossible.
     let l1 = r#"<link name="l1"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="2.5"/></inertial></link>"#;
     let text = robot(&[
         link("base"),
         l1.into(),
         joint("j1", "revolute", "base", "l1"),
     ]);
-    assert!(load(&text).is_ok());
-    let strict = ModelOptions {
-        strict_inertia: true,
+    let err = bad(
+        &text,
+        &["`l1`", "triangle inequality 2.5 <= 1 + 1", "repair_inertia"],
+    );
+    assert!(matches!(err, ModelError::InvalidInertia { .. }), "{err}");
+    // Equality (a flat plate) is fine.
+    let plate = text.replace(r#"izz="2.5""#, r#"izz="2""#);
+    assert!(load(&plate).is_ok());
+    // Repaired: the principal moments become their mean, and a warning says so.
+    let repair = ModelOptions {
+        repair_inertia: true,
         ..ModelOptions::default()
     };
-    let err = error(&text, &strict, &["`l1`", "triangle"]);
-    assert!(matches!(err, ModelError::InvalidInertia { .. }), "{err}");
-    // Equality (a flat plate) is fine even when strict.
-    let plate = text.replace(r#"izz="2.5""#, r#"izz="2""#);
-    assert!(load_str(&plate, FILE, &strict).is_ok());
+    let model = load_str(&text, FILE, &repair).unwrap();
+    assert_eq!(model.bodies[0].inertia, Matrix3::identity() * 1.5);
+    match &model.warnings[..] {
+        [w @ ModelWarning::InertiaRepaired {
+            link,
+            before,
+            after,
+            ..
+        }] => {
+            assert_eq!(
+                (link.as_str(), *before, *after),
+                ("l1", [1.0, 1.0, 2.5], [1.5; 3])
+            );
+            let message = w.to_string();
+            assert!(
+                message.contains("triangle inequality") && message.contains("1.5, 1.5, 1.5"),
+                "{message}"
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+    // A possible inertia is left alone.
+    let model = load_str(&plate, FILE, &repair).unwrap();
+    assert!(model.warnings.is_empty());
+    assert_eq!(model.bodies[0].inertia[(2, 2)], 2.0);
+}
+
+#[test]
+fn inertia_is_checked_on_merged_bodies_with_an_absolute_tolerance() {
+    // Each of l1's two halves breaks the triangle inequality (0.03 > 0.01 + 0.01); welded
+    // together 0.2 m apart along z, they do not (0.06 <= 0.04 + 0.04).
+    let half = |name: &str, z: f64| {
+        format!(
+            r#"<link name="{name}"><inertial><origin xyz="0 0 {z}"/><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.03"/></inertial></link>"#
+        )
+    };
+    let text = robot(&[
+        link("base"),
+        half("l1", 0.1),
+        half("l1b", -0.1),
+        joint("j1", "revolute", "base", "l1"),
+        r#"<joint name="weld" type="fixed"><parent link="l1"/><child link="l1b"/></joint>"#.into(),
+    ]);
+    let model = load(&text).unwrap();
+    assert!(model.warnings.is_empty(), "{:?}", model.warnings);
+    // Without its other half, l1 is refused.
+    let alone = robot(&[
+        link("base"),
+        half("l1", 0.1),
+        joint("j1", "revolute", "base", "l1"),
+    ]);
+    bad(&alone, &["`l1`", "triangle"]);
+    // Rounding noise on a point mass passes (a relative tolerance alone would refuse it).
+    let noisy = r#"<link name="l1"><inertial><origin xyz="0.5 0.5 0.5"/><mass value="1"/><inertia ixx="1e-20" ixy="0" ixz="0" iyy="-1e-20" iyz="0" izz="1e-35"/></inertial></link>"#;
+    let text = robot(&[
+        link("base"),
+        noisy.into(),
+        joint("j1", "revolute", "base", "l1"),
+    ]);
+    load(&text).unwrap();
 }
 
 #[test]
@@ -1246,7 +1316,8 @@ proptest! {
         match eomgen::Builder::from_urdf_str(&mutated, "mutated.urdf").generate() {
             Ok(source) => prop_assert!(source.starts_with("// @generated by eomgen")),
             Err(eomgen::Error::Emit(e)) => prop_assert!(false, "emission failed: {}", e),
-            Err(e) => prop_assert!(e.to_string().starts_with("mutated.urdf: "), "{}", e),
+            // `mutated.urdf: ...`, or `mutated.urdf:line:column: ...` for format errors.
+            Err(e) => prop_assert!(e.to_string().starts_with("mutated.urdf:"), "{}", e),
         }
     }
 }

@@ -45,6 +45,9 @@ pub fn print(
         model.bodies.len()
     );
     let _ = writeln!(out, "gravity: {} m/s^2", vec3(&model.gravity));
+    if let Some(note) = super::floating_base::note(model) {
+        let _ = writeln!(out, "note: {note}");
+    }
 
     // The tree, depth first with an explicit stack (no recursion on user input).
     let _ = writeln!(

@@ -4,7 +4,9 @@
 //! `eomgen: error:`), 2 on bad usage (clap's message). Nothing panics visibly: a panic would be
 //! a bug, and is reported as one line too.
 
+mod conditioning;
 mod eval;
+mod floating_base;
 mod info;
 mod progress;
 mod simulate;
@@ -89,6 +91,11 @@ struct ModelArgs {
     /// this uniform density (kg/m^3); each filled link is reported on stderr.
     #[arg(long, value_name = "KG_PER_M3", allow_hyphen_values = true)]
     density: Option<f64>,
+    /// Repairs a moving body's impossible rotational inertia (not positive semi-definite, or
+    /// breaking the triangle inequality) instead of refusing the robot: its principal moments
+    /// become their mean, as MuJoCo's balanceinertia does; each repair is reported on stderr.
+    #[arg(long)]
+    repair_inertia: bool,
     /// Refuse robots with more degrees of freedom than this.
     #[arg(long, value_name = "N", default_value_t = eomgen::DEFAULT_MAX_DOF)]
     max_dof: usize,
@@ -112,6 +119,7 @@ impl ModelArgs {
             friction: self.friction,
             coulomb_smoothing: self.coulomb_smoothing,
             inertia_from_collision: self.density,
+            repair_inertia: self.repair_inertia,
             ..ModelOptions::default()
         }
     }
@@ -404,11 +412,14 @@ pub fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(Failure(message)) => {
-            // Exactly one line, whatever the underlying message looks like, and no control or
-            // bidirectional-text characters from names in the URDF reach the terminal.
-            let line = message.split_whitespace().collect::<Vec<_>>().join(" ");
-            let line = terminal_safe(&line);
-            let _ = writeln!(std::io::stderr(), "eomgen: error: {line}");
+            // One line per line of the message (a file's format errors come one per line),
+            // and no control or bidirectional-text characters from names in the URDF reach
+            // the terminal.
+            for line in message.lines().filter(|l| !l.trim().is_empty()) {
+                let line = line.split_whitespace().collect::<Vec<_>>().join(" ");
+                let line = terminal_safe(&line);
+                let _ = writeln!(std::io::stderr(), "eomgen: error: {line}");
+            }
             ExitCode::from(1)
         }
     }
@@ -442,14 +453,23 @@ fn file_name(p: &Path) -> String {
         .unwrap_or_else(|| p.display().to_string())
 }
 
+/// Loads the model of `b`, printing its warnings on stderr whether loading succeeds or not.
+fn load(b: &Builder) -> Result<Model, Failure> {
+    let (model, warnings) = b.model_with_warnings();
+    warn(&warnings);
+    Ok(model?)
+}
+
 /// Prints the model's warnings on stderr, one line each.
-fn warn(model: &Model) {
-    for w in &model.warnings {
-        let line = w
-            .to_string()
-            .split_whitespace()
-            .collect::<Vec<_>>()
-            .join(" ");
+fn warn(warnings: &[eomgen::model::ModelWarning]) {
+    warn_lines(warnings.iter().map(|w| w.to_string()));
+}
+
+/// Prints warnings on stderr, one line each.
+fn warn_lines(warnings: impl IntoIterator<Item = String>) {
+    for w in warnings {
+        let line = w.split_whitespace().collect::<Vec<_>>().join(" ");
+        let line = terminal_safe(&line);
         let _ = writeln!(std::io::stderr(), "eomgen: warning: {line}");
     }
 }
@@ -486,8 +506,7 @@ fn generate(a: GenerateArgs) -> Result<(), Failure> {
         b = b.quantities(only);
     }
     // Fail fast on bad input, before a long derivation.
-    let model = b.model()?;
-    warn(&model);
+    let model = load(&b)?;
     let label = format!(
         "deriving and emitting {} ({} joints)",
         model.name,
@@ -528,7 +547,7 @@ fn show(a: ShowArgs) -> Result<(), Failure> {
             .exit();
     }
     let b = a.model.builder(&a.urdf, &a.symbolic);
-    let model = b.model()?;
+    let model = load(&b)?;
     let d = derive(&b, &model)?;
     let opts = ShowOptions {
         terms,
@@ -563,9 +582,8 @@ fn show(a: ShowArgs) -> Result<(), Failure> {
 fn info_cmd(a: InfoArgs) -> Result<(), Failure> {
     let b = a.model.builder(&a.urdf, &None);
     let start = Instant::now();
-    let model = b.model()?;
-    let load = start.elapsed();
-    warn(&model);
+    let model = load(&b)?;
+    let load_time = start.elapsed();
     let label = format!(
         "deriving and emitting {} ({} joints)",
         model.name,
@@ -575,20 +593,21 @@ fn info_cmd(a: InfoArgs) -> Result<(), Failure> {
     let (generated, model, d) =
         progress::run(&label, || b.generate_with_report()).map_err(cli_error)?;
     let derive: std::time::Duration = d.timings.iter().map(|t| t.1).sum();
-    let emit_time = start.elapsed().saturating_sub(derive + load);
+    let emit_time = start.elapsed().saturating_sub(derive + load_time);
+    warn_lines(conditioning::sampled_warnings(&model, &d));
     emit(&info::print(
         &model,
         &d,
         &generated,
         &file_name(&a.urdf),
-        load,
+        load_time,
         emit_time,
     ))
 }
 
 fn eval_cmd(a: EvalArgs) -> Result<(), Failure> {
     let b = a.model.builder(&a.urdf, &None);
-    let model = b.model()?;
+    let model = load(&b)?;
     let n = model.dof();
     let joints = model
         .joints
@@ -615,13 +634,18 @@ fn eval_cmd(a: EvalArgs) -> Result<(), Failure> {
     };
     let d = derive(&b, &model)?;
     let values = eval::evaluate(&model, &d, &state).map_err(Failure)?;
+    warn_lines(conditioning::warning(
+        &model,
+        &values.mass_matrix,
+        "at this state",
+    ));
     let digits = (a.digits > 0).then_some(a.digits);
     emit(&eval::print(&model, &state, &values, digits))
 }
 
 fn simulate_cmd(a: SimulateArgs) -> Result<(), Failure> {
     let b = a.model.builder(&a.urdf, &None);
-    let model = b.model()?;
+    let model = load(&b)?;
     let n = model.dof();
     let check = |flag: &str, v: Option<Numbers>, default: &[f64]| -> Result<Vec<f64>, Failure> {
         match v {

@@ -13,8 +13,11 @@
 use nalgebra::{Matrix3, Vector3};
 
 mod build;
+mod inertia_check;
 pub mod shapes;
-pub use build::{ModelError, ModelOptions, ModelWarning, SymbolicParams, MAX_MAGNITUDE};
+pub use build::{
+    FormatIssue, ModelError, ModelOptions, ModelWarning, SymbolicParams, MAX_MAGNITUDE,
+};
 // The format-neutral description that readers (`crate::urdf`) fill in.
 pub(crate) use build::{
     build_model, CollisionDescription, InertialDescription, JointDescription, JointType,
