@@ -447,7 +447,7 @@ fn catalogue() -> Vec<(&'static str, String, Expect)> {
             chain(10_000, "revolute"),
             Error(&[
                 "10000 degrees of freedom",
-                "limit of 40",
+                "limit of 64",
                 "Builder::max_dof",
             ]),
         ),

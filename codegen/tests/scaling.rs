@@ -36,3 +36,13 @@ fn inverse_dynamics_operations_grow_linearly() {
         "24 joints: +{extra} over 12, step {typical}"
     );
 }
+
+#[test]
+fn the_synthetic_chain_is_a_valid_robot_at_every_length_up_to_the_default_limit() {
+    for n in [1, 27, 40, eomgen::DEFAULT_MAX_DOF] {
+        let urdf = chain::serial_chain_urdf(n);
+        let model = eomgen::urdf::load_str(&urdf, "chain.urdf", &Default::default())
+            .unwrap_or_else(|e| panic!("chain of {n}: {e}"));
+        assert_eq!(model.dof(), n);
+    }
+}

@@ -47,6 +47,7 @@ pub fn axis(g: &mut Graph, joint: &Joint) -> V3 {
 /// The body's placement in the joint frame, for the joint's position coordinates `q`
 /// (`joint.kind.nq()` of them).
 pub fn motion(g: &mut Graph, joint: &Joint, q: &[Id]) -> Placement {
+    debug_assert_eq!(q.len(), joint.kind.nq(), "joint {}", joint.name);
     let zero = [g.zero(); 3];
     match joint.kind {
         JointKind::Revolute | JointKind::Continuous => Placement {
@@ -80,7 +81,8 @@ pub fn compose(g: &mut Graph, outer: &Placement, inner: &Placement) -> Placement
     }
 }
 
-/// The motion subspace: `nv` spatial columns (angular; linear) in body axes.
+/// The motion subspace: `nv` spatial columns (angular; linear) in body axes
+/// (`joint.kind.nv()` of them).
 pub fn subspace(g: &mut Graph, joint: &Joint) -> Vec<Spatial> {
     let a = axis(g, joint);
     let zero = [g.zero(); 3];

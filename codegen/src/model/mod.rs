@@ -60,8 +60,25 @@ pub enum JointKind {
 }
 
 impl JointKind {
+    /// Whether the joint rotates its body (revolute and continuous joints).
     pub fn is_revolute(self) -> bool {
         matches!(self, JointKind::Revolute | JointKind::Continuous)
+    }
+
+    /// How many position coordinates the joint has in `q` (see
+    /// [`crate::kinematics::joint`] for what they mean).
+    pub fn nq(self) -> usize {
+        match self {
+            JointKind::Revolute | JointKind::Continuous | JointKind::Prismatic => 1,
+        }
+    }
+
+    /// How many velocity coordinates the joint has in `qd` (the columns of its motion
+    /// subspace).
+    pub fn nv(self) -> usize {
+        match self {
+            JointKind::Revolute | JointKind::Continuous | JointKind::Prismatic => 1,
+        }
     }
 }
 
