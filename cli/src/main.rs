@@ -1,4 +1,6 @@
-//! The `eomgen` command line (clap): `generate`, `show`, `info`, `eval`, `simulate`.
+//! The `eomgen` command line (clap): `generate`, `show`, `info`, `eval`, `simulate`. Run
+//! `eomgen --help`. It is a crate of its own (`eomgen-cli`) so that build scripts depending on
+//! the `eomgen` library compile none of its dependencies.
 //!
 //! Exit codes: 0 on success, 1 on bad input (one line on stderr, starting with
 //! `eomgen: error:`), 2 on bad usage (clap's message). Nothing panics visibly: a panic would be
@@ -379,7 +381,7 @@ impl<E: std::fmt::Display> From<E> for Failure {
 }
 
 /// Entry point of the binary.
-pub fn main() -> ExitCode {
+fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(c) => c,
         Err(e) => {

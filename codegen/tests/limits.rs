@@ -93,39 +93,3 @@ fn a_full_graph_stops_growing_and_reports_instead_of_panicking() {
     g.sin(x);
     assert!(g.check().is_ok());
 }
-
-#[test]
-fn show_names_the_graph_limit_when_expansion_fills_the_graph() {
-    // Just enough nodes for the derivation, not for the expansion.
-    let builder = eomgen::Builder::new(urdf("double_pendulum"));
-    let derived = builder.derive(&builder.model().unwrap()).unwrap();
-    let limit = (derived.graph.len() + 2).to_string();
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_eomgen"))
-        .arg("show")
-        .arg(urdf("double_pendulum"))
-        .args(["--max-graph-nodes", &limit])
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{stderr}");
-    assert_eq!(stderr.lines().count(), 1, "{stderr}");
-    assert!(
-        stderr.contains("double_pendulum.urdf")
-            && stderr.contains(&format!("limit of {limit} nodes"))
-            && stderr.contains("while expanding the equations")
-            && stderr.contains("--max-graph-nodes"),
-        "{stderr}"
-    );
-    // In program form nothing is expanded: the same limit suffices.
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_eomgen"))
-        .arg("show")
-        .arg(urdf("double_pendulum"))
-        .args(["--max-graph-nodes", &limit, "--form", "program"])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-}
