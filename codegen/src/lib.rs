@@ -16,10 +16,12 @@ use std::path::{Path, PathBuf};
 
 mod builder;
 pub mod cas;
+mod debug_display;
 pub mod dynamics;
 pub mod emit;
 pub mod kinematics;
 pub mod model;
+mod regenerate;
 pub mod report;
 pub mod urdf;
 
@@ -27,7 +29,18 @@ pub use builder::{Builder, DEFAULT_MAX_DOF, DEFAULT_MAX_GRAPH_NODES};
 pub use model::{ModelError, ModelOptions, SymbolicParams};
 
 /// Everything that can go wrong between a URDF and a written module.
-#[derive(Debug, thiserror::Error)]
+///
+/// `Debug` prints the same one-line message as `Display`, so that `.compile().unwrap()` in a
+/// build script shows it readably:
+///
+/// ```
+/// let err = eomgen::Builder::from_urdf_str("<robot name=\"r\"/>", "empty.urdf")
+///     .generate()
+///     .unwrap_err();
+/// assert_eq!(format!("{err:?}"), err.to_string());
+/// assert!(err.to_string().starts_with("empty.urdf: "));
+/// ```
+#[derive(thiserror::Error)]
 pub enum Error {
     /// The URDF is unreadable or describes no valid robot.
     #[error(transparent)]
