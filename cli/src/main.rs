@@ -84,6 +84,7 @@ struct ModelArgs {
         long,
         value_name = "EPS",
         default_value_t = 0.0,
+        hide_default_value = true,
         allow_hyphen_values = true
     )]
     coulomb_smoothing: f64,
@@ -266,7 +267,7 @@ struct EvalArgs {
     /// Joint torques (N m) or forces (N) for the forward dynamics [default: 0]
     #[arg(long, value_name = "TAU1,...", allow_hyphen_values = true, value_parser = parse_numbers)]
     tau: Option<Numbers>,
-    /// Significant digits of numbers; 0 (the default) prints the shortest exact decimals.
+    /// Significant digits of numbers; 0 prints the shortest exact decimals.
     #[arg(long, value_name = "N", default_value_t = 0)]
     digits: usize,
     #[command(flatten)]

@@ -576,6 +576,20 @@ fn help_documents_every_command_and_flag() {
                 "`eomgen {cmd} --help` does not document {f}"
             );
         }
+        // Each flag states its default once.
+        let mut options: Vec<String> = Vec::new();
+        for line in help.lines() {
+            match options.last_mut() {
+                Some(option) if !line.trim_start().starts_with('-') => option.push_str(line),
+                _ => options.push(line.to_string()),
+            }
+        }
+        for option in options {
+            assert!(
+                option.matches("[default:").count() <= 1,
+                "`eomgen {cmd} --help` repeats a default: {option}"
+            );
+        }
     }
 }
 
