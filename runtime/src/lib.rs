@@ -59,6 +59,7 @@ mod dynamics;
 mod joint_effects;
 mod linalg;
 mod pose;
+pub mod prelude;
 mod real;
 pub mod sim;
 
