@@ -202,7 +202,10 @@ pub fn run(model: &Model, d: &Derivation, o: &Options) -> Result<Outcome, String
             q[i] += h / 6.0 * (v1[i] + 2.0 * (v2[i] + v3[i]) + v4[i]);
             qd[i] += h / 6.0 * (a1[i] + 2.0 * (a2[i] + a3[i]) + a4[i]);
         }
-        if q.iter().chain(&qd).any(|x| !x.is_finite() || x.abs() >= DIVERGED) {
+        if q.iter()
+            .chain(&qd)
+            .any(|x| !x.is_finite() || x.abs() >= DIVERGED)
+        {
             return Err(diverged(t + h, h));
         }
     }

@@ -72,8 +72,11 @@ fn flags(o: &ModelOptions) -> Vec<(&'static str, Option<String>)> {
         SymbolicParams::All => f.push(("symbolic", None)),
         SymbolicParams::Links(links) => f.push(("symbolic", Some(links.join(",")))),
     }
-    if !o.armature.is_empty() {
-        let pairs: Vec<String> = o.armature.iter().map(|(j, v)| format!("{j}={v}")).collect();
+    // Zero rotor inertia changes nothing in the output: left out, as the default.
+    let pairs: Vec<String> = (o.armature.iter().filter(|(_, v)| *v != 0.0))
+        .map(|(j, v)| format!("{j}={v}"))
+        .collect();
+    if !pairs.is_empty() {
         f.push(("armature", Some(pairs.join(","))));
     }
     if o.friction {
