@@ -42,6 +42,8 @@
 
 // Matrix code reads best with explicit indices.
 #![allow(clippy::needless_range_loop)]
+// The front page's first example is a whole build.rs.
+#![allow(clippy::needless_doctest_main)]
 
 use std::path::{Path, PathBuf};
 
