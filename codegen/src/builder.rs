@@ -272,7 +272,8 @@ impl Builder {
         self
     }
 
-    /// The "Regenerate:" line of the banner.
+    /// The "Regenerate:" line of the banner; default: the `eomgen generate` command line that
+    /// writes the same file, with the options given to this builder.
     pub fn regenerate_hint(mut self, hint: &str) -> Builder {
         self.regenerate = Some(hint.to_string());
         self
@@ -360,7 +361,7 @@ impl Builder {
     /// Derives and emits, returning the source and the operation counts.
     pub fn generate_with_report(&self) -> Result<(Generated, Model, Derivation), Error> {
         let model = self.model()?;
-        let (type_name, _) = self.names(&model)?;
+        let (type_name, module_name) = self.names(&model)?;
         let derivation = self.derive(&model)?;
         let source_name = self
             .urdf
@@ -368,7 +369,18 @@ impl Builder {
             .map(|f| f.to_string_lossy().into_owned())
             .unwrap_or_else(|| "robot.urdf".into());
         let regenerate = self.regenerate.clone().unwrap_or_else(|| {
-            format!("eomgen generate {source_name} --type-name {type_name} (or eomgen::Builder in a build script)")
+            crate::regenerate::command_line(
+                &crate::regenerate::Command {
+                    urdf: &self.urdf,
+                    type_name: &type_name,
+                    module_name: &module_name,
+                    module_name_given: self.module_name.is_some(),
+                    max_dof: self.max_dof,
+                    max_graph_nodes: self.max_graph_nodes,
+                    quantities: self.quantities.as_deref(),
+                },
+                &self.options,
+            )
         });
         let opts = EmitOptions {
             type_name,

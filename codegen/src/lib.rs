@@ -2,7 +2,38 @@
 //!
 //! eomgen reads a robot's URDF, derives its rigid-body dynamics with its own small computer
 //! algebra system ([`cas`]) and emits allocation-free `no_std` Rust that the
-//! `eomgen-runtime` crate supports. Most users need only [`Builder`], from a build script.
+//! `eomgen-runtime` crate supports. Most users need only [`Builder`], from a build script:
+//!
+//! ```no_run
+//! // build.rs, with `eomgen` in [build-dependencies] and `eomgen-runtime` in [dependencies]
+//! fn main() {
+//!     eomgen::Builder::new("robots/panda.urdf").compile().unwrap();
+//! }
+//! ```
+//!
+//! and then, in the crate, a robot type with its mass matrix, gravity, Coriolis terms, inverse
+//! and forward dynamics, energies, link poses and Jacobians (here the double pendulum that the
+//! repository's `generated/` crate holds):
+//!
+//! ```
+//! # mod generated { include!("../../generated/src/double_pendulum.rs"); }
+//! # use generated::{DoublePendulum, DoublePendulumLink};
+//! // include!(concat!(env!("OUT_DIR"), "/double_pendulum.rs"));
+//! use eomgen_runtime::prelude::*;
+//!
+//! let robot = DoublePendulum::<f64>::default(); // DoublePendulum::<f32> on a microcontroller
+//! let (q, qd) = ([0.3, -0.2], [0.0, 0.0]);
+//! let hold = robot.inverse_dynamics(&q, &qd, &[0.0, 0.0]); // gravity compensation
+//! let g = robot.gravity(&q);
+//! assert!((hold[0] - g[0]).abs() < 1e-12 && (hold[1] - g[1]).abs() < 1e-12);
+//! let tip: Pose<f64> = robot.link_pose(DoublePendulumLink::Link2, &q);
+//! assert!(tip.translation.iter().all(|x| x.is_finite()));
+//! ```
+//!
+//! `.compile().unwrap()` prints a bad URDF's one-line message (`robot.urdf: the robot has no
+//! links`): [`Error`]'s `Debug` is its `Display`. The repository's `examples/` crate controls a
+//! 7-joint arm generated this way (`cargo run --example computed_torque`), and the `eomgen`
+//! command line (crate `eomgen-cli`) prints the same equations for people.
 //!
 //! The pipeline, one module per stage:
 //! [`urdf`] (the only module that sees XML) → [`model`] (kinematic tree, merged fixed links) →
@@ -12,15 +43,19 @@
 
 // Matrix code reads best with explicit indices.
 #![allow(clippy::needless_range_loop)]
+// The front page's first example is a whole build.rs.
+#![allow(clippy::needless_doctest_main)]
 
 use std::path::{Path, PathBuf};
 
 mod builder;
 pub mod cas;
+mod debug_display;
 pub mod dynamics;
 pub mod emit;
 pub mod kinematics;
 pub mod model;
+mod regenerate;
 pub mod report;
 pub mod spatial;
 pub mod urdf;
@@ -29,7 +64,18 @@ pub use builder::{Builder, DEFAULT_MAX_DOF, DEFAULT_MAX_GRAPH_NODES};
 pub use model::{ModelError, ModelOptions, SymbolicParams};
 
 /// Everything that can go wrong between a URDF and a written module.
-#[derive(Debug, thiserror::Error)]
+///
+/// `Debug` prints the same one-line message as `Display`, so that `.compile().unwrap()` in a
+/// build script shows it readably:
+///
+/// ```
+/// let err = eomgen::Builder::from_urdf_str("<robot name=\"r\"/>", "empty.urdf")
+///     .generate()
+///     .unwrap_err();
+/// assert_eq!(format!("{err:?}"), err.to_string());
+/// assert!(err.to_string().starts_with("empty.urdf: "));
+/// ```
+#[derive(thiserror::Error)]
 pub enum Error {
     /// The URDF is unreadable or describes no valid robot.
     #[error(transparent)]

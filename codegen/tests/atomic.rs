@@ -3,7 +3,6 @@
 //! unchanged regeneration does not touch the file.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use std::time::{Duration, SystemTime};
 
 fn robot(name: &str) -> PathBuf {
@@ -147,44 +146,4 @@ fn write_failures_leave_no_temporary_file() {
     let missing = dir.join("missing/robot.rs");
     assert!(eomgen::write_if_changed(&missing, b"fn main() {}").is_err());
     assert_eq!(listing(&dir), ["robot.rs"]);
-}
-
-#[test]
-fn the_cli_leaves_the_previous_output_untouched_on_error() {
-    let dir = scratch("cli");
-    let output = dir.join("robot.rs");
-    let bad_file = dir.join("bad.urdf");
-    std::fs::write(&bad_file, BAD_URDF).unwrap();
-    let generate = |urdf: &Path, extra: &[&str]| {
-        Command::new(env!("CARGO_BIN_EXE_eomgen"))
-            .arg("generate")
-            .arg(urdf)
-            .arg("-o")
-            .arg(&output)
-            .args(extra)
-            .output()
-            .unwrap()
-    };
-    let ok = generate(&robot("double_pendulum"), &[]);
-    assert!(
-        ok.status.success(),
-        "{}",
-        String::from_utf8_lossy(&ok.stderr)
-    );
-    let before = std::fs::read(&output).unwrap();
-    let written = mtime(&output);
-    for (urdf, extra) in [
-        (bad_file.as_path(), &[][..]),
-        (robot("ur5").as_path(), &["--max-dof", "2"][..]),
-        (robot("ur5").as_path(), &["--max-graph-nodes", "1000"][..]),
-        (robot("ur5").as_path(), &["--type-name", "not a type"][..]),
-    ] {
-        let out = generate(urdf, extra);
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(1), "{extra:?}: {stderr}");
-        assert_eq!(stderr.lines().count(), 1, "{stderr}");
-        assert_eq!(std::fs::read(&output).unwrap(), before, "{extra:?}");
-        assert_eq!(mtime(&output), written, "{extra:?}");
-        assert_eq!(listing(&dir), ["bad.urdf", "robot.rs"], "{extra:?}");
-    }
 }

@@ -15,28 +15,66 @@ const KEYWORDS: &[&str] = &[
     "override", "priv", "try", "typeof", "unsized", "virtual", "yield", "union", "_",
 ];
 
-/// Splits a name into ASCII alphanumeric words; every other character separates words.
-/// Non-ASCII characters become their code point (`é` -> `u00e9`) so that distinct names stay
-/// distinct as far as possible.
+/// Splits a name into words as the `heck` crate does: runs of ASCII letters and digits, cut
+/// where a lowercase letter (or a digit after one) meets an uppercase letter (`linkTip` ->
+/// `link`, `Tip`) and before the last capital of an acronym followed by a lowercase letter
+/// (`URDFRobot` -> `URDF`, `Robot`). Every other character separates words; non-ASCII
+/// characters become their code point (`é` -> `u00e9`) so that distinct names stay distinct as
+/// far as possible.
 fn words(name: &str) -> Vec<String> {
     let mut out = Vec::new();
-    let mut cur = String::new();
+    let mut run = String::new();
     for ch in name.chars() {
         if ch.is_ascii_alphanumeric() {
-            cur.push(ch);
-        } else {
-            if !cur.is_empty() {
-                out.push(std::mem::take(&mut cur));
-            }
-            if !ch.is_ascii() {
-                out.push(format!("u{:04x}", ch as u32));
-            }
+            run.push(ch);
+            continue;
+        }
+        out.extend(case_words(&std::mem::take(&mut run)));
+        if !ch.is_ascii() {
+            out.push(format!("u{:04x}", ch as u32));
         }
     }
-    if !cur.is_empty() {
-        out.push(cur);
-    }
+    out.extend(case_words(&run));
     out
+}
+
+/// The case of the letters read so far in a word (digits keep it).
+#[derive(Clone, Copy, PartialEq)]
+enum Case {
+    Boundary,
+    Lower,
+    Upper,
+}
+
+/// Cuts a run of ASCII letters and digits at its case boundaries (see [`words`]).
+fn case_words(run: &str) -> Vec<String> {
+    let b = run.as_bytes();
+    let mut cuts = vec![0];
+    let mut mode = Case::Boundary;
+    for i in 0..b.len() {
+        let here = match b[i] {
+            c if c.is_ascii_lowercase() => Case::Lower,
+            c if c.is_ascii_uppercase() => Case::Upper,
+            _ => mode,
+        };
+        let next = b.get(i + 1).copied().unwrap_or(b'_');
+        if here == Case::Lower && next.is_ascii_uppercase() {
+            // `linkTip`: a word ends after the lowercase letter.
+            cuts.push(i + 1);
+            mode = Case::Boundary;
+        } else if mode == Case::Upper && b[i].is_ascii_uppercase() && next.is_ascii_lowercase() {
+            // `URDFRobot`: the acronym ends before its last capital.
+            cuts.push(i);
+            mode = Case::Boundary;
+        } else {
+            mode = here;
+        }
+    }
+    cuts.push(b.len());
+    cuts.windows(2)
+        .filter(|w| w[0] < w[1])
+        .map(|w| run[w[0]..w[1]].to_string())
+        .collect()
 }
 
 fn finish(mut s: String, fallback: &str) -> String {
@@ -52,12 +90,15 @@ fn finish(mut s: String, fallback: &str) -> String {
     s
 }
 
-/// `panda_link0` -> `PandaLink0`; `2dof planar` -> `Robot2dofPlanar` with fallback `Robot`.
+/// UpperCamelCase as the `heck` crate writes it: each word capitalized, the rest of it in
+/// lowercase. `panda_link0` -> `PandaLink0`, `UF_ROBOT` -> `UfRobot`; `2dof planar` ->
+/// `Robot2dofPlanar` with fallback `Robot`.
 pub fn upper_camel(name: &str, fallback: &str) -> String {
     let s: String = words(name)
         .iter()
         .map(|w| {
-            let mut c = w.chars();
+            let lower = w.to_ascii_lowercase();
+            let mut c = lower.chars();
             match c.next() {
                 Some(f) => f.to_ascii_uppercase().to_string() + c.as_str(),
                 None => String::new(),
@@ -67,7 +108,8 @@ pub fn upper_camel(name: &str, fallback: &str) -> String {
     finish(s, fallback)
 }
 
-/// `Panda Arm` -> `panda_arm`; fallback used when empty or starting with a digit.
+/// snake_case as the `heck` crate writes it: `Panda Arm` and `PandaArm` -> `panda_arm`;
+/// fallback used when empty or starting with a digit.
 pub fn snake(name: &str, fallback: &str) -> String {
     let s = words(name)
         .iter()
@@ -145,6 +187,24 @@ mod tests {
         assert_eq!(snake("Panda Arm", "robot"), "panda_arm");
         assert_eq!(snake("fn", "robot"), "fn_");
         assert_eq!(snake("9lives", "robot"), "robot9lives");
+    }
+
+    #[test]
+    fn case_follows_heck() {
+        for (name, camel, snake_case) in [
+            ("UF_ROBOT", "UfRobot", "uf_robot"),
+            ("xArm7", "XArm7", "x_arm7"),
+            ("URDFRobot", "UrdfRobot", "urdf_robot"),
+            ("PandaArm", "PandaArm", "panda_arm"),
+            ("link0Tip", "Link0Tip", "link0_tip"),
+            ("ABC", "Abc", "abc"),
+            ("j2n6s300_link_1", "J2n6s300Link1", "j2n6s300_link_1"),
+            ("a-b", "AB", "a_b"),
+            ("A1Bc", "A1Bc", "a1_bc"),
+        ] {
+            assert_eq!(upper_camel(name, "Robot"), camel, "{name}");
+            assert_eq!(snake(name, "robot"), snake_case, "{name}");
+        }
     }
 
     #[test]

@@ -231,7 +231,8 @@ pub enum SymbolicParams {
 
 /// Why a robot description could not become a [`Model`]. Every message starts with the file
 /// name and names the offending link or joint.
-#[derive(Debug, Error)]
+// Debug prints the Display message: see `debug_display.rs`.
+#[derive(Error)]
 pub enum ModelError {
     /// The file could not be read (or is not UTF-8).
     #[error("{file}: cannot read the file: {source}")]

@@ -3,7 +3,7 @@
 //! and the README's quick start.
 //!
 //! Snapshots live in `tests/snapshots/`; refresh them with
-//! `EOMGEN_BLESS=1 cargo test -p eomgen --test cli`.
+//! `EOMGEN_BLESS=1 cargo test -p eomgen-cli --test cli`.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -20,7 +20,7 @@ const ROBOTS: [&str; 5] = [
 fn workspace() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .parent()
-        .expect("the workspace holds codegen/")
+        .expect("the workspace holds cli/")
         .to_path_buf()
 }
 
@@ -117,7 +117,7 @@ fn snapshot(name: &str, actual: &str) {
         return;
     }
     let expected = std::fs::read(&path).unwrap_or_else(|_| {
-        panic!("missing snapshot {name}; create it with EOMGEN_BLESS=1 cargo test -p eomgen --test cli")
+        panic!("missing snapshot {name}; create it with EOMGEN_BLESS=1 cargo test -p eomgen-cli --test cli")
     });
     if expected != actual.as_bytes() {
         let expected = String::from_utf8_lossy(&expected);
@@ -127,7 +127,7 @@ fn snapshot(name: &str, actual: &str) {
             .position(|(a, b)| a != b)
             .unwrap_or(expected.lines().count().min(actual.lines().count()));
         panic!(
-            "snapshot {name} differs at line {}:\n- {}\n+ {}\nrefresh with EOMGEN_BLESS=1 cargo test -p eomgen --test cli",
+            "snapshot {name} differs at line {}:\n- {}\n+ {}\nrefresh with EOMGEN_BLESS=1 cargo test -p eomgen-cli --test cli",
             line + 1,
             expected.lines().nth(line).unwrap_or("<end>"),
             actual.lines().nth(line).unwrap_or("<end>")
@@ -290,7 +290,17 @@ fn generate_matches_the_builder_and_writes_files() {
         let expected = eomgen::Builder::new(workspace().join(&path))
             .generate()
             .expect("generates");
-        assert!(out == expected, "{name}: CLI and Builder differ");
+        // The same code; the banner's Regenerate line records the path as each was given it.
+        let code = |s: &str| {
+            s.lines()
+                .filter(|l| !l.starts_with("// Regenerate: "))
+                .collect::<Vec<_>>()
+                .join("\n")
+        };
+        assert!(
+            code(&out) == code(&expected),
+            "{name}: CLI and Builder differ"
+        );
     }
     let dir = scratch("generate");
     let file = dir.join("pendulum.rs");
@@ -574,6 +584,20 @@ fn help_documents_every_command_and_flag() {
             assert!(
                 help.contains(f),
                 "`eomgen {cmd} --help` does not document {f}"
+            );
+        }
+        // Each flag states its default once.
+        let mut options: Vec<String> = Vec::new();
+        for line in help.lines() {
+            match options.last_mut() {
+                Some(option) if !line.trim_start().starts_with('-') => option.push_str(line),
+                _ => options.push(line.to_string()),
+            }
+        }
+        for option in options {
+            assert!(
+                option.matches("[default:").count() <= 1,
+                "`eomgen {cmd} --help` repeats a default: {option}"
             );
         }
     }
@@ -867,7 +891,7 @@ fn readme_quick_start_works() {
     assert_eq!(commands.len(), 2, "{commands:?}");
     assert_eq!(commands[1], "cargo test --workspace");
     let args: Vec<&str> = commands[0]
-        .strip_prefix("cargo run -p eomgen -- ")
+        .strip_prefix("cargo run -p eomgen-cli -- ")
         .expect("the first command runs eomgen through cargo")
         .split_whitespace()
         .collect();

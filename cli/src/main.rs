@@ -1,4 +1,6 @@
-//! The `eomgen` command line (clap): `generate`, `show`, `info`, `eval`, `simulate`.
+//! The `eomgen` command line (clap): `generate`, `show`, `info`, `eval`, `simulate`. Run
+//! `eomgen --help`. It is a crate of its own (`eomgen-cli`) so that build scripts depending on
+//! the `eomgen` library compile none of its dependencies.
 //!
 //! Exit codes: 0 on success, 1 on bad input (one line on stderr, starting with
 //! `eomgen: error:`), 2 on bad usage (clap's message). Nothing panics visibly: a panic would be
@@ -84,6 +86,7 @@ struct ModelArgs {
         long,
         value_name = "EPS",
         default_value_t = 0.0,
+        hide_default_value = true,
         allow_hyphen_values = true
     )]
     coulomb_smoothing: f64,
@@ -276,7 +279,7 @@ struct EvalArgs {
     /// Joint torques (N m) or forces (N) for the forward dynamics [default: 0]
     #[arg(long, value_name = "TAU1,...", allow_hyphen_values = true, value_parser = parse_numbers)]
     tau: Option<Numbers>,
-    /// Significant digits of numbers; 0 (the default) prints the shortest exact decimals.
+    /// Significant digits of numbers; 0 prints the shortest exact decimals.
     #[arg(long, value_name = "N", default_value_t = 0)]
     digits: usize,
     #[command(flatten)]
@@ -391,7 +394,7 @@ impl<E: std::fmt::Display> From<E> for Failure {
 }
 
 /// Entry point of the binary.
-pub fn main() -> ExitCode {
+fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(c) => c,
         Err(e) => {

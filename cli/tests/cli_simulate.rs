@@ -7,7 +7,7 @@ use std::process::{Command, Output};
 fn workspace() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .parent()
-        .expect("the workspace holds codegen/")
+        .expect("the workspace holds cli/")
         .to_path_buf()
 }
 

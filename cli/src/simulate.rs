@@ -50,6 +50,41 @@ pub struct Outcome {
     pub positions: Vec<Vec<f64>>,
 }
 
+/// Positions (rad, m) or velocities (rad/s, m/s) beyond this mean the integration diverged.
+const DIVERGED: f64 = 1e8;
+
+/// Why the accelerations at a state could not be computed.
+enum StepError {
+    /// The mass matrix's factorization failed at this pivot (1-based) of `of`.
+    MassMatrix { pivot: usize, of: usize },
+    /// The interpreter failed.
+    Eval(String),
+}
+
+/// The message for a failed step at time `t` of a run with step `dt`: at the initial state
+/// the model is at fault; later, a mass matrix that was positive definite at the start can
+/// only fail on a state that the integration blew up (M depends on q through sines and
+/// cosines, which lose all precision or become NaN for huge or infinite angles).
+fn step_message(e: StepError, name: &str, t: f64, dt: f64) -> String {
+    match e {
+        StepError::Eval(message) => message,
+        StepError::MassMatrix { pivot, of } if t == 0.0 => format!(
+            "{name}: the mass matrix is not positive definite at the initial state (pivot \
+             {pivot} of {of}): check the inertias and --q0"
+        ),
+        StepError::MassMatrix { .. } => diverged(t, dt),
+    }
+}
+
+/// The integration diverged at `t`: what to do about it.
+fn diverged(t: f64, dt: f64) -> String {
+    format!(
+        "the integration diverged at t = {t} s (the state became non-finite or exploded): the \
+         step is too large for the system's fastest dynamics (stiff friction on a light link, \
+         high gains); try a smaller --dt than {dt}"
+    )
+}
+
 /// M, b, G and the energies at `(q, qd)`.
 fn terms(model: &Model, d: &Derivation, q: &[f64], qd: &[f64]) -> Result<eval::Values, String> {
     let n = q.len();
@@ -72,9 +107,9 @@ fn step_eval(
     o: &Options,
     q: &[f64],
     qd: &[f64],
-) -> Result<(Vec<f64>, Vec<f64>), String> {
+) -> Result<(Vec<f64>, Vec<f64>), StepError> {
     let n = q.len();
-    let v = terms(model, d, q, qd)?;
+    let v = terms(model, d, q, qd).map_err(StepError::Eval)?;
     // The effort friction takes (zero unless the model includes it, `--friction`).
     let friction = &v.friction;
     let tau: Vec<f64> = match o.controller {
@@ -100,13 +135,9 @@ fn step_eval(
     let rhs: Vec<f64> = (0..n)
         .map(|i| tau[i] - v.bias[i] - v.gravity[i] - friction[i])
         .collect();
-    let qdd = eval::cholesky_solve(&v.mass_matrix, &rhs).map_err(|k| {
-        format!(
-            "{}: the mass matrix is not positive definite during the simulation (pivot {} of \
-             {n}); the state diverged or the inertias are wrong",
-            model.name,
-            k + 1
-        )
+    let qdd = eval::cholesky_solve(&v.mass_matrix, &rhs).map_err(|k| StepError::MassMatrix {
+        pivot: k + 1,
+        of: n,
     })?;
     Ok((tau, qdd))
 }
@@ -152,32 +183,34 @@ pub fn run(model: &Model, d: &Derivation, o: &Options) -> Result<Outcome, String
     let e0 = e(&q, &qd)?;
     let h = o.dt;
     let (mut times, mut positions) = (Vec::new(), Vec::new());
+    let fail = |e: StepError, t: f64| step_message(e, &model.name, t, h);
     for k in 0..steps {
         let t = k as f64 * h;
-        let (tau, a1) = step_eval(model, d, o, &q, &qd)?;
+        let (tau, a1) = step_eval(model, d, o, &q, &qd).map_err(|e| fail(e, t))?;
         row(&mut csv, t, &q, &qd, &tau);
         times.push(t);
         positions.push(q.clone());
         let v1 = qd.clone();
+        let stage = |q: &[f64], v: &[f64]| step_eval(model, d, o, q, v).map_err(|e| fail(e, t + h));
         let (q2, v2) = (axpy(&q, h / 2.0, &v1), axpy(&qd, h / 2.0, &a1));
-        let (_, a2) = step_eval(model, d, o, &q2, &v2)?;
+        let (_, a2) = stage(&q2, &v2)?;
         let (q3, v3) = (axpy(&q, h / 2.0, &v2), axpy(&qd, h / 2.0, &a2));
-        let (_, a3) = step_eval(model, d, o, &q3, &v3)?;
+        let (_, a3) = stage(&q3, &v3)?;
         let (q4, v4) = (axpy(&q, h, &v3), axpy(&qd, h, &a3));
-        let (_, a4) = step_eval(model, d, o, &q4, &v4)?;
+        let (_, a4) = stage(&q4, &v4)?;
         for i in 0..q.len() {
             q[i] += h / 6.0 * (v1[i] + 2.0 * (v2[i] + v3[i]) + v4[i]);
             qd[i] += h / 6.0 * (a1[i] + 2.0 * (a2[i] + a3[i]) + a4[i]);
         }
-        if q.iter().chain(&qd).any(|x| !x.is_finite()) {
-            return Err(format!(
-                "the simulation diverged at t = {}; try a smaller --dt",
-                t + h
-            ));
+        if q.iter()
+            .chain(&qd)
+            .any(|x| !x.is_finite() || x.abs() >= DIVERGED)
+        {
+            return Err(diverged(t + h, h));
         }
     }
-    let (tau, _) = step_eval(model, d, o, &q, &qd)?;
     let t_end = steps as f64 * h;
+    let (tau, _) = step_eval(model, d, o, &q, &qd).map_err(|e| fail(e, t_end))?;
     row(&mut csv, t_end, &q, &qd, &tau);
     times.push(t_end);
     positions.push(q.clone());

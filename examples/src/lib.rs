@@ -1,0 +1,28 @@
+//! The robot of eomgen's examples: the Franka Emika Panda arm, 7 revolute joints with the
+//! gripper held closed, generated from `robots/panda_arm.urdf` by this crate's `build.rs`.
+//!
+//! Run the examples from the repository root:
+//!
+//! ```sh
+//! cargo run --example computed_torque       # track a joint target in simulation (f64)
+//! cargo run --example gravity_compensation  # hold a pose against gravity (f32)
+//! cargo run --example task_space_force      # push with the hand: tau = J^T F
+//! ```
+//!
+//! ```
+//! use eomgen_examples::{PandaArm, PandaArmLink};
+//! use eomgen_runtime::prelude::*;
+//!
+//! let robot = PandaArm::<f64>::default();
+//! let q = [0.0, -0.3, 0.0, -2.2, 0.0, 2.0, 0.8];
+//! let hand: Pose<f64> = robot.link_pose(PandaArmLink::PandaHand, &q);
+//! assert!(hand.translation[2] > 0.3);
+//! assert_eq!(PandaArm::<f64>::JOINT_NAMES.len(), 7);
+//! ```
+
+#![no_std]
+
+include!(concat!(env!("OUT_DIR"), "/panda_arm.rs"));
+
+/// A comfortable start configuration (rad): elbow bent, hand pointing down.
+pub const READY: [f64; 7] = [0.0, -0.3, 0.0, -2.2, 0.0, 2.0, 0.8];

@@ -1,0 +1,15 @@
+//! Everything code that uses a generated robot needs in scope, in one line:
+//!
+//! ```
+//! use eomgen_runtime::prelude::*;
+//! ```
+//!
+//! It brings [`Dynamics`] (the trait every generated robot implements, so that
+//! `robot.mass_matrix(&q)` resolves), [`Real`] (the scalar trait, for code generic over `f32`
+//! and `f64`), and the types generated methods return: [`Pose`] (from `link_pose`) and
+//! [`FactorError`] (from `try_forward_dynamics`).
+//!
+//! The prelude is part of the public API: items are added to it only in minor versions and
+//! never removed outside a major one.
+
+pub use crate::{Dynamics, FactorError, Pose, Real};
