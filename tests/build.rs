@@ -2,6 +2,9 @@
 //! joint friction, rotor inertia and an inertia filled from its collision box, and two
 //! bad-input robots.
 
+#[path = "../codegen/tests/support/chain.rs"]
+mod chain;
+
 fn main() {
     for (file, module, ty) in [
         (
@@ -35,6 +38,7 @@ fn main() {
     joint_effects();
     // What a firmware that needs inverse dynamics alone generates (plus Craig's B, which
     // brings the Coriolis matrix it loops over).
+    deep_chain();
     eomgen::Builder::new("robots/panda.urdf")
         .module_name("panda_selected")
         .type_name("PandaSelected")
@@ -82,4 +86,17 @@ fn joint_effects() {
         let path = out_dir.join(format!("{module}.rs"));
         eomgen::write_if_changed(&path, generated.source.as_bytes()).unwrap();
     }
+}
+
+/// A 24-joint serial chain, deep enough that forward dynamics solves at run time instead of
+/// unrolling (only the functions the tests call, to keep the build small).
+fn deep_chain() {
+    let out_dir = std::path::PathBuf::from(std::env::var_os("OUT_DIR").unwrap());
+    let urdf = chain::write_serial_chain(&out_dir, 24).unwrap();
+    eomgen::Builder::new(&urdf)
+        .module_name("chain24")
+        .type_name("Chain24")
+        .quantities(["forward_dynamics", "inverse_dynamics"])
+        .compile()
+        .unwrap();
 }

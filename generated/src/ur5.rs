@@ -79,7 +79,7 @@ impl<T: ::eomgen_runtime::Real> Ur5<T> {
     pub const DOF: usize = 6;
     /// Forward dynamics `qdd = M(q)^-1 (tau - b(q, qd) - G(q))`, or which pivot of the
     /// `L^T D L` factorization of M(q) was not positive (a non-physical model or
-    /// non-finite input); see `forward_dynamics` for the operation count.
+    /// non-finite input); see `forward_dynamics` for the route and operation count.
     /// `Ok` holds only finite numbers: a non-finite component `i` of the solution (from
     /// a non-finite `qd` or `tau`, or a `q` that leaves M(q) finite) is reported as
     /// `FactorError::NonFinite { pivot: i }`.

@@ -6,7 +6,7 @@
 //! straight-line code, the joint axes, the chains from the root); the loops here are the same
 //! for every robot, so a 48-joint robot costs no more code than its joints.
 
-use crate::{Pose, Real};
+use crate::{FactorError, Pose, Real};
 
 /// How a joint moves its body, for Jacobian columns.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -166,4 +166,79 @@ pub fn coriolis_pairs_from_coriolis<T: Real, const N: usize, const P: usize>(
         }
     }
     out
+}
+
+/// Solves `M x = b` for the mass matrix of a kinematic tree by Featherstone's `L^T D L`
+/// factorization in reverse joint order, which creates no fill-in: `M_ij` is touched only when
+/// one of `i`, `j` is an ancestor of the other (`parent[i]` is joint `i`'s parent joint, `None`
+/// at the root; a parent comes before its children). `m` is overwritten by the factors.
+///
+/// Fails with the first pivot, in elimination order (last joint first), that is not finite or
+/// not positive, or with the first component of `x` that is not finite.
+///
+/// ```
+/// use eomgen_runtime::tree::ltdl_solve;
+/// // a two-joint chain
+/// let mut m = [[2.0_f64, 0.5], [0.5, 1.0]];
+/// let x = ltdl_solve(&mut m, &[None, Some(0)], &[2.5, 1.5]).unwrap();
+/// assert!((x[0] - 1.0).abs() < 1e-12 && (x[1] - 1.0).abs() < 1e-12);
+/// ```
+pub fn ltdl_solve<T: Real, const N: usize>(
+    m: &mut [[T; N]; N],
+    parent: &[Option<usize>; N],
+    b: &[T; N],
+) -> Result<[T; N], FactorError> {
+    // Parents precede children, so every index below is in range.
+    if parent
+        .iter()
+        .enumerate()
+        .any(|(i, p)| p.is_some_and(|p| p >= i))
+    {
+        return Err(FactorError::NonFinite { pivot: 0 });
+    }
+    for k in (0..N).rev() {
+        let d = m[k][k];
+        if !d.is_finite() {
+            return Err(FactorError::NonFinite { pivot: k });
+        }
+        if d <= T::zero() {
+            return Err(FactorError::NotPositiveDefinite { pivot: k });
+        }
+        let mut i = parent[k];
+        while let Some(ii) = i {
+            let a = m[k][ii] / d;
+            let mut j = Some(ii);
+            while let Some(jj) = j {
+                let v = m[k][jj] * a;
+                m[ii][jj] -= v;
+                j = parent[jj];
+            }
+            m[k][ii] = a;
+            i = parent[ii];
+        }
+    }
+    let mut x = *b;
+    for i in (0..N).rev() {
+        let mut j = parent[i];
+        while let Some(jj) = j {
+            let v = m[i][jj] * x[i];
+            x[jj] -= v;
+            j = parent[jj];
+        }
+    }
+    for (i, xi) in x.iter_mut().enumerate() {
+        *xi /= m[i][i];
+    }
+    for i in 0..N {
+        let mut j = parent[i];
+        while let Some(jj) = j {
+            let v = m[i][jj] * x[jj];
+            x[i] -= v;
+            j = parent[jj];
+        }
+    }
+    match x.iter().position(|v| !v.is_finite()) {
+        Some(pivot) => Err(FactorError::NonFinite { pivot }),
+        None => Ok(x),
+    }
 }

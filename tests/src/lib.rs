@@ -257,6 +257,11 @@ pub mod robots {
     pub mod panda_selected {
         include!(concat!(env!("OUT_DIR"), "/panda_selected.rs"));
     }
+    /// A synthetic 24-joint serial chain with only forward and inverse dynamics: forward
+    /// dynamics solves at run time (`eomgen_runtime::tree::ltdl_solve`).
+    pub mod chain24 {
+        include!(concat!(env!("OUT_DIR"), "/chain24.rs"));
+    }
     /// `codegen/tests/urdf/hostile/names.urdf`: link and joint names that try to break out of
     /// comments and string literals; compiling this module is the test.
     pub mod hostile_names {

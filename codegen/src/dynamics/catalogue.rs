@@ -91,6 +91,10 @@ pub enum Evaluation {
         accelerations: Vec<Id>,
         pivots: Vec<Id>,
     },
+    /// The same solve at run time: `M` from `mass_matrix`, `h = b + G + F` as straight-line
+    /// code, then the runtime's sparse `L^T D L` (`tree::ltdl_solve`) over the joint tree, for
+    /// robots whose unrolled solve (and second copy of `M`) would be large.
+    ForwardDynamicsSolve { h: Vec<Id> },
     /// A link frame's world pose: per-joint transforms composed along the link's chain.
     LinkPose,
     /// A link frame's 6 x N Jacobian, from the same per-joint transforms.
@@ -126,6 +130,7 @@ impl Quantity {
                 accelerations,
                 pivots,
             } => accelerations.iter().chain(pivots).copied().collect(),
+            Evaluation::ForwardDynamicsSolve { h } => h.clone(),
             _ => Vec::new(),
         }
     }
@@ -139,6 +144,7 @@ impl Quantity {
     pub fn needs(&self) -> &'static [&'static str] {
         match self.eval {
             Evaluation::CraigColumns(_) => &["coriolis_matrix"],
+            Evaluation::ForwardDynamicsSolve { .. } => &["mass_matrix"],
             _ => &[],
         }
     }

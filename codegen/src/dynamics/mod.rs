@@ -151,6 +151,8 @@ pub struct Fast {
     pub kinetic_energy_route: Route,
     /// Joint efforts as symbols `tau_i` (inputs of forward dynamics).
     pub tau_in: Vec<Id>,
+    /// `h = b + G + F(qd)`, the right-hand side's part that forward dynamics subtracts.
+    pub bias_gravity_friction: Vec<Id>,
     /// `qdd = M^-1 (tau_in - b - G - F)`, with an unrolled sparse `L^T D L` solve.
     pub forward_dynamics: Vec<Id>,
     /// The pivots `D` of that factorization, all positive when `M` is positive definite.
@@ -472,6 +474,7 @@ fn fast_forms(
         kinetic_energy,
         kinetic_energy_route,
         tau_in,
+        bias_gravity_friction: h,
         forward_dynamics,
         pivots,
     })

@@ -169,7 +169,35 @@ fn inverse_dynamics(d: &Derivation, notes: &Notes) -> Quantity {
     }
 }
 
+/// Forward dynamics unrolled into straight-line code when that is at most this many
+/// operations; beyond, `M` from `mass_matrix` and a sparse solve at run time (a 48-joint chain's
+/// unrolled solve and second copy of `M` were 49k lines of its 172k).
+pub const FORWARD_DYNAMICS_FLAT_MAX_OPS: usize = 20_000;
+
 fn forward_dynamics(d: &Derivation, notes: &Notes) -> Quantity {
+    let unrolled: Vec<Id> = d
+        .fast
+        .forward_dynamics
+        .iter()
+        .chain(&d.fast.pivots)
+        .copied()
+        .collect();
+    let (route, eval) = if ops(&d.graph, &unrolled) <= FORWARD_DYNAMICS_FLAT_MAX_OPS {
+        (
+            "Route: M and b + G as in `mass_matrix` and `bias`, then an unrolled L^T D L solve without fill-in.",
+            Evaluation::ForwardDynamics {
+                accelerations: d.fast.forward_dynamics.clone(),
+                pivots: d.fast.pivots.clone(),
+            },
+        )
+    } else {
+        (
+            "Route: M from `mass_matrix`, b + G by Newton-Euler, then a sparse L^T D L solve over the joint tree at run time (eomgen_runtime::tree::ltdl_solve).",
+            Evaluation::ForwardDynamicsSolve {
+                h: d.fast.bias_gravity_friction.clone(),
+            },
+        )
+    };
     Quantity {
         name: "forward_dynamics",
         inputs: &[Input::Q, Input::Qd, Input::Tau],
@@ -185,11 +213,8 @@ fn forward_dynamics(d: &Derivation, notes: &Notes) -> Quantity {
             &notes.friction("`qdd = M^-1 (tau - b - G - F(qd))`: includes"),
             &notes.armature("M includes"),
         ]),
-        route: "Route: M and b + G as in `mass_matrix` and `bias`, then an unrolled L^T D L solve without fill-in.".into(),
-        eval: Evaluation::ForwardDynamics {
-            accelerations: d.fast.forward_dynamics.clone(),
-            pivots: d.fast.pivots.clone(),
-        },
+        route: route.into(),
+        eval,
     }
 }
 

@@ -313,10 +313,9 @@ impl Emitter<'_> {
         match &q.eval {
             Evaluation::Exprs(ids) => self.exprs_fn(q, ids),
             Evaluation::CraigColumns(which) => self.craig_fn(q, *which),
-            Evaluation::ForwardDynamics {
-                accelerations,
-                pivots,
-            } => self.forward_dynamics_fns(q, accelerations, pivots),
+            Evaluation::ForwardDynamics { .. } | Evaluation::ForwardDynamicsSolve { .. } => {
+                self.forward_dynamics_fns(q)
+            }
             Evaluation::LinkPose => self.link_pose_fn(q),
             Evaluation::LinkJacobian => self.link_jacobian_fn(q),
         }
@@ -362,13 +361,12 @@ impl Emitter<'_> {
         }
     }
 
-    /// `try_forward_dynamics`, which reports a failed pivot, and `forward_dynamics`, which
-    /// gives NaN then.
-    fn forward_dynamics_fns(&mut self, q: &Quantity, acc: &[Id], piv: &[Id]) -> TokenStream {
+    /// The body of an unrolled `try_forward_dynamics`: accelerations and pivots in one
+    /// straight-line program, the pivots checked.
+    fn unrolled_solve(&mut self, q: &Quantity, acc: &[Id], piv: &[Id]) -> (TokenStream, OpCount) {
         let dof = acc.len();
         let outputs: Vec<Id> = acc.iter().chain(piv).copied().collect();
         let (b, ops) = self.straight(q.name, &outputs, Shape::Vector(2 * dof));
-        let docs = Self::quantity_doc(q, Some(ops));
         let len = usize_lit(2 * dof);
         let x = (0..dof).map(|i| {
             let i = usize_lit(i);
@@ -378,35 +376,83 @@ impl Emitter<'_> {
             let i = usize_lit(dof + i);
             quote!(o[#i])
         });
+        let body = quote! {
+            let o: [T; #len] = { #b };
+            let pivots = [#(#pivots),*];
+            for (pivot, d) in pivots.iter().enumerate() {
+                if !d.is_finite() {
+                    return Err(::eomgen_runtime::FactorError::NonFinite { pivot });
+                }
+                if *d <= T::zero() {
+                    return Err(::eomgen_runtime::FactorError::NotPositiveDefinite { pivot });
+                }
+            }
+            let qdd = [#(#x),*];
+            for (pivot, x) in qdd.iter().enumerate() {
+                if !x.is_finite() {
+                    return Err(::eomgen_runtime::FactorError::NonFinite { pivot });
+                }
+            }
+            Ok(qdd)
+        };
+        (body, ops)
+    }
+
+    /// The body of a `try_forward_dynamics` that solves at run time: `M` from `mass_matrix`,
+    /// `h` straight-line, the runtime's tree `L^T D L` over the joints' parents.
+    fn runtime_solve(&mut self, q: &Quantity, h: &[Id]) -> (TokenStream, OpCount) {
+        let (hb, ops) = self.straight(q.name, h, Shape::Vector(h.len()));
+        let n = &self.n;
+        let mass_matrix = if self.in_trait {
+            quote!(<Self as ::eomgen_runtime::Dynamics<T, #n>>::mass_matrix)
+        } else {
+            quote!(Self::mass_matrix)
+        };
+        let parents = self.model.joints.iter().map(|j| match j.parent {
+            Some(p) => {
+                let p = usize_lit(p);
+                quote!(Some(#p))
+            }
+            None => quote!(None),
+        });
+        let body = quote! {
+            /// Each joint's parent joint (`None`: the root), parents first.
+            const PARENTS: [Option<usize>; #n] = [#(#parents),*];
+            let mut m = #mass_matrix(self, q);
+            let h: [T; #n] = { #hb };
+            let mut rhs = *tau;
+            for (r, h) in rhs.iter_mut().zip(h) {
+                *r -= h;
+            }
+            ::eomgen_runtime::tree::ltdl_solve(&mut m, &PARENTS, &rhs)
+        };
+        (body, ops)
+    }
+
+    /// `try_forward_dynamics`, which reports a failed pivot, and `forward_dynamics`, which
+    /// gives NaN then.
+    fn forward_dynamics_fns(&mut self, q: &Quantity) -> TokenStream {
+        let (body, ops) = match &q.eval {
+            Evaluation::ForwardDynamics {
+                accelerations,
+                pivots,
+            } => self.unrolled_solve(q, accelerations, pivots),
+            Evaluation::ForwardDynamicsSolve { h } => self.runtime_solve(q, h),
+            _ => unreachable!("forward_dynamics_fns on another evaluation"),
+        };
+        let docs = Self::quantity_doc(q, Some(ops));
         let (n, vis) = (&self.n, self.vis(q));
-        let try_fd = quote! {
+        self.try_forward_dynamics = quote! {
             /// Forward dynamics `qdd = M(q)^-1 (tau - b(q, qd) - G(q))`, or which pivot of the
             /// `L^T D L` factorization of M(q) was not positive (a non-physical model or
-            /// non-finite input); see `forward_dynamics` for the operation count.
+            /// non-finite input); see `forward_dynamics` for the route and operation count.
             /// `Ok` holds only finite numbers: a non-finite component `i` of the solution (from
             /// a non-finite `qd` or `tau`, or a `q` that leaves M(q) finite) is reported as
             /// `FactorError::NonFinite { pivot: i }`.
             pub fn try_forward_dynamics(&self, q: &[T; #n], qd: &[T; #n], tau: &[T; #n]) -> ::core::result::Result<[T; #n], ::eomgen_runtime::FactorError> {
-                let o: [T; #len] = { #b };
-                let pivots = [#(#pivots),*];
-                for (pivot, d) in pivots.iter().enumerate() {
-                    if !d.is_finite() {
-                        return Err(::eomgen_runtime::FactorError::NonFinite { pivot });
-                    }
-                    if *d <= T::zero() {
-                        return Err(::eomgen_runtime::FactorError::NotPositiveDefinite { pivot });
-                    }
-                }
-                let qdd = [#(#x),*];
-                for (pivot, x) in qdd.iter().enumerate() {
-                    if !x.is_finite() {
-                        return Err(::eomgen_runtime::FactorError::NonFinite { pivot });
-                    }
-                }
-                Ok(qdd)
+                #body
             }
         };
-        self.try_forward_dynamics = try_fd;
         quote! {
             #docs
             #vis fn forward_dynamics(&self, q: &[T; #n], qd: &[T; #n], tau: &[T; #n]) -> [T; #n] {
