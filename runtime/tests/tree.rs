@@ -1,6 +1,9 @@
 //! The tree kernels: the sparse `L^T D L` solve against the dense Cholesky solve, on a chain
 //! (dense) and a branched tree (zeros between branches), and its failures.
 
+// Matrix code reads best with explicit indices.
+#![allow(clippy::needless_range_loop)]
+
 use eomgen_runtime::tree::ltdl_solve;
 use eomgen_runtime::{solve_spd, FactorError};
 use proptest::prelude::*;
