@@ -92,3 +92,35 @@ fn an_unknown_name_is_an_error_listing_the_known_ones() {
     );
     assert!(text.contains("mass_matrix, gravity"), "{text}");
 }
+
+#[test]
+fn every_catalogue_entry_is_consistent_with_its_shape_and_names_are_unique() {
+    use eomgen::dynamics::{Derivation, Evaluation};
+    let model = eomgen::urdf::load_str(URDF, "arm.urdf", &Default::default()).unwrap();
+    let d = Derivation::new(&model);
+    let mut names: Vec<&str> = d.quantities.iter().map(|q| q.name).collect();
+    names.sort();
+    names.dedup();
+    assert_eq!(names.len(), d.quantities.len(), "unique names");
+    for q in &d.quantities {
+        match &q.eval {
+            Evaluation::Exprs(ids) => {
+                assert_eq!(ids.len(), q.shape.len(), "{}", q.name);
+                assert!(q.ops(&d.graph).total() > 0, "{} computes something", q.name);
+            }
+            Evaluation::ForwardDynamics {
+                accelerations,
+                pivots,
+            } => {
+                assert_eq!(accelerations.len(), q.shape.len());
+                assert_eq!(pivots.len(), q.shape.len());
+            }
+            Evaluation::ForwardDynamicsSolve { h } => assert_eq!(h.len(), q.shape.len()),
+            _ => assert!(q.exprs().is_empty(), "{} is a loop", q.name),
+        }
+        for needed in q.needs() {
+            assert!(d.quantity(needed).is_some(), "{} needs {needed}", q.name);
+        }
+    }
+    assert_eq!(d.quantity("mass_matrix").unwrap().shape.len(), 4);
+}

@@ -2,7 +2,7 @@
 //! name, arguments, result shape, documentation, route and expressions.
 //!
 //! Emission ([`crate::emit`]), `eomgen eval` and the tests loop over the catalogue, so adding a
-//! quantity is one entry here (in [`catalogue`]) plus the function that derives its
+//! quantity is one entry in `quantities.rs` (its `catalogue` function) plus the function that derives its
 //! expressions. See `docs/architecture.md`.
 
 use crate::cas::{Graph, Id, OpCount, Program};

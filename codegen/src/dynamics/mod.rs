@@ -1,7 +1,7 @@
 //! The derivation: every quantity of a robot as expressions in one [`Graph`], by two routes,
 //! and the [`catalogue`] of what generated code evaluates.
 //!
-//! - [`lagrangian`]: the closed forms (`M` from body Jacobians, `G = dV/dq`, Christoffel
+//! - `lagrangian`: the closed forms (`M` from body Jacobians, `G = dV/dq`, Christoffel
 //!   symbols), readable and the reference for the reports;
 //! - [`newton_euler`]: the customized recursive algorithms (Newton-Euler, composite rigid
 //!   bodies, Echeandia and Wensing's Coriolis matrix), far fewer operations;

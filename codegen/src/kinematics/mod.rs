@@ -8,7 +8,7 @@
 //! to any result is of the order of 1e-9 relative, below the precision URDF numbers carry.
 //!
 //! - [`joint`]: the joint model (how each kind of joint places its body);
-//! - [`params`]: the model's parameters as numbers or symbols;
+//! - `params` ([`Params`]): the model's parameters as numbers or symbols;
 //! - here: world and body-frame kinematics built on both.
 
 pub mod joint;

@@ -25,7 +25,7 @@
 //!   byte order of their names (the order of urdfdom's name-keyed map, hence Pinocchio's),
 //!   unless [`ModelOptions::joint_order`] gives an explicit order. A parent joint always comes
 //!   before its children.
-//! - Mimic joints are independent joints, as in Pinocchio; the [`Mimic`]
+//! - Mimic joints are independent joints, as in Pinocchio; the [`Mimic`](crate::model::Mimic)
 //!   relation is kept for information only. Limits and `<dynamics damping friction>` are kept
 //!   (the friction enters the dynamics only with [`ModelOptions::friction`]).
 //! - `<collision>` boxes, cylinders and spheres give a link without `<inertial>` its inertia
