@@ -39,6 +39,7 @@ fn main() {
     // What a firmware that needs inverse dynamics alone generates (plus Craig's B, which
     // brings the Coriolis matrix it loops over).
     deep_chain();
+    derivatives();
     eomgen::Builder::new("robots/panda.urdf")
         .module_name("panda_selected")
         .type_name("PandaSelected")
@@ -99,4 +100,35 @@ fn deep_chain() {
         .quantities(["forward_dynamics", "inverse_dynamics"])
         .compile()
         .unwrap();
+}
+
+/// The reference robots with the derivatives of their dynamics and what those call.
+fn derivatives() {
+    for (file, module, ty) in [
+        ("robots/ur5.urdf", "ur5_derivatives", "Ur5Derivatives"),
+        ("robots/panda.urdf", "panda_derivatives", "PandaDerivatives"),
+        (
+            "robots/kinova.urdf",
+            "kinova_derivatives",
+            "KinovaDerivatives",
+        ),
+        (
+            "robots/allegro_right_hand.urdf",
+            "allegro_derivatives",
+            "AllegroDerivatives",
+        ),
+    ] {
+        eomgen::Builder::new(file)
+            .module_name(module)
+            .type_name(ty)
+            .derivatives()
+            .quantities([
+                "inverse_dynamics",
+                "inverse_dynamics_derivatives",
+                "forward_dynamics_derivatives",
+                "mass_matrix_inverse",
+            ])
+            .compile()
+            .unwrap();
+    }
 }

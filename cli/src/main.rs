@@ -193,6 +193,10 @@ struct GenerateArgs {
     /// [default: all]
     #[arg(long, value_name = "NAME,...", value_delimiter = ',')]
     only: Option<Vec<String>>,
+    /// Also generate the derivatives of the dynamics: inverse_dynamics_derivatives,
+    /// forward_dynamics_derivatives and mass_matrix_inverse
+    #[arg(long)]
+    derivatives: bool,
     #[command(flatten)]
     model: ModelArgs,
 }
@@ -507,6 +511,9 @@ fn generate(a: GenerateArgs) -> Result<(), Failure> {
     }
     if let Some(only) = &a.only {
         b = b.quantities(only);
+    }
+    if a.derivatives {
+        b = b.derivatives();
     }
     // Fail fast on bad input, before a long derivation.
     let model = load(&b)?;

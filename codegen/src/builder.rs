@@ -56,6 +56,8 @@ pub struct Builder {
     max_graph_nodes: usize,
     /// The quantities to generate, by name; `None` for all of them.
     quantities: Option<Vec<String>>,
+    /// Whether to add the derivatives of the dynamics ([`Builder::derivatives`]).
+    derivatives: bool,
 }
 
 /// Robots with more joints than this are refused unless [`Builder::max_dof`] raises the limit:
@@ -94,6 +96,7 @@ impl Builder {
             max_dof: DEFAULT_MAX_DOF,
             max_graph_nodes: DEFAULT_MAX_GRAPH_NODES,
             quantities: None,
+            derivatives: false,
         }
     }
 
@@ -272,6 +275,32 @@ impl Builder {
         self
     }
 
+    /// Adds the derivatives of the dynamics, for optimal control and estimation:
+    /// `inverse_dynamics_derivatives(&q, &qd, &qdd) -> (dtau/dq, dtau/dqd)`,
+    /// `forward_dynamics_derivatives(&q, &qd, &tau) -> (dqdd/dq, dqdd/dqd, M^-1)` and
+    /// `mass_matrix_inverse(&q)`, element `[i][j]` the derivative of component `i` in
+    /// coordinate `j`. Friction and rotor inertia are included when generated; a continuous
+    /// joint's coordinate is its angle. Off by default.
+    ///
+    /// ```
+    /// # let urdf = r#"<robot name="pendulum"><link name="base"/>
+    /// #   <link name="arm"><inertial><origin xyz="0 0 -0.5"/><mass value="1"/>
+    /// #   <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.001"/></inertial></link>
+    /// #   <joint name="swing" type="continuous"><parent link="base"/><child link="arm"/>
+    /// #   <axis xyz="0 1 0"/></joint></robot>"#;
+    /// let source = eomgen::Builder::from_urdf_str(urdf, "pendulum.urdf")
+    ///     .derivatives()
+    ///     .generate()
+    ///     .unwrap();
+    /// assert!(source.contains("pub fn inverse_dynamics_derivatives("));
+    /// assert!(source.contains("pub fn forward_dynamics_derivatives("));
+    /// assert!(source.contains("pub fn mass_matrix_inverse("));
+    /// ```
+    pub fn derivatives(mut self) -> Builder {
+        self.derivatives = true;
+        self
+    }
+
     /// The "Regenerate:" line of the banner; default: the `eomgen generate` command line that
     /// writes the same file, with the options given to this builder.
     pub fn regenerate_hint(mut self, hint: &str) -> Builder {
@@ -342,13 +371,17 @@ impl Builder {
             max_nodes: self.max_graph_nodes,
             ..Limits::default()
         };
-        let mut d = Derivation::try_new(model, limits).map_err(|e| Error::Limit {
+        let full = |e: crate::cas::GraphFull| Error::Limit {
             file: file.clone(),
             what: "expression graph nodes (or more)",
             value: e.nodes,
             limit: e.max_nodes,
             raise: "Builder::max_graph_nodes",
-        })?;
+        };
+        let mut d = Derivation::try_new(model, limits).map_err(full)?;
+        if self.derivatives {
+            d.add_derivatives().map_err(full)?;
+        }
         if let Some(wanted) = &self.quantities {
             let all = std::mem::take(&mut d.quantities);
             let known = catalogue::names(&all).join(", ");
@@ -378,6 +411,7 @@ impl Builder {
                     max_dof: self.max_dof,
                     max_graph_nodes: self.max_graph_nodes,
                     quantities: self.quantities.as_deref(),
+                    derivatives: self.derivatives,
                 },
                 &self.options,
             )

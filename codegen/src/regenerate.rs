@@ -19,6 +19,8 @@ pub(crate) struct Command<'a> {
     pub max_graph_nodes: usize,
     /// `Builder::quantities`, when given.
     pub quantities: Option<&'a [String]>,
+    /// `Builder::derivatives`.
+    pub derivatives: bool,
 }
 
 /// `eomgen generate URDF --type-name T [options] -o MODULE.rs  # ...`.
@@ -42,6 +44,9 @@ pub(crate) fn command_line(c: &Command, o: &ModelOptions) -> String {
     }
     if c.max_graph_nodes != crate::DEFAULT_MAX_GRAPH_NODES {
         let _ = write!(line, " --max-graph-nodes {}", c.max_graph_nodes);
+    }
+    if c.derivatives {
+        line.push_str(" --derivatives");
     }
     if let Some(names) = c.quantities {
         let _ = write!(line, " --only {}", quote(&names.join(",")));
@@ -121,6 +126,7 @@ mod tests {
             max_dof: crate::DEFAULT_MAX_DOF,
             max_graph_nodes: crate::DEFAULT_MAX_GRAPH_NODES,
             quantities: None,
+            derivatives: false,
         }
     }
 

@@ -97,7 +97,8 @@ fn an_unknown_name_is_an_error_listing_the_known_ones() {
 fn every_catalogue_entry_is_consistent_with_its_shape_and_names_are_unique() {
     use eomgen::dynamics::{Derivation, Evaluation};
     let model = eomgen::urdf::load_str(URDF, "arm.urdf", &Default::default()).unwrap();
-    let d = Derivation::new(&model);
+    let mut d = Derivation::new(&model);
+    d.add_derivatives().unwrap();
     let mut names: Vec<&str> = d.quantities.iter().map(|q| q.name).collect();
     names.sort();
     names.dedup();

@@ -102,7 +102,8 @@ impl AllegroRightHandLink {
     clippy::double_parens,
     clippy::identity_op,
     clippy::needless_range_loop,
-    clippy::let_and_return
+    clippy::let_and_return,
+    clippy::type_complexity
 )]
 impl<T: ::eomgen_runtime::Real> AllegroRightHand<T> {
     /// Number of joint coordinates.
@@ -2934,7 +2935,8 @@ impl<T: ::eomgen_runtime::Real> AllegroRightHand<T> {
     clippy::double_parens,
     clippy::identity_op,
     clippy::needless_range_loop,
-    clippy::let_and_return
+    clippy::let_and_return,
+    clippy::type_complexity
 )]
 impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 16>
 for AllegroRightHand<T> {

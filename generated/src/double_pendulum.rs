@@ -48,7 +48,8 @@ impl DoublePendulumLink {
     clippy::double_parens,
     clippy::identity_op,
     clippy::needless_range_loop,
-    clippy::let_and_return
+    clippy::let_and_return,
+    clippy::type_complexity
 )]
 impl<T: ::eomgen_runtime::Real> DoublePendulum<T> {
     /// Number of joint coordinates.
@@ -319,7 +320,8 @@ impl<T: ::eomgen_runtime::Real> DoublePendulum<T> {
     clippy::double_parens,
     clippy::identity_op,
     clippy::needless_range_loop,
-    clippy::let_and_return
+    clippy::let_and_return,
+    clippy::type_complexity
 )]
 impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 2> for DoublePendulum<T> {
     const JOINT_NAMES: [&'static str; 2] = ["joint1", "joint2"];

@@ -78,7 +78,8 @@ impl KinovaLink {
     clippy::double_parens,
     clippy::identity_op,
     clippy::needless_range_loop,
-    clippy::let_and_return
+    clippy::let_and_return,
+    clippy::type_complexity
 )]
 impl<T: ::eomgen_runtime::Real> Kinova<T> {
     /// Number of joint coordinates.
@@ -3069,7 +3070,8 @@ impl<T: ::eomgen_runtime::Real> Kinova<T> {
     clippy::double_parens,
     clippy::identity_op,
     clippy::needless_range_loop,
-    clippy::let_and_return
+    clippy::let_and_return,
+    clippy::type_complexity
 )]
 impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 6> for Kinova<T> {
     const JOINT_NAMES: [&'static str; 6] = [

@@ -72,7 +72,8 @@ impl Ur5Link {
     clippy::double_parens,
     clippy::identity_op,
     clippy::needless_range_loop,
-    clippy::let_and_return
+    clippy::let_and_return,
+    clippy::type_complexity
 )]
 impl<T: ::eomgen_runtime::Real> Ur5<T> {
     /// Number of joint coordinates.
@@ -2790,7 +2791,8 @@ impl<T: ::eomgen_runtime::Real> Ur5<T> {
     clippy::double_parens,
     clippy::identity_op,
     clippy::needless_range_loop,
-    clippy::let_and_return
+    clippy::let_and_return,
+    clippy::type_complexity
 )]
 impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
     const JOINT_NAMES: [&'static str; 6] = [

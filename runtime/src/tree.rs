@@ -168,26 +168,18 @@ pub fn coriolis_pairs_from_coriolis<T: Real, const N: usize, const P: usize>(
     out
 }
 
-/// Solves `M x = b` for the mass matrix of a kinematic tree by Featherstone's `L^T D L`
+/// Factorizes the mass matrix of a kinematic tree in place as `L^T D L`, Featherstone's
 /// factorization in reverse joint order, which creates no fill-in: `M_ij` is touched only when
 /// one of `i`, `j` is an ancestor of the other (`parent[i]` is joint `i`'s parent joint, `None`
-/// at the root; a parent comes before its children). `m` is overwritten by the factors.
+/// at the root; a parent comes before its children). Afterwards `m[i][i]` holds `D` and
+/// `m[i][j]` (`j` an ancestor of `i`) holds `L`.
 ///
 /// Fails with the first pivot, in elimination order (last joint first), that is not finite or
-/// not positive, or with the first component of `x` that is not finite.
-///
-/// ```
-/// use eomgen_runtime::tree::ltdl_solve;
-/// // a two-joint chain
-/// let mut m = [[2.0_f64, 0.5], [0.5, 1.0]];
-/// let x = ltdl_solve(&mut m, &[None, Some(0)], &[2.5, 1.5]).unwrap();
-/// assert!((x[0] - 1.0).abs() < 1e-12 && (x[1] - 1.0).abs() < 1e-12);
-/// ```
-pub fn ltdl_solve<T: Real, const N: usize>(
+/// not positive.
+pub fn ltdl_factor<T: Real, const N: usize>(
     m: &mut [[T; N]; N],
     parent: &[Option<usize>; N],
-    b: &[T; N],
-) -> Result<[T; N], FactorError> {
+) -> Result<(), FactorError> {
     // Parents precede children, so every index below is in range.
     if parent
         .iter()
@@ -217,6 +209,15 @@ pub fn ltdl_solve<T: Real, const N: usize>(
             i = parent[ii];
         }
     }
+    Ok(())
+}
+
+/// Solves `M x = b` with the factors of [`ltdl_factor`] (`m` as it left it).
+pub fn ltdl_substitute<T: Real, const N: usize>(
+    m: &[[T; N]; N],
+    parent: &[Option<usize>; N],
+    b: &[T; N],
+) -> [T; N] {
     let mut x = *b;
     for i in (0..N).rev() {
         let mut j = parent[i];
@@ -237,8 +238,71 @@ pub fn ltdl_solve<T: Real, const N: usize>(
             j = parent[jj];
         }
     }
+    x
+}
+
+/// Solves `M x = b` for the mass matrix of a kinematic tree ([`ltdl_factor`], then
+/// [`ltdl_substitute`]); `m` is overwritten by the factors. Fails like [`ltdl_factor`], or
+/// with the first component of `x` that is not finite.
+///
+/// ```
+/// use eomgen_runtime::tree::ltdl_solve;
+/// // a two-joint chain
+/// let mut m = [[2.0_f64, 0.5], [0.5, 1.0]];
+/// let x = ltdl_solve(&mut m, &[None, Some(0)], &[2.5, 1.5]).unwrap();
+/// assert!((x[0] - 1.0).abs() < 1e-12 && (x[1] - 1.0).abs() < 1e-12);
+/// ```
+pub fn ltdl_solve<T: Real, const N: usize>(
+    m: &mut [[T; N]; N],
+    parent: &[Option<usize>; N],
+    b: &[T; N],
+) -> Result<[T; N], FactorError> {
+    ltdl_factor(m, parent)?;
+    let x = ltdl_substitute(m, parent, b);
     match x.iter().position(|v| !v.is_finite()) {
         Some(pivot) => Err(FactorError::NonFinite { pivot }),
         None => Ok(x),
     }
+}
+
+/// The inverse of a tree's mass matrix: one factorization, then `N` substitutions. `m` is
+/// overwritten by the factors. Fails like [`ltdl_factor`].
+///
+/// ```
+/// use eomgen_runtime::tree::ltdl_inverse;
+/// let mut m = [[2.0_f64, 0.0], [0.0, 4.0]];
+/// assert_eq!(ltdl_inverse(&mut m, &[None, None]).unwrap(), [[0.5, 0.0], [0.0, 0.25]]);
+/// ```
+pub fn ltdl_inverse<T: Real, const N: usize>(
+    m: &mut [[T; N]; N],
+    parent: &[Option<usize>; N],
+) -> Result<[[T; N]; N], FactorError> {
+    ltdl_factor(m, parent)?;
+    let mut inv = [[T::zero(); N]; N];
+    let mut e = [T::zero(); N];
+    for j in 0..N {
+        e[j] = T::one();
+        let col = ltdl_substitute(m, parent, &e);
+        e[j] = T::zero();
+        for (i, row) in inv.iter_mut().enumerate() {
+            row[j] = col[i];
+        }
+    }
+    Ok(inv)
+}
+
+/// `-a b` for square matrices, the product forward-dynamics derivatives need
+/// (`d qdd / d x = -M^-1 d tau / d x`).
+pub fn neg_mat_mul<T: Real, const N: usize>(a: &[[T; N]; N], b: &[[T; N]; N]) -> [[T; N]; N] {
+    let mut out = [[T::zero(); N]; N];
+    for (i, row) in out.iter_mut().enumerate() {
+        for (j, x) in row.iter_mut().enumerate() {
+            let mut s = T::zero();
+            for k in 0..N {
+                s += a[i][k] * b[k][j];
+            }
+            *x = -s;
+        }
+    }
+    out
 }

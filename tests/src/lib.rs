@@ -262,6 +262,23 @@ pub mod robots {
     pub mod chain24 {
         include!(concat!(env!("OUT_DIR"), "/chain24.rs"));
     }
+    /// The reference robots with `Builder::derivatives`, inverse dynamics, its derivatives,
+    /// forward-dynamics derivatives and `M^-1` (and what those call) only.
+    pub mod ur5_derivatives {
+        include!(concat!(env!("OUT_DIR"), "/ur5_derivatives.rs"));
+    }
+    /// See [`ur5_derivatives`].
+    pub mod panda_derivatives {
+        include!(concat!(env!("OUT_DIR"), "/panda_derivatives.rs"));
+    }
+    /// See [`ur5_derivatives`].
+    pub mod kinova_derivatives {
+        include!(concat!(env!("OUT_DIR"), "/kinova_derivatives.rs"));
+    }
+    /// See [`ur5_derivatives`].
+    pub mod allegro_derivatives {
+        include!(concat!(env!("OUT_DIR"), "/allegro_derivatives.rs"));
+    }
     /// `codegen/tests/urdf/hostile/names.urdf`: link and joint names that try to break out of
     /// comments and string literals; compiling this module is the test.
     pub mod hostile_names {

@@ -41,6 +41,8 @@ pub enum Shape {
     Vector(usize),
     /// Rows x columns, row-major.
     Matrix(usize, usize),
+    /// A tuple of this many rows x columns matrices, one after the other.
+    Matrices(usize, usize, usize),
 }
 
 impl Shape {
@@ -50,6 +52,7 @@ impl Shape {
             Shape::Scalar => 1,
             Shape::Vector(n) => n,
             Shape::Matrix(r, c) => r * c,
+            Shape::Matrices(k, r, c) => k * r * c,
         }
     }
 
@@ -99,6 +102,12 @@ pub enum Evaluation {
     LinkPose,
     /// A link frame's 6 x N Jacobian, from the same per-joint transforms.
     LinkJacobian,
+    /// `M^-1`: `M` from `mass_matrix`, factorized once at run time and solved for each column
+    /// (`tree::ltdl_inverse`).
+    MassMatrixInverse,
+    /// `(d qdd/dq, d qdd/dqd, M^-1)` at run time: `qdd` from `forward_dynamics`, then
+    /// `-M^-1` times `inverse_dynamics_derivatives` at `(q, qd, qdd)`.
+    ForwardDynamicsDerivatives,
 }
 
 /// One generated function.
@@ -144,7 +153,14 @@ impl Quantity {
     pub fn needs(&self) -> &'static [&'static str] {
         match self.eval {
             Evaluation::CraigColumns(_) => &["coriolis_matrix"],
-            Evaluation::ForwardDynamicsSolve { .. } => &["mass_matrix"],
+            Evaluation::ForwardDynamicsSolve { .. } | Evaluation::MassMatrixInverse => {
+                &["mass_matrix"]
+            }
+            Evaluation::ForwardDynamicsDerivatives => &[
+                "forward_dynamics",
+                "inverse_dynamics_derivatives",
+                "mass_matrix_inverse",
+            ],
             _ => &[],
         }
     }

@@ -329,6 +329,28 @@ impl Derivation {
             .collect()
     }
 
+    /// Adds the derivatives of the dynamics to the catalogue: `inverse_dynamics_derivatives`
+    /// (the generated inverse dynamics differentiated in `q` and `qd`), `mass_matrix_inverse`
+    /// and `forward_dynamics_derivatives`. Fails when the graph fills.
+    pub fn add_derivatives(&mut self) -> Result<(), GraphFull> {
+        let tau = self.fast.tau.1.clone();
+        let n = self.dof;
+        let mut dq = vec![vec![self.graph.zero(); n]; n];
+        let mut dqd = vec![vec![self.graph.zero(); n]; n];
+        for j in 0..n {
+            let col_q = self.graph.diff_many(&tau, self.q[j]);
+            let col_qd = self.graph.diff_many(&tau, self.qd[j]);
+            for i in 0..n {
+                dq[i][j] = col_q[i];
+                dqd[i][j] = col_qd[i];
+            }
+            self.graph.check()?;
+        }
+        let extra = quantities::derivatives(self, &dq, &dqd);
+        self.quantities.extend(extra);
+        Ok(())
+    }
+
     /// The catalogue entry called `name`.
     pub fn quantity(&self, name: &str) -> Option<&Quantity> {
         self.quantities.iter().find(|q| q.name == name)

@@ -353,3 +353,49 @@ fn link_jacobian(n: usize) -> Quantity {
         eval: Evaluation::LinkJacobian,
     }
 }
+
+/// The derivatives of the dynamics ([`Derivation::add_derivatives`]): inverse dynamics
+/// differentiated in the CAS, `M^-1` and forward dynamics composed at run time.
+pub fn derivatives(d: &Derivation, dtau_dq: &[Vec<Id>], dtau_dqd: &[Vec<Id>]) -> Vec<Quantity> {
+    let n = d.dof;
+    let mut both = flat(dtau_dq);
+    both.extend(flat(dtau_dqd));
+    vec![
+        Quantity {
+            name: "inverse_dynamics_derivatives",
+            inputs: &[Input::Q, Input::Qd, Input::Qdd],
+            shape: Shape::Matrices(2, n, n),
+            home: Home::Inherent,
+            doc: vec![
+                "The derivatives of inverse dynamics: (d tau / d q, d tau / d qd), element `[i][j]` =".into(),
+                "d tau_i / d x_j, friction and rotor inertia included when generated.".into(),
+            ],
+            route: "Route: the inverse-dynamics expressions differentiated symbolically.".into(),
+            eval: Evaluation::Exprs(both),
+        },
+        Quantity {
+            name: "mass_matrix_inverse",
+            inputs: Q,
+            shape: Shape::Matrix(n, n),
+            home: Home::Inherent,
+            doc: vec![
+                "The inverse of the mass matrix, M(q)^-1 (NaN in every entry when M(q) is not".into(),
+                "positive definite).".into(),
+            ],
+            route: "Route: M from `mass_matrix`, one sparse L^T D L factorization over the joint tree, N substitutions (eomgen_runtime::tree::ltdl_inverse).".into(),
+            eval: Evaluation::MassMatrixInverse,
+        },
+        Quantity {
+            name: "forward_dynamics_derivatives",
+            inputs: &[Input::Q, Input::Qd, Input::Tau],
+            shape: Shape::Matrices(3, n, n),
+            home: Home::Inherent,
+            doc: vec![
+                "The derivatives of forward dynamics qdd(q, qd, tau): (d qdd / d q, d qdd / d qd,".into(),
+                "d qdd / d tau = M^-1).".into(),
+            ],
+            route: "Route: qdd from `forward_dynamics`, then -M^-1 times `inverse_dynamics_derivatives` at (q, qd, qdd).".into(),
+            eval: Evaluation::ForwardDynamicsDerivatives,
+        },
+    ]
+}

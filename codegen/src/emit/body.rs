@@ -89,5 +89,11 @@ fn shaped(outs: &[TokenStream], shape: Shape) -> TokenStream {
             let rows = outs.chunks(cols).map(|r| quote!([#(#r),*]));
             quote!([#(#rows),*])
         }
+        Shape::Matrices(_, rows, cols) => {
+            let each = outs
+                .chunks((rows * cols).max(1))
+                .map(|m| shaped(m, Shape::Matrix(rows, cols)));
+            quote!((#(#each),*))
+        }
     }
 }

@@ -31,7 +31,7 @@ pub struct EmitOptions {
 
 /// The lints generated code may trip: long literals, `x * -1.0` and the like.
 fn allow_lints() -> TokenStream {
-    quote!(#[allow(unused_variables, clippy::approx_constant, clippy::excessive_precision, clippy::unreadable_literal, clippy::neg_multiply, clippy::double_parens, clippy::identity_op, clippy::needless_range_loop, clippy::let_and_return)])
+    quote!(#[allow(unused_variables, clippy::approx_constant, clippy::excessive_precision, clippy::unreadable_literal, clippy::neg_multiply, clippy::double_parens, clippy::identity_op, clippy::needless_range_loop, clippy::let_and_return, clippy::type_complexity)])
 }
 
 fn doc(lines: &[String]) -> TokenStream {
@@ -162,6 +162,7 @@ impl Emitter<'_> {
         let trait_impl = self.trait_impl(&trait_methods);
         let (ty, n, allow) = (&self.ty, &self.n, allow_lints());
         let try_fd = &self.try_forward_dynamics;
+        let parents = self.parents_const();
         // Without the trait, the joint order still has to be said.
         let joint_names = if self.in_trait {
             TokenStream::new()
@@ -179,6 +180,7 @@ impl Emitter<'_> {
             impl<T: ::eomgen_runtime::Real> #ty<T> {
                 /// Number of joint coordinates.
                 pub const DOF: usize = #n;
+                #parents
                 #joint_names
                 #try_fd
                 #(#methods)*
@@ -289,6 +291,11 @@ impl Emitter<'_> {
                 let (r, c) = (usize_lit(r), usize_lit(c));
                 quote!([[T; #c]; #r])
             }
+            Shape::Matrices(k, r, c) => {
+                let one = Self::return_type(Shape::Matrix(r, c));
+                let all = std::iter::repeat_n(one, k);
+                quote!((#(#all),*))
+            }
         }
     }
 
@@ -318,6 +325,8 @@ impl Emitter<'_> {
             }
             Evaluation::LinkPose => self.link_pose_fn(q),
             Evaluation::LinkJacobian => self.link_jacobian_fn(q),
+            Evaluation::MassMatrixInverse => self.mass_matrix_inverse_fn(q),
+            Evaluation::ForwardDynamicsDerivatives => self.forward_dynamics_derivatives_fn(q),
         }
     }
 
@@ -403,28 +412,15 @@ impl Emitter<'_> {
     fn runtime_solve(&mut self, q: &Quantity, h: &[Id]) -> (TokenStream, OpCount) {
         let (hb, ops) = self.straight(q.name, h, Shape::Vector(h.len()));
         let n = &self.n;
-        let mass_matrix = if self.in_trait {
-            quote!(<Self as ::eomgen_runtime::Dynamics<T, #n>>::mass_matrix)
-        } else {
-            quote!(Self::mass_matrix)
-        };
-        let parents = self.model.joints.iter().map(|j| match j.parent {
-            Some(p) => {
-                let p = usize_lit(p);
-                quote!(Some(#p))
-            }
-            None => quote!(None),
-        });
+        let mass_matrix = self.call("mass_matrix");
         let body = quote! {
-            /// Each joint's parent joint (`None`: the root), parents first.
-            const PARENTS: [Option<usize>; #n] = [#(#parents),*];
             let mut m = #mass_matrix(self, q);
             let h: [T; #n] = { #hb };
             let mut rhs = *tau;
             for (r, h) in rhs.iter_mut().zip(h) {
                 *r -= h;
             }
-            ::eomgen_runtime::tree::ltdl_solve(&mut m, &PARENTS, &rhs)
+            ::eomgen_runtime::tree::ltdl_solve(&mut m, &Self::PARENTS, &rhs)
         };
         (body, ops)
     }
@@ -460,6 +456,84 @@ impl Emitter<'_> {
                     Ok(qdd) => qdd,
                     Err(_) => [T::nan(); #n],
                 }
+            }
+        }
+    }
+
+    /// The path that calls the generated function `name` from inside the impl: through the
+    /// trait when it is a trait method there.
+    fn call(&self, name: &str) -> TokenStream {
+        let (f, n) = (format_ident!("{}", name), &self.n);
+        let in_trait = self
+            .quantities
+            .iter()
+            .any(|q| q.name == name && q.home == Home::Dynamics);
+        if self.in_trait && in_trait {
+            quote!(<Self as ::eomgen_runtime::Dynamics<T, #n>>::#f)
+        } else {
+            quote!(Self::#f)
+        }
+    }
+
+    /// Whether any quantity needs the joints' parents at run time.
+    fn needs_parents(&self) -> bool {
+        self.quantities.iter().any(|q| {
+            matches!(
+                q.eval,
+                Evaluation::ForwardDynamicsSolve { .. } | Evaluation::MassMatrixInverse
+            )
+        })
+    }
+
+    /// `const PARENTS`: each joint's parent joint, for the run-time tree solves.
+    fn parents_const(&self) -> TokenStream {
+        if !self.needs_parents() {
+            return TokenStream::new();
+        }
+        let n = &self.n;
+        let parents = self.model.joints.iter().map(|j| match j.parent {
+            Some(p) => {
+                let p = usize_lit(p);
+                quote!(Some(#p))
+            }
+            None => quote!(None),
+        });
+        quote! {
+            /// Each joint's parent joint (`None`: the root), parents first.
+            const PARENTS: [Option<usize>; #n] = [#(#parents),*];
+        }
+    }
+
+    fn mass_matrix_inverse_fn(&mut self, q: &Quantity) -> TokenStream {
+        let docs = Self::quantity_doc(q, None);
+        let (n, mass_matrix) = (&self.n, self.call("mass_matrix"));
+        quote! {
+            #docs
+            pub fn mass_matrix_inverse(&self, q: &[T; #n]) -> [[T; #n]; #n] {
+                let mut m = #mass_matrix(self, q);
+                match ::eomgen_runtime::tree::ltdl_inverse(&mut m, &Self::PARENTS) {
+                    Ok(inv) => inv,
+                    Err(_) => [[T::nan(); #n]; #n],
+                }
+            }
+        }
+    }
+
+    fn forward_dynamics_derivatives_fn(&mut self, q: &Quantity) -> TokenStream {
+        let docs = Self::quantity_doc(q, None);
+        let n = &self.n;
+        let fd = self.call("forward_dynamics");
+        quote! {
+            #docs
+            pub fn forward_dynamics_derivatives(&self, q: &[T; #n], qd: &[T; #n], tau: &[T; #n]) -> ([[T; #n]; #n], [[T; #n]; #n], [[T; #n]; #n]) {
+                let qdd = #fd(self, q, qd, tau);
+                let (dq, dqd) = self.inverse_dynamics_derivatives(q, qd, &qdd);
+                let minv = self.mass_matrix_inverse(q);
+                (
+                    ::eomgen_runtime::tree::neg_mat_mul(&minv, &dq),
+                    ::eomgen_runtime::tree::neg_mat_mul(&minv, &dqd),
+                    minv,
+                )
             }
         }
     }
