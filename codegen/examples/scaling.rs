@@ -86,7 +86,7 @@ fn render(rows: &[Row], functions: &[String], stages: &[&'static str]) -> String
          inertia tensors), runs `eomgen::Builder::generate_with_report` once and records its \
          wall-clock time and the operation count of every straight-line generated function (a \
          blank cell: that function is a loop over a runtime kernel, as Craig's forms are beyond \
-         12 joints; link poses and Jacobians always are). Times are from one run on a shared \
+         16 joints or 8,000 operations; link poses and Jacobians always are). Times are from one run on a shared \
          2-core machine: read them for growth, not to a few percent.\n"
     );
     let _ = writeln!(s, "## Generation time (seconds)\n");

@@ -141,7 +141,7 @@ pub struct Fast {
     /// `C(q, qd)`: Christoffel symbols, or Echeandia and Wensing's `O(N^2)` recursion.
     pub coriolis_matrix: (Route, Vec<Vec<Id>>),
     /// Craig's `C(q)` as flattened expressions (Christoffel symbols, or
-    /// `1/2 d^2 b_i / dqd_j^2`), for robots of at most [`CRAIG_FLAT_MAX_DOF`] joints; larger
+    /// `1/2 d^2 b_i / dqd_j^2`), for robots whose `B(q)` has at most [`CRAIG_FLAT_MAX_ENTRIES`] entries; larger
     /// robots evaluate it from the columns of `C(q, qd)` ([`Evaluation::CraigColumns`]).
     pub centrifugal: Option<(Route, Vec<Vec<Id>>)>,
     /// Craig's `B(q)` likewise (Christoffel symbols, or `d^2 b_i / dqd_j dqd_k`).
@@ -159,9 +159,9 @@ pub struct Fast {
     pub pivots: Vec<Id>,
 }
 
-/// Robots with more joints than this never get flattened Craig forms: `B(q)` alone has
-/// `N^2 (N-1) / 2` entries.
-pub const CRAIG_FLAT_MAX_DOF: usize = 12;
+/// Robots whose Craig's `B(q)` has more entries than this (`N^2 (N-1) / 2`; 16 joints have
+/// 1,920) never get flattened Craig forms: even when most entries are zero, each is code.
+pub const CRAIG_FLAT_MAX_ENTRIES: usize = 2000;
 
 /// Robots with a chain of more joints than this take the recursive route for `b`, `tau` and
 /// `C(q, qd)` without comparing it with the Christoffel forms.
@@ -472,7 +472,8 @@ fn fast_forms(
     } else {
         (Route::Recursive, rec.coriolis_matrix.clone())
     };
-    let (centrifugal, coriolis_pairs) = if n <= CRAIG_FLAT_MAX_DOF {
+    let (centrifugal, coriolis_pairs) = if n * n * n.saturating_sub(1) / 2 <= CRAIG_FLAT_MAX_ENTRIES
+    {
         let (cf, cp) = craig_from_bias(g, &rec.bias, qd)?;
         (
             Some(cheaper(g, &closed.centrifugal.to_vec(), &cf, fl)),
