@@ -330,22 +330,32 @@ impl Derivation {
     }
 
     /// Adds the derivatives of the dynamics to the catalogue: `inverse_dynamics_derivatives`
-    /// (the generated inverse dynamics differentiated in `q` and `qd`), `mass_matrix_inverse`
-    /// and `forward_dynamics_derivatives`. Fails when the graph fills.
+    /// (the generated inverse dynamics differentiated in `q`; in `qd`, `2 C(q, qd) + dF/dqd`,
+    /// since the bias is quadratic in `qd` with Christoffel symbols symmetric in their last
+    /// two indices), `mass_matrix_inverse` and `forward_dynamics_derivatives`. Fails when the
+    /// graph fills.
     pub fn add_derivatives(&mut self) -> Result<(), GraphFull> {
         let tau = self.fast.tau.1.clone();
         let n = self.dof;
-        let mut dq = vec![vec![self.graph.zero(); n]; n];
-        let mut dqd = vec![vec![self.graph.zero(); n]; n];
+        let g = &mut self.graph;
+        let mut dq = vec![vec![g.zero(); n]; n];
         for j in 0..n {
-            let col_q = self.graph.diff_many(&tau, self.q[j]);
-            let col_qd = self.graph.diff_many(&tau, self.qd[j]);
+            let col_q = g.diff_many(&tau, self.q[j]);
             for i in 0..n {
                 dq[i][j] = col_q[i];
-                dqd[i][j] = col_qd[i];
             }
-            self.graph.check()?;
+            g.check()?;
         }
+        let c = &self.fast.coriolis_matrix.1;
+        let mut dqd: Vec<Vec<Id>> = c
+            .iter()
+            .map(|row| row.iter().map(|&x| g.scale(x, 2.0)).collect())
+            .collect();
+        for i in 0..n {
+            let df = g.diff(self.friction[i], self.qd[i]);
+            dqd[i][i] = g.add(dqd[i][i], df);
+        }
+        g.check()?;
         let extra = quantities::derivatives(self, &dq, &dqd);
         self.quantities.extend(extra);
         Ok(())

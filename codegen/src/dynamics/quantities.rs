@@ -371,7 +371,7 @@ pub fn derivatives(d: &Derivation, dtau_dq: &[Vec<Id>], dtau_dqd: &[Vec<Id>]) ->
                 "The derivatives of inverse dynamics: (d tau / d q, d tau / d qd), element `[i][j]` =".into(),
                 "d tau_i / d x_j, friction and rotor inertia included when generated.".into(),
             ],
-            route: "Route: the inverse-dynamics expressions differentiated symbolically.".into(),
+            route: "Route: d tau / d q by symbolic differentiation of the inverse-dynamics expressions; d tau / d qd = 2 C(q, qd) + dF/dqd from the Coriolis matrix.".into(),
             eval: Evaluation::Exprs(both),
         },
         Quantity {
