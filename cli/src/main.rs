@@ -241,6 +241,9 @@ struct ShowArgs {
     /// Output language.
     #[arg(long, value_enum, default_value_t = FormatArg::Text)]
     format: FormatArg,
+    /// With --format latex: a complete document that pdflatex compiles, instead of fragments
+    #[arg(long)]
+    standalone: bool,
     /// Keep masses, centres of mass, inertias and link lengths as named symbols instead of the
     /// URDF's numbers: of every link, or of the links listed (put the URDF first, or write
     /// --symbolic=LINK,...).
@@ -548,6 +551,14 @@ fn show(a: ShowArgs) -> Result<(), Failure> {
         seen.push(*t);
         new
     });
+    if a.standalone && !matches!(a.format, FormatArg::Latex) {
+        Cli::command()
+            .error(
+                clap::error::ErrorKind::ArgumentConflict,
+                "--standalone makes a LaTeX document: it needs --format latex",
+            )
+            .exit();
+    }
     if a.entry.is_some() && terms.len() != 1 {
         Cli::command()
             .error(
@@ -574,6 +585,7 @@ fn show(a: ShowArgs) -> Result<(), Failure> {
         digits: (a.digits > 0).then_some(a.digits),
         max_terms: a.max_terms,
         source: Some(file_name(&a.urdf)),
+        standalone: a.standalone,
     };
     let text = progress::run("printing the equations", || {
         report::render(&model, &d, &opts)

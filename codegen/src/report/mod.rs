@@ -186,6 +186,9 @@ pub struct ShowOptions {
     pub max_terms: usize,
     /// The URDF's name for the heading (a file name, not a path, keeps output portable).
     pub source: Option<String>,
+    /// With [`Format::Latex`]: a complete document (`\documentclass` to `\end{document}`,
+    /// each term an `align*` that may break across pages) instead of fragments to paste.
+    pub standalone: bool,
 }
 
 impl Default for ShowOptions {
@@ -199,6 +202,7 @@ impl Default for ShowOptions {
             digits: Some(6),
             max_terms: 100,
             source: None,
+            standalone: false,
         }
     }
 }
@@ -768,6 +772,19 @@ pub fn render(model: &Model, d: &Derivation, opts: &ShowOptions) -> Result<Strin
                 }
             }
         }
+        Format::Latex if opts.standalone => {
+            latex_document(&mut out, &model.name, &intro, &joints, &sections, &bodies);
+            if !legend.is_empty() || !legend_text.is_empty() {
+                let _ = writeln!(out, "\\section*{{Legend}}");
+                for (a, b) in &legend_text {
+                    let _ = writeln!(out, "${a}$: {}\n", tex_escape(b));
+                }
+                if !legend.is_empty() {
+                    align(&mut out, &legend);
+                }
+            }
+            let _ = writeln!(out, "\\end{{document}}");
+        }
         Format::Latex => {
             for l in &intro {
                 let _ = writeln!(out, "% {l}");
@@ -830,6 +847,110 @@ pub fn render(model: &Model, d: &Derivation, opts: &ShowOptions) -> Result<Strin
         }
     }
     Ok(out)
+}
+
+/// The preamble, title, joints and terms of a standalone LaTeX document (the caller adds the
+/// legend and `\end{document}`).
+fn latex_document(
+    out: &mut String,
+    robot: &str,
+    intro: &[String],
+    joints: &[(String, String)],
+    sections: &[Section],
+    bodies: &[Vec<(String, String)>],
+) {
+    let _ = writeln!(out, "\\documentclass{{article}}");
+    let _ = writeln!(out, "\\usepackage{{amsmath}}");
+    let _ = writeln!(out, "\\allowdisplaybreaks");
+    let _ = writeln!(out, "\\begin{{document}}");
+    let _ = writeln!(
+        out,
+        "\\section*{{{}: equations of motion}}",
+        tex_escape(robot)
+    );
+    for l in intro {
+        let _ = writeln!(out, "{}\n", tex_escape(l));
+    }
+    let _ = writeln!(out, "\\begin{{itemize}}");
+    for (q, what) in joints {
+        let _ = writeln!(out, "\\item ${q}$: {}", tex_escape(what));
+    }
+    let _ = writeln!(out, "\\end{{itemize}}");
+    for (s, body) in sections.iter().zip(bodies) {
+        let _ = writeln!(out, "\\section*{{{}}}", tex_escape(s.term.title().0));
+        for n in &s.notes {
+            let _ = writeln!(out, "{}\n", tex_escape(n));
+        }
+        if !body.is_empty() {
+            align(out, body);
+        }
+    }
+}
+
+/// An `align*` block of `name &= formula` lines (may break across pages); a long formula
+/// continues on further lines, broken between its top-level terms (TeX cannot set a line
+/// wider than about 5.7 m, which a large robot's entries exceed).
+fn align(out: &mut String, lines: &[(String, String)]) {
+    const WIDTH: usize = 120;
+    let mut rows = Vec::new();
+    for (a, b) in lines {
+        for (k, chunk) in wrap_formula(b, WIDTH).into_iter().enumerate() {
+            rows.push(match k {
+                0 => format!("{a} &= {chunk}"),
+                _ => format!("&\\quad {chunk}"),
+            });
+        }
+    }
+    let _ = writeln!(out, "\\begin{{align*}}");
+    let _ = writeln!(out, "{}", rows.join(" \\\\\n"));
+    let _ = writeln!(out, "\\end{{align*}}");
+}
+
+/// Splits a LaTeX formula before its top-level ` + ` and ` - ` (outside braces and
+/// `\left`/`\right` pairs) into pieces of about `width` characters.
+fn wrap_formula(b: &str, width: usize) -> Vec<String> {
+    let mut pieces = Vec::new();
+    let (mut depth, mut start) = (0i32, 0);
+    let bytes = b.as_bytes();
+    for (i, &c) in bytes.iter().enumerate() {
+        match c {
+            b'{' => depth += 1,
+            b'}' => depth -= 1,
+            b'\\' if b[i..].starts_with("\\left") => depth += 1,
+            b'\\' if b[i..].starts_with("\\right") => depth -= 1,
+            b' ' if depth == 0
+                && i + 2 < bytes.len()
+                && matches!(bytes[i + 1], b'+' | b'-')
+                && bytes[i + 2] == b' '
+                && i - start >= width =>
+            {
+                pieces.push(b[start..i].to_string());
+                start = i + 1;
+            }
+            _ => {}
+        }
+    }
+    pieces.push(b[start..].to_string());
+    pieces
+}
+
+/// Text for LaTeX's text mode: its special characters escaped, control characters dropped.
+fn tex_escape(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            '\\' => out.push_str("\\textbackslash{}"),
+            '&' | '%' | '$' | '#' | '_' | '{' | '}' => {
+                out.push('\\');
+                out.push(c);
+            }
+            '~' => out.push_str("\\textasciitilde{}"),
+            '^' => out.push_str("\\textasciicircum{}"),
+            c if c.is_control() => {}
+            c => out.push(c),
+        }
+    }
+    out
 }
 
 /// An `aligned` block of `name &= formula` lines.
