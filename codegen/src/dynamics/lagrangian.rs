@@ -13,7 +13,7 @@
 //!   bias `b = C(q, qd) qd`.
 
 use crate::cas::{Graph, GraphFull, Id};
-use crate::kinematics::{BodyKinematics, Params, WorldKinematics};
+use crate::kinematics::{joint, BodyKinematics, Params, WorldKinematics};
 use crate::model::Model;
 use crate::spatial::{cross, mat_vec, vec_add, V3};
 
@@ -202,7 +202,7 @@ pub(super) fn mass_matrix(
             .iter()
             .map(|&j| {
                 let axis = body.axis[b][j].expect("path joint");
-                if model.joints[j].kind.is_revolute() {
+                if joint::rotates(&model.joints[j]) {
                     let off = body.offset[b][j].expect("path joint");
                     let r = vec_add(g, &params.com[b], &off);
                     let v = cross(g, &axis, &r);

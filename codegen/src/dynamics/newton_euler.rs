@@ -58,13 +58,11 @@ impl LocalModel {
         };
         for (i, joint) in model.joints.iter().enumerate() {
             let placed = joint::body_in_parent(g, joint, &params.origin[i], &q[i..i + 1]);
-            let s = joint::subspace(g, joint);
-            let zero = [g.zero(); 3];
             lm.rotation.push(placed.rotation);
             lm.translation.push(placed.translation);
             lm.axis.push(joint::axis(g, joint));
-            lm.revolute.push(s[0].0 != zero);
-            lm.subspace.push(s[0]);
+            lm.revolute.push(joint::rotates(joint));
+            lm.subspace.push(joint::subspace(g, joint)[0]);
             lm.parent.push(joint.parent);
             let m = params.mass[i];
             let c = params.com[i];

@@ -581,7 +581,7 @@ impl Emitter<'_> {
         let joints = self.model.joints.iter().map(|j| {
             let axis = j.axis.map(snap);
             let [x, y, z] = [0, 1, 2].map(|k| f64_literal(axis[k]));
-            let motion = if j.kind.is_revolute() {
+            let motion = if crate::kinematics::joint::rotates(j) {
                 quote!(Rotation)
             } else {
                 quote!(Translation)

@@ -92,6 +92,15 @@ pub fn subspace(g: &mut Graph, joint: &Joint) -> Vec<Spatial> {
     }
 }
 
+/// Whether the joint rotates its body (its subspace has an angular part): what the algorithms
+/// that still treat rotation and translation apart ask, instead of matching joint kinds.
+pub fn rotates(joint: &Joint) -> bool {
+    match joint.kind {
+        JointKind::Revolute | JointKind::Continuous => true,
+        JointKind::Prismatic => false,
+    }
+}
+
 fn identity(g: &mut Graph) -> M3 {
     let (o, z) = (g.one(), g.zero());
     [[o, z, z], [z, o, z], [z, z, o]]

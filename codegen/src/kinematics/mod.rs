@@ -100,8 +100,8 @@ impl WorldKinematics {
     }
 
     /// The 6 x N Jacobian (linear rows, then angular, world axes) of a point `p` (world
-    /// coordinates) rigidly attached to `body`: per joint on its path, the joint's subspace
-    /// moved to the world and to `p`.
+    /// coordinates) rigidly attached to `body`: per joint on its path, its world axis (and, for
+    /// a rotating joint, the axis crossed with the lever arm to `p`).
     pub fn point_jacobian(
         &self,
         g: &mut Graph,
@@ -114,13 +114,11 @@ impl WorldKinematics {
         let Some(b) = body else { return jac };
         for j in model.path_to_root(b) {
             let z = self.axis[j];
-            let zero = [g.zero(); 3];
-            let (lin, ang) = match joint::subspace(g, &model.joints[j])[0] {
-                (w, _) if w != zero => {
-                    let r = vec_sub(g, p, &self.origin[j]);
-                    (cross(g, &z, &r), z)
-                }
-                _ => (z, zero),
+            let (lin, ang) = if joint::rotates(&model.joints[j]) {
+                let r = vec_sub(g, p, &self.origin[j]);
+                (cross(g, &z, &r), z)
+            } else {
+                (z, [g.zero(); 3])
             };
             for k in 0..3 {
                 jac[k][j] = lin[k];
