@@ -40,6 +40,7 @@ fn main() {
     // brings the Coriolis matrix it loops over).
     deep_chain();
     derivatives();
+    floating();
     eomgen::Builder::new("robots/panda.urdf")
         .module_name("panda_selected")
         .type_name("PandaSelected")
@@ -103,6 +104,40 @@ fn deep_chain() {
 }
 
 /// The reference robots with the derivatives of their dynamics and what those call.
+/// The floating-base reference robots: anymal standing on its four feet (contacts), the same
+/// without gravity (for momentum conservation), and the iris drone (a free body, no joints).
+fn floating() {
+    let feet = ["LF_FOOT", "RF_FOOT", "LH_FOOT", "RH_FOOT"];
+    let anymal = || {
+        eomgen::Builder::new("robots/floating/anymal.urdf")
+            .floating_base()
+            .contact_points(&feet)
+    };
+    anymal()
+        .module_name("anymal")
+        .type_name("Anymal")
+        .compile()
+        .unwrap();
+    anymal()
+        .gravity([0.0; 3])
+        .module_name("anymal_weightless")
+        .type_name("AnymalWeightless")
+        .quantities([
+            "forward_dynamics",
+            "centroidal_map",
+            "kinetic_energy",
+            "integrate",
+        ])
+        .compile()
+        .unwrap();
+    eomgen::Builder::new("robots/floating/iris_simple.urdf")
+        .floating_base()
+        .module_name("iris_simple")
+        .type_name("IrisSimple")
+        .compile()
+        .unwrap();
+}
+
 fn derivatives() {
     for (file, module, ty) in [
         ("robots/ur5.urdf", "ur5_derivatives", "Ur5Derivatives"),

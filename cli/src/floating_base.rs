@@ -14,6 +14,9 @@ const LEG_WORDS: [&str; 11] = [
 
 /// The note `info` prints when the robot looks legged, naming the first joint of each leg.
 pub fn note(model: &Model) -> Option<String> {
+    if model.is_floating() {
+        return None;
+    }
     let leggy = |i: usize| {
         let names = [&model.joints[i].name, &model.bodies[i].name];
         names.iter().any(|n| {
@@ -36,7 +39,8 @@ pub fn note(model: &Model) -> Option<String> {
     let shown: Vec<String> = starts.iter().take(4).map(|s| format!("`{s}`")).collect();
     Some(format!(
         "{} looks like a legged robot ({} legs, from {}{}): eomgen welds its root link `{}` \
-         to the world, as for a fixed-base robot, since floating bases are not implemented yet",
+         to the world, as for a fixed-base robot; --floating-base (Builder::floating_base) \
+         lets it move freely",
         model.name,
         starts.len(),
         shown.join(", "),

@@ -35,14 +35,24 @@ pub fn print(
     emit: Duration,
 ) -> String {
     let mut out = String::new();
-    let total_mass: f64 = model.bodies.iter().map(|b| b.mass).sum();
+    let total_mass: f64 = model.bodies.iter().chain(&model.base).map(|b| b.mass).sum();
     let _ = writeln!(out, "robot: {} ({source})", model.name);
-    let _ = writeln!(out, "degrees of freedom: {}", model.dof());
+    if model.is_floating() {
+        let _ = writeln!(
+            out,
+            "degrees of freedom: {} joints + 6 of the floating base (NQ {}, NV {})",
+            model.dof(),
+            model.nq(),
+            model.nv()
+        );
+    } else {
+        let _ = writeln!(out, "degrees of freedom: {}", model.dof());
+    }
     let _ = writeln!(
         out,
         "moving mass: {} kg in {} bodies",
         format_number(total_mass, Some(6)),
-        model.bodies.len()
+        model.bodies.len() + usize::from(model.is_floating())
     );
     let _ = writeln!(out, "gravity: {} m/s^2", vec3(&model.gravity));
     if let Some(note) = super::floating_base::note(model) {
@@ -61,8 +71,20 @@ pub fn print(
         .map(|f| f.name.as_str())
         .collect();
     let _ = write!(out, "{}", model.root);
+    if let Some(base) = &model.base {
+        let _ = write!(
+            out,
+            " (floating base, {} kg)",
+            format_number(base.mass, Some(6))
+        );
+    }
     if !welded.is_empty() {
-        let _ = write!(out, " (welded: {})", welded.join(", "));
+        let kind = if model.is_floating() {
+            "merged"
+        } else {
+            "welded"
+        };
+        let _ = write!(out, " ({kind}: {})", welded.join(", "));
     }
     out.push('\n');
     let children = |parent: Option<usize>| -> Vec<usize> {

@@ -99,6 +99,15 @@ struct ModelArgs {
     /// become their mean, as MuJoCo's balanceinertia does; each repair is reported on stderr.
     #[arg(long)]
     repair_inertia: bool,
+    /// Lets the root link move freely (a floating base, as Pinocchio's free flyer): q = [base
+    /// position (3), unit quaternion x, y, z, w (4), joints], velocities = [base linear, angular
+    /// (base axes), joints]
+    #[arg(long)]
+    floating_base: bool,
+    /// A 3D point contact at the origin of this link (repeatable, in order): adds
+    /// contact_jacobian, contact_drift and contact_forward_dynamics
+    #[arg(long = "contact", value_name = "LINK")]
+    contacts: Vec<String>,
     /// Refuse robots with more degrees of freedom than this.
     #[arg(long, value_name = "N", default_value_t = eomgen::DEFAULT_MAX_DOF)]
     max_dof: usize,
@@ -123,6 +132,8 @@ impl ModelArgs {
             coulomb_smoothing: self.coulomb_smoothing,
             inertia_from_collision: self.density,
             repair_inertia: self.repair_inertia,
+            floating_base: self.floating_base,
+            contact_points: self.contacts.clone(),
             ..ModelOptions::default()
         }
     }
@@ -627,9 +638,22 @@ fn info_cmd(a: InfoArgs) -> Result<(), Failure> {
     ))
 }
 
+/// The commands that do not handle a floating base yet say so.
+fn fixed_base_only(model: &eomgen::model::Model, command: &str) -> Result<(), Failure> {
+    if model.is_floating() {
+        return Err(Failure(format!(
+            "{}: `eomgen {command}` does not handle a floating base yet: generate the code \
+             (eomgen generate --floating-base) and call it",
+            model.name
+        )));
+    }
+    Ok(())
+}
+
 fn eval_cmd(a: EvalArgs) -> Result<(), Failure> {
     let b = a.model.builder(&a.urdf, &None);
     let model = load(&b)?;
+    fixed_base_only(&model, "eval")?;
     let n = model.dof();
     let joints = model
         .joints
@@ -668,6 +692,7 @@ fn eval_cmd(a: EvalArgs) -> Result<(), Failure> {
 fn simulate_cmd(a: SimulateArgs) -> Result<(), Failure> {
     let b = a.model.builder(&a.urdf, &None);
     let model = load(&b)?;
+    fixed_base_only(&model, "simulate")?;
     let n = model.dof();
     let check = |flag: &str, v: Option<Numbers>, default: &[f64]| -> Result<Vec<f64>, Failure> {
         match v {

@@ -16,7 +16,8 @@ const STIFF: &str = r#"<robot name="stiff">
 </robot>"#;
 
 fn simulate(dt: &str) -> std::process::Output {
-    let path = scratch("divergence").join("stiff.urdf");
+    // One directory per step: the two tests run in parallel, and `scratch` empties its directory.
+    let path = scratch(&format!("divergence-{dt}")).join("stiff.urdf");
     std::fs::write(&path, STIFF).unwrap();
     let path = path.to_str().unwrap().to_string();
     eomgen(&[

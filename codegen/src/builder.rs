@@ -301,6 +301,39 @@ impl Builder {
         self
     }
 
+    /// Lets the robot's root link move freely: a floating base (quadrupeds, humanoids, drones),
+    /// as Pinocchio's free flyer. The generated type then has `NQ` position coordinates (base
+    /// position in world, base orientation as a unit quaternion x, y, z, w, then the joints)
+    /// and `NV` velocity coordinates (base linear and angular velocity, both in base axes, then
+    /// the joints), with `center_of_mass`, `center_of_mass_jacobian`, `centroidal_map` and
+    /// `integrate`. A URDF whose root is a massless link attached to the robot by a
+    /// `floating` joint is floating without this call. See [`ModelOptions::floating_base`].
+    ///
+    /// ```
+    /// # let urdf = r#"<robot name="brick"><link name="body"><inertial><mass value="2"/>
+    /// #   <inertia ixx="0.1" ixy="0" ixz="0" iyy="0.2" iyz="0" izz="0.3"/></inertial></link></robot>"#;
+    /// let source = eomgen::Builder::from_urdf_str(urdf, "brick.urdf")
+    ///     .floating_base()
+    ///     .generate()
+    ///     .unwrap();
+    /// assert!(source.contains("pub const NQ: usize = 7;"));
+    /// assert!(source.contains("pub fn centroidal_map("));
+    /// ```
+    pub fn floating_base(mut self) -> Builder {
+        self.options.floating_base = true;
+        self
+    }
+
+    /// A 3D point contact at the origin of each named link (links merged into their parent by
+    /// fixed joints keep their own names: feet usually are such links), in this order: adds
+    /// `contact_jacobian(&q)` (3K x N, world axes), `contact_drift(&q, &qd)` (`Jdot qd`) and
+    /// `contact_forward_dynamics(&q, &qd, &tau)` (accelerations and contact forces) with its
+    /// `try_` variant. An unknown link is [`crate::model::ModelError::UnknownContactLink`].
+    pub fn contact_points<S: AsRef<str>>(mut self, links: &[S]) -> Builder {
+        self.options.contact_points = links.iter().map(|l| l.as_ref().to_string()).collect();
+        self
+    }
+
     /// The "Regenerate:" line of the banner; default: the `eomgen generate` command line that
     /// writes the same file, with the options given to this builder.
     pub fn regenerate_hint(mut self, hint: &str) -> Builder {
@@ -378,6 +411,12 @@ impl Builder {
             limit: e.max_nodes,
             raise: "Builder::max_graph_nodes",
         };
+        if self.derivatives && model.is_floating() {
+            return Err(Error::Unsupported {
+                file,
+                what: "derivatives of a floating-base robot are not generated yet",
+            });
+        }
         let mut d = Derivation::try_new(model, limits).map_err(full)?;
         if self.derivatives {
             d.add_derivatives().map_err(full)?;

@@ -104,6 +104,9 @@ pub enum Error {
         raise: &'static str,
     },
     /// [`Builder::quantities`] named something eomgen does not generate.
+    /// A combination of options that is not generated (yet).
+    #[error("{file}: {what}")]
+    Unsupported { file: String, what: &'static str },
     #[error("{file}: unknown quantity `{name}` (known: {known})")]
     UnknownQuantity {
         file: String,

@@ -101,6 +101,12 @@ fn flags(o: &ModelOptions) -> Vec<(&'static str, Option<String>)> {
     if o.repair_inertia {
         f.push(("repair-inertia", None));
     }
+    if o.floating_base {
+        f.push(("floating-base", None));
+    }
+    for link in &o.contact_points {
+        f.push(("contact", Some(link.clone())));
+    }
     f
 }
 

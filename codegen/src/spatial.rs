@@ -29,12 +29,27 @@ pub fn snap(v: f64) -> f64 {
     v
 }
 
-/// Constant matrix into the graph, snapped.
+/// A rotation matrix with its entries snapped ([`snap`]) when the snapped matrix is still a
+/// rotation (orthonormal to 1e-12); otherwise unchanged. Snapping one small entry of a
+/// genuine rotation (a product of two small angles, 4e-10) would make it non-orthogonal by as
+/// much, an error heavy bodies multiply.
+pub fn snap_rotation(m: &Matrix3<f64>) -> Matrix3<f64> {
+    let snapped = m.map(snap);
+    let off = (snapped * snapped.transpose() - Matrix3::identity()).amax();
+    if off <= 1e-12 {
+        snapped
+    } else {
+        *m
+    }
+}
+
+/// Constant rotation matrix into the graph, snapped ([`snap_rotation`]).
 pub fn const_m3(g: &mut Graph, m: &Matrix3<f64>) -> M3 {
+    let m = snap_rotation(m);
     let mut out = [[g.zero(); 3]; 3];
     for (r, row) in out.iter_mut().enumerate() {
         for (c, e) in row.iter_mut().enumerate() {
-            *e = g.constant(snap(m[(r, c)]));
+            *e = g.constant(m[(r, c)]);
         }
     }
     out

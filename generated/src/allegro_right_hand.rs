@@ -106,7 +106,7 @@ impl AllegroRightHandLink {
     clippy::type_complexity
 )]
 impl<T: ::eomgen_runtime::Real> AllegroRightHand<T> {
-    /// Number of joint coordinates.
+    /// Number of joint coordinates (velocity coordinates with a floating base).
     pub const DOF: usize = 16;
     /// Forward dynamics `qdd = M(q)^-1 (tau - b(q, qd) - G(q))`, or which pivot of the
     /// `L^T D L` factorization of M(q) was not positive (a non-physical model or
@@ -6407,6 +6407,574 @@ impl<T: ::eomgen_runtime::Real> AllegroRightHand<T> {
             &placement,
         )
     }
+    /// The centre of mass of the moving bodies in world coordinates (a fixed root link, welded to the world, is not counted).
+    ///
+    /// Route: the bodies' centres of mass by forward kinematics.
+    /// Operations: 148 mul, 91 add, 0 div, 16 sin, 16 cos.
+    pub fn center_of_mass(&self, q: &[T; 16]) -> [T; 3] {
+        let (s0, c0) = q[0].sin_cos();
+        let (s1, c1) = q[1].sin_cos();
+        let (s2, c2) = q[2].sin_cos();
+        let (s3, c3) = q[3].sin_cos();
+        let (s4, c4) = q[4].sin_cos();
+        let (s5, c5) = q[5].sin_cos();
+        let (s6, c6) = q[6].sin_cos();
+        let (s7, c7) = q[7].sin_cos();
+        let (s8, c8) = q[8].sin_cos();
+        let (s9, c9) = q[9].sin_cos();
+        let (s10, c10) = q[10].sin_cos();
+        let (s11, c11) = q[11].sin_cos();
+        let (s12, c12) = q[12].sin_cos();
+        let (s13, c13) = q[13].sin_cos();
+        let (s14, c14) = q[14].sin_cos();
+        let (s15, c15) = q[15].sin_cos();
+        let t0 = s0;
+        let t1 = c0;
+        let t2 = s1;
+        let t3 = c1;
+        let t4 = s2;
+        let t5 = c2;
+        let t6 = s3;
+        let t7 = c3;
+        let t8 = s4;
+        let t9 = c4;
+        let t10 = s5;
+        let t11 = c5;
+        let t12 = s6;
+        let t13 = c6;
+        let t14 = s7;
+        let t15 = c7;
+        let t16 = s8;
+        let t17 = c8;
+        let t18 = s9;
+        let t19 = c9;
+        let t20 = s10;
+        let t21 = c10;
+        let t22 = s11;
+        let t23 = c11;
+        let t24 = s12;
+        let t25 = c12;
+        let t26 = s13;
+        let t27 = c13;
+        let t28 = s14;
+        let t29 = c14;
+        let t30 = s15;
+        let t31 = c15;
+        let t32 = t0 * t3;
+        let t33 = t0 * t2;
+        let t34 = t8 * t10;
+        let t35 = t9 * t12;
+        let t36 = t9 * t13;
+        let t37 = t24 * t27;
+        let t38 = t24 * t26;
+        let t39 = T::from_f64(0.9961946980960786) * t32
+            - T::from_f64(0.08715574269813088) * t2;
+        let t40 = T::from_f64(0.08715574269813088) * t3
+            + T::from_f64(0.9961946980960786) * t33;
+        let t41 = -T::from_f64(0.9961946980960786) * t2
+            - T::from_f64(0.08715574269813088) * t32;
+        let t42 = T::from_f64(0.9961946980960786) * t3
+            - T::from_f64(0.08715574269813088) * t33;
+        let t43 = t1 * t3 * t4 + t1 * t2 * t5;
+        let t44 = T::from_f64(0.08715574180663972) * t11
+            - T::from_f64(0.996194698174074) * t34;
+        let t45 = T::from_f64(0.996194698174074) * t11
+            + T::from_f64(0.08715574180663972) * t34;
+        let t46 = t9 * t10 * t12 + t8 * t13;
+        let t47 = t17 * t19 * t20 + t17 * t18 * t21;
+        let t48 = t16 * t19 * t20 + t16 * t18 * t21;
+        let t49 = t19 * t21 - t18 * t20;
+        let t50 = T::from_f64(0.08715574269813088) * t26
+            + T::from_f64(0.9961946980960786) * t37;
+        let t51 = T::from_f64(0.9961946980960786) * t38
+            - T::from_f64(0.08715574269813088) * t27;
+        let t52 = T::from_f64(0.08715574269813088) * t37
+            - T::from_f64(0.9961946980960786) * t26;
+        let t53 = T::from_f64(0.9961946980960786) * t27
+            + T::from_f64(0.08715574269813088) * t38;
+        let t54 = t25 * t27 * t28 + t25 * t26 * t29;
+        let t55 = t44 * t12;
+        let t56 = t45 * t12;
+        let t57 = t39 * t4 + t40 * t5;
+        let t58 = t41 * t4 + t42 * t5;
+        let t59 = t50 * t28 + t51 * t29;
+        let t60 = t52 * t28 + t53 * t29;
+        let t61 = T::from_f64(0.006195736793327155) * (t1 * t2 + t17 * t18 + t25 * t26)
+            + T::from_f64(0.0018790732159406857) * (t43 + t47 + t54)
+            + T::from_f64(0.0008314365152919371)
+                * ((t1 * t3 * t5 - t1 * t2 * t4) * t6 + t43 * t7
+                    + (t17 * t19 * t21 - t17 * t18 * t20) * t22 + t47 * t23
+                    + (t25 * t27 * t29 - t25 * t26 * t28) * t30 + t54 * t31)
+            + T::from_f64(0.010873345690454124) * t8
+            + T::from_f64(0.0009777571825764597) * t9
+            + T::from_f64(0.005297201112140872) * t46
+            + T::from_f64(0.0013172196478220574)
+                * ((t9 * t10 * t13 - t8 * t12) * t14 + t46 * t15)
+            - T::from_f64(0.004152771084337349);
+        let t62 = T::from_f64(0.000539994041784564) * (t3 - t27)
+            + T::from_f64(0.0061721601443113115) * (t33 + t38)
+            + T::from_f64(0.0018790732159406857) * (t57 + t48 + t59)
+            + T::from_f64(0.0008314365152919371)
+                * ((t39 * t5 - t40 * t4) * t6 + t57 * t7
+                    + (t16 * t19 * t21 - t16 * t18 * t20) * t22 + t48 * t23
+                    + (t50 * t29 - t51 * t28) * t30 + t59 * t31)
+            + T::from_f64(0.010831969328244316) * t9
+            + T::from_f64(0.005297201112140872) * t55
+            + T::from_f64(0.0052770436630765446) * t36
+            + T::from_f64(0.0013172196478220574)
+                * ((t44 * t13 - T::from_f64(0.996194698174074) * t35) * t14
+                    + (t55 + T::from_f64(0.996194698174074) * t36) * t15)
+            + T::from_f64(0.006195736793327155) * t16 * t18
+            + T::from_f64(0.0039511198692563235)
+            - T::from_f64(0.0009740365213842892) * t8;
+        let t63 = T::from_f64(0.0061721601443113115) * (t3 + t27)
+            + T::from_f64(0.000539994041784564) * (t38 - t33)
+            + T::from_f64(0.0018790732159406857) * (t58 + t49 + t60)
+            + T::from_f64(0.0008314365152919371)
+                * ((t41 * t5 - t42 * t4) * t6 + t58 * t7 + (-t18 * t21 - t19 * t20) * t22
+                    + t49 * t23 + (t52 * t29 - t53 * t28) * t30 + t60 * t31)
+            + T::from_f64(0.00008521715255422142) * t8
+            + T::from_f64(0.005297201112140872) * t56
+            + T::from_f64(0.0013172196478220574)
+                * ((T::from_f64(0.08715574180663972) * t35 + t45 * t13) * t14
+                    + (t56 - T::from_f64(0.08715574180663972) * t36) * t15)
+            + T::from_f64(0.006195736793327155) * t19
+            - T::from_f64(0.0009476745095715584) * t9
+            - T::from_f64(0.0004616814924275946) * t36
+            - T::from_f64(0.004822832960091898);
+        [t61, t62, t63]
+    }
+    /// The Jacobian of `center_of_mass`, 3 x N, world axes.
+    ///
+    /// Route: each coordinate's composite-body momentum (the composite-rigid-body algorithm's), moved to the world.
+    /// Operations: 270 mul, 95 add, 0 div, 16 sin, 16 cos.
+    pub fn center_of_mass_jacobian(&self, q: &[T; 16]) -> [[T; 16]; 3] {
+        let (s0, c0) = q[0].sin_cos();
+        let (s1, c1) = q[1].sin_cos();
+        let (s2, c2) = q[2].sin_cos();
+        let (s3, c3) = q[3].sin_cos();
+        let (s4, c4) = q[4].sin_cos();
+        let (s5, c5) = q[5].sin_cos();
+        let (s6, c6) = q[6].sin_cos();
+        let (s7, c7) = q[7].sin_cos();
+        let (s8, c8) = q[8].sin_cos();
+        let (s9, c9) = q[9].sin_cos();
+        let (s10, c10) = q[10].sin_cos();
+        let (s11, c11) = q[11].sin_cos();
+        let (s12, c12) = q[12].sin_cos();
+        let (s13, c13) = q[13].sin_cos();
+        let (s14, c14) = q[14].sin_cos();
+        let (s15, c15) = q[15].sin_cos();
+        let (
+            t0,
+            t1,
+            t2,
+            t3,
+            t4,
+            t5,
+            t6,
+            t7,
+            t8,
+            t9,
+            t10,
+            t11,
+            t12,
+            t13,
+            t14,
+            t15,
+            t16,
+            t17,
+            t18,
+            t19,
+            t20,
+            t21,
+            t22,
+            t23,
+            t24,
+            t25,
+            t26,
+            t27,
+            t28,
+            t29,
+            t30,
+            t31,
+            t32,
+            t33,
+            t34,
+            t35,
+            t36,
+            t37,
+            t38,
+            t39,
+            t40,
+            t41,
+            t42,
+            t43,
+            t44,
+            t45,
+            t46,
+            t47,
+            t48,
+            t49,
+            t50,
+            t51,
+            t52,
+            t53,
+            t54,
+            t55,
+            t56,
+            t57,
+            t58,
+            t59,
+            t60,
+            t61,
+            t62,
+            t63,
+        ) = {
+            let t0 = s0;
+            let t1 = c0;
+            let t2 = s1;
+            let t3 = c1;
+            let t4 = s2;
+            let t5 = c2;
+            let t6 = s3;
+            let t7 = c3;
+            let t8 = s4;
+            let t9 = c4;
+            let t10 = s5;
+            let t11 = c5;
+            let t12 = s6;
+            let t13 = c6;
+            let t14 = s7;
+            let t15 = c7;
+            let t16 = s8;
+            let t17 = c8;
+            let t18 = s9;
+            let t19 = c9;
+            let t20 = s10;
+            let t21 = c10;
+            let t22 = s11;
+            let t23 = c11;
+            let t24 = s12;
+            let t25 = c12;
+            let t26 = s13;
+            let t27 = c13;
+            let t28 = s14;
+            let t29 = c14;
+            let t30 = s15;
+            let t31 = c15;
+            let t32 = t0 * t3;
+            let t33 = t0 * t2;
+            let t34 = t8 * t10;
+            let t35 = t8 * t11;
+            let t36 = t9 * t12;
+            let t37 = t9 * t13;
+            let t38 = t24 * t27;
+            let t39 = t24 * t26;
+            let t40 = t5 * t6;
+            let t41 = t21 * t22;
+            let t42 = t29 * t30;
+            let t43 = T::from_f64(0.00044856000000000003) * t31
+                + T::from_f64(0.0010137599999999998);
+            let t44 = T::from_f64(0.00044856000000000003) * t23
+                + T::from_f64(0.0010137599999999998);
+            let t45 = T::from_f64(0.0007106399999999999) * t15 + T::from_f64(0.00285784);
+            let t46 = T::from_f64(0.00044856000000000003) * t7
+                + T::from_f64(0.0010137599999999998);
+            let t47 = T::from_f64(0.9961946980960786) * t32
+                - T::from_f64(0.08715574269813088) * t2;
+            let t48 = T::from_f64(0.08715574269813088) * t3
+                + T::from_f64(0.9961946980960786) * t33;
+            let t49 = -T::from_f64(0.9961946980960786) * t2
+                - T::from_f64(0.08715574269813088) * t32;
+            let t50 = T::from_f64(0.9961946980960786) * t3
+                - T::from_f64(0.08715574269813088) * t33;
+            let t51 = t1 * t3 * t5 - t1 * t2 * t4;
+            let t52 = T::from_f64(0.08715574180663972) * t11
+                - T::from_f64(0.996194698174074) * t34;
+            let t53 = T::from_f64(0.996194698174074) * t11
+                + T::from_f64(0.08715574180663972) * t34;
+            let t54 = t9 * t10 * t13 - t8 * t12;
+            let t55 = t17 * t19 * t21 - t17 * t18 * t20;
+            let t56 = t16 * t19 * t21 - t16 * t18 * t20;
+            let t57 = -t18 * t21 - t19 * t20;
+            let t58 = T::from_f64(0.08715574269813088) * t26
+                + T::from_f64(0.9961946980960786) * t38;
+            let t59 = T::from_f64(0.9961946980960786) * t39
+                - T::from_f64(0.08715574269813088) * t27;
+            let t60 = T::from_f64(0.08715574269813088) * t38
+                - T::from_f64(0.9961946980960786) * t26;
+            let t61 = T::from_f64(0.9961946980960786) * t27
+                + T::from_f64(0.08715574269813088) * t39;
+            let t62 = t25 * t27 * t29 - t25 * t26 * t28;
+            let t63 = t28 * t43;
+            (
+                t0,
+                t1,
+                t2,
+                t3,
+                t4,
+                t5,
+                t6,
+                t7,
+                t8,
+                t9,
+                t10,
+                t11,
+                t12,
+                t13,
+                t14,
+                t15,
+                t16,
+                t17,
+                t18,
+                t19,
+                t20,
+                t21,
+                t22,
+                t23,
+                t24,
+                t25,
+                t26,
+                t27,
+                t28,
+                t29,
+                t30,
+                t31,
+                t32,
+                t33,
+                t34,
+                t35,
+                t36,
+                t37,
+                t38,
+                t39,
+                t40,
+                t41,
+                t42,
+                t43,
+                t44,
+                t45,
+                t46,
+                t47,
+                t48,
+                t49,
+                t50,
+                t51,
+                t52,
+                t53,
+                t54,
+                t55,
+                t56,
+                t57,
+                t58,
+                t59,
+                t60,
+                t61,
+                t62,
+                t63,
+            )
+        };
+        let (
+            t64,
+            t65,
+            t66,
+            t67,
+            t68,
+            t69,
+            t70,
+            t71,
+            t72,
+            t73,
+            t74,
+            t75,
+            t76,
+            t77,
+            t78,
+            t79,
+            t80,
+            t81,
+            t82,
+            t83,
+            t84,
+            t85,
+            t86,
+            t87,
+            t88,
+            t89,
+            t90,
+            t91,
+            t92,
+            t93,
+            t94,
+            t95,
+            t96,
+            t97,
+            t98,
+            t99,
+            t100,
+            t101,
+            t102,
+        ) = {
+            let t64 = t20 * t44;
+            let t65 = t4 * t46;
+            let t66 = (t1 * t3 * t4 + t1 * t2 * t5) * t6;
+            let t67 = (t9 * t10 * t12 + t8 * t13) * t14;
+            let t68 = (t17 * t19 * t20 + t17 * t18 * t21) * t22;
+            let t69 = (t16 * t19 * t20 + t16 * t18 * t21) * t22;
+            let t70 = (t19 * t21 - t18 * t20) * t22;
+            let t71 = (t25 * t27 * t28 + t25 * t26 * t29) * t30;
+            let t72 = t29 * t43 + T::from_f64(0.0033426)
+                - T::from_f64(0.00044856000000000003) * t28 * t30;
+            let t73 = t21 * t44 + T::from_f64(0.0033426)
+                - T::from_f64(0.00044856000000000003) * t20 * t22;
+            let t74 = T::from_f64(0.0007106399999999999) * t13 * t14 + t12 * t45;
+            let t75 = t13 * t45 + T::from_f64(0.005866169999999999)
+                - T::from_f64(0.0007106399999999999) * t12 * t14;
+            let t76 = t5 * t46 + T::from_f64(0.0033426)
+                - T::from_f64(0.00044856000000000003) * t4 * t6;
+            let t77 = -T::from_f64(0.00044856000000000003) * t40 - t65;
+            let t78 = -T::from_f64(0.00044856000000000003) * t41 - t64;
+            let t79 = -T::from_f64(0.00044856000000000003) * t42 - t63;
+            let t80 = t47 * t5 - t48 * t4;
+            let t81 = t49 * t5 - t50 * t4;
+            let t82 = t52 * t13 - T::from_f64(0.996194698174074) * t36;
+            let t83 = T::from_f64(0.08715574180663972) * t36 + t53 * t13;
+            let t84 = t58 * t29 - t59 * t28;
+            let t85 = t60 * t29 - t61 * t28;
+            let t86 = t18 * t73;
+            let t87 = t8 * t75;
+            let t88 = (t47 * t4 + t48 * t5) * t6;
+            let t89 = (t49 * t4 + t50 * t5) * t6;
+            let t90 = (t52 * t12 + T::from_f64(0.996194698174074) * t37) * t14;
+            let t91 = (t53 * t12 - T::from_f64(0.08715574180663972) * t37) * t14;
+            let t92 = (t58 * t28 + t59 * t29) * t30;
+            let t93 = (t60 * t28 + t61 * t29) * t30;
+            let t94 = t27 * (T::from_f64(0.00044856000000000003) * t42 + t63)
+                + t26 * t72;
+            let t95 = t19 * (T::from_f64(0.00044856000000000003) * t41 + t64) + t86;
+            let t96 = t3 * (T::from_f64(0.00044856000000000003) * t40 + t65) + t2 * t76;
+            let t97 = -t10 * t74 - T::from_f64(0.0005275);
+            let t98 = T::from_f64(1.8535681186283597)
+                * (-T::from_f64(0.08715574180663972) * t10
+                    - T::from_f64(0.996194698174074) * t35) * t74;
+            let t99 = T::from_f64(1.8535681186283597)
+                * (T::from_f64(0.08715574180663972) * t35
+                    - T::from_f64(0.996194698174074) * t10) * t74;
+            let t100 = t1 * t96;
+            let t101 = t9 * t97;
+            let t102 = t25 * t94;
+            (
+                t64,
+                t65,
+                t66,
+                t67,
+                t68,
+                t69,
+                t70,
+                t71,
+                t72,
+                t73,
+                t74,
+                t75,
+                t76,
+                t77,
+                t78,
+                t79,
+                t80,
+                t81,
+                t82,
+                t83,
+                t84,
+                t85,
+                t86,
+                t87,
+                t88,
+                t89,
+                t90,
+                t91,
+                t92,
+                t93,
+                t94,
+                t95,
+                t96,
+                t97,
+                t98,
+                t99,
+                t100,
+                t101,
+                t102,
+            )
+        };
+        [
+            [
+                -T::from_f64(1.8535681186283597) * t0 * t96,
+                T::from_f64(1.8535681186283597) * (t1 * t3 * t76 + t1 * t2 * t77),
+                T::from_f64(1.8535681186283597) * t51 * t46
+                    - T::from_f64(0.0008314365152919371) * t66,
+                T::from_f64(0.0008314365152919371) * (t51 * t7 - t66),
+                T::from_f64(1.8535681186283597) * (t9 * t75 + t8 * t97),
+                T::from_f64(1.8535681186283597) * t9 * t11 * t74,
+                T::from_f64(1.8535681186283597) * t54 * t45
+                    - T::from_f64(0.0013172196478220574) * t67,
+                T::from_f64(0.0013172196478220574) * (t54 * t15 - t67),
+                -T::from_f64(1.8535681186283597) * t16 * t95,
+                T::from_f64(1.8535681186283597) * (t17 * t19 * t73 + t17 * t18 * t78),
+                T::from_f64(1.8535681186283597) * t55 * t44
+                    - T::from_f64(0.0008314365152919371) * t68,
+                T::from_f64(0.0008314365152919371) * (t55 * t23 - t68),
+                -T::from_f64(1.8535681186283597) * t24 * t94,
+                T::from_f64(1.8535681186283597) * (t25 * t27 * t72 + t25 * t26 * t79),
+                T::from_f64(1.8535681186283597) * t62 * t43
+                    - T::from_f64(0.0008314365152919371) * t71,
+                T::from_f64(0.0008314365152919371) * (t62 * t31 - t71),
+            ],
+            [
+                T::from_f64(1.8465147323374953) * t100,
+                T::from_f64(1.8535681186283597) * (t47 * t76 + t48 * t77),
+                T::from_f64(1.8535681186283597) * t80 * t46
+                    - T::from_f64(0.0008314365152919371) * t88,
+                T::from_f64(0.0008314365152919371) * (t80 * t7 - t88),
+                T::from_f64(1.846514732482065) * (t101 - t87),
+                t98,
+                T::from_f64(1.8535681186283597) * t82 * t45
+                    - T::from_f64(0.0013172196478220574) * t90,
+                T::from_f64(0.0013172196478220574) * (t82 * t15 - t90),
+                T::from_f64(1.8535681186283597) * t17 * t95,
+                T::from_f64(1.8535681186283597) * (t16 * t19 * t73 + t16 * t18 * t78),
+                T::from_f64(1.8535681186283597) * t56 * t44
+                    - T::from_f64(0.0008314365152919371) * t69,
+                T::from_f64(0.0008314365152919371) * (t56 * t23 - t69),
+                T::from_f64(1.8465147323374953) * t102,
+                T::from_f64(1.8535681186283597) * (t58 * t72 + t59 * t79),
+                T::from_f64(1.8535681186283597) * t84 * t43
+                    - T::from_f64(0.0008314365152919371) * t92,
+                T::from_f64(0.0008314365152919371) * (t84 * t31 - t92),
+            ],
+            [
+                -T::from_f64(0.16154910602063186) * t100,
+                T::from_f64(1.8535681186283597) * (t49 * t76 + t50 * t77),
+                T::from_f64(1.8535681186283597) * t81 * t46
+                    - T::from_f64(0.0008314365152919371) * t89,
+                T::from_f64(0.0008314365152919371) * (t81 * t7 - t89),
+                T::from_f64(0.16154910436819225) * (t87 - t101),
+                t99,
+                T::from_f64(1.8535681186283597) * t83 * t45
+                    - T::from_f64(0.0013172196478220574) * t91,
+                T::from_f64(0.0013172196478220574) * (t83 * t15 - t91),
+                T::zero(),
+                T::from_f64(1.8535681186283597) * (t19 * t78 - t86),
+                T::from_f64(1.8535681186283597) * t57 * t44
+                    - T::from_f64(0.0008314365152919371) * t70,
+                T::from_f64(0.0008314365152919371) * (t57 * t23 - t70),
+                T::from_f64(0.16154910602063186) * t102,
+                T::from_f64(1.8535681186283597) * (t60 * t72 + t61 * t79),
+                T::from_f64(1.8535681186283597) * t85 * t43
+                    - T::from_f64(0.0008314365152919371) * t93,
+                T::from_f64(0.0008314365152919371) * (t85 * t31 - t93),
+            ],
+        ]
+    }
     /// Each joint's axis (in the frame of the body it moves) and motion.
     const TREE_JOINTS: [::eomgen_runtime::tree::TreeJoint; 16] = [
         ::eomgen_runtime::tree::TreeJoint {
@@ -6474,7 +7042,7 @@ impl<T: ::eomgen_runtime::Real> AllegroRightHand<T> {
             motion: ::eomgen_runtime::tree::Motion::Rotation,
         },
     ];
-    /// The pose of body `j` in its parent body's frame.
+    /// The pose of body `j` in its parent body's frame (a floating base is body 0).
     fn joint_transform(&self, j: usize, q: &[T; 16]) -> ::eomgen_runtime::Pose<T> {
         match j {
             0 => {

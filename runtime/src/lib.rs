@@ -66,8 +66,10 @@
 #[cfg(feature = "std")]
 extern crate std;
 
+pub mod contact;
 pub mod control;
 mod dynamics;
+pub mod free_flyer;
 mod joint_effects;
 mod linalg;
 mod pose;

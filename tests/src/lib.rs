@@ -279,6 +279,19 @@ pub mod robots {
     pub mod allegro_derivatives {
         include!(concat!(env!("OUT_DIR"), "/allegro_derivatives.rs"));
     }
+    /// `floating/anymal.urdf` with a floating base and point contacts at its four feet.
+    pub mod anymal {
+        include!(concat!(env!("OUT_DIR"), "/anymal.rs"));
+    }
+    /// `floating/anymal.urdf` without gravity: forward dynamics, the centroidal map, the
+    /// kinetic energy and `integrate` only.
+    pub mod anymal_weightless {
+        include!(concat!(env!("OUT_DIR"), "/anymal_weightless.rs"));
+    }
+    /// `floating/iris_simple.urdf` with a floating base: a drone, one free body.
+    pub mod iris_simple {
+        include!(concat!(env!("OUT_DIR"), "/iris_simple.rs"));
+    }
     /// `codegen/tests/urdf/hostile/names.urdf`: link and joint names that try to break out of
     /// comments and string literals; compiling this module is the test.
     pub mod hostile_names {

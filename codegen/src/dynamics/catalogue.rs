@@ -108,6 +108,12 @@ pub enum Evaluation {
     /// `(d qdd/dq, d qdd/dqd, M^-1)` at run time: `qdd` from `forward_dynamics`, then
     /// `-M^-1` times `inverse_dynamics_derivatives` at `(q, qd, qdd)`.
     ForwardDynamicsDerivatives,
+    /// The accelerations and contact forces with the contact points held, solved at run time:
+    /// `M` from `mass_matrix`, `h = b + G + F` straight-line, `J_c` and its drift from
+    /// `contact_jacobian` and `contact_drift` (`eomgen_runtime::contact::solve`).
+    ContactForwardDynamics { h: Vec<Id> },
+    /// A floating base's `q (+) v dt` (`eomgen_runtime::free_flyer::integrate`).
+    Integrate,
 }
 
 /// One generated function.
@@ -139,7 +145,9 @@ impl Quantity {
                 accelerations,
                 pivots,
             } => accelerations.iter().chain(pivots).copied().collect(),
-            Evaluation::ForwardDynamicsSolve { h } => h.clone(),
+            Evaluation::ForwardDynamicsSolve { h } | Evaluation::ContactForwardDynamics { h } => {
+                h.clone()
+            }
             _ => Vec::new(),
         }
     }
@@ -155,6 +163,9 @@ impl Quantity {
             Evaluation::CraigColumns(_) => &["coriolis_matrix"],
             Evaluation::ForwardDynamicsSolve { .. } | Evaluation::MassMatrixInverse => {
                 &["mass_matrix"]
+            }
+            Evaluation::ContactForwardDynamics { .. } => {
+                &["mass_matrix", "contact_jacobian", "contact_drift"]
             }
             Evaluation::ForwardDynamicsDerivatives => &[
                 "forward_dynamics",

@@ -12,6 +12,8 @@
 //! includes it) adds to `tau` and enters forward dynamics, but not `b`.
 
 pub mod catalogue;
+mod centroidal;
+mod floating;
 mod lagrangian;
 pub mod newton_euler;
 mod quantities;
@@ -23,6 +25,7 @@ use crate::kinematics::{const_v3, BodyKinematics, Params, WorldKinematics, M3, V
 use crate::model::Model;
 
 pub use catalogue::{Craig, Evaluation, Home, Input, Quantity, Shape};
+pub use centroidal::Centroidal;
 pub use lagrangian::pairs;
 
 /// The pose of a body in its parent body's frame (the root's for a body whose parent is the
@@ -49,8 +52,11 @@ pub struct FrameExprs {
 #[derive(Clone, Debug)]
 pub struct Derivation {
     pub graph: Graph,
-    /// Degrees of freedom.
+    /// Degrees of freedom: the number of velocity coordinates.
     pub dof: usize,
+    /// The number of position coordinates (`dof`, or `dof + 1` with a floating base's
+    /// quaternion).
+    pub nq: usize,
     /// The joint symbols.
     pub q: Vec<Id>,
     pub qd: Vec<Id>,
@@ -81,6 +87,10 @@ pub struct Derivation {
     /// Per joint, its body's pose in the parent body's frame: what link poses and Jacobians
     /// compose along a chain.
     pub joint_transforms: Vec<JointTransform>,
+    /// Each velocity coordinate's parent coordinate, for the sparse factorizations of `M`.
+    pub coordinate_parents: Vec<Option<usize>>,
+    /// The centre of mass, its Jacobian, the centroidal momentum map and the contacts.
+    pub centroidal: Centroidal,
     /// The same quantities by the recursive algorithms.
     pub recursive: Recursive,
     /// For each function of generated code, the cheaper of the two routes.
@@ -227,6 +237,9 @@ impl Derivation {
     /// the graph is full (checked after every stage and every joint's step within a stage, so
     /// that a robot too large for the limit costs little time and at most the limit's memory).
     pub fn try_new(model: &Model, limits: Limits) -> Result<Derivation, GraphFull> {
+        if model.is_floating() {
+            return floating::derive(model, limits);
+        }
         let mut clock = Clock::new();
         let mut g = Graph::with_limits(limits);
         let n = model.dof();
@@ -277,9 +290,12 @@ impl Derivation {
                 translation: lm.translation[i],
             })
             .collect();
-        let mut d = Derivation {
+        let centroidal = Centroidal::new(&mut g, model, &lm, &world, &qd);
+        g.check()?;
+        let d = Derivation {
             graph: g,
             dof: n,
+            nq: n,
             q,
             qd,
             qdd,
@@ -295,15 +311,14 @@ impl Derivation {
             kinetic_energy: en.kinetic_energy,
             potential_energy: en.potential_energy,
             joint_transforms,
+            coordinate_parents: lm.coordinate_parents(),
+            centroidal,
             recursive,
             fast,
             quantities: Vec::new(),
             timings: Vec::new(),
         };
-        d.quantities = quantities::catalogue(model, &d);
-        clock.lap("catalogue");
-        d.timings = clock.laps;
-        Ok(d)
+        Ok(finish(d, model, clock))
     }
 
     /// The closed-form world pose and Jacobian of every URDF link frame, in the model's
@@ -388,6 +403,14 @@ impl Derivation {
         let d = self.graph.time_derivative_many(&flat);
         d.chunks(self.dof).map(|r| r.to_vec()).collect()
     }
+}
+
+/// `d` with its catalogue and the stage timings.
+fn finish(mut d: Derivation, model: &Model, mut clock: Clock) -> Derivation {
+    d.quantities = quantities::catalogue(model, &d);
+    clock.lap("catalogue");
+    d.timings = clock.laps;
+    d
 }
 
 /// The recursive algorithms on the local model: CRBA, Newton-Euler for gravity, bias, `b + G`

@@ -18,73 +18,157 @@ use crate::spatial::{
     M3, V3,
 };
 
+/// How a joint moves its body, for the recursions' velocity and acceleration steps.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Step {
+    /// One coordinate rotating the body about its axis.
+    Revolute,
+    /// One coordinate translating the body along its axis.
+    Prismatic,
+    /// A free flyer on the world (a floating base): six coordinates, the body's own velocity.
+    Free,
+}
+
 /// Each body's placement relative to its parent and its inertia about its own origin.
+///
+/// Bodies are the model's, in its order, after the floating base (body 0) when the model has
+/// one. Joint `i`'s velocity coordinates are `column[i]..column[i] + subspace[i].len()`.
 #[derive(Clone, Debug)]
 pub struct LocalModel {
-    /// Parent from body rotation, `R_origin R_joint(q)`.
+    /// Parent from body rotation, `R_origin R_joint(q)` (world from base for a floating base).
     pub rotation: Vec<M3>,
     /// Body origin in parent coordinates (including a prismatic joint's travel).
     pub translation: Vec<V3>,
-    /// Joint axis in body coordinates.
+    /// Joint axis in body coordinates (zero for a free flyer).
     pub axis: Vec<V3>,
+    /// How the joint moves its body.
+    pub step: Vec<Step>,
     /// Whether the joint rotates its body (its subspace has an angular part).
     pub revolute: Vec<bool>,
-    /// The joint's motion subspace in body axes (one column per joint coordinate).
-    pub subspace: Vec<Spatial>,
+    /// The joint's motion subspace in body axes (one column per velocity coordinate).
+    pub subspace: Vec<Vec<Spatial>>,
+    /// The joint's first velocity coordinate.
+    pub column: Vec<usize>,
     pub parent: Vec<Option<usize>>,
     pub mass: Vec<Id>,
     /// First moment `m c`.
     pub first_moment: Vec<V3>,
     /// Rotational inertia about the body origin, `I_c + m (|c|^2 1 - c c^T)`.
     pub inertia: Vec<M3>,
-    /// Rotor inertia of each joint: `M_ii += armature_i`, `tau_i += armature_i qdd_i`.
+    /// Rotor inertia of each joint: `M_ii += armature_i`, `tau_i += armature_i qdd_i` (zero for
+    /// a free flyer).
     pub armature: Vec<Id>,
 }
 
+/// `J = I_c + m (c.c 1 - c c^T)`: the inertia about the origin.
+fn inertia_about_origin(g: &mut Graph, m: Id, c: &V3, ic: &M3) -> M3 {
+    let cc = g.dot(c, c);
+    let mut j = *ic;
+    for r in 0..3 {
+        for k in 0..3 {
+            let ck = g.mul(c[r], c[k]);
+            let shift = if r == k { g.sub(cc, ck) } else { g.neg(ck) };
+            let ms = g.mul(m, shift);
+            j[r][k] = g.add(ic[r][k], ms);
+        }
+    }
+    j
+}
+
 impl LocalModel {
+    /// The local model for position coordinates `q` (`model.nq()` of them).
     pub fn new(g: &mut Graph, model: &Model, params: &Params, q: &[Id]) -> LocalModel {
         let n = model.dof();
         let mut lm = LocalModel {
-            rotation: Vec::with_capacity(n),
-            translation: Vec::with_capacity(n),
-            axis: Vec::with_capacity(n),
-            revolute: Vec::with_capacity(n),
-            subspace: Vec::with_capacity(n),
-            parent: Vec::with_capacity(n),
-            mass: params.mass.clone(),
-            first_moment: Vec::with_capacity(n),
-            inertia: Vec::with_capacity(n),
-            armature: params.armature.clone(),
+            rotation: Vec::with_capacity(n + 1),
+            translation: Vec::with_capacity(n + 1),
+            axis: Vec::with_capacity(n + 1),
+            step: Vec::with_capacity(n + 1),
+            revolute: Vec::with_capacity(n + 1),
+            subspace: Vec::with_capacity(n + 1),
+            column: Vec::with_capacity(n + 1),
+            parent: Vec::with_capacity(n + 1),
+            mass: Vec::with_capacity(n + 1),
+            first_moment: Vec::with_capacity(n + 1),
+            inertia: Vec::with_capacity(n + 1),
+            armature: Vec::with_capacity(n + 1),
         };
+        let shift = usize::from(model.is_floating());
+        if let Some((m, c, ic)) = &params.base {
+            let placed = joint::free_flyer_placement(g, &q[..7]);
+            lm.push_body(g, placed, (*m, *c, *ic), g.zero());
+            lm.axis.push([g.zero(); 3]);
+            lm.step.push(Step::Free);
+            lm.revolute.push(true);
+            lm.subspace.push(joint::free_flyer_subspace(g));
+            lm.column.push(0);
+            lm.parent.push(None);
+        }
+        let (q0, v0) = (model.base_nq(), model.base_nv());
         for (i, joint) in model.joints.iter().enumerate() {
-            let placed = joint::body_in_parent(g, joint, &params.origin[i], &q[i..i + 1]);
-            lm.rotation.push(placed.rotation);
-            lm.translation.push(placed.translation);
+            let coords = &q[q0 + i..q0 + i + 1];
+            let placed = joint::body_in_parent(g, joint, &params.origin[i], coords);
+            let inertial = (params.mass[i], params.com[i], params.inertia[i]);
+            lm.push_body(g, placed, inertial, params.armature[i]);
             lm.axis.push(joint::axis(g, joint));
-            lm.revolute.push(joint::rotates(joint));
-            lm.subspace.push(joint::subspace(g, joint)[0]);
-            lm.parent.push(joint.parent);
-            let m = params.mass[i];
-            let c = params.com[i];
-            lm.first_moment.push(vec_scale(g, &c, m));
-            // J = I_c + m (c.c 1 - c c^T)
-            let cc = g.dot(&c, &c);
-            let mut j = params.inertia[i];
-            for r in 0..3 {
-                for k in 0..3 {
-                    let ck = g.mul(c[r], c[k]);
-                    let shift = if r == k { g.sub(cc, ck) } else { g.neg(ck) };
-                    let ms = g.mul(m, shift);
-                    j[r][k] = g.add(params.inertia[i][r][k], ms);
-                }
-            }
-            lm.inertia.push(j);
+            let rotates = joint::rotates(joint);
+            lm.step.push(if rotates {
+                Step::Revolute
+            } else {
+                Step::Prismatic
+            });
+            lm.revolute.push(rotates);
+            lm.subspace.push(joint::subspace(g, joint));
+            lm.column.push(v0 + i);
+            lm.parent.push(match joint.parent {
+                Some(p) => Some(p + shift),
+                None if shift == 1 => Some(0),
+                None => None,
+            });
         }
         lm
     }
 
-    fn dof(&self) -> usize {
+    fn push_body(
+        &mut self,
+        g: &mut Graph,
+        placed: joint::Placement,
+        (m, c, ic): (Id, V3, M3),
+        armature: Id,
+    ) {
+        self.rotation.push(placed.rotation);
+        self.translation.push(placed.translation);
+        self.mass.push(m);
+        self.first_moment.push(vec_scale(g, &c, m));
+        self.inertia.push(inertia_about_origin(g, m, &c, &ic));
+        self.armature.push(armature);
+    }
+
+    /// Number of bodies.
+    pub fn bodies(&self) -> usize {
         self.rotation.len()
+    }
+
+    /// Number of velocity coordinates.
+    pub fn nv(&self) -> usize {
+        self.column.last().map_or(0, |&c| c) + self.subspace.last().map_or(0, Vec::len)
+    }
+
+    /// Each velocity coordinate's parent coordinate in the tree of coordinates that the
+    /// sparse factorizations walk: the previous column of its own joint, else the last column
+    /// of the parent body's joint.
+    pub fn coordinate_parents(&self) -> Vec<Option<usize>> {
+        let mut out = Vec::with_capacity(self.nv());
+        for i in 0..self.bodies() {
+            let above = self.parent[i].map(|p| self.column[p] + self.subspace[p].len() - 1);
+            out.push(above);
+            out.extend((1..self.subspace[i].len()).map(|k| Some(self.column[i] + k - 1)));
+        }
+        out
+    }
+
+    fn dof(&self) -> usize {
+        self.bodies()
     }
 
     /// Children of each body, in index order.
@@ -96,6 +180,17 @@ impl LocalModel {
             }
         }
         ch
+    }
+
+    /// Joint `i`'s velocity `S qd` in body axes for the velocity coordinates `qd`.
+    fn joint_velocity(&self, g: &mut Graph, i: usize, qd: &[Id]) -> Spatial {
+        let zero = [g.zero(); 3];
+        let mut v = (zero, zero);
+        for (k, s) in self.subspace[i].iter().enumerate() {
+            let sq = spatial_scale(g, s, qd[self.column[i] + k]);
+            v = spatial_add(g, &v, &sq);
+        }
+        v
     }
 }
 
@@ -110,8 +205,23 @@ pub struct Terms<'a> {
     pub gravity: Option<V3>,
 }
 
-/// Recursive Newton-Euler: the joint efforts for the selected terms.
-pub fn rnea(g: &mut Graph, lm: &LocalModel, terms: Terms<'_>) -> Vec<Id> {
+/// A body's motion in its own axes: angular velocity, angular acceleration and the classical
+/// acceleration of its origin.
+#[derive(Clone, Copy, Debug)]
+pub struct BodyMotion {
+    pub w: V3,
+    pub dw: V3,
+    pub acc: V3,
+}
+
+/// Newton-Euler's forward pass: every body's motion for the selected terms, root first,
+/// calling `each` on each body as soon as its motion is known.
+pub fn forward_pass(
+    g: &mut Graph,
+    lm: &LocalModel,
+    terms: Terms<'_>,
+    mut each: impl FnMut(&mut Graph, usize, &BodyMotion),
+) -> Vec<BodyMotion> {
     let n = lm.dof();
     let zero = [g.zero(); 3];
     // Gravity enters as an upward acceleration of the base.
@@ -119,21 +229,18 @@ pub fn rnea(g: &mut Graph, lm: &LocalModel, terms: Terms<'_>) -> Vec<Id> {
         Some(gv) => [0, 1, 2].map(|k| g.neg(gv[k])),
         None => zero,
     };
-    let mut w: Vec<V3> = Vec::with_capacity(n);
-    let mut dw: Vec<V3> = Vec::with_capacity(n);
-    let mut acc: Vec<V3> = Vec::with_capacity(n);
-    let mut force: Vec<V3> = Vec::with_capacity(n);
-    let mut moment: Vec<V3> = Vec::with_capacity(n);
+    let mut out: Vec<BodyMotion> = Vec::with_capacity(n);
     for i in 0..n {
         let (wp, dwp, ap) = match lm.parent[i] {
-            Some(p) => (w[p], dw[p], acc[p]),
+            Some(p) => (out[p].w, out[p].dw, out[p].acc),
             None => (zero, zero, base_acc),
         };
         let r = &lm.rotation[i];
         let t = &lm.translation[i];
         let a = &lm.axis[i];
-        let qd = terms.qd.map(|v| v[i]);
-        let qdd = terms.qdd.map(|v| v[i]);
+        let col = lm.column[i];
+        let qd = terms.qd.map(|v| v[col]);
+        let qdd = terms.qdd.map(|v| v[col]);
         // Parent quantities in body axes.
         let wp_b = mat_t_vec(g, r, &wp);
         let dwp_b = mat_t_vec(g, r, &dwp);
@@ -145,7 +252,9 @@ pub fn rnea(g: &mut Graph, lm: &LocalModel, terms: Terms<'_>) -> Vec<Id> {
             let s = [0, 1, 2].map(|k| g.add_all([ap[k], c1[k], c2[k]]));
             mat_t_vec(g, r, &s)
         };
-        let (wi, dwi, ai) = if lm.revolute[i] {
+        let (wi, dwi, ai) = if lm.step[i] == Step::Free {
+            free_step(g, lm, i, terms, a_origin)
+        } else if lm.revolute[i] {
             let wi = match qd {
                 Some(v) => {
                     let aq = vec_scale(g, a, v);
@@ -179,6 +288,25 @@ pub fn rnea(g: &mut Graph, lm: &LocalModel, terms: Terms<'_>) -> Vec<Id> {
             }
             (wp_b, dwp_b, ai)
         };
+        let motion = BodyMotion {
+            w: wi,
+            dw: dwi,
+            acc: ai,
+        };
+        each(g, i, &motion);
+        out.push(motion);
+    }
+    out
+}
+
+/// Recursive Newton-Euler: the generalized efforts for the selected terms (for a floating
+/// base, first the force and torque on the base in base axes).
+pub fn rnea(g: &mut Graph, lm: &LocalModel, terms: Terms<'_>) -> Vec<Id> {
+    let n = lm.dof();
+    let mut force: Vec<V3> = Vec::with_capacity(n);
+    let mut moment: Vec<V3> = Vec::with_capacity(n);
+    forward_pass(g, lm, terms, |g, i, motion| {
+        let (wi, dwi, ai) = (motion.w, motion.dw, motion.acc);
         // F = m a + dw x h + w x (w x h);  N = J dw + w x (J w) + h x a   (about the origin)
         let h = &lm.first_moment[i];
         let j = &lm.inertia[i];
@@ -192,33 +320,63 @@ pub fn rnea(g: &mut Graph, lm: &LocalModel, terms: Terms<'_>) -> Vec<Id> {
         let wjw = cross(g, &wi, &jw);
         let ha = cross(g, h, &ai);
         let nm = [0, 1, 2].map(|k| g.add_all([jdw[k], wjw[k], ha[k]]));
-        w.push(wi);
-        dw.push(dwi);
-        acc.push(ai);
         force.push(f);
         moment.push(nm);
-    }
+    });
     // Backward: add each body's children, moved to its frame.
     let children = lm.children();
-    let mut tau = vec![g.zero(); n];
+    let mut tau = vec![g.zero(); lm.nv()];
     for i in (0..n).rev() {
         for &c in &children[i] {
             let (fc, nc) = transfer(g, lm, c, &force[c], &moment[c]);
             force[i] = vec_add(g, &force[i], &fc);
             moment[i] = vec_add(g, &moment[i], &nc);
         }
-        tau[i] = if lm.revolute[i] {
+        let col = lm.column[i];
+        if lm.step[i] == Step::Free {
+            // The wrench on the base: force, then torque about its origin.
+            for k in 0..3 {
+                tau[col + k] = force[i][k];
+                tau[col + 3 + k] = moment[i][k];
+            }
+            continue;
+        }
+        tau[col] = if lm.revolute[i] {
             g.dot(&lm.axis[i], &moment[i])
         } else {
             g.dot(&lm.axis[i], &force[i])
         };
         // The rotor, spun up by the joint alone (its gyroscopic terms are neglected).
         if let Some(qdd) = terms.qdd {
-            let rotor = g.mul(lm.armature[i], qdd[i]);
-            tau[i] = g.add(tau[i], rotor);
+            let rotor = g.mul(lm.armature[i], qdd[col]);
+            tau[col] = g.add(tau[col], rotor);
         }
     }
     tau
+}
+
+/// Newton-Euler's forward step for a free flyer on the world (a floating base, whose parent is
+/// at rest): angular velocity and acceleration from its coordinates, and the classical
+/// acceleration of its origin in its axes, `a_origin + dv/dt + w x v` (`a_origin`: gravity's
+/// upward acceleration, moved to base axes).
+fn free_step(
+    g: &mut Graph,
+    lm: &LocalModel,
+    i: usize,
+    terms: Terms<'_>,
+    a_origin: V3,
+) -> (V3, V3, V3) {
+    debug_assert!(lm.parent[i].is_none(), "a free flyer on another body");
+    let col = lm.column[i];
+    let zero = [g.zero(); 3];
+    let part = |x: Option<&[Id]>, k: usize| {
+        x.map_or(zero, |x| [x[col + k], x[col + k + 1], x[col + k + 2]])
+    };
+    let (v, w) = (part(terms.qd, 0), part(terms.qd, 3));
+    let (dv, dw) = (part(terms.qdd, 0), part(terms.qdd, 3));
+    let wv = cross(g, &w, &v);
+    let acc = [0, 1, 2].map(|k| g.add_all([a_origin[k], dv[k], wv[k]]));
+    (w, dw, acc)
 }
 
 /// A force `f` and moment `n` (about body `c`'s origin, in its axes) expressed in the parent's
@@ -306,11 +464,6 @@ fn composites(g: &mut Graph, lm: &LocalModel) -> Composite {
     Composite { mass, h, j: jm }
 }
 
-/// The motion subspace of joint `i` in its body axes (see [`joint::subspace`]).
-fn subspace(lm: &LocalModel, i: usize) -> Spatial {
-    lm.subspace[i]
-}
-
 /// The momentum-like product `I v` for inertia parameters `(m, h, J)` about the origin:
 /// moment `J w + h x u`, force `w x h + m u` (with `m = None` for an inertia derivative).
 fn inertia_times(g: &mut Graph, m: Option<Id>, h: &V3, j: &M3, v: &Spatial) -> Spatial {
@@ -331,26 +484,49 @@ fn inertia_times(g: &mut Graph, m: Option<Id>, h: &V3, j: &M3, v: &Spatial) -> S
 
 /// Composite-rigid-body algorithm: the upper triangle of `M(q)` (mirrored into a full matrix).
 pub fn crba(g: &mut Graph, lm: &LocalModel) -> Vec<Vec<Id>> {
-    let n = lm.dof();
+    let nv = lm.nv();
     let comp = composites(g, lm);
-    let mut m = vec![vec![g.zero(); n]; n];
-    for i in 0..n {
-        // Force and moment on composite body i for a unit rate of joint i.
-        let s = subspace(lm, i);
-        let mut force = inertia_times(g, Some(comp.mass[i]), &comp.h[i], &comp.j[i], &s);
-        let own = spatial_dot(g, &s, &force);
-        m[i][i] = g.add(own, lm.armature[i]);
-        let mut j = i;
-        while let Some(p) = lm.parent[j] {
-            force = transfer_spatial(g, lm, j, &force);
-            let sp = subspace(lm, p);
-            let e = spatial_dot(g, &sp, &force);
-            m[p][i] = e;
-            m[i][p] = e;
-            j = p;
+    let mut m = vec![vec![g.zero(); nv]; nv];
+    for i in 0..lm.dof() {
+        for (ci, s) in lm.subspace[i].iter().enumerate() {
+            let col = lm.column[i] + ci;
+            // Force and moment on composite body i for a unit rate of this coordinate.
+            let mut force = inertia_times(g, Some(comp.mass[i]), &comp.h[i], &comp.j[i], s);
+            let own = &lm.subspace[i][..=ci];
+            for (k, sk) in own.iter().enumerate() {
+                let e = spatial_dot(g, sk, &force);
+                m[lm.column[i] + k][col] = e;
+                m[col][lm.column[i] + k] = e;
+            }
+            m[col][col] = g.add(m[col][col], lm.armature[i]);
+            let mut j = i;
+            while let Some(p) = lm.parent[j] {
+                force = transfer_spatial(g, lm, j, &force);
+                for (k, sp) in lm.subspace[p].iter().enumerate() {
+                    let e = spatial_dot(g, sp, &force);
+                    m[lm.column[p] + k][col] = e;
+                    m[col][lm.column[p] + k] = e;
+                }
+                j = p;
+            }
         }
     }
     m
+}
+
+/// For every velocity coordinate, in order: the coordinate, the body its joint moves, and the
+/// momentum `I^C S` (moment about the body origin, then force, body axes) of the composite
+/// body below the joint moving with a unit rate of that coordinate.
+pub fn column_momenta(g: &mut Graph, lm: &LocalModel) -> Vec<(usize, usize, Spatial)> {
+    let comp = composites(g, lm);
+    let mut out = Vec::with_capacity(lm.nv());
+    for i in 0..lm.dof() {
+        for (k, s) in lm.subspace[i].iter().enumerate() {
+            let m = inertia_times(g, Some(comp.mass[i]), &comp.h[i], &comp.j[i], s);
+            out.push((lm.column[i] + k, i, m));
+        }
+    }
+    out
 }
 
 /// A body's velocity and its parent's, both in the body's axes (angular, then the velocity of
@@ -376,7 +552,10 @@ pub fn velocities(g: &mut Graph, lm: &LocalModel, qd: &[Id]) -> Vec<Velocity> {
         let wt = cross(g, &wp, &lm.translation[i]);
         let ut = vec_add(g, &up, &wt);
         let parent = (mat_t_vec(g, r, &wp), mat_t_vec(g, r, &ut));
-        let sq = spatial_scale(g, &subspace(lm, i), qd[i]);
+        let sq = match lm.subspace[i].as_slice() {
+            [s] => spatial_scale(g, s, qd[lm.column[i]]),
+            _ => lm.joint_velocity(g, i, qd),
+        };
         let body = spatial_add(g, &parent, &sq);
         out.push(Velocity { parent, body });
     }
@@ -397,8 +576,10 @@ pub fn kinetic_energy(g: &mut Graph, lm: &LocalModel, qd: &[Id]) -> Id {
         terms.push((g.dot(&u, &wh), 1.0));
         let jw = mat_vec(g, &lm.inertia[i], &w);
         terms.push((g.dot(&w, &jw), 0.5));
-        let q2 = g.powi(qd[i], 2);
-        terms.push((g.mul(lm.armature[i], q2), 0.5));
+        if lm.step[i] != Step::Free {
+            let q2 = g.powi(qd[lm.column[i]], 2);
+            terms.push((g.mul(lm.armature[i], q2), 0.5));
+        }
     }
     g.sum(0.0, terms)
 }
@@ -420,11 +601,21 @@ pub fn kinetic_energy(g: &mut Graph, lm: &LocalModel, qd: &[Id]) -> Id {
 pub fn coriolis(g: &mut Graph, lm: &LocalModel, qd: &[Id]) -> Vec<Vec<Id>> {
     let n = lm.dof();
     // Body velocities (angular, origin) and the joint subspaces' time derivatives:
-    // dS/dt = v x S, and S x S = 0 lets the parent's velocity stand in for the body's.
+    // dS/dt = v x S; for a one-column joint S x S = 0 lets the parent's velocity stand in for
+    // the body's.
     let moved = velocities(g, lm, qd);
     let vel: Vec<Spatial> = moved.iter().map(|m| m.body).collect();
-    let sdot: Vec<Spatial> = (0..n)
-        .map(|i| motion_cross(g, &moved[i].parent, &subspace(lm, i)))
+    let sdot: Vec<Vec<Spatial>> = (0..n)
+        .map(|i| {
+            let v = match lm.subspace[i].len() {
+                1 => moved[i].parent,
+                _ => moved[i].body,
+            };
+            lm.subspace[i]
+                .iter()
+                .map(|s| motion_cross(g, &v, s))
+                .collect()
+        })
         .collect();
     // Per body, both halved (with halved inertia parameters, so that no product by 1/2 is
     // left for run time): the momentum H = I v, and dI/dt's parameters: dh/dt (the linear
@@ -468,29 +659,37 @@ pub fn coriolis(g: &mut Graph, lm: &LocalModel, qd: &[Id]) -> Vec<Vec<Id>> {
             mom[i] = spatial_add(g, &mom[i], &moved);
         }
     }
-    let mut c = vec![vec![g.zero(); n]; n];
+    let nv = lm.nv();
+    let mut c = vec![vec![g.zero(); nv]; nv];
     for j in 0..n {
-        let s = subspace(lm, j);
-        let (m, h, jc) = (Some(comp.mass[j]), &comp.h[j], &comp.j[j]);
-        let mut f2 = inertia_times(g, m, h, jc, &s);
-        let isd = inertia_times(g, m, h, jc, &sdot[j]);
-        let dis = inertia_times(g, None, &dh[j], &dj[j], &s);
-        let sh = cross_force(g, &s, &mom[j]);
-        let sym = spatial_add(g, &isd, &dis);
-        let mut f1 = spatial_add(g, &sym, &sh);
-        let mut f3 = spatial_sub(g, &dis, &sh);
-        c[j][j] = spatial_dot(g, &s, &f1);
-        let mut k = j;
-        while let Some(i) = lm.parent[k] {
-            f1 = transfer_spatial(g, lm, k, &f1);
-            f2 = transfer_spatial(g, lm, k, &f2);
-            f3 = transfer_spatial(g, lm, k, &f3);
-            let si = subspace(lm, i);
-            c[i][j] = spatial_dot(g, &si, &f1);
-            let a = spatial_dot(g, &sdot[i], &f2);
-            let b = spatial_dot(g, &si, &f3);
-            c[j][i] = g.add(a, b);
-            k = i;
+        for (cj, s) in lm.subspace[j].iter().enumerate() {
+            let col = lm.column[j] + cj;
+            let (m, h, jc) = (Some(comp.mass[j]), &comp.h[j], &comp.j[j]);
+            let mut f2 = inertia_times(g, m, h, jc, s);
+            let isd = inertia_times(g, m, h, jc, &sdot[j][cj]);
+            let dis = inertia_times(g, None, &dh[j], &dj[j], s);
+            let sh = cross_force(g, s, &mom[j]);
+            let sym = spatial_add(g, &isd, &dis);
+            let mut f1 = spatial_add(g, &sym, &sh);
+            let mut f3 = spatial_sub(g, &dis, &sh);
+            // The joint's own columns, then every ancestor's.
+            for (ck, sk) in lm.subspace[j].iter().enumerate() {
+                c[lm.column[j] + ck][col] = spatial_dot(g, sk, &f1);
+            }
+            let mut k = j;
+            while let Some(i) = lm.parent[k] {
+                f1 = transfer_spatial(g, lm, k, &f1);
+                f2 = transfer_spatial(g, lm, k, &f2);
+                f3 = transfer_spatial(g, lm, k, &f3);
+                for (ci, si) in lm.subspace[i].iter().enumerate() {
+                    let row = lm.column[i] + ci;
+                    c[row][col] = spatial_dot(g, si, &f1);
+                    let a = spatial_dot(g, &sdot[i][ci], &f2);
+                    let b = spatial_dot(g, si, &f3);
+                    c[col][row] = g.add(a, b);
+                }
+                k = i;
+            }
         }
     }
     c

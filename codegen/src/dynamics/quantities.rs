@@ -2,7 +2,7 @@
 //! expressions. One function per quantity; [`catalogue`] lists them in file order.
 
 use super::catalogue::{Craig, Evaluation, Home, Input, Quantity, Shape};
-use super::{flat, Derivation, Route};
+use super::{centroidal, flat, Derivation, Route};
 use crate::cas::{Graph, Id, Program};
 use crate::model::Model;
 
@@ -28,14 +28,23 @@ pub fn catalogue(model: &Model, d: &Derivation) -> Vec<Quantity> {
         forward_dynamics(d, &notes),
         kinetic_energy(d, &notes),
         potential_energy(d),
-        craig(d, Craig::Centrifugal),
-        craig(d, Craig::CoriolisPairs),
     ];
+    if !model.is_floating() {
+        out.push(craig(d, Craig::Centrifugal));
+        out.push(craig(d, Craig::CoriolisPairs));
+    }
     if model.include_friction {
         out.push(friction(model, d));
     }
     out.push(link_pose());
     out.push(link_jacobian(d.dof));
+    out.extend(centroidal::quantities(model, d));
+    if model.is_floating() {
+        // Without the `Dynamics` trait (whose arrays are all N long): inherent methods.
+        for q in &mut out {
+            q.home = Home::Inherent;
+        }
+    }
     out
 }
 

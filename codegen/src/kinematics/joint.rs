@@ -14,8 +14,12 @@
 //! | revolute, continuous | 1 | 1 | rotation by `q` about `a` | `(a; 0)` |
 //! | prismatic | 1 | 1 | translation by `q a` | `(0; a)` |
 //!
+//! | free flyer (a floating base) | 7 | 6 | translation `q[0..3]`, rotation by the unit quaternion `q[3..7]` (x, y, z, w) | the six unit columns, linear first |
+//!
 //! Revolute and prismatic joints integrate as `q + v dt`; a continuous joint's coordinate is
-//! its angle.
+//! its angle. The free flyer's velocity is the base's own (linear velocity of its origin, then
+//! angular velocity, both in base axes), as Pinocchio's `JointModelFreeFlyer`; it integrates on
+//! SE(3) (`eomgen_runtime::free_flyer::integrate`).
 
 use crate::cas::{Graph, Id};
 use crate::model::{Joint, JointKind};
@@ -99,6 +103,41 @@ pub fn rotates(joint: &Joint) -> bool {
         JointKind::Revolute | JointKind::Continuous => true,
         JointKind::Prismatic => false,
     }
+}
+
+/// A free flyer's placement of the base in the world: translation `q[0..3]` and the rotation of
+/// the unit quaternion `q[3..7]` = (x, y, z, w), in the form that assumes unit length (as
+/// Pinocchio's), so that it is exact for unit quaternions and polynomial in `q`.
+pub fn free_flyer_placement(g: &mut Graph, q: &[Id]) -> Placement {
+    debug_assert_eq!(q.len(), 7);
+    let (x, y, z, w) = (q[3], q[4], q[5], q[6]);
+    let p = |g: &mut Graph, a: Id, b: Id| g.mul(a, b);
+    let (xx, yy, zz) = (p(g, x, x), p(g, y, y), p(g, z, z));
+    let (xy, xz, yz) = (p(g, x, y), p(g, x, z), p(g, y, z));
+    let (xw, yw, zw) = (p(g, x, w), p(g, y, w), p(g, z, w));
+    let diag = |g: &mut Graph, a: Id, b: Id| g.sum(1.0, [(a, -2.0), (b, -2.0)]);
+    let off = |g: &mut Graph, a: Id, b: Id, sign: f64| g.sum(0.0, [(a, 2.0), (b, 2.0 * sign)]);
+    let rotation = [
+        [diag(g, yy, zz), off(g, xy, zw, -1.0), off(g, xz, yw, 1.0)],
+        [off(g, xy, zw, 1.0), diag(g, xx, zz), off(g, yz, xw, -1.0)],
+        [off(g, xz, yw, -1.0), off(g, yz, xw, 1.0), diag(g, xx, yy)],
+    ];
+    Placement {
+        rotation,
+        translation: [q[0], q[1], q[2]],
+    }
+}
+
+/// A free flyer's motion subspace in base axes: the six unit columns, linear velocity first
+/// (`(0; e_k)`), then angular (`(e_k; 0)`).
+pub fn free_flyer_subspace(g: &mut Graph) -> Vec<Spatial> {
+    let (o, z) = (g.one(), g.zero());
+    let unit = |k: usize| [0, 1, 2].map(|i| if i == k { o } else { z });
+    let zero = [z; 3];
+    (0..3)
+        .map(|k| (zero, unit(k)))
+        .chain((0..3).map(|k| (unit(k), zero)))
+        .collect()
 }
 
 fn identity(g: &mut Graph) -> M3 {

@@ -37,22 +37,33 @@ pub struct WorldKinematics {
     pub origin: Vec<V3>,
     /// Each body's centre of mass in world coordinates.
     pub com: Vec<V3>,
+    /// The root's placement in the world: the identity, or a floating base's pose.
+    pub root: joint::Placement,
+    /// Whether the root is a floating base.
+    pub floating: bool,
 }
 
 impl WorldKinematics {
     /// Forward kinematics from the root.
     pub fn new(g: &mut Graph, model: &Model, params: &Params, q: &[Id]) -> WorldKinematics {
         let n = model.dof();
-        let root = joint::Placement {
-            rotation: const_m3(g, &nalgebra::Matrix3::identity()),
-            translation: [g.zero(); 3],
+        let root = if model.is_floating() {
+            joint::free_flyer_placement(g, &q[..7])
+        } else {
+            joint::Placement {
+                rotation: const_m3(g, &nalgebra::Matrix3::identity()),
+                translation: [g.zero(); 3],
+            }
         };
+        let q = &q[model.base_nq()..];
         let mut wk = WorldKinematics {
             rotation: Vec::with_capacity(n),
             position: Vec::with_capacity(n),
             axis: Vec::with_capacity(n),
             origin: Vec::with_capacity(n),
             com: Vec::with_capacity(n),
+            root,
+            floating: model.is_floating(),
         };
         for (i, j) in model.joints.iter().enumerate() {
             let parent = match j.parent {
@@ -89,14 +100,20 @@ impl WorldKinematics {
     ) -> (M3, V3) {
         let rp = const_m3(g, &placement.rotation);
         let tp = [0, 1, 2].map(|k| g.constant(placement.translation[k]));
-        match body {
-            None => (rp, tp),
-            Some(b) => {
-                let r = mat_mul(g, &self.rotation[b], &rp);
-                let off = mat_vec(g, &self.rotation[b], &tp);
-                (r, vec_add(g, &self.position[b], &off))
-            }
-        }
+        let (rb, pb) = match body {
+            None if !self.floating => return (rp, tp),
+            None => (self.root.rotation, self.root.translation),
+            Some(b) => (self.rotation[b], self.position[b]),
+        };
+        let r = mat_mul(g, &rb, &rp);
+        let off = mat_vec(g, &rb, &tp);
+        (r, vec_add(g, &pb, &off))
+    }
+
+    /// The centre of mass of a floating base (centre `com` in base axes) in the world.
+    pub fn base_com(&self, g: &mut Graph, com: &V3) -> V3 {
+        let rc = mat_vec(g, &self.root.rotation, com);
+        vec_add(g, &self.root.translation, &rc)
     }
 
     /// The 6 x N Jacobian (linear rows, then angular, world axes) of a point `p` (world
@@ -109,8 +126,22 @@ impl WorldKinematics {
         body: Option<usize>,
         p: &V3,
     ) -> Vec<Vec<Id>> {
-        let n = model.dof();
-        let mut jac = vec![vec![g.zero(); n]; 6];
+        let (nv, v0) = (model.nv(), model.base_nv());
+        let mut jac = vec![vec![g.zero(); nv]; 6];
+        if model.is_floating() {
+            // The base's columns: its linear velocity, then its angular velocity about its
+            // origin, both in base axes.
+            let r = vec_sub(g, p, &self.root.translation);
+            for k in 0..3 {
+                let e = [0, 1, 2].map(|row| self.root.rotation[row][k]);
+                let lin = cross(g, &e, &r);
+                for row in 0..3 {
+                    jac[row][k] = e[row];
+                    jac[row][3 + k] = lin[row];
+                    jac[3 + row][3 + k] = e[row];
+                }
+            }
+        }
         let Some(b) = body else { return jac };
         for j in model.path_to_root(b) {
             let z = self.axis[j];
@@ -121,8 +152,8 @@ impl WorldKinematics {
                 (z, [g.zero(); 3])
             };
             for k in 0..3 {
-                jac[k][j] = lin[k];
-                jac[3 + k][j] = ang[k];
+                jac[k][v0 + j] = lin[k];
+                jac[3 + k][v0 + j] = ang[k];
             }
         }
         jac

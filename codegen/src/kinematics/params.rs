@@ -19,6 +19,9 @@ pub struct Params {
     /// includes friction).
     pub damping: Vec<Id>,
     pub coulomb: Vec<Id>,
+    /// The floating base's mass, centre of mass and inertia about it (numbers), when the model
+    /// has one.
+    pub base: Option<(Id, V3, M3)>,
     /// Every symbolic parameter: (symbol name, node, the URDF's value), in creation order.
     pub symbols: Vec<(String, Id, f64)>,
 }
@@ -82,7 +85,18 @@ impl Params {
             damping.push(value(g, s, format!("damping_{n}"), d));
             coulomb.push(value(g, s, format!("friction_{n}"), f));
         }
+        let base = model.base.as_ref().map(|b| {
+            let com = [0, 1, 2].map(|k| g.constant(b.com[k]));
+            let mut i = [[g.zero(); 3]; 3];
+            for r in 0..3 {
+                for c in 0..3 {
+                    i[r][c] = g.constant(b.inertia[(r.min(c), r.max(c))]);
+                }
+            }
+            (g.constant(b.mass), com, i)
+        });
         Params {
+            base,
             mass,
             com,
             inertia,

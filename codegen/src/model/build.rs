@@ -75,6 +75,16 @@ pub struct ModelOptions {
     /// inertia never matters). `None` (the default) leaves such links massless. The density
     /// must be positive and finite ([`ModelError::InvalidOption`]).
     pub inertia_from_collision: Option<f64>,
+    /// Lets the root link move freely (a free-flyer root, as Pinocchio's
+    /// `JointModelFreeFlyer`): the model gains [`Model::base`], the root link's body, whose
+    /// six velocity coordinates come before the joints'. A URDF whose root is a massless
+    /// world link attached to the robot by a `floating` joint means the same. `false` by
+    /// default.
+    pub floating_base: bool,
+    /// Links with a 3D point contact at their origin, in the order of the contact quantities
+    /// (`contact_jacobian` rows, contact forces). Links merged into their parent by fixed joints
+    /// keep their own names (feet usually are such links). Empty by default.
+    pub contact_points: Vec<String>,
 }
 
 impl Default for ModelOptions {
@@ -89,6 +99,8 @@ impl Default for ModelOptions {
             friction: false,
             coulomb_smoothing: 0.0,
             inertia_from_collision: None,
+            floating_base: false,
+            contact_points: Vec::new(),
         }
     }
 }
@@ -378,6 +390,9 @@ pub enum ModelError {
     /// [`SymbolicParams::Links`] names a link that does not exist.
     #[error("{file}: symbolic parameters requested for link `{link}`, which does not exist")]
     UnknownSymbolicLink { file: String, link: String },
+    /// [`ModelOptions::contact_points`] names a link that does not exist.
+    #[error("{file}: contact point requested at link `{link}`, which does not exist")]
+    UnknownContactLink { file: String, link: String },
     /// [`ModelOptions::armature`] names a joint that does not exist or is fixed, or gives a
     /// negative or non-finite value.
     #[error("{file}: armature: joint `{joint}` {reason}")]
@@ -527,6 +542,9 @@ pub(crate) fn build_model(
     options: &ModelOptions,
     warnings: &mut Vec<ModelWarning>,
 ) -> Result<Model, ModelError> {
+    let (unwelded, floating_joint) = without_world_floating_joint(robot);
+    let robot = unwelded.as_ref().unwrap_or(robot);
+    let floating = options.floating_base || floating_joint;
     let tree = Tree::new(robot, file)?;
     check_numbers(robot, file)?;
     check_options(options, file)?;
@@ -540,9 +558,9 @@ pub(crate) fn build_model(
         }
         None => robot,
     };
-    let mut model = merge(robot, &tree, file, options)?;
+    let mut model = merge(robot, &tree, file, options, floating)?;
     inertia_check::warn_welded(robot, &model, file, warnings);
-    if model.joints.is_empty() {
+    if model.joints.is_empty() && model.base.is_none() {
         return Err(ModelError::NoMovingJoint { file: file.into() });
     }
     inertia_check::check_bodies(&mut model, file, options.repair_inertia, warnings)?;
@@ -552,6 +570,7 @@ pub(crate) fn build_model(
         reorder(&mut model, robot, order, file)?;
     }
     mark_symbolic(&mut model, &options.symbolic, file)?;
+    model.contacts = contact_frames(&model, &options.contact_points, file)?;
     model.warnings = warnings.clone();
     Ok(model)
 }
@@ -1006,6 +1025,18 @@ impl Inertia {
         Inertia { mass, com, inertia }
     }
 
+    /// Stores mass, centre of mass and (exactly symmetric) inertia in `body`.
+    fn set(&self, body: &mut Body) {
+        body.mass = self.mass;
+        body.com = if self.mass > 0.0 {
+            self.com
+        } else {
+            Vector3::zeros()
+        };
+        // Exactly symmetric, whatever the rounding of the rotations.
+        body.inertia = (self.inertia + self.inertia.transpose()) * 0.5;
+    }
+
     /// The rotational inertia about the frame origin.
     fn about_origin(&self) -> Matrix3<f64> {
         self.inertia + shift(&self.com) * self.mass
@@ -1031,7 +1062,11 @@ fn merge(
     tree: &Tree,
     file: &str,
     options: &ModelOptions,
+    floating: bool,
 ) -> Result<Model, ModelError> {
+    let root_link = &robot.links[tree.root];
+    let mut root_inertia = Inertia::of_link(&root_link.inertial, &Transform::identity());
+    let mut root_links = vec![root_link.name.clone()];
     let mut attach = vec![
         Attachment {
             body: None,
@@ -1083,10 +1118,16 @@ fn merge(
                 };
             }
             JointType::Fixed | JointType::Unsupported(_) => {
-                if let Some(b) = above.body {
-                    bodies[b].merged_links.push(child_link.name.clone());
-                    inertias[b] =
-                        inertias[b].combine(&Inertia::of_link(&child_link.inertial, &placement));
+                let part = Inertia::of_link(&child_link.inertial, &placement);
+                match above.body {
+                    Some(b) => {
+                        bodies[b].merged_links.push(child_link.name.clone());
+                        inertias[b] = inertias[b].combine(&part);
+                    }
+                    None => {
+                        root_links.push(child_link.name.clone());
+                        root_inertia = root_inertia.combine(&part);
+                    }
                 }
                 attach[child] = Attachment {
                     body: above.body,
@@ -1097,15 +1138,20 @@ fn merge(
     }
 
     for (body, inertia) in bodies.iter_mut().zip(inertias) {
-        body.mass = inertia.mass;
-        body.com = if inertia.mass > 0.0 {
-            inertia.com
-        } else {
-            Vector3::zeros()
-        };
-        // Exactly symmetric, whatever the rounding of the rotations.
-        body.inertia = (inertia.inertia + inertia.inertia.transpose()) * 0.5;
+        inertia.set(body);
     }
+    let base = floating.then(|| {
+        let mut base = Body {
+            name: root_link.name.clone(),
+            mass: 0.0,
+            com: Vector3::zeros(),
+            inertia: Matrix3::zeros(),
+            merged_links: root_links,
+            symbolic: false,
+        };
+        root_inertia.set(&mut base);
+        base
+    });
     let frames: Vec<Frame> = robot
         .links
         .iter()
@@ -1125,7 +1171,7 @@ fn merge(
     };
     let transform_finite =
         |t: &Transform| all_finite(t.rotation.as_slice()) && all_finite(t.translation.as_slice());
-    for body in &bodies {
+    for body in bodies.iter().chain(&base) {
         if !(body.mass.is_finite()
             && all_finite(body.com.as_slice())
             && all_finite(body.inertia.as_slice()))
@@ -1156,11 +1202,56 @@ fn merge(
         gravity: Vector3::from(options.gravity),
         joints,
         bodies,
+        base,
         frames,
+        contacts: Vec::new(),
         include_friction: options.friction,
         coulomb_smoothing: options.coulomb_smoothing,
         warnings: Vec::new(),
     })
+}
+
+/// The frame index of each contact link, in order.
+fn contact_frames(model: &Model, links: &[String], file: &str) -> Result<Vec<usize>, ModelError> {
+    links
+        .iter()
+        .map(|name| {
+            model
+                .frames
+                .iter()
+                .position(|f| &f.name == name)
+                .ok_or_else(|| ModelError::UnknownContactLink {
+                    file: file.into(),
+                    link: name.clone(),
+                })
+        })
+        .collect()
+}
+
+/// A robot whose root is a massless link (conventionally `world`) attached to the real root by a
+/// single `floating` joint, without that link and joint: the real root then floats. `None`
+/// (and `false`) when the robot has no such joint.
+fn without_world_floating_joint(robot: &RobotDescription) -> (Option<RobotDescription>, bool) {
+    let is_child = |link: &str| robot.joints.iter().any(|j| j.child == link);
+    let floating = robot.joints.iter().position(|j| {
+        matches!(&j.joint_type, JointType::Unsupported(k) if k == "floating")
+            && !is_child(&j.parent)
+            && robot.joints.iter().filter(|o| o.parent == j.parent).count() == 1
+    });
+    let Some(f) = floating else {
+        return (None, false);
+    };
+    let world = robot.joints[f].parent.clone();
+    let Some(w) = robot.links.iter().position(|l| l.name == world) else {
+        return (None, false);
+    };
+    if robot.links[w].inertial.mass != 0.0 {
+        return (None, false);
+    }
+    let mut out = robot.clone();
+    out.joints.remove(f);
+    out.links.remove(w);
+    (Some(out), true)
 }
 
 /// The unit vector along a finite, non-zero `axis`, scaled first so that tiny or huge

@@ -82,7 +82,7 @@ pub(super) fn check_bodies(
     repair: bool,
     warnings: &mut Vec<ModelWarning>,
 ) -> Result<(), ModelError> {
-    for body in &mut model.bodies {
+    for body in model.bodies.iter_mut().chain(&mut model.base) {
         if body.mass < 0.0 {
             return Err(ModelError::NegativeMass {
                 file: file.into(),
@@ -134,9 +134,10 @@ pub(super) fn warn_welded(
     file: &str,
     warnings: &mut Vec<ModelWarning>,
 ) {
-    // `model.frames` follows the links of `robot` one to one.
+    // `model.frames` follows the links of `robot` one to one. A floating base's links move:
+    // their merged body is checked with the others.
     for (link, frame) in robot.links.iter().zip(&model.frames) {
-        if frame.body.is_some() {
+        if frame.body.is_some() || model.is_floating() {
             continue;
         }
         let inertial = &link.inertial;

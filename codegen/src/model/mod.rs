@@ -6,7 +6,10 @@
 //! address each link by name.
 //!
 //! Conventions:
-//! - the root link is welded to the world; its inertia never matters;
+//! - the root link is welded to the world (its inertia never matters), or, with a floating
+//!   base, moves freely: [`Model::base`] is its body, and the base's coordinates come first
+//!   (`q`: position and unit quaternion x, y, z, w, 7 numbers; velocities: linear then
+//!   angular, in base axes, 6 numbers);
 //! - body `i` is moved by joint `i`; its frame is the child link frame of joint `i`;
 //! - all quantities are in SI units (m, kg, kg m^2, rad).
 
@@ -165,8 +168,14 @@ pub struct Model {
     /// Moving joints; joint `i` moves body `i`. A parent body always precedes its children.
     pub joints: Vec<Joint>,
     pub bodies: Vec<Body>,
+    /// The root link's body (with every link welded to it) when the root moves freely
+    /// ([`ModelOptions::floating_base`]); `None` when it is welded to the world.
+    pub base: Option<Body>,
     /// One frame per URDF link, in the URDF's link order.
     pub frames: Vec<Frame>,
+    /// The frames (indices into [`Model::frames`]) with a 3D point contact at their origin
+    /// ([`ModelOptions::contact_points`]), in order.
+    pub contacts: Vec<usize>,
     /// Whether the joint friction (`damping qd + friction sign(qd)` per joint) is part of the
     /// inverse and forward dynamics ([`ModelOptions::friction`]).
     pub include_friction: bool,
@@ -181,6 +190,40 @@ impl Model {
     /// Degrees of freedom.
     pub fn dof(&self) -> usize {
         self.joints.len()
+    }
+
+    /// Whether the root link moves freely ([`Model::base`]).
+    pub fn is_floating(&self) -> bool {
+        self.base.is_some()
+    }
+
+    /// Number of position coordinates: 7 for a floating base (position and unit quaternion),
+    /// then one per joint.
+    pub fn nq(&self) -> usize {
+        self.base_nq() + self.joints.iter().map(|j| j.kind.nq()).sum::<usize>()
+    }
+
+    /// Number of velocity coordinates: 6 for a floating base, then one per joint.
+    pub fn nv(&self) -> usize {
+        self.base_nv() + self.joints.iter().map(|j| j.kind.nv()).sum::<usize>()
+    }
+
+    /// Position coordinates of the base before the joints' (7 floating, else 0).
+    pub fn base_nq(&self) -> usize {
+        if self.is_floating() {
+            7
+        } else {
+            0
+        }
+    }
+
+    /// Velocity coordinates of the base before the joints' (6 floating, else 0).
+    pub fn base_nv(&self) -> usize {
+        if self.is_floating() {
+            6
+        } else {
+            0
+        }
     }
 
     /// The chain of joints from the root to joint `i`, root first, `i` last.

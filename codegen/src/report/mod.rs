@@ -597,7 +597,13 @@ pub fn render(model: &Model, d: &Derivation, opts: &ShowOptions) -> Result<Strin
     let mut g = d.graph.clone();
     let mut dropped = 0;
     let mut sections = Vec::with_capacity(opts.terms.len());
-    for &term in &opts.terms {
+    // Craig's velocity products need qd = dq/dt, which a floating base's velocities are not.
+    let craig = |t: &Term| matches!(t, Term::CoriolisPairs | Term::Centrifugal);
+    for &term in opts
+        .terms
+        .iter()
+        .filter(|t| !(model.is_floating() && craig(t)))
+    {
         let mut s = section(&mut g, d, term, opts, syntax, &mut dropped)?;
         if term == Term::Tau && model.include_friction {
             let sign = if model.coulomb_smoothing > 0.0 {
@@ -692,42 +698,56 @@ pub fn render(model: &Model, d: &Derivation, opts: &ShowOptions) -> Result<Strin
              values, printed with {numbers}."
         )
     });
+    if model.is_floating() {
+        intro.extend(floating_intro(model));
+    }
     if dropped > 0 {
         intro.push(format!(
             "Expanded entries omit {dropped} numeric term(s) below {NOISE:e} times the largest \
              of their entry (rounding noise; --form program shows every term)."
         ));
     }
-    let joints: Vec<(String, String)> = model
-        .joints
-        .iter()
-        .enumerate()
-        .map(|(i, j)| {
-            let q = g.print(d.q[i], style);
-            let mut what = format!(
-                "{}, {} about {}",
-                j.name,
-                kind_name(j.kind),
-                vec3(&j.axis, opts.digits)
+    let q0 = model.base_nq();
+    let mut joints: Vec<(String, String)> = Vec::new();
+    if model.is_floating() {
+        let q = |i: usize| g.print(d.q[i], style);
+        let base = [
+            (
+                format!("{}, {}, {}", q(0), q(1), q(2)),
+                "base position in the world",
+            ),
+            (
+                format!("{}, {}, {}, {}", q(3), q(4), q(5), q(6)),
+                "base orientation, unit quaternion x, y, z, w",
+            ),
+        ];
+        joints.extend(base.map(|(q, w)| (q, w.to_string())));
+    }
+    joints.extend(model.joints.iter().enumerate().map(|(i, j)| {
+        let q = g.print(d.q[q0 + i], style);
+        let mut what = format!(
+            "{}, {} about {}",
+            j.name,
+            kind_name(j.kind),
+            vec3(&j.axis, opts.digits)
+        );
+        if j.armature != 0.0 {
+            let _ = write!(
+                what,
+                ", rotor inertia {}",
+                format_number(j.armature, opts.digits)
             );
-            if j.armature != 0.0 {
-                let _ = write!(
-                    what,
-                    ", rotor inertia {}",
-                    format_number(j.armature, opts.digits)
-                );
-            }
-            if model.include_friction {
-                let _ = write!(
-                    what,
-                    ", damping {}, friction {}",
-                    format_number(j.damping, opts.digits),
-                    format_number(j.friction, opts.digits)
-                );
-            }
-            (q, what)
-        })
-        .collect();
+        }
+        if model.include_friction {
+            let _ = write!(
+                what,
+                ", damping {}, friction {}",
+                format_number(j.damping, opts.digits),
+                format_number(j.friction, opts.digits)
+            );
+        }
+        (q, what)
+    }));
     let legend: Vec<(String, String)> = short
         .iter()
         .map(|s| (s.short().to_string(), s.meaning.clone()))
@@ -847,6 +867,22 @@ pub fn render(model: &Model, d: &Derivation, opts: &ShowOptions) -> Result<Strin
         }
     }
     Ok(out)
+}
+
+/// What the equations of a floating-base robot are, for the introduction.
+fn floating_intro(model: &Model) -> Vec<String> {
+    let nv = model.nv();
+    vec![
+        format!(
+            "Floating base (a free flyer): M(q) qdd + b(q, qd) + G(q) = S^T tau + J_c(q)^T F_c, with {nv} \
+             velocity coordinates: the first three are the base's linear velocity and the next three \
+             its angular velocity, both in base axes, then the joints' rates follow."
+        ),
+        "The first six rows of tau are the force and torque on the base in base axes: S^T tau is zero there \
+         (the robot's own efforts act on the joints only), so those rows are balanced by contact \
+         forces J_c^T F_c (or thrust)."
+            .to_string(),
+    ]
 }
 
 /// The preamble, title, joints and terms of a standalone LaTeX document (the caller adds the

@@ -12,7 +12,14 @@ use crate::model::{CollisionDescription, InertialDescription, LinkDescription};
 pub(super) fn read(node: Node, report: &mut Report) -> Option<LinkDescription> {
     let name = element::required(node, "name", &Context::top(), report)?;
     let ctx = Context::owner(format!("link `{name}`"));
-    element::warn_unknown(node, &["inertial", "visual", "collision"], &ctx, report);
+    // PyBullet's `<contact>` (friction and stiffness of the link's contacts) is known and has
+    // nothing for rigid-body dynamics.
+    element::warn_unknown(
+        node,
+        &["inertial", "visual", "collision", "contact"],
+        &ctx,
+        report,
+    );
     let inertial = match single(node, "inertial", &ctx, report) {
         Some(i) => inertial(i, &ctx, report),
         None => InertialDescription::default(),
@@ -69,7 +76,8 @@ fn inertial(node: Node, ctx: &Context, report: &mut Report) -> InertialDescripti
 
 /// `<collision>`: an optional `<origin>` and a `<geometry>`; `None` after a problem.
 fn collision(node: Node, ctx: &Context, report: &mut Report) -> Option<CollisionDescription> {
-    element::warn_unknown(node, &["origin", "geometry"], ctx, report);
+    // Some exporters give collisions a `<material>` (as visuals have): known, no dynamics.
+    element::warn_unknown(node, &["origin", "geometry", "material"], ctx, report);
     let origin = element::origin(node, ctx, report);
     let Some(g) = single(node, "geometry", ctx, report) else {
         report.element(node, ctx, "<collision> has no <geometry>".into());

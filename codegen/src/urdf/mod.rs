@@ -40,7 +40,8 @@
 //! missing element or attribute, a number that does not parse, a vector with the wrong count,
 //! an unknown joint type, an element given twice with different content) is an error.
 //! Everything else is read tolerantly: `<visual>`, `<material>` (colours, textures), mesh
-//! files and scales, `<gazebo>`, `<transmission>`, `<sensor>`, and unknown elements give at
+//! files and scales, `<gazebo>`, `<transmission>`, `<sensor>`, PyBullet's `<contact>` in a
+//! link and a `<material>` in a collision are ignored; unknown elements give at
 //! most a [`ModelWarning::Markup`], never a refusal; so does an element repeated with the same
 //! content.
 //!

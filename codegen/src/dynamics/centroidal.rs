@@ -1,0 +1,275 @@
+//! The centre of mass, its Jacobian and the centroidal momentum map, from the composite
+//! inertias of the recursive algorithms; and the contact points' Jacobian and drift.
+//!
+//! For every velocity coordinate `k` (a column `S_k` of the joint moving body `i`), the
+//! composite body below the joint moving with `S_k` has momentum `(L_o, P) = I^C_i S_k` about
+//! body `i`'s origin (the composite-rigid-body algorithm's force). In world axes, about the
+//! centre of mass `G`: `P_w = R_i P`, `L_G = R_i L_o + (o_i - G) x P_w`. These columns are the
+//! centroidal momentum map `A_g`, and `P_w / m` is the centre of mass Jacobian.
+
+use super::catalogue::{Evaluation, Home, Input, Quantity, Shape};
+use super::newton_euler::{self, LocalModel, Terms};
+use super::{flat, Derivation};
+use crate::cas::{Graph, Id};
+use crate::kinematics::{cross, mat_vec, vec_add, vec_scale, vec_sub, WorldKinematics, M3, V3};
+use crate::model::Model;
+
+/// World rotation and origin of every body of the local model (the floating base first when
+/// there is one).
+fn body_poses(model: &Model, wk: &WorldKinematics) -> Vec<(M3, V3)> {
+    let base = model
+        .is_floating()
+        .then_some((wk.root.rotation, wk.root.translation));
+    base.into_iter()
+        .chain(wk.rotation.iter().copied().zip(wk.position.iter().copied()))
+        .collect()
+}
+
+/// The centre of mass, its Jacobian, the centroidal momentum map and the contact points'
+/// Jacobian and drift, as expressions.
+#[derive(Clone, Debug)]
+pub struct Centroidal {
+    /// Total mass of the moving bodies (the floating base included; a fixed root, welded to
+    /// the world, is not counted, as in Pinocchio's `centerOfMass`).
+    pub mass: Id,
+    /// `sum m c` in world coordinates.
+    pub first_moment: V3,
+    /// The centre of mass in world coordinates.
+    pub com: V3,
+    /// 3 x nv.
+    pub com_jacobian: Vec<Vec<Id>>,
+    /// `A_g`, 6 x nv: linear momentum rows, then angular momentum about the centre of mass,
+    /// world axes.
+    pub map: Vec<Vec<Id>>,
+    /// 3K x nv, world axes.
+    pub contact_jacobian: Vec<Vec<Id>>,
+    /// `Jdot v`, 3K, world axes.
+    pub contact_drift: Vec<Id>,
+}
+
+impl Centroidal {
+    /// Everything for `model`, from its local model, world kinematics and velocity symbols.
+    pub fn new(
+        g: &mut Graph,
+        model: &Model,
+        lm: &LocalModel,
+        wk: &WorldKinematics,
+        v: &[Id],
+    ) -> Centroidal {
+        let poses = body_poses(model, wk);
+        let mass = g.add_all(lm.mass.iter().copied());
+        let mut first_moment = [g.zero(); 3];
+        for (i, (r, o)) in poses.iter().enumerate() {
+            // m c_world = m o + R h
+            let rh = mat_vec(g, r, &lm.first_moment[i]);
+            let mo = vec_scale(g, o, lm.mass[i]);
+            let s = vec_add(g, &rh, &mo);
+            first_moment = vec_add(g, &first_moment, &s);
+        }
+        let inv = g.powi(mass, -1);
+        let com = vec_scale(g, &first_moment, inv);
+        let (map, com_jacobian) = centroidal_map(g, lm, &poses, &com, inv);
+        let (contact_jacobian, contact_drift) = contacts(g, model, lm, wk, &poses, v);
+        Centroidal {
+            mass,
+            first_moment,
+            com,
+            com_jacobian,
+            map,
+            contact_jacobian,
+            contact_drift,
+        }
+    }
+}
+
+/// `A_g` (6 x nv: linear momentum rows, then angular momentum about the centre of mass, world
+/// axes) and the centre of mass Jacobian `A_g[0..3] / m` (3 x nv).
+fn centroidal_map(
+    g: &mut Graph,
+    lm: &LocalModel,
+    poses: &[(M3, V3)],
+    com: &V3,
+    inv_mass: Id,
+) -> (Vec<Vec<Id>>, Vec<Vec<Id>>) {
+    let nv = lm.nv();
+    let mut ag = vec![vec![g.zero(); nv]; 6];
+    for (col, body, (moment, force)) in newton_euler::column_momenta(g, lm) {
+        let (r, o) = &poses[body];
+        let p = mat_vec(g, r, &force);
+        let l = mat_vec(g, r, &moment);
+        let lever = vec_sub(g, o, com);
+        let shift = cross(g, &lever, &p);
+        let lg = vec_add(g, &l, &shift);
+        for k in 0..3 {
+            ag[k][col] = p[k];
+            ag[3 + k][col] = lg[k];
+        }
+    }
+    let jcom = ag[..3]
+        .iter()
+        .map(|row| row.iter().map(|&x| g.mul(x, inv_mass)).collect())
+        .collect();
+    (ag, jcom)
+}
+
+/// The contact points' Jacobian (3K x nv: linear rows of each contact link's Jacobian, world
+/// axes) and drift `Jdot v` (the classical acceleration of the points at zero generalized
+/// acceleration, world axes), with `q`, `v` the coordinate symbols.
+fn contacts(
+    g: &mut Graph,
+    model: &Model,
+    lm: &LocalModel,
+    wk: &WorldKinematics,
+    poses: &[(M3, V3)],
+    v: &[Id],
+) -> (Vec<Vec<Id>>, Vec<Id>) {
+    let shift = usize::from(model.is_floating());
+    let motions = newton_euler::forward_pass(
+        g,
+        lm,
+        Terms {
+            qd: Some(v),
+            qdd: None,
+            gravity: None,
+        },
+        |_, _, _| {},
+    );
+    let mut jac = Vec::with_capacity(3 * model.contacts.len());
+    let mut drift = Vec::with_capacity(3 * model.contacts.len());
+    for &f in &model.contacts {
+        let frame = &model.frames[f];
+        let (_, position) = wk.frame_pose(g, frame.body, &frame.placement);
+        let full = wk.point_jacobian(g, model, frame.body, &position);
+        jac.extend(full.into_iter().take(3));
+        let Some(body) = frame.body.map(|b| b + shift).or((shift == 1).then_some(0)) else {
+            // On a fixed root: the point never moves.
+            drift.extend([g.zero(); 3]);
+            continue;
+        };
+        let m = &motions[body];
+        let t = [0, 1, 2].map(|k| g.constant(frame.placement.translation[k]));
+        let dwt = cross(g, &m.dw, &t);
+        let wt = cross(g, &m.w, &t);
+        let wwt = cross(g, &m.w, &wt);
+        let a = [0, 1, 2].map(|k| g.add_all([m.acc[k], dwt[k], wwt[k]]));
+        drift.extend(mat_vec(g, &poses[body].0, &a));
+    }
+    (jac, drift)
+}
+
+const Q: &[Input] = &[Input::Q];
+
+fn quantity(
+    name: &'static str,
+    inputs: &'static [Input],
+    shape: Shape,
+    doc: &[&str],
+    route: &str,
+    eval: Evaluation,
+) -> Quantity {
+    Quantity {
+        name,
+        inputs,
+        shape,
+        home: Home::Inherent,
+        doc: doc.iter().map(|s| s.to_string()).collect(),
+        route: format!("Route: {route}."),
+        eval,
+    }
+}
+
+/// The catalogue's centre of mass quantities (every robot), the centroidal map and `integrate`
+/// (floating bases) and the contact quantities (robots with contact points).
+pub(super) fn quantities(model: &Model, d: &Derivation) -> Vec<Quantity> {
+    let (nv, c) = (d.dof, &d.centroidal);
+    let from_momenta = "each coordinate's composite-body momentum (the composite-rigid-body algorithm's), moved to the world";
+    let mut out = vec![
+        quantity(
+            "center_of_mass",
+            Q,
+            Shape::Vector(3),
+            &["The centre of mass of the moving bodies in world coordinates (a fixed root link, welded to the world, is not counted)."],
+            "the bodies' centres of mass by forward kinematics",
+            Evaluation::Exprs(c.com.to_vec()),
+        ),
+        quantity(
+            "center_of_mass_jacobian",
+            Q,
+            Shape::Matrix(3, nv),
+            &["The Jacobian of `center_of_mass`, 3 x N, world axes."],
+            from_momenta,
+            Evaluation::Exprs(flat(&c.com_jacobian)),
+        ),
+    ];
+    if model.is_floating() {
+        out.push(quantity(
+            "centroidal_map",
+            Q,
+            Shape::Matrix(6, nv),
+            &[
+                "The centroidal momentum map A_g, 6 x N: `A_g v` = [linear momentum; angular momentum about",
+                "the centre of mass], world axes.",
+            ],
+            from_momenta,
+            Evaluation::Exprs(flat(&c.map)),
+        ));
+    }
+    let k3 = c.contact_drift.len();
+    if k3 > 0 {
+        let names: Vec<String> = model
+            .contacts
+            .iter()
+            .map(|&f| format!("`{}`", model.frames[f].name.replace('`', "'")))
+            .collect();
+        let order = format!(
+            "Contact points, 3 rows each, in this order: {}.",
+            names.join(", ")
+        );
+        out.push(quantity(
+            "contact_jacobian",
+            Q,
+            Shape::Matrix(k3, nv),
+            &["The contact points' Jacobian J_c, 3K x N: linear velocity of each contact link's origin,", "world axes.", "", &order],
+            "joint axes and origins by forward kinematics",
+            Evaluation::Exprs(flat(&c.contact_jacobian)),
+        ));
+        out.push(quantity(
+            "contact_drift",
+            &[Input::Q, Input::Qd],
+            Shape::Vector(k3),
+            &["`Jdot_c qd`: the contact points' acceleration at zero generalized acceleration, world axes.", "", &order],
+            "Newton-Euler's forward pass without acceleration and gravity",
+            Evaluation::Exprs(c.contact_drift.clone()),
+        ));
+        out.push(quantity(
+            "contact_forward_dynamics",
+            &[Input::Q, Input::Qd, Input::Tau],
+            Shape::Vector(nv + k3),
+            &[
+                "Forward dynamics with the contact points held: the accelerations and the contact forces",
+                "(on the robot, world axes) of `M qdd + b + G = tau + J_c^T F`, `J_c qdd + Jdot_c qd = 0`.",
+                "",
+                "NaN in every entry when M(q) is not positive definite or J_c is rank-deficient;",
+                "`try_contact_forward_dynamics` says why.",
+            ],
+            "M from `mass_matrix`, b + G by Newton-Euler, J_c and its drift, then the runtime's sparse L^T D L of M and a Cholesky factorization of J_c M^-1 J_c^T (eomgen_runtime::contact::solve)",
+            Evaluation::ContactForwardDynamics {
+                h: d.fast.bias_gravity_friction.clone(),
+            },
+        ));
+    }
+    if model.is_floating() {
+        out.push(quantity(
+            "integrate",
+            &[Input::Q, Input::Qd],
+            Shape::Vector(d.nq),
+            &[
+                "`q (+) qd dt`: the configuration reached from `q` moving at constant velocity `qd` for `dt`:",
+                "the base along the SE(3) exponential (the quaternion stays unit), the joints by `qd dt`.",
+            ],
+            "eomgen_runtime::free_flyer::integrate",
+            Evaluation::Integrate,
+        ));
+    }
+    out
+}
