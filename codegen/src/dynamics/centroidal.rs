@@ -48,27 +48,34 @@ pub struct Centroidal {
 }
 
 impl Centroidal {
-    /// Everything for `model`, from its local model, world kinematics and velocity symbols.
+    /// Everything for `model`, from its local model, world kinematics and velocity symbols;
+    /// for a floating base, from the base's rows of the mass matrix `mass_matrix` too.
     pub fn new(
         g: &mut Graph,
         model: &Model,
         lm: &LocalModel,
         wk: &WorldKinematics,
         v: &[Id],
+        mass_matrix: &[Vec<Id>],
     ) -> Centroidal {
         let poses = body_poses(model, wk);
-        let mass = g.add_all(lm.mass.iter().copied());
-        let mut first_moment = [g.zero(); 3];
-        for (i, (r, o)) in poses.iter().enumerate() {
-            // m c_world = m o + R h
-            let rh = mat_vec(g, r, &lm.first_moment[i]);
-            let mo = vec_scale(g, o, lm.mass[i]);
-            let s = vec_add(g, &rh, &mo);
-            first_moment = vec_add(g, &first_moment, &s);
-        }
-        let inv = g.powi(mass, -1);
-        let com = vec_scale(g, &first_moment, inv);
-        let (map, com_jacobian) = centroidal_map(g, lm, &poses, &com, inv);
+        let (mass, first_moment, com, map, com_jacobian) = if model.is_floating() {
+            from_base_rows(g, lm, wk, mass_matrix)
+        } else {
+            let mass = g.add_all(lm.mass.iter().copied());
+            let mut first_moment = [g.zero(); 3];
+            for (i, (r, o)) in poses.iter().enumerate() {
+                // m c_world = m o + R h
+                let rh = mat_vec(g, r, &lm.first_moment[i]);
+                let mo = vec_scale(g, o, lm.mass[i]);
+                let s = vec_add(g, &rh, &mo);
+                first_moment = vec_add(g, &first_moment, &s);
+            }
+            let inv = g.powi(mass, -1);
+            let com = vec_scale(g, &first_moment, inv);
+            let (map, com_jacobian) = centroidal_map(g, lm, &poses, &com, inv);
+            (mass, first_moment, com, map, com_jacobian)
+        };
         let (contact_jacobian, contact_drift) = contacts(g, model, lm, wk, &poses, v);
         Centroidal {
             mass,
@@ -80,6 +87,48 @@ impl Centroidal {
             contact_drift,
         }
     }
+}
+
+/// The centroidal quantities of a floating base from the base's rows of `M`: they are the
+/// robot's momentum in base axes about the base origin, `(P_b; L_b) = M[0..6] v` (linear, then
+/// angular). With `R` the base rotation, `p` its position, `h` the robot's first moment about
+/// the base origin (base axes) and `c_b = h / m`: `com = p + R c_b`, and each column of `A_g`
+/// is `(R P_b; R (L_b - c_b x P_b))`, far cheaper than moving every body's momentum to the
+/// world.
+#[allow(clippy::type_complexity)]
+fn from_base_rows(
+    g: &mut Graph,
+    lm: &LocalModel,
+    wk: &WorldKinematics,
+    m: &[Vec<Id>],
+) -> (Id, V3, V3, Vec<Vec<Id>>, Vec<Vec<Id>>) {
+    let (mass, h) = newton_euler::root_composite(g, lm);
+    let (r, p) = (&wk.root.rotation, &wk.root.translation);
+    let inv = g.powi(mass, -1);
+    let rh = mat_vec(g, r, &h);
+    let mp = vec_scale(g, p, mass);
+    let first_moment = vec_add(g, &mp, &rh);
+    let com = vec_scale(g, &first_moment, inv);
+    let cb = vec_scale(g, &h, inv);
+    let nv = m.len();
+    let mut ag = vec![vec![g.zero(); nv]; 6];
+    for c in 0..nv {
+        let pb = [m[0][c], m[1][c], m[2][c]];
+        let lb = [m[3][c], m[4][c], m[5][c]];
+        let cp = cross(g, &cb, &pb);
+        let lg = vec_sub(g, &lb, &cp);
+        let pw = mat_vec(g, r, &pb);
+        let lw = mat_vec(g, r, &lg);
+        for k in 0..3 {
+            ag[k][c] = pw[k];
+            ag[3 + k][c] = lw[k];
+        }
+    }
+    let jcom = ag[..3]
+        .iter()
+        .map(|row| row.iter().map(|&x| g.mul(x, inv)).collect())
+        .collect();
+    (mass, first_moment, com, ag, jcom)
 }
 
 /// `A_g` (6 x nv: linear momentum rows, then angular momentum about the centre of mass, world

@@ -32,7 +32,7 @@ pub(super) fn derive(model: &Model, limits: Limits) -> Result<Derivation, GraphF
     friction.extend(lagrangian::joint_friction(&mut g, model, &params, &qd[6..]));
     let rec = recursive(&mut g, &lm, grav, &qd, &qdd, &friction)?;
     clock.lap("recursive algorithms");
-    let centroidal = Centroidal::new(&mut g, model, &lm, &world, &qd);
+    let centroidal = Centroidal::new(&mut g, model, &lm, &world, &qd, &rec.mass_matrix);
     let potential_energy = {
         // V = -sum m g.c
         let gc = g.dot(&grav, &centroidal.first_moment);

@@ -290,7 +290,7 @@ impl Derivation {
                 translation: lm.translation[i],
             })
             .collect();
-        let centroidal = Centroidal::new(&mut g, model, &lm, &world, &qd);
+        let centroidal = Centroidal::new(&mut g, model, &lm, &world, &qd, &[]);
         g.check()?;
         let d = Derivation {
             graph: g,

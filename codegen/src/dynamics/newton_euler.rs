@@ -514,6 +514,13 @@ pub fn crba(g: &mut Graph, lm: &LocalModel) -> Vec<Vec<Id>> {
     m
 }
 
+/// The mass and first moment (about the origin, in the axes of body 0) of the whole tree below
+/// body 0: a floating base's composite body, the robot.
+pub fn root_composite(g: &mut Graph, lm: &LocalModel) -> (Id, V3) {
+    let comp = composites(g, lm);
+    (comp.mass[0], comp.h[0])
+}
+
 /// For every velocity coordinate, in order: the coordinate, the body its joint moves, and the
 /// momentum `I^C S` (moment about the body origin, then force, body axes) of the composite
 /// body below the joint moving with a unit rate of that coordinate.
