@@ -23,11 +23,18 @@ pub mod allegro_right_hand;
 #[rustfmt::skip]
 pub mod double_pendulum;
 #[rustfmt::skip]
+pub mod iris_simple;
+#[rustfmt::skip]
 pub mod kinova;
 #[rustfmt::skip]
 pub mod panda;
 #[rustfmt::skip]
 pub mod ur5;
+
+/// The floating-base robots of this crate (generated with `Builder::floating_base`): (module,
+/// type name, URDF file in `robots/`).
+pub const FLOATING_ROBOTS: [(&str, &str, &str); 1] =
+    [("iris_simple", "IrisSimple", "iris_simple.urdf")];
 
 /// The robots of this crate: (module, type name, URDF file in `robots/`).
 pub const ROBOTS: [(&str, &str, &str); 5] = [

@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use eomgen_generated::ROBOTS;
+use eomgen_generated::{FLOATING_ROBOTS, ROBOTS};
 
 const REFRESH: &str = "EOMGEN_BLESS=1 cargo test -p eomgen-generated --test golden";
 
@@ -40,8 +40,16 @@ fn diff(old: &str, new: &str) -> String {
 fn checked_in_code_is_what_eomgen_generates() {
     let bless = std::env::var_os("EOMGEN_BLESS").is_some();
     let mut stale = Vec::new();
-    for (module, ty, urdf) in ROBOTS {
-        let generated = eomgen::Builder::new(root().join("robots").join(urdf))
+    let fixed = ROBOTS.iter().map(|r| (r, false));
+    let floating = FLOATING_ROBOTS.iter().map(|r| (r, true));
+    for ((module, ty, urdf), floats) in fixed.chain(floating) {
+        let builder = eomgen::Builder::new(root().join("robots").join(urdf));
+        let builder = if floats {
+            builder.floating_base()
+        } else {
+            builder
+        };
+        let generated = builder
             .type_name(ty)
             .module_name(module)
             .regenerate_hint(REFRESH)
