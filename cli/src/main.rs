@@ -12,6 +12,7 @@ mod floating_base;
 mod info;
 mod progress;
 mod simulate;
+mod simulate_floating;
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -312,6 +313,12 @@ enum ControllerArg {
     GravityComp,
     /// Computed torque to the target, critically damped at --omega.
     ComputedTorque,
+    /// Floating base on contacts: PD on the joints (--kp, --kd) plus gravity compensation
+    /// projected through the contacts.
+    Stand,
+    /// Floating base: computed torque on the base (thrust and torque) to a level pose at
+    /// --base-target, critically damped at --omega; PD on the joints.
+    Hover,
 }
 
 #[derive(Args, Debug)]
@@ -349,9 +356,17 @@ struct SimulateArgs {
     /// of the CSV to stdout.
     #[arg(long, value_name = "FILE")]
     csv: Option<PathBuf>,
-    /// Also writes an SVG plot of the joint positions against time to FILE.
+    /// Also writes an SVG plot of the joint positions against time to FILE (with a floating
+    /// base: the base position, and the vertical contact forces to FILE's stem + `-forces.svg`).
     #[arg(long, value_name = "FILE.svg")]
     plot: Option<PathBuf>,
+    /// With --floating-base: the base's initial position and orientation (a unit quaternion
+    /// x, y, z, w) [default: 0,0,0,0,0,0,1]
+    #[arg(long, value_name = "X,Y,Z[,QX,QY,QZ,QW]", allow_hyphen_values = true, value_parser = parse_numbers)]
+    base: Option<Numbers>,
+    /// With --controller hover: where the base is held, level [default: its initial position]
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true, value_parser = parse_numbers)]
+    base_target: Option<Numbers>,
     #[command(flatten)]
     model: ModelArgs,
 }
@@ -650,6 +665,127 @@ fn fixed_base_only(model: &eomgen::model::Model, command: &str) -> Result<(), Fa
     Ok(())
 }
 
+/// The CSV to `path` and the summary to stdout, or the CSV to stdout.
+fn csv_or_summary(path: Option<&Path>, csv: &str, summary: &str) -> Result<(), Failure> {
+    match path {
+        Some(path) => {
+            std::fs::write(path, csv)
+                .map_err(|e| Failure(format!("cannot write {}: {e}", path.display())))?;
+            emit(summary)
+        }
+        None => emit(csv),
+    }
+}
+
+/// `simulate` for a floating base: initial state, controller, run, plots.
+fn simulate_floating_cmd(a: SimulateArgs, b: Builder, model: Model) -> Result<(), Failure> {
+    let (nj, nv) = (model.dof(), model.nv());
+    let count = |flag: &str, v: Option<Numbers>, n: usize, default: Vec<f64>| match v {
+        None => Ok(default),
+        Some(Numbers(v)) if v.len() == n => Ok(v),
+        Some(Numbers(v)) => Err(Failure(format!(
+            "{flag} has {} value(s), but {} needs {n} with a floating base",
+            v.len(),
+            model.name
+        ))),
+    };
+    let joints = count("--q0", a.q0, nj, vec![0.0; nj])?;
+    let mut q0 = vec![0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0];
+    match a.base {
+        None => {}
+        Some(Numbers(v)) if v.len() == 3 => q0[..3].copy_from_slice(&v),
+        Some(Numbers(v)) if v.len() == 7 => {
+            let n = v[3..].iter().map(|x| x * x).sum::<f64>().sqrt();
+            if n == 0.0 || !n.is_finite() {
+                return Err(Failure("--base: the quaternion is zero".into()));
+            }
+            q0[..3].copy_from_slice(&v[..3]);
+            q0[3..]
+                .iter_mut()
+                .zip(&v[3..])
+                .for_each(|(o, x)| *o = x / n);
+        }
+        Some(Numbers(v)) => {
+            return Err(Failure(format!(
+                "--base has {} value(s): give X,Y,Z or X,Y,Z,QX,QY,QZ,QW",
+                v.len()
+            )))
+        }
+    }
+    q0.extend(&joints);
+    let controller = match a.controller {
+        ControllerArg::None => simulate_floating::Controller::None,
+        ControllerArg::Stand if model.contacts.is_empty() => {
+            return Err(Failure(format!(
+            "{}: --controller stand holds the robot on its contacts: give them with --contact LINK",
+            model.name
+        )))
+        }
+        ControllerArg::Stand => simulate_floating::Controller::Stand,
+        ControllerArg::Hover => simulate_floating::Controller::Hover,
+        other => {
+            return Err(Failure(format!(
+            "{}: --controller {} is for a fixed base; a floating base takes none, stand or hover",
+            model.name,
+            other
+                .to_possible_value()
+                .map(|v| v.get_name().to_string())
+                .unwrap_or_default()
+        )))
+        }
+    };
+    let base_target = match a.base_target {
+        None => [q0[0], q0[1], q0[2]],
+        Some(Numbers(v)) if v.len() == 3 => [v[0], v[1], v[2]],
+        Some(Numbers(v)) => {
+            return Err(Failure(format!(
+                "--base-target has {} value(s): give X,Y,Z",
+                v.len()
+            )))
+        }
+    };
+    let options = simulate_floating::Options {
+        base_target,
+        duration: a.duration,
+        dt: a.dt,
+        v0: count("--qd0", a.qd0, nv, vec![0.0; nv])?,
+        target: count("--target", a.target, nj, joints)?,
+        q0,
+        controller,
+        kp: a.kp,
+        kd: a.kd,
+        omega: a.omega,
+    };
+    let d = derive(&b, &model)?;
+    let outcome = simulate_floating::run(&model, &d, &options).map_err(Failure)?;
+    if let Some(path) = &a.plot {
+        let write = |path: &Path, svg: String| {
+            std::fs::write(path, svg)
+                .map_err(|e| Failure(format!("cannot write {}: {e}", path.display())))
+        };
+        let title = format!("{}: base position (m)", model.name);
+        write(
+            path,
+            simulate::svg(&title, &["x", "y", "z"], &outcome.times, &outcome.base),
+        )?;
+        if !model.contacts.is_empty() {
+            let names: Vec<&str> = model
+                .contacts
+                .iter()
+                .map(|&f| model.frames[f].name.as_str())
+                .collect();
+            let title = format!("{}: vertical contact forces (N)", model.name);
+            let stem = path.with_extension("");
+            let forces = PathBuf::from(format!("{}-forces.svg", stem.display()));
+            write(
+                &forces,
+                simulate::svg(&title, &names, &outcome.times, &outcome.forces),
+            )?;
+        }
+    }
+    csv_or_summary(a.csv.as_deref(), &outcome.csv, &outcome.summary)
+}
+
 fn eval_cmd(a: EvalArgs) -> Result<(), Failure> {
     let b = a.model.builder(&a.urdf, &None);
     let model = load(&b)?;
@@ -692,7 +828,15 @@ fn eval_cmd(a: EvalArgs) -> Result<(), Failure> {
 fn simulate_cmd(a: SimulateArgs) -> Result<(), Failure> {
     let b = a.model.builder(&a.urdf, &None);
     let model = load(&b)?;
-    fixed_base_only(&model, "simulate")?;
+    if model.is_floating() {
+        return simulate_floating_cmd(a, b, model);
+    }
+    if matches!(a.controller, ControllerArg::Stand | ControllerArg::Hover) {
+        return Err(Failure(format!(
+            "{}: --controller stand and hover are for a floating base (--floating-base)",
+            model.name
+        )));
+    }
     let n = model.dof();
     let check = |flag: &str, v: Option<Numbers>, default: &[f64]| -> Result<Vec<f64>, Failure> {
         match v {
@@ -713,9 +857,9 @@ fn simulate_cmd(a: SimulateArgs) -> Result<(), Failure> {
         target: check("--target", a.target, &q0)?,
         q0,
         controller: match a.controller {
-            ControllerArg::None => simulate::Controller::None,
             ControllerArg::GravityComp => simulate::Controller::GravityComp,
             ControllerArg::ComputedTorque => simulate::Controller::ComputedTorque,
+            _ => simulate::Controller::None,
         },
         kp: a.kp,
         kd: a.kd,
@@ -730,12 +874,5 @@ fn simulate_cmd(a: SimulateArgs) -> Result<(), Failure> {
         std::fs::write(path, svg)
             .map_err(|e| Failure(format!("cannot write {}: {e}", path.display())))?;
     }
-    match &a.csv {
-        Some(path) => {
-            std::fs::write(path, &outcome.csv)
-                .map_err(|e| Failure(format!("cannot write {}: {e}", path.display())))?;
-            emit(&outcome.summary)
-        }
-        None => emit(&outcome.csv),
-    }
+    csv_or_summary(a.csv.as_deref(), &outcome.csv, &outcome.summary)
 }

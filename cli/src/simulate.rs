@@ -77,7 +77,7 @@ fn step_message(e: StepError, name: &str, t: f64, dt: f64) -> String {
 }
 
 /// The integration diverged at `t`: what to do about it.
-fn diverged(t: f64, dt: f64) -> String {
+pub(crate) fn diverged(t: f64, dt: f64) -> String {
     format!(
         "the integration diverged at t = {t} s (the state became non-finite or exploded): the \
          step is too large for the system's fastest dynamics (stiff friction on a light link, \

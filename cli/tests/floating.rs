@@ -112,3 +112,136 @@ fn bad_floating_requests_get_one_line_errors() {
     let e = one_line_error(&eomgen(&["eval", "--floating-base", urdf, "--q", "0"]));
     assert!(e.contains("does not handle a floating base yet"), "{e}");
 }
+
+/// The numbers after `label` in `text`, up to the end of the line.
+fn numbers_after(text: &str, label: &str) -> Vec<f64> {
+    let rest = &text[text
+        .find(label)
+        .unwrap_or_else(|| panic!("no {label} in {text}"))
+        + label.len()..];
+    let line = rest.lines().next().unwrap_or("");
+    line.split(|c: char| !(c.is_ascii_digit() || "-.e".contains(c)))
+        .filter_map(|t| t.parse().ok())
+        .collect()
+}
+
+#[test]
+fn a_drone_hovers_to_its_target() {
+    let dir = scratch("hover");
+    let csv = dir.join("iris.csv");
+    let plot = dir.join("iris.svg");
+    let urdf = robot("floating/iris_simple");
+    let out = stdout(&eomgen(&[
+        "simulate",
+        "--floating-base",
+        urdf.to_str().unwrap(),
+        "--controller",
+        "hover",
+        "--base",
+        "0.2,-0.1,1,0.1,0,0,1",
+        "--base-target",
+        "0,0,1.5",
+        "--omega",
+        "4",
+        "--duration",
+        "3",
+        "--csv",
+        csv.to_str().unwrap(),
+        "--plot",
+        plot.to_str().unwrap(),
+    ]));
+    let end = numbers_after(&out, "m at t = 0, (");
+    assert!(
+        end[0].abs() < 1e-3 && end[1].abs() < 1e-3 && (end[2] - 1.5).abs() < 1e-3,
+        "{out}"
+    );
+    let svg = std::fs::read_to_string(&plot).unwrap();
+    assert_eq!(svg.matches("<polyline class=\"trajectory\"").count(), 3);
+    let header = std::fs::read_to_string(&csv).unwrap();
+    assert!(header.starts_with("t,base_x,base_y,base_z,base_qx,base_qy,base_qz,base_qw,base_vx"));
+}
+
+#[test]
+fn a_quadruped_stands_on_its_four_feet() {
+    let dir = scratch("stand");
+    let plot = dir.join("anymal.svg");
+    let csv = dir.join("anymal.csv");
+    let urdf = robot("floating/anymal");
+    let mut args: Vec<String> = ["simulate", "--floating-base", urdf.to_str().unwrap()]
+        .map(String::from)
+        .to_vec();
+    for foot in ["LF_FOOT", "RF_FOOT", "LH_FOOT", "RH_FOOT"] {
+        args.extend(["--contact".to_string(), foot.to_string()]);
+    }
+    args.extend(
+        [
+            "--q0",
+            "0,0.6,-1.2,0,-0.6,1.2,0,0.6,-1.2,0,-0.6,1.2",
+            "--base",
+            "0,0,0.5",
+            "--controller",
+            "stand",
+            "--kp",
+            "50",
+            "--kd",
+            "2",
+            "--duration",
+            "0.2",
+            "--csv",
+            csv.to_str().unwrap(),
+            "--plot",
+            plot.to_str().unwrap(),
+        ]
+        .map(String::from),
+    );
+    let out = stdout(&eomgen(&args));
+    let residual = numbers_after(&out, "max |J a + Jdot v| = ");
+    assert!(residual[0] < 1e-9, "{out}");
+    // The four vertical forces carry the robot's weight (its mass from the generated gravity).
+    let forces = numbers_after(&out, "vertical forces at the end: ");
+    let weight: f64 = forces.iter().sum();
+    assert!(
+        forces.len() == 4 && forces.iter().all(|f| *f > 0.0),
+        "{out}"
+    );
+    assert!(
+        (weight - 30.4 * 9.81).abs() < 0.01 * weight,
+        "{weight} N: {out}"
+    );
+    let end = numbers_after(&out, "m at t = 0, (");
+    assert!((end[2] - 0.5).abs() < 1e-6, "{out}");
+    let forces_plot = std::fs::read_to_string(dir.join("anymal-forces.svg")).unwrap();
+    assert_eq!(forces_plot.matches("data-joint=\"LF_FOOT\"").count(), 1);
+}
+
+#[test]
+fn floating_controllers_are_checked() {
+    let urdf = robot("floating/iris_simple");
+    let urdf = urdf.to_str().unwrap();
+    let e = one_line_error(&eomgen(&[
+        "simulate",
+        "--floating-base",
+        urdf,
+        "--controller",
+        "stand",
+    ]));
+    assert!(e.contains("give them with --contact LINK"), "{e}");
+    let e = one_line_error(&eomgen(&[
+        "simulate",
+        "--floating-base",
+        urdf,
+        "--controller",
+        "computed-torque",
+    ]));
+    assert!(
+        e.contains("a floating base takes none, stand or hover"),
+        "{e}"
+    );
+    let e = one_line_error(&eomgen(&[
+        "simulate",
+        robot("ur5").to_str().unwrap(),
+        "--controller",
+        "hover",
+    ]));
+    assert!(e.contains("are for a floating base"), "{e}");
+}

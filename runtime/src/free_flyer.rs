@@ -24,6 +24,16 @@ pub fn integrate<T: Real, const NQ: usize, const NV: usize>(
     dt: T,
 ) -> [T; NQ] {
     let mut out = *q;
+    integrate_into(q, v, dt, &mut out);
+    out
+}
+
+/// [`integrate`] on slices (`q.len() == out.len() == v.len() + 1`), for sizes known only at
+/// run time. Entries beyond the shortest of the three are left alone.
+pub fn integrate_into<T: Real>(q: &[T], v: &[T], dt: T, out: &mut [T]) {
+    if q.len() < 7 || v.len() < 6 || out.len() < 7 {
+        return;
+    }
     let w = [v[3] * dt, v[4] * dt, v[5] * dt];
     let u = [v[0] * dt, v[1] * dt, v[2] * dt];
     let (dq, vmat) = exp_so3(&w);
@@ -42,10 +52,9 @@ pub fn integrate<T: Real, const NQ: usize, const NV: usize>(
         *x /= norm;
     }
     out[3..7].copy_from_slice(&n);
-    for k in 6..NV {
+    for k in 6..v.len().min(q.len() - 1).min(out.len() - 1) {
         out[k + 1] = q[k + 1] + v[k] * dt;
     }
-    out
 }
 
 /// The rotation of a unit quaternion (x, y, z, w).

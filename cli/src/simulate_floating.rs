@@ -1,0 +1,399 @@
+//! `eomgen simulate` for a floating base (NQ = NV + 1): RK4 on the configuration manifold
+//! (stages integrated from the step's start with the runtime's SE(3) `integrate_into`), with
+//! M, b, G, the contact Jacobian and its drift evaluated through the CAS interpreter, and the
+//! contact forward dynamics solved densely each stage (as `eomgen_runtime::contact::solve`
+//! does with fixed sizes).
+//!
+//! Controllers: none (free flight, or standing on the contacts unactuated), `stand` (PD on the
+//! joints plus gravity compensation projected through the contacts: the contact forces of least
+//! norm that hold the base's gravity, and the joint efforts that go with them) and `hover`
+//! (computed torque on the base, a fully actuated thrust and torque, to a level pose at a
+//! target position, with PD on the joints).
+
+use std::fmt::Write as _;
+
+use eomgen::cas::SymbolKind;
+use eomgen::dynamics::Derivation;
+use eomgen::model::Model;
+use nalgebra::{DMatrix, DVector};
+
+/// The controller closing the loop.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Controller {
+    /// No effort at all.
+    None,
+    /// PD on the joints plus gravity compensation projected through the contacts.
+    Stand,
+    /// Computed torque on the base (a thrust and torque on it) and PD on the joints.
+    Hover,
+}
+
+/// What to simulate.
+pub struct Options {
+    pub duration: f64,
+    pub dt: f64,
+    /// Initial position coordinates (NQ) and velocities (NV).
+    pub q0: Vec<f64>,
+    pub v0: Vec<f64>,
+    /// Joint targets (one per joint).
+    pub target: Vec<f64>,
+    /// Where `hover` holds the base, level.
+    pub base_target: [f64; 3],
+    pub controller: Controller,
+    /// Joint PD gains.
+    pub kp: f64,
+    pub kd: f64,
+    /// Bandwidth of the base's computed torque for `hover` (rad/s).
+    pub omega: f64,
+}
+
+/// The result: CSV, summary, and per sample the base position and the contact forces.
+pub struct Outcome {
+    pub csv: String,
+    pub summary: String,
+    pub times: Vec<f64>,
+    pub base: Vec<Vec<f64>>,
+    pub forces: Vec<Vec<f64>>,
+}
+
+/// Everything the dynamics needs at one state.
+struct Terms {
+    m: DMatrix<f64>,
+    /// `b + G + F(v)`.
+    h: DVector<f64>,
+    gravity: DVector<f64>,
+    /// 3K x NV and 3K.
+    j: DMatrix<f64>,
+    drift: DVector<f64>,
+    energy: f64,
+}
+
+fn terms(d: &Derivation, q: &[f64], v: &[f64]) -> Result<Terms, String> {
+    let nv = d.dof;
+    let c = &d.centroidal;
+    let k3 = c.contact_drift.len();
+    let mut outputs: Vec<_> = d.mass_matrix.iter().flatten().copied().collect();
+    outputs.extend(&d.bias);
+    outputs.extend(&d.gravity);
+    outputs.extend(&d.friction);
+    outputs.extend(c.contact_jacobian.iter().flatten());
+    outputs.extend(&c.contact_drift);
+    outputs.push(d.kinetic_energy);
+    outputs.push(d.potential_energy);
+    let x = d
+        .graph
+        .eval(&outputs, |sym| match sym.kind {
+            SymbolKind::Q(i) => q.get(i).copied(),
+            SymbolKind::Qd(i) => v.get(i).copied(),
+            SymbolKind::Param => d.params.iter().find(|p| p.0 == sym.name).map(|p| p.2),
+            _ => None,
+        })
+        .map_err(|e| format!("internal error while evaluating: {e}"))?;
+    let mut at = 0;
+    let mut take = |n: usize| {
+        let s = x[at..at + n].to_vec();
+        at += n;
+        s
+    };
+    let m = DMatrix::from_row_slice(nv, nv, &take(nv * nv));
+    let (b, g, f) = (take(nv), take(nv), take(nv));
+    let j = DMatrix::from_row_slice(k3, nv, &take(k3 * nv));
+    let drift = DVector::from_vec(take(k3));
+    let e = take(2);
+    Ok(Terms {
+        m,
+        h: DVector::from_fn(nv, |i, _| b[i] + g[i] + f[i]),
+        gravity: DVector::from_vec(g),
+        j,
+        drift,
+        energy: e[0] + e[1],
+    })
+}
+
+/// Accelerations and contact forces of `M a + h = tau + J^T F`, `J a + drift = 0`.
+fn accelerations(t: &Terms, tau: &DVector<f64>) -> Option<(DVector<f64>, DVector<f64>)> {
+    let chol = t.m.clone().cholesky()?;
+    let free = chol.solve(&(tau - &t.h));
+    if t.j.nrows() == 0 {
+        return Some((free, DVector::zeros(0)));
+    }
+    let y = chol.solve(&t.j.transpose());
+    let lambda = &t.j * &y;
+    let rhs = -(&t.drift + &t.j * &free);
+    let forces = lambda.cholesky()?.solve(&rhs);
+    Some((free + y * &forces, forces))
+}
+
+/// The effort of the controller at `(q, v)`.
+fn control(o: &Options, t: &Terms, q: &[f64], v: &[f64]) -> DVector<f64> {
+    let nv = v.len();
+    let mut tau = DVector::zeros(nv);
+    let pd = |i: usize| o.kp * (o.target[i - 6] - q[i + 1]) - o.kd * v[i];
+    match o.controller {
+        Controller::None => {}
+        Controller::Stand => {
+            // Least-norm contact forces holding the base's gravity rows, J_b^T F = G_b.
+            let jb_t = t.j.columns(0, 6).transpose();
+            let pinv = jb_t
+                .pseudo_inverse(1e-9)
+                .unwrap_or_else(|_| DMatrix::zeros(0, 0));
+            let gb = t.gravity.rows(0, 6).into_owned();
+            let f = if pinv.ncols() == 6 {
+                pinv * gb
+            } else {
+                DVector::zeros(t.j.nrows())
+            };
+            let comp = &t.gravity - t.j.transpose() * f;
+            for i in 6..nv {
+                tau[i] = comp[i] + pd(i);
+            }
+        }
+        Controller::Hover => {
+            let (wn, z) = (o.omega, 2.0 * o.omega);
+            let r = eomgen_runtime::free_flyer::rotation(&[q[3], q[4], q[5], q[6]]);
+            let mut a = DVector::zeros(nv);
+            // World position error and velocity; the wanted acceleration in base axes.
+            let vw: Vec<f64> = (0..3)
+                .map(|i| (0..3).map(|k| r[i][k] * v[k]).sum())
+                .collect();
+            let aw: Vec<f64> = (0..3)
+                .map(|i| wn * wn * (o.base_target[i] - q[i]) - z * vw[i])
+                .collect();
+            // Attitude error from level: twice the quaternion's vector part (small-angle).
+            let e = attitude_error(&q[3..7]);
+            for i in 0..3 {
+                a[i] = (0..3).map(|k| r[k][i] * aw[k]).sum();
+                a[3 + i] = -wn * wn * e[i] - z * v[3 + i];
+            }
+            for i in 6..nv {
+                a[i] = pd(i);
+            }
+            tau = &t.m * a + &t.h;
+        }
+    }
+    tau
+}
+
+/// The attitude error from level, `2 vec(q)` with the sign of the scalar part (twice the
+/// half-angle's sine: the rotation vector for small angles), in base axes.
+fn attitude_error(q: &[f64]) -> [f64; 3] {
+    let sign = if q[3] < 0.0 { -2.0 } else { 2.0 };
+    [sign * q[0], sign * q[1], sign * q[2]]
+}
+
+/// One evaluation: accelerations, effort and contact forces at `(q, v)`.
+type Eval = (DVector<f64>, DVector<f64>, DVector<f64>, f64);
+
+fn evaluate(
+    d: &Derivation,
+    o: &Options,
+    name: &str,
+    q: &[f64],
+    v: &[f64],
+    t: f64,
+) -> Result<Eval, String> {
+    let terms = terms(d, q, v)?;
+    let tau = control(o, &terms, q, v);
+    match accelerations(&terms, &tau) {
+        Some((a, f)) if a.iter().chain(f.iter()).all(|x| x.is_finite()) => {
+            Ok((a, tau, f, terms.energy))
+        }
+        _ if t == 0.0 => Err(format!(
+            "{name}: the mass matrix or the contacts' J M^-1 J^T is not positive definite at \
+             the initial state (contacts that cannot all hold?)"
+        )),
+        _ => Err(super::simulate::diverged(t, o.dt)),
+    }
+}
+
+fn integrate(q: &[f64], v: &[f64], h: f64) -> Vec<f64> {
+    let mut out = q.to_vec();
+    eomgen_runtime::free_flyer::integrate_into(q, v, h, &mut out);
+    out
+}
+
+fn axpy(a: &DVector<f64>, h: f64, b: &DVector<f64>) -> DVector<f64> {
+    a + b * h
+}
+
+/// Runs the simulation.
+pub fn run(model: &Model, d: &Derivation, o: &Options) -> Result<Outcome, String> {
+    let nq = d.nq;
+    let steps = (o.duration / o.dt).round().max(1.0) as usize;
+    let mut q = o.q0.clone();
+    let mut v = DVector::from_vec(o.v0.clone());
+    let k3 = d.centroidal.contact_drift.len();
+    let mut out = Outcome {
+        csv: header(model, nq, v.len(), k3),
+        summary: String::new(),
+        times: Vec::new(),
+        base: Vec::new(),
+        forces: Vec::new(),
+    };
+    let (mut worst_contact, mut e0, mut e_end) = (0.0_f64, 0.0, 0.0);
+    for step in 0..=steps {
+        let t = step as f64 * o.dt;
+        let (a1, tau, f, energy) = evaluate(d, o, &model.name, &q, v.as_slice(), t)?;
+        if step == 0 {
+            e0 = energy;
+        }
+        e_end = energy;
+        if k3 > 0 {
+            let terms = terms(d, &q, v.as_slice())?;
+            let res = &terms.j * &a1 + &terms.drift;
+            worst_contact = worst_contact.max(res.amax());
+        }
+        record(&mut out, t, &q, &v, &tau, &f);
+        if step == steps {
+            break;
+        }
+        let h = o.dt;
+        let v2 = axpy(&v, h / 2.0, &a1);
+        let a2 = evaluate(
+            d,
+            o,
+            &model.name,
+            &integrate(&q, v.as_slice(), h / 2.0),
+            v2.as_slice(),
+            t,
+        )?
+        .0;
+        let v3 = axpy(&v, h / 2.0, &a2);
+        let a3 = evaluate(
+            d,
+            o,
+            &model.name,
+            &integrate(&q, v2.as_slice(), h / 2.0),
+            v3.as_slice(),
+            t,
+        )?
+        .0;
+        let v4 = axpy(&v, h, &a3);
+        let a4 = evaluate(
+            d,
+            o,
+            &model.name,
+            &integrate(&q, v3.as_slice(), h),
+            v4.as_slice(),
+            t,
+        )?
+        .0;
+        let mean_v = (&v + &v2 * 2.0 + &v3 * 2.0 + &v4) / 6.0;
+        let mean_a = (&a1 + &a2 * 2.0 + &a3 * 2.0 + &a4) / 6.0;
+        q = integrate(&q, mean_v.as_slice(), h);
+        v = axpy(&v, h, &mean_a);
+        if q.iter()
+            .chain(v.iter())
+            .any(|x| !x.is_finite() || x.abs() > 1e8)
+        {
+            return Err(super::simulate::diverged(t + h, o.dt));
+        }
+    }
+    out.summary = summary(model, o, &out, worst_contact, e0, e_end, k3);
+    Ok(out)
+}
+
+fn header(model: &Model, nq: usize, nv: usize, k3: usize) -> String {
+    let mut cols = vec!["t".to_string()];
+    let base_q = ["x", "y", "z", "qx", "qy", "qz", "qw"];
+    let base_v = ["vx", "vy", "vz", "wx", "wy", "wz"];
+    cols.extend(base_q.iter().map(|c| format!("base_{c}")));
+    cols.extend(
+        model
+            .joints
+            .iter()
+            .take(nq - 7)
+            .map(|j| format!("q_{}", j.name)),
+    );
+    cols.extend(base_v.iter().map(|c| format!("base_{c}")));
+    cols.extend(
+        model
+            .joints
+            .iter()
+            .take(nv - 6)
+            .map(|j| format!("qd_{}", j.name)),
+    );
+    cols.extend(["fx", "fy", "fz", "mx", "my", "mz"].map(|c| format!("tau_base_{c}")));
+    cols.extend(
+        model
+            .joints
+            .iter()
+            .take(nv - 6)
+            .map(|j| format!("tau_{}", j.name)),
+    );
+    for &f in &model.contacts {
+        let name = &model.frames[f].name;
+        cols.extend(["x", "y", "z"].map(|c| format!("force_{name}_{c}")));
+    }
+    debug_assert_eq!(cols.len(), 1 + nq + 2 * nv + k3);
+    format!("{}\n", cols.join(","))
+}
+
+fn record(
+    out: &mut Outcome,
+    t: f64,
+    q: &[f64],
+    v: &DVector<f64>,
+    tau: &DVector<f64>,
+    f: &DVector<f64>,
+) {
+    let mut line = format!("{t}");
+    for x in q.iter().chain(v.iter()).chain(tau.iter()).chain(f.iter()) {
+        let _ = write!(line, ",{x}");
+    }
+    out.csv.push_str(&line);
+    out.csv.push('\n');
+    out.times.push(t);
+    out.base.push(q[..3].to_vec());
+    out.forces
+        .push(f.iter().skip(2).step_by(3).copied().collect());
+}
+
+fn summary(
+    model: &Model,
+    o: &Options,
+    out: &Outcome,
+    worst_contact: f64,
+    e0: f64,
+    e_end: f64,
+    k3: usize,
+) -> String {
+    let mut s = String::new();
+    let first = &out.base[0];
+    let last = out.base.last().unwrap_or(first);
+    let _ = writeln!(
+        s,
+        "{}: floating base, {} steps of {} s; base position ({:.6}, {:.6}, {:.6}) m at t = 0, \
+         ({:.6}, {:.6}, {:.6}) m at the end",
+        model.name,
+        out.times.len() - 1,
+        o.dt,
+        first[0],
+        first[1],
+        first[2],
+        last[0],
+        last[1],
+        last[2]
+    );
+    if k3 > 0 {
+        let fz: Vec<String> = out
+            .forces
+            .last()
+            .map(|f| f.iter().map(|x| format!("{x:.3}")).collect())
+            .unwrap_or_default();
+        let _ = writeln!(
+            s,
+            "contacts: max |J a + Jdot v| = {worst_contact:.3e} m/s^2; vertical forces at the \
+             end: {} N",
+            fz.join(", ")
+        );
+    }
+    if o.controller == Controller::None {
+        let _ = writeln!(
+            s,
+            "energy: {e0:.9e} J at t = 0, {e_end:.9e} J at the end (change {:.3e} J)",
+            e_end - e0
+        );
+    }
+    s
+}
