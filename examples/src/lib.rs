@@ -7,6 +7,7 @@
 //! cargo run --example computed_torque       # track a joint target in simulation (f64)
 //! cargo run --example gravity_compensation  # hold a pose against gravity (f32)
 //! cargo run --example task_space_force      # push with the hand: tau = J^T F
+//! cargo run --example quadruped_stand       # a floating-base quadruped standing on its feet
 //! ```
 //!
 //! ```
@@ -23,6 +24,18 @@
 #![no_std]
 
 include!(concat!(env!("OUT_DIR"), "/panda_arm.rs"));
+
+/// ANYmal, a quadruped, with a floating base and a point contact at each foot (`LF_FOOT`,
+/// `RF_FOOT`, `LH_FOOT`, `RH_FOOT`, in that order), generated from `robots/anymal.urdf`.
+pub mod anymal {
+    include!(concat!(env!("OUT_DIR"), "/anymal.rs"));
+
+    /// A standing configuration: base 0.5 m above the ground, level; knees bent.
+    pub const STANDING: [f64; 19] = [
+        0.0, 0.0, 0.5, 0.0, 0.0, 0.0, 1.0, // base position, quaternion x y z w
+        0.0, 0.6, -1.2, 0.0, -0.6, 1.2, 0.0, 0.6, -1.2, 0.0, -0.6, 1.2, // LF, LH, RF, RH
+    ];
+}
 
 /// A comfortable start configuration (rad): elbow bent, hand pointing down.
 pub const READY: [f64; 7] = [0.0, -0.3, 0.0, -2.2, 0.0, 2.0, 0.8];

@@ -802,3 +802,36 @@ impl<T: ::eomgen_runtime::Real> IrisSimple<T> {
         }
     }
 }
+#[allow(
+    unused_variables,
+    clippy::approx_constant,
+    clippy::excessive_precision,
+    clippy::unreadable_literal,
+    clippy::neg_multiply,
+    clippy::double_parens,
+    clippy::identity_op,
+    clippy::needless_range_loop,
+    clippy::let_and_return,
+    clippy::type_complexity
+)]
+impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::FloatingDynamics<T, 7, 6>
+for IrisSimple<T> {
+    fn mass_matrix(&self, q: &[T; 7]) -> [[T; 6]; 6] {
+        Self::mass_matrix(self, q)
+    }
+    fn gravity(&self, q: &[T; 7]) -> [T; 6] {
+        Self::gravity(self, q)
+    }
+    fn bias(&self, q: &[T; 7], v: &[T; 6]) -> [T; 6] {
+        Self::bias(self, q, v)
+    }
+    fn integrate(&self, q: &[T; 7], v: &[T; 6], dt: T) -> [T; 7] {
+        Self::integrate(self, q, v, dt)
+    }
+    fn inverse_dynamics(&self, q: &[T; 7], v: &[T; 6], a: &[T; 6]) -> [T; 6] {
+        Self::inverse_dynamics(self, q, v, a)
+    }
+    fn forward_dynamics(&self, q: &[T; 7], v: &[T; 6], tau: &[T; 6]) -> [T; 6] {
+        Self::forward_dynamics(self, q, v, tau)
+    }
+}

@@ -69,6 +69,7 @@ extern crate std;
 pub mod contact;
 pub mod control;
 mod dynamics;
+mod floating;
 pub mod free_flyer;
 mod joint_effects;
 mod linalg;
@@ -85,6 +86,7 @@ pub use control::{
     wrench_to_torque, ComputedTorque, Ellipsoid, PdGravity, Setpoint, SymmetricEigen,
 };
 pub use dynamics::Dynamics;
+pub use floating::{rk4_step_floating, Contacts, FloatingDynamics, StandOnContacts};
 pub use joint_effects::WithJointEffects;
 pub use linalg::{solve_spd, solve_spd_or_nan, Cholesky, FactorError, Ldlt};
 pub use pose::Pose;

@@ -171,6 +171,7 @@ impl Emitter<'_> {
             TokenStream::new()
         };
         let trait_impl = self.trait_impl(&trait_methods);
+        let floating_impls = self.floating_impls(d);
         let (ty, n, allow) = (&self.ty, &self.n, allow_lints());
         let try_fd = &self.try_forward_dynamics;
         let parents = self.parents_const();
@@ -216,6 +217,7 @@ impl Emitter<'_> {
                 #frames
             }
             #trait_impl
+            #floating_impls
         }
     }
 
@@ -743,6 +745,58 @@ impl Emitter<'_> {
                 #(#methods)*
             }
         }
+    }
+}
+
+impl Emitter<'_> {
+    fn has(&self, name: &str) -> bool {
+        self.quantities.iter().any(|q| q.name == name)
+    }
+
+    /// A floating-base robot's `FloatingDynamics` implementation (when its methods are all
+    /// generated) and `Contacts` (with contact points), delegating to the inherent methods.
+    fn floating_impls(&self, d: &Derivation) -> TokenStream {
+        if !self.floating {
+            return TokenStream::new();
+        }
+        let (ty, n, nq, allow) = (&self.ty, &self.n, &self.nq, allow_lints());
+        let needed = [
+            "mass_matrix",
+            "gravity",
+            "bias",
+            "integrate",
+            "inverse_dynamics",
+            "forward_dynamics",
+        ];
+        let mut out = TokenStream::new();
+        if needed.iter().all(|q| self.has(q)) {
+            out.extend(quote! {
+                #allow
+                impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::FloatingDynamics<T, #nq, #n> for #ty<T> {
+                    fn mass_matrix(&self, q: &[T; #nq]) -> [[T; #n]; #n] { Self::mass_matrix(self, q) }
+                    fn gravity(&self, q: &[T; #nq]) -> [T; #n] { Self::gravity(self, q) }
+                    fn bias(&self, q: &[T; #nq], v: &[T; #n]) -> [T; #n] { Self::bias(self, q, v) }
+                    fn integrate(&self, q: &[T; #nq], v: &[T; #n], dt: T) -> [T; #nq] { Self::integrate(self, q, v, dt) }
+                    fn inverse_dynamics(&self, q: &[T; #nq], v: &[T; #n], a: &[T; #n]) -> [T; #n] { Self::inverse_dynamics(self, q, v, a) }
+                    fn forward_dynamics(&self, q: &[T; #nq], v: &[T; #n], tau: &[T; #n]) -> [T; #n] { Self::forward_dynamics(self, q, v, tau) }
+                }
+            });
+        }
+        let k3 = d.centroidal.contact_drift.len();
+        if k3 > 0 && self.has("contact_forward_dynamics") {
+            let k3 = usize_lit(k3);
+            out.extend(quote! {
+                #allow
+                impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Contacts<T, #nq, #n, #k3> for #ty<T> {
+                    fn contact_jacobian(&self, q: &[T; #nq]) -> [[T; #n]; #k3] { Self::contact_jacobian(self, q) }
+                    fn contact_drift(&self, q: &[T; #nq], v: &[T; #n]) -> [T; #k3] { Self::contact_drift(self, q, v) }
+                    fn try_contact_forward_dynamics(&self, q: &[T; #nq], v: &[T; #n], tau: &[T; #n]) -> ::core::result::Result<([T; #n], [T; #k3]), ::eomgen_runtime::FactorError> {
+                        Self::try_contact_forward_dynamics(self, q, v, tau)
+                    }
+                }
+            });
+        }
+        out
     }
 }
 
