@@ -11,10 +11,13 @@
 //! Rotor inertia (armature) adds to `M`'s diagonal; joint friction `F(qd)` (when the model
 //! includes it) adds to `tau` and enters forward dynamics, but not `b`.
 
+pub mod base_parameters;
 pub mod catalogue;
+pub mod identification;
 mod lagrangian;
 pub mod newton_euler;
 mod quantities;
+pub mod regressor;
 
 use std::time::{Duration, Instant};
 
@@ -23,6 +26,7 @@ use crate::kinematics::{const_v3, BodyKinematics, Params, WorldKinematics, M3, V
 use crate::model::Model;
 
 pub use catalogue::{Craig, Evaluation, Home, Input, Quantity, Shape};
+pub use identification::Identification;
 pub use lagrangian::pairs;
 
 /// The pose of a body in its parent body's frame (the root's for a body whose parent is the
@@ -87,6 +91,9 @@ pub struct Derivation {
     pub fast: Fast,
     /// What generated code evaluates, one entry per generated function.
     pub quantities: Vec<Quantity>,
+    /// The regressor and the standard and base parameters, after
+    /// [`Derivation::add_regressor`].
+    pub identification: Option<Identification>,
     /// How long each stage took.
     pub timings: Vec<(&'static str, Duration)>,
 }
@@ -298,6 +305,7 @@ impl Derivation {
             recursive,
             fast,
             quantities: Vec::new(),
+            identification: None,
             timings: Vec::new(),
         };
         d.quantities = quantities::catalogue(model, &d);

@@ -163,6 +163,7 @@ impl Emitter<'_> {
         let (ty, n, allow) = (&self.ty, &self.n, allow_lints());
         let try_fd = &self.try_forward_dynamics;
         let parents = self.parents_const();
+        let identification = super::identification::constants(d, self.quantities);
         // Without the trait, the joint order still has to be said.
         let joint_names = if self.in_trait {
             TokenStream::new()
@@ -182,6 +183,7 @@ impl Emitter<'_> {
                 pub const DOF: usize = #n;
                 #parents
                 #joint_names
+                #identification
                 #try_fd
                 #(#methods)*
                 #frames
