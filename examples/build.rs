@@ -1,8 +1,14 @@
-//! Generates the example robot, as a user's build script would: `$OUT_DIR/panda_arm.rs`
-//! defines `PandaArm<T>` (7 joints) and `PandaArmLink`.
+//! Generates the example robots, as a user's build script would: `$OUT_DIR/panda_arm.rs`
+//! defines `PandaArm<T>` (7 joints) and `PandaArmLink`; `$OUT_DIR/ur5.rs` defines `Ur5<T>`
+//! (6 joints) with identification (`regressor`, `base_regressor`, `base_parameters`).
 
 fn main() {
     eomgen::Builder::new("robots/panda_arm.urdf")
+        .compile()
+        .unwrap();
+    eomgen::Builder::new("robots/ur5.urdf")
+        .type_name("Ur5")
+        .regressor()
         .compile()
         .unwrap();
 }
