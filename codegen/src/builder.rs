@@ -248,8 +248,11 @@ impl Builder {
     /// the generated methods: `mass_matrix`, `gravity`, `bias`, `coriolis_matrix`,
     /// `inverse_dynamics`, `forward_dynamics` (with `try_forward_dynamics`), `kinetic_energy`,
     /// `potential_energy`, `centrifugal`, `coriolis_pairs`, `friction` (with
-    /// [`Builder::friction`]), `link_pose` and `link_jacobian`. An unknown name fails generation
-    /// with [`Error::UnknownQuantity`].
+    /// [`Builder::friction`]), `link_pose` and `link_jacobian`; with [`Builder::derivatives`],
+    /// `inverse_dynamics_derivatives`, `forward_dynamics_derivatives` and
+    /// `mass_matrix_inverse`; with [`Builder::regressor`], `regressor`, `parameters`,
+    /// `base_regressor` and `base_parameters`. An unknown name fails generation with
+    /// [`Error::UnknownQuantity`].
     ///
     /// The `Dynamics` trait is implemented when all its eight methods are selected; otherwise
     /// the selected ones are inherent methods of the generated type. Craig's `centrifugal` and
