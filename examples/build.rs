@@ -1,6 +1,8 @@
 //! Generates the example robots, as a user's build script would: `$OUT_DIR/panda_arm.rs`
 //! defines `PandaArm<T>` (7 joints) and `PandaArmLink`; `$OUT_DIR/anymal.rs` the quadruped
-//! `Anymal<T>` with a floating base and point contacts at its four feet.
+//! `Anymal<T>` with a floating base and point contacts at its four feet; `$OUT_DIR/ur5.rs`
+//! defines `Ur5<T>` (6 joints) with identification (`regressor`, `base_regressor`,
+//! `base_parameters`).
 
 fn main() {
     eomgen::Builder::new("robots/panda_arm.urdf")
@@ -9,6 +11,11 @@ fn main() {
     eomgen::Builder::new("robots/anymal.urdf")
         .floating_base()
         .contact_points(&["LF_FOOT", "RF_FOOT", "LH_FOOT", "RH_FOOT"])
+        .compile()
+        .unwrap();
+    eomgen::Builder::new("robots/ur5.urdf")
+        .type_name("Ur5")
+        .regressor()
         .compile()
         .unwrap();
 }

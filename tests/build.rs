@@ -41,6 +41,7 @@ fn main() {
     deep_chain();
     derivatives();
     floating();
+    regressors();
     eomgen::Builder::new("robots/panda.urdf")
         .module_name("panda_selected")
         .type_name("PandaSelected")
@@ -166,4 +167,51 @@ fn derivatives() {
             .compile()
             .unwrap();
     }
+}
+
+/// The reference robots with identification (and the inverse dynamics it must reproduce), and
+/// the joint-effects arm with rotor inertia and friction as extra parameters.
+fn regressors() {
+    let only = [
+        "inverse_dynamics",
+        "regressor",
+        "parameters",
+        "base_regressor",
+        "base_parameters",
+    ];
+    for (file, module, ty) in [
+        (
+            "robots/double_pendulum.urdf",
+            "double_pendulum_regressor",
+            "DoublePendulumRegressor",
+        ),
+        ("robots/ur5.urdf", "ur5_regressor", "Ur5Regressor"),
+        ("robots/panda.urdf", "panda_regressor", "PandaRegressor"),
+        ("robots/kinova.urdf", "kinova_regressor", "KinovaRegressor"),
+        (
+            "robots/allegro_right_hand.urdf",
+            "allegro_regressor",
+            "AllegroRegressor",
+        ),
+    ] {
+        eomgen::Builder::new(file)
+            .module_name(module)
+            .type_name(ty)
+            .regressor()
+            .quantities(only)
+            .compile()
+            .unwrap();
+    }
+    let out_dir = std::path::PathBuf::from(std::env::var_os("OUT_DIR").unwrap());
+    let (generated, _, _) = eomgen::Builder::new("fixtures/joint_effects.urdf")
+        .inertia_from_collision(1000.0)
+        .armature([("shoulder", 0.2), ("elbow", 0.05)])
+        .friction(true)
+        .type_name("JointEffectsRegressor")
+        .regressor()
+        .quantities(only)
+        .generate_with_report()
+        .unwrap();
+    let path = out_dir.join("joint_effects_regressor.rs");
+    eomgen::write_if_changed(&path, generated.source.as_bytes()).unwrap();
 }

@@ -209,6 +209,10 @@ struct GenerateArgs {
     /// forward_dynamics_derivatives and mass_matrix_inverse
     #[arg(long)]
     derivatives: bool,
+    /// Also generate identification: regressor, parameters, base_regressor and
+    /// base_parameters (tau = Y(q, qd, qdd) pi, linear in the inertial parameters)
+    #[arg(long)]
+    regressor: bool,
     #[command(flatten)]
     model: ModelArgs,
 }
@@ -270,6 +274,11 @@ struct ShowArgs {
     /// In expanded form, a term whose expansion exceeds N terms is shown in program form.
     #[arg(long, value_name = "N", default_value_t = 100)]
     max_terms: usize,
+    /// Instead of the equations, print the base parameters for identification: the minimal
+    /// set of combinations of inertial parameters that the dynamics depend on, each as its
+    /// exact formula (with --friction and --armature, their coefficients too).
+    #[arg(long, conflicts_with_all = ["term", "entry", "form"])]
+    base_parameters: bool,
     #[command(flatten)]
     model: ModelArgs,
 }
@@ -544,6 +553,9 @@ fn generate(a: GenerateArgs) -> Result<(), Failure> {
     if a.derivatives {
         b = b.derivatives();
     }
+    if a.regressor {
+        b = b.regressor();
+    }
     // Fail fast on bad input, before a long derivation.
     let model = load(&b)?;
     let label = format!(
@@ -593,7 +605,10 @@ fn show(a: ShowArgs) -> Result<(), Failure> {
             )
             .exit();
     }
-    let b = a.model.builder(&a.urdf, &a.symbolic);
+    let mut b = a.model.builder(&a.urdf, &a.symbolic);
+    if a.base_parameters {
+        b = b.regressor();
+    }
     let model = load(&b)?;
     let d = derive(&b, &model)?;
     let opts = ShowOptions {
@@ -614,7 +629,11 @@ fn show(a: ShowArgs) -> Result<(), Failure> {
         standalone: a.standalone,
     };
     let text = progress::run("printing the equations", || {
-        report::render(&model, &d, &opts)
+        if a.base_parameters {
+            report::render_base_parameters(&model, &d, &opts)
+        } else {
+            report::render(&model, &d, &opts)
+        }
     })
     .map_err(|e| match e {
         report::ReportError::GraphFull(full) => Failure(format!(

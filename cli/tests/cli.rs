@@ -282,6 +282,15 @@ fn show_symbolic_digits_and_model_options() {
     assert!(program.contains("  t0 = "));
 }
 
+/// Generated code without its banner's Regenerate line (which records the path as given).
+fn code(source: &str) -> String {
+    source
+        .lines()
+        .filter(|l| !l.starts_with("// Regenerate: "))
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
 #[test]
 fn generate_matches_the_builder_and_writes_files() {
     for name in ROBOTS {
@@ -291,12 +300,6 @@ fn generate_matches_the_builder_and_writes_files() {
             .generate()
             .expect("generates");
         // The same code; the banner's Regenerate line records the path as each was given it.
-        let code = |s: &str| {
-            s.lines()
-                .filter(|l| !l.starts_with("// Regenerate: "))
-                .collect::<Vec<_>>()
-                .join("\n")
-        };
         assert!(
             code(&out) == code(&expected),
             "{name}: CLI and Builder differ"
@@ -328,6 +331,47 @@ fn generate_matches_the_builder_and_writes_files() {
     assert!(e.contains("not a type"), "{e}");
     bad_input(&["generate", &path, "-o", path_str(&dir.join("missing/x.rs"))]);
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// `generate --regressor` is `Builder::regressor`, and `show --base-parameters` prints each
+/// base parameter's formula (snapshots for the double pendulum in every format).
+#[test]
+fn identification_from_the_command_line() {
+    let path = robot("ur5");
+    let out = ok(&["generate", &path, "--regressor"]);
+    let expected = eomgen::Builder::new(workspace().join(&path))
+        .regressor()
+        .generate()
+        .expect("generates");
+    assert!(code(&out) == code(&expected), "CLI and Builder differ");
+    assert!(out.contains("--regressor -o ur5.rs"));
+    assert!(out.contains("pub fn base_parameters(&self) -> [T; 36]"));
+    let text = ok(&["show", &path, "--base-parameters"]);
+    assert!(
+        text.contains("36 base parameters of 60 standard parameters"),
+        "{text}"
+    );
+    assert!(
+        text.contains("  MZR_forearm_link = MZ_forearm_link + 0.39225*M_wrist_1_link"),
+        "{text}"
+    );
+    let dp = robot("double_pendulum");
+    for (format, file) in [("text", "txt"), ("latex", "tex"), ("markdown", "md")] {
+        snapshot(
+            &format!("double_pendulum_base_parameters.{file}"),
+            &ok(&["show", &dp, "--base-parameters", "--format", format]),
+        );
+    }
+    let document = ok(&[
+        "show",
+        &dp,
+        "--base-parameters",
+        "--format",
+        "latex",
+        "--standalone",
+    ]);
+    assert!(document.starts_with("\\documentclass") && document.ends_with("\\end{document}\n"));
+    bad_usage(&["show", &dp, "--base-parameters", "--term", "M"]);
 }
 
 #[test]
@@ -561,6 +605,8 @@ fn help_documents_every_command_and_flag() {
                 "--gravity",
                 "--joint-order",
                 "--symbolic",
+                "--derivatives",
+                "--regressor",
             ],
         ),
         (
@@ -573,6 +619,7 @@ fn help_documents_every_command_and_flag() {
                 "--digits",
                 "--form",
                 "--max-terms",
+                "--base-parameters",
             ],
         ),
         ("info", &["--gravity", "--joint-order"]),

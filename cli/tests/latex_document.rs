@@ -62,18 +62,23 @@ fn pdflatex_compiles_it_where_installed() {
     let dir = std::env::temp_dir().join(format!("eomgen-latex-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::write(dir.join("ur5.tex"), standalone("ur5", &[])).unwrap();
-    let out = std::process::Command::new("pdflatex")
-        .args(["-interaction=nonstopmode", "-halt-on-error", "ur5.tex"])
-        .current_dir(&dir)
-        .output()
-        .unwrap();
-    let log = String::from_utf8_lossy(&out.stdout).into_owned();
+    // The base parameters' document too (long formulas, names with underscores).
+    let base = standalone("ur5", &["--base-parameters"]);
+    std::fs::write(dir.join("ur5_base.tex"), base).unwrap();
+    for file in ["ur5.tex", "ur5_base.tex"] {
+        let out = std::process::Command::new("pdflatex")
+            .args(["-interaction=nonstopmode", "-halt-on-error", file])
+            .current_dir(&dir)
+            .output()
+            .unwrap();
+        let log = String::from_utf8_lossy(&out.stdout).into_owned();
+        assert!(
+            out.status.success(),
+            "{file}: {}",
+            &log[log.len().saturating_sub(2000)..]
+        );
+    }
     let _ = std::fs::remove_dir_all(&dir);
-    assert!(
-        out.status.success(),
-        "{}",
-        &log[log.len().saturating_sub(2000)..]
-    );
 }
 
 #[test]

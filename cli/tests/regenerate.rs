@@ -26,6 +26,7 @@ fn the_regenerate_line_reproduces_the_file() {
         .friction(true)
         .armature([("shoulder", 0.2)])
         .inertia_from_collision(1000.0)
+        .regressor()
         .max_dof(12);
     let source = builder.generate().unwrap();
     let args = regenerate_command(&source);

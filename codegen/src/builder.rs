@@ -58,6 +58,8 @@ pub struct Builder {
     quantities: Option<Vec<String>>,
     /// Whether to add the derivatives of the dynamics ([`Builder::derivatives`]).
     derivatives: bool,
+    /// Whether to add the regressor and the parameters ([`Builder::regressor`]).
+    regressor: bool,
 }
 
 /// Robots with more joints than this are refused unless [`Builder::max_dof`] raises the limit:
@@ -97,6 +99,7 @@ impl Builder {
             max_graph_nodes: DEFAULT_MAX_GRAPH_NODES,
             quantities: None,
             derivatives: false,
+            regressor: false,
         }
     }
 
@@ -245,8 +248,11 @@ impl Builder {
     /// the generated methods: `mass_matrix`, `gravity`, `bias`, `coriolis_matrix`,
     /// `inverse_dynamics`, `forward_dynamics` (with `try_forward_dynamics`), `kinetic_energy`,
     /// `potential_energy`, `centrifugal`, `coriolis_pairs`, `friction` (with
-    /// [`Builder::friction`]), `link_pose` and `link_jacobian`. An unknown name fails generation
-    /// with [`Error::UnknownQuantity`].
+    /// [`Builder::friction`]), `link_pose` and `link_jacobian`; with [`Builder::derivatives`],
+    /// `inverse_dynamics_derivatives`, `forward_dynamics_derivatives` and
+    /// `mass_matrix_inverse`; with [`Builder::regressor`], `regressor`, `parameters`,
+    /// `base_regressor` and `base_parameters`. An unknown name fails generation with
+    /// [`Error::UnknownQuantity`].
     ///
     /// The `Dynamics` trait is implemented when all its eight methods are selected; otherwise
     /// the selected ones are inherent methods of the generated type. Craig's `centrifugal` and
@@ -334,6 +340,35 @@ impl Builder {
         self
     }
 
+    /// Adds identification, for estimating a robot's inertial parameters from measured
+    /// torques: `regressor(&q, &qd, &qdd)` (N x P, `tau = Y pi`) and `parameters()` (the P
+    /// standard parameters: per body, in joint order, m, m cx, m cy, m cz, Ixx, Ixy, Iyy, Ixz,
+    /// Iyz, Izz, with the inertia about the body frame's origin; then rotor inertia and
+    /// friction coefficients when generated), `base_regressor` and `base_parameters()` (the
+    /// minimal set of exact combinations that determines the dynamics, each formula in its
+    /// documentation), and the constants `BODY_NAMES`, `PARAMETER_NAMES` and
+    /// `BASE_PARAMETER_NAMES`. Off by default.
+    ///
+    /// ```
+    /// # let urdf = r#"<robot name="pendulum"><link name="base"/>
+    /// #   <link name="arm"><inertial><origin xyz="0 0 -0.5"/><mass value="1"/>
+    /// #   <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.001"/></inertial></link>
+    /// #   <joint name="swing" type="continuous"><parent link="base"/><child link="arm"/>
+    /// #   <axis xyz="0 1 0"/></joint></robot>"#;
+    /// let source = eomgen::Builder::from_urdf_str(urdf, "pendulum.urdf")
+    ///     .regressor()
+    ///     .generate()
+    ///     .unwrap();
+    /// assert!(source.contains("pub fn regressor(&self, q: &[T; 1], qd: &[T; 1], qdd: &[T; 1]) -> [[T; 10]; 1]"));
+    /// assert!(source.contains("pub fn parameters(&self) -> [T; 10]"));
+    /// // A pendulum about y: YY (about the pivot) and MX, MZ (gravity) are what it shows.
+    /// assert!(source.contains("pub fn base_parameters(&self) -> [T; 3]"));
+    /// ```
+    pub fn regressor(mut self) -> Builder {
+        self.regressor = true;
+        self
+    }
+
     /// The "Regenerate:" line of the banner; default: the `eomgen generate` command line that
     /// writes the same file, with the options given to this builder.
     pub fn regenerate_hint(mut self, hint: &str) -> Builder {
@@ -417,9 +452,18 @@ impl Builder {
                 what: "derivatives of a floating-base robot are not generated yet",
             });
         }
+        if self.regressor && model.is_floating() {
+            return Err(Error::Unsupported {
+                file,
+                what: "the regressor of a floating-base robot is not generated yet",
+            });
+        }
         let mut d = Derivation::try_new(model, limits).map_err(full)?;
         if self.derivatives {
             d.add_derivatives().map_err(full)?;
+        }
+        if self.regressor {
+            d.add_regressor(model).map_err(full)?;
         }
         if let Some(wanted) = &self.quantities {
             let all = std::mem::take(&mut d.quantities);
@@ -451,6 +495,7 @@ impl Builder {
                     max_graph_nodes: self.max_graph_nodes,
                     quantities: self.quantities.as_deref(),
                     derivatives: self.derivatives,
+                    regressor: self.regressor,
                 },
                 &self.options,
             )

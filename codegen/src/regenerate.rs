@@ -21,6 +21,8 @@ pub(crate) struct Command<'a> {
     pub quantities: Option<&'a [String]>,
     /// `Builder::derivatives`.
     pub derivatives: bool,
+    /// `Builder::regressor`.
+    pub regressor: bool,
 }
 
 /// `eomgen generate URDF --type-name T [options] -o MODULE.rs  # ...`.
@@ -47,6 +49,9 @@ pub(crate) fn command_line(c: &Command, o: &ModelOptions) -> String {
     }
     if c.derivatives {
         line.push_str(" --derivatives");
+    }
+    if c.regressor {
+        line.push_str(" --regressor");
     }
     if let Some(names) = c.quantities {
         let _ = write!(line, " --only {}", quote(&names.join(",")));
@@ -133,6 +138,7 @@ mod tests {
             max_graph_nodes: crate::DEFAULT_MAX_GRAPH_NODES,
             quantities: None,
             derivatives: false,
+            regressor: false,
         }
     }
 

@@ -716,6 +716,14 @@ fn hostile_names_stay_data_with_symbolic_parameters() {
         .generate()
         .unwrap();
     check_safe_source("names_symbolic", &source).unwrap();
+    // Identification puts them into parameter names, base-parameter formulas and constants.
+    let source = eomgen::Builder::from_urdf_str(&fixture("names.urdf"), "names.urdf")
+        .symbolic(eomgen::SymbolicParams::All)
+        .friction(true)
+        .regressor()
+        .generate()
+        .unwrap();
+    check_safe_source("names_regressor", &source).unwrap();
 }
 
 #[test]

@@ -8,7 +8,11 @@
 //! cargo run --example gravity_compensation  # hold a pose against gravity (f32)
 //! cargo run --example task_space_force      # push with the hand: tau = J^T F
 //! cargo run --example quadruped_stand       # a floating-base quadruped standing on its feet
+//! cargo run --example identify              # base inertial parameters of a UR5 from noisy torques
 //! ```
+//!
+//! `Ur5` (6 joints, `robots/ur5.urdf`) is generated with identification: `regressor`,
+//! `parameters`, `base_regressor` and `base_parameters`.
 //!
 //! ```
 //! use eomgen_examples::{PandaArm, PandaArmLink};
@@ -36,6 +40,12 @@ pub mod anymal {
         0.0, 0.6, -1.2, 0.0, -0.6, 1.2, 0.0, 0.6, -1.2, 0.0, -0.6, 1.2, // LF, LH, RF, RH
     ];
 }
+
+/// The UR5 arm with identification, generated from `robots/ur5.urdf`.
+pub mod ur5 {
+    include!(concat!(env!("OUT_DIR"), "/ur5.rs"));
+}
+pub use ur5::Ur5;
 
 /// A comfortable start configuration (rad): elbow bent, hand pointing down.
 pub const READY: [f64; 7] = [0.0, -0.3, 0.0, -2.2, 0.0, 2.0, 0.8];

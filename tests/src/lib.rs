@@ -152,7 +152,6 @@ impl JointMap {
             .collect();
         JointMap { ours: map }
     }
-
     /// A reference-ordered vector in our order.
     pub fn to_ours(&self, v: &[f64]) -> Vec<f64> {
         let mut out = vec![0.0; v.len()];
@@ -161,7 +160,6 @@ impl JointMap {
         }
         out
     }
-
     /// Our pair index of the reference's pair `(a, b)`, `a < b`.
     pub fn pair(&self, a: usize, b: usize) -> usize {
         let n = self.ours.len();
@@ -190,7 +188,6 @@ impl Checker {
             failures: Vec::new(),
         }
     }
-
     /// Compares one number.
     pub fn check(&mut self, what: impl FnOnce() -> String, got: f64, want: f64) {
         self.compared += 1;
@@ -200,7 +197,6 @@ impl Checker {
                 .push(format!("{}: got {got:e}, want {want:e}", what()));
         }
     }
-
     /// Panics with every failure when there was one.
     pub fn finish(self, context: &str) {
         assert!(self.compared > 0, "{context}: nothing compared");
@@ -292,6 +288,31 @@ pub mod robots {
     pub mod iris_simple {
         include!(concat!(env!("OUT_DIR"), "/iris_simple.rs"));
     }
+    /// `double_pendulum.urdf` with identification (`Builder::regressor`) and inverse dynamics.
+    pub mod double_pendulum_regressor {
+        include!(concat!(env!("OUT_DIR"), "/double_pendulum_regressor.rs"));
+    }
+    /// `ur5.urdf` with identification and inverse dynamics.
+    pub mod ur5_regressor {
+        include!(concat!(env!("OUT_DIR"), "/ur5_regressor.rs"));
+    }
+    /// `panda.urdf` with identification and inverse dynamics.
+    pub mod panda_regressor {
+        include!(concat!(env!("OUT_DIR"), "/panda_regressor.rs"));
+    }
+    /// `kinova.urdf` with identification and inverse dynamics.
+    pub mod kinova_regressor {
+        include!(concat!(env!("OUT_DIR"), "/kinova_regressor.rs"));
+    }
+    /// `allegro_right_hand.urdf` with identification and inverse dynamics.
+    pub mod allegro_regressor {
+        include!(concat!(env!("OUT_DIR"), "/allegro_regressor.rs"));
+    }
+    /// The joint-effects arm with rotor inertia, friction and identification.
+    pub mod joint_effects_regressor {
+        include!(concat!(env!("OUT_DIR"), "/joint_effects_regressor.rs"));
+    }
+
     /// `codegen/tests/urdf/hostile/names.urdf`: link and joint names that try to break out of
     /// comments and string literals; compiling this module is the test.
     pub mod hostile_names {
@@ -337,7 +358,6 @@ pub mod alloc_counter {
             unsafe { System.realloc(ptr, layout, new_size) }
         }
     }
-
     /// Allocations made by `f` on this thread (needs [`Counting`] as the global allocator).
     pub fn allocations(f: impl FnOnce()) -> usize {
         let before = ALLOCATIONS.load(Ordering::SeqCst);

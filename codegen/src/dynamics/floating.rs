@@ -90,6 +90,7 @@ pub(super) fn derive(model: &Model, limits: Limits) -> Result<Derivation, GraphF
         potential_energy,
         joint_transforms,
         coordinate_parents: parents,
+        identification: None,
         centroidal,
         recursive: rec,
         fast,

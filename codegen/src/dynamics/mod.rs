@@ -11,12 +11,15 @@
 //! Rotor inertia (armature) adds to `M`'s diagonal; joint friction `F(qd)` (when the model
 //! includes it) adds to `tau` and enters forward dynamics, but not `b`.
 
+pub mod base_parameters;
 pub mod catalogue;
 mod centroidal;
 mod floating;
+pub mod identification;
 mod lagrangian;
 pub mod newton_euler;
 mod quantities;
+pub mod regressor;
 
 use std::time::{Duration, Instant};
 
@@ -26,6 +29,7 @@ use crate::model::Model;
 
 pub use catalogue::{Craig, Evaluation, Home, Input, Quantity, Shape};
 pub use centroidal::Centroidal;
+pub use identification::Identification;
 pub use lagrangian::pairs;
 
 /// The pose of a body in its parent body's frame (the root's for a body whose parent is the
@@ -97,6 +101,9 @@ pub struct Derivation {
     pub fast: Fast,
     /// What generated code evaluates, one entry per generated function.
     pub quantities: Vec<Quantity>,
+    /// The regressor and the standard and base parameters, after
+    /// [`Derivation::add_regressor`].
+    pub identification: Option<Identification>,
     /// How long each stage took.
     pub timings: Vec<(&'static str, Duration)>,
 }
@@ -316,6 +323,7 @@ impl Derivation {
             recursive,
             fast,
             quantities: Vec::new(),
+            identification: None,
             timings: Vec::new(),
         };
         Ok(finish(d, model, clock))

@@ -399,7 +399,7 @@ struct Composite {
 /// Moves a body's inertia parameters `(m, h, J)` about its origin (in its axes) to the parent's
 /// origin and axes: `J_O = R J R^T - m [t]^2 - [t][R h] - [R h][t]`, `h_O = R h + m t`. With
 /// `m = None` the same map moves the time derivative of an inertia (whose mass part is zero).
-fn inertia_to_parent(
+pub(crate) fn inertia_to_parent(
     g: &mut Graph,
     lm: &LocalModel,
     c: usize,
@@ -466,7 +466,7 @@ fn composites(g: &mut Graph, lm: &LocalModel) -> Composite {
 
 /// The momentum-like product `I v` for inertia parameters `(m, h, J)` about the origin:
 /// moment `J w + h x u`, force `w x h + m u` (with `m = None` for an inertia derivative).
-fn inertia_times(g: &mut Graph, m: Option<Id>, h: &V3, j: &M3, v: &Spatial) -> Spatial {
+pub(crate) fn inertia_times(g: &mut Graph, m: Option<Id>, h: &V3, j: &M3, v: &Spatial) -> Spatial {
     let (w, u) = v;
     let jw = mat_vec(g, j, w);
     let hu = cross(g, h, u);

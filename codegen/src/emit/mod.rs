@@ -5,6 +5,7 @@
 
 mod body;
 mod expr;
+mod identification;
 pub mod names;
 mod rust;
 

@@ -176,6 +176,7 @@ impl Emitter<'_> {
         let try_fd = &self.try_forward_dynamics;
         let parents = self.parents_const();
         let nj = usize_lit(self.model.joints.len());
+        let identification = super::identification::constants(d, self.quantities);
         // Without the trait, the joint order still has to be said.
         let joint_names = if self.in_trait {
             TokenStream::new()
@@ -212,6 +213,7 @@ impl Emitter<'_> {
                 #sizes
                 #parents
                 #joint_names
+                #identification
                 #try_fd
                 #(#methods)*
                 #frames

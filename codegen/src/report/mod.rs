@@ -34,7 +34,10 @@
 //! assert!(text.contains("s1 = sin(q1)"));
 //! ```
 
+mod base_parameters;
 mod trig;
+
+pub use base_parameters::render_base_parameters;
 
 use std::collections::BTreeSet;
 use std::fmt::Write as _;
@@ -563,6 +566,18 @@ fn vec3(v: &nalgebra::Vector3<f64>, digits: Option<usize>) -> String {
     )
 }
 
+/// How formulas are printed for `opts`: LaTeX syntax for LaTeX and Markdown.
+fn style_of(opts: &ShowOptions) -> Style {
+    let syntax = match opts.format {
+        Format::Text => Syntax::Text,
+        Format::Latex | Format::Markdown => Syntax::Latex,
+    };
+    Style {
+        syntax,
+        digits: opts.digits,
+    }
+}
+
 /// Prints the chosen terms of a derived robot.
 ///
 /// The heading lists the joints (`q1` is the first joint of the model's order); then each
@@ -586,14 +601,8 @@ pub fn render(model: &Model, d: &Derivation, opts: &ShowOptions) -> Result<Strin
             reason: "needs exactly one term".to_string(),
         });
     }
-    let syntax = match opts.format {
-        Format::Text => Syntax::Text,
-        Format::Latex | Format::Markdown => Syntax::Latex,
-    };
-    let style = Style {
-        syntax,
-        digits: opts.digits,
-    };
+    let style = style_of(opts);
+    let syntax = style.syntax;
     let mut g = d.graph.clone();
     let mut dropped = 0;
     let mut sections = Vec::with_capacity(opts.terms.len());
