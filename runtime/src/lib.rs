@@ -78,6 +78,7 @@ pub mod prelude;
 mod real;
 pub mod sim;
 pub mod tree;
+mod trig;
 
 #[cfg(feature = "nalgebra")]
 pub mod nalgebra_support;

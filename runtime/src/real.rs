@@ -92,6 +92,16 @@ pub trait Real:
     fn is_finite(self) -> bool;
 }
 
+#[inline(always)]
+fn sin_f64(x: f64) -> f64 {
+    crate::trig::sin_cos(x).0
+}
+
+#[inline(always)]
+fn cos_f64(x: f64) -> f64 {
+    crate::trig::sin_cos(x).1
+}
+
 macro_rules! impl_real {
     ($t:ty, $sin:path, $cos:path, $sincos:path, $atan2:path, $sqrt:path, $fabs:path,
      $fmin:path, $fmax:path) => {
@@ -191,9 +201,9 @@ impl_real!(
 );
 impl_real!(
     f64,
-    libm::sin,
-    libm::cos,
-    libm::sincos,
+    sin_f64,
+    cos_f64,
+    crate::trig::sin_cos,
     libm::atan2,
     libm::sqrt,
     libm::fabs,
