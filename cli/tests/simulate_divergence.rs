@@ -16,7 +16,7 @@ const STIFF: &str = r#"<robot name="stiff">
 </robot>"#;
 
 fn simulate(dt: &str) -> std::process::Output {
-    let path = scratch("divergence").join("stiff.urdf");
+    let path = scratch(&format!("divergence-{dt}")).join("stiff.urdf");
     std::fs::write(&path, STIFF).unwrap();
     let path = path.to_str().unwrap().to_string();
     eomgen(&[
