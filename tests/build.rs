@@ -153,6 +153,8 @@ fn derivatives() {
             "allegro_derivatives",
             "AllegroDerivatives",
         ),
+        // Not one of the five reference robots: a 7-joint arm from example-robot-data.
+        ("robots/xarm7.urdf", "xarm7_derivatives", "Xarm7Derivatives"),
     ] {
         eomgen::Builder::new(file)
             .module_name(module)
@@ -167,6 +169,29 @@ fn derivatives() {
             .compile()
             .unwrap();
     }
+    // Friction (smoothed, so that it is differentiable) and rotor inertia enter the
+    // derivatives: checked against finite differences only (Pinocchio has neither).
+    eomgen::Builder::new("fixtures/joint_effects.urdf")
+        .module_name("joint_effects_derivatives")
+        .type_name("JointEffectsDerivatives")
+        .inertia_from_collision(1000.0)
+        .armature([("shoulder", 0.2), ("elbow", 0.05)])
+        .friction(true)
+        .coulomb_smoothing(0.05)
+        .derivatives()
+        .quantities([
+            "inverse_dynamics",
+            "forward_dynamics",
+            "inverse_dynamics_derivatives",
+            "forward_dynamics_derivatives",
+        ])
+        .generate()
+        .map(|source| {
+            let out = std::path::PathBuf::from(std::env::var_os("OUT_DIR").unwrap());
+            eomgen::write_if_changed(&out.join("joint_effects_derivatives.rs"), source.as_bytes())
+                .unwrap();
+        })
+        .unwrap();
 }
 
 /// The reference robots with identification (and the inverse dynamics it must reproduce), and

@@ -4,7 +4,7 @@
 
 mod support;
 
-use support::{eomgen, robot};
+use support::{eomgen, robot, stdout_of};
 
 fn standalone(name: &str, extra: &[&str]) -> String {
     let urdf = robot(name);
@@ -16,13 +16,7 @@ fn standalone(name: &str, extra: &[&str]) -> String {
         "--standalone",
     ];
     args.extend(extra);
-    let out = eomgen(&args);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout).unwrap()
+    stdout_of(&args)
 }
 
 #[test]

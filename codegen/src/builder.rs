@@ -460,7 +460,7 @@ impl Builder {
         }
         let mut d = Derivation::try_new(model, limits).map_err(full)?;
         if self.derivatives {
-            d.add_derivatives().map_err(full)?;
+            d.add_derivatives(model).map_err(full)?;
         }
         if self.regressor {
             d.add_regressor(model).map_err(full)?;

@@ -98,7 +98,7 @@ fn every_catalogue_entry_is_consistent_with_its_shape_and_names_are_unique() {
     use eomgen::dynamics::{Derivation, Evaluation};
     let model = eomgen::urdf::load_str(URDF, "arm.urdf", &Default::default()).unwrap();
     let mut d = Derivation::new(&model);
-    d.add_derivatives().unwrap();
+    d.add_derivatives(&model).unwrap();
     let mut names: Vec<&str> = d.quantities.iter().map(|q| q.name).collect();
     names.sort();
     names.dedup();
@@ -117,6 +117,10 @@ fn every_catalogue_entry_is_consistent_with_its_shape_and_names_are_unique() {
                 assert_eq!(pivots.len(), q.shape.len());
             }
             Evaluation::ForwardDynamicsSolve { h } => assert_eq!(h.len(), q.shape.len()),
+            Evaluation::Factored { outputs, pivots } => {
+                assert_eq!(outputs.len(), q.shape.len(), "{}", q.name);
+                assert_eq!(pivots.len(), d.dof, "{}", q.name);
+            }
             _ => assert!(q.exprs().is_empty(), "{} is a loop", q.name),
         }
         for needed in q.needs() {

@@ -77,33 +77,90 @@ impl<T: ::eomgen_runtime::Real> DoublePendulum<T> {
             let t5 = t0 * t2;
             let t6 = t1 * t2;
             let t7 = t0 * t3;
-            let t8 = T::from_f64(0.0000000014126230823060105) * t2
-                + T::from_f64(0.7356637062775817) * t3 + T::one();
-            let t9 = t2 * (-T::from_f64(0.1) * t3 - T::from_f64(0.10088));
-            let t10 = t3 * (T::from_f64(0.1) * t2 + T::from_f64(0.00000000019371));
-            let t11 = T::from_f64(0.000000000012877065959999999) * t2
-                + T::from_f64(0.006706098880000001) * t3
-                + T::from_f64(0.00863622790870487)
-                - (T::from_f64(0.0000000000064385329799999996) * t2
-                    + T::from_f64(0.0033530494400000003) * t3
-                    + T::from_f64(0.004557856275072)) * t8;
-            let t12 = qd[0] * qd[0] * (-T::from_f64(0.033238000000000004) * (t9 + t10));
-            let t13 = T::from_f64(0.42040052957160007) * t0
-                + T::from_f64(0.0000000006316200853380001) * (t5 - t4)
-                + T::from_f64(0.328934150064) * (t6 + t7) + tau[0]
-                - T::from_f64(0.0000056915273546100005) * t1
-                - qd[1] * qd[1]
-                    * (T::from_f64(0.000000000006438532980000001) * t3
-                        - T::from_f64(0.00335304944) * t2)
-                - qd[0] * qd[1] * (T::from_f64(0.06647600000000001) * (t9 + t10))
-                - (T::from_f64(0.0000000006316200853380001) * (t5 - t4)
-                    + T::from_f64(0.328934150064) * (t6 + t7) + tau[1] - t12) * t8;
+            let t8 = T::mul_add(
+                T::from_f64(0.7356637062775817),
+                t3,
+                T::mul_add(T::from_f64(0.0000000014126230823060105), t2, T::one()),
+            );
+            let t9 = t2 * (T::mul_add(T::from_f64(0.1), t3, T::from_f64(0.10088)));
+            let t10 = t3
+                * (T::mul_add(T::from_f64(0.1), t2, T::from_f64(0.00000000019371)));
+            let t11 = T::mul_add(
+                -(T::mul_add(
+                    T::from_f64(0.0033530494400000003),
+                    t3,
+                    T::mul_add(
+                        T::from_f64(0.0000000000064385329799999996),
+                        t2,
+                        T::from_f64(0.004557856275072),
+                    ),
+                )),
+                t8,
+                T::mul_add(
+                    T::from_f64(0.006706098880000001),
+                    t3,
+                    T::mul_add(
+                        T::from_f64(0.000000000012877065959999999),
+                        t2,
+                        T::from_f64(0.00863622790870487),
+                    ),
+                ),
+            );
+            let t12 = qd[0] * qd[0] * (T::from_f64(0.033238000000000004) * (t9 - t10));
+            let t13 = T::mul_add(
+                t8,
+                T::mul_add(
+                    -T::from_f64(0.328934150064),
+                    t6 + t7,
+                    T::mul_add(
+                        T::from_f64(0.0000000006316200853380001),
+                        t4 - t5,
+                        t12 - tau[1],
+                    ),
+                ),
+                T::mul_add(
+                    qd[0],
+                    qd[1] * (T::from_f64(0.06647600000000001) * (t9 - t10)),
+                    T::mul_add(
+                        qd[1],
+                        qd[1]
+                            * (T::mul_add(
+                                -T::from_f64(0.000000000006438532980000001),
+                                t3,
+                                T::from_f64(0.00335304944) * t2,
+                            )),
+                        T::mul_add(
+                            T::from_f64(0.328934150064),
+                            t6 + t7,
+                            T::mul_add(
+                                T::from_f64(0.0000000006316200853380001),
+                                t5 - t4,
+                                T::mul_add(
+                                    -T::from_f64(0.0000056915273546100005),
+                                    t1,
+                                    T::mul_add(T::from_f64(0.42040052957160007), t0, tau[0]),
+                                ),
+                            ),
+                        ),
+                    ),
+                ),
+            );
             let t14 = T::one() / t11;
             [
                 t13 * t14,
-                T::from_f64(0.00000013857832437421965) * (t5 - t4)
-                    + T::from_f64(72.16860958583077) * (t6 + t7)
-                    + T::from_f64(219.4013895236754) * (tau[1] - t12) - t8 * t13 * t14,
+                T::mul_add(
+                    -t8,
+                    t13 * t14,
+                    T::mul_add(
+                        T::from_f64(219.4013895236754),
+                        tau[1] - t12,
+                        T::mul_add(
+                            T::from_f64(72.16860958583077),
+                            t6 + t7,
+                            T::from_f64(0.00000013857832437421965) * (t5 - t4),
+                        ),
+                    ),
+                ),
                 t11,
                 T::from_f64(0.004557856275072),
             ]
@@ -139,14 +196,20 @@ impl<T: ::eomgen_runtime::Real> DoublePendulum<T> {
         let (s1, c1) = q[1].sin_cos();
         let t0 = s1;
         let t1 = c1;
-        let t2 = -T::from_f64(0.033238000000000004)
-            * (t0 * (-T::from_f64(0.1) * t1 - T::from_f64(0.10088))
-                + t1 * (T::from_f64(0.1) * t0 + T::from_f64(0.00000000019371)));
+        let t2 = T::from_f64(0.033238000000000004)
+            * (T::mul_add(
+                -t1,
+                T::mul_add(T::from_f64(0.1), t0, T::from_f64(0.00000000019371)),
+                t0 * (T::mul_add(T::from_f64(0.1), t1, T::from_f64(0.10088))),
+            ));
         [
             [
                 T::zero(),
-                T::from_f64(0.000000000006438532980000001) * t1
-                    - T::from_f64(0.00335304944) * t0,
+                T::mul_add(
+                    T::from_f64(0.000000000006438532980000001),
+                    t1,
+                    -T::from_f64(0.00335304944) * t0,
+                ),
             ],
             [t2, T::zero()],
         ]
@@ -159,8 +222,11 @@ impl<T: ::eomgen_runtime::Real> DoublePendulum<T> {
         let (s1, c1) = q[1].sin_cos();
         [
             [
-                T::from_f64(0.000000000012877065959999999) * c1
-                    - T::from_f64(0.006706098880000001) * s1,
+                T::mul_add(
+                    T::from_f64(0.000000000012877065959999999),
+                    c1,
+                    -T::from_f64(0.006706098880000001) * s1,
+                ),
             ],
             [T::zero()],
         ]
@@ -206,15 +272,36 @@ impl<T: ::eomgen_runtime::Real> DoublePendulum<T> {
         let t7 = t0 * t3;
         [
             T::from_f64(0.01989844564988906),
-            T::from_f64(0.0000009679119150497988) * t1
-                + T::from_f64(0.0000000001074145072654777) * (t4 - t5)
-                - T::from_f64(0.07149410980797784) * t0
-                - T::from_f64(0.05593916417810847) * (t6 + t7),
-            T::from_f64(0.0000009679119150497988) * t0
-                + T::from_f64(0.07149410980797784) * t1
-                + T::from_f64(0.05593916417810847) * (t4 - t5)
-                + T::from_f64(0.0000000001074145072654777) * (t6 + t7)
-                + T::from_f64(0.034999999999999996),
+            T::mul_add(
+                -T::from_f64(0.05593916417810847),
+                t6 + t7,
+                T::mul_add(
+                    T::from_f64(0.0000000001074145072654777),
+                    t4 - t5,
+                    T::mul_add(
+                        T::from_f64(0.0000009679119150497988),
+                        t1,
+                        -T::from_f64(0.07149410980797784) * t0,
+                    ),
+                ),
+            ),
+            T::mul_add(
+                T::from_f64(0.0000000001074145072654777),
+                t6 + t7,
+                T::mul_add(
+                    T::from_f64(0.05593916417810847),
+                    t4 - t5,
+                    T::mul_add(
+                        T::from_f64(0.07149410980797784),
+                        t1,
+                        T::mul_add(
+                            T::from_f64(0.0000009679119150497988),
+                            t0,
+                            T::from_f64(0.034999999999999996),
+                        ),
+                    ),
+                ),
+            ),
         ]
     }
     /// The Jacobian of `center_of_mass`, 3 x N, world axes.
@@ -232,21 +319,41 @@ impl<T: ::eomgen_runtime::Real> DoublePendulum<T> {
         let t5 = t0 * t2;
         let t6 = t1 * t2;
         let t7 = t0 * t3;
-        let t8 = T::from_f64(0.0000000000643853298) * t3
-            + T::from_f64(0.0000005801760809999999) - T::from_f64(0.0335304944) * t2;
-        let t9 = -T::from_f64(0.0000000000643853298) * t2
-            - T::from_f64(0.0335304944) * t3 - T::from_f64(0.04285428436);
+        let t8 = T::mul_add(
+            T::from_f64(0.0335304944),
+            t3,
+            T::mul_add(
+                T::from_f64(0.0000000000643853298),
+                t2,
+                T::from_f64(0.04285428436),
+            ),
+        );
+        let t9 = T::mul_add(
+            -T::from_f64(0.0000000000643853298),
+            t3,
+            T::mul_add(
+                T::from_f64(0.0335304944),
+                t2,
+                -T::from_f64(0.0000005801760809999999),
+            ),
+        );
         [
             [T::zero(), T::zero()],
             [
-                T::from_f64(1.668307168715904) * (t1 * t9 - t0 * t8),
-                T::from_f64(0.05593916417810847) * (t5 - t4)
-                    - T::from_f64(0.0000000001074145072654777) * (t6 + t7),
+                T::from_f64(1.668307168715904) * (T::mul_add(t0, t9, -t1 * t8)),
+                T::mul_add(
+                    -T::from_f64(0.0000000001074145072654777),
+                    t6 + t7,
+                    T::from_f64(0.05593916417810847) * (t5 - t4),
+                ),
             ],
             [
-                T::from_f64(1.668307168715904) * (t0 * t9 + t1 * t8),
-                T::from_f64(0.0000000001074145072654777) * (t4 - t5)
-                    - T::from_f64(0.05593916417810847) * (t6 + t7),
+                -T::from_f64(1.668307168715904) * (T::mul_add(t1, t9, t0 * t8)),
+                T::mul_add(
+                    -T::from_f64(0.05593916417810847),
+                    t6 + t7,
+                    T::from_f64(0.0000000001074145072654777) * (t4 - t5),
+                ),
             ],
         ]
     }
@@ -394,13 +501,26 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 2> for DoublePendu
         let (s1, c1) = q[1].sin_cos();
         let t0 = s1;
         let t1 = c1;
-        let t2 = T::from_f64(0.0000000000064385329799999996) * t0
-            + T::from_f64(0.0033530494400000003) * t1 + T::from_f64(0.004557856275072);
+        let t2 = T::mul_add(
+            T::from_f64(0.0033530494400000003),
+            t1,
+            T::mul_add(
+                T::from_f64(0.0000000000064385329799999996),
+                t0,
+                T::from_f64(0.004557856275072),
+            ),
+        );
         [
             [
-                T::from_f64(0.000000000012877065959999999) * t0
-                    + T::from_f64(0.006706098880000001) * t1
-                    + T::from_f64(0.00863622790870487),
+                T::mul_add(
+                    T::from_f64(0.006706098880000001),
+                    t1,
+                    T::mul_add(
+                        T::from_f64(0.000000000012877065959999999),
+                        t0,
+                        T::from_f64(0.00863622790870487),
+                    ),
+                ),
                 t2,
             ],
             [t2, T::from_f64(0.004557856275072)],
@@ -422,12 +542,24 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 2> for DoublePendu
         let t6 = t1 * t2;
         let t7 = t0 * t3;
         [
-            T::from_f64(0.0000056915273546100005) * t1
-                + T::from_f64(0.0000000006316200853380001) * (t4 - t5)
-                - T::from_f64(0.42040052957160007) * t0
-                - T::from_f64(0.328934150064) * (t6 + t7),
-            T::from_f64(0.0000000006316200853380001) * (t4 - t5)
-                - T::from_f64(0.328934150064) * (t6 + t7),
+            T::mul_add(
+                -T::from_f64(0.328934150064),
+                t6 + t7,
+                T::mul_add(
+                    T::from_f64(0.0000000006316200853380001),
+                    t4 - t5,
+                    T::mul_add(
+                        T::from_f64(0.0000056915273546100005),
+                        t1,
+                        -T::from_f64(0.42040052957160007) * t0,
+                    ),
+                ),
+            ),
+            T::mul_add(
+                -T::from_f64(0.328934150064),
+                t6 + t7,
+                T::from_f64(0.0000000006316200853380001) * (t4 - t5),
+            ),
         ]
     }
     /// The Coriolis and centrifugal effort b(q, qd) = C(q, qd) qd, without gravity.
@@ -438,33 +570,46 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 2> for DoublePendu
         let (s1, c1) = q[1].sin_cos();
         let t0 = s1;
         let t1 = c1;
-        let t2 = t0 * (-T::from_f64(0.1) * t1 - T::from_f64(0.10088));
-        let t3 = t1 * (T::from_f64(0.1) * t0 + T::from_f64(0.00000000019371));
-        let t4 = qd[1] * qd[1]
-            * (T::from_f64(0.000000000006438532980000001) * t1
-                - T::from_f64(0.00335304944) * t0)
-            + qd[0] * qd[1] * (T::from_f64(0.06647600000000001) * (t2 + t3));
-        [t4, qd[0] * qd[0] * (-T::from_f64(0.033238000000000004) * (t2 + t3))]
+        let t2 = t0 * (T::mul_add(T::from_f64(0.1), t1, T::from_f64(0.10088)));
+        let t3 = t1 * (T::mul_add(T::from_f64(0.1), t0, T::from_f64(0.00000000019371)));
+        let t4 = T::mul_add(
+            -qd[0],
+            qd[1] * (T::from_f64(0.06647600000000001) * (t2 - t3)),
+            -qd[1] * qd[1]
+                * (T::mul_add(
+                    -T::from_f64(0.000000000006438532980000001),
+                    t1,
+                    T::from_f64(0.00335304944) * t0,
+                )),
+        );
+        [t4, qd[0] * qd[0] * (T::from_f64(0.033238000000000004) * (t2 - t3))]
     }
     /// The Christoffel-form Coriolis matrix C(q, qd): C qd = b, dM/dt - 2C skew-symmetric.
     ///
     /// Route: closed-form Lagrangian expressions.
-    /// Operations: 15 mul, 6 add, 0 div, 1 sin, 1 cos.
+    /// Operations: 13 mul, 5 add, 0 div, 1 sin, 1 cos.
     fn coriolis_matrix(&self, q: &[T; 2], qd: &[T; 2]) -> [[T; 2]; 2] {
         let (s1, c1) = q[1].sin_cos();
         let t0 = s1;
         let t1 = c1;
-        let t2 = t0 * (-T::from_f64(0.1) * t1 - T::from_f64(0.10088));
-        let t3 = t1 * (T::from_f64(0.1) * t0 + T::from_f64(0.00000000019371));
-        let t4 = T::from_f64(0.06647600000000001) * (t2 + t3);
-        let t5 = T::from_f64(0.5)
-            * (qd[0] * t4
-                + qd[1]
-                    * (T::from_f64(0.000000000012877065960000002) * t1
-                        - T::from_f64(0.00670609888) * t0));
-        let t6 = T::from_f64(0.5) * qd[0]
-            * (-T::from_f64(0.06647600000000001) * (t2 + t3));
-        [[T::from_f64(0.5) * qd[1] * t4, t5], [t6, T::zero()]]
+        let t2 = T::from_f64(0.06647600000000001)
+            * (T::mul_add(
+                -t1,
+                T::mul_add(T::from_f64(0.1), t0, T::from_f64(0.00000000019371)),
+                t0 * (T::mul_add(T::from_f64(0.1), t1, T::from_f64(0.10088))),
+            ));
+        let t3 = qd[0] * t2;
+        let t4 = -T::from_f64(0.5)
+            * (T::mul_add(
+                qd[1],
+                T::mul_add(
+                    -T::from_f64(0.000000000012877065960000002),
+                    t1,
+                    T::from_f64(0.00670609888) * t0,
+                ),
+                t3,
+            ));
+        [[-T::from_f64(0.5) * qd[1] * t2, t4], [T::from_f64(0.5) * t3, T::zero()]]
     }
     /// Inverse dynamics: tau = M(q) qdd + b(q, qd) + G(q).
     ///
@@ -478,28 +623,65 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 2> for DoublePendu
         let t2 = s1;
         let t3 = c1;
         let t4 = qd[0] + qd[1];
-        let t5 = T::from_f64(9.81) * t1 - T::from_f64(0.1) * qd[0] * qd[0];
-        let t6 = T::from_f64(9.81) * t0 - T::from_f64(0.1) * qdd[0];
+        let t5 = T::mul_add(-T::from_f64(0.1), qd[0] * qd[0], T::from_f64(9.81) * t1);
+        let t6 = T::mul_add(-T::from_f64(9.81), t0, T::from_f64(0.1) * qdd[0]);
         let t7 = t2 * t5;
         let t8 = t3 * t5;
         let t9 = t3 * t6;
         let t10 = t2 * t6;
-        let t11 = T::from_f64(0.33238) * (t7 + t9)
-            - T::from_f64(0.0335304944) * (qdd[0] + qdd[1])
-            - t4 * (T::from_f64(0.0000000000643853298) * t4);
-        let t12 = T::from_f64(0.0000000000643853298) * (qdd[0] + qdd[1])
-            + t4 * (-T::from_f64(0.0335304944) * t4) + T::from_f64(0.33238) * (t8 - t10);
+        let t11 = T::mul_add(
+            T::from_f64(0.33238),
+            t8 + t10,
+            T::mul_add(
+                -t4,
+                T::from_f64(0.0335304944) * t4,
+                T::from_f64(0.0000000000643853298) * (qdd[0] + qdd[1]),
+            ),
+        );
+        let t12 = T::mul_add(
+            T::from_f64(0.33238),
+            t9 - t7,
+            T::mul_add(
+                t4,
+                T::from_f64(0.0000000000643853298) * t4,
+                T::from_f64(0.0335304944) * (qdd[0] + qdd[1]),
+            ),
+        );
         [
-            T::from_f64(0.005312427908704868) * qdd[0]
-                + T::from_f64(0.004557856275072) * qdd[1]
-                + T::from_f64(0.00000569152735461) * t1
-                + T::from_f64(0.0000000000643853298) * (t8 - t10)
-                + T::from_f64(0.1) * (t2 * t12 - t3 * t11)
-                - T::from_f64(0.0943357495716) * t0
-                - T::from_f64(0.0335304944) * (t7 + t9),
-            T::from_f64(0.004557856275072) * (qdd[0] + qdd[1])
-                + T::from_f64(0.0000000000643853298) * (t8 - t10)
-                - T::from_f64(0.0335304944) * (t7 + t9),
+            T::mul_add(
+                T::from_f64(0.1),
+                T::mul_add(t2, t11, t3 * t12),
+                T::mul_add(
+                    T::from_f64(0.0000000000643853298),
+                    t8 + t10,
+                    T::mul_add(
+                        T::from_f64(0.0335304944),
+                        t9 - t7,
+                        T::mul_add(
+                            T::from_f64(0.00000569152735461),
+                            t1,
+                            T::mul_add(
+                                -T::from_f64(0.0943357495716),
+                                t0,
+                                T::mul_add(
+                                    T::from_f64(0.004557856275072),
+                                    qdd[1],
+                                    T::from_f64(0.005312427908704868) * qdd[0],
+                                ),
+                            ),
+                        ),
+                    ),
+                ),
+            ),
+            T::mul_add(
+                T::from_f64(0.0000000000643853298),
+                t8 + t10,
+                T::mul_add(
+                    T::from_f64(0.0335304944),
+                    t9 - t7,
+                    T::from_f64(0.004557856275072) * (qdd[0] + qdd[1]),
+                ),
+            ),
         ]
     }
     /// Forward dynamics: qdd = M(q)^-1 (tau - b(q, qd) - G(q)).
@@ -523,15 +705,35 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 2> for DoublePendu
         let (s1, c1) = q[1].sin_cos();
         let t0 = s1;
         let t1 = c1;
-        let t2 = T::from_f64(0.0000000000064385329799999996) * t0
-            + T::from_f64(0.0033530494400000003) * t1 + T::from_f64(0.004557856275072);
-        let t3 = qd[0]
-            * (T::from_f64(0.000000000012877065959999999) * t0
-                + T::from_f64(0.006706098880000001) * t1
-                + T::from_f64(0.00863622790870487)) + qd[1] * t2;
+        let t2 = T::mul_add(
+            T::from_f64(0.0033530494400000003),
+            t1,
+            T::mul_add(
+                T::from_f64(0.0000000000064385329799999996),
+                t0,
+                T::from_f64(0.004557856275072),
+            ),
+        );
+        let t3 = T::mul_add(
+            qd[1],
+            t2,
+            qd[0]
+                * (T::mul_add(
+                    T::from_f64(0.006706098880000001),
+                    t1,
+                    T::mul_add(
+                        T::from_f64(0.000000000012877065959999999),
+                        t0,
+                        T::from_f64(0.00863622790870487),
+                    ),
+                )),
+        );
         let t4 = T::from_f64(0.5)
-            * (qd[0] * t3
-                + qd[1] * (T::from_f64(0.004557856275072) * qd[1] + qd[0] * t2));
+            * (T::mul_add(
+                qd[1],
+                T::mul_add(qd[0], t2, T::from_f64(0.004557856275072) * qd[1]),
+                qd[0] * t3,
+            ));
         t4
     }
     /// The gravitational potential energy V = -sum m g.c, zero with every centre of mass at the origin.
@@ -545,10 +747,22 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 2> for DoublePendu
         let t1 = c0;
         let t2 = s1;
         let t3 = c1;
-        T::from_f64(0.0000056915273546100005) * t0
-            + T::from_f64(0.42040052957160007) * t1
-            + T::from_f64(0.328934150064) * (t1 * t3 - t0 * t2)
-            + T::from_f64(0.0000000006316200853380001) * (t1 * t2 + t0 * t3)
-            + T::from_f64(0.20580742350000003)
+        T::mul_add(
+            T::from_f64(0.0000000006316200853380001),
+            T::mul_add(t0, t3, t1 * t2),
+            T::mul_add(
+                T::from_f64(0.328934150064),
+                T::mul_add(-t0, t2, t1 * t3),
+                T::mul_add(
+                    T::from_f64(0.42040052957160007),
+                    t1,
+                    T::mul_add(
+                        T::from_f64(0.0000056915273546100005),
+                        t0,
+                        T::from_f64(0.20580742350000003),
+                    ),
+                ),
+            ),
+        )
     }
 }

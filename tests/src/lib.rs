@@ -313,6 +313,15 @@ pub mod robots {
         include!(concat!(env!("OUT_DIR"), "/joint_effects_regressor.rs"));
     }
 
+    /// `xarm7.urdf` (a 7-joint arm that is not one of the five reference robots) likewise.
+    pub mod xarm7_derivatives {
+        include!(concat!(env!("OUT_DIR"), "/xarm7_derivatives.rs"));
+    }
+    /// `fixtures/joint_effects.urdf` with friction (Coulomb smoothed below 0.05 rad/s), rotor
+    /// inertia and the derivatives.
+    pub mod joint_effects_derivatives {
+        include!(concat!(env!("OUT_DIR"), "/joint_effects_derivatives.rs"));
+    }
     /// `codegen/tests/urdf/hostile/names.urdf`: link and joint names that try to break out of
     /// comments and string literals; compiling this module is the test.
     pub mod hostile_names {

@@ -29,6 +29,17 @@ pub fn eomgen<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> Output {
         .expect("the binary runs")
 }
 
+/// Runs the binary and returns its standard output, which it must end with success.
+pub fn stdout_of<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> String {
+    let out = eomgen(args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).unwrap()
+}
+
 /// A fresh scratch directory for one test.
 pub fn scratch(test: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("eomgen-cli-{}-{test}", std::process::id()));

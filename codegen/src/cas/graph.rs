@@ -442,6 +442,14 @@ impl Graph {
             if e == 0 {
                 continue;
             }
+            // A sum whose first term is negative enters as -1 times its negation, so that
+            // `x y` and `x (-y)` share one sum `y` (computed once, the sign in the coefficient).
+            if self.negative_sum(id) {
+                coef *= (-1.0f64).powi(e);
+                let pos = self.scale(id, -1.0);
+                work.push((pos, e));
+                continue;
+            }
             match &self.nodes[id.index()] {
                 Node::Const(v) => coef *= v.get().powi(e),
                 Node::Mul(fs) if fs.len() <= self.limits.max_flatten => {
@@ -473,6 +481,19 @@ impl Graph {
             _ => self.intern(Node::Mul(merged.into_boxed_slice())),
         };
         self.scale(core, coef)
+    }
+
+    /// Whether `id` is a sum of several terms (or a term and a constant) whose first term has a
+    /// negative coefficient, small enough that its negation is flattened.
+    fn negative_sum(&self, id: Id) -> bool {
+        match &self.nodes[id.index()] {
+            Node::Add(c, ts) => {
+                (ts.len() > 1 || c.get() != 0.0)
+                    && ts.len() <= self.limits.max_flatten
+                    && ts[0].1.get() < 0.0
+            }
+            _ => false,
+        }
     }
 
     /// `k * a`.

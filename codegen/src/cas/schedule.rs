@@ -174,6 +174,11 @@ pub enum Order {
     /// (a force carried up a kinematic chain, say) waits on its previous step. For generated
     /// code.
     Levels,
+    /// Depth first from each output in turn: a temporary is computed just before its first
+    /// use, so that few values are live at once. For long programs (thousands of operations),
+    /// where level order keeps so many values live that the compiled code spends its time
+    /// spilling registers.
+    Depth,
 }
 
 impl Program {
@@ -214,7 +219,11 @@ impl Program {
         // after its user moves just before it, after whatever it reuses in turn.
         let mut visit: Vec<usize> = Vec::with_capacity(order.len());
         let mut placed = vec![false; order.len()];
-        for k in 0..order.len() {
+        let starts: Vec<usize> = match order_by {
+            Order::Depth => outputs.iter().map(|&o| slot(o)).collect(),
+            _ => (0..order.len()).collect(),
+        };
+        for k in starts {
             let mut stack = vec![(k, false)];
             while let Some((j, ready)) = stack.pop() {
                 if placed[j] {

@@ -105,6 +105,9 @@ pub enum Evaluation {
     /// `M^-1`: `M` from `mass_matrix`, factorized once at run time and solved for each column
     /// (`tree::ltdl_inverse`).
     MassMatrixInverse,
+    /// Straight-line expressions that hold when every pivot of the unrolled `L^T D L`
+    /// factorization of `M` is positive (checked at run time: NaN in every entry otherwise).
+    Factored { outputs: Vec<Id>, pivots: Vec<Id> },
     /// `(d qdd/dq, d qdd/dqd, M^-1)` at run time: `qdd` from `forward_dynamics`, then
     /// `-M^-1` times `inverse_dynamics_derivatives` at `(q, qd, qdd)`.
     ForwardDynamicsDerivatives,
@@ -147,6 +150,9 @@ impl Quantity {
             } => accelerations.iter().chain(pivots).copied().collect(),
             Evaluation::ForwardDynamicsSolve { h } | Evaluation::ContactForwardDynamics { h } => {
                 h.clone()
+            }
+            Evaluation::Factored { outputs, pivots } => {
+                outputs.iter().chain(pivots).copied().collect()
             }
             _ => Vec::new(),
         }

@@ -14,12 +14,14 @@
 pub mod base_parameters;
 pub mod catalogue;
 mod centroidal;
+mod derivatives;
 mod floating;
 pub mod identification;
 mod lagrangian;
 pub mod newton_euler;
 mod quantities;
 pub mod regressor;
+pub mod rnea_derivatives;
 
 use std::time::{Duration, Instant};
 
@@ -353,33 +355,13 @@ impl Derivation {
     }
 
     /// Adds the derivatives of the dynamics to the catalogue: `inverse_dynamics_derivatives`
-    /// (the generated inverse dynamics differentiated in `q`; in `qd`, `2 C(q, qd) + dF/dqd`,
-    /// since the bias is quadratic in `qd` with Christoffel symbols symmetric in their last
-    /// two indices), `mass_matrix_inverse` and `forward_dynamics_derivatives`. Fails when the
-    /// graph fills.
-    pub fn add_derivatives(&mut self) -> Result<(), GraphFull> {
-        let tau = self.fast.tau.1.clone();
-        let n = self.dof;
-        let g = &mut self.graph;
-        let mut dq = vec![vec![g.zero(); n]; n];
-        for j in 0..n {
-            let col_q = g.diff_many(&tau, self.q[j]);
-            for i in 0..n {
-                dq[i][j] = col_q[i];
-            }
-            g.check()?;
-        }
-        let c = &self.fast.coriolis_matrix.1;
-        let mut dqd: Vec<Vec<Id>> = c
-            .iter()
-            .map(|row| row.iter().map(|&x| g.scale(x, 2.0)).collect())
-            .collect();
-        for i in 0..n {
-            let df = g.diff(self.friction[i], self.qd[i]);
-            dqd[i][i] = g.add(dqd[i][i], df);
-        }
-        g.check()?;
-        let extra = quantities::derivatives(self, &dq, &dqd);
+    /// by the recursive algorithm of [`rnea_derivatives`], `mass_matrix_inverse` and
+    /// `forward_dynamics_derivatives` through one factorization of `M` (see `derivatives.rs`).
+    /// Fails when the graph fills.
+    pub fn add_derivatives(&mut self, model: &Model) -> Result<(), GraphFull> {
+        let derived = derivatives::derive(self, model);
+        self.graph.check()?;
+        let extra = quantities::derivatives(self, &derived);
         self.quantities.extend(extra);
         Ok(())
     }

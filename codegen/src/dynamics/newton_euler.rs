@@ -390,10 +390,10 @@ fn transfer(g: &mut Graph, lm: &LocalModel, c: usize, f: &V3, n: &V3) -> (V3, V3
 
 /// Mass, first moment and rotational inertia of each composite body (a body and everything
 /// below it), about the body origin in body axes.
-struct Composite {
-    mass: Vec<Id>,
-    h: Vec<V3>,
-    j: Vec<M3>,
+pub(crate) struct Composite {
+    pub mass: Vec<Id>,
+    pub h: Vec<V3>,
+    pub j: Vec<M3>,
 }
 
 /// Moves a body's inertia parameters `(m, h, J)` about its origin (in its axes) to the parent's
@@ -447,7 +447,7 @@ pub(crate) fn inertia_to_parent(
     (h_o, out)
 }
 
-fn composites(g: &mut Graph, lm: &LocalModel) -> Composite {
+pub(crate) fn composites(g: &mut Graph, lm: &LocalModel) -> Composite {
     let n = lm.dof();
     let children = lm.children();
     let mut mass = lm.mass.clone();
@@ -591,6 +591,31 @@ pub fn kinetic_energy(g: &mut Graph, lm: &LocalModel, qd: &[Id]) -> Id {
     g.sum(0.0, terms)
 }
 
+/// The time derivative of a body's rotational inertia about its origin (in its axes, first
+/// moment `h`), for body velocity `(w, u)`:
+/// `dJ/dt = [w]J - J[w] + 2 (h.u) 1 - u h^T - h u^T`. (The first moment's derivative is the
+/// linear momentum `w x h + m u`; the mass is constant.)
+pub(crate) fn rotational_inertia_rate(g: &mut Graph, h: &V3, j: &M3, v: &Spatial) -> M3 {
+    let (w, u) = v;
+    let hu = g.dot(h, u);
+    let wj = skew_times(g, w, j);
+    let mut d = [[g.zero(); 3]; 3];
+    for a in 0..3 {
+        for b in a..3 {
+            // ([w]J)_ab - (J[w])_ab = ([w]J)_ab + ([w]J)_ba, as J is symmetric.
+            let uh = g.mul(u[a], h[b]);
+            let hu_ab = g.mul(h[a], u[b]);
+            let mut terms = vec![(wj[a][b], 1.0), (wj[b][a], 1.0), (uh, -1.0), (hu_ab, -1.0)];
+            if a == b {
+                terms.push((hu, 2.0));
+            }
+            d[a][b] = g.sum(0.0, terms);
+            d[b][a] = d[a][b];
+        }
+    }
+    d
+}
+
 /// The Christoffel-consistent Coriolis matrix `C(q, qd)` in `O(N^2)`, after Echeandia and
 /// Wensing's recursive algorithm (the one behind Pinocchio's `computeCoriolisMatrix`), in body
 /// axes.
@@ -635,23 +660,7 @@ pub fn coriolis(g: &mut Graph, lm: &LocalModel, qd: &[Id]) -> Vec<Vec<Id>> {
         let h = lm.first_moment[k].map(|x| g.scale(x, 0.5));
         let j = lm.inertia[k].map(|row| row.map(|x| g.scale(x, 0.5)));
         mom.push(inertia_times(g, Some(m), &h, &j, &(w, u)));
-        let hu = g.dot(&h, &u);
-        let wj = skew_times(g, &w, &j);
-        let mut d = [[g.zero(); 3]; 3];
-        for a in 0..3 {
-            for b in a..3 {
-                // ([w]J)_ab - (J[w])_ab = ([w]J)_ab + ([w]J)_ba, as J is symmetric.
-                let uh = g.mul(u[a], h[b]);
-                let hu_ab = g.mul(h[a], u[b]);
-                let mut terms = vec![(wj[a][b], 1.0), (wj[b][a], 1.0), (uh, -1.0), (hu_ab, -1.0)];
-                if a == b {
-                    terms.push((hu, 2.0));
-                }
-                d[a][b] = g.sum(0.0, terms);
-                d[b][a] = d[a][b];
-            }
-        }
-        dj.push(d);
+        dj.push(rotational_inertia_rate(g, &h, &j, &(w, u)));
     }
     // Composites, leaves first: inertia, and the halved derivative and momentum.
     let comp = composites(g, lm);
@@ -703,7 +712,7 @@ pub fn coriolis(g: &mut Graph, lm: &LocalModel, qd: &[Id]) -> Vec<Vec<Id>> {
 }
 
 /// A (moment, force) pair of body `c` moved to its parent (see [`transfer`]).
-fn transfer_spatial(g: &mut Graph, lm: &LocalModel, c: usize, f: &Spatial) -> Spatial {
+pub(crate) fn transfer_spatial(g: &mut Graph, lm: &LocalModel, c: usize, f: &Spatial) -> Spatial {
     let (fp, np) = transfer(g, lm, c, &f.1, &f.0);
     (np, fp)
 }

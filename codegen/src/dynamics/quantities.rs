@@ -2,6 +2,7 @@
 //! expressions. One function per quantity; [`catalogue`] lists them in file order.
 
 use super::catalogue::{Craig, Evaluation, Home, Input, Quantity, Shape};
+use super::derivatives::Derivatives;
 use super::{centroidal, flat, Derivation, Route};
 use crate::cas::{Graph, Id, Program};
 use crate::model::Model;
@@ -364,12 +365,38 @@ fn link_jacobian(n: usize) -> Quantity {
     }
 }
 
+/// `mass_matrix_inverse` and `forward_dynamics_derivatives` are straight-line code (sharing `M`,
+/// its factorization and the accelerations) up to this many operations each; beyond, they are
+/// composed at run time from `mass_matrix`, `forward_dynamics` and
+/// `inverse_dynamics_derivatives`.
+pub const DERIVATIVES_FLAT_MAX_OPS: usize = 40_000;
+
 /// The derivatives of the dynamics ([`Derivation::add_derivatives`]): inverse dynamics
-/// differentiated in the CAS, `M^-1` and forward dynamics composed at run time.
-pub fn derivatives(d: &Derivation, dtau_dq: &[Vec<Id>], dtau_dqd: &[Vec<Id>]) -> Vec<Quantity> {
+/// (straight-line), `M^-1` and forward dynamics (straight-line, or composed at run time when
+/// that is large).
+pub fn derivatives(d: &Derivation, x: &Derivatives) -> Vec<Quantity> {
     let n = d.dof;
-    let mut both = flat(dtau_dq);
-    both.extend(flat(dtau_dqd));
+    let mut both = flat(&x.inverse.dq);
+    both.extend(flat(&x.inverse.dqd));
+    let minv = flat(&x.mass_matrix_inverse);
+    let mut fd = flat(&x.forward.dq);
+    fd.extend(flat(&x.forward.dqd));
+    fd.extend(&minv);
+    let factored = |outputs: Vec<Id>| {
+        let all: Vec<Id> = outputs.iter().chain(&x.pivots).copied().collect();
+        (ops(&d.graph, &all) <= DERIVATIVES_FLAT_MAX_OPS).then(|| Evaluation::Factored {
+            outputs,
+            pivots: x.pivots.clone(),
+        })
+    };
+    let (minv_route, minv_eval) = match factored(minv) {
+        Some(e) => ("Route: M as in `mass_matrix`, an unrolled L^T D L factorization without fill-in, one substitution per column.", e),
+        None => ("Route: M from `mass_matrix`, one sparse L^T D L factorization over the joint tree, N substitutions (eomgen_runtime::tree::ltdl_inverse).", Evaluation::MassMatrixInverse),
+    };
+    let (fd_route, fd_eval) = match factored(fd) {
+        Some(e) => ("Route: qdd as in `forward_dynamics`, `inverse_dynamics_derivatives` at (q, qd, qdd), then -M^-1 times them by substitutions through the one unrolled factorization of M, all in one straight-line body.", e),
+        None => ("Route: qdd from `forward_dynamics`, then -M^-1 times `inverse_dynamics_derivatives` at (q, qd, qdd).", Evaluation::ForwardDynamicsDerivatives),
+    };
     vec![
         Quantity {
             name: "inverse_dynamics_derivatives",
@@ -380,7 +407,7 @@ pub fn derivatives(d: &Derivation, dtau_dq: &[Vec<Id>], dtau_dqd: &[Vec<Id>]) ->
                 "The derivatives of inverse dynamics: (d tau / d q, d tau / d qd), element `[i][j]` =".into(),
                 "d tau_i / d x_j, friction and rotor inertia included when generated.".into(),
             ],
-            route: "Route: d tau / d q by symbolic differentiation of the inverse-dynamics expressions; d tau / d qd = 2 C(q, qd) + dF/dqd from the Coriolis matrix.".into(),
+            route: "Route: Carpentier and Mansard's recursive derivatives of Newton-Euler, customized (d tau / d qd = 2 C(q, qd) + dF/dqd).".into(),
             eval: Evaluation::Exprs(both),
         },
         Quantity {
@@ -392,8 +419,8 @@ pub fn derivatives(d: &Derivation, dtau_dq: &[Vec<Id>], dtau_dqd: &[Vec<Id>]) ->
                 "The inverse of the mass matrix, M(q)^-1 (NaN in every entry when M(q) is not".into(),
                 "positive definite).".into(),
             ],
-            route: "Route: M from `mass_matrix`, one sparse L^T D L factorization over the joint tree, N substitutions (eomgen_runtime::tree::ltdl_inverse).".into(),
-            eval: Evaluation::MassMatrixInverse,
+            route: minv_route.into(),
+            eval: minv_eval,
         },
         Quantity {
             name: "forward_dynamics_derivatives",
@@ -402,10 +429,10 @@ pub fn derivatives(d: &Derivation, dtau_dq: &[Vec<Id>], dtau_dqd: &[Vec<Id>]) ->
             home: Home::Inherent,
             doc: vec![
                 "The derivatives of forward dynamics qdd(q, qd, tau): (d qdd / d q, d qdd / d qd,".into(),
-                "d qdd / d tau = M^-1).".into(),
+                "d qdd / d tau = M^-1) (NaN in every entry when M(q) is not positive definite).".into(),
             ],
-            route: "Route: qdd from `forward_dynamics`, then -M^-1 times `inverse_dynamics_derivatives` at (q, qd, qdd).".into(),
-            eval: Evaluation::ForwardDynamicsDerivatives,
+            route: fd_route.into(),
+            eval: fd_eval,
         },
     ]
 }

@@ -149,39 +149,7 @@ impl Ctx<'_> {
                     atom: false,
                 }
             }
-            Expr::Add(c, terms) => {
-                // Positive terms first, so that the sum starts without a negation when it can.
-                let mut parts: Vec<(bool, TokenStream)> = Vec::new();
-                for (t, k) in terms {
-                    let tt = self.expr(t, trig);
-                    let body = if k.abs() == 1.0 {
-                        tt.ts
-                    } else {
-                        let coef = lit(k.abs());
-                        let inner = if tt.sum { paren(tt.ts) } else { tt.ts };
-                        quote!(#coef * #inner)
-                    };
-                    parts.push((*k < 0.0, body));
-                }
-                if *c != 0.0 {
-                    parts.push((*c < 0.0, lit(c.abs())));
-                }
-                parts.sort_by_key(|p| p.0);
-                let mut ts = TokenStream::new();
-                for (i, (neg, body)) in parts.into_iter().enumerate() {
-                    ts = match (i, neg) {
-                        (0, false) => body,
-                        (0, true) => quote!(-#body),
-                        (_, false) => quote!(#ts + #body),
-                        (_, true) => quote!(#ts - #body),
-                    };
-                }
-                Tok {
-                    ts,
-                    sum: true,
-                    atom: false,
-                }
-            }
+            Expr::Add(c, terms) => self.sum(*c, terms, trig),
             Expr::Mul(factors) => {
                 let mut num: Vec<TokenStream> = Vec::new();
                 let mut den: Vec<TokenStream> = Vec::new();
@@ -192,8 +160,11 @@ impl Ctx<'_> {
                     let n = x.unsigned_abs() as usize;
                     let power = if n == 1 {
                         base
-                    } else if ft.atom {
+                    } else if ft.atom && *x > 0 {
                         join_mul(std::iter::repeat_n(base, n).collect())
+                    } else if ft.atom {
+                        // A divisor `t * t * t` needs its parentheses: `a / (t * t * t)`.
+                        paren(join_mul(std::iter::repeat_n(base, n).collect()))
                     } else {
                         // Evaluate a compound base once.
                         let prod = join_mul(std::iter::repeat_n(quote!(b), n).collect());
@@ -230,6 +201,96 @@ impl Ctx<'_> {
         }
     }
 
+    /// A sum: the terms that are no product first (positive ones first, so that the sum starts
+    /// without a negation when it can), then each product `k x y` folded in by a multiply-add,
+    /// `T::mul_add(x, y, acc)`: one fused instruction where the target has one (the runtime's
+    /// `Real::mul_add`), a multiplication and an addition elsewhere.
+    fn sum(&self, c: f64, terms: &[(Expr, f64)], trig: &mut BTreeSet<(usize, bool)>) -> Tok {
+        let mut plain: Vec<(bool, TokenStream)> = Vec::new();
+        let mut products: Vec<(bool, Tok, Tok)> = Vec::new();
+        for (t, k) in terms {
+            match self.product_parts(t, *k, trig) {
+                Some((x, y)) => products.push((*k < 0.0, x, y)),
+                None => plain.push((*k < 0.0, self.expr(t, trig).ts)),
+            }
+        }
+        if c != 0.0 {
+            plain.push((c < 0.0, lit(c.abs())));
+        }
+        plain.sort_by_key(|p| p.0);
+        let mut acc: Option<TokenStream> = None;
+        for (neg, body) in plain {
+            acc = Some(match (acc, neg) {
+                (None, false) => body,
+                (None, true) => quote!(-#body),
+                (Some(a), false) => quote!(#a + #body),
+                (Some(a), true) => quote!(#a - #body),
+            });
+        }
+        for (neg, x, y) in products {
+            acc = Some(match acc {
+                None => {
+                    let (x, y) = (parenthesized(x), parenthesized(y));
+                    if neg {
+                        quote!(-#x * #y)
+                    } else {
+                        quote!(#x * #y)
+                    }
+                }
+                Some(a) => {
+                    let x = if neg {
+                        let x = parenthesized(x);
+                        quote!(-#x)
+                    } else {
+                        x.ts
+                    };
+                    let y = y.ts;
+                    quote!(T::mul_add(#x, #y, #a))
+                }
+            });
+        }
+        Tok {
+            ts: acc.unwrap_or_else(|| lit(0.0)),
+            sum: true,
+            atom: false,
+        }
+    }
+
+    /// A term `k t` of a sum as the two factors `(x, y)` of a product, magnitudes only: `|k|`
+    /// and `t` for a coefficient other than one, else the first factor of a product `t` and the
+    /// rest; `None` for a term that is no product (or holds a division).
+    fn product_parts(
+        &self,
+        t: &Expr,
+        k: f64,
+        trig: &mut BTreeSet<(usize, bool)>,
+    ) -> Option<(Tok, Tok)> {
+        if k.abs() != 1.0 {
+            let x = Tok {
+                ts: lit(k.abs()),
+                sum: false,
+                atom: true,
+            };
+            return Some((x, self.expr(t, trig)));
+        }
+        let Expr::Mul(fs) = t else { return None };
+        if fs.iter().any(|f| f.1 < 0) || (fs.len() == 1 && fs[0].1 == 1) {
+            return None;
+        }
+        let mut rest = fs.clone();
+        let first = rest[0].0.clone();
+        if rest[0].1 == 1 {
+            rest.remove(0);
+        } else {
+            rest[0].1 -= 1;
+        }
+        let y = match rest.as_slice() {
+            [(only, 1)] => self.expr(only, trig),
+            _ => self.expr(&Expr::Mul(rest), trig),
+        };
+        Some((self.expr(&first, trig), y))
+    }
+
     fn paren(&self, e: &Expr, trig: &mut BTreeSet<(usize, bool)>) -> TokenStream {
         let t = self.expr(e, trig);
         if t.atom {
@@ -242,6 +303,15 @@ impl Ctx<'_> {
 
 fn paren(ts: TokenStream) -> TokenStream {
     quote!((#ts))
+}
+
+/// A factor's tokens, parenthesized when it is a sum.
+fn parenthesized(t: Tok) -> TokenStream {
+    if t.sum {
+        paren(t.ts)
+    } else {
+        t.ts
+    }
 }
 
 fn join_mul(items: Vec<TokenStream>) -> TokenStream {

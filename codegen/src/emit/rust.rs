@@ -10,7 +10,7 @@ use std::collections::BTreeMap;
 use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote};
 
-use super::body::body;
+use super::body::{body, factored_body};
 use super::expr::{lit, Ctx};
 use super::names::{comment_text, snake, upper_camel, Scope};
 use crate::cas::{Graph, Id, OpCount};
@@ -373,11 +373,24 @@ impl Emitter<'_> {
             Evaluation::ForwardDynamicsDerivatives => self.forward_dynamics_derivatives_fn(q),
             Evaluation::ContactForwardDynamics { h } => self.contact_forward_dynamics_fns(q, h),
             Evaluation::Integrate => self.integrate_fn(q),
+            Evaluation::Factored { outputs, pivots } => self.factored_fn(q, outputs, pivots),
         }
     }
 
     fn exprs_fn(&mut self, q: &Quantity, ids: &[Id]) -> TokenStream {
         let (b, ops) = self.straight(q.name, ids, q.shape);
+        self.plain_fn(q, ops, b)
+    }
+
+    /// Straight-line code whose outputs hold when the factorization's pivots are positive.
+    fn factored_fn(&mut self, q: &Quantity, outputs: &[Id], pivots: &[Id]) -> TokenStream {
+        let (b, ops) = factored_body(self.graph, &self.cx, outputs, pivots, q.shape);
+        self.counts.push((q.name.to_string(), ops));
+        self.plain_fn(q, ops, b)
+    }
+
+    /// The method of `q` taking its inputs, with `body` (counted `ops`).
+    fn plain_fn(&self, q: &Quantity, ops: OpCount, body: TokenStream) -> TokenStream {
         let docs = Self::quantity_doc(q, Some(ops));
         let (name, args, ret) = (
             format_ident!("{}", q.name),
@@ -387,7 +400,7 @@ impl Emitter<'_> {
         let vis = self.vis(q);
         quote! {
             #docs
-            #vis fn #name(&self, #(#args),*) -> #ret { #b }
+            #vis fn #name(&self, #(#args),*) -> #ret { #body }
         }
     }
 

@@ -43,7 +43,7 @@ use std::collections::BTreeSet;
 use std::fmt::Write as _;
 
 use crate::cas::{format_number, Graph, Id, Node, Program, Style, SymbolKind, Syntax};
-use crate::dynamics::{pairs, Derivation};
+use crate::dynamics::{pairs, Derivation, Evaluation};
 use crate::model::{JointKind, Model};
 
 /// A derived quantity that can be printed.
@@ -67,6 +67,9 @@ pub enum Term {
     KineticEnergy,
     /// Potential energy `V`.
     PotentialEnergy,
+    /// The derivatives of inverse dynamics in the joint positions, `d tau / d q` (needs a
+    /// derivation with [`Derivation::add_derivatives`]; not in [`Term::ALL`]).
+    DtauDq,
 }
 
 impl Term {
@@ -83,7 +86,7 @@ impl Term {
         Term::PotentialEnergy,
     ];
 
-    /// The command-line name: `M`, `B`, `C`, `G`, `b`, `coriolis`, `tau`, `T`, `V`.
+    /// The command-line name: `M`, `B`, `C`, `G`, `b`, `coriolis`, `tau`, `T`, `V`, `dtau_dq`.
     pub fn label(self) -> &'static str {
         match self {
             Term::MassMatrix => "M",
@@ -95,12 +98,13 @@ impl Term {
             Term::Tau => "tau",
             Term::KineticEnergy => "T",
             Term::PotentialEnergy => "V",
+            Term::DtauDq => "dtau_dq",
         }
     }
 
     /// Parses a [`Term::label`] (case matters: `B` and `b` differ) or a long name such as
     /// `mass_matrix`, `coriolis_pairs`, `centrifugal`, `gravity`, `bias`, `coriolis_matrix`,
-    /// `kinetic_energy`, `potential_energy`.
+    /// `kinetic_energy`, `potential_energy`; and `dtau_dq`.
     pub fn parse(s: &str) -> Option<Term> {
         let long = [
             "mass_matrix",
@@ -118,6 +122,7 @@ impl Term {
             .zip(long)
             .find(|(t, l)| t.label() == s || *l == s)
             .map(|(t, _)| *t)
+            .or((s == Term::DtauDq.label()).then_some(Term::DtauDq))
     }
 
     /// Heading and the sentence that defines the term.
@@ -145,6 +150,10 @@ impl Term {
             Term::Tau => ("Inverse dynamics tau = M(q) qdd + b(q, qd) + G(q)", ""),
             Term::KineticEnergy => ("Kinetic energy T = qd^T M(q) qd / 2", ""),
             Term::PotentialEnergy => ("Potential energy V = -sum over bodies of m g.c", ""),
+            Term::DtauDq => (
+                "Derivatives of inverse dynamics d tau / d q (q, qd, qdd)",
+                "dtau_i/dq_j: how joint effort i changes with joint position j.",
+            ),
         }
     }
 }
@@ -216,6 +225,9 @@ pub enum ReportError {
     /// `entry` does not name an entry of the term.
     #[error("entry {entry} {reason}")]
     InvalidEntry { entry: String, reason: String },
+    /// `d tau / d q` was asked for but not derived, or is too large to print.
+    #[error("{0}")]
+    Derivatives(String),
     /// Expanding the equations for print ran into the expression graph's node limit.
     #[error("{0} while expanding the equations for print: try --form program")]
     GraphFull(#[from] crate::cas::GraphFull),
@@ -225,8 +237,34 @@ pub enum ReportError {
 /// are rounding noise (from rotations like `rpy="0 0 1.5708"`) and are not printed.
 pub const NOISE: f64 = 1e-12;
 
+/// `d tau / d q` is printed when its straight-line program has at most this many operations
+/// (the 6-joint UR5 and Kinova arms have about 1,500 and 3,200, the 9-joint panda 5,800);
+/// beyond, `show` refuses it with an error that points to generated code.
+pub const DTAU_DQ_MAX_OPS: usize = 4000;
+
+/// `d tau / d q` of a derivation with derivatives, row-major, or why it cannot be printed.
+fn dtau_dq(d: &Derivation) -> Result<Vec<Vec<Id>>, ReportError> {
+    let n = d.dof;
+    let Some(Evaluation::Exprs(ids)) = d.quantity("inverse_dynamics_derivatives").map(|q| &q.eval)
+    else {
+        return Err(ReportError::Derivatives(
+            "d tau / d q was not derived: derive with Builder::derivatives (show --derivatives)"
+                .to_string(),
+        ));
+    };
+    let dq = &ids[..n * n];
+    let ops = Program::new(&d.graph, dq).ops().total();
+    if ops > DTAU_DQ_MAX_OPS {
+        return Err(ReportError::Derivatives(format!(
+            "d tau / d q is too large to print ({ops} operations, more than {DTAU_DQ_MAX_OPS}): \
+             generate it as code with `eomgen generate --derivatives`"
+        )));
+    }
+    Ok(dq.chunks(n.max(1)).map(|r| r.to_vec()).collect())
+}
+
 /// Every entry of a term: 0-based indices (`[i, j, k]` for `B`) and expression.
-fn all_entries(d: &Derivation, term: Term) -> Vec<(Vec<usize>, Id)> {
+fn all_entries(d: &Derivation, term: Term) -> Result<Vec<(Vec<usize>, Id)>, ReportError> {
     let n = d.dof;
     let square = |m: &Vec<Vec<Id>>, upper: bool| -> Vec<(Vec<usize>, Id)> {
         (0..n)
@@ -239,7 +277,7 @@ fn all_entries(d: &Derivation, term: Term) -> Vec<(Vec<usize>, Id)> {
     let vector = |v: &Vec<Id>| -> Vec<(Vec<usize>, Id)> {
         v.iter().enumerate().map(|(i, &e)| (vec![i], e)).collect()
     };
-    match term {
+    Ok(match term {
         Term::MassMatrix => square(&d.mass_matrix, true),
         Term::Centrifugal => square(&d.centrifugal, false),
         Term::CoriolisMatrix => square(&d.coriolis_matrix, false),
@@ -258,7 +296,8 @@ fn all_entries(d: &Derivation, term: Term) -> Vec<(Vec<usize>, Id)> {
         Term::Tau => vector(&d.tau),
         Term::KineticEnergy => vec![(vec![], d.kinetic_energy)],
         Term::PotentialEnergy => vec![(vec![], d.potential_energy)],
-    }
+        Term::DtauDq => square(&dtau_dq(d)?, false),
+    })
 }
 
 /// The one entry named by a 1-based `entry`.
@@ -303,10 +342,15 @@ fn one_entry(d: &Derivation, term: Term, entry: &[usize]) -> Result<(Vec<usize>,
             };
             Ok((idx.clone(), m[idx[0]][idx[1]]))
         }
-        (Term::MassMatrix | Term::Centrifugal | Term::CoriolisMatrix, _) => Err(err(format!(
-            "is not an entry of {}: give I,J with both from 1 to {n}",
-            term.label()
-        ))),
+        (Term::DtauDq, &[i, j]) if in_range(i, n) && in_range(j, n) => {
+            Ok((idx.clone(), dtau_dq(d)?[idx[0]][idx[1]]))
+        }
+        (Term::MassMatrix | Term::Centrifugal | Term::CoriolisMatrix | Term::DtauDq, _) => {
+            Err(err(format!(
+                "is not an entry of {}: give I,J with both from 1 to {n}",
+                term.label()
+            )))
+        }
         (Term::CoriolisPairs, &[i, p]) if in_range(i, n) && in_range(p, np) => {
             let (j, k) = pairs(n)[p - 1];
             Ok((vec![i - 1, j, k], d.coriolis_pairs[i - 1][p - 1]))
@@ -350,6 +394,7 @@ fn entry_name(term: Term, idx: &[usize], dof: usize, syntax: Syntax) -> String {
         (Term::Tau, true) => "\\tau",
         (Term::KineticEnergy, _) => "T",
         (Term::PotentialEnergy, _) => "V",
+        (Term::DtauDq, _) => return dtau_dq_name(idx, latex),
     };
     let sub = match idx {
         [] => return base.to_string(),
@@ -370,6 +415,16 @@ fn entry_name(term: Term, idx: &[usize], dof: usize, syntax: Syntax) -> String {
         format!("{base}_{{{sub}}}")
     } else {
         format!("{base}{sub}")
+    }
+}
+
+/// `dtau1/dq2` (text) or `\partial\tau_{1}/\partial q_{2}` (LaTeX).
+fn dtau_dq_name(idx: &[usize], latex: bool) -> String {
+    let (i, j) = (idx[0] + 1, idx[1] + 1);
+    if latex {
+        format!("\\partial\\tau_{{{i}}}/\\partial q_{{{j}}}")
+    } else {
+        format!("dtau{i}/dq{j}")
     }
 }
 
@@ -451,7 +506,7 @@ fn section(
     let single = opts.entry.is_some();
     let entries = match &opts.entry {
         Some(e) => vec![one_entry(d, term, e)?],
-        None => all_entries(d, term),
+        None => all_entries(d, term)?,
     };
     let mut notes = Vec::new();
     let (_, definition) = term.title();
@@ -465,7 +520,7 @@ fn section(
         .into_iter()
         .filter(|(_, e)| single || g.as_const(*e) != Some(0.0))
         .collect();
-    let mut omitted_zero = !single && structural.len() < all_entries(d, term).len();
+    let mut omitted_zero = !single && structural.len() < all_entries(d, term)?.len();
     let mut body = None;
     if opts.form == Form::Expanded {
         let mut out = Vec::with_capacity(structural.len());

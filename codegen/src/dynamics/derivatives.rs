@@ -1,0 +1,92 @@
+//! The derivatives of the dynamics that [`Derivation::add_derivatives`](super::Derivation)
+//! adds: inverse dynamics by the recursion of [`rnea_derivatives`](super::rnea_derivatives),
+//! and `M^-1` and forward dynamics through one `L^T D L` factorization of `M`, as straight-line
+//! expressions that share `M`, its factorization and the accelerations.
+//!
+//! Forward dynamics `qdd(q, qd, tau)` satisfies `tau = ID(q, qd, qdd)`, so
+//! `d qdd / d x = -M^-1 d ID / d x` at `qdd = FD(q, qd, tau)` for `x` = `q` or `qd`, and
+//! `d qdd / d tau = M^-1`: each column is one more substitution through the factorization.
+
+use super::newton_euler::{ltdl_solve, LocalModel};
+use super::rnea_derivatives::{inverse_dynamics_derivatives, InverseDynamicsDerivatives};
+use super::Derivation;
+use crate::cas::{Graph, Id};
+use crate::kinematics::{const_v3, Params};
+use crate::model::Model;
+
+/// The expressions of the three generated derivative functions.
+#[derive(Clone, Debug)]
+pub struct Derivatives {
+    /// `(d tau / d q, d tau / d qd)` at the inputs `(q, qd, qdd)`.
+    pub inverse: InverseDynamicsDerivatives,
+    /// `M^-1`, row-major.
+    pub mass_matrix_inverse: Vec<Vec<Id>>,
+    /// `(d qdd / d q, d qdd / d qd)` at the inputs `(q, qd, tau)`; the third matrix of
+    /// `forward_dynamics_derivatives` is [`Derivatives::mass_matrix_inverse`].
+    pub forward: InverseDynamicsDerivatives,
+    /// The pivots of the factorization of `M`: every expression above is valid when all are
+    /// positive.
+    pub pivots: Vec<Id>,
+}
+
+/// Derives the three functions for `model` in `d`'s graph.
+pub fn derive(d: &mut Derivation, model: &Model) -> Derivatives {
+    let g = &mut d.graph;
+    let params = Params::new(g, model);
+    let lm = LocalModel::new(g, model, &params, &d.q);
+    let grav = const_v3(g, &model.gravity);
+    let inverse = inverse_dynamics_derivatives(g, &lm, grav, &d.qd, &d.qdd, &d.friction);
+    let parents: Vec<Option<usize>> = model.joints.iter().map(|j| j.parent).collect();
+    let m = &d.fast.mass_matrix.1;
+    let n = d.dof;
+    let unit = identity(g, n);
+    let (mass_matrix_inverse, pivots) = solve_columns(g, &parents, m, &unit);
+    let at_fd =
+        inverse_dynamics_derivatives(g, &lm, grav, &d.qd, &d.fast.forward_dynamics, &d.friction);
+    let neg = |g: &mut Graph, a: &[Vec<Id>]| -> Vec<Vec<Id>> {
+        a.iter()
+            .map(|row| row.iter().map(|&x| g.neg(x)).collect())
+            .collect()
+    };
+    let rhs_q = neg(g, &at_fd.dq);
+    let rhs_qd = neg(g, &at_fd.dqd);
+    let forward = InverseDynamicsDerivatives {
+        dq: solve_columns(g, &parents, m, &rhs_q).0,
+        dqd: solve_columns(g, &parents, m, &rhs_qd).0,
+    };
+    Derivatives {
+        inverse,
+        mass_matrix_inverse,
+        forward,
+        pivots,
+    }
+}
+
+fn identity(g: &mut Graph, n: usize) -> Vec<Vec<Id>> {
+    let (zero, one) = (g.zero(), g.one());
+    (0..n)
+        .map(|i| (0..n).map(|j| if i == j { one } else { zero }).collect())
+        .collect()
+}
+
+/// `M^-1 B` column by column through the tree `L^T D L` factorization of `M` (built once: the
+/// graph shares it between columns), and the pivots.
+fn solve_columns(
+    g: &mut Graph,
+    parents: &[Option<usize>],
+    m: &[Vec<Id>],
+    b: &[Vec<Id>],
+) -> (Vec<Vec<Id>>, Vec<Id>) {
+    let n = m.len();
+    let mut out = vec![vec![g.zero(); n]; n];
+    let mut pivots = Vec::new();
+    for j in 0..n {
+        let col: Vec<Id> = (0..n).map(|i| b[i][j]).collect();
+        let (x, p) = ltdl_solve(g, parents, m, &col);
+        for i in 0..n {
+            out[i][j] = x[i];
+        }
+        pivots = p;
+    }
+    (out, pivots)
+}
