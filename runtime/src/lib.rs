@@ -78,7 +78,6 @@ pub mod prelude;
 mod real;
 pub mod sim;
 pub mod tree;
-mod trig;
 
 #[cfg(feature = "nalgebra")]
 pub mod nalgebra_support;

@@ -94,16 +94,6 @@ pub trait Real:
     fn is_finite(self) -> bool;
 }
 
-#[inline(always)]
-fn sin_f64(x: f64) -> f64 {
-    crate::trig::sin_cos(x).0
-}
-
-#[inline(always)]
-fn cos_f64(x: f64) -> f64 {
-    crate::trig::sin_cos(x).1
-}
-
 macro_rules! impl_real {
     ($t:ty, $sin:path, $cos:path, $sincos:path, $atan2:path, $sqrt:path, $fabs:path,
      $fmin:path, $fmax:path, $fma:path) => {
@@ -204,9 +194,9 @@ impl_real!(
 );
 impl_real!(
     f64,
-    sin_f64,
-    cos_f64,
-    crate::trig::sin_cos,
+    libm::sin,
+    libm::cos,
+    libm::sincos,
     libm::atan2,
     libm::sqrt,
     libm::fabs,
