@@ -118,18 +118,7 @@ fn derivatives() {
             "AllegroDerivatives",
         ),
     ] {
-        eomgen::Builder::new(file)
-            .module_name(module)
-            .type_name(ty)
-            .derivatives()
-            .quantities([
-                "inverse_dynamics",
-                "inverse_dynamics_derivatives",
-                "forward_dynamics_derivatives",
-                "mass_matrix_inverse",
-            ])
-            .compile()
-            .unwrap();
+        with_derivatives(file, module, ty);
     }
     unshipped_derivatives();
     // Friction (smoothed, so that it is differentiable) and rotor inertia enter the
@@ -168,9 +157,14 @@ fn unshipped_derivatives() {
         return;
     }
     println!("cargo:rustc-cfg=unshipped");
-    eomgen::Builder::new("robots/xarm7.urdf")
-        .module_name("xarm7_derivatives")
-        .type_name("Xarm7Derivatives")
+    with_derivatives("robots/xarm7.urdf", "xarm7_derivatives", "Xarm7Derivatives");
+}
+
+/// `file` with the derivatives of its dynamics, inverse dynamics and what those call.
+fn with_derivatives(file: &str, module: &str, ty: &str) {
+    eomgen::Builder::new(file)
+        .module_name(module)
+        .type_name(ty)
         .derivatives()
         .quantities([
             "inverse_dynamics",
