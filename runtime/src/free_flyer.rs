@@ -2,7 +2,7 @@
 //! x, y, z, w (4), joints], velocities `v` = [linear (3), angular (3), both in base axes,
 //! joints], as Pinocchio's free flyer.
 
-use crate::tree::{Motion, TreeJoint};
+use crate::tree::{cross, Motion, TreeJoint};
 use crate::{Pose, Real};
 
 /// `q (+) v dt`: the base moved along the SE(3) exponential of its body-frame velocity for
@@ -129,14 +129,6 @@ fn quat_mul<T: Real>(a: &[T; 4], b: &[T; 4]) -> [T; 4] {
 
 fn mul<T: Real>(m: &[[T; 3]; 3], v: &[T; 3]) -> [T; 3] {
     [0, 1, 2].map(|r| m[r][0] * v[0] + m[r][1] * v[1] + m[r][2] * v[2])
-}
-
-fn cross<T: Real>(a: &[T; 3], b: &[T; 3]) -> [T; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }
 
 /// The 6 x NV Jacobian (linear rows, then angular, world axes, at the frame's origin) of a frame

@@ -45,7 +45,8 @@ pub fn chain_pose<T: Real>(path: &[usize], transform: impl Fn(usize) -> Pose<T>)
     pose
 }
 
-fn cross<T: Real>(a: &[T; 3], b: &[T; 3]) -> [T; 3] {
+/// `a x b`.
+pub(crate) fn cross<T: Real>(a: &[T; 3], b: &[T; 3]) -> [T; 3] {
     [
         a[1] * b[2] - a[2] * b[1],
         a[2] * b[0] - a[0] * b[2],

@@ -43,8 +43,6 @@ pub struct LocalModel {
     pub axis: Vec<V3>,
     /// How the joint moves its body.
     pub step: Vec<Step>,
-    /// Whether the joint rotates its body (its subspace has an angular part).
-    pub revolute: Vec<bool>,
     /// The joint's motion subspace in body axes (one column per velocity coordinate).
     pub subspace: Vec<Vec<Spatial>>,
     /// The joint's first velocity coordinate.
@@ -84,7 +82,6 @@ impl LocalModel {
             translation: Vec::with_capacity(n + 1),
             axis: Vec::with_capacity(n + 1),
             step: Vec::with_capacity(n + 1),
-            revolute: Vec::with_capacity(n + 1),
             subspace: Vec::with_capacity(n + 1),
             column: Vec::with_capacity(n + 1),
             parent: Vec::with_capacity(n + 1),
@@ -99,7 +96,6 @@ impl LocalModel {
             lm.push_body(g, placed, (*m, *c, *ic), g.zero());
             lm.axis.push([g.zero(); 3]);
             lm.step.push(Step::Free);
-            lm.revolute.push(true);
             lm.subspace.push(joint::free_flyer_subspace(g));
             lm.column.push(0);
             lm.parent.push(None);
@@ -117,7 +113,6 @@ impl LocalModel {
             } else {
                 Step::Prismatic
             });
-            lm.revolute.push(rotates);
             lm.subspace.push(joint::subspace(g, joint));
             lm.column.push(v0 + i);
             lm.parent.push(match joint.parent {
@@ -254,7 +249,7 @@ pub fn forward_pass(
         };
         let (wi, dwi, ai) = if lm.step[i] == Step::Free {
             free_step(g, lm, i, terms, a_origin)
-        } else if lm.revolute[i] {
+        } else if lm.step[i] == Step::Revolute {
             let wi = match qd {
                 Some(v) => {
                     let aq = vec_scale(g, a, v);
@@ -341,7 +336,7 @@ pub fn rnea(g: &mut Graph, lm: &LocalModel, terms: Terms<'_>) -> Vec<Id> {
             }
             continue;
         }
-        tau[col] = if lm.revolute[i] {
+        tau[col] = if lm.step[i] == Step::Revolute {
             g.dot(&lm.axis[i], &moment[i])
         } else {
             g.dot(&lm.axis[i], &force[i])

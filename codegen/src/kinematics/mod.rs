@@ -110,12 +110,6 @@ impl WorldKinematics {
         (r, vec_add(g, &pb, &off))
     }
 
-    /// The centre of mass of a floating base (centre `com` in base axes) in the world.
-    pub fn base_com(&self, g: &mut Graph, com: &V3) -> V3 {
-        let rc = mat_vec(g, &self.root.rotation, com);
-        vec_add(g, &self.root.translation, &rc)
-    }
-
     /// The 6 x N Jacobian (linear rows, then angular, world axes) of a point `p` (world
     /// coordinates) rigidly attached to `body`: per joint on its path, its world axis (and, for
     /// a rotating joint, the axis crossed with the lever arm to `p`).
