@@ -131,6 +131,23 @@ fn floating() {
         ])
         .compile()
         .unwrap();
+    // The derivatives with a floating base, q perturbed in its tangent space.
+    eomgen::Builder::new("robots/floating/anymal.urdf")
+        .floating_base()
+        .derivatives()
+        .module_name("anymal_derivatives")
+        .type_name("AnymalDerivatives")
+        .quantities([
+            "inverse_dynamics",
+            "forward_dynamics",
+            "mass_matrix",
+            "integrate",
+            "inverse_dynamics_derivatives",
+            "forward_dynamics_derivatives",
+            "mass_matrix_inverse",
+        ])
+        .compile()
+        .unwrap();
     eomgen::Builder::new("robots/floating/iris_simple.urdf")
         .floating_base()
         .module_name("iris_simple")

@@ -102,11 +102,11 @@ fn bad_floating_requests_get_one_line_errors() {
     let e = one_line_error(&eomgen(&[
         "generate",
         "--floating-base",
-        "--derivatives",
+        "--regressor",
         urdf,
     ]));
     assert!(
-        e.contains("derivatives of a floating-base robot are not generated yet"),
+        e.contains("the regressor of a floating-base robot is not generated yet"),
         "{e}"
     );
     let e = one_line_error(&eomgen(&["eval", "--floating-base", urdf, "--q", "0"]));

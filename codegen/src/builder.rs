@@ -446,12 +446,6 @@ impl Builder {
             limit: e.max_nodes,
             raise: "Builder::max_graph_nodes",
         };
-        if self.derivatives && model.is_floating() {
-            return Err(Error::Unsupported {
-                file,
-                what: "derivatives of a floating-base robot are not generated yet",
-            });
-        }
         if self.regressor && model.is_floating() {
             return Err(Error::Unsupported {
                 file,

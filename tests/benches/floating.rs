@@ -1,6 +1,6 @@
 //! Speed of the generated floating-base dynamics of anymal (18 velocity coordinates, four
-//! point contacts at the feet), f64, named `anymal/<function>` like the fixed-base benches of
-//! `eomgen-generated`. Compare with `pinbench robots/floating/anymal.urdf --free-flyer` in the
+//! point contacts at the feet; the derivatives from a second module), f64, named
+//! `anymal/<function>` like the fixed-base benches of `eomgen-generated`. Compare with `pinbench robots/floating/anymal.urdf --free-flyer` in the
 //! same run, both compiled for the native CPU:
 //!
 //!     RUSTFLAGS="-C target-cpu=native" cargo bench -p eomgen-tests --bench floating
@@ -13,6 +13,7 @@ use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use eomgen_tests::robots::anymal::Anymal;
+use eomgen_tests::robots::anymal_derivatives::AnymalDerivatives;
 
 struct State {
     q: [f64; 19],
@@ -78,6 +79,18 @@ fn anymal(c: &mut Criterion) {
     bench("contact_forward_dynamics", &|s| {
         let (a, f) = r.contact_forward_dynamics(&s.q, &s.v, &s.tau);
         a[0] + f[0]
+    });
+    let d = AnymalDerivatives::<f64>::default();
+    bench("inverse_dynamics_derivatives", &|s| {
+        let (dq, dv) = d.inverse_dynamics_derivatives(&s.q, &s.v, &s.a);
+        dq[0][0] + dv[17][17]
+    });
+    bench("forward_dynamics_derivatives", &|s| {
+        let (dq, dv, minv) = d.forward_dynamics_derivatives(&s.q, &s.v, &s.tau);
+        dq[0][0] + dv[17][17] + minv[0][17]
+    });
+    bench("mass_matrix_inverse", &|s| {
+        d.mass_matrix_inverse(&s.q)[0][17]
     });
     g.finish();
 }

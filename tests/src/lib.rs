@@ -284,6 +284,11 @@ pub mod robots {
     pub mod anymal_weightless {
         include!(concat!(env!("OUT_DIR"), "/anymal_weightless.rs"));
     }
+    /// `floating/anymal.urdf` with a floating base and the derivatives of its dynamics (and
+    /// what they are checked with).
+    pub mod anymal_derivatives {
+        include!(concat!(env!("OUT_DIR"), "/anymal_derivatives.rs"));
+    }
     /// `floating/iris_simple.urdf` with a floating base: a drone, one free body.
     pub mod iris_simple {
         include!(concat!(env!("OUT_DIR"), "/iris_simple.rs"));

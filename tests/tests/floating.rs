@@ -5,7 +5,7 @@
 
 #![allow(clippy::needless_range_loop)]
 
-use eomgen_tests::robots::{anymal, anymal_weightless, iris_simple};
+use eomgen_tests::robots::{anymal, anymal_derivatives, anymal_weightless, iris_simple};
 use serde_json::Value;
 
 fn reference(name: &str) -> Value {
@@ -351,5 +351,97 @@ fn centroidal_linear_rows_are_mass_times_com_jacobian() {
         // And the mass matrix is symmetric positive definite.
         let mm = r.mass_matrix(&q);
         assert!(eomgen_runtime::Cholesky::new(mm).is_ok());
+    }
+}
+
+/// `|a - b|_F / max(1, |b|_F)` of two flat matrices.
+fn frobenius(ours: &[f64], reference: &[f64]) -> f64 {
+    let d: f64 = ours
+        .iter()
+        .zip(reference)
+        .map(|(a, b)| (a - b).powi(2))
+        .sum();
+    let w: f64 = reference.iter().map(|b| b * b).sum();
+    d.sqrt() / w.sqrt().max(1.0)
+}
+
+#[test]
+fn anymal_derivatives_match_pinocchio() {
+    let doc = reference("anymal");
+    let r = anymal_derivatives::AnymalDerivatives::<f64>::default();
+    let o = Order::new(
+        &doc,
+        &anymal_derivatives::AnymalDerivatives::<f64>::JOINT_NAMES,
+    );
+    let mut worst = (0.0_f64, 0.0_f64);
+    for s in doc["samples"].as_array().unwrap() {
+        let q: [f64; 19] = Order::arr(&o.q, &s["q"]);
+        let v: [f64; 18] = Order::arr(&o.v, &s["v"]);
+        let a: [f64; 18] = Order::arr(&o.v, &s["a"]);
+        let (dq, dv) = r.inverse_dynamics_derivatives(&q, &v, &a);
+        let eq = frobenius(&flat(&dq), &pick(&s["dtau_dq"], &o.v, &o.v));
+        let ev = frobenius(&flat(&dv), &pick(&s["dtau_dv"], &o.v, &o.v));
+        worst = (worst.0.max(eq), worst.1.max(ev));
+    }
+    assert!(worst.0 <= 1e-8, "d tau / d q off by {:e}", worst.0);
+    assert!(worst.1 <= 1e-8, "d tau / d v off by {:e}", worst.1);
+}
+
+/// Central differences of `f` along each tangent direction of the configuration (through the
+/// generated `integrate`) and of the velocity, as columns.
+fn tangent_differences(
+    r: &anymal_derivatives::AnymalDerivatives<f64>,
+    q: &[f64; 19],
+    v: &[f64; 18],
+    f: impl Fn(&[f64; 19], &[f64; 18]) -> [f64; 18],
+) -> ([[f64; 18]; 18], [[f64; 18]; 18]) {
+    let h = 1e-6;
+    let (mut dq, mut dv) = ([[0.0; 18]; 18], [[0.0; 18]; 18]);
+    for k in 0..18 {
+        let e: [f64; 18] = core::array::from_fn(|i| if i == k { h } else { 0.0 });
+        let (qp, qm) = (r.integrate(q, &e, 1.0), r.integrate(q, &e, -1.0));
+        let (vp, vm): ([f64; 18], [f64; 18]) = (
+            core::array::from_fn(|i| v[i] + e[i]),
+            core::array::from_fn(|i| v[i] - e[i]),
+        );
+        let (fqp, fqm, fvp, fvm) = (f(&qp, v), f(&qm, v), f(q, &vp), f(q, &vm));
+        for i in 0..18 {
+            dq[i][k] = (fqp[i] - fqm[i]) / (2.0 * h);
+            dv[i][k] = (fvp[i] - fvm[i]) / (2.0 * h);
+        }
+    }
+    (dq, dv)
+}
+
+#[test]
+fn anymal_derivatives_match_finite_differences() {
+    let r = anymal_derivatives::AnymalDerivatives::<f64>::default();
+    for seed in 1..4 {
+        let (q, v) = state(seed);
+        let (_, a) = state(seed + 100);
+        let tau: [f64; 18] = core::array::from_fn(|i| 10.0 * a[i]);
+        let (id_q, id_v) = tangent_differences(&r, &q, &v, |q, v| r.inverse_dynamics(q, v, &a));
+        let (dq, dv) = r.inverse_dynamics_derivatives(&q, &v, &a);
+        let (fd_q, fd_v) = tangent_differences(&r, &q, &v, |q, v| r.forward_dynamics(q, v, &tau));
+        let (fq, fv, minv) = r.forward_dynamics_derivatives(&q, &v, &tau);
+        for (what, ours, diff) in [
+            ("d tau / d q", &dq, &id_q),
+            ("d tau / d v", &dv, &id_v),
+            ("d a / d q", &fq, &fd_q),
+            ("d a / d v", &fv, &fd_v),
+        ] {
+            let e = frobenius(&flat(ours), &flat(diff));
+            assert!(e < 1e-6, "seed {seed}: {what} off by {e:e}");
+        }
+        let m = r.mass_matrix(&q);
+        let direct = r.mass_matrix_inverse(&q);
+        for i in 0..18 {
+            for j in 0..18 {
+                let mm: f64 = (0..18).map(|k| m[i][k] * minv[k][j]).sum();
+                let want = if i == j { 1.0 } else { 0.0 };
+                assert!((mm - want).abs() < 1e-9, "M M^-1 [{i}][{j}] = {mm}");
+                assert!((direct[i][j] - minv[i][j]).abs() < 1e-9 * (1.0 + minv[i][j].abs()));
+            }
+        }
     }
 }

@@ -36,7 +36,7 @@ pub fn derive(d: &mut Derivation, model: &Model) -> Derivatives {
     let lm = LocalModel::new(g, model, &params, &d.q);
     let grav = const_v3(g, &model.gravity);
     let inverse = inverse_dynamics_derivatives(g, &lm, grav, &d.qd, &d.qdd, &d.friction);
-    let parents: Vec<Option<usize>> = model.joints.iter().map(|j| j.parent).collect();
+    let parents = lm.coordinate_parents();
     let m = &d.fast.mass_matrix.1;
     let n = d.dof;
     let unit = identity(g, n);

@@ -15,10 +15,17 @@
 //! - for `i` on the path from `j` to the root, `d tau_i / d q_j = S_i . g_j` and
 //!   `d tau_i / d qd_j = S_i . c_j`, carried to body `i`'s axes, with
 //!   `g_j = S_j x* f^C_j + I^C_j u1_j + dI^C_j/dt u2_j + u2_j x* H^C_j` and
-//!   `c_j = dI^C_j/dt S_j + S_j x* H^C_j + 2 I^C_j u2_j`;
+//!   `c_j = dI^C_j/dt S_j + S_j x* H^C_j + I^C_j w_j`, `w_j = (v_p + v_j) x S_j` (`= 2 u2_j`
+//!   for a joint of one column);
 //! - for `i` below `j`, `d tau_i / d q_j = F_i . u1_j + G_i . u2_j` and
-//!   `d tau_i / d qd_j = G_i . S_j + 2 F_i . u2_j`, with `F_i = I^C_i S_i` and
+//!   `d tau_i / d qd_j = G_i . S_j + F_i . w_j`, with `F_i = I^C_i S_i` and
 //!   `G_i = dI^C_i/dt S_i - S_i x* H^C_i` carried up to body `j`'s axes.
+//!
+//! A joint of several columns (a floating base's free flyer, `S` constant in body axes, its
+//! position perturbed in the tangent space as Pinocchio's `integrate` does) follows the same
+//! formulas column by column; between two columns of one joint, `d tau / d q` takes
+//! `g_j - S_j x* f^C_j` (the joint's own axes move with it). With gravity, a free flyer's
+//! position columns give zero and its rotation columns turn gravity in base axes.
 //!
 //! So `d tau / d qd = 2 C(q, qd)` (Echeandia and Wensing's recursion computes the same vectors
 //! halved), plus the friction's `dF/dqd` on the diagonal; rotor inertia does not depend on `q`
@@ -27,12 +34,12 @@
 
 use super::newton_euler::{
     composites, inertia_times, inertia_to_parent, rotational_inertia_rate, transfer_spatial,
-    velocities, LocalModel,
+    velocities, Composite, LocalModel,
 };
 use crate::cas::{Graph, Id};
 use crate::spatial::{
     cross, cross_force, mat_add, mat_t_vec, motion_cross, spatial_add, spatial_dot, spatial_scale,
-    vec_add, Spatial, M3, V3,
+    spatial_sub, vec_add, Spatial, M3, V3,
 };
 
 /// `d tau / d q` and `d tau / d qd`, element `[i][j]` = `d tau_i / d x_j`.
@@ -53,10 +60,14 @@ fn motion_to_child(g: &mut Graph, lm: &LocalModel, i: usize, m: &Spatial) -> Spa
 
 /// Per body, what the derivatives need from the forward pass and the composites.
 struct Pass {
-    /// `dS_j/dt = v_p x S_j`.
-    u2: Vec<Spatial>,
-    /// `a_p x S_j + v_p x u2_j`.
-    u1: Vec<Spatial>,
+    /// Per column of each body's joint, `dS/dt = v_p x S`.
+    u2: Vec<Vec<Spatial>>,
+    /// Per column of each body's joint, `a_p x S + v_p x u2`.
+    u1: Vec<Vec<Spatial>>,
+    /// Per column of each body's joint, `(v_p + v) x S` with the body's own velocity `v`: how
+    /// the subtree's accelerations change with the column's rate. It is `2 u2` for a joint of
+    /// one column (`S x S = 0`), and differs for a free flyer, whose columns do not commute.
+    w: Vec<Vec<Spatial>>,
     /// Composite force `f^C` and momentum `H^C`.
     force: Vec<Spatial>,
     momentum: Vec<Spatial>,
@@ -66,9 +77,9 @@ struct Pass {
 }
 
 /// The forward pass (velocities, accelerations, body forces, momenta and inertia rates) and
-/// the backward accumulation over subtrees.
+/// the backward accumulation over subtrees. `qd` and `qdd` are velocity coordinates.
 fn pass(g: &mut Graph, lm: &LocalModel, gravity: V3, qd: &[Id], qdd: &[Id]) -> Pass {
-    let n = qd.len();
+    let n = lm.bodies();
     let zero = [g.zero(); 3];
     let base_acc = (zero, gravity.map(|x| g.neg(x)));
     let vel = velocities(g, lm, qd);
@@ -76,28 +87,43 @@ fn pass(g: &mut Graph, lm: &LocalModel, gravity: V3, qd: &[Id], qdd: &[Id]) -> P
     let mut out = Pass {
         u2: Vec::with_capacity(n),
         u1: Vec::with_capacity(n),
+        w: Vec::with_capacity(n),
         force: Vec::with_capacity(n),
         momentum: Vec::with_capacity(n),
         rate_h: Vec::with_capacity(n),
         rate_j: Vec::with_capacity(n),
     };
     for i in 0..n {
-        let s = lm.subspace[i][0];
         let vp = vel[i].parent;
         let ap = match lm.parent[i] {
             Some(p) => motion_to_child(g, lm, i, &acc[p]),
             None => motion_to_child(g, lm, i, &base_acc),
         };
-        let u2 = motion_cross(g, &vp, &s);
-        let aps = motion_cross(g, &ap, &s);
-        let vu = motion_cross(g, &vp, &u2);
-        out.u1.push(spatial_add(g, &aps, &vu));
-        let sa = spatial_scale(g, &s, qdd[i]);
-        let ua = spatial_scale(g, &u2, qd[i]);
-        let a_rel = spatial_add(g, &sa, &ua);
-        let a = spatial_add(g, &ap, &a_rel);
-        out.u2.push(u2);
+        let mut a = ap;
         let v = vel[i].body;
+        let one_column = lm.subspace[i].len() == 1;
+        let (mut u1s, mut u2s, mut ws) = (Vec::new(), Vec::new(), Vec::new());
+        for (k, s) in lm.subspace[i].iter().enumerate() {
+            let col = lm.column[i] + k;
+            let u2 = motion_cross(g, &vp, s);
+            let aps = motion_cross(g, &ap, s);
+            let vu = motion_cross(g, &vp, &u2);
+            u1s.push(spatial_add(g, &aps, &vu));
+            let sa = spatial_scale(g, s, qdd[col]);
+            let ua = spatial_scale(g, &u2, qd[col]);
+            let a_rel = spatial_add(g, &sa, &ua);
+            a = spatial_add(g, &a, &a_rel);
+            ws.push(if one_column {
+                spatial_scale_const(g, &u2, 2.0)
+            } else {
+                let vs = motion_cross(g, &v, s);
+                spatial_add(g, &u2, &vs)
+            });
+            u2s.push(u2);
+        }
+        out.u1.push(u1s);
+        out.u2.push(u2s);
+        out.w.push(ws);
         let (m, h, j) = (lm.mass[i], &lm.first_moment[i], &lm.inertia[i]);
         let mom = inertia_times(g, Some(m), h, j, &v);
         let ia = inertia_times(g, Some(m), h, j, &a);
@@ -122,10 +148,64 @@ fn pass(g: &mut Graph, lm: &LocalModel, gravity: V3, qd: &[Id], qdd: &[Id]) -> P
     out
 }
 
+/// The four vectors that moving one velocity column `S` of body `j`'s joint contributes, in
+/// body `j`'s axes (module documentation).
+struct ColumnVectors {
+    /// `I^C S`.
+    f: Spatial,
+    /// `dI^C/dt S - S x* H^C`.
+    g: Spatial,
+    /// `c = dI^C/dt S + S x* H^C + I^C w`: `d tau / d qd` against the ancestors' columns and
+    /// the joint's own.
+    c: Spatial,
+    /// `I^C u1 + dI^C/dt u2 + u2 x* H^C`: `d tau / d q` against the joint's own columns (the
+    /// subtree moves with the joint's own axes).
+    own: Spatial,
+    /// `S x* f^C + own`: `d tau / d q` against the ancestors' columns (which see the subtree's
+    /// force turn).
+    q: Spatial,
+}
+
+fn column_vectors(
+    g: &mut Graph,
+    comp: &Composite,
+    p: &Pass,
+    j: usize,
+    k: usize,
+    s: &Spatial,
+) -> ColumnVectors {
+    let (m, h, jc) = (Some(comp.mass[j]), &comp.h[j], &comp.j[j]);
+    let (rh, rj) = (&p.rate_h[j], &p.rate_j[j]);
+    let (u1, u2) = (&p.u1[j][k], &p.u2[j][k]);
+    let f = inertia_times(g, m, h, jc, s);
+    let rate_s = inertia_times(g, None, rh, rj, s);
+    let sh = cross_force(g, s, &p.momentum[j]);
+    let gv = spatial_sub(g, &rate_s, &sh);
+    let iw = inertia_times(g, m, h, jc, &p.w[j][k]);
+    let c0 = spatial_add(g, &rate_s, &sh);
+    let c = spatial_add(g, &c0, &iw);
+    let iu1 = inertia_times(g, m, h, jc, u1);
+    let ru2 = inertia_times(g, None, rh, rj, u2);
+    let u2h = cross_force(g, u2, &p.momentum[j]);
+    let own0 = spatial_add(g, &iu1, &ru2);
+    let own = spatial_add(g, &own0, &u2h);
+    let sf = cross_force(g, s, &p.force[j]);
+    let q = spatial_add(g, &sf, &own);
+    ColumnVectors {
+        f,
+        g: gv,
+        c,
+        own,
+        q,
+    }
+}
+
 /// `d tau / d q` and `d tau / d qd` of `tau = M qdd + b + G + F(qd)` by the recursive
 /// algorithm (module documentation), with gravity in root axes and the joint friction `F`
-/// (zeros without friction). `qdd` may be any expressions (forward dynamics' accelerations,
-/// for the derivatives of forward dynamics).
+/// (zeros without friction), over velocity coordinates: a floating base's position is
+/// perturbed in its tangent space (a displacement and a rotation in base axes, as Pinocchio's
+/// `integrate`). `qdd` may be any expressions (forward dynamics' accelerations, for the
+/// derivatives of forward dynamics).
 pub fn inverse_dynamics_derivatives(
     g: &mut Graph,
     lm: &LocalModel,
@@ -139,48 +219,37 @@ pub fn inverse_dynamics_derivatives(
     let comp = composites(g, lm);
     let mut dq = vec![vec![g.zero(); n]; n];
     let mut dqd = vec![vec![g.zero(); n]; n];
-    for j in 0..n {
-        let s = lm.subspace[j][0];
-        let (m, h, jc) = (Some(comp.mass[j]), &comp.h[j], &comp.j[j]);
-        let (rh, rj) = (&p.rate_h[j], &p.rate_j[j]);
-        // F = I^C S, G = dI^C/dt S - S x* H^C, and the two vectors carried to the ancestors.
-        let mut f_vec = inertia_times(g, m, h, jc, &s);
-        let rate_s = inertia_times(g, None, rh, rj, &s);
-        let sh = cross_force(g, &s, &p.momentum[j]);
-        let mut g_vec = crate::spatial::spatial_sub(g, &rate_s, &sh);
-        // c = dI^C/dt S + S x* H^C + 2 I^C u2.
-        let iu2 = inertia_times(g, m, h, jc, &p.u2[j]);
-        let iu2 = spatial_scale_const(g, &iu2, 2.0);
-        let c0 = spatial_add(g, &rate_s, &sh);
-        let mut c_vec = spatial_add(g, &c0, &iu2);
-        // g = S x* f^C + I^C u1 + dI^C/dt u2 + u2 x* H^C.
-        let sf = cross_force(g, &s, &p.force[j]);
-        let iu1 = inertia_times(g, m, h, jc, &p.u1[j]);
-        let ru2 = inertia_times(g, None, rh, rj, &p.u2[j]);
-        let u2h = cross_force(g, &p.u2[j], &p.momentum[j]);
-        let g0 = spatial_add(g, &sf, &iu1);
-        let g1 = spatial_add(g, &ru2, &u2h);
-        let mut q_vec = spatial_add(g, &g0, &g1);
-        dq[j][j] = spatial_dot(g, &s, &q_vec);
-        let cjj = spatial_dot(g, &s, &c_vec);
-        let df = g.diff(friction[j], qd[j]);
-        dqd[j][j] = g.add(cjj, df);
-        let mut k = j;
-        while let Some(i) = lm.parent[k] {
-            q_vec = transfer_spatial(g, lm, k, &q_vec);
-            c_vec = transfer_spatial(g, lm, k, &c_vec);
-            f_vec = transfer_spatial(g, lm, k, &f_vec);
-            g_vec = transfer_spatial(g, lm, k, &g_vec);
-            let si = lm.subspace[i][0];
-            dq[i][j] = spatial_dot(g, &si, &q_vec);
-            dqd[i][j] = spatial_dot(g, &si, &c_vec);
-            let a = spatial_dot(g, &f_vec, &p.u1[i]);
-            let b = spatial_dot(g, &g_vec, &p.u2[i]);
-            dq[j][i] = g.add(a, b);
-            let a = spatial_dot(g, &g_vec, &si);
-            let b = spatial_dot(g, &f_vec, &p.u2[i]);
-            dqd[j][i] = g.sum(0.0, [(a, 1.0), (b, 2.0)]);
-            k = i;
+    for j in 0..lm.bodies() {
+        for (k, s) in lm.subspace[j].iter().enumerate() {
+            let x = lm.column[j] + k;
+            let mut v = column_vectors(g, &comp, &p, j, k, s);
+            // The joint's own columns, this one included.
+            for (kk, sk) in lm.subspace[j].iter().enumerate() {
+                let y = lm.column[j] + kk;
+                dq[y][x] = spatial_dot(g, sk, &v.own);
+                dqd[y][x] = spatial_dot(g, sk, &v.c);
+            }
+            let df = g.diff(friction[x], qd[x]);
+            dqd[x][x] = g.add(dqd[x][x], df);
+            // The ancestors' columns, carried up one body at a time.
+            let mut b = j;
+            while let Some(i) = lm.parent[b] {
+                for w in [&mut v.q, &mut v.c, &mut v.f, &mut v.g] {
+                    *w = transfer_spatial(g, lm, b, w);
+                }
+                for (kk, si) in lm.subspace[i].iter().enumerate() {
+                    let y = lm.column[i] + kk;
+                    dq[y][x] = spatial_dot(g, si, &v.q);
+                    dqd[y][x] = spatial_dot(g, si, &v.c);
+                    let a = spatial_dot(g, &v.f, &p.u1[i][kk]);
+                    let bb = spatial_dot(g, &v.g, &p.u2[i][kk]);
+                    dq[x][y] = g.add(a, bb);
+                    let a = spatial_dot(g, &v.g, si);
+                    let bb = spatial_dot(g, &v.f, &p.w[i][kk]);
+                    dqd[x][y] = g.add(a, bb);
+                }
+                b = i;
+            }
         }
     }
     InverseDynamicsDerivatives { dq, dqd }

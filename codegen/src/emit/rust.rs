@@ -568,10 +568,10 @@ impl Emitter<'_> {
 
     fn mass_matrix_inverse_fn(&mut self, q: &Quantity) -> TokenStream {
         let docs = Self::quantity_doc(q, None);
-        let (n, mass_matrix) = (&self.n, self.call("mass_matrix"));
+        let (n, nq, mass_matrix) = (&self.n, &self.nq, self.call("mass_matrix"));
         quote! {
             #docs
-            pub fn mass_matrix_inverse(&self, q: &[T; #n]) -> [[T; #n]; #n] {
+            pub fn mass_matrix_inverse(&self, q: &[T; #nq]) -> [[T; #n]; #n] {
                 let mut m = #mass_matrix(self, q);
                 match ::eomgen_runtime::tree::ltdl_inverse(&mut m, &Self::PARENTS) {
                     Ok(inv) => inv,
@@ -583,11 +583,11 @@ impl Emitter<'_> {
 
     fn forward_dynamics_derivatives_fn(&mut self, q: &Quantity) -> TokenStream {
         let docs = Self::quantity_doc(q, None);
-        let n = &self.n;
+        let (n, nq) = (&self.n, &self.nq);
         let fd = self.call("forward_dynamics");
         quote! {
             #docs
-            pub fn forward_dynamics_derivatives(&self, q: &[T; #n], qd: &[T; #n], tau: &[T; #n]) -> ([[T; #n]; #n], [[T; #n]; #n], [[T; #n]; #n]) {
+            pub fn forward_dynamics_derivatives(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n]) -> ([[T; #n]; #n], [[T; #n]; #n], [[T; #n]; #n]) {
                 let qdd = #fd(self, q, qd, tau);
                 let (dq, dqd) = self.inverse_dynamics_derivatives(q, qd, &qdd);
                 let minv = self.mass_matrix_inverse(q);
