@@ -93,6 +93,15 @@ impl AllegroRightHandLink {
         }
     }
 }
+impl AllegroRightHand<f64> {
+    /// Number of joint coordinates (velocity coordinates with a floating base).
+    pub const DOF: usize = 16;
+}
+impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dimensions for AllegroRightHand<T> {
+    const DOF: usize = 16;
+    const NQ: usize = 16;
+    const NV: usize = 16;
+}
 #[allow(
     unused_variables,
     clippy::approx_constant,
@@ -106,8 +115,6 @@ impl AllegroRightHandLink {
     clippy::type_complexity
 )]
 impl<T: ::eomgen_runtime::Real> AllegroRightHand<T> {
-    /// Number of joint coordinates (velocity coordinates with a floating base).
-    pub const DOF: usize = 16;
     /// Forward dynamics `qdd = M(q)^-1 (tau - b(q, qd) - G(q))`, or which pivot of the
     /// `L^T D L` factorization of M(q) was not positive (a non-physical model or
     /// non-finite input); see `forward_dynamics` for the route and operation count.

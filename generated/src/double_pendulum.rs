@@ -39,6 +39,15 @@ impl DoublePendulumLink {
         }
     }
 }
+impl DoublePendulum<f64> {
+    /// Number of joint coordinates (velocity coordinates with a floating base).
+    pub const DOF: usize = 2;
+}
+impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dimensions for DoublePendulum<T> {
+    const DOF: usize = 2;
+    const NQ: usize = 2;
+    const NV: usize = 2;
+}
 #[allow(
     unused_variables,
     clippy::approx_constant,
@@ -52,8 +61,6 @@ impl DoublePendulumLink {
     clippy::type_complexity
 )]
 impl<T: ::eomgen_runtime::Real> DoublePendulum<T> {
-    /// Number of joint coordinates (velocity coordinates with a floating base).
-    pub const DOF: usize = 2;
     /// Forward dynamics `qdd = M(q)^-1 (tau - b(q, qd) - G(q))`, or which pivot of the
     /// `L^T D L` factorization of M(q) was not positive (a non-physical model or
     /// non-finite input); see `forward_dynamics` for the route and operation count.

@@ -53,6 +53,19 @@ impl IrisSimpleLink {
         }
     }
 }
+impl IrisSimple<f64> {
+    /// Number of joint coordinates (velocity coordinates with a floating base).
+    pub const DOF: usize = 6;
+    /// Number of position coordinates: the base's 7 (position, unit quaternion x, y, z, w), then the joints'.
+    pub const NQ: usize = 7;
+    /// Number of velocity coordinates: the base's 6 (linear, then angular velocity, base axes), then the joints'.
+    pub const NV: usize = 6;
+}
+impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dimensions for IrisSimple<T> {
+    const DOF: usize = 6;
+    const NQ: usize = 7;
+    const NV: usize = 6;
+}
 #[allow(
     unused_variables,
     clippy::approx_constant,
@@ -66,12 +79,6 @@ impl IrisSimpleLink {
     clippy::type_complexity
 )]
 impl<T: ::eomgen_runtime::Real> IrisSimple<T> {
-    /// Number of joint coordinates (velocity coordinates with a floating base).
-    pub const DOF: usize = 6;
-    /// Number of position coordinates: the base's 7 (position, unit quaternion x, y, z, w), then the joints'.
-    pub const NQ: usize = 7;
-    /// Number of velocity coordinates: the base's 6 (linear, then angular velocity, base axes), then the joints'.
-    pub const NV: usize = 6;
     ///The URDF names of the joints, in the order of the joint part of every array (after the base's coordinates).
     pub const JOINT_NAMES: [&'static str; 0] = [];
     /// Forward dynamics `qdd = M(q)^-1 (tau - b(q, qd) - G(q))`, or which pivot of the

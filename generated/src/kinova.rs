@@ -69,6 +69,15 @@ impl KinovaLink {
         }
     }
 }
+impl Kinova<f64> {
+    /// Number of joint coordinates (velocity coordinates with a floating base).
+    pub const DOF: usize = 6;
+}
+impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dimensions for Kinova<T> {
+    const DOF: usize = 6;
+    const NQ: usize = 6;
+    const NV: usize = 6;
+}
 #[allow(
     unused_variables,
     clippy::approx_constant,
@@ -82,8 +91,6 @@ impl KinovaLink {
     clippy::type_complexity
 )]
 impl<T: ::eomgen_runtime::Real> Kinova<T> {
-    /// Number of joint coordinates (velocity coordinates with a floating base).
-    pub const DOF: usize = 6;
     /// Forward dynamics `qdd = M(q)^-1 (tau - b(q, qd) - G(q))`, or which pivot of the
     /// `L^T D L` factorization of M(q) was not positive (a non-physical model or
     /// non-finite input); see `forward_dynamics` for the route and operation count.

@@ -63,6 +63,15 @@ impl Ur5Link {
         }
     }
 }
+impl Ur5<f64> {
+    /// Number of joint coordinates (velocity coordinates with a floating base).
+    pub const DOF: usize = 6;
+}
+impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dimensions for Ur5<T> {
+    const DOF: usize = 6;
+    const NQ: usize = 6;
+    const NV: usize = 6;
+}
 #[allow(
     unused_variables,
     clippy::approx_constant,
@@ -76,8 +85,6 @@ impl Ur5Link {
     clippy::type_complexity
 )]
 impl<T: ::eomgen_runtime::Real> Ur5<T> {
-    /// Number of joint coordinates (velocity coordinates with a floating base).
-    pub const DOF: usize = 6;
     /// Forward dynamics `qdd = M(q)^-1 (tau - b(q, qd) - G(q))`, or which pivot of the
     /// `L^T D L` factorization of M(q) was not positive (a non-physical model or
     /// non-finite input); see `forward_dynamics` for the route and operation count.

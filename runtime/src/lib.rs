@@ -68,6 +68,7 @@ extern crate std;
 
 pub mod contact;
 pub mod control;
+mod dimensions;
 mod dynamics;
 mod floating;
 pub mod free_flyer;
@@ -85,6 +86,7 @@ pub mod nalgebra_support;
 pub use control::{
     wrench_to_torque, ComputedTorque, Ellipsoid, PdGravity, Setpoint, SymmetricEigen,
 };
+pub use dimensions::Dimensions;
 pub use dynamics::Dynamics;
 pub use floating::{rk4_step_floating, Contacts, FloatingDynamics, StandOnContacts};
 pub use joint_effects::WithJointEffects;

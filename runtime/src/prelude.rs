@@ -8,9 +8,10 @@
 //! `robot.mass_matrix(&q)` resolves), [`Real`] (the scalar trait, for code generic over `f32`
 //! and `f64`), and the types generated methods return: [`Pose`] (from `link_pose`) and
 //! [`FactorError`] (from `try_forward_dynamics`); for floating-base robots
-//! [`FloatingDynamics`] and, with contact points, [`Contacts`].
+//! [`FloatingDynamics`] and, with contact points, [`Contacts`]; and [`Dimensions`] (`DOF`, `NQ`,
+//! `NV` for any scalar type).
 //!
 //! The prelude is part of the public API: items are added to it only in minor versions and
 //! never removed outside a major one.
 
-pub use crate::{Contacts, Dynamics, FactorError, FloatingDynamics, Pose, Real};
+pub use crate::{Contacts, Dimensions, Dynamics, FactorError, FloatingDynamics, Pose, Real};

@@ -172,7 +172,7 @@ impl Emitter<'_> {
         };
         let trait_impl = self.trait_impl(&trait_methods);
         let floating_impls = self.floating_impls(d);
-        let (ty, n, allow) = (&self.ty, &self.n, allow_lints());
+        let (ty, allow) = (&self.ty, allow_lints());
         let try_fd = &self.try_forward_dynamics;
         let parents = self.parents_const();
         let nj = usize_lit(self.model.joints.len());
@@ -192,8 +192,31 @@ impl Emitter<'_> {
                 pub const JOINT_NAMES: [&'static str; #nj] = [#(#names),*];
             }
         };
-        let sizes = if self.floating {
-            let nq = &self.nq;
+        let sizes = self.sizes();
+        quote! {
+            #strukt
+            #links
+            #sizes
+            #allow
+            impl<T: ::eomgen_runtime::Real> #ty<T> {
+                #parents
+                #joint_names
+                #identification
+                #try_fd
+                #(#methods)*
+                #frames
+            }
+            #trait_impl
+            #floating_impls
+        }
+    }
+
+    /// `DOF` (and `NQ`, `NV` with a floating base) as inherent constants of the `f64` type, so
+    /// that `Robot::DOF` needs no type parameter, and the runtime's `Dimensions` for every
+    /// scalar type (`Robot::<f32>::DOF`, generic code).
+    fn sizes(&self) -> TokenStream {
+        let (ty, n, nq) = (&self.ty, &self.n, &self.nq);
+        let floating = if self.floating {
             quote! {
                 /// Number of position coordinates: the base's 7 (position, unit quaternion x, y, z, w), then the joints'.
                 pub const NQ: usize = #nq;
@@ -204,22 +227,16 @@ impl Emitter<'_> {
             TokenStream::new()
         };
         quote! {
-            #strukt
-            #links
-            #allow
-            impl<T: ::eomgen_runtime::Real> #ty<T> {
+            impl #ty<f64> {
                 /// Number of joint coordinates (velocity coordinates with a floating base).
                 pub const DOF: usize = #n;
-                #sizes
-                #parents
-                #joint_names
-                #identification
-                #try_fd
-                #(#methods)*
-                #frames
+                #floating
             }
-            #trait_impl
-            #floating_impls
+            impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dimensions for #ty<T> {
+                const DOF: usize = #n;
+                const NQ: usize = #nq;
+                const NV: usize = #n;
+            }
         }
     }
 
