@@ -109,6 +109,10 @@ struct ModelArgs {
     /// contact_jacobian, contact_drift and contact_forward_dynamics
     #[arg(long = "contact", value_name = "LINK")]
     contacts: Vec<String>,
+    /// A joint without an actuator (repeatable): adds selection, ACTUATED_JOINT_NAMES and
+    /// forward_dynamics_actuated; simulate applies no effort to it
+    #[arg(long = "passive", value_name = "JOINT")]
+    passive: Vec<String>,
     /// Refuse robots with more degrees of freedom than this.
     #[arg(long, value_name = "N", default_value_t = eomgen::DEFAULT_MAX_DOF)]
     max_dof: usize,
@@ -135,6 +139,7 @@ impl ModelArgs {
             repair_inertia: self.repair_inertia,
             floating_base: self.floating_base,
             contact_points: self.contacts.clone(),
+            passive_joints: self.passive.clone(),
             ..ModelOptions::default()
         }
     }

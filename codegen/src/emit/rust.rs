@@ -43,7 +43,7 @@ fn doc(lines: &[String]) -> TokenStream {
     quote!(#(#attrs)*)
 }
 
-fn usize_lit(n: usize) -> Literal {
+pub(super) fn usize_lit(n: usize) -> Literal {
     Literal::usize_unsuffixed(n)
 }
 
@@ -177,6 +177,11 @@ impl Emitter<'_> {
         let parents = self.parents_const();
         let nj = usize_lit(self.model.joints.len());
         let identification = super::identification::constants(d, self.quantities);
+        let actuation = super::actuation::items(
+            self.model,
+            self.has("forward_dynamics")
+                .then(|| self.call("forward_dynamics")),
+        );
         // Without the trait, the joint order still has to be said.
         let joint_names = if self.in_trait {
             TokenStream::new()
@@ -214,6 +219,7 @@ impl Emitter<'_> {
                 #parents
                 #joint_names
                 #identification
+                #actuation
                 #try_fd
                 #(#methods)*
                 #frames
