@@ -13,6 +13,7 @@ mod info;
 mod progress;
 mod simulate;
 mod simulate_floating;
+mod symplectic;
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -335,12 +336,30 @@ enum ControllerArg {
     GravityComp,
     /// Computed torque to the target, critically damped at --omega.
     ComputedTorque,
+    /// Collocated partial feedback linearization (Spong) for one passive joint (--passive):
+    /// the actuated joints go to the target, critically damped at --omega, their target moved
+    /// by --swing times atan of the passive joint's velocity (swing-up); no effort on the
+    /// passive joint.
+    Pfl,
     /// Floating base on contacts: PD on the joints (--kp, --kd) plus gravity compensation
     /// projected through the contacts.
     Stand,
     /// Floating base: computed torque on the base (thrust and torque) to a level pose at
     /// --base-target, critically damped at --omega; PD on the joints.
     Hover,
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+enum IntegratorArg {
+    /// Classical Runge-Kutta, fourth order (the controller re-evaluated at every stage).
+    Rk4,
+    /// Symplectic Euler on Hamilton's equations, first order (fixed-point iterations; the
+    /// effort held over each step).
+    SymplecticEuler,
+    /// The implicit midpoint rule on Hamilton's equations: second order, symplectic.
+    ImplicitMidpoint,
+    /// Yoshida's fourth-order composition of three implicit midpoint steps: symplectic.
+    Yoshida4,
 }
 
 #[derive(Args, Debug)]
@@ -371,9 +390,21 @@ struct SimulateArgs {
     /// Derivative gain of gravity-comp (N m s/rad or N s/m).
     #[arg(long, value_name = "KD", default_value_t = 0.0)]
     kd: f64,
-    /// Bandwidth of computed-torque (rad/s): Kp = omega^2, Kd = 2 omega.
+    /// Bandwidth of computed-torque and pfl (rad/s): Kp = omega^2, Kd = 2 omega.
     #[arg(long, value_name = "RAD_PER_S", default_value_t = 10.0)]
     omega: f64,
+    /// Swing-up gain of pfl (rad): the actuated joints' target moves by SWING atan(qd_passive);
+    /// its sign depends on the robot (negative for an arm with a passive elbow).
+    #[arg(
+        long,
+        value_name = "SWING",
+        default_value_t = 0.0,
+        allow_hyphen_values = true
+    )]
+    swing: f64,
+    /// The integration method (a floating base takes RK4 only).
+    #[arg(long, value_enum, default_value_t = IntegratorArg::Rk4)]
+    integrator: IntegratorArg,
     /// Writes the CSV (t, q_*, qd_*, tau_* per joint) to FILE and a summary to stdout, instead
     /// of the CSV to stdout.
     #[arg(long, value_name = "FILE")]
@@ -721,6 +752,12 @@ fn csv_or_summary(path: Option<&Path>, csv: &str, summary: &str) -> Result<(), F
 
 /// `simulate` for a floating base: initial state, controller, run, plots.
 fn simulate_floating_cmd(a: SimulateArgs, b: Builder, model: Model) -> Result<(), Failure> {
+    if !matches!(a.integrator, IntegratorArg::Rk4) {
+        return Err(Failure(format!(
+            "{}: a floating base is simulated with RK4 only (--integrator rk4)",
+            model.name
+        )));
+    }
     let (nj, nv) = (model.dof(), model.nv());
     let count = |flag: &str, v: Option<Numbers>, n: usize, default: Vec<f64>| match v {
         None => Ok(default),
@@ -879,6 +916,13 @@ fn simulate_cmd(a: SimulateArgs) -> Result<(), Failure> {
             model.name
         )));
     }
+    if matches!(a.controller, ControllerArg::Pfl) && model.passive.len() != 1 {
+        return Err(Failure(format!(
+            "{}: --controller pfl needs exactly one passive joint (--passive JOINT), not {}",
+            a.urdf.display(),
+            model.passive.len()
+        )));
+    }
     let n = model.dof();
     let check = |flag: &str, v: Option<Numbers>, default: &[f64]| -> Result<Vec<f64>, Failure> {
         match v {
@@ -901,11 +945,25 @@ fn simulate_cmd(a: SimulateArgs) -> Result<(), Failure> {
         controller: match a.controller {
             ControllerArg::GravityComp => simulate::Controller::GravityComp,
             ControllerArg::ComputedTorque => simulate::Controller::ComputedTorque,
+            ControllerArg::Pfl => simulate::Controller::Pfl,
             _ => simulate::Controller::None,
         },
         kp: a.kp,
         kd: a.kd,
         omega: a.omega,
+        swing: a.swing,
+        integrator: match a.integrator {
+            IntegratorArg::Rk4 => simulate::Integrator::Rk4,
+            IntegratorArg::SymplecticEuler => {
+                simulate::Integrator::Symplectic(symplectic::Method::SymplecticEuler)
+            }
+            IntegratorArg::ImplicitMidpoint => {
+                simulate::Integrator::Symplectic(symplectic::Method::ImplicitMidpoint)
+            }
+            IntegratorArg::Yoshida4 => {
+                simulate::Integrator::Symplectic(symplectic::Method::Yoshida4)
+            }
+        },
     };
     let d = derive(&b, &model)?;
     let outcome = simulate::run(&model, &d, &options).map_err(Failure)?;
