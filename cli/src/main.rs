@@ -236,6 +236,13 @@ enum FormArg {
     Expanded,
     /// Shared temporaries, then the entries: for large robots.
     Program,
+    /// M and b as sums of each body's share, J_P^T m J_P + J_R^T Theta J_R and
+    /// J_P^T m Jdot_P qd + J_R^T (Theta Jdot_R qd + omega x Theta omega), from the body's
+    /// Jacobians (small fixed-base robots; --term does not apply)
+    ProjectedNewtonEuler,
+    /// The Hamiltonian H(q, p) = 1/2 p^T M^-1 p + V and Hamilton's equations (small
+    /// fixed-base robots; --term does not apply)
+    Hamiltonian,
 }
 
 const TERMS: [&str; 11] = [
@@ -675,6 +682,8 @@ fn show(a: ShowArgs) -> Result<(), Failure> {
         form: match a.form {
             FormArg::Expanded => Form::Expanded,
             FormArg::Program => Form::Program,
+            FormArg::ProjectedNewtonEuler => Form::ProjectedNewtonEuler,
+            FormArg::Hamiltonian => Form::Hamiltonian,
         },
         digits: (a.digits > 0).then_some(a.digits),
         max_terms: a.max_terms,
@@ -695,6 +704,7 @@ fn show(a: ShowArgs) -> Result<(), Failure> {
             a.urdf.display()
         )),
         report::ReportError::Derivatives(why) => Failure(format!("{}: {why}", a.urdf.display())),
+        report::ReportError::TooLarge(why) => Failure(format!("{}: {why}", a.urdf.display())),
         e => e.into(),
     })?;
     emit(&text)
