@@ -346,7 +346,8 @@ impl Builder {
     /// `ACTUATED_JOINT_NAMES: [&str; NA]`, `ACTUATED_JOINTS` and `PASSIVE_JOINTS` (joint
     /// indices), `selection()` (`S`, `NA x N`: row `k` is the unit row of the `k`-th actuated
     /// joint, so that `S^T tau_a` is the full effort, zero on every passive joint),
-    /// `full_effort(&tau_a)` (`S^T tau_a`) and `forward_dynamics_actuated(&q, &qd, &tau_a)`.
+    /// `full_effort(&tau_a)` (`S^T tau_a`) and `forward_dynamics_actuated(&q, &qd, &tau_a)`
+    /// (when `forward_dynamics` is generated; see [`Builder::quantities`]).
     /// Every other function, and the `Dynamics` trait, stays over all `N` joints. An unknown
     /// or fixed joint, every joint passive, or a floating base fails with
     /// [`crate::model::ModelError::InvalidPassiveJoints`], naming the joint. A name listed

@@ -40,19 +40,10 @@ fn matrix_entries(g: &Graph, m: &[Vec<Id>], dof: usize, syntax: Syntax) -> Vec<E
     out
 }
 
-fn vector_entries(
-    g: &Graph,
-    v: &[Id],
-    base: (&str, &str),
-    dof: usize,
-    syntax: Syntax,
-) -> Vec<Entry> {
+/// The nonzero entries of `v`, named `base.0` + index in text, `base.1`_{index} in LaTeX.
+fn vector_entries(g: &Graph, v: &[Id], base: (&str, &str), syntax: Syntax) -> Vec<Entry> {
     let name = |i: usize, syntax: Syntax| {
-        let sub = if dof <= 9 {
-            (i + 1).to_string()
-        } else {
-            format!("{}", i + 1)
-        };
+        let sub = (i + 1).to_string();
         match syntax {
             Syntax::Latex => format!("{}_{{{sub}}}", base.1),
             _ => format!("{}{sub}", base.0),
@@ -111,7 +102,7 @@ pub(super) fn projected_newton_euler(
              omega = J_R qd.",
             k + 1
         )];
-        let entries = vector_entries(g, &t.bias, ("b", "b"), d.dof, syntax);
+        let entries = vector_entries(g, &t.bias, ("b", "b"), syntax);
         let omitted = entries.len() < d.dof;
         sections.push(build_section(
             g,
@@ -221,13 +212,13 @@ pub(super) fn hamiltonian(
         g,
         "Generalized momentum p = M(q) qd".to_string(),
         Vec::new(),
-        vector_entries(g, &momentum, ("p", "p"), n, syntax),
+        vector_entries(g, &momentum, ("p", "p"), syntax),
         opts,
         false,
         false,
         dropped,
     )?);
-    let entries = vector_entries(g, &pd, ("pd", "\\dot{p}"), n, syntax);
+    let entries = vector_entries(g, &pd, ("pd", "\\dot{p}"), syntax);
     let omitted = entries.len() < n;
     sections.push(build_section(
         g,
