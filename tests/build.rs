@@ -42,6 +42,7 @@ fn main() {
     derivatives();
     floating();
     regressors();
+    underactuated();
     eomgen::Builder::new("robots/panda.urdf")
         .module_name("panda_selected")
         .type_name("PandaSelected")
@@ -258,6 +259,25 @@ fn unshipped_derivatives() {
     }
     println!("cargo:rustc-cfg=unshipped");
     with_derivatives("robots/xarm7.urdf", "xarm7_derivatives", "Xarm7Derivatives");
+}
+
+/// Robots with passive joints (`Builder::passive_joints`): the acrobot with its elbow passive,
+/// and the panda with its last finger passive (the harness's choice: the last joint).
+fn underactuated() {
+    let urdf = "fixtures/acrobot.urdf";
+    println!("cargo:rerun-if-changed={urdf}");
+    eomgen::Builder::new(urdf)
+        .module_name("acrobot")
+        .type_name("Acrobot")
+        .passive_joints(&["elbow"])
+        .compile()
+        .unwrap();
+    eomgen::Builder::new("robots/ur5.urdf")
+        .module_name("ur5_passive_wrist")
+        .type_name("Ur5PassiveWrist")
+        .passive_joints(&["wrist_1_joint", "wrist_3_joint"])
+        .compile()
+        .unwrap();
 }
 
 /// `file` with the derivatives of its dynamics, inverse dynamics and what those call.

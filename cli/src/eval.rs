@@ -2,7 +2,7 @@
 
 use std::fmt::Write as _;
 
-use eomgen::cas::{format_number, SymbolKind};
+use eomgen::cas::{format_number, Id, SymbolKind};
 use eomgen::dynamics::Derivation;
 use eomgen::model::Model;
 
@@ -57,6 +57,21 @@ pub fn cholesky_solve(m: &[Vec<f64>], rhs: &[f64]) -> Result<Vec<f64>, usize> {
     Ok(x)
 }
 
+/// Evaluates expressions of the derivation at `s` (parameters at their URDF values).
+pub fn evaluate_ids(d: &Derivation, s: &State, outputs: &[Id]) -> Result<Vec<f64>, String> {
+    d.graph
+        .eval(outputs, |sym| match sym.kind {
+            SymbolKind::Q(i) => s.q.get(i).copied(),
+            SymbolKind::Qd(i) => s.qd.get(i).copied(),
+            SymbolKind::Qdd(i) => s.qdd.get(i).copied(),
+            SymbolKind::Param => d.params.iter().find(|p| p.0 == sym.name).map(|p| p.2),
+            // No other symbol appears in M, b, G, C, tau or the energies.
+            #[allow(unreachable_patterns)]
+            _ => None,
+        })
+        .map_err(|e| format!("internal error while evaluating: {e}"))
+}
+
 /// Evaluates the derivation at `s` (parameters at their URDF values).
 pub fn evaluate(model: &Model, d: &Derivation, s: &State) -> Result<Values, String> {
     let n = d.dof;
@@ -67,18 +82,7 @@ pub fn evaluate(model: &Model, d: &Derivation, s: &State) -> Result<Values, Stri
     outputs.extend(&d.friction);
     outputs.push(d.kinetic_energy);
     outputs.push(d.potential_energy);
-    let v = d
-        .graph
-        .eval(&outputs, |sym| match sym.kind {
-            SymbolKind::Q(i) => s.q.get(i).copied(),
-            SymbolKind::Qd(i) => s.qd.get(i).copied(),
-            SymbolKind::Qdd(i) => s.qdd.get(i).copied(),
-            SymbolKind::Param => d.params.iter().find(|p| p.0 == sym.name).map(|p| p.2),
-            // No other symbol appears in M, b, G, tau or the energies.
-            #[allow(unreachable_patterns)]
-            _ => None,
-        })
-        .map_err(|e| format!("internal error while evaluating: {e}"))?;
+    let v = evaluate_ids(d, s, &outputs)?;
     let mass_matrix: Vec<Vec<f64>> = v[..n * n].chunks(n).map(|r| r.to_vec()).collect();
     let bias = v[n * n..n * n + n].to_vec();
     let gravity = v[n * n + n..n * n + 2 * n].to_vec();

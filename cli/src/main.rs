@@ -13,6 +13,7 @@ mod info;
 mod progress;
 mod simulate;
 mod simulate_floating;
+mod symplectic;
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -109,6 +110,10 @@ struct ModelArgs {
     /// contact_jacobian, contact_drift and contact_forward_dynamics
     #[arg(long = "contact", value_name = "LINK")]
     contacts: Vec<String>,
+    /// A joint without an actuator (repeatable): adds selection, ACTUATED_JOINT_NAMES and
+    /// forward_dynamics_actuated; simulate applies no effort to it
+    #[arg(long = "passive", value_name = "JOINT")]
+    passive: Vec<String>,
     /// Refuse robots with more degrees of freedom than this.
     #[arg(long, value_name = "N", default_value_t = eomgen::DEFAULT_MAX_DOF)]
     max_dof: usize,
@@ -135,6 +140,7 @@ impl ModelArgs {
             repair_inertia: self.repair_inertia,
             floating_base: self.floating_base,
             contact_points: self.contacts.clone(),
+            passive_joints: self.passive.clone(),
             ..ModelOptions::default()
         }
     }
@@ -230,6 +236,13 @@ enum FormArg {
     Expanded,
     /// Shared temporaries, then the entries: for large robots.
     Program,
+    /// M and b as sums of each body's share, J_P^T m J_P + J_R^T Theta J_R and
+    /// J_P^T m Jdot_P qd + J_R^T (Theta Jdot_R qd + omega x Theta omega), from the body's
+    /// Jacobians (small fixed-base robots; --term does not apply)
+    ProjectedNewtonEuler,
+    /// The Hamiltonian H(q, p) = 1/2 p^T M^-1 p + V and Hamilton's equations (small
+    /// fixed-base robots; --term does not apply)
+    Hamiltonian,
 }
 
 const TERMS: [&str; 11] = [
@@ -330,12 +343,30 @@ enum ControllerArg {
     GravityComp,
     /// Computed torque to the target, critically damped at --omega.
     ComputedTorque,
+    /// Collocated partial feedback linearization (Spong) for one passive joint (--passive):
+    /// the actuated joints go to the target, critically damped at --omega, their target moved
+    /// by --swing times atan of the passive joint's velocity (swing-up); no effort on the
+    /// passive joint.
+    Pfl,
     /// Floating base on contacts: PD on the joints (--kp, --kd) plus gravity compensation
     /// projected through the contacts.
     Stand,
     /// Floating base: computed torque on the base (thrust and torque) to a level pose at
     /// --base-target, critically damped at --omega; PD on the joints.
     Hover,
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+enum IntegratorArg {
+    /// Classical Runge-Kutta, fourth order (the controller re-evaluated at every stage).
+    Rk4,
+    /// Symplectic Euler on Hamilton's equations, first order (fixed-point iterations; the
+    /// effort held over each step).
+    SymplecticEuler,
+    /// The implicit midpoint rule on Hamilton's equations: second order, symplectic.
+    ImplicitMidpoint,
+    /// Yoshida's fourth-order composition of three implicit midpoint steps: symplectic.
+    Yoshida4,
 }
 
 #[derive(Args, Debug)]
@@ -366,9 +397,21 @@ struct SimulateArgs {
     /// Derivative gain of gravity-comp (N m s/rad or N s/m).
     #[arg(long, value_name = "KD", default_value_t = 0.0)]
     kd: f64,
-    /// Bandwidth of computed-torque (rad/s): Kp = omega^2, Kd = 2 omega.
+    /// Bandwidth of computed-torque and pfl (rad/s): Kp = omega^2, Kd = 2 omega.
     #[arg(long, value_name = "RAD_PER_S", default_value_t = 10.0)]
     omega: f64,
+    /// Swing-up gain of pfl (rad): the actuated joints' target moves by SWING atan(qd_passive);
+    /// its sign depends on the robot (negative for an arm with a passive elbow).
+    #[arg(
+        long,
+        value_name = "SWING",
+        default_value_t = 0.0,
+        allow_hyphen_values = true
+    )]
+    swing: f64,
+    /// The integration method (a floating base takes RK4 only).
+    #[arg(long, value_enum, default_value_t = IntegratorArg::Rk4)]
+    integrator: IntegratorArg,
     /// Writes the CSV (t, q_*, qd_*, tau_* per joint) to FILE and a summary to stdout, instead
     /// of the CSV to stdout.
     #[arg(long, value_name = "FILE")]
@@ -639,6 +682,8 @@ fn show(a: ShowArgs) -> Result<(), Failure> {
         form: match a.form {
             FormArg::Expanded => Form::Expanded,
             FormArg::Program => Form::Program,
+            FormArg::ProjectedNewtonEuler => Form::ProjectedNewtonEuler,
+            FormArg::Hamiltonian => Form::Hamiltonian,
         },
         digits: (a.digits > 0).then_some(a.digits),
         max_terms: a.max_terms,
@@ -659,6 +704,7 @@ fn show(a: ShowArgs) -> Result<(), Failure> {
             a.urdf.display()
         )),
         report::ReportError::Derivatives(why) => Failure(format!("{}: {why}", a.urdf.display())),
+        report::ReportError::TooLarge(why) => Failure(format!("{}: {why}", a.urdf.display())),
         e => e.into(),
     })?;
     emit(&text)
@@ -716,6 +762,12 @@ fn csv_or_summary(path: Option<&Path>, csv: &str, summary: &str) -> Result<(), F
 
 /// `simulate` for a floating base: initial state, controller, run, plots.
 fn simulate_floating_cmd(a: SimulateArgs, b: Builder, model: Model) -> Result<(), Failure> {
+    if !matches!(a.integrator, IntegratorArg::Rk4) {
+        return Err(Failure(format!(
+            "{}: a floating base is simulated with RK4 only (--integrator rk4)",
+            model.name
+        )));
+    }
     let (nj, nv) = (model.dof(), model.nv());
     let count = |flag: &str, v: Option<Numbers>, n: usize, default: Vec<f64>| match v {
         None => Ok(default),
@@ -874,6 +926,13 @@ fn simulate_cmd(a: SimulateArgs) -> Result<(), Failure> {
             model.name
         )));
     }
+    if matches!(a.controller, ControllerArg::Pfl) && model.passive.len() != 1 {
+        return Err(Failure(format!(
+            "{}: --controller pfl needs exactly one passive joint (--passive JOINT), not {}",
+            a.urdf.display(),
+            model.passive.len()
+        )));
+    }
     let n = model.dof();
     let check = |flag: &str, v: Option<Numbers>, default: &[f64]| -> Result<Vec<f64>, Failure> {
         match v {
@@ -896,11 +955,25 @@ fn simulate_cmd(a: SimulateArgs) -> Result<(), Failure> {
         controller: match a.controller {
             ControllerArg::GravityComp => simulate::Controller::GravityComp,
             ControllerArg::ComputedTorque => simulate::Controller::ComputedTorque,
+            ControllerArg::Pfl => simulate::Controller::Pfl,
             _ => simulate::Controller::None,
         },
         kp: a.kp,
         kd: a.kd,
         omega: a.omega,
+        swing: a.swing,
+        integrator: match a.integrator {
+            IntegratorArg::Rk4 => simulate::Integrator::Rk4,
+            IntegratorArg::SymplecticEuler => {
+                simulate::Integrator::Symplectic(symplectic::Method::SymplecticEuler)
+            }
+            IntegratorArg::ImplicitMidpoint => {
+                simulate::Integrator::Symplectic(symplectic::Method::ImplicitMidpoint)
+            }
+            IntegratorArg::Yoshida4 => {
+                simulate::Integrator::Symplectic(symplectic::Method::Yoshida4)
+            }
+        },
     };
     let d = derive(&b, &model)?;
     let outcome = simulate::run(&model, &d, &options).map_err(Failure)?;

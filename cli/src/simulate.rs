@@ -1,10 +1,13 @@
-//! `eomgen simulate`: integrates the equation of motion with RK4, evaluating M, b and G through
-//! the CAS interpreter (the command line cannot compile the generated code), and writes the
-//! trajectory as CSV.
+//! `eomgen simulate`: integrates the equation of motion with RK4 or a symplectic method,
+//! evaluating M, b and G through the CAS interpreter (the command line cannot compile the
+//! generated code), and writes the trajectory as CSV.
 //!
-//! The integrator and controllers mirror the runtime's (`rk4_step_closed_loop`, `PdGravity`,
-//! `ComputedTorque` in `eomgen_runtime`), written again for a joint count known only at run
-//! time; the controller is re-evaluated at every RK4 stage (a continuous-time controller).
+//! The integrators and controllers mirror the runtime's (`rk4_step_closed_loop`, the
+//! symplectic steps of `symplectic.rs`, `PdGravity`, `ComputedTorque`, `CollocatedPfl` in
+//! `eomgen_runtime`), written again for a joint count known only at run time. With RK4 the
+//! controller is re-evaluated at every stage (a continuous-time controller); the symplectic
+//! methods hold its effort over each step. Passive joints (`--passive`) get no effort from any
+//! controller: `tau = S^T S tau`.
 
 use std::fmt::Write as _;
 
@@ -12,6 +15,7 @@ use eomgen::dynamics::Derivation;
 use eomgen::model::Model;
 
 use super::eval;
+use super::symplectic::{self, Method};
 
 /// The controller closing the loop.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -24,6 +28,27 @@ pub enum Controller {
     /// Computed torque to the target, `tau = M (Kp e - Kd qd) + b + G`: critically damped
     /// at `omega` rad/s.
     ComputedTorque,
+    /// Collocated partial feedback linearization (Spong) for one passive joint: the actuated
+    /// joints follow `Kp (q* + swing atan(qd_u) - q) - Kd qd`, critically damped at `omega`.
+    Pfl,
+}
+
+/// The integration method.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Integrator {
+    Rk4,
+    Symplectic(Method),
+}
+
+impl Integrator {
+    fn name(self) -> &'static str {
+        match self {
+            Integrator::Rk4 => "RK4",
+            Integrator::Symplectic(Method::SymplecticEuler) => "symplectic Euler",
+            Integrator::Symplectic(Method::ImplicitMidpoint) => "implicit midpoint",
+            Integrator::Symplectic(Method::Yoshida4) => "Yoshida 4",
+        }
+    }
 }
 
 /// What to simulate.
@@ -37,8 +62,11 @@ pub struct Options {
     /// Proportional and derivative gains for `GravityComp` (N m/rad, N m s/rad).
     pub kp: f64,
     pub kd: f64,
-    /// Bandwidth of `ComputedTorque` (rad/s).
+    /// Bandwidth of `ComputedTorque` and `Pfl` (rad/s).
     pub omega: f64,
+    /// The swing-up gain of `Pfl` (rad).
+    pub swing: f64,
+    pub integrator: Integrator,
 }
 
 /// The result: the CSV text, a one-paragraph summary and the joint trajectories.
@@ -131,7 +159,12 @@ fn step_eval(
                 })
                 .collect()
         }
+        Controller::Pfl => pfl(model, o, &v, q, qd),
     };
+    let mut tau = tau;
+    for &p in &model.passive {
+        tau[p] = 0.0;
+    }
     let rhs: Vec<f64> = (0..n)
         .map(|i| tau[i] - v.bias[i] - v.gravity[i] - friction[i])
         .collect();
@@ -140,6 +173,56 @@ fn step_eval(
         of: n,
     })?;
     Ok((tau, qdd))
+}
+
+/// Collocated partial feedback linearization for the (single) passive joint `u`: `v` on the
+/// actuated joints, `qdd_u = -(h_u + M_ua v) / M_uu`, `tau = M qdd + h` (zero on `u`).
+fn pfl(model: &Model, o: &Options, v: &eval::Values, q: &[f64], qd: &[f64]) -> Vec<f64> {
+    let n = q.len();
+    let Some(&u) = model.passive.first() else {
+        return vec![0.0; n];
+    };
+    let h: Vec<f64> = (0..n)
+        .map(|i| v.bias[i] + v.gravity[i] + v.friction[i])
+        .collect();
+    let (kp, kd) = (o.omega * o.omega, 2.0 * o.omega);
+    let lead = o.swing * qd[u].atan();
+    let mut a: Vec<f64> = (0..n)
+        .map(|i| kp * (o.target[i] + lead - q[i]) - kd * qd[i])
+        .collect();
+    a[u] = 0.0;
+    let m = &v.mass_matrix;
+    a[u] = -(h[u] + (0..n).map(|j| m[u][j] * a[j]).sum::<f64>()) / m[u][u];
+    (0..n)
+        .map(|i| (0..n).map(|j| m[i][j] * a[j]).sum::<f64>() + h[i])
+        .collect()
+}
+
+/// `M`, `h = b + G + F` and `C(q, qd)`.
+type HamiltonTerms = (Vec<Vec<f64>>, Vec<f64>, Vec<Vec<f64>>);
+
+/// `M(q)` and the momentum rate `pd = tau - h + (C + C^T) qd` for the symplectic methods.
+fn hamilton_terms(
+    model: &Model,
+    d: &Derivation,
+    q: &[f64],
+    qd: &[f64],
+) -> Result<HamiltonTerms, StepError> {
+    let n = q.len();
+    let v = terms(model, d, q, qd).map_err(StepError::Eval)?;
+    let c_ids: Vec<_> = d.fast.coriolis_matrix.1.iter().flatten().copied().collect();
+    let state = eval::State {
+        q: q.to_vec(),
+        qd: qd.to_vec(),
+        qdd: vec![0.0; n],
+        tau: vec![0.0; n],
+    };
+    let c = eval::evaluate_ids(d, &state, &c_ids).map_err(StepError::Eval)?;
+    let c: Vec<Vec<f64>> = c.chunks(n).map(|r| r.to_vec()).collect();
+    let h = (0..n)
+        .map(|i| v.bias[i] + v.gravity[i] + v.friction[i])
+        .collect();
+    Ok((v.mass_matrix, h, c))
 }
 
 fn axpy(a: &[f64], h: f64, b: &[f64]) -> Vec<f64> {
@@ -154,7 +237,7 @@ fn row(out: &mut String, t: f64, q: &[f64], qd: &[f64], tau: &[f64]) {
     out.push('\n');
 }
 
-/// Runs the simulation: `round(duration / dt)` RK4 steps.
+/// Runs the simulation: `round(duration / dt)` steps of the chosen integrator.
 pub fn run(model: &Model, d: &Derivation, o: &Options) -> Result<Outcome, String> {
     let valid = o.dt > 0.0 && o.dt.is_finite() && o.duration >= 0.0 && o.duration.is_finite();
     if !valid {
@@ -190,17 +273,50 @@ pub fn run(model: &Model, d: &Derivation, o: &Options) -> Result<Outcome, String
         row(&mut csv, t, &q, &qd, &tau);
         times.push(t);
         positions.push(q.clone());
-        let v1 = qd.clone();
-        let stage = |q: &[f64], v: &[f64]| step_eval(model, d, o, q, v).map_err(|e| fail(e, t + h));
-        let (q2, v2) = (axpy(&q, h / 2.0, &v1), axpy(&qd, h / 2.0, &a1));
-        let (_, a2) = stage(&q2, &v2)?;
-        let (q3, v3) = (axpy(&q, h / 2.0, &v2), axpy(&qd, h / 2.0, &a2));
-        let (_, a3) = stage(&q3, &v3)?;
-        let (q4, v4) = (axpy(&q, h, &v3), axpy(&qd, h, &a3));
-        let (_, a4) = stage(&q4, &v4)?;
-        for i in 0..q.len() {
-            q[i] += h / 6.0 * (v1[i] + 2.0 * (v2[i] + v3[i]) + v4[i]);
-            qd[i] += h / 6.0 * (a1[i] + 2.0 * (a2[i] + a3[i]) + a4[i]);
+        match o.integrator {
+            Integrator::Rk4 => {
+                let v1 = qd.clone();
+                let stage =
+                    |q: &[f64], v: &[f64]| step_eval(model, d, o, q, v).map_err(|e| fail(e, t + h));
+                let (q2, v2) = (axpy(&q, h / 2.0, &v1), axpy(&qd, h / 2.0, &a1));
+                let (_, a2) = stage(&q2, &v2)?;
+                let (q3, v3) = (axpy(&q, h / 2.0, &v2), axpy(&qd, h / 2.0, &a2));
+                let (_, a3) = stage(&q3, &v3)?;
+                let (q4, v4) = (axpy(&q, h, &v3), axpy(&qd, h, &a3));
+                let (_, a4) = stage(&q4, &v4)?;
+                for i in 0..q.len() {
+                    q[i] += h / 6.0 * (v1[i] + 2.0 * (v2[i] + v3[i]) + v4[i]);
+                    qd[i] += h / 6.0 * (a1[i] + 2.0 * (a2[i] + a3[i]) + a4[i]);
+                }
+            }
+            Integrator::Symplectic(method) => {
+                let n = q.len();
+                let mass = |q: &[f64]| -> Result<Vec<Vec<f64>>, StepError> {
+                    Ok(hamilton_terms(model, d, q, &vec![0.0; n])?.0)
+                };
+                let rate = |q: &[f64], qd: &[f64], tau: &[f64]| -> Result<Vec<f64>, StepError> {
+                    let (_, hh, c) = hamilton_terms(model, d, q, qd)?;
+                    Ok((0..n)
+                        .map(|k| {
+                            tau[k] - hh[k]
+                                + (0..n).map(|j| (c[k][j] + c[j][k]) * qd[j]).sum::<f64>()
+                        })
+                        .collect())
+                };
+                let solve = |m: &[Vec<f64>], b: &[f64]| -> Result<Vec<f64>, StepError> {
+                    eval::cholesky_solve(m, b).map_err(|k| StepError::MassMatrix {
+                        pivot: k + 1,
+                        of: n,
+                    })
+                };
+                let sys = symplectic::System {
+                    mass: &mass,
+                    rate: &rate,
+                    solve: &solve,
+                };
+                (q, qd) =
+                    symplectic::step(&sys, method, &q, &qd, &tau, h).map_err(|e| fail(e, t + h))?;
+            }
         }
         if q.iter()
             .chain(&qd)
@@ -222,13 +338,14 @@ pub fn run(model: &Model, d: &Derivation, o: &Options) -> Result<Outcome, String
             .join(", ")
     };
     let mut summary = format!(
-        "{}: {} RK4 steps of {h} s to t = {t_end} s\nq  = [{}]\nqd = [{}]\n",
+        "{}: {} {} steps of {h} s to t = {t_end} s\nq  = [{}]\nqd = [{}]\n",
         model.name,
         steps,
+        o.integrator.name(),
         fmt(&q),
         fmt(&qd)
     );
-    if o.controller == Controller::None {
+    if matches!(o.controller, Controller::None | Controller::Pfl) {
         let _ = writeln!(
             summary,
             "energy: {e0:.9e} J at t = 0, {e_end:.9e} J at the end (change {:.3e} J)",

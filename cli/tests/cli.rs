@@ -958,3 +958,52 @@ fn readme_quick_start_works() {
         assert!(readme.contains(line), "README sample is stale: {line}");
     }
 }
+
+/// `--form projected-newton-euler` and `--form hamiltonian` print the double pendulum as a
+/// person writes them (snapshots in every format), and refuse a robot too large to print in
+/// one line.
+#[test]
+fn show_other_forms() {
+    let path = robot("double_pendulum");
+    for (form, stem) in [
+        (
+            "projected-newton-euler",
+            "double_pendulum_projected_newton_euler",
+        ),
+        ("hamiltonian", "double_pendulum_hamiltonian"),
+    ] {
+        for (format, ext) in [("text", "txt"), ("latex", "tex"), ("markdown", "md")] {
+            let out = ok(&["show", &path, "--form", form, "--format", format]);
+            snapshot(&format!("{stem}.{ext}"), &out);
+        }
+    }
+    let text = ok(&["show", &path, "--form", "projected-newton-euler"]);
+    for section in [
+        "Mass matrix, share of body 1 of 2, link `link1`:",
+        "Bias, share of body 2 of 2, link `link2`:",
+        "(M = M^(1) + M^(2))",
+    ] {
+        assert!(text.contains(section), "no {section:?}");
+    }
+    let text = ok(&["show", &path, "--form", "hamiltonian"]);
+    assert!(text.contains("\n  pd1 = tau1 + "), "{text}");
+    // A 14-joint chain whose axes alternate is beyond what is printed.
+    let mut urdf = String::from(r#"<robot name="chain"><link name="l0"/>"#);
+    for i in 1..=14 {
+        let axis = ["1 0 0", "0 1 0", "0 0 1"][i % 3];
+        urdf.push_str(&format!(
+            r#"<link name="l{i}"><inertial><origin xyz="0.1 0.02 0.3"/><mass value="1"/><inertia ixx="0.01" ixy="0.001" ixz="0" iyy="0.02" iyz="0" izz="0.015"/></inertial></link><joint name="j{i}" type="revolute"><parent link="l{}"/><child link="l{i}"/><origin xyz="0 0.1 0.4" rpy="0.1 0 0"/><axis xyz="{axis}"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint>"#,
+            i - 1
+        ));
+    }
+    urdf.push_str("</robot>");
+    let chain = scratch("chain14").join("chain14.urdf");
+    std::fs::write(&chain, urdf).expect("write");
+    let err = bad_input(&["show", path_str(&chain), "--form", "projected-newton-euler"]);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("the projected Newton-Euler form takes"),
+        "{err}"
+    );
+    assert!(err.contains("it is for small robots"), "{err}");
+}

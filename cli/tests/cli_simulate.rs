@@ -280,3 +280,126 @@ fn friction_dissipates_and_computed_torque_compensates_it() {
         }
     }
 }
+
+/// The energy change printed by the summary (`change X J`).
+fn energy_change(summary: &str) -> f64 {
+    let line = summary
+        .lines()
+        .find(|l| l.starts_with("energy:"))
+        .expect("energy line");
+    let change = line.split("change ").nth(1).expect("change");
+    change.trim_end_matches(" J)").parse().expect("number")
+}
+
+/// `--integrator`: the symplectic methods agree with RK4 on a short run and keep the energy of
+/// the undamped double pendulum (the runtime's test measures the long runs).
+#[test]
+fn integrators() {
+    let out = std::env::temp_dir().join(format!("eomgen-integrators-{}.csv", std::process::id()));
+    let mut finals = Vec::new();
+    for (integrator, name, tolerance) in [
+        ("rk4", "RK4", 1e-7),
+        ("symplectic-euler", "symplectic Euler", 1e-3),
+        ("implicit-midpoint", "implicit midpoint", 1e-6),
+        ("yoshida4", "Yoshida 4", 1e-8),
+    ] {
+        let summary = ok(&[
+            "simulate",
+            "tests/robots/double_pendulum.urdf",
+            "--q0",
+            "3.4416,-0.3",
+            "--dt",
+            "3e-3",
+            "--duration",
+            "3",
+            "--integrator",
+            integrator,
+            "--csv",
+            out.to_str().unwrap(),
+        ]);
+        assert!(
+            summary.contains(&format!("1000 {name} steps of 0.003 s")),
+            "{summary}"
+        );
+        let change = energy_change(&summary);
+        assert!(
+            change.abs() < tolerance,
+            "{integrator}: energy change {change}"
+        );
+        let csv = std::fs::read_to_string(&out).unwrap();
+        finals.push(rows(&csv).last().unwrap()[1..3].to_vec());
+    }
+    let _ = std::fs::remove_file(&out);
+    // Second and fourth order methods end where RK4 does, to their accuracy.
+    for (k, tol) in [(2, 1e-2), (3, 1e-4)] {
+        for j in 0..2 {
+            assert!((finals[k][j] - finals[0][j]).abs() < tol, "{finals:?}");
+        }
+    }
+}
+
+/// `--controller pfl` on the acrobot with its elbow passive (`--passive elbow`): no effort on
+/// the elbow, the shoulder at its target; with `--swing` the energy grows.
+#[test]
+fn acrobot_collocated_pfl() {
+    let csv = ok(&[
+        "simulate",
+        "tests/fixtures/acrobot.urdf",
+        "--passive",
+        "elbow",
+        "--controller",
+        "pfl",
+        "--omega",
+        "4",
+        "--target",
+        "0.8,0",
+        "--duration",
+        "3",
+    ]);
+    let r = rows(&csv);
+    // t, q_shoulder, q_elbow, qd_shoulder, qd_elbow, tau_shoulder, tau_elbow
+    assert!(r.iter().all(|row| row[6] == 0.0));
+    let last = r.last().unwrap();
+    let want = 0.8 - 0.8 * (1.0 + 4.0 * 3.0) * (-12.0f64).exp();
+    assert!((last[1] - want).abs() < 1e-6, "{last:?}");
+    let out = std::env::temp_dir().join(format!("eomgen-pfl-{}.csv", std::process::id()));
+    let summary = ok(&[
+        "simulate",
+        "tests/fixtures/acrobot.urdf",
+        "--passive",
+        "elbow",
+        "--controller",
+        "pfl",
+        "--omega",
+        "6",
+        "--swing",
+        "-1",
+        "--q0",
+        "0,0.1",
+        "--duration",
+        "10",
+        "--csv",
+        out.to_str().unwrap(),
+    ]);
+    let _ = std::fs::remove_file(&out);
+    assert!(energy_change(&summary) > 10.0, "{summary}");
+
+    let err = eomgen(&[
+        "simulate",
+        "tests/fixtures/acrobot.urdf",
+        "--controller",
+        "pfl",
+    ]);
+    assert!(!err.status.success());
+    assert!(String::from_utf8_lossy(&err.stderr).contains(
+        "tests/fixtures/acrobot.urdf: --controller pfl needs exactly one passive joint (--passive JOINT), not 0"
+    ));
+    let err = eomgen(&[
+        "simulate",
+        "tests/fixtures/acrobot.urdf",
+        "--passive",
+        "wrist",
+    ]);
+    assert!(String::from_utf8_lossy(&err.stderr)
+        .contains("tests/fixtures/acrobot.urdf: passive joints: joint `wrist` does not exist"));
+}

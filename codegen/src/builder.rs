@@ -340,6 +340,52 @@ impl Builder {
         self
     }
 
+    /// Joints without an actuator, by URDF name (the acrobot's elbow, a cart-pole's pole, a
+    /// passive wrist or toe), for underactuated robots: `M qdd + b + G = S^T tau_a`. Adds to
+    /// the generated type the constants `NA` (actuated joints) and
+    /// `ACTUATED_JOINT_NAMES: [&str; NA]`, `ACTUATED_JOINTS` and `PASSIVE_JOINTS` (joint
+    /// indices), `selection()` (`S`, `NA x N`: row `k` is the unit row of the `k`-th actuated
+    /// joint, so that `S^T tau_a` is the full effort, zero on every passive joint),
+    /// `full_effort(&tau_a)` (`S^T tau_a`) and `forward_dynamics_actuated(&q, &qd, &tau_a)`
+    /// (when `forward_dynamics` is generated; see [`Builder::quantities`]).
+    /// Every other function, and the `Dynamics` trait, stays over all `N` joints. An unknown
+    /// or fixed joint, every joint passive, or a floating base fails with
+    /// [`crate::model::ModelError::InvalidPassiveJoints`], naming the joint. A name listed
+    /// twice counts once. See [`ModelOptions::passive_joints`].
+    ///
+    /// ```
+    /// let urdf = r#"<robot name="acrobot"><link name="base"/>
+    ///   <link name="upper"><inertial><origin xyz="0 0 -0.5"/><mass value="1"/>
+    ///   <inertia ixx="0.08" ixy="0" ixz="0" iyy="0.08" iyz="0" izz="0.001"/></inertial></link>
+    ///   <link name="lower"><inertial><origin xyz="0 0 -0.5"/><mass value="1"/>
+    ///   <inertia ixx="0.08" ixy="0" ixz="0" iyy="0.08" iyz="0" izz="0.001"/></inertial></link>
+    ///   <joint name="shoulder" type="continuous"><parent link="base"/><child link="upper"/>
+    ///   <axis xyz="0 1 0"/></joint>
+    ///   <joint name="elbow" type="continuous"><parent link="upper"/><child link="lower"/>
+    ///   <origin xyz="0 0 -1"/><axis xyz="0 1 0"/></joint></robot>"#;
+    /// let source = eomgen::Builder::from_urdf_str(urdf, "acrobot.urdf")
+    ///     .passive_joints(&["elbow"])
+    ///     .generate()
+    ///     .unwrap();
+    /// assert!(source.contains(r#"pub const ACTUATED_JOINT_NAMES: [&'static str; 1] = ["shoulder"];"#));
+    /// assert!(source.contains("pub fn forward_dynamics_actuated("));
+    /// let err = eomgen::Builder::from_urdf_str(urdf, "acrobot.urdf")
+    ///     .passive_joints(&["wrist"])
+    ///     .generate()
+    ///     .unwrap_err();
+    /// assert_eq!(err.to_string(), "acrobot.urdf: passive joints: joint `wrist` does not exist");
+    /// ```
+    pub fn passive_joints<S: AsRef<str>>(mut self, joints: &[S]) -> Builder {
+        self.options.passive_joints.clear();
+        for joint in joints {
+            let joint = joint.as_ref().to_string();
+            if !self.options.passive_joints.contains(&joint) {
+                self.options.passive_joints.push(joint);
+            }
+        }
+        self
+    }
+
     /// Adds identification, for estimating a robot's inertial parameters from measured
     /// torques: `regressor(&q, &qd, &qdd)` (N x P, `tau = Y pi`) and `parameters()` (the P
     /// standard parameters: per body, in joint order, m, m cx, m cy, m cz, Ixx, Ixy, Iyy, Ixz,

@@ -34,13 +34,16 @@
 //!   (firmware) and [`f64`] (host), with the transcendental functions taken from [`libm`] since
 //!   `core` has none;
 //! - [`Dynamics`]: the trait every generated robot type implements, with its conventions;
+//! - [`Hamiltonian`]: momentum, Hamiltonian and Hamilton's equations of any [`Dynamics`];
 //! - [`Pose`]: a rigid transform (world from link) as returned by the generated `link_pose`;
 //! - fixed-size, allocation-free and panic-free solvers for symmetric positive definite systems
 //!   ([`Ldlt`], [`Cholesky`], [`solve_spd`], [`solve_spd_or_nan`]) used by forward dynamics;
 //! - simulation over any [`Dynamics`] (module [`sim`]): [`State`], semi-implicit Euler and RK4
-//!   steps, a [`Simulator`] loop with a torque callback;
+//!   steps, the symplectic [`symplectic_euler_step`] and [`implicit_midpoint_step`], a
+//!   [`Simulator`] loop with a torque callback;
 //! - control (module [`control`]): PD with gravity compensation ([`PdGravity`]),
-//!   [`ComputedTorque`], the Jacobian-transpose map [`wrench_to_torque`], velocity and force
+//!   [`ComputedTorque`], [`CollocatedPfl`] for a robot with a passive joint, the
+//!   Jacobian-transpose map [`wrench_to_torque`], velocity and force
 //!   manipulability [`Ellipsoid`]s and the [`SymmetricEigen`] solver behind them;
 //! - kernels that generated code loops over (module [`tree`]): poses and Jacobians along a
 //!   kinematic chain, Craig's `B(q)` and `C(q)` from the Christoffel-form Coriolis matrix;
@@ -51,8 +54,8 @@
 //!
 //! All matrices are plain row-major arrays: `m[i][j]` is the entry in row `i`, column `j`.
 //!
-//! `use eomgen_runtime::prelude::*;` brings [`Dynamics`], [`Real`], [`Pose`] and
-//! [`FactorError`] into scope (module [`prelude`]).
+//! `use eomgen_runtime::prelude::*;` brings [`Dynamics`], [`Hamiltonian`], [`Real`], [`Pose`]
+//! and [`FactorError`] into scope (module [`prelude`]).
 //!
 //! # Cargo features
 //! - `nalgebra`: conversions to and from `nalgebra` (no_std compatible; uses nalgebra's `libm`).
@@ -72,6 +75,7 @@ mod dimensions;
 mod dynamics;
 mod floating;
 pub mod free_flyer;
+mod hamiltonian;
 mod joint_effects;
 mod linalg;
 mod pose;
@@ -84,15 +88,17 @@ pub mod tree;
 pub mod nalgebra_support;
 
 pub use control::{
-    wrench_to_torque, ComputedTorque, Ellipsoid, PdGravity, Setpoint, SymmetricEigen,
+    wrench_to_torque, CollocatedPfl, ComputedTorque, Ellipsoid, PdGravity, Setpoint, SymmetricEigen,
 };
 pub use dimensions::Dimensions;
 pub use dynamics::Dynamics;
 pub use floating::{rk4_step_floating, Contacts, FloatingDynamics, StandOnContacts};
+pub use hamiltonian::Hamiltonian;
 pub use joint_effects::WithJointEffects;
 pub use linalg::{solve_spd, solve_spd_or_nan, Cholesky, FactorError, Ldlt};
 pub use pose::Pose;
 pub use real::Real;
 pub use sim::{
-    rk4_step, rk4_step_closed_loop, semi_implicit_euler_step, Integrator, Simulator, State,
+    implicit_midpoint_step, rk4_step, rk4_step_closed_loop, semi_implicit_euler_step,
+    symplectic_euler_step, yoshida4_step, Integrator, Simulator, State,
 };

@@ -1,6 +1,7 @@
 //! Time integration of the equation of motion: [`State`], the fixed-step integrators
-//! [`semi_implicit_euler_step`] and [`rk4_step`], and a [`Simulator`] loop driven by a torque
-//! callback.
+//! [`semi_implicit_euler_step`], [`rk4_step`], and the symplectic [`symplectic_euler_step`]
+//! and [`implicit_midpoint_step`] (in Hamilton's form, see [`Hamiltonian`]), and a
+//! [`Simulator`] loop driven by a torque callback.
 //!
 //! Everything works on any [`Dynamics`] implementation (generated or hand-written), any
 //! [`Real`] scalar and any number of joints, without allocating or panicking. The effort is
@@ -8,7 +9,8 @@
 //! [`rk4_step_closed_loop`] / [`Simulator::run_continuous`], which model a continuous-time
 //! controller.
 
-use crate::{Dynamics, Real};
+use crate::hamiltonian::momentum_rate;
+use crate::{Dynamics, Hamiltonian, Ldlt, Real};
 
 /// The state of a robot: joint positions `q` and velocities `qd`, in the order of
 /// [`Dynamics::JOINT_NAMES`].
@@ -222,6 +224,218 @@ where
     State { q, qd }
 }
 
+/// The most fixed-point iterations a step of [`symplectic_euler_step`] or
+/// [`implicit_midpoint_step`] takes. The iterations stop earlier, as soon as an update is below
+/// `4 ε` relative (`ε` the scalar's machine epsilon) or stops
+/// shrinking (each of `q` and `p` relative to itself); they contract by about `dt` times the fastest rate of the system, so a step
+/// well inside the stable range needs about 10 (9.8 per step on average for the implicit
+/// midpoint rule on the reference double pendulum at `dt = 3e-3`, `tests/tests/hamiltonian.rs`).
+pub const FIXED_POINT_MAX_ITERATIONS: usize = 50;
+
+/// The largest change `|a - b|` relative to the largest `|a|` (0 when both are zero).
+fn relative_change<T: Real, const N: usize>(a: &[T; N], b: &[T; N]) -> T {
+    let mut d = T::zero();
+    let mut s = T::zero();
+    for i in 0..N {
+        d = d.max((a[i] - b[i]).abs());
+        s = s.max(a[i].abs());
+    }
+    if s > T::zero() {
+        d / s
+    } else {
+        d
+    }
+}
+
+/// Whether a fixed-point update has converged: a relative change of at most `4 ε`, or one
+/// that no longer shrinks (rounding noise).
+fn converged<T: Real>(change: T, previous: T) -> bool {
+    let tol = T::from_f64(4.0) * T::epsilon();
+    change <= tol || change >= previous || !change.is_finite()
+}
+
+/// The state of a position and momentum: `qd = M(q)⁻¹ p`.
+fn from_momentum<T: Real, D: Dynamics<T, N>, const N: usize>(
+    robot: &D,
+    q: [T; N],
+    p: &[T; N],
+) -> State<T, N> {
+    State {
+        q,
+        qd: robot.velocity_from_momentum(&q, p),
+    }
+}
+
+/// One step of the symplectic Euler method on Hamilton's equations ([`Hamiltonian`]), with
+/// effort `tau` held over the step:
+///
+/// ```text
+/// p' = p + dt (-∂H/∂q (q, p') + tau)     (implicit in p': fixed-point iterations)
+/// q' = q + dt ∂H/∂p (q, p') = q + dt M(q)⁻¹ p'
+/// ```
+///
+/// with `p = M(q) qd`. First order and symplectic for any robot (`H` is not separable: `M`
+/// depends on `q`), so that without effort the energy error stays bounded, of order `dt`,
+/// instead of drifting. `M(q)` is factorized once per step; each iteration costs one
+/// `coriolis_matrix` and one `inverse_dynamics` (at most [`FIXED_POINT_MAX_ITERATIONS`]), and
+/// the step ends with one more factorization for `qd' = M(q')⁻¹ p'`. Its accuracy is that of
+/// [`semi_implicit_euler_step`], at a few times the cost, but the energy error does not grow:
+/// for long runs of a conservative system.
+///
+/// ```
+/// # mod generated { include!("../../generated/src/double_pendulum.rs"); }
+/// # use generated::DoublePendulum;
+/// use eomgen_runtime::{symplectic_euler_step, State};
+///
+/// let robot = DoublePendulum::<f64>::default();
+/// let mut s = State::new([1.0, -0.5], [0.0, 0.0]);
+/// let e0 = s.energy(&robot);
+/// for _ in 0..2000 {
+///     s = symplectic_euler_step(&robot, &s, &[0.0, 0.0], 1e-3);
+/// }
+/// assert!(((s.energy(&robot) - e0) / e0).abs() < 1e-2);
+/// ```
+pub fn symplectic_euler_step<T, D, const N: usize>(
+    robot: &D,
+    state: &State<T, N>,
+    tau: &[T; N],
+    dt: T,
+) -> State<T, N>
+where
+    T: Real,
+    D: Dynamics<T, N>,
+{
+    let q0 = &state.q;
+    let Ok(m) = Ldlt::new(robot.mass_matrix(q0)) else {
+        return State {
+            q: [T::nan(); N],
+            qd: [T::nan(); N],
+        };
+    };
+    let p0 = robot.momentum(q0, &state.qd);
+    // p' = p + dt pd(q, M(q)^-1 p'), starting from the explicit step.
+    let mut qd = state.qd;
+    let mut p = p0;
+    let mut previous = T::from_f64(f64::INFINITY);
+    for _ in 0..FIXED_POINT_MAX_ITERATIONS {
+        let pd = momentum_rate(robot, q0, &qd, tau);
+        let next = axpy(&p0, dt, &pd);
+        let delta = relative_change(&next, &p);
+        p = next;
+        qd = m.solve(&p);
+        if converged(delta, previous) {
+            break;
+        }
+        previous = delta;
+    }
+    let q = axpy(q0, dt, &qd);
+    from_momentum(robot, q, &p)
+}
+
+/// One step of the implicit midpoint rule on Hamilton's equations ([`Hamiltonian`]), with
+/// effort `tau` held over the step: with `z = (q, p)` and `f` Hamilton's equations,
+///
+/// ```text
+/// z' = z + dt f((z + z') / 2)     (the midpoint by fixed-point iterations)
+/// ```
+///
+/// Second order, symmetric and symplectic for any Hamiltonian, separable or not (robots' are
+/// not): without effort the energy error stays bounded, of order `dt²`, over any number of
+/// steps, where [`rk4_step`]'s drifts. Each iteration is one [`Hamiltonian::hamilton`] (one
+/// factorization of `M`, one `coriolis_matrix`, one `inverse_dynamics`), at most
+/// [`FIXED_POINT_MAX_ITERATIONS`] per step (9.8 on average on the reference double pendulum
+/// at `dt = 3e-3`). Measured there (`tests/tests/hamiltonian.rs`, 10⁵ steps of 3 ms, 300 s
+/// swinging from rest 0.3 rad away from hanging in each joint): the relative energy error
+/// stays below `8.1e-7` while RK4's drifts to `1.23e-6`.
+///
+/// ```
+/// # mod generated { include!("../../generated/src/double_pendulum.rs"); }
+/// # use generated::DoublePendulum;
+/// use eomgen_runtime::{implicit_midpoint_step, State};
+///
+/// let robot = DoublePendulum::<f64>::default();
+/// // It hangs straight down at q = (pi, 0).
+/// let mut s = State::new([core::f64::consts::PI + 0.3, -0.3], [0.0, 0.0]);
+/// let e0 = s.energy(&robot);
+/// for _ in 0..2000 {
+///     s = implicit_midpoint_step(&robot, &s, &[0.0, 0.0], 3e-3);
+/// }
+/// assert!(((s.energy(&robot) - e0) / e0).abs() < 1e-6);
+/// ```
+pub fn implicit_midpoint_step<T, D, const N: usize>(
+    robot: &D,
+    state: &State<T, N>,
+    tau: &[T; N],
+    dt: T,
+) -> State<T, N>
+where
+    T: Real,
+    D: Dynamics<T, N>,
+{
+    let half = T::from_f64(0.5) * dt;
+    let (q0, p0) = (state.q, robot.momentum(&state.q, &state.qd));
+    // The midpoint (qm, pm) = z + dt/2 f(qm, pm), starting from the explicit half step.
+    let (mut qm, mut pm) = (q0, p0);
+    let mut qd = state.qd;
+    let mut pd = momentum_rate(robot, &q0, &qd, tau);
+    let mut previous = T::from_f64(f64::INFINITY);
+    for _ in 0..FIXED_POINT_MAX_ITERATIONS {
+        let (q_next, p_next) = (axpy(&q0, half, &qd), axpy(&p0, half, &pd));
+        let delta = relative_change(&q_next, &qm).max(relative_change(&p_next, &pm));
+        (qm, pm) = (q_next, p_next);
+        (qd, pd) = robot.hamilton(&qm, &pm, tau);
+        if converged(delta, previous) {
+            break;
+        }
+        previous = delta;
+    }
+    // z' = 2 zm - z = z + dt f(zm).
+    let q = axpy(&q0, dt, &qd);
+    let p = axpy(&p0, dt, &pd);
+    from_momentum(robot, q, &p)
+}
+
+/// One step of Yoshida's fourth-order composition of [`implicit_midpoint_step`]: three
+/// midpoint steps of `w1 dt`, `w0 dt`, `w1 dt` with `w1 = 1 / (2 - 2^(1/3))` and
+/// `w0 = 1 - 2 w1` (negative), effort `tau` held over the step.
+///
+/// Fourth order, symmetric and symplectic: without effort the energy error stays bounded, of
+/// order `dt⁴`. Three times the cost of a midpoint step; the choice for long conservative runs
+/// that must also be accurate. Measured on the reference double pendulum
+/// (`tests/tests/hamiltonian.rs`, README): over 10⁵ steps the relative energy error stays
+/// below `1e-6` at a step where RK4's drifts past it.
+///
+/// ```
+/// # mod generated { include!("../../generated/src/double_pendulum.rs"); }
+/// # use generated::DoublePendulum;
+/// use eomgen_runtime::{yoshida4_step, State};
+///
+/// let robot = DoublePendulum::<f64>::default();
+/// let mut s = State::new([core::f64::consts::PI + 0.3, -0.3], [0.0, 0.0]);
+/// let e0 = s.energy(&robot);
+/// for _ in 0..1000 {
+///     s = yoshida4_step(&robot, &s, &[0.0, 0.0], 3e-3);
+/// }
+/// assert!(((s.energy(&robot) - e0) / e0).abs() < 1e-6);
+/// ```
+pub fn yoshida4_step<T, D, const N: usize>(
+    robot: &D,
+    state: &State<T, N>,
+    tau: &[T; N],
+    dt: T,
+) -> State<T, N>
+where
+    T: Real,
+    D: Dynamics<T, N>,
+{
+    let cbrt2 = 1.259_921_049_894_873_2_f64;
+    let w1 = T::from_f64(1.0 / (2.0 - cbrt2));
+    let w0 = T::from_f64(1.0 - 2.0 / (2.0 - cbrt2));
+    let s = implicit_midpoint_step(robot, state, tau, w1 * dt);
+    let s = implicit_midpoint_step(robot, &s, tau, w0 * dt);
+    implicit_midpoint_step(robot, &s, tau, w1 * dt)
+}
+
 /// The fixed-step integration method used by a [`Simulator`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Integrator {
@@ -229,6 +443,13 @@ pub enum Integrator {
     SemiImplicitEuler,
     /// [`rk4_step`]: fourth order, four forward-dynamics calls per step.
     Rk4,
+    /// [`symplectic_euler_step`]: first order, symplectic (on Hamilton's equations, with
+    /// fixed-point iterations).
+    SymplecticEuler,
+    /// [`implicit_midpoint_step`]: second order, symplectic (fixed-point iterations).
+    ImplicitMidpoint,
+    /// [`yoshida4_step`]: fourth order, symplectic (three implicit midpoint steps).
+    Yoshida4,
 }
 
 impl Integrator {
@@ -243,6 +464,9 @@ impl Integrator {
         match self {
             Integrator::SemiImplicitEuler => semi_implicit_euler_step(robot, state, tau, dt),
             Integrator::Rk4 => rk4_step(robot, state, tau, dt),
+            Integrator::SymplecticEuler => symplectic_euler_step(robot, state, tau, dt),
+            Integrator::ImplicitMidpoint => implicit_midpoint_step(robot, state, tau, dt),
+            Integrator::Yoshida4 => yoshida4_step(robot, state, tau, dt),
         }
     }
 }
@@ -330,8 +554,9 @@ impl<'a, T: Real, D: Dynamics<T, N>, const N: usize> Simulator<'a, T, D, N> {
 
     /// Like [`run`](Self::run), but for a continuous-time controller: with
     /// [`Integrator::Rk4`] the effort is re-evaluated at every stage
-    /// ([`rk4_step_closed_loop`]); semi-implicit Euler has a single stage, so it is the same as
-    /// `run` there.
+    /// ([`rk4_step_closed_loop`]); the other integrators hold the effort over the step, as in
+    /// `run` (semi-implicit Euler has a single stage; the symplectic ones keep their structure
+    /// only for an effort that does not depend on the state within the step).
     pub fn run_continuous<F>(&mut self, steps: usize, mut torque: F) -> State<T, N>
     where
         F: FnMut(T, &State<T, N>) -> [T; N],
@@ -344,7 +569,10 @@ impl<'a, T: Real, D: Dynamics<T, N>, const N: usize> Simulator<'a, T, D, N> {
                         rk4_step_closed_loop(self.robot, &self.state, t, self.dt, &mut torque);
                     self.steps += 1;
                 }
-                Integrator::SemiImplicitEuler => {
+                Integrator::SemiImplicitEuler
+                | Integrator::SymplecticEuler
+                | Integrator::ImplicitMidpoint
+                | Integrator::Yoshida4 => {
                     let tau = torque(self.time(), &self.state);
                     self.step(&tau);
                 }

@@ -9,7 +9,7 @@ use eomgen_tests::robots::{
     allegro_regressor, double_pendulum_regressor, joint_effects_regressor, kinova_regressor,
     panda_regressor, ur5_regressor,
 };
-use eomgen_tests::JointMap;
+use eomgen_tests::{JointMap, Lcg};
 use nalgebra::DMatrix;
 use serde_json::Value;
 
@@ -28,25 +28,13 @@ fn numbers(v: &Value) -> Vec<f64> {
         .collect()
 }
 
-/// A small deterministic generator of states.
-struct Lcg(u64);
-
-impl Lcg {
-    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        lo + (hi - lo) * ((self.0 >> 11) as f64 / (1u64 << 53) as f64)
-    }
-
-    fn state<const N: usize>(&mut self) -> ([f64; N], [f64; N], [f64; N]) {
-        (
-            core::array::from_fn(|_| self.uniform(-3.0, 3.0)),
-            core::array::from_fn(|_| self.uniform(-2.0, 2.0)),
-            core::array::from_fn(|_| self.uniform(-2.0, 2.0)),
-        )
-    }
+/// A random state: positions, velocities and accelerations.
+fn state<const N: usize>(rng: &mut Lcg) -> ([f64; N], [f64; N], [f64; N]) {
+    (
+        core::array::from_fn(|_| rng.uniform(-3.0, 3.0)),
+        core::array::from_fn(|_| rng.uniform(-2.0, 2.0)),
+        core::array::from_fn(|_| rng.uniform(-2.0, 2.0)),
+    )
 }
 
 /// Numerical rank, with NumPy's default tolerance (largest singular value times the
@@ -68,7 +56,7 @@ macro_rules! random_identities {
         let mut rng = Lcg(0x0123_4567_89ab_cdef);
         let (mut full, mut reduced) = (Vec::new(), Vec::new());
         for _ in 0..$count {
-            let (q, qd, qdd) = rng.state::<{ $n }>();
+            let (q, qd, qdd) = state::<{ $n }>(&mut rng);
             let (y, yb, tau) = (
                 $robot.regressor(&q, &qd, &qdd),
                 $robot.base_regressor(&q, &qd, &qdd),

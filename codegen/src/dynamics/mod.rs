@@ -19,6 +19,7 @@ mod floating;
 pub mod identification;
 mod lagrangian;
 pub mod newton_euler;
+pub mod projected;
 mod quantities;
 pub mod regressor;
 pub mod rnea_derivatives;
@@ -364,6 +365,13 @@ impl Derivation {
         let extra = quantities::derivatives(self, &derived);
         self.quantities.extend(extra);
         Ok(())
+    }
+
+    /// Each body's share of `M` and `b` by the projected Newton-Euler form, from its own
+    /// Jacobians ([`projected`]; fixed base only): what `eomgen show --form
+    /// projected-newton-euler` prints. The shares sum to `M` (without rotor inertia) and `b`.
+    pub fn projected_newton_euler(&mut self, model: &Model) -> Vec<projected::BodyTerms> {
+        projected::body_terms(&mut self.graph, model, &self.q, &self.qd)
     }
 
     /// The catalogue entry called `name`.

@@ -3,6 +3,7 @@
 //! Code is built as tokens with `quote`, parsed into a `syn::File` (which also proves it is
 //! valid Rust) and formatted with `prettyplease`, so output never depends on a user's rustfmt.
 
+mod actuation;
 mod body;
 mod expr;
 mod identification;

@@ -43,7 +43,7 @@ fn doc(lines: &[String]) -> TokenStream {
     quote!(#(#attrs)*)
 }
 
-fn usize_lit(n: usize) -> Literal {
+pub(super) fn usize_lit(n: usize) -> Literal {
     Literal::usize_unsuffixed(n)
 }
 
@@ -177,6 +177,11 @@ impl Emitter<'_> {
         let parents = self.parents_const();
         let nj = usize_lit(self.model.joints.len());
         let identification = super::identification::constants(d, self.quantities);
+        let actuation = super::actuation::items(
+            self.model,
+            self.has("forward_dynamics")
+                .then(|| self.call("forward_dynamics")),
+        );
         // Without the trait, the joint order still has to be said.
         let joint_names = if self.in_trait {
             TokenStream::new()
@@ -227,17 +232,28 @@ impl Emitter<'_> {
             TokenStream::new()
         };
         quote! {
-            impl #ty<f64> {
-                /// Number of joint coordinates (velocity coordinates with a floating base).
-                pub const DOF: usize = #n;
-                #floating
-            }
-            impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dimensions for #ty<T> {
-                const DOF: usize = #n;
-                const NQ: usize = #nq;
-                const NV: usize = #n;
-            }
-        }
+                    impl #ty<f64> {
+                        /// Number of joint coordinates (velocity coordinates with a floating base).
+                        pub const DOF: usize = #n;
+        <<<<<<< HEAD
+                        #floating
+                    }
+                    impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dimensions for #ty<T> {
+                        const DOF: usize = #n;
+                        const NQ: usize = #nq;
+                        const NV: usize = #n;
+        =======
+                        #sizes
+                        #parents
+                        #joint_names
+                        #identification
+                        #actuation
+                        #try_fd
+                        #(#methods)*
+                        #frames
+        >>>>>>> issue22-forms
+                    }
+                }
     }
 
     /// `pub` in the inherent impl; nothing in the trait's.

@@ -85,6 +85,13 @@ pub struct ModelOptions {
     /// (`contact_jacobian` rows, contact forces). Links merged into their parent by fixed joints
     /// keep their own names (feet usually are such links). Empty by default.
     pub contact_points: Vec<String>,
+    /// Moving joints without an actuator, by URDF name (the acrobot's elbow, a cart-pole's
+    /// pole, a passive wrist or toe): the equation of motion becomes `M qdd + b + G = S^T
+    /// tau_a` with `S` the `NA x N` selection matrix of the actuated joints
+    /// ([`Model::passive`]). An unknown or fixed joint, every joint passive, or a floating
+    /// base is [`ModelError::InvalidPassiveJoints`]. A name listed twice counts once. Empty by
+    /// default.
+    pub passive_joints: Vec<String>,
 }
 
 impl Default for ModelOptions {
@@ -101,6 +108,7 @@ impl Default for ModelOptions {
             inertia_from_collision: None,
             floating_base: false,
             contact_points: Vec::new(),
+            passive_joints: Vec::new(),
         }
     }
 }
@@ -401,6 +409,10 @@ pub enum ModelError {
         joint: String,
         reason: String,
     },
+    /// [`ModelOptions::passive_joints`] names a joint that does not exist or is fixed, leaves
+    /// no joint actuated, or is given for a floating-base robot.
+    #[error("{file}: passive joints: {reason}")]
+    InvalidPassiveJoints { file: String, reason: String },
     /// A numeric option is out of its range (for example a density that is not positive).
     #[error("{file}: option {option}: {reason}")]
     InvalidOption {
@@ -571,6 +583,7 @@ pub(crate) fn build_model(
     }
     mark_symbolic(&mut model, &options.symbolic, file)?;
     model.contacts = contact_frames(&model, &options.contact_points, file)?;
+    model.passive = passive_joints(&model, robot, &options.passive_joints, file)?;
     model.warnings = warnings.clone();
     Ok(model)
 }
@@ -1205,10 +1218,55 @@ fn merge(
         base,
         frames,
         contacts: Vec::new(),
+        passive: Vec::new(),
         include_friction: options.friction,
         coulomb_smoothing: options.coulomb_smoothing,
         warnings: Vec::new(),
     })
+}
+
+/// The indices (in joint order, ascending) of the joints named passive.
+fn passive_joints(
+    model: &Model,
+    robot: &RobotDescription,
+    names: &[String],
+    file: &str,
+) -> Result<Vec<usize>, ModelError> {
+    let error = |reason: String| ModelError::InvalidPassiveJoints {
+        file: file.into(),
+        reason,
+    };
+    if names.is_empty() {
+        return Ok(Vec::new());
+    }
+    if model.is_floating() {
+        return Err(error(format!(
+            "joint `{}` cannot be made passive on a floating-base robot (not supported yet: \
+             the base is already unactuated)",
+            names[0]
+        )));
+    }
+    let mut passive = Vec::new();
+    for name in names {
+        let Some(i) = model.joints.iter().position(|j| &j.name == name) else {
+            return Err(error(if robot.joints.iter().any(|j| &j.name == name) {
+                format!("joint `{name}` is fixed: only moving joints can be passive")
+            } else {
+                format!("joint `{name}` does not exist")
+            }));
+        };
+        if !passive.contains(&i) {
+            passive.push(i);
+        }
+    }
+    if passive.len() == model.joints.len() {
+        return Err(error(format!(
+            "every joint is passive (the last named: `{}`): at least one must be actuated",
+            names[names.len() - 1]
+        )));
+    }
+    passive.sort_unstable();
+    Ok(passive)
 }
 
 /// The frame index of each contact link, in order.

@@ -176,6 +176,9 @@ pub struct Model {
     /// The frames (indices into [`Model::frames`]) with a 3D point contact at their origin
     /// ([`ModelOptions::contact_points`]), in order.
     pub contacts: Vec<usize>,
+    /// The joints without an actuator ([`ModelOptions::passive_joints`]), as indices into
+    /// [`Model::joints`], ascending; empty when every joint is actuated.
+    pub passive: Vec<usize>,
     /// Whether the joint friction (`damping qd + friction sign(qd)` per joint) is part of the
     /// inverse and forward dynamics ([`ModelOptions::friction`]).
     pub include_friction: bool,
@@ -187,6 +190,13 @@ pub struct Model {
 }
 
 impl Model {
+    /// The indices of the actuated joints, ascending: the rows of the selection matrix `S`.
+    pub fn actuated(&self) -> Vec<usize> {
+        (0..self.joints.len())
+            .filter(|i| !self.passive.contains(i))
+            .collect()
+    }
+
     /// Degrees of freedom.
     pub fn dof(&self) -> usize {
         self.joints.len()

@@ -35,6 +35,7 @@
 //! ```
 
 mod base_parameters;
+pub mod forms;
 mod trig;
 
 pub use base_parameters::render_base_parameters;
@@ -178,6 +179,12 @@ pub enum Form {
     Expanded,
     /// Shared temporaries, then the entries.
     Program,
+    /// `M` and `b` as sums of each body's share, from its Jacobians (projected Newton-Euler),
+    /// expanded; [`ShowOptions::terms`] and [`ShowOptions::entry`] do not apply.
+    ProjectedNewtonEuler,
+    /// The Hamiltonian and Hamilton's equations, expanded; [`ShowOptions::terms`] and
+    /// [`ShowOptions::entry`] do not apply.
+    Hamiltonian,
 }
 
 /// What [`render`] prints.
@@ -231,6 +238,10 @@ pub enum ReportError {
     /// Expanding the equations for print ran into the expression graph's node limit.
     #[error("{0} while expanding the equations for print: try --form program")]
     GraphFull(#[from] crate::cas::GraphFull),
+    /// A form of the equations is too large to print (see [`forms::FORMS_MAX_OPS`]), or not
+    /// available for the robot.
+    #[error("{0}")]
+    TooLarge(String),
 }
 
 /// In an expanded numeric entry, terms below this fraction of the entry's largest coefficient
@@ -474,7 +485,7 @@ fn drop_noise(g: &mut Graph, e: Id) -> (Id, usize) {
 
 /// One printed term.
 struct Section {
-    term: Term,
+    title: String,
     /// Expanded entries (name, expression), or the program form.
     body: Body,
     notes: Vec<String>,
@@ -515,26 +526,64 @@ fn section(
     if !skip {
         notes.push(definition.to_string());
     }
-    let name = |idx: &[usize]| entry_name(term, idx, d.dof, syntax);
-    let structural: Vec<(Vec<usize>, Id)> = entries
+    let structural: Vec<Entry> = entries
         .into_iter()
         .filter(|(_, e)| single || g.as_const(*e) != Some(0.0))
+        .map(|(idx, e)| Entry {
+            name: entry_name(term, &idx, d.dof, syntax),
+            text: entry_name(term, &idx, d.dof, Syntax::Text),
+            expr: e,
+        })
         .collect();
-    let mut omitted_zero = !single && structural.len() < all_entries(d, term)?.len();
+    let omitted_zero = !single && structural.len() < all_entries(d, term)?.len();
+    let title = term.title().0.to_string();
+    build_section(
+        g,
+        title,
+        notes,
+        structural,
+        opts,
+        single,
+        omitted_zero,
+        dropped,
+    )
+}
+
+/// An entry to print: its name in the document's syntax and in plain text (for notes), and
+/// its expression.
+struct Entry {
+    name: String,
+    text: String,
+    expr: Id,
+}
+
+/// A section of `entries` under `title`: expanded (the zeros left out unless `single`), or in
+/// program form when an expansion exceeds [`ShowOptions::max_terms`] (a note says which).
+#[allow(clippy::too_many_arguments)]
+fn build_section(
+    g: &mut Graph,
+    title: String,
+    mut notes: Vec<String>,
+    structural: Vec<Entry>,
+    opts: &ShowOptions,
+    single: bool,
+    mut omitted_zero: bool,
+    dropped: &mut usize,
+) -> Result<Section, ReportError> {
     let mut body = None;
-    if opts.form == Form::Expanded {
+    if opts.form != Form::Program {
         let mut out = Vec::with_capacity(structural.len());
         let mut noise = 0;
         let mut too_large = None;
-        for (idx, e) in &structural {
-            let Ok(x) = g.expand_trig(*e, opts.max_terms) else {
-                too_large = Some(entry_name(term, idx, d.dof, Syntax::Text));
+        for entry in &structural {
+            let Ok(x) = g.expand_trig(entry.expr, opts.max_terms) else {
+                too_large = Some(entry.text.clone());
                 break;
             };
             let (x, k) = drop_noise(g, x);
             noise += k;
             if single || g.as_const(x) != Some(0.0) {
-                out.push((name(idx), x));
+                out.push((entry.name.clone(), x));
             } else {
                 omitted_zero = true;
             }
@@ -553,8 +602,8 @@ fn section(
     let body = match body {
         Some(b) => b,
         None => {
-            let names = structural.iter().map(|(idx, _)| name(idx)).collect();
-            let ids = structural.iter().map(|x| x.1).collect();
+            let names = structural.iter().map(|e| e.name.clone()).collect();
+            let ids = structural.iter().map(|e| e.expr).collect();
             Body::Program(names, ids)
         }
     };
@@ -567,7 +616,8 @@ fn section(
     } else if omitted_zero {
         notes.push("Entries not listed are 0.".to_string());
     }
-    Ok(Section { term, body, notes })
+    g.check()?;
+    Ok(Section { title, body, notes })
 }
 
 /// What a parameter symbol stands for, from its name (see [`crate::kinematics::Params`]).
@@ -633,6 +683,20 @@ fn style_of(opts: &ShowOptions) -> Style {
     }
 }
 
+/// [`ShowOptions::entry`] cannot be printed, for `reason`.
+fn invalid_entry(opts: &ShowOptions, reason: &str) -> ReportError {
+    ReportError::InvalidEntry {
+        entry: opts
+            .entry
+            .iter()
+            .flatten()
+            .map(|i| i.to_string())
+            .collect::<Vec<_>>()
+            .join(","),
+        reason: reason.to_string(),
+    }
+}
+
 /// Prints the chosen terms of a derived robot.
 ///
 /// The heading lists the joints (`q1` is the first joint of the model's order); then each
@@ -640,51 +704,69 @@ fn style_of(opts: &ShowOptions) -> Style {
 /// parameters used. Entries that are structurally 0 are not listed (a note says so), unless
 /// [`ShowOptions::entry`] asks for one.
 ///
+/// With [`Form::ProjectedNewtonEuler`] or [`Form::Hamiltonian`], prints that form of the
+/// equations instead of the terms (fixed-base robots, at most [`forms::FORMS_MAX_OPS`]
+/// operations, else [`ReportError::TooLarge`]).
+///
 /// Fails when [`ShowOptions::entry`] names no entry of the term (or is given with other than
-/// exactly one term), and when expanding the entries for print fills the expression graph
-/// ([`ReportError::GraphFull`]).
+/// exactly one term, or with another form), and when expanding the entries for print fills the
+/// expression graph ([`ReportError::GraphFull`]).
 pub fn render(model: &Model, d: &Derivation, opts: &ShowOptions) -> Result<String, ReportError> {
     if opts.entry.is_some() && opts.terms.len() != 1 {
-        return Err(ReportError::InvalidEntry {
-            entry: opts
-                .entry
-                .iter()
-                .flatten()
-                .map(|i| i.to_string())
-                .collect::<Vec<_>>()
-                .join(","),
-            reason: "needs exactly one term".to_string(),
-        });
+        return Err(invalid_entry(opts, "needs exactly one term"));
     }
     let style = style_of(opts);
     let syntax = style.syntax;
     let mut g = d.graph.clone();
     let mut dropped = 0;
-    let mut sections = Vec::with_capacity(opts.terms.len());
-    // Craig's velocity products need qd = dq/dt, which a floating base's velocities are not.
-    let craig = |t: &Term| matches!(t, Term::CoriolisPairs | Term::Centrifugal);
-    for &term in opts
-        .terms
-        .iter()
-        .filter(|t| !(model.is_floating() && craig(t)))
-    {
-        let mut s = section(&mut g, d, term, opts, syntax, &mut dropped)?;
-        if term == Term::Tau && model.include_friction {
-            let sign = if model.coulomb_smoothing > 0.0 {
-                format!(
-                    "qd_i / sqrt(qd_i^2 + {}^2)",
-                    format_number(model.coulomb_smoothing, opts.digits)
-                )
-            } else {
-                "sign(qd_i)".to_string()
-            };
-            s.notes.push(format!(
-                "Plus the joint friction F_i = damping_i qd_i + friction_i {sign}."
-            ));
-        }
-        sections.push(s);
-        g.check()?;
+    let other_form = matches!(opts.form, Form::ProjectedNewtonEuler | Form::Hamiltonian);
+    if other_form && opts.entry.is_some() {
+        return Err(invalid_entry(
+            opts,
+            "is not for the projected Newton-Euler and Hamiltonian forms",
+        ));
     }
+    if other_form && model.is_floating() {
+        return Err(ReportError::TooLarge(format!(
+            "{}: the projected Newton-Euler and Hamiltonian forms are printed for fixed-base \
+             robots only",
+            model.name
+        )));
+    }
+    let sections = match opts.form {
+        Form::ProjectedNewtonEuler => {
+            forms::projected_newton_euler(&mut g, model, d, opts, syntax, &mut dropped)?
+        }
+        Form::Hamiltonian => forms::hamiltonian(&mut g, model, d, opts, syntax, &mut dropped)?,
+        Form::Expanded | Form::Program => {
+            let mut sections = Vec::with_capacity(opts.terms.len());
+            // Craig's velocity products need qd = dq/dt, which a floating base's velocities are not.
+            let craig = |t: &Term| matches!(t, Term::CoriolisPairs | Term::Centrifugal);
+            for &term in opts
+                .terms
+                .iter()
+                .filter(|t| !(model.is_floating() && craig(t)))
+            {
+                let mut s = section(&mut g, d, term, opts, syntax, &mut dropped)?;
+                if term == Term::Tau && model.include_friction {
+                    let sign = if model.coulomb_smoothing > 0.0 {
+                        format!(
+                            "qd_i / sqrt(qd_i^2 + {}^2)",
+                            format_number(model.coulomb_smoothing, opts.digits)
+                        )
+                    } else {
+                        "sign(qd_i)".to_string()
+                    };
+                    s.notes.push(format!(
+                        "Plus the joint friction F_i = damping_i qd_i + friction_i {sign}."
+                    ));
+                }
+                sections.push(s);
+                g.check()?;
+            }
+            sections
+        }
+    };
     let expanded_roots: Vec<Id> = sections
         .iter()
         .filter(|s| matches!(s.body, Body::Expanded(_)))
@@ -838,7 +920,7 @@ pub fn render(model: &Model, d: &Derivation, opts: &ShowOptions) -> Result<Strin
                 let _ = writeln!(out, "  {q}: {what}");
             }
             for (s, body) in sections.iter().zip(&bodies) {
-                let _ = writeln!(out, "\n{}:", s.term.title().0);
+                let _ = writeln!(out, "\n{}:", s.title);
                 for n in &s.notes {
                     let _ = writeln!(out, "  ({n})");
                 }
@@ -878,7 +960,7 @@ pub fn render(model: &Model, d: &Derivation, opts: &ShowOptions) -> Result<Strin
                 let _ = writeln!(out, "%   {q}: {what}");
             }
             for (s, body) in sections.iter().zip(&bodies) {
-                let _ = writeln!(out, "\n% {}", s.term.title().0);
+                let _ = writeln!(out, "\n% {}", s.title);
                 for n in &s.notes {
                     let _ = writeln!(out, "% {n}");
                 }
@@ -904,7 +986,7 @@ pub fn render(model: &Model, d: &Derivation, opts: &ShowOptions) -> Result<Strin
                 let _ = writeln!(out, "| ${q}$ | {} |", md_escape(what));
             }
             for (s, body) in sections.iter().zip(&bodies) {
-                let _ = writeln!(out, "\n## {}\n", s.term.title().0);
+                let _ = writeln!(out, "\n## {}\n", s.title);
                 for n in &s.notes {
                     let _ = writeln!(out, "{}\n", md_escape(n));
                 }
@@ -977,7 +1059,7 @@ fn latex_document(
     }
     let _ = writeln!(out, "\\end{{itemize}}");
     for (s, body) in sections.iter().zip(bodies) {
-        let _ = writeln!(out, "\\section*{{{}}}", tex_escape(s.term.title().0));
+        let _ = writeln!(out, "\\section*{{{}}}", tex_escape(&s.title));
         for n in &s.notes {
             let _ = writeln!(out, "{}\n", tex_escape(n));
         }
