@@ -207,6 +207,7 @@ impl Emitter<'_> {
                 #parents
                 #joint_names
                 #identification
+                #actuation
                 #try_fd
                 #(#methods)*
                 #frames
@@ -232,28 +233,17 @@ impl Emitter<'_> {
             TokenStream::new()
         };
         quote! {
-                    impl #ty<f64> {
-                        /// Number of joint coordinates (velocity coordinates with a floating base).
-                        pub const DOF: usize = #n;
-        <<<<<<< HEAD
-                        #floating
-                    }
-                    impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dimensions for #ty<T> {
-                        const DOF: usize = #n;
-                        const NQ: usize = #nq;
-                        const NV: usize = #n;
-        =======
-                        #sizes
-                        #parents
-                        #joint_names
-                        #identification
-                        #actuation
-                        #try_fd
-                        #(#methods)*
-                        #frames
-        >>>>>>> issue22-forms
-                    }
-                }
+            impl #ty<f64> {
+                /// Number of joint coordinates (velocity coordinates with a floating base).
+                pub const DOF: usize = #n;
+                #floating
+            }
+            impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dimensions for #ty<T> {
+                const DOF: usize = #n;
+                const NQ: usize = #nq;
+                const NV: usize = #n;
+            }
+        }
     }
 
     /// `pub` in the inherent impl; nothing in the trait's.
