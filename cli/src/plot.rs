@@ -247,9 +247,10 @@ pub fn write(path: &Path, fig: &Figure) -> Result<(), String> {
         .map_err(|e| format!("cannot write {e}"))
 }
 
-/// The energy drift of a run: `(E(t) - E(0)) / |E(0)|`, or `E(t) - E(0)` in J when `E(0)` is
-/// about zero (below 1e-9 J or a millionth of the largest |E|). Returns the values (one series),
-/// the series' name and the axis title.
+/// The energy change of a run (its drift when nothing adds or takes energy):
+/// `(E(t) - E(0)) / |E(0)|`, or `E(t) - E(0)` in J when `E(0)` is about zero (below 1e-9 J or
+/// a millionth of the largest |E|). Returns the values (one series), the series' name and the
+/// axis title.
 pub fn energy_drift(energy: &[f64]) -> (Vec<Vec<f64>>, &'static str, &'static str) {
     let e0 = energy.first().copied().unwrap_or(0.0);
     let largest = energy.iter().fold(0.0_f64, |m, e| m.max(e.abs()));
@@ -258,11 +259,11 @@ pub fn energy_drift(energy: &[f64]) -> (Vec<Vec<f64>>, &'static str, &'static st
         (
             values,
             "(E - E0) / |E0|",
-            "relative energy drift (E - E0) / |E0|",
+            "relative energy change (E - E0) / |E0|",
         )
     } else {
         let values = energy.iter().map(|e| vec![e - e0]).collect();
-        (values, "E - E0", "energy drift E - E0 (J)")
+        (values, "E - E0", "energy change E - E0 (J)")
     }
 }
 
@@ -274,4 +275,53 @@ pub fn columns(values: &[Vec<f64>], cols: std::ops::Range<usize>) -> Vec<Vec<f64
 /// Writes the figures, each to its file.
 pub fn write_all(figures: &[(PathBuf, Figure)]) -> Result<(), String> {
     figures.iter().try_for_each(|(path, fig)| write(path, fig))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn formats_come_from_the_extension() {
+        assert_eq!(Format::of(Path::new("a/b.svg")), Ok(Format::Svg));
+        assert_eq!(Format::of(Path::new("b.PNG")), Ok(Format::Png));
+        for bad in ["b.pdf", "b", "b.svg.txt"] {
+            let e = Format::of(Path::new(bad)).unwrap_err();
+            assert!(e.contains(bad) && e.contains(".svg or .png"), "{e}");
+        }
+        assert_eq!(
+            sibling(Path::new("run/ur5.png"), "energy"),
+            Path::new("run/ur5-energy.png")
+        );
+    }
+
+    #[test]
+    fn units_follow_the_joints() {
+        assert_eq!(unit(&[true, true], "rad", "m"), "rad");
+        assert_eq!(unit(&[false], "rad", "m"), "m");
+        assert_eq!(unit(&[true, false], "N m", "N"), "N m or N");
+    }
+
+    #[test]
+    fn energy_is_relative_unless_it_starts_at_zero() {
+        let (v, name, label) = energy_drift(&[-2.0, -1.0, -3.0]);
+        assert_eq!(v, [[0.0], [0.5], [-0.5]]);
+        assert_eq!(name, "(E - E0) / |E0|");
+        assert!(label.starts_with("relative"));
+        let (v, name, label) = energy_drift(&[1e-12, 2.0, 1.0]);
+        assert_eq!(v[1], [2.0 - 1e-12]);
+        assert_eq!(name, "E - E0");
+        assert!(label.ends_with("(J)"));
+    }
+
+    #[test]
+    fn ticks_have_the_decimals_they_need() {
+        assert_eq!(tick(0.2, 1.0, 1.0), "0.2");
+        assert_eq!(tick(0.05, 0.3, 0.3), "0.05");
+        assert_eq!(tick(0.10, 0.3, 0.3), "0.10");
+        assert_eq!(tick(-2.0, 9.6, 6.0), "-2");
+        assert_eq!(tick(5e-29, 1e-12, 1e-12), "0");
+        assert_eq!(tick(-2.5e-13, 3e-13, 3e-13), "-2.50e-13");
+        assert_eq!(tick(25.0, 2e-3, 25.0), "2.50e1");
+    }
 }
