@@ -10,6 +10,7 @@ mod conditioning;
 mod eval;
 mod floating_base;
 mod info;
+mod plot;
 mod progress;
 mod simulate;
 mod simulate_floating;
@@ -416,9 +417,11 @@ struct SimulateArgs {
     /// of the CSV to stdout.
     #[arg(long, value_name = "FILE")]
     csv: Option<PathBuf>,
-    /// Also writes an SVG plot of the joint positions against time to FILE (with a floating
-    /// base: the base position, and the vertical contact forces to FILE's stem + `-forces.svg`).
-    #[arg(long, value_name = "FILE.svg")]
+    /// Also plots the run, as SVG or PNG by FILE's extension: the joint positions against time
+    /// to FILE, and beside it FILE-velocities, FILE-efforts and FILE-energy (the energy drift).
+    /// With a floating base, FILE has the base position, FILE-forces the vertical contact
+    /// forces and FILE-joints the joint positions.
+    #[arg(long, value_name = "FILE.svg|FILE.png")]
     plot: Option<PathBuf>,
     /// With --floating-base: the base's initial position and orientation (a unit quaternion
     /// x, y, z, w) [default: 0,0,0,0,0,0,1]
@@ -845,32 +848,13 @@ fn simulate_floating_cmd(a: SimulateArgs, b: Builder, model: Model) -> Result<()
         kd: a.kd,
         omega: a.omega,
     };
+    if let Some(path) = &a.plot {
+        plot::Format::of(path).map_err(Failure)?;
+    }
     let d = derive(&b, &model)?;
     let outcome = simulate_floating::run(&model, &d, &options).map_err(Failure)?;
     if let Some(path) = &a.plot {
-        let write = |path: &Path, svg: String| {
-            std::fs::write(path, svg)
-                .map_err(|e| Failure(format!("cannot write {}: {e}", path.display())))
-        };
-        let title = format!("{}: base position (m)", model.name);
-        write(
-            path,
-            simulate::svg(&title, &["x", "y", "z"], &outcome.times, &outcome.base),
-        )?;
-        if !model.contacts.is_empty() {
-            let names: Vec<&str> = model
-                .contacts
-                .iter()
-                .map(|&f| model.frames[f].name.as_str())
-                .collect();
-            let title = format!("{}: vertical contact forces (N)", model.name);
-            let stem = path.with_extension("");
-            let forces = PathBuf::from(format!("{}-forces.svg", stem.display()));
-            write(
-                &forces,
-                simulate::svg(&title, &names, &outcome.times, &outcome.forces),
-            )?;
-        }
+        floating_plots(path, &model, &options, &outcome).map_err(Failure)?;
     }
     csv_or_summary(a.csv.as_deref(), &outcome.csv, &outcome.summary)
 }
@@ -975,14 +959,220 @@ fn simulate_cmd(a: SimulateArgs) -> Result<(), Failure> {
             }
         },
     };
+    if let Some(path) = &a.plot {
+        plot::Format::of(path).map_err(Failure)?;
+    }
     let d = derive(&b, &model)?;
     let outcome = simulate::run(&model, &d, &options).map_err(Failure)?;
     if let Some(path) = &a.plot {
-        let names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
-        let title = format!("{}: joint positions", model.name);
-        let svg = simulate::svg(&title, &names, &outcome.times, &outcome.positions);
-        std::fs::write(path, svg)
-            .map_err(|e| Failure(format!("cannot write {}: {e}", path.display())))?;
+        fixed_plots(path, &model, &options, &outcome).map_err(Failure)?;
     }
     csv_or_summary(a.csv.as_deref(), &outcome.csv, &outcome.summary)
+}
+
+/// The title of the energy plot: whether the run should conserve energy.
+fn energy_title(
+    name: &str,
+    integrator: &str,
+    controlled: bool,
+    dissipative: bool,
+    dt: f64,
+) -> String {
+    match (controlled, dissipative) {
+        (true, _) => format!("{name}: energy (controlled run: not conserved by design)"),
+        (false, true) => format!("{name}: energy (damped run: not conserved by design)"),
+        (false, false) => format!("{name}: energy drift of {integrator} (dt = {dt} s)"),
+    }
+}
+
+/// The plots of a fixed-base run: positions to `path`, velocities, efforts and energy beside.
+fn fixed_plots(
+    path: &Path,
+    model: &Model,
+    o: &simulate::Options,
+    out: &simulate::Outcome,
+) -> Result<(), String> {
+    let name = &model.name;
+    let names: Vec<String> = model.joints.iter().map(|j| j.name.clone()).collect();
+    let rotating: Vec<bool> = model.joints.iter().map(|j| j.kind.is_revolute()).collect();
+    let controlled = o.controller != simulate::Controller::None;
+    let (energy, series, y_label) = plot::energy_drift(&out.energy);
+    let figure = |title: String, y_label: String, names: Vec<String>, values| plot::Figure {
+        title,
+        y_label,
+        names,
+        times: &out.times,
+        values,
+    };
+    let efforts = if controlled {
+        format!("{name}: joint efforts of the controller")
+    } else {
+        format!("{name}: joint efforts (no controller: none applied)")
+    };
+    plot::write_all(&[
+        (
+            path.to_path_buf(),
+            figure(
+                format!("{name}: joint positions"),
+                format!("position ({})", plot::unit(&rotating, "rad", "m")),
+                names.clone(),
+                &out.positions,
+            ),
+        ),
+        (
+            plot::sibling(path, "velocities"),
+            figure(
+                format!("{name}: joint velocities"),
+                format!("velocity ({})", plot::unit(&rotating, "rad/s", "m/s")),
+                names.clone(),
+                &out.velocities,
+            ),
+        ),
+        (
+            plot::sibling(path, "efforts"),
+            figure(
+                efforts,
+                format!("effort ({})", plot::unit(&rotating, "N m", "N")),
+                names,
+                &out.efforts,
+            ),
+        ),
+        (
+            plot::sibling(path, "energy"),
+            figure(
+                energy_title(name, o.integrator.name(), controlled, out.dissipative, o.dt),
+                y_label.to_string(),
+                vec![series.to_string()],
+                &energy,
+            ),
+        ),
+    ])
+}
+
+/// The plots of a floating-base run: the base position to `path`; beside it the vertical
+/// contact forces, the joint positions, the velocities and efforts (the joints', or the
+/// base's without joints) and the energy.
+fn floating_plots(
+    path: &Path,
+    model: &Model,
+    o: &simulate_floating::Options,
+    out: &simulate_floating::Outcome,
+) -> Result<(), String> {
+    let name = &model.name;
+    let nj = out.joints.first().map_or(0, Vec::len);
+    let joints: Vec<String> = model
+        .joints
+        .iter()
+        .take(nj)
+        .map(|j| j.name.clone())
+        .collect();
+    let rotating: Vec<bool> = model
+        .joints
+        .iter()
+        .take(nj)
+        .map(|j| j.kind.is_revolute())
+        .collect();
+    let nv = 6 + nj;
+    let controlled = o.controller != simulate_floating::Controller::None;
+    let xyz = |prefix: &str| ["x", "y", "z"].map(|c| format!("{prefix}{c}")).to_vec();
+    let (energy, series, energy_label) = plot::energy_drift(&out.energy);
+    let base_v = plot::columns(&out.velocities, 0..3);
+    let joint_v = plot::columns(&out.velocities, 6..nv);
+    let base_f = plot::columns(&out.efforts, 0..3);
+    let joint_f = plot::columns(&out.efforts, 6..nv);
+    let figure = |title: String, y_label: &str, names: Vec<String>, values| plot::Figure {
+        title,
+        y_label: y_label.to_string(),
+        names,
+        times: &out.times,
+        values,
+    };
+    let mut figures = vec![(
+        path.to_path_buf(),
+        figure(
+            format!("{name}: base position"),
+            "position (m)",
+            xyz(""),
+            &out.base,
+        ),
+    )];
+    if !model.contacts.is_empty() {
+        let feet = model
+            .contacts
+            .iter()
+            .map(|&f| model.frames[f].name.clone())
+            .collect();
+        figures.push((
+            plot::sibling(path, "forces"),
+            figure(
+                format!("{name}: vertical contact forces"),
+                "vertical force (N)",
+                feet,
+                &out.forces,
+            ),
+        ));
+    }
+    if nj > 0 {
+        let unit = |a, l| plot::unit(&rotating, a, l);
+        figures.extend([
+            (
+                plot::sibling(path, "joints"),
+                figure(
+                    format!("{name}: joint positions"),
+                    &format!("position ({})", unit("rad", "m")),
+                    joints.clone(),
+                    &out.joints,
+                ),
+            ),
+            (
+                plot::sibling(path, "velocities"),
+                figure(
+                    format!("{name}: joint velocities"),
+                    &format!("velocity ({})", unit("rad/s", "m/s")),
+                    joints.clone(),
+                    &joint_v,
+                ),
+            ),
+            (
+                plot::sibling(path, "efforts"),
+                figure(
+                    format!("{name}: joint efforts"),
+                    &format!("effort ({})", unit("N m", "N")),
+                    joints,
+                    &joint_f,
+                ),
+            ),
+        ]);
+    } else {
+        figures.push((
+            plot::sibling(path, "velocities"),
+            figure(
+                format!("{name}: base linear velocity (base axes)"),
+                "velocity (m/s)",
+                xyz("v"),
+                &base_v,
+            ),
+        ));
+        if controlled {
+            figures.push((
+                plot::sibling(path, "efforts"),
+                figure(
+                    format!("{name}: force on the base (base axes)"),
+                    "force (N)",
+                    xyz("f"),
+                    &base_f,
+                ),
+            ));
+        }
+    }
+    figures.push((
+        plot::sibling(path, "energy"),
+        figure(
+            energy_title(name, "RK4", controlled, out.dissipative, o.dt),
+            energy_label,
+            vec![series.to_string()],
+            &energy,
+        ),
+    ));
+    plot::write_all(&figures)
 }

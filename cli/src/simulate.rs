@@ -41,7 +41,8 @@ pub enum Integrator {
 }
 
 impl Integrator {
-    fn name(self) -> &'static str {
+    /// The method's name, for the summary and the plots.
+    pub fn name(self) -> &'static str {
         match self {
             Integrator::Rk4 => "RK4",
             Integrator::Symplectic(Method::SymplecticEuler) => "symplectic Euler",
@@ -69,13 +70,19 @@ pub struct Options {
     pub integrator: Integrator,
 }
 
-/// The result: the CSV text, a one-paragraph summary and the joint trajectories.
+/// The result: the CSV text, a one-paragraph summary and the sampled trajectories.
 pub struct Outcome {
     pub csv: String,
     pub summary: String,
-    /// Sample times and, per sample, the joint positions.
+    /// Sample times and, per sample, the joint positions, velocities and applied efforts, and
+    /// the total energy (kinetic plus potential, J).
     pub times: Vec<f64>,
     pub positions: Vec<Vec<f64>>,
+    pub velocities: Vec<Vec<f64>>,
+    pub efforts: Vec<Vec<f64>>,
+    pub energy: Vec<f64>,
+    /// Whether friction or damping took energy out during the run (`--friction`).
+    pub dissipative: bool,
 }
 
 /// Positions (rad, m) or velocities (rad/s, m/s) beyond this mean the integration diverged.
@@ -128,6 +135,15 @@ fn terms(model: &Model, d: &Derivation, q: &[f64], qd: &[f64]) -> Result<eval::V
     )
 }
 
+/// What one evaluation gives: the controller's effort, the resulting acceleration, the total
+/// energy and whether friction acts.
+struct Step {
+    tau: Vec<f64>,
+    qdd: Vec<f64>,
+    energy: f64,
+    friction: bool,
+}
+
 /// The controller's effort and the resulting acceleration at `(q, qd)`.
 fn step_eval(
     model: &Model,
@@ -135,7 +151,7 @@ fn step_eval(
     o: &Options,
     q: &[f64],
     qd: &[f64],
-) -> Result<(Vec<f64>, Vec<f64>), StepError> {
+) -> Result<Step, StepError> {
     let n = q.len();
     let v = terms(model, d, q, qd).map_err(StepError::Eval)?;
     // The effort friction takes (zero unless the model includes it, `--friction`).
@@ -172,7 +188,12 @@ fn step_eval(
         pivot: k + 1,
         of: n,
     })?;
-    Ok((tau, qdd))
+    Ok(Step {
+        tau,
+        qdd,
+        energy: v.kinetic_energy + v.potential_energy,
+        friction: friction.iter().any(|f| *f != 0.0),
+    })
 }
 
 /// Collocated partial feedback linearization for the (single) passive joint `u`: `v` on the
@@ -259,31 +280,46 @@ pub fn run(model: &Model, d: &Derivation, o: &Options) -> Result<Outcome, String
     }
     csv.push('\n');
     let (mut q, mut qd) = (o.q0.clone(), o.qd0.clone());
-    let e = |q: &[f64], qd: &[f64]| -> Result<f64, String> {
-        let v = terms(model, d, q, qd)?;
-        Ok(v.kinetic_energy + v.potential_energy)
-    };
-    let e0 = e(&q, &qd)?;
     let h = o.dt;
-    let (mut times, mut positions) = (Vec::new(), Vec::new());
+    let mut out = Outcome {
+        csv,
+        summary: String::new(),
+        times: Vec::new(),
+        positions: Vec::new(),
+        velocities: Vec::new(),
+        efforts: Vec::new(),
+        energy: Vec::new(),
+        dissipative: false,
+    };
+    let record = |out: &mut Outcome, t: f64, q: &[f64], qd: &[f64], s: &Step| {
+        row(&mut out.csv, t, q, qd, &s.tau);
+        out.times.push(t);
+        out.positions.push(q.to_vec());
+        out.velocities.push(qd.to_vec());
+        out.efforts.push(s.tau.clone());
+        out.energy.push(s.energy);
+        out.dissipative |= s.friction;
+    };
     let fail = |e: StepError, t: f64| step_message(e, &model.name, t, h);
     for k in 0..steps {
         let t = k as f64 * h;
-        let (tau, a1) = step_eval(model, d, o, &q, &qd).map_err(|e| fail(e, t))?;
-        row(&mut csv, t, &q, &qd, &tau);
-        times.push(t);
-        positions.push(q.clone());
+        let first = step_eval(model, d, o, &q, &qd).map_err(|e| fail(e, t))?;
+        record(&mut out, t, &q, &qd, &first);
         match o.integrator {
             Integrator::Rk4 => {
+                let a1 = first.qdd;
                 let v1 = qd.clone();
-                let stage =
-                    |q: &[f64], v: &[f64]| step_eval(model, d, o, q, v).map_err(|e| fail(e, t + h));
+                let stage = |q: &[f64], v: &[f64]| {
+                    step_eval(model, d, o, q, v)
+                        .map(|s| s.qdd)
+                        .map_err(|e| fail(e, t + h))
+                };
                 let (q2, v2) = (axpy(&q, h / 2.0, &v1), axpy(&qd, h / 2.0, &a1));
-                let (_, a2) = stage(&q2, &v2)?;
+                let a2 = stage(&q2, &v2)?;
                 let (q3, v3) = (axpy(&q, h / 2.0, &v2), axpy(&qd, h / 2.0, &a2));
-                let (_, a3) = stage(&q3, &v3)?;
+                let a3 = stage(&q3, &v3)?;
                 let (q4, v4) = (axpy(&q, h, &v3), axpy(&qd, h, &a3));
-                let (_, a4) = stage(&q4, &v4)?;
+                let a4 = stage(&q4, &v4)?;
                 for i in 0..q.len() {
                     q[i] += h / 6.0 * (v1[i] + 2.0 * (v2[i] + v3[i]) + v4[i]);
                     qd[i] += h / 6.0 * (a1[i] + 2.0 * (a2[i] + a3[i]) + a4[i]);
@@ -314,8 +350,8 @@ pub fn run(model: &Model, d: &Derivation, o: &Options) -> Result<Outcome, String
                     rate: &rate,
                     solve: &solve,
                 };
-                (q, qd) =
-                    symplectic::step(&sys, method, &q, &qd, &tau, h).map_err(|e| fail(e, t + h))?;
+                (q, qd) = symplectic::step(&sys, method, &q, &qd, &first.tau, h)
+                    .map_err(|e| fail(e, t + h))?;
             }
         }
         if q.iter()
@@ -326,18 +362,16 @@ pub fn run(model: &Model, d: &Derivation, o: &Options) -> Result<Outcome, String
         }
     }
     let t_end = steps as f64 * h;
-    let (tau, _) = step_eval(model, d, o, &q, &qd).map_err(|e| fail(e, t_end))?;
-    row(&mut csv, t_end, &q, &qd, &tau);
-    times.push(t_end);
-    positions.push(q.clone());
-    let e_end = e(&q, &qd)?;
+    let last = step_eval(model, d, o, &q, &qd).map_err(|e| fail(e, t_end))?;
+    record(&mut out, t_end, &q, &qd, &last);
+    let (e0, e_end) = (out.energy[0], last.energy);
     let fmt = |v: &[f64]| {
         v.iter()
             .map(|x| format!("{x:.6}"))
             .collect::<Vec<_>>()
             .join(", ")
     };
-    let mut summary = format!(
+    out.summary = format!(
         "{}: {} {} steps of {h} s to t = {t_end} s\nq  = [{}]\nqd = [{}]\n",
         model.name,
         steps,
@@ -347,7 +381,7 @@ pub fn run(model: &Model, d: &Derivation, o: &Options) -> Result<Outcome, String
     );
     if matches!(o.controller, Controller::None | Controller::Pfl) {
         let _ = writeln!(
-            summary,
+            out.summary,
             "energy: {e0:.9e} J at t = 0, {e_end:.9e} J at the end (change {:.3e} J)",
             e_end - e0
         );
@@ -355,115 +389,7 @@ pub fn run(model: &Model, d: &Derivation, o: &Options) -> Result<Outcome, String
         let err = (0..q.len())
             .map(|i| (q[i] - o.target[i]).abs())
             .fold(0.0, f64::max);
-        let _ = writeln!(summary, "max |q - target| at the end: {err:.3e}");
+        let _ = writeln!(out.summary, "max |q - target| at the end: {err:.3e}");
     }
-    Ok(Outcome {
-        csv,
-        summary,
-        times,
-        positions,
-    })
-}
-
-/// Escapes text for SVG/XML.
-fn xml(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
-}
-
-/// An SVG line plot of every joint position against time: one `<polyline>` per joint (class
-/// `trajectory`, attribute `data-joint` with the joint's name), a frame with the time and
-/// position ranges, and a legend. Written by hand to keep the command line free of a plotting
-/// dependency; at most about 2000 points per line.
-pub fn svg(title: &str, joints: &[&str], times: &[f64], positions: &[Vec<f64>]) -> String {
-    const PALETTE: [&str; 10] = [
-        "#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f",
-        "#bcbd22", "#17becf",
-    ];
-    let (w, h, left, right, top, bottom) = (900.0, 480.0, 70.0, 170.0, 40.0, 50.0);
-    let (pw, ph) = (w - left - right, h - top - bottom);
-    let t_max = times.last().copied().unwrap_or(0.0).max(f64::MIN_POSITIVE);
-    let t_min = times.first().copied().unwrap_or(0.0).min(t_max);
-    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    for q in positions.iter().flatten().filter(|x| x.is_finite()) {
-        lo = lo.min(*q);
-        hi = hi.max(*q);
-    }
-    // No finite sample at all: an arbitrary range.
-    if lo > hi {
-        (lo, hi) = (-1.0, 1.0);
-    }
-    if hi - lo < 1e-9 {
-        (lo, hi) = (lo - 0.5, hi + 0.5);
-    }
-    let x = |t: f64| left + pw * (t - t_min) / (t_max - t_min).max(f64::MIN_POSITIVE);
-    let y = |q: f64| top + ph * (hi - q) / (hi - lo);
-    let stride = (times.len() / 2000).max(1);
-    let mut out = String::new();
-    let _ = writeln!(
-        out,
-        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" \
-         viewBox=\"0 0 {w} {h}\" font-family=\"sans-serif\" font-size=\"12\">"
-    );
-    let _ = writeln!(out, "<rect width=\"{w}\" height=\"{h}\" fill=\"white\"/>");
-    let _ = writeln!(
-        out,
-        "<text x=\"{}\" y=\"24\" text-anchor=\"middle\" font-size=\"15\">{}</text>",
-        left + pw / 2.0,
-        xml(title)
-    );
-    let _ = writeln!(
-        out,
-        "<rect x=\"{left}\" y=\"{top}\" width=\"{pw}\" height=\"{ph}\" fill=\"none\" \
-         stroke=\"black\"/>"
-    );
-    let labels = [
-        (left, h - bottom + 18.0, "start", format!("{t_min} s")),
-        (left + pw, h - bottom + 18.0, "end", format!("{t_max} s")),
-        (left + pw / 2.0, h - 12.0, "middle", "time (s)".to_string()),
-        (left - 6.0, top + 4.0, "end", format!("{hi:.4}")),
-        (left - 6.0, top + ph, "end", format!("{lo:.4}")),
-        (left - 6.0, top + ph / 2.0, "end", "q (rad, m)".to_string()),
-    ];
-    for (lx, ly, anchor, text) in labels {
-        let _ = writeln!(
-            out,
-            "<text x=\"{lx}\" y=\"{ly}\" text-anchor=\"{anchor}\">{}</text>",
-            xml(&text)
-        );
-    }
-    for (j, name) in joints.iter().enumerate() {
-        let color = PALETTE[j % PALETTE.len()];
-        let mut points = String::new();
-        let samples = times.iter().zip(positions).enumerate();
-        for (k, (t, q)) in samples {
-            let keep = k % stride == 0 || k + 1 == times.len();
-            if let (true, Some(qj)) = (keep, q.get(j).filter(|v| v.is_finite())) {
-                let _ = write!(points, "{:.2},{:.2} ", x(*t), y(*qj));
-            }
-        }
-        let _ = writeln!(
-            out,
-            "<polyline class=\"trajectory\" data-joint=\"{}\" fill=\"none\" \
-             stroke=\"{color}\" stroke-width=\"1.5\" points=\"{}\"/>",
-            xml(name),
-            points.trim_end()
-        );
-        let ly = top + 14.0 + 18.0 * j as f64;
-        let lx = w - right + 12.0;
-        let _ = writeln!(
-            out,
-            "<line x1=\"{lx}\" y1=\"{}\" x2=\"{}\" y2=\"{}\" stroke=\"{color}\" \
-             stroke-width=\"3\"/><text x=\"{}\" y=\"{ly}\">{}</text>",
-            ly - 4.0,
-            lx + 20.0,
-            ly - 4.0,
-            lx + 26.0,
-            xml(name)
-        );
-    }
-    out.push_str("</svg>\n");
-    out
+    Ok(out)
 }

@@ -47,13 +47,22 @@ pub struct Options {
     pub omega: f64,
 }
 
-/// The result: CSV, summary, and per sample the base position and the contact forces.
+/// The result: CSV, summary, and per sample the base position, the vertical contact forces,
+/// the velocities (NV: the base's in its axes, then the joints'), the efforts (NV: the wrench
+/// on the base, then the joints') and the total energy (J).
 pub struct Outcome {
     pub csv: String,
     pub summary: String,
     pub times: Vec<f64>,
     pub base: Vec<Vec<f64>>,
     pub forces: Vec<Vec<f64>>,
+    /// The joint positions (NQ - 7).
+    pub joints: Vec<Vec<f64>>,
+    pub velocities: Vec<Vec<f64>>,
+    pub efforts: Vec<Vec<f64>>,
+    pub energy: Vec<f64>,
+    /// Whether friction or damping took energy out during the run (`--friction`).
+    pub dissipative: bool,
 }
 
 /// Everything the dynamics needs at one state.
@@ -66,6 +75,8 @@ struct Terms {
     j: DMatrix<f64>,
     drift: DVector<f64>,
     energy: f64,
+    /// Whether friction acts at this state.
+    friction: bool,
 }
 
 fn terms(d: &Derivation, q: &[f64], v: &[f64]) -> Result<Terms, String> {
@@ -107,6 +118,7 @@ fn terms(d: &Derivation, q: &[f64], v: &[f64]) -> Result<Terms, String> {
         j,
         drift,
         energy: e[0] + e[1],
+        friction: f.iter().any(|x| *x != 0.0),
     })
 }
 
@@ -181,8 +193,9 @@ fn attitude_error(q: &[f64]) -> [f64; 3] {
     [sign * q[0], sign * q[1], sign * q[2]]
 }
 
-/// One evaluation: accelerations, effort and contact forces at `(q, v)`.
-type Eval = (DVector<f64>, DVector<f64>, DVector<f64>, f64);
+/// One evaluation: accelerations, effort, contact forces, energy and whether friction acts at
+/// `(q, v)`.
+type Eval = (DVector<f64>, DVector<f64>, DVector<f64>, f64, bool);
 
 fn evaluate(
     d: &Derivation,
@@ -196,7 +209,7 @@ fn evaluate(
     let tau = control(o, &terms, q, v);
     match accelerations(&terms, &tau) {
         Some((a, f)) if a.iter().chain(f.iter()).all(|x| x.is_finite()) => {
-            Ok((a, tau, f, terms.energy))
+            Ok((a, tau, f, terms.energy, terms.friction))
         }
         _ if t == 0.0 => Err(format!(
             "{name}: the mass matrix or the contacts' J M^-1 J^T is not positive definite at \
@@ -229,15 +242,22 @@ pub fn run(model: &Model, d: &Derivation, o: &Options) -> Result<Outcome, String
         times: Vec::new(),
         base: Vec::new(),
         forces: Vec::new(),
+        joints: Vec::new(),
+        velocities: Vec::new(),
+        efforts: Vec::new(),
+        energy: Vec::new(),
+        dissipative: false,
     };
     let (mut worst_contact, mut e0, mut e_end) = (0.0_f64, 0.0, 0.0);
     for step in 0..=steps {
         let t = step as f64 * o.dt;
-        let (a1, tau, f, energy) = evaluate(d, o, &model.name, &q, v.as_slice(), t)?;
+        let (a1, tau, f, energy, friction) = evaluate(d, o, &model.name, &q, v.as_slice(), t)?;
         if step == 0 {
             e0 = energy;
         }
         e_end = energy;
+        out.energy.push(energy);
+        out.dissipative |= friction;
         if k3 > 0 {
             let terms = terms(d, &q, v.as_slice())?;
             let res = &terms.j * &a1 + &terms.drift;
@@ -347,6 +367,9 @@ fn record(
     out.base.push(q[..3].to_vec());
     out.forces
         .push(f.iter().skip(2).step_by(3).copied().collect());
+    out.joints.push(q[7..].to_vec());
+    out.velocities.push(v.iter().copied().collect());
+    out.efforts.push(tau.iter().copied().collect());
 }
 
 fn summary(

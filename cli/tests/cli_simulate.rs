@@ -144,66 +144,6 @@ fn gravity_compensation_holds_still_and_bad_input_fails() {
     assert_eq!(out.status.code(), Some(1));
 }
 
-#[test]
-fn plot_has_one_trajectory_per_joint() {
-    let dir = std::env::temp_dir().join(format!("eomgen-plot-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join("ur5.svg");
-    ok(&[
-        "simulate",
-        "tests/robots/ur5.urdf",
-        "--duration",
-        "0.3",
-        "--q0",
-        "0.1,-1.2,1.4,-1,-1.5,0.3",
-        "--controller",
-        "computed-torque",
-        "--target",
-        "0.3,-1,1.2,-0.8,-1.3,0.5",
-        "--plot",
-        file.to_str().unwrap(),
-    ]);
-    let svg = std::fs::read_to_string(&file).unwrap();
-    std::fs::remove_dir_all(&dir).unwrap();
-    assert!(svg.starts_with("<svg xmlns=\"http://www.w3.org/2000/svg\""));
-    assert!(svg.trim_end().ends_with("</svg>"));
-    let joints = [
-        "shoulder_pan_joint",
-        "shoulder_lift_joint",
-        "elbow_joint",
-        "wrist_1_joint",
-        "wrist_2_joint",
-        "wrist_3_joint",
-    ];
-    let lines: Vec<&str> = svg
-        .lines()
-        .filter(|l| l.starts_with("<polyline class=\"trajectory\""))
-        .collect();
-    assert_eq!(lines.len(), joints.len(), "one trajectory per joint");
-    for (line, joint) in lines.iter().zip(joints) {
-        assert!(line.contains(&format!("data-joint=\"{joint}\"")), "{joint}");
-        let points = line
-            .split("points=\"")
-            .nth(1)
-            .unwrap()
-            .trim_end_matches("\"/>");
-        let xy: Vec<(f64, f64)> = points
-            .split(' ')
-            .map(|p| {
-                let (x, y) = p.split_once(',').unwrap();
-                (x.parse().unwrap(), y.parse().unwrap())
-            })
-            .collect();
-        // Every sample (300 steps and the initial state), inside the 900 x 480 picture, in
-        // time order.
-        assert_eq!(xy.len(), 301);
-        assert!(xy.windows(2).all(|w| w[1].0 > w[0].0));
-        assert!(xy
-            .iter()
-            .all(|&(x, y)| (0.0..=900.0).contains(&x) && (0.0..=480.0).contains(&y)));
-    }
-}
-
 /// `--friction` applies the URDF's `<dynamics damping friction>`: the double pendulum's
 /// energy then drops, and computed torque on the allegro hand (damping and Coulomb friction on
 /// every joint) compensates it exactly, so the error still decays as `(1 + w t) exp(-w t)`.

@@ -156,7 +156,20 @@ fn a_drone_hovers_to_its_target() {
         "{out}"
     );
     let svg = std::fs::read_to_string(&plot).unwrap();
-    assert_eq!(svg.matches("<polyline class=\"trajectory\"").count(), 3);
+    assert!(svg.contains(">\niris: base position\n</text>"), "{svg}");
+    let lines = svg
+        .lines()
+        .filter(|l| l.starts_with("<polyline") && l.contains("stroke-width=\"2\""));
+    assert_eq!(lines.count(), 3, "x, y and z");
+    // Without joints: the base's velocity, the hover's force on the base and the energy.
+    for (file, label) in [
+        ("iris-velocities.svg", "velocity (m/s)"),
+        ("iris-efforts.svg", "force (N)"),
+        ("iris-energy.svg", "not conserved by design"),
+    ] {
+        let svg = std::fs::read_to_string(dir.join(file)).unwrap();
+        assert!(svg.contains(label), "{file}: {svg}");
+    }
     let header = std::fs::read_to_string(&csv).unwrap();
     assert!(header.starts_with("t,base_x,base_y,base_z,base_qx,base_qy,base_qz,base_qw,base_vx"));
 }
@@ -211,7 +224,23 @@ fn a_quadruped_stands_on_its_four_feet() {
     let end = numbers_after(&out, "m at t = 0, (");
     assert!((end[2] - 0.5).abs() < 1e-6, "{out}");
     let forces_plot = std::fs::read_to_string(dir.join("anymal-forces.svg")).unwrap();
-    assert_eq!(forces_plot.matches("data-joint=\"LF_FOOT\"").count(), 1);
+    assert_eq!(forces_plot.matches(">\nLF_FOOT\n</text>").count(), 1);
+    assert!(forces_plot.contains(">\nvertical force (N)\n</text>"));
+    // With joints: their positions, velocities and efforts beside, and the energy.
+    for (file, label) in [
+        ("anymal-joints.svg", "position (rad)"),
+        ("anymal-velocities.svg", "velocity (rad/s)"),
+        ("anymal-efforts.svg", "effort (N m)"),
+        ("anymal-energy.svg", "not conserved by design"),
+    ] {
+        let svg = std::fs::read_to_string(dir.join(file)).unwrap();
+        assert!(svg.contains(label), "{file}");
+        assert_eq!(
+            svg.matches(">\nLF_HFE\n</text>").count(),
+            usize::from(file != "anymal-energy.svg"),
+            "{file}"
+        );
+    }
 }
 
 #[test]
