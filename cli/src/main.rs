@@ -109,6 +109,10 @@ struct ModelArgs {
     /// contact_jacobian, contact_drift and contact_forward_dynamics
     #[arg(long = "contact", value_name = "LINK")]
     contacts: Vec<String>,
+    /// Honours the URDF's <mimic> tags: a mimic joint is no coordinate but follows the joint it
+    /// mimics (multiplier x joint + offset); every quantity is in the independent joints
+    #[arg(long)]
+    mimic: bool,
     /// Refuse robots with more degrees of freedom than this.
     #[arg(long, value_name = "N", default_value_t = eomgen::DEFAULT_MAX_DOF)]
     max_dof: usize,
@@ -135,6 +139,7 @@ impl ModelArgs {
             repair_inertia: self.repair_inertia,
             floating_base: self.floating_base,
             contact_points: self.contacts.clone(),
+            mimic_joints: self.mimic,
             ..ModelOptions::default()
         }
     }
@@ -827,13 +832,8 @@ fn eval_cmd(a: EvalArgs) -> Result<(), Failure> {
     let b = a.model.builder(&a.urdf, &None);
     let model = load(&b)?;
     fixed_base_only(&model, "eval")?;
-    let n = model.dof();
-    let joints = model
-        .joints
-        .iter()
-        .map(|j| j.name.as_str())
-        .collect::<Vec<_>>()
-        .join(", ");
+    let n = model.coordinates();
+    let joints = model.coordinate_names().join(", ");
     let check = |flag: &str, v: Option<Numbers>| -> Result<Vec<f64>, Failure> {
         match v {
             None => Ok(vec![0.0; n]),
@@ -874,7 +874,7 @@ fn simulate_cmd(a: SimulateArgs) -> Result<(), Failure> {
             model.name
         )));
     }
-    let n = model.dof();
+    let n = model.coordinates();
     let check = |flag: &str, v: Option<Numbers>, default: &[f64]| -> Result<Vec<f64>, Failure> {
         match v {
             None => Ok(default.to_vec()),
@@ -905,7 +905,7 @@ fn simulate_cmd(a: SimulateArgs) -> Result<(), Failure> {
     let d = derive(&b, &model)?;
     let outcome = simulate::run(&model, &d, &options).map_err(Failure)?;
     if let Some(path) = &a.plot {
-        let names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
+        let names = model.coordinate_names();
         let title = format!("{}: joint positions", model.name);
         let svg = simulate::svg(&title, &names, &outcome.times, &outcome.positions);
         std::fs::write(path, svg)

@@ -340,6 +340,43 @@ impl Builder {
         self
     }
 
+    /// Honours the URDF's mimic joints (`<mimic joint=".." multiplier=".." offset=".."/>`,
+    /// as grippers and hands couple their fingers): a mimic joint is then no coordinate of
+    /// its own but follows the joint it mimics, `q_mimic = multiplier q_joint + offset`, for
+    /// revolute, continuous and prismatic joints. The generated type has one coordinate per
+    /// independent joint (`JOINT_NAMES` lists them), and every quantity is in those
+    /// coordinates: `tau = G^T tau_joints`, `M = G^T M_joints G`, the bias, gravity, Coriolis
+    /// matrices, energies, link Jacobians `J G`, forward dynamics (the coupling's inertia is
+    /// in `M`) and the derivatives, with `G` the constant map from coordinates to joint rates.
+    /// A mimic of a mimic follows the root of the chain. A mimic of a missing or fixed joint,
+    /// a mimic tag on a fixed joint and a cycle of mimics fail with an error naming the
+    /// joints; a floating base and [`Builder::regressor`] are not supported with mimic joints
+    /// yet ([`Error::Unsupported`]). Off by default: mimic joints are independent joints, as
+    /// in Pinocchio. See [`ModelOptions::mimic_joints`].
+    ///
+    /// ```
+    /// let urdf = r#"<robot name="gripper"><link name="base"/>
+    ///   <link name="left"><inertial><mass value="0.1"/>
+    ///   <inertia ixx="1e-4" ixy="0" ixz="0" iyy="1e-4" iyz="0" izz="1e-4"/></inertial></link>
+    ///   <link name="right"><inertial><mass value="0.1"/>
+    ///   <inertia ixx="1e-4" ixy="0" ixz="0" iyy="1e-4" iyz="0" izz="1e-4"/></inertial></link>
+    ///   <joint name="finger_left" type="prismatic"><parent link="base"/><child link="left"/>
+    ///   <axis xyz="0 1 0"/><limit lower="0" upper="0.04" effort="20" velocity="0.2"/></joint>
+    ///   <joint name="finger_right" type="prismatic"><parent link="base"/><child link="right"/>
+    ///   <axis xyz="0 -1 0"/><limit lower="0" upper="0.04" effort="20" velocity="0.2"/>
+    ///   <mimic joint="finger_left"/></joint></robot>"#;
+    /// let source = eomgen::Builder::from_urdf_str(urdf, "gripper.urdf")
+    ///     .mimic_joints()
+    ///     .generate()
+    ///     .unwrap();
+    /// // One coordinate: the right finger follows the left one.
+    /// assert!(source.contains(r#"const JOINT_NAMES: [&'static str; 1] = ["finger_left"];"#));
+    /// ```
+    pub fn mimic_joints(mut self) -> Builder {
+        self.options.mimic_joints = true;
+        self
+    }
+
     /// Adds identification, for estimating a robot's inertial parameters from measured
     /// torques: `regressor(&q, &qd, &qdd)` (N x P, `tau = Y pi`) and `parameters()` (the P
     /// standard parameters: per body, in joint order, m, m cx, m cy, m cz, Ixx, Ixy, Iyy, Ixz,
@@ -456,6 +493,18 @@ impl Builder {
             return Err(Error::Unsupported {
                 file,
                 what: "the regressor of a floating-base robot is not generated yet",
+            });
+        }
+        if model.is_coupled() && model.is_floating() {
+            return Err(Error::Unsupported {
+                file,
+                what: "mimic joints (Builder::mimic_joints, --mimic) on a floating-base robot are not supported yet",
+            });
+        }
+        if self.regressor && model.is_coupled() {
+            return Err(Error::Unsupported {
+                file,
+                what: "the regressor of a robot with mimic joints (Builder::mimic_joints, --mimic) is not generated yet",
             });
         }
         let mut d = Derivation::try_new(model, limits).map_err(full)?;

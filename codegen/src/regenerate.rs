@@ -112,6 +112,9 @@ fn flags(o: &ModelOptions) -> Vec<(&'static str, Option<String>)> {
     for link in &o.contact_points {
         f.push(("contact", Some(link.clone())));
     }
+    if o.mimic_joints {
+        f.push(("mimic", None));
+    }
     f
 }
 

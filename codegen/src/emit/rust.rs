@@ -175,13 +175,17 @@ impl Emitter<'_> {
         let (ty, n, allow) = (&self.ty, &self.n, allow_lints());
         let try_fd = &self.try_forward_dynamics;
         let parents = self.parents_const();
-        let nj = usize_lit(self.model.joints.len());
+        let nj = usize_lit(self.model.coordinates());
         let identification = super::identification::constants(d, self.quantities);
         // Without the trait, the joint order still has to be said.
         let joint_names = if self.in_trait {
             TokenStream::new()
         } else {
-            let names = self.model.joints.iter().map(|j| Literal::string(&j.name));
+            let names = self
+                .model
+                .coordinate_names()
+                .into_iter()
+                .map(Literal::string);
             let what = if self.floating {
                 "The URDF names of the joints, in the order of the joint part of every array (after the base's coordinates)."
             } else {
@@ -239,6 +243,9 @@ impl Emitter<'_> {
             self.model.dof(),
             if self.floating { ", floating base" } else { "" }
         )];
+        if self.model.is_coupled() {
+            lines.extend(coupling_doc(self.model));
+        }
         if self.floating {
             lines.extend([
                 String::new(),
@@ -666,6 +673,18 @@ impl Emitter<'_> {
         } else {
             quote!(::eomgen_runtime::tree::chain_jacobian)
         };
+        if self.model.is_coupled() {
+            // Columns per joint, then summed into the coordinates' (`J G`).
+            let nj = usize_lit(self.model.joints.len());
+            return quote! {
+                #docs
+                pub fn link_jacobian(&self, link: #link_ty, q: &[T; #nq]) -> [[T; #n]; 6] {
+                    let (path, placement) = Self::link_frame(link);
+                    let joints: [[T; #nj]; 6] = #kernel(path, &Self::TREE_JOINTS, |j| self.joint_transform(j, q), &placement);
+                    ::eomgen_runtime::tree::couple_columns(&joints, &Self::COUPLING)
+                }
+            };
+        }
         quote! {
             #docs
             pub fn link_jacobian(&self, link: #link_ty, q: &[T; #nq]) -> [[T; #n]; 6] {
@@ -703,9 +722,23 @@ impl Emitter<'_> {
         });
         let link_arms = self.link_frame_arms();
         let link_ty = &self.link_ty;
+        let coupling = if self.model.is_coupled() {
+            let entries = self.model.coupling.iter().map(|c| {
+                let (i, k) = (usize_lit(c.coordinate), f64_literal(c.multiplier));
+                quote!((#i, #k))
+            });
+            quote! {
+                /// Per joint, the coordinate it follows and its multiplier (its rate is the
+                /// multiplier times the coordinate's).
+                const COUPLING: [(usize, f64); #nj] = [#(#entries),*];
+            }
+        } else {
+            TokenStream::new()
+        };
         quote! {
             /// Each joint's axis (in the frame of the body it moves) and motion.
             const TREE_JOINTS: [::eomgen_runtime::tree::TreeJoint; #nj] = [#(#joints),*];
+            #coupling
 
             /// The pose of body `j` in its parent body's frame (a floating base is body 0).
             fn joint_transform(&self, j: usize, q: &[T; #nq]) -> ::eomgen_runtime::Pose<T> {
@@ -751,7 +784,11 @@ impl Emitter<'_> {
         if !self.in_trait {
             return TokenStream::new();
         }
-        let names = self.model.joints.iter().map(|j| Literal::string(&j.name));
+        let names = self
+            .model
+            .coordinate_names()
+            .into_iter()
+            .map(Literal::string);
         let (ty, n, allow) = (&self.ty, &self.n, allow_lints());
         quote! {
             #allow
@@ -813,6 +850,32 @@ impl Emitter<'_> {
         }
         out
     }
+}
+
+/// The type documentation's paragraph on mimic joints: which joints follow which coordinate.
+fn coupling_doc(model: &Model) -> Vec<String> {
+    let mut lines = vec![
+        String::new(),
+        format!(
+            "Mimic joints follow other joints (URDF `<mimic>`, honoured): the {} coordinates are the independent",
+            model.coordinates()
+        ),
+        "joints (`JOINT_NAMES`), and every quantity is in them (efforts `G^T tau`, `M = G^T M_joints G`,".into(),
+        "Jacobians `J G`, with `q_joint = multiplier q_coordinate + offset`):".into(),
+    ];
+    let names = model.coordinate_names();
+    for (j, c) in model.joints.iter().zip(&model.coupling) {
+        if c.leader.is_some() {
+            lines.push(format!(
+                "- `{}` = {} `{}` + {}",
+                j.name.replace('`', "'"),
+                c.multiplier,
+                names[c.coordinate].replace('`', "'"),
+                c.offset
+            ));
+        }
+    }
+    lines
 }
 
 /// A constant pose as `Pose { .. }` with `T::from_f64` literals (rotation entries snapped).
