@@ -163,7 +163,11 @@ pub fn inverse_dynamics_derivatives(
         let mut q_vec = spatial_add(g, &g0, &g1);
         dq[j][j] = spatial_dot(g, &s, &q_vec);
         let cjj = spatial_dot(g, &s, &c_vec);
-        let df = g.diff(friction[j], qd[j]);
+        // No friction, nothing to differentiate (and `qd[j]` need not be a symbol then).
+        let df = match g.as_const(friction[j]) {
+            Some(_) => g.zero(),
+            None => g.diff(friction[j], qd[j]),
+        };
         dqd[j][j] = g.add(cjj, df);
         let mut k = j;
         while let Some(i) = lm.parent[k] {
