@@ -280,19 +280,21 @@ fn mimic() {
             "PandaMimic",
             eomgen::Builder::new("robots/panda.urdf")
                 .mimic_joints()
-                .derivatives(),
+                .derivatives()
+                .regressor(),
         ),
         (
             "mimic_tree",
             "MimicTree",
             effects(eomgen::Builder::new(tree))
                 .mimic_joints()
-                .derivatives(),
+                .derivatives()
+                .regressor(),
         ),
         (
             "mimic_tree_full",
             "MimicTreeFull",
-            effects(eomgen::Builder::new(tree)),
+            effects(eomgen::Builder::new(tree)).regressor(),
         ),
     ] {
         builder.module_name(module).type_name(ty).compile().unwrap();

@@ -346,11 +346,12 @@ impl Builder {
     /// revolute, continuous and prismatic joints. The generated type has one coordinate per
     /// independent joint (`JOINT_NAMES` lists them), and every quantity is in those
     /// coordinates: `tau = G^T tau_joints`, `M = G^T M_joints G`, the bias, gravity, Coriolis
-    /// matrices, energies, link Jacobians `J G`, forward dynamics (the coupling's inertia is
-    /// in `M`) and the derivatives, with `G` the constant map from coordinates to joint rates.
-    /// A mimic of a mimic follows the root of the chain. A mimic of a missing or fixed joint,
-    /// a mimic tag on a fixed joint and a cycle of mimics fail with an error naming the
-    /// joints; a floating base and [`Builder::regressor`] are not supported with mimic joints
+    /// matrices, energies, link Jacobians `J G`, the centre of mass, forward dynamics (the
+    /// coupling's inertia is in `M`), the derivatives ([`Builder::derivatives`]) and the
+    /// regressor (`G^T Y`, [`Builder::regressor`]), with `G` the constant map from
+    /// coordinates to joint rates. A mimic of a mimic follows the root of the chain. A mimic
+    /// of a missing or fixed joint, a mimic tag on a fixed joint and a cycle of mimics fail
+    /// with an error naming the joints; a floating base is not supported with mimic joints
     /// yet ([`Error::Unsupported`]). Off by default: mimic joints are independent joints, as
     /// in Pinocchio. See [`ModelOptions::mimic_joints`].
     ///
@@ -499,12 +500,6 @@ impl Builder {
             return Err(Error::Unsupported {
                 file,
                 what: "mimic joints (Builder::mimic_joints, --mimic) on a floating-base robot are not supported yet",
-            });
-        }
-        if self.regressor && model.is_coupled() {
-            return Err(Error::Unsupported {
-                file,
-                what: "the regressor of a robot with mimic joints (Builder::mimic_joints, --mimic) is not generated yet",
             });
         }
         let mut d = Derivation::try_new(model, limits).map_err(full)?;

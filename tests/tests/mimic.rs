@@ -221,6 +221,29 @@ fn the_tree_with_mimic_joints_is_the_full_tree_projected() {
         for (name, got, want) in scalars {
             c.check(|| format!("#{s} {name}"), got, want);
         }
+        // The regressor: G^T Y_full over the same standard parameters, which reproduce tau,
+        // as the base parameters do with the base regressor.
+        let (y, want_y) = (
+            tree.regressor(&q, &qd, &qdd),
+            full.regressor(&qf, &qdf, &qddf),
+        );
+        let (pi, pi_b, y_b) = (
+            tree.parameters(),
+            tree.base_parameters(),
+            tree.base_regressor(&q, &qd, &qdd),
+        );
+        let tau = tree.inverse_dynamics(&q, &qd, &qdd);
+        assert_eq!(pi, full.parameters());
+        for i in 0..4 {
+            for p in 0..pi.len() {
+                let want: f64 = (0..8).map(|j| gm[j][i] * want_y[j][p]).sum();
+                c.check(|| format!("#{s} Y[{i}][{p}]"), y[i][p], want);
+            }
+            let y_pi: f64 = (0..pi.len()).map(|p| y[i][p] * pi[p]).sum();
+            let yb_pib: f64 = (0..pi_b.len()).map(|p| y_b[i][p] * pi_b[p]).sum();
+            c.check(|| format!("#{s} (Y pi)[{i}]"), y_pi, tau[i]);
+            c.check(|| format!("#{s} (Y_b pi_b)[{i}]"), yb_pib, tau[i]);
+        }
         // Forward dynamics: the full tree's equations of motion, projected, hold.
         let fd = tree.forward_dynamics(&q, &qd, &tau_in);
         let tau_back = g_t_times(&gm, &full.inverse_dynamics(&qf, &qdf, &g_times(&gm, &fd)));

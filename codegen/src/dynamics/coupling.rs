@@ -108,6 +108,22 @@ impl CoordinateMap {
         a.iter().map(|row| self.project(g, row)).collect()
     }
 
+    /// `G^T A` for a matrix `A` whose rows are the joints (regressors).
+    pub fn project_rows(&self, g: &mut Graph, a: &[Vec<Id>]) -> Vec<Vec<Id>> {
+        if !self.coupled {
+            return a.to_vec();
+        }
+        let columns = a.first().map_or(0, Vec::len);
+        let mut out = vec![Vec::with_capacity(columns); self.coordinates];
+        for p in 0..columns {
+            let column: Vec<Id> = a.iter().map(|row| row[p]).collect();
+            for (row, x) in out.iter_mut().zip(self.project(g, &column)) {
+                row.push(x);
+            }
+        }
+        out
+    }
+
     /// `G^T M G` for a matrix over the joints; `symmetric`: `M` is, and the result's
     /// `[i][j]` and `[j][i]` are then one expression.
     pub fn project_matrix(&self, g: &mut Graph, m: &[Vec<Id>], symmetric: bool) -> Vec<Vec<Id>> {
