@@ -296,6 +296,21 @@ fn mimic() {
             "MimicTreeFull",
             effects(eomgen::Builder::new(tree)).regressor(),
         ),
+        (
+            "mimic_tree_floating",
+            "MimicTreeFloating",
+            eomgen::Builder::new(tree)
+                .floating_base()
+                .contact_points(&["tip", "lb2"])
+                .mimic_joints(),
+        ),
+        (
+            "mimic_tree_floating_full",
+            "MimicTreeFloatingFull",
+            eomgen::Builder::new(tree)
+                .floating_base()
+                .contact_points(&["tip", "lb2"]),
+        ),
     ] {
         builder.module_name(module).type_name(ty).compile().unwrap();
     }

@@ -865,6 +865,13 @@ fn eval_cmd(a: EvalArgs) -> Result<(), Failure> {
 fn simulate_cmd(a: SimulateArgs) -> Result<(), Failure> {
     let b = a.model.builder(&a.urdf, &None);
     let model = load(&b)?;
+    if model.is_floating() && model.is_coupled() {
+        return Err(Failure(format!(
+            "{}: `eomgen simulate` does not handle mimic joints on a floating base yet: \
+             generate the code (eomgen generate --floating-base --mimic) and call it",
+            model.name
+        )));
+    }
     if model.is_floating() {
         return simulate_floating_cmd(a, b, model);
     }

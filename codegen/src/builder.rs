@@ -351,8 +351,8 @@ impl Builder {
     /// regressor (`G^T Y`, [`Builder::regressor`]), with `G` the constant map from
     /// coordinates to joint rates. A mimic of a mimic follows the root of the chain. A mimic
     /// of a missing or fixed joint, a mimic tag on a fixed joint and a cycle of mimics fail
-    /// with an error naming the joints; a floating base is not supported with mimic joints
-    /// yet ([`Error::Unsupported`]). Off by default: mimic joints are independent joints, as
+    /// with an error naming the joints. With a floating base, the base's coordinates come
+    /// first, never coupled. Off by default: mimic joints are independent joints, as
     /// in Pinocchio. See [`ModelOptions::mimic_joints`].
     ///
     /// ```
@@ -494,12 +494,6 @@ impl Builder {
             return Err(Error::Unsupported {
                 file,
                 what: "the regressor of a floating-base robot is not generated yet",
-            });
-        }
-        if model.is_coupled() && model.is_floating() {
-            return Err(Error::Unsupported {
-                file,
-                what: "mimic joints (Builder::mimic_joints, --mimic) on a floating-base robot are not supported yet",
             });
         }
         let mut d = Derivation::try_new(model, limits).map_err(full)?;

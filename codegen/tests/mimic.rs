@@ -167,18 +167,24 @@ fn a_cycle_of_mimics_is_an_error_listing_it() {
 }
 
 #[test]
-fn unsupported_combinations_are_refused_naming_the_file() {
+fn a_floating_base_keeps_its_six_coordinates_before_the_coupled_joints() {
     let text = chain(["", r#"<mimic joint="j1"/>"#, ""], "revolute");
-    let refused = |b: Builder| match b.generate() {
-        Err(e @ Error::Unsupported { .. }) => e.to_string(),
-        other => panic!("expected a refusal, got {:?}", other.map(|s| s.len())),
-    };
-    let e = refused(
-        Builder::from_urdf_str(&text, "chain.urdf")
-            .mimic_joints()
-            .floating_base(),
-    );
-    assert!(e.starts_with("chain.urdf: mimic joints"), "{e}");
+    let source = Builder::from_urdf_str(&text, "chain.urdf")
+        .mimic_joints()
+        .floating_base()
+        .generate()
+        .unwrap();
+    assert!(source.contains("pub const NQ: usize = 9;"), "7 + 2");
+    assert!(source.contains("pub const NV: usize = 8;"), "6 + 2");
+    assert!(source.contains(r#"pub const JOINT_NAMES: [&'static str; 2] = ["j1", "j3"];"#));
+    // A floating robot's derivatives are refused whatever its joints (not mimic-specific).
+    let e = Builder::from_urdf_str(&text, "chain.urdf")
+        .mimic_joints()
+        .floating_base()
+        .derivatives()
+        .generate()
+        .unwrap_err();
+    assert!(matches!(e, Error::Unsupported { .. }), "{e}");
 }
 
 #[test]

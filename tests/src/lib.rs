@@ -257,6 +257,15 @@ pub mod robots {
     pub mod mimic_tree_full {
         include!(concat!(env!("OUT_DIR"), "/mimic_tree_full.rs"));
     }
+    /// The mimic tree on a floating base (its root link free), with contacts at `tip` and
+    /// `lb2`, mimic joints honoured (6 + 4 velocity coordinates).
+    pub mod mimic_tree_floating {
+        include!(concat!(env!("OUT_DIR"), "/mimic_tree_floating.rs"));
+    }
+    /// The same without the option (6 + 8).
+    pub mod mimic_tree_floating_full {
+        include!(concat!(env!("OUT_DIR"), "/mimic_tree_floating_full.rs"));
+    }
     /// `urdf/light_tip.urdf`: a 1e-12 kg last link, an ill-conditioned mass matrix.
     pub mod light_tip {
         include!(concat!(env!("OUT_DIR"), "/light_tip.rs"));

@@ -12,8 +12,10 @@
 
 #![allow(clippy::needless_range_loop)]
 
-use eomgen_runtime::Dynamics;
-use eomgen_tests::robots::{mimic_tree, mimic_tree_full, panda_mimic};
+use eomgen_runtime::{Dynamics, Pose};
+use eomgen_tests::robots::{
+    mimic_tree, mimic_tree_floating, mimic_tree_floating_full, mimic_tree_full, panda_mimic,
+};
 use eomgen_tests::{Checker, JointMap};
 use serde_json::Value;
 
@@ -128,32 +130,72 @@ fn coupling() -> (Vec<Vec<f64>>, Vec<f64>) {
     (g, o)
 }
 
-fn g_times(g: &[Vec<f64>], x: &[f64; 4]) -> [f64; 8] {
-    core::array::from_fn(|i| (0..4).map(|c| g[i][c] * x[c]).sum())
+/// `G x` (`G` is F x N: the full tree's coordinates by ours).
+fn g_times<const F: usize, const N: usize>(g: &[Vec<f64>], x: &[f64; N]) -> [f64; F] {
+    core::array::from_fn(|i| (0..N).map(|c| g[i][c] * x[c]).sum())
 }
 
-fn g_t_times(g: &[Vec<f64>], x: &[f64]) -> [f64; 4] {
-    core::array::from_fn(|c| (0..8).map(|i| g[i][c] * x[i]).sum())
+/// `G^T x`.
+fn g_t_times<const N: usize>(g: &[Vec<f64>], x: &[f64]) -> [f64; N] {
+    core::array::from_fn(|c| (0..g.len()).map(|i| g[i][c] * x[i]).sum())
 }
 
-/// `G^T A G` for an 8 x 8 `A`.
-fn project(g: &[Vec<f64>], a: &[[f64; 8]; 8]) -> [[f64; 4]; 4] {
-    core::array::from_fn(|c| {
-        core::array::from_fn(|d| {
-            let mut s = 0.0;
-            for i in 0..8 {
-                for j in 0..8 {
-                    s += g[i][c] * a[i][j] * g[j][d];
-                }
-            }
-            s
-        })
-    })
+/// `G^T A G`.
+fn project<const F: usize, const N: usize>(g: &[Vec<f64>], a: &[[f64; F]; F]) -> [[f64; N]; N] {
+    let ag: [[f64; N]; F] = columns(g, a);
+    core::array::from_fn(|c| core::array::from_fn(|d| (0..F).map(|i| g[i][c] * ag[i][d]).sum()))
 }
 
-/// `A G` for an R x 8 `A`.
-fn columns<const R: usize>(g: &[Vec<f64>], a: &[[f64; 8]; R]) -> [[f64; 4]; R] {
+/// `A G` for an R x F `A`.
+fn columns<const R: usize, const F: usize, const N: usize>(
+    g: &[Vec<f64>],
+    a: &[[f64; F]; R],
+) -> [[f64; N]; R] {
     core::array::from_fn(|r| g_t_times(g, &a[r]))
+}
+
+/// Checks matrices and vectors by name against their expected values.
+#[allow(clippy::type_complexity)]
+fn same<const N: usize>(
+    c: &mut Checker,
+    s: usize,
+    matrices: &[(&str, &[[f64; N]; N], &[[f64; N]; N])],
+    vectors: &[(&str, [f64; N], [f64; N])],
+) {
+    for i in 0..N {
+        for (name, got, want) in matrices {
+            for j in 0..N {
+                c.check(|| format!("#{s} {name}[{i}][{j}]"), got[i][j], want[i][j]);
+            }
+        }
+        for (name, got, want) in vectors {
+            c.check(|| format!("#{s} {name}[{i}]"), got[i], want[i]);
+        }
+    }
+}
+
+/// Checks a link's pose and Jacobian against the full tree's (Jacobian already projected).
+fn same_link<const N: usize>(
+    c: &mut Checker,
+    what: &str,
+    (pose, want_pose): (&Pose<f64>, &Pose<f64>),
+    jacobian: &[[f64; N]; 6],
+    want_jacobian: &[[f64; N]; 6],
+) {
+    for r in 0..3 {
+        let (got, want) = (pose.translation[r], want_pose.translation[r]);
+        c.check(|| format!("{what} position[{r}]"), got, want);
+        for k in 0..3 {
+            let (got, want) = (pose.rotation[r][k], want_pose.rotation[r][k]);
+            c.check(|| format!("{what} rotation[{r}][{k}]"), got, want);
+        }
+    }
+    for r in 0..6 {
+        for k in 0..N {
+            let (got, want) = (jacobian[r][k], want_jacobian[r][k]);
+            c.check(|| format!("{what} J[{r}][{k}]"), got, want);
+        }
+    }
 }
 
 /// Deterministic states with entries in [-1.5, 1.5].
@@ -201,15 +243,12 @@ fn the_tree_with_mimic_joints_is_the_full_tree_projected() {
                 g_t_times(&gm, &full.friction(&qdf)),
             ),
         ];
-        for i in 0..4 {
-            for j in 0..4 {
-                c.check(|| format!("#{s} M[{i}][{j}]"), m[i][j], want_m[i][j]);
-                c.check(|| format!("#{s} C[{i}][{j}]"), cm[i][j], want_cm[i][j]);
-            }
-            for (name, got, want) in &vectors {
-                c.check(|| format!("#{s} {name}[{i}]"), got[i], want[i]);
-            }
-        }
+        same(
+            &mut c,
+            s,
+            &[("M", &m, &want_m), ("C", &cm, &want_cm)],
+            &vectors,
+        );
         let scalars = [
             (
                 "T",
@@ -246,7 +285,8 @@ fn the_tree_with_mimic_joints_is_the_full_tree_projected() {
         }
         // Forward dynamics: the full tree's equations of motion, projected, hold.
         let fd = tree.forward_dynamics(&q, &qd, &tau_in);
-        let tau_back = g_t_times(&gm, &full.inverse_dynamics(&qf, &qdf, &g_times(&gm, &fd)));
+        let tau_back: [f64; 4] =
+            g_t_times(&gm, &full.inverse_dynamics(&qf, &qdf, &g_times(&gm, &fd)));
         for i in 0..4 {
             c.check(|| format!("#{s} ID(FD)[{i}]"), tau_back[i], tau_in[i]);
         }
@@ -256,36 +296,17 @@ fn the_tree_with_mimic_joints_is_the_full_tree_projected() {
             .zip(mimic_tree_full::MimicTreeFullLink::ALL)
         {
             assert_eq!(link.name(), full_link.name());
-            let (p, want_p) = (tree.link_pose(*link, &q), full.link_pose(full_link, &qf));
-            for r in 0..3 {
-                c.check(
-                    || format!("#{s} {} position[{r}]", link.name()),
-                    p.translation[r],
-                    want_p.translation[r],
-                );
-                for k in 0..3 {
-                    c.check(
-                        || format!("#{s} {} rotation[{r}][{k}]", link.name()),
-                        p.rotation[r][k],
-                        want_p.rotation[r][k],
-                    );
-                }
-            }
-            let j = tree.link_jacobian(*link, &q);
-            let want_j = columns(&gm, &full.link_jacobian(full_link, &qf));
-            for r in 0..6 {
-                for k in 0..4 {
-                    c.check(
-                        || format!("#{s} {} J[{r}][{k}]", link.name()),
-                        j[r][k],
-                        want_j[r][k],
-                    );
-                }
-            }
+            same_link(
+                &mut c,
+                &format!("#{s} {}", link.name()),
+                (&tree.link_pose(*link, &q), &full.link_pose(full_link, &qf)),
+                &tree.link_jacobian(*link, &q),
+                &columns(&gm, &full.link_jacobian(full_link, &qf)),
+            );
         }
         let (com, want_com) = (tree.center_of_mass(&q), full.center_of_mass(&qf));
         let jc = tree.center_of_mass_jacobian(&q);
-        let want_jc = columns(&gm, &full.center_of_mass_jacobian(&qf));
+        let want_jc: [[f64; 4]; 3] = columns(&gm, &full.center_of_mass_jacobian(&qf));
         for r in 0..3 {
             c.check(|| format!("#{s} com[{r}]"), com[r], want_com[r]);
             for k in 0..4 {
@@ -531,4 +552,149 @@ fn the_run_time_tree_solve_handles_a_mimic_across_branches() {
         }
     }
     c.finish("run-time solve with a cross-branch mimic");
+}
+
+/// The floating tree's `G`: the base's six velocity coordinates unchanged, then the joints'.
+fn floating_coupling() -> (Vec<Vec<f64>>, Vec<f64>) {
+    let (gm, off) = coupling();
+    let mut g = vec![vec![0.0; 10]; 14];
+    let mut o = vec![0.0; 14];
+    for i in 0..6 {
+        g[i][i] = 1.0;
+    }
+    for i in 0..8 {
+        for c in 0..4 {
+            g[6 + i][6 + c] = gm[i][c];
+        }
+        o[6 + i] = off[i];
+    }
+    (g, o)
+}
+
+#[test]
+fn the_floating_tree_with_mimic_joints_is_the_full_floating_tree_projected() {
+    use mimic_tree_floating::{MimicTreeFloating, MimicTreeFloatingLink};
+    use mimic_tree_floating_full::{MimicTreeFloatingFull, MimicTreeFloatingFullLink};
+    let (gm, off) = floating_coupling();
+    let (tree, full) = (
+        MimicTreeFloating::<f64>::default(),
+        MimicTreeFloatingFull::<f64>::default(),
+    );
+    assert_eq!(
+        MimicTreeFloating::<f64>::JOINT_NAMES,
+        ["j1", "a1", "b1", "c2"]
+    );
+    let gv = |x: &[f64; 10]| -> [f64; 14] { g_times(&gm, x) };
+    let gt = |x: &[f64]| -> [f64; 10] { g_t_times(&gm, x) };
+    let proj = |a: &[[f64; 14]; 14]| -> [[f64; 10]; 10] { project(&gm, a) };
+    let mut c = Checker::new(1e-10);
+    for (s, [x, v, a, tau]) in states::<10>(6).into_iter().enumerate() {
+        // q = [position, unit quaternion, the 4 coordinates].
+        let n = norm(&x[3..7]);
+        let mut q = [0.0; 11];
+        q[..3].copy_from_slice(&x[..3]);
+        for k in 0..4 {
+            q[3 + k] = x[3 + k] / n;
+            q[7 + k] = x[6 + k];
+        }
+        let mut qf = [0.0; 15];
+        qf[..7].copy_from_slice(&q[..7]);
+        let joints: [f64; 10] = core::array::from_fn(|i| if i < 6 { 0.0 } else { q[1 + i] });
+        let jf = gv(&joints);
+        for i in 0..8 {
+            qf[7 + i] = jf[6 + i] + off[6 + i];
+        }
+        let (vf, af) = (gv(&v), gv(&a));
+        let m = tree.mass_matrix(&q);
+        let want_m = proj(&full.mass_matrix(&qf));
+        let cm = tree.coriolis_matrix(&q, &v);
+        let want_cm = proj(&full.coriolis_matrix(&qf, &vf));
+        let vectors = [
+            (
+                "tau",
+                tree.inverse_dynamics(&q, &v, &a),
+                gt(&full.inverse_dynamics(&qf, &vf, &af)),
+            ),
+            ("g", tree.gravity(&q), gt(&full.gravity(&qf))),
+            ("b", tree.bias(&q, &v), gt(&full.bias(&qf, &vf))),
+        ];
+        same(
+            &mut c,
+            s,
+            &[("M", &m, &want_m), ("C", &cm, &want_cm)],
+            &vectors,
+        );
+        c.check(
+            || format!("#{s} T"),
+            tree.kinetic_energy(&q, &v),
+            full.kinetic_energy(&qf, &vf),
+        );
+        c.check(
+            || format!("#{s} V"),
+            tree.potential_energy(&q),
+            full.potential_energy(&qf),
+        );
+        let fd = tree.forward_dynamics(&q, &v, &tau);
+        let back = gt(&full.inverse_dynamics(&qf, &vf, &gv(&fd)));
+        for i in 0..10 {
+            c.check(|| format!("#{s} ID(FD)[{i}]"), back[i], tau[i]);
+        }
+        let rows = |a: &[[f64; 14]]| -> Vec<[f64; 10]> { a.iter().map(|r| gt(r)).collect() };
+        let (com, want_com) = (tree.center_of_mass(&q), full.center_of_mass(&qf));
+        let jc = tree.center_of_mass_jacobian(&q);
+        let want_jc = rows(&full.center_of_mass_jacobian(&qf));
+        let ag = tree.centroidal_map(&q);
+        let want_ag = rows(&full.centroidal_map(&qf));
+        let jk = tree.contact_jacobian(&q);
+        let want_jk = rows(&full.contact_jacobian(&qf));
+        let (drift, want_drift) = (tree.contact_drift(&q, &v), full.contact_drift(&qf, &vf));
+        for r in 0..3 {
+            c.check(|| format!("#{s} com[{r}]"), com[r], want_com[r]);
+        }
+        for (name, got, want) in [
+            ("com J", &jc[..], &want_jc),
+            ("A_g", &ag[..], &want_ag),
+            ("contact J", &jk[..], &want_jk),
+        ] {
+            for r in 0..got.len() {
+                for k in 0..10 {
+                    c.check(|| format!("#{s} {name}[{r}][{k}]"), got[r][k], want[r][k]);
+                }
+            }
+        }
+        for r in 0..6 {
+            c.check(|| format!("#{s} drift[{r}]"), drift[r], want_drift[r]);
+        }
+        // Contact forward dynamics: M a + b + g = tau + J^T F and J a + drift = 0.
+        let (acc, forces) = tree.contact_forward_dynamics(&q, &v, &tau);
+        let h = tree.bias(&q, &v);
+        let g = tree.gravity(&q);
+        for i in 0..10 {
+            let lhs: f64 = (0..10).map(|j| m[i][j] * acc[j]).sum::<f64>() + h[i] + g[i];
+            let rhs: f64 = tau[i] + (0..6).map(|r| jk[r][i] * forces[r]).sum::<f64>();
+            c.check(|| format!("#{s} contact dynamics[{i}]"), lhs, rhs);
+        }
+        for r in 0..6 {
+            let ja: f64 = (0..10).map(|k| jk[r][k] * acc[k]).sum();
+            c.check(|| format!("#{s} contact held[{r}]"), ja + drift[r], 0.0);
+        }
+        for (link, full_link) in MimicTreeFloatingLink::ALL
+            .iter()
+            .zip(MimicTreeFloatingFullLink::ALL)
+        {
+            same_link(
+                &mut c,
+                &format!("#{s} {}", link.name()),
+                (&tree.link_pose(*link, &q), &full.link_pose(full_link, &qf)),
+                &tree.link_jacobian(*link, &q),
+                &columns(&gm, &full.link_jacobian(full_link, &qf)),
+            );
+        }
+        // Integration moves the coordinates by v dt (the base on SE(3), as the full tree's).
+        let (qn, want_qn) = (tree.integrate(&q, &v, 0.01), full.integrate(&qf, &vf, 0.01));
+        for k in 0..7 {
+            c.check(|| format!("#{s} integrate[{k}]"), qn[k], want_qn[k]);
+        }
+    }
+    c.finish("floating mimic tree against the full floating tree projected");
 }

@@ -17,21 +17,27 @@ use crate::model::{Coupling, Model};
 /// The map between a model's joints and its coordinates.
 #[derive(Clone, Debug)]
 pub struct CoordinateMap {
-    /// Per joint, its coordinate, multiplier and offset.
+    /// Per joint, its coordinate (in the joints' part), multiplier and offset.
     coupling: Vec<Coupling>,
-    /// The number of coordinates.
+    /// The number of the joints' coordinates.
     coordinates: usize,
+    /// A floating base's position and velocity coordinates before the joints' (7 and 6, or
+    /// none), never coupled.
+    base_q: usize,
+    base_v: usize,
     /// Whether some joint follows another.
     coupled: bool,
 }
 
 impl CoordinateMap {
-    /// The map of `model`'s joints (the joints' part of the coordinates: after a floating
-    /// base's, which is never coupled).
+    /// The map of `model`'s coordinates (a floating base's first, never coupled, then the
+    /// joints').
     pub fn new(model: &Model) -> CoordinateMap {
         CoordinateMap {
             coupling: model.coupling.clone(),
             coordinates: model.coordinates(),
+            base_q: model.base_nq(),
+            base_v: model.base_nv(),
             coupled: model.is_coupled(),
         }
     }
@@ -41,66 +47,76 @@ impl CoordinateMap {
         self.coupled
     }
 
-    /// The number of coordinates.
+    /// The number of velocity coordinates (a floating base's six, then the joints').
     pub fn coordinates(&self) -> usize {
-        self.coordinates
+        self.base_v + self.coordinates
     }
 
-    /// The joints' positions for the coordinates' positions `q`: `k q[c] + o`.
+    /// The number of position coordinates (a floating base's seven, then the joints').
+    pub fn positions_len(&self) -> usize {
+        self.base_q + self.coordinates
+    }
+
+    /// The joints' positions for the coordinates' positions `q`: `k q[c] + o` (a floating
+    /// base's first, unchanged).
     pub fn positions(&self, g: &mut Graph, q: &[Id]) -> Vec<Id> {
         if !self.coupled {
             return q.to_vec();
         }
-        self.coupling
-            .iter()
-            .map(|c| {
-                if c.is_identity() {
-                    q[c.coordinate]
-                } else {
-                    g.sum(c.offset, [(q[c.coordinate], c.multiplier)])
-                }
-            })
-            .collect()
+        let (base, joints) = q.split_at(self.base_q);
+        let mut out = base.to_vec();
+        out.extend(self.coupling.iter().map(|c| {
+            if c.is_identity() {
+                joints[c.coordinate]
+            } else {
+                g.sum(c.offset, [(joints[c.coordinate], c.multiplier)])
+            }
+        }));
+        out
     }
 
-    /// The joints' rates (velocities, accelerations) for the coordinates' `x`: `k x[c]`.
+    /// The joints' rates (velocities, accelerations) for the coordinates' `x`: `k x[c]` (a
+    /// floating base's first, unchanged).
     pub fn rates(&self, g: &mut Graph, x: &[Id]) -> Vec<Id> {
         if !self.coupled {
             return x.to_vec();
         }
-        self.coupling
-            .iter()
-            .map(|c| {
-                if c.multiplier == 1.0 {
-                    x[c.coordinate]
-                } else {
-                    g.scale(x[c.coordinate], c.multiplier)
-                }
-            })
-            .collect()
+        let (base, joints) = x.split_at(self.base_v);
+        let mut out = base.to_vec();
+        out.extend(self.coupling.iter().map(|c| {
+            if c.multiplier == 1.0 {
+                joints[c.coordinate]
+            } else {
+                g.scale(joints[c.coordinate], c.multiplier)
+            }
+        }));
+        out
     }
 
-    /// `G^T v` for a vector `v` over the joints (efforts): per coordinate, the sum of its
-    /// joints' entries times their multipliers.
+    /// `G^T v` for a vector `v` over the velocity coordinates of the joint tree (efforts):
+    /// per coordinate, the sum of its joints' entries times their multipliers (a floating
+    /// base's first, unchanged).
     pub fn project(&self, g: &mut Graph, v: &[Id]) -> Vec<Id> {
         if !self.coupled {
             return v.to_vec();
         }
-        (0..self.coordinates)
-            .map(|c| {
-                let terms: Vec<(Id, f64)> = self
-                    .coupling
-                    .iter()
-                    .zip(v)
-                    .filter(|(k, _)| k.coordinate == c)
-                    .map(|(k, &x)| (x, k.multiplier))
-                    .collect();
-                g.sum(0.0, terms)
-            })
-            .collect()
+        let (base, joints) = v.split_at(self.base_v);
+        let mut out = base.to_vec();
+        out.extend((0..self.coordinates).map(|c| {
+            let terms: Vec<(Id, f64)> = self
+                .coupling
+                .iter()
+                .zip(joints)
+                .filter(|(k, _)| k.coordinate == c)
+                .map(|(k, &x)| (x, k.multiplier))
+                .collect();
+            g.sum(0.0, terms)
+        }));
+        out
     }
 
-    /// `A G` for a matrix `A` whose columns are the joints (Jacobians).
+    /// `A G` for a matrix `A` whose columns are the velocity coordinates of the joint tree
+    /// (Jacobians).
     pub fn project_columns(&self, g: &mut Graph, a: &[Vec<Id>]) -> Vec<Vec<Id>> {
         if !self.coupled {
             return a.to_vec();
@@ -108,13 +124,14 @@ impl CoordinateMap {
         a.iter().map(|row| self.project(g, row)).collect()
     }
 
-    /// `G^T A` for a matrix `A` whose rows are the joints (regressors).
+    /// `G^T A` for a matrix `A` whose rows are the velocity coordinates of the joint tree
+    /// (regressors).
     pub fn project_rows(&self, g: &mut Graph, a: &[Vec<Id>]) -> Vec<Vec<Id>> {
         if !self.coupled {
             return a.to_vec();
         }
         let columns = a.first().map_or(0, Vec::len);
-        let mut out = vec![Vec::with_capacity(columns); self.coordinates];
+        let mut out = vec![Vec::with_capacity(columns); self.coordinates()];
         for p in 0..columns {
             let column: Vec<Id> = a.iter().map(|row| row[p]).collect();
             for (row, x) in out.iter_mut().zip(self.project(g, &column)) {
@@ -130,7 +147,7 @@ impl CoordinateMap {
         if !self.coupled {
             return m.to_vec();
         }
-        let n = self.coordinates;
+        let n = self.coordinates();
         let mg = self.project_columns(g, m);
         let mut out = vec![vec![g.zero(); n]; n];
         for d in 0..n {
@@ -163,22 +180,28 @@ impl CoordinateMap {
         if !self.coupled {
             return joint_parents;
         }
-        let n = self.coordinates;
+        let n = self.coordinates();
+        // Each coordinate's joints; a floating base's coordinates have none and are coupled
+        // with every coordinate (the base is every joint's ancestor).
         let joints: Vec<Vec<usize>> = (0..n)
-            .map(|c| {
-                (0..self.coupling.len())
+            .map(|c| match c.checked_sub(self.base_v) {
+                Some(c) => (0..self.coupling.len())
                     .filter(|&j| self.coupling[j].coordinate == c)
-                    .collect()
+                    .collect(),
+                None => Vec::new(),
             })
             .collect();
+        let base = |c: usize| c < self.base_v;
         let related = |a: usize, b: usize| model.is_ancestor(a, b) || model.is_ancestor(b, a);
         // pattern[k][i], i < k: the filled lower triangle.
         let mut pattern = vec![vec![false; n]; n];
         for k in 0..n {
             for i in 0..k {
-                pattern[k][i] = joints[k]
-                    .iter()
-                    .any(|&a| joints[i].iter().any(|&b| related(a, b)));
+                pattern[k][i] = base(k)
+                    || base(i)
+                    || joints[k]
+                        .iter()
+                        .any(|&a| joints[i].iter().any(|&b| related(a, b)));
             }
         }
         let mut parents = vec![None; n];

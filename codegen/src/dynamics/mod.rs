@@ -380,11 +380,7 @@ impl Derivation {
         let g = &mut self.graph;
         let params = Params::new(g, model);
         let map = CoordinateMap::new(model);
-        let q = if model.is_floating() {
-            self.q.clone()
-        } else {
-            map.positions(g, &self.q)
-        };
+        let q = map.positions(g, &self.q);
         let world = WorldKinematics::new(g, model, &params, &q);
         model
             .frames

@@ -674,8 +674,9 @@ impl Emitter<'_> {
             quote!(::eomgen_runtime::tree::chain_jacobian)
         };
         if self.model.is_coupled() {
-            // Columns per joint, then summed into the coordinates' (`J G`).
-            let nj = usize_lit(self.model.joints.len());
+            // Columns per joint (after a floating base's six), then summed into the
+            // coordinates' (`J G`).
+            let nj = usize_lit(self.model.nv());
             return quote! {
                 #docs
                 pub fn link_jacobian(&self, link: #link_ty, q: &[T; #nq]) -> [[T; #n]; 6] {
@@ -723,14 +724,23 @@ impl Emitter<'_> {
         let link_arms = self.link_frame_arms();
         let link_ty = &self.link_ty;
         let coupling = if self.model.is_coupled() {
-            let entries = self.model.coupling.iter().map(|c| {
-                let (i, k) = (usize_lit(c.coordinate), f64_literal(c.multiplier));
+            let v0 = self.model.base_nv();
+            let base = (0..v0).map(|i| (i, 1.0));
+            let joints = self
+                .model
+                .coupling
+                .iter()
+                .map(|c| (v0 + c.coordinate, c.multiplier));
+            let entries = base.chain(joints).map(|(i, k)| {
+                let (i, k) = (usize_lit(i), f64_literal(k));
                 quote!((#i, #k))
             });
+            let nv = usize_lit(self.model.nv());
             quote! {
-                /// Per joint, the coordinate it follows and its multiplier (its rate is the
+                /// Per velocity column of the joint tree (a floating base's six, then one per
+                /// joint), the coordinate it follows and its multiplier (its rate is the
                 /// multiplier times the coordinate's).
-                const COUPLING: [(usize, f64); #nj] = [#(#entries),*];
+                const COUPLING: [(usize, f64); #nv] = [#(#entries),*];
             }
         } else {
             TokenStream::new()
