@@ -78,9 +78,9 @@ pub fn print(
         let _ = writeln!(
             out,
             "degrees of freedom: {} joints + 6 of the floating base (NQ {}, NV {})",
-            model.dof(),
-            model.nq(),
-            model.nv()
+            model.coordinates(),
+            d.nq,
+            d.dof
         );
     } else if model.is_coupled() {
         let _ = writeln!(

@@ -950,7 +950,7 @@ pub fn render(model: &Model, d: &Derivation, opts: &ShowOptions) -> Result<Strin
 
 /// What the equations of a floating-base robot are, for the introduction.
 fn floating_intro(model: &Model) -> Vec<String> {
-    let nv = model.nv();
+    let nv = model.base_nv() + model.coordinates();
     vec![
         format!(
             "Floating base (a free flyer): M(q) qdd + b(q, qd) + G(q) = S^T tau + J_c(q)^T F_c, with {nv} \
