@@ -43,6 +43,7 @@ fn main() {
     floating();
     regressors();
     underactuated();
+    mimic();
     eomgen::Builder::new("robots/panda.urdf")
         .module_name("panda_selected")
         .type_name("PandaSelected")
@@ -294,4 +295,60 @@ fn with_derivatives(file: &str, module: &str, ty: &str) {
         ])
         .compile()
         .unwrap();
+}
+
+/// Mimic joints honoured (`Builder::mimic_joints`): the panda (its second finger follows the
+/// first) against Pinocchio, and `fixtures/mimic_tree.urdf` (multipliers, offsets, a chain, a
+/// prismatic and a cross-branch mimic) with joint friction and rotor inertia on mimic joints,
+/// against the same tree generated without the option (every joint a coordinate).
+fn mimic() {
+    let tree = "fixtures/mimic_tree.urdf";
+    println!("cargo:rerun-if-changed={tree}");
+    let effects = |b: eomgen::Builder| {
+        b.friction(true).coulomb_smoothing(0.05).armature([
+            ("a2", 0.01),
+            ("b2", 0.02),
+            ("j1", 0.05),
+        ])
+    };
+    for (module, ty, builder) in [
+        (
+            "panda_mimic",
+            "PandaMimic",
+            eomgen::Builder::new("robots/panda.urdf")
+                .mimic_joints()
+                .derivatives()
+                .regressor(),
+        ),
+        (
+            "mimic_tree",
+            "MimicTree",
+            effects(eomgen::Builder::new(tree))
+                .mimic_joints()
+                .derivatives()
+                .regressor(),
+        ),
+        (
+            "mimic_tree_full",
+            "MimicTreeFull",
+            effects(eomgen::Builder::new(tree)).regressor(),
+        ),
+        (
+            "mimic_tree_floating",
+            "MimicTreeFloating",
+            eomgen::Builder::new(tree)
+                .floating_base()
+                .contact_points(&["tip", "lb2"])
+                .mimic_joints(),
+        ),
+        (
+            "mimic_tree_floating_full",
+            "MimicTreeFloatingFull",
+            eomgen::Builder::new(tree)
+                .floating_base()
+                .contact_points(&["tip", "lb2"]),
+        ),
+    ] {
+        builder.module_name(module).type_name(ty).compile().unwrap();
+    }
 }

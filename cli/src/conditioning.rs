@@ -71,7 +71,7 @@ pub fn warning(model: &Model, m: &[Vec<f64>], at: &str) -> Option<String> {
     let (estimate, weak) = near_singular(m)?;
     let names: Vec<String> = weak
         .iter()
-        .map(|&i| format!("`{}`", model.joints[i].name))
+        .map(|&i| format!("`{}`", model.coordinate_names()[i]))
         .collect();
     let estimate = if estimate.is_finite() {
         format!("condition estimate {}", format_number(estimate, Some(2)))
@@ -93,14 +93,18 @@ pub fn sampled_warnings(model: &Model, d: &Derivation) -> Vec<String> {
     if model.is_floating() {
         return Vec::new();
     }
-    let n = model.dof();
+    let n = model.coordinates();
     let mut rng = 0x2545_f491_4f6c_dd1d_u64;
     let mut worst: Option<(f64, String)> = None;
     for k in 0..=SAMPLES {
         let q: Vec<f64> = if k == 0 {
             vec![0.0; n]
         } else {
-            model.joints.iter().map(|j| sample(j, &mut rng)).collect()
+            model
+                .coordinate_joints()
+                .into_iter()
+                .map(|j| sample(&model.joints[j], &mut rng))
+                .collect()
         };
         let state = eval::State {
             q,

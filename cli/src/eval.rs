@@ -97,7 +97,7 @@ pub fn evaluate(model: &Model, d: &Derivation, s: &State) -> Result<Values, Stri
              `{}`): check the masses and inertias",
             model.name,
             k + 1,
-            model.joints[k].name
+            model.coordinate_names()[k]
         )
     })?;
     Ok(Values {
@@ -119,7 +119,7 @@ fn list(v: &[f64], digits: Option<usize>) -> String {
 
 /// The text `eval` prints.
 pub fn print(model: &Model, s: &State, v: &Values, digits: Option<usize>) -> String {
-    let names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
+    let names = model.coordinate_names();
     let mut out = String::new();
     let _ = writeln!(
         out,

@@ -25,6 +25,43 @@ fn ms(d: Duration) -> String {
     format!("{:.1} ms", d.as_secs_f64() * 1e3)
 }
 
+/// Joint `j`'s coordinate as `q3`, or `mimic` for a mimic joint that follows another.
+fn label(model: &Model, j: usize) -> String {
+    match model.coupling.get(j) {
+        Some(c) if c.leader.is_some() => "mimic".to_string(),
+        Some(c) => format!("q{}", c.coordinate + 1),
+        None => format!("q{}", j + 1),
+    }
+}
+
+/// What `info` says about the URDF's mimic tags: how to honour them, or that they are.
+fn mimic_note(model: &Model) -> Option<String> {
+    let tagged: Vec<String> = model
+        .joints
+        .iter()
+        .filter(|j| j.mimic.is_some())
+        .map(|j| format!("`{}`", j.name))
+        .collect();
+    if tagged.is_empty() {
+        return None;
+    }
+    Some(if model.is_coupled() {
+        format!(
+            "mimic joints honoured (--mimic): {} follow(s) the joint(s) they mimic; the {} \
+             coordinates are the other joints",
+            tagged.join(", "),
+            model.coordinates()
+        )
+    } else {
+        format!(
+            "the URDF has <mimic> tags on {}: they are independent coordinates here, as in \
+             Pinocchio; --mimic (Builder::mimic_joints() in a build script) makes each follow \
+             the joint it mimics, with fewer coordinates and the coupling's inertia in M",
+            tagged.join(", ")
+        )
+    })
+}
+
 /// The report. `load` and `emit` are the times of reading the URDF and of emitting code.
 pub fn print(
     model: &Model,
@@ -41,9 +78,17 @@ pub fn print(
         let _ = writeln!(
             out,
             "degrees of freedom: {} joints + 6 of the floating base (NQ {}, NV {})",
+            model.coordinates(),
+            d.nq,
+            d.dof
+        );
+    } else if model.is_coupled() {
+        let _ = writeln!(
+            out,
+            "degrees of freedom: {} ({} moving joints, {} of them mimic joints following others)",
+            model.coordinates(),
             model.dof(),
-            model.nq(),
-            model.nv()
+            model.dof() - model.coordinates()
         );
     } else {
         let _ = writeln!(out, "degrees of freedom: {}", model.dof());
@@ -56,6 +101,9 @@ pub fn print(
     );
     let _ = writeln!(out, "gravity: {} m/s^2", vec3(&model.gravity));
     if let Some(note) = super::floating_base::note(model) {
+        let _ = writeln!(out, "note: {note}");
+    }
+    if let Some(note) = mimic_note(model) {
         let _ = writeln!(out, "note: {note}");
     }
 
@@ -105,9 +153,9 @@ pub fn print(
         let body = &model.bodies[j];
         let _ = write!(
             out,
-            "{prefix}{} q{} {}: {} about {} -> {}, {} kg",
+            "{prefix}{} {} {}: {} about {} -> {}, {} kg",
             if last { "└──" } else { "├──" },
-            j + 1,
+            label(model, j),
             joint.name,
             kind(joint.kind),
             vec3(&joint.axis),
@@ -123,14 +171,28 @@ pub fn print(
         if !merged.is_empty() {
             let _ = write!(out, " (merged: {})", merged.join(", "));
         }
-        if let Some(m) = &joint.mimic {
-            let _ = write!(
-                out,
-                " (mimics {} x {} + {}, treated as independent)",
-                m.joint,
-                format_number(m.multiplier, Some(6)),
-                format_number(m.offset, Some(6))
-            );
+        let coupling = model.coupling.get(j).filter(|c| c.leader.is_some());
+        match (&joint.mimic, coupling) {
+            (Some(m), Some(c)) => {
+                let _ = write!(
+                    out,
+                    " (mimics {}: follows q{} x {} + {})",
+                    m.joint,
+                    c.coordinate + 1,
+                    format_number(c.multiplier, Some(6)),
+                    format_number(c.offset, Some(6))
+                );
+            }
+            (Some(m), None) => {
+                let _ = write!(
+                    out,
+                    " (mimics {} x {} + {}, treated as independent)",
+                    m.joint,
+                    format_number(m.multiplier, Some(6)),
+                    format_number(m.offset, Some(6))
+                );
+            }
+            _ => {}
         }
         out.push('\n');
         let deeper = format!("{prefix}{}", if last { "    " } else { "│   " });
@@ -149,7 +211,7 @@ pub fn print(
             ),
             None => "none".to_string(),
         };
-        let _ = writeln!(out, "  q{} {}: {limits}", i + 1, j.name);
+        let _ = writeln!(out, "  {} {}: {limits}", label(model, i), j.name);
     }
 
     let has_effects = model
@@ -169,8 +231,8 @@ pub fn print(
         for (i, j) in model.joints.iter().enumerate() {
             let _ = writeln!(
                 out,
-                "  q{} {}: {}, {}, {}",
-                i + 1,
+                "  {} {}: {}, {}, {}",
+                label(model, i),
                 j.name,
                 format_number(j.damping, Some(6)),
                 format_number(j.friction, Some(6)),

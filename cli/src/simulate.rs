@@ -271,7 +271,7 @@ pub fn run(model: &Model, d: &Derivation, o: &Options) -> Result<Outcome, String
         ));
     }
     let steps = steps as u64;
-    let names: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
+    let names = model.coordinate_names();
     let mut csv = String::from("t");
     for prefix in ["q", "qd", "tau"] {
         for name in &names {

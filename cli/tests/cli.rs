@@ -959,6 +959,61 @@ fn readme_quick_start_works() {
     }
 }
 
+#[test]
+fn mimic_joints_on_the_command_line() {
+    let panda = robot("panda");
+    // info says how to honour the tag, and what honouring it does.
+    let plain = ok(&["info", &panda]);
+    assert!(
+        plain.contains("--mimic (Builder::mimic_joints()"),
+        "{plain}"
+    );
+    let honoured = ok(&["info", &panda, "--mimic"]);
+    assert!(
+        honoured.contains("degrees of freedom: 8 (9 moving joints, 1 of them mimic joints"),
+        "{honoured}"
+    );
+    assert!(honoured.contains("mimic panda_finger_joint2: prismatic"));
+    assert!(honoured.contains("(mimics panda_finger_joint1: follows q8 x 1 + 0)"));
+    // eval in the 8 coordinates, against Pinocchio with the mimic tag honoured.
+    let text = std::fs::read_to_string(workspace().join("tests/robots/panda.mimic.json"))
+        .expect("reference JSON");
+    let json: serde_json::Value = serde_json::from_str(&text).expect("valid JSON");
+    let s = &json["samples"][3];
+    let (q, qd, qdd, tau_in) = (
+        joined(&numbers(&s["q"])),
+        joined(&numbers(&s["qd"])),
+        joined(&numbers(&s["qdd"])),
+        joined(&numbers(&s["tau_in"])),
+    );
+    let out = ok(&[
+        "eval", &panda, "--mimic", "--q", &q, "--qd", &qd, "--qdd", &qdd, "--tau", &tau_in,
+    ]);
+    assert!(out.starts_with("panda: 8 degrees of freedom; joint order: panda_joint1, "));
+    assert!(out.contains(", panda_finger_joint1\n"), "{out}");
+    close(
+        "panda --mimic tau",
+        &parse_list(&out, "inverse dynamics "),
+        &numbers(&s["tau"]),
+    );
+    close(
+        "panda --mimic qdd",
+        &parse_list(&out, "forward dynamics "),
+        &numbers(&s["forward_dynamics"]),
+    );
+    let e = bad_input(&["eval", &panda, "--mimic", "--q", &joined(&[0.0; 9])]);
+    assert!(e.contains("has 8 joint(s)"), "{e}");
+    // show: the reduced equations, the mimic joint described by its coordinate.
+    let shown = ok(&["show", &panda, "--mimic", "--term", "G"]);
+    assert!(shown.contains("8 degrees of freedom"), "{shown}");
+    assert!(
+        shown.contains(
+            "mimic: panda_finger_joint2, prismatic about (0, -1, 0), mimic joint: 1 q8 + 0"
+        ),
+        "{shown}"
+    );
+}
+
 /// `--form projected-newton-euler` and `--form hamiltonian` print the double pendulum as a
 /// person writes them (snapshots in every format), and refuse a robot too large to print in
 /// one line.

@@ -340,6 +340,44 @@ impl Builder {
         self
     }
 
+    /// Honours the URDF's mimic joints (`<mimic joint=".." multiplier=".." offset=".."/>`,
+    /// as grippers and hands couple their fingers): a mimic joint is then no coordinate of
+    /// its own but follows the joint it mimics, `q_mimic = multiplier q_joint + offset`, for
+    /// revolute, continuous and prismatic joints. The generated type has one coordinate per
+    /// independent joint (`JOINT_NAMES` lists them), and every quantity is in those
+    /// coordinates: `tau = G^T tau_joints`, `M = G^T M_joints G`, the bias, gravity, Coriolis
+    /// matrices, energies, link Jacobians `J G`, the centre of mass, forward dynamics (the
+    /// coupling's inertia is in `M`), the derivatives ([`Builder::derivatives`]) and the
+    /// regressor (`G^T Y`, [`Builder::regressor`]), with `G` the constant map from
+    /// coordinates to joint rates. A mimic of a mimic follows the root of the chain. A mimic
+    /// of a missing or fixed joint, a mimic tag on a fixed joint and a cycle of mimics fail
+    /// with an error naming the joints. With a floating base, the base's coordinates come
+    /// first, never coupled. Off by default: mimic joints are independent joints, as
+    /// in Pinocchio. See [`ModelOptions::mimic_joints`].
+    ///
+    /// ```
+    /// let urdf = r#"<robot name="gripper"><link name="base"/>
+    ///   <link name="left"><inertial><mass value="0.1"/>
+    ///   <inertia ixx="1e-4" ixy="0" ixz="0" iyy="1e-4" iyz="0" izz="1e-4"/></inertial></link>
+    ///   <link name="right"><inertial><mass value="0.1"/>
+    ///   <inertia ixx="1e-4" ixy="0" ixz="0" iyy="1e-4" iyz="0" izz="1e-4"/></inertial></link>
+    ///   <joint name="finger_left" type="prismatic"><parent link="base"/><child link="left"/>
+    ///   <axis xyz="0 1 0"/><limit lower="0" upper="0.04" effort="20" velocity="0.2"/></joint>
+    ///   <joint name="finger_right" type="prismatic"><parent link="base"/><child link="right"/>
+    ///   <axis xyz="0 -1 0"/><limit lower="0" upper="0.04" effort="20" velocity="0.2"/>
+    ///   <mimic joint="finger_left"/></joint></robot>"#;
+    /// let source = eomgen::Builder::from_urdf_str(urdf, "gripper.urdf")
+    ///     .mimic_joints()
+    ///     .generate()
+    ///     .unwrap();
+    /// // One coordinate: the right finger follows the left one.
+    /// assert!(source.contains(r#"const JOINT_NAMES: [&'static str; 1] = ["finger_left"];"#));
+    /// ```
+    pub fn mimic_joints(mut self) -> Builder {
+        self.options.mimic_joints = true;
+        self
+    }
+
     /// Joints without an actuator, by URDF name (the acrobot's elbow, a cart-pole's pole, a
     /// passive wrist or toe), for underactuated robots: `M qdd + b + G = S^T tau_a`. Adds to
     /// the generated type the constants `NA` (actuated joints) and

@@ -115,6 +115,9 @@ fn flags(o: &ModelOptions) -> Vec<(&'static str, Option<String>)> {
     for joint in &o.passive_joints {
         f.push(("passive", Some(joint.clone())));
     }
+    if o.mimic_joints {
+        f.push(("mimic", None));
+    }
     f
 }
 

@@ -41,6 +41,12 @@ fn generate_all() -> String {
         .generate()
         .unwrap();
     out += &format!("base {} {:016x}\n", src.len(), digest(src.as_bytes()));
+    // Mimic joints honoured: the coupling's projections and the coordinates' parents.
+    let src = eomgen::Builder::new(urdf("panda"))
+        .mimic_joints()
+        .generate()
+        .unwrap();
+    out += &format!("mimic {} {:016x}\n", src.len(), digest(src.as_bytes()));
     out
 }
 
@@ -55,7 +61,7 @@ fn child_process_generates() {
 fn every_reference_robot_generates_identical_bytes_in_two_processes() {
     let run = || child::run_child("child_process_generates");
     let (a, b) = (run(), run());
-    assert_eq!(a.lines().count(), ROBOTS.len() + 1);
+    assert_eq!(a.lines().count(), ROBOTS.len() + 2);
     assert_eq!(a, b);
     assert_eq!(a, generate_all(), "and identical to this process");
 }

@@ -101,6 +101,33 @@ pub fn chain_jacobian<T: Real, const N: usize>(
     jac
 }
 
+/// A matrix over a robot's joints (columns: joints, as [`chain_jacobian`] gives them) in the
+/// robot's coordinates when some joints follow others (URDF mimic joints): joint `j` moves
+/// at `coupling[j].1` times the rate of coordinate `coupling[j].0`, so column `c` of the
+/// result is the sum of the columns of its joints times their multipliers (`J G`).
+///
+/// ```
+/// use eomgen_runtime::tree::couple_columns;
+/// // three joints; the third follows the first at twice its rate
+/// let j = [[1.0_f64, 2.0, 3.0]];
+/// let reduced: [[f64; 2]; 1] = couple_columns(&j, &[(0, 1.0), (1, 1.0), (0, 2.0)]);
+/// assert_eq!(reduced, [[7.0, 2.0]]);
+/// ```
+pub fn couple_columns<T: Real, const R: usize, const NJ: usize, const N: usize>(
+    joints: &[[T; NJ]; R],
+    coupling: &[(usize, f64); NJ],
+) -> [[T; N]; R] {
+    let mut out = [[T::zero(); N]; R];
+    for (row, joint_row) in out.iter_mut().zip(joints) {
+        for (&(c, k), &x) in coupling.iter().zip(joint_row) {
+            if let Some(entry) = row.get_mut(c) {
+                *entry += T::from_f64(k) * x;
+            }
+        }
+    }
+    out
+}
+
 /// The column of the pair `(j, k)`, `j < k`, in Craig's order (0,1), (0,2), ..., (1,2), ...
 #[inline]
 pub const fn pair_index(n: usize, j: usize, k: usize) -> usize {

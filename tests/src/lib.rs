@@ -268,6 +268,28 @@ pub mod robots {
     pub mod joint_effects_smooth {
         include!(concat!(env!("OUT_DIR"), "/joint_effects_smooth.rs"));
     }
+    /// `panda.urdf` with its mimic joint honoured (8 coordinates) and the derivatives.
+    pub mod panda_mimic {
+        include!(concat!(env!("OUT_DIR"), "/panda_mimic.rs"));
+    }
+    /// `fixtures/mimic_tree.urdf` with its mimic joints honoured (4 coordinates), joint
+    /// friction, rotor inertia and the derivatives.
+    pub mod mimic_tree {
+        include!(concat!(env!("OUT_DIR"), "/mimic_tree.rs"));
+    }
+    /// The same tree without the option: every joint a coordinate (8).
+    pub mod mimic_tree_full {
+        include!(concat!(env!("OUT_DIR"), "/mimic_tree_full.rs"));
+    }
+    /// The mimic tree on a floating base (its root link free), with contacts at `tip` and
+    /// `lb2`, mimic joints honoured (6 + 4 velocity coordinates).
+    pub mod mimic_tree_floating {
+        include!(concat!(env!("OUT_DIR"), "/mimic_tree_floating.rs"));
+    }
+    /// The same without the option (6 + 8).
+    pub mod mimic_tree_floating_full {
+        include!(concat!(env!("OUT_DIR"), "/mimic_tree_floating_full.rs"));
+    }
     /// `urdf/light_tip.urdf`: a 1e-12 kg last link, an ill-conditioned mass matrix.
     pub mod light_tip {
         include!(concat!(env!("OUT_DIR"), "/light_tip.rs"));

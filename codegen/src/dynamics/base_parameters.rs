@@ -325,7 +325,8 @@ pub fn base_parameters(
         .iter()
         .map(|&(lead, _)| regressor.iter().map(|row| row[lead]).collect())
         .collect();
-    let sampled = sampled_columns(g, &columns, &params.symbols, n);
+    // One row per coordinate (fewer than joints with mimic joints).
+    let sampled = sampled_columns(g, &columns, &params.symbols, regressor.len());
     let (kept, fits) = reduce(&sampled);
     let mut formulas: Vec<Id> = kept.iter().map(|&k| groups[k].1).collect();
     for (k, beta) in fits {

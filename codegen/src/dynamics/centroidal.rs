@@ -89,6 +89,22 @@ impl Centroidal {
     }
 }
 
+impl Centroidal {
+    /// The Jacobians' columns in the coordinates of `map` (`J G`, see
+    /// [`super::coupling`]); unchanged without coupled joints.
+    pub fn projected(self, g: &mut Graph, map: &super::CoordinateMap) -> Centroidal {
+        if !map.is_coupled() {
+            return self;
+        }
+        Centroidal {
+            com_jacobian: map.project_columns(g, &self.com_jacobian),
+            map: map.project_columns(g, &self.map),
+            contact_jacobian: map.project_columns(g, &self.contact_jacobian),
+            ..self
+        }
+    }
+}
+
 /// The centroidal quantities of a floating base from the base's rows of `M`: they are the
 /// robot's momentum in base axes about the base origin, `(P_b; L_b) = M[0..6] v` (linear, then
 /// angular). With `R` the base rotation, `p` its position, `h` the robot's first moment about

@@ -9,7 +9,7 @@
 
 use super::newton_euler::{ltdl_solve, LocalModel};
 use super::rnea_derivatives::{inverse_dynamics_derivatives, InverseDynamicsDerivatives};
-use super::Derivation;
+use super::{lagrangian, CoordinateMap, Derivation};
 use crate::cas::{Graph, Id};
 use crate::kinematics::{const_v3, Params};
 use crate::model::Model;
@@ -30,19 +30,60 @@ pub struct Derivatives {
 }
 
 /// Derives the three functions for `model` in `d`'s graph.
+///
+/// With coupled joints (mimic joints, see [`super::coupling`]) the recursion runs over the
+/// joint tree at the joints' coordinates and is projected, `G^T (d tau / d x) G`: the joints'
+/// coordinates are affine in the robot's (`G` constant), so the chain rule is exact. The
+/// friction's part, diagonal in the joints but not in the coordinates, is differentiated in
+/// the coordinates.
 pub fn derive(d: &mut Derivation, model: &Model) -> Derivatives {
     let g = &mut d.graph;
     let params = Params::new(g, model);
-    let lm = LocalModel::new(g, model, &params, &d.q);
+    let map = CoordinateMap::new(model);
+    let joint_q = map.positions(g, &d.q);
+    let joint_qd = map.rates(g, &d.qd);
+    let lm = LocalModel::new(g, model, &params, &joint_q);
     let grav = const_v3(g, &model.gravity);
-    let inverse = inverse_dynamics_derivatives(g, &lm, grav, &d.qd, &d.qdd, &d.friction);
-    let parents = lm.coordinate_parents();
     let m = &d.fast.mass_matrix.1;
     let n = d.dof;
+    let parents = d.coordinate_parents.clone();
+    // Per velocity column of the joint tree: none on a floating base's six.
+    let base = model.base_nv();
+    let mut joint_friction = vec![g.zero(); base];
+    joint_friction.extend(lagrangian::joint_friction(
+        g,
+        model,
+        &params,
+        &joint_qd[base..],
+    ));
+    let id = |g: &mut Graph, qdd: &[Id]| {
+        let joint_qdd = map.rates(g, qdd);
+        if !map.is_coupled() {
+            return inverse_dynamics_derivatives(
+                g,
+                &lm,
+                grav,
+                &joint_qd,
+                &joint_qdd,
+                &joint_friction,
+            );
+        }
+        let zeros = vec![g.zero(); joint_qd.len()];
+        let r = inverse_dynamics_derivatives(g, &lm, grav, &joint_qd, &joint_qdd, &zeros);
+        let dq = map.project_matrix(g, &r.dq, false);
+        let mut dqd = map.project_matrix(g, &r.dqd, false);
+        for (i, row) in dqd.iter_mut().enumerate() {
+            for (j, x) in row.iter_mut().enumerate() {
+                let df = g.diff(d.friction[i], d.qd[j]);
+                *x = g.add(*x, df);
+            }
+        }
+        InverseDynamicsDerivatives { dq, dqd }
+    };
+    let inverse = id(g, &d.qdd);
     let unit = identity(g, n);
     let (mass_matrix_inverse, pivots) = solve_columns(g, &parents, m, &unit);
-    let at_fd =
-        inverse_dynamics_derivatives(g, &lm, grav, &d.qd, &d.fast.forward_dynamics, &d.friction);
+    let at_fd = id(g, &d.fast.forward_dynamics);
     let neg = |g: &mut Graph, a: &[Vec<Id>]| -> Vec<Vec<Id>> {
         a.iter()
             .map(|row| row.iter().map(|&x| g.neg(x)).collect())

@@ -7,32 +7,56 @@
 //! Craig's velocity-product matrices are not generated.
 
 use super::{
-    finish, lagrangian, newton_euler, recursive, Centroidal, Clock, Derivation, Fast,
-    JointTransform, Route,
+    finish, lagrangian, newton_euler, recursive, Centroidal, Clock, CoordinateMap, Derivation,
+    Fast, JointTransform, Route,
 };
 use crate::cas::{Graph, GraphFull, Id, Limits};
 use crate::kinematics::{const_v3, Params, WorldKinematics};
 use crate::model::Model;
 
-/// Derives every quantity of a floating-base `model`.
+/// Derives every quantity of a floating-base `model`. With coupled joints (mimic joints) the
+/// joint tree runs in the joints' coordinates and is projected, as for a fixed base (see
+/// `coupling`): the base's coordinates are never coupled.
 pub(super) fn derive(model: &Model, limits: Limits) -> Result<Derivation, GraphFull> {
     let mut clock = Clock::new();
     let mut g = Graph::with_limits(limits);
-    let (nq, nv) = (model.nq(), model.nv());
+    let map = CoordinateMap::new(model);
+    let (nq, nv) = (map.positions_len(), map.coordinates());
     let q: Vec<Id> = (0..nq).map(|i| g.q(i)).collect();
     let qd: Vec<Id> = (0..nv).map(|i| g.qd(i)).collect();
     let qdd: Vec<Id> = (0..nv).map(|i| g.qdd(i)).collect();
+    let (joint_q, joint_qd, joint_qdd) = (
+        map.positions(&mut g, &q),
+        map.rates(&mut g, &qd),
+        map.rates(&mut g, &qdd),
+    );
     let params = Params::new(&mut g, model);
-    let world = WorldKinematics::new(&mut g, model, &params, &q);
-    let lm = newton_euler::LocalModel::new(&mut g, model, &params, &q);
+    let world = WorldKinematics::new(&mut g, model, &params, &joint_q);
+    let lm = newton_euler::LocalModel::new(&mut g, model, &params, &joint_q);
     g.check()?;
     clock.lap("kinematics");
     let grav = const_v3(&mut g, &model.gravity);
-    let mut friction = vec![g.zero(); 6];
-    friction.extend(lagrangian::joint_friction(&mut g, model, &params, &qd[6..]));
-    let rec = recursive(&mut g, &lm, grav, &qd, &qdd, &friction)?;
+    let mut joint_friction = vec![g.zero(); 6];
+    joint_friction.extend(lagrangian::joint_friction(
+        &mut g,
+        model,
+        &params,
+        &joint_qd[6..],
+    ));
+    let friction = map.project(&mut g, &joint_friction);
+    let joint_rec = recursive(&mut g, &lm, grav, &joint_qd, &joint_qdd, &joint_friction)?;
+    // The centroidal quantities from the base's rows of the joint tree's M, then projected.
+    let centroidal = Centroidal::new(
+        &mut g,
+        model,
+        &lm,
+        &world,
+        &joint_qd,
+        &joint_rec.mass_matrix,
+    );
+    let centroidal = centroidal.projected(&mut g, &map);
+    let rec = joint_rec.projected(&mut g, &map);
     clock.lap("recursive algorithms");
-    let centroidal = Centroidal::new(&mut g, model, &lm, &world, &qd, &rec.mass_matrix);
     let potential_energy = {
         // V = -sum m g.c
         let gc = g.dot(&grav, &centroidal.first_moment);
@@ -43,7 +67,7 @@ pub(super) fn derive(model: &Model, limits: Limits) -> Result<Derivation, GraphF
         .map(|i| g.add(rec.bias_and_gravity[i], friction[i]))
         .collect();
     let rhs: Vec<Id> = (0..nv).map(|i| g.sub(tau_in[i], h[i])).collect();
-    let parents = lm.coordinate_parents();
+    let parents = map.parents(model, lm.coordinate_parents());
     let (forward_dynamics, pivots) =
         newton_euler::ltdl_solve(&mut g, &parents, &rec.mass_matrix, &rhs);
     g.check()?;

@@ -10,7 +10,7 @@ use super::base_parameters::{base_parameters, BaseParameter};
 use super::catalogue::{Evaluation, Home, Input, Quantity, Shape};
 use super::newton_euler::LocalModel;
 use super::regressor::{self, standard_parameters, Parameter};
-use super::{flat, Derivation};
+use super::{flat, CoordinateMap, Derivation};
 
 /// The regressor and the parameters of a derivation (with [`Derivation::add_regressor`]).
 #[derive(Clone, Debug)]
@@ -72,7 +72,12 @@ impl Derivation {
     pub fn add_regressor(&mut self, model: &Model) -> Result<(), GraphFull> {
         let g = &mut self.graph;
         let params = Params::new(g, model);
-        let lm = LocalModel::new(g, model, &params, &self.q);
+        // The joint tree's regressor at the joints' coordinates, projected onto the robot's
+        // (`G^T Y`: unchanged without mimic joints, see `coupling`).
+        let map = CoordinateMap::new(model);
+        let joint_q = map.positions(g, &self.q);
+        let (joint_qd, joint_qdd) = (map.rates(g, &self.qd), map.rates(g, &self.qdd));
+        let lm = LocalModel::new(g, model, &params, &joint_q);
         let grav = const_v3(g, &model.gravity);
         let parameters = standard_parameters(g, model, &lm, &params);
         let inputs = regressor::Inputs {
@@ -80,13 +85,15 @@ impl Derivation {
             lm: &lm,
             params: &params,
             parameters: &parameters,
-            qd: &self.qd,
-            qdd: &self.qdd,
+            qd: &joint_qd,
+            qdd: &joint_qdd,
             gravity: grav,
         };
+        let projected = regressor::projected(g, &inputs)?;
+        let differentiated = regressor::differentiated(g, &inputs)?;
         let routes = [
-            (PROJECTED, regressor::projected(g, &inputs)?),
-            (DIFFERENTIATED, regressor::differentiated(g, &inputs)?),
+            (PROJECTED, map.project_rows(g, &projected)),
+            (DIFFERENTIATED, map.project_rows(g, &differentiated)),
         ];
         let (route, y) = cheapest(g, &routes, |y| y.to_vec());
         let base = base_parameters(g, model, &params, &parameters, &y)?;

@@ -14,6 +14,7 @@
 pub mod base_parameters;
 pub mod catalogue;
 mod centroidal;
+pub mod coupling;
 mod derivatives;
 mod floating;
 pub mod identification;
@@ -32,6 +33,7 @@ use crate::model::Model;
 
 pub use catalogue::{Craig, Evaluation, Home, Input, Quantity, Shape};
 pub use centroidal::Centroidal;
+pub use coupling::CoordinateMap;
 pub use identification::Identification;
 pub use lagrangian::pairs;
 
@@ -130,6 +132,25 @@ pub struct Recursive {
     pub coriolis_matrix: Vec<Vec<Id>>,
     /// `T` from body velocities ([`newton_euler::kinetic_energy`]).
     pub kinetic_energy: Id,
+}
+
+impl Recursive {
+    /// The joint tree's quantities in the coordinates of `map` (see [`coupling`]): efforts
+    /// `G^T x`, matrices `G^T X G`; unchanged without coupled joints.
+    fn projected(self, g: &mut Graph, map: &CoordinateMap) -> Recursive {
+        if !map.is_coupled() {
+            return self;
+        }
+        Recursive {
+            mass_matrix: map.project_matrix(g, &self.mass_matrix, true),
+            gravity: map.project(g, &self.gravity),
+            bias: map.project(g, &self.bias),
+            bias_and_gravity: map.project(g, &self.bias_and_gravity),
+            tau: map.project(g, &self.tau),
+            coriolis_matrix: map.project_matrix(g, &self.coriolis_matrix, false),
+            kinetic_energy: self.kinetic_energy,
+        }
+    }
 }
 
 /// Which derivation a fast form comes from.
@@ -252,18 +273,27 @@ impl Derivation {
         }
         let mut clock = Clock::new();
         let mut g = Graph::with_limits(limits);
-        let n = model.dof();
+        // The coordinates' symbols, and the joints' coordinates as expressions of them (the
+        // same symbols unless mimic joints follow others: see `coupling`).
+        let map = CoordinateMap::new(model);
+        let n = map.coordinates();
         let q: Vec<Id> = (0..n).map(|i| g.q(i)).collect();
         let qd: Vec<Id> = (0..n).map(|i| g.qd(i)).collect();
         let qdd: Vec<Id> = (0..n).map(|i| g.qdd(i)).collect();
+        let (joint_q, joint_qd, joint_qdd) = (
+            map.positions(&mut g, &q),
+            map.rates(&mut g, &qd),
+            map.rates(&mut g, &qdd),
+        );
         let params = Params::new(&mut g, model);
-        let world = WorldKinematics::new(&mut g, model, &params, &q);
+        let world = WorldKinematics::new(&mut g, model, &params, &joint_q);
         g.check()?;
-        let body = BodyKinematics::new(&mut g, model, &params, &q);
+        let body = BodyKinematics::new(&mut g, model, &params, &joint_q);
         g.check()?;
         clock.lap("kinematics");
 
-        let mass_matrix = lagrangian::mass_matrix(&mut g, model, &params, &body)?;
+        let joint_mass_matrix = lagrangian::mass_matrix(&mut g, model, &params, &body)?;
+        let mass_matrix = map.project_matrix(&mut g, &joint_mass_matrix, true);
         clock.lap("mass matrix");
         let grav = const_v3(&mut g, &model.gravity);
         let en = lagrangian::energies(&mut g, &params, &world, &grav, &mass_matrix, &q, &qd);
@@ -271,7 +301,8 @@ impl Derivation {
         clock.lap("energies and gravity");
         let ch = lagrangian::christoffel(&mut g, &mass_matrix, &q, &qd)?;
         clock.lap("Christoffel symbols");
-        let friction = lagrangian::joint_friction(&mut g, model, &params, &qd);
+        let joint_friction = lagrangian::joint_friction(&mut g, model, &params, &joint_qd);
+        let friction = map.project(&mut g, &joint_friction);
         let tau: Vec<Id> = (0..n)
             .map(|i| {
                 let mq = g.dot(&mass_matrix[i], &qdd);
@@ -279,9 +310,10 @@ impl Derivation {
             })
             .collect();
 
-        let lm = newton_euler::LocalModel::new(&mut g, model, &params, &q);
+        let lm = newton_euler::LocalModel::new(&mut g, model, &params, &joint_q);
         g.check()?;
-        let recursive = recursive(&mut g, &lm, grav, &qd, &qdd, &friction)?;
+        let joint_recursive = recursive(&mut g, &lm, grav, &joint_qd, &joint_qdd, &joint_friction)?;
+        let recursive = joint_recursive.projected(&mut g, &map);
         clock.lap("recursive algorithms");
         let closed = Closed {
             mass_matrix: &mass_matrix,
@@ -292,15 +324,25 @@ impl Derivation {
             centrifugal: &ch.centrifugal,
             coriolis_pairs: &ch.coriolis_pairs,
         };
-        let fast = fast_forms(&mut g, model, &closed, &recursive, &friction, &qd)?;
+        let coordinate_parents = map.parents(model, lm.coordinate_parents());
+        let fast = fast_forms(
+            &mut g,
+            model,
+            &closed,
+            &recursive,
+            &friction,
+            &qd,
+            &coordinate_parents,
+        )?;
         clock.lap("fast forms");
-        let joint_transforms = (0..n)
+        let joint_transforms = (0..model.dof())
             .map(|i| JointTransform {
                 rotation: lm.rotation[i],
                 translation: lm.translation[i],
             })
             .collect();
-        let centroidal = Centroidal::new(&mut g, model, &lm, &world, &qd, &[]);
+        let centroidal = Centroidal::new(&mut g, model, &lm, &world, &joint_qd, &[]);
+        let centroidal = centroidal.projected(&mut g, &map);
         g.check()?;
         let d = Derivation {
             graph: g,
@@ -321,7 +363,7 @@ impl Derivation {
             kinetic_energy: en.kinetic_energy,
             potential_energy: en.potential_energy,
             joint_transforms,
-            coordinate_parents: lm.coordinate_parents(),
+            coordinate_parents,
             centroidal,
             recursive,
             fast,
@@ -338,13 +380,16 @@ impl Derivation {
     pub fn frames(&mut self, model: &Model) -> Vec<FrameExprs> {
         let g = &mut self.graph;
         let params = Params::new(g, model);
-        let world = WorldKinematics::new(g, model, &params, &self.q);
+        let map = CoordinateMap::new(model);
+        let q = map.positions(g, &self.q);
+        let world = WorldKinematics::new(g, model, &params, &q);
         model
             .frames
             .iter()
             .map(|f| {
                 let (rotation, position) = world.frame_pose(g, f.body, &f.placement);
-                let jacobian = world.point_jacobian(g, model, f.body, &position);
+                let joint_jacobian = world.point_jacobian(g, model, f.body, &position);
+                let jacobian = map.project_columns(g, &joint_jacobian);
                 FrameExprs {
                     name: f.name.clone(),
                     rotation,
@@ -462,6 +507,7 @@ fn fast_forms(
     rec: &Recursive,
     friction: &[Id],
     qd: &[Id],
+    parents: &[Option<usize>],
 ) -> Result<Fast, GraphFull> {
     let n = qd.len();
     let vec = |v: &Vec<Id>| v.clone();
@@ -471,7 +517,7 @@ fn fast_forms(
     // On chains longer than a dozen joints the Christoffel forms of b, tau and C(q, qd) are
     // never the cheaper ones, and merely costing them (scheduling millions of nodes) took most
     // of a 64-joint chain's generation time. (A branched hand of short fingers keeps them.)
-    let depth = (0..n)
+    let depth = (0..model.dof())
         .map(|i| model.path_to_root(i).len())
         .max()
         .unwrap_or(0);
@@ -491,8 +537,7 @@ fn fast_forms(
     let h: Vec<Id> = (0..n).map(|i| g.add(h[i], friction[i])).collect();
     let tau_in: Vec<Id> = (0..n).map(|i| g.tau(i)).collect();
     let rhs: Vec<Id> = (0..n).map(|i| g.sub(tau_in[i], h[i])).collect();
-    let parents: Vec<Option<usize>> = model.joints.iter().map(|j| j.parent).collect();
-    let (forward_dynamics, pivots) = newton_euler::ltdl_solve(g, &parents, &mm.1, &rhs);
+    let (forward_dynamics, pivots) = newton_euler::ltdl_solve(g, parents, &mm.1, &rhs);
     let cm = if small {
         cheaper(
             g,

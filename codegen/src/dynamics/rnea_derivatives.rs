@@ -229,7 +229,11 @@ pub fn inverse_dynamics_derivatives(
                 dq[y][x] = spatial_dot(g, sk, &v.own);
                 dqd[y][x] = spatial_dot(g, sk, &v.c);
             }
-            let df = g.diff(friction[x], qd[x]);
+            // No friction, nothing to differentiate (and `qd[x]` need not be a symbol then).
+            let df = match g.as_const(friction[x]) {
+                Some(_) => g.zero(),
+                None => g.diff(friction[x], qd[x]),
+            };
             dqd[x][x] = g.add(dqd[x][x], df);
             // The ancestors' columns, carried up one body at a time.
             let mut b = j;

@@ -175,7 +175,7 @@ impl Emitter<'_> {
         let (ty, allow) = (&self.ty, allow_lints());
         let try_fd = &self.try_forward_dynamics;
         let parents = self.parents_const();
-        let nj = usize_lit(self.model.joints.len());
+        let nj = usize_lit(self.model.coordinates());
         let identification = super::identification::constants(d, self.quantities);
         let actuation = super::actuation::items(
             self.model,
@@ -186,7 +186,11 @@ impl Emitter<'_> {
         let joint_names = if self.in_trait {
             TokenStream::new()
         } else {
-            let names = self.model.joints.iter().map(|j| Literal::string(&j.name));
+            let names = self
+                .model
+                .coordinate_names()
+                .into_iter()
+                .map(Literal::string);
             let what = if self.floating {
                 "The URDF names of the joints, in the order of the joint part of every array (after the base's coordinates)."
             } else {
@@ -262,6 +266,9 @@ impl Emitter<'_> {
             self.model.dof(),
             if self.floating { ", floating base" } else { "" }
         )];
+        if self.model.is_coupled() {
+            lines.extend(coupling_doc(self.model));
+        }
         if self.floating {
             lines.extend([
                 String::new(),
@@ -689,6 +696,19 @@ impl Emitter<'_> {
         } else {
             quote!(::eomgen_runtime::tree::chain_jacobian)
         };
+        if self.model.is_coupled() {
+            // Columns per joint (after a floating base's six), then summed into the
+            // coordinates' (`J G`).
+            let nj = usize_lit(self.model.nv());
+            return quote! {
+                #docs
+                pub fn link_jacobian(&self, link: #link_ty, q: &[T; #nq]) -> [[T; #n]; 6] {
+                    let (path, placement) = Self::link_frame(link);
+                    let joints: [[T; #nj]; 6] = #kernel(path, &Self::TREE_JOINTS, |j| self.joint_transform(j, q), &placement);
+                    ::eomgen_runtime::tree::couple_columns(&joints, &Self::COUPLING)
+                }
+            };
+        }
         quote! {
             #docs
             pub fn link_jacobian(&self, link: #link_ty, q: &[T; #nq]) -> [[T; #n]; 6] {
@@ -726,9 +746,32 @@ impl Emitter<'_> {
         });
         let link_arms = self.link_frame_arms();
         let link_ty = &self.link_ty;
+        let coupling = if self.model.is_coupled() {
+            let v0 = self.model.base_nv();
+            let base = (0..v0).map(|i| (i, 1.0));
+            let joints = self
+                .model
+                .coupling
+                .iter()
+                .map(|c| (v0 + c.coordinate, c.multiplier));
+            let entries = base.chain(joints).map(|(i, k)| {
+                let (i, k) = (usize_lit(i), f64_literal(k));
+                quote!((#i, #k))
+            });
+            let nv = usize_lit(self.model.nv());
+            quote! {
+                /// Per velocity column of the joint tree (a floating base's six, then one per
+                /// joint), the coordinate it follows and its multiplier (its rate is the
+                /// multiplier times the coordinate's).
+                const COUPLING: [(usize, f64); #nv] = [#(#entries),*];
+            }
+        } else {
+            TokenStream::new()
+        };
         quote! {
             /// Each joint's axis (in the frame of the body it moves) and motion.
             const TREE_JOINTS: [::eomgen_runtime::tree::TreeJoint; #nj] = [#(#joints),*];
+            #coupling
 
             /// The pose of body `j` in its parent body's frame (a floating base is body 0).
             fn joint_transform(&self, j: usize, q: &[T; #nq]) -> ::eomgen_runtime::Pose<T> {
@@ -774,7 +817,11 @@ impl Emitter<'_> {
         if !self.in_trait {
             return TokenStream::new();
         }
-        let names = self.model.joints.iter().map(|j| Literal::string(&j.name));
+        let names = self
+            .model
+            .coordinate_names()
+            .into_iter()
+            .map(Literal::string);
         let (ty, n, allow) = (&self.ty, &self.n, allow_lints());
         quote! {
             #allow
@@ -836,6 +883,32 @@ impl Emitter<'_> {
         }
         out
     }
+}
+
+/// The type documentation's paragraph on mimic joints: which joints follow which coordinate.
+fn coupling_doc(model: &Model) -> Vec<String> {
+    let mut lines = vec![
+        String::new(),
+        format!(
+            "Mimic joints follow other joints (URDF `<mimic>`, honoured): the {} coordinates are the independent",
+            model.coordinates()
+        ),
+        "joints (`JOINT_NAMES`), and every quantity is in them (efforts `G^T tau`, `M = G^T M_joints G`,".into(),
+        "Jacobians `J G`, with `q_joint = multiplier q_coordinate + offset`):".into(),
+    ];
+    let names = model.coordinate_names();
+    for (j, c) in model.joints.iter().zip(&model.coupling) {
+        if c.leader.is_some() {
+            lines.push(format!(
+                "- `{}` = {} `{}` + {}",
+                j.name.replace('`', "'"),
+                c.multiplier,
+                names[c.coordinate].replace('`', "'"),
+                c.offset
+            ));
+        }
+    }
+    lines
 }
 
 /// A constant pose as `Pose { .. }` with `T::from_f64` literals (rotation entries snapped).

@@ -15,7 +15,7 @@ use thiserror::Error;
 
 use super::inertia_check;
 use super::shapes::{mass_properties, Shape};
-use super::{Body, Frame, Joint, JointKind, Limits, Mimic, Model, Transform};
+use super::{Body, Coupling, Frame, Joint, JointKind, Limits, Mimic, Model, Transform};
 
 /// The largest magnitude accepted for a number that enters the equations (lengths, angles,
 /// masses, inertias, damping, friction, gravity). Far beyond any robot in SI units, and small
@@ -92,6 +92,14 @@ pub struct ModelOptions {
     /// base is [`ModelError::InvalidPassiveJoints`]. A name listed twice counts once. Empty by
     /// default.
     pub passive_joints: Vec<String>,
+    /// Honours the URDF's `<mimic joint multiplier offset>` tags: a mimic joint is no
+    /// coordinate of its own, its value is `multiplier * (the mimicked joint) + offset`, and
+    /// every quantity is in the remaining, independent coordinates ([`Model::coupling`]). A
+    /// mimic of a mimic follows the root of the chain (multipliers multiplied, offsets
+    /// composed). A mimic of a missing or fixed joint, a mimic tag on a fixed joint and a cycle
+    /// of mimics are errors ([`ModelError::InvalidMimic`], [`ModelError::MimicCycle`]).
+    /// `false` by default: mimic joints are independent joints, as in Pinocchio.
+    pub mimic_joints: bool,
 }
 
 impl Default for ModelOptions {
@@ -108,6 +116,7 @@ impl Default for ModelOptions {
             inertia_from_collision: None,
             floating_base: false,
             contact_points: Vec::new(),
+            mimic_joints: false,
             passive_joints: Vec::new(),
         }
     }
@@ -413,6 +422,18 @@ pub enum ModelError {
     /// no joint actuated, or is given for a floating-base robot.
     #[error("{file}: passive joints: {reason}")]
     InvalidPassiveJoints { file: String, reason: String },
+    /// With [`ModelOptions::mimic_joints`], a `<mimic>` tag that cannot be honoured: it names
+    /// a joint that does not exist or does not move, or sits on a joint that does not move.
+    #[error("{file}: joint `{joint}` mimics `{leader}`, {reason}")]
+    InvalidMimic {
+        file: String,
+        joint: String,
+        leader: String,
+        reason: String,
+    },
+    /// With [`ModelOptions::mimic_joints`], joints that mimic each other in a cycle.
+    #[error("{file}: the mimic joints {} form a cycle: none of them is a coordinate", name_list(.joints, " -> "))]
+    MimicCycle { file: String, joints: Vec<String> },
     /// A numeric option is out of its range (for example a density that is not positive).
     #[error("{file}: option {option}: {reason}")]
     InvalidOption {
@@ -584,6 +605,18 @@ pub(crate) fn build_model(
     mark_symbolic(&mut model, &options.symbolic, file)?;
     model.contacts = contact_frames(&model, &options.contact_points, file)?;
     model.passive = passive_joints(&model, robot, &options.passive_joints, file)?;
+    if options.mimic_joints {
+        model.coupling = couplings(&model, robot, file)?;
+    }
+    if let (Some(&p), true) = (model.passive.first(), model.is_coupled()) {
+        return Err(ModelError::InvalidPassiveJoints {
+            file: file.into(),
+            reason: format!(
+                "joint `{}`: passive joints cannot be combined with mimic joints yet",
+                model.joints[p].name
+            ),
+        });
+    }
     model.warnings = warnings.clone();
     Ok(model)
 }
@@ -1209,6 +1242,7 @@ fn merge(
         }
     }
 
+    let joints_len = joints.len();
     Ok(Model {
         name: robot.name.clone(),
         root: robot.links[tree.root].name.clone(),
@@ -1222,6 +1256,7 @@ fn merge(
         include_friction: options.friction,
         coulomb_smoothing: options.coulomb_smoothing,
         warnings: Vec::new(),
+        coupling: (0..joints_len).map(Coupling::independent).collect(),
     })
 }
 
@@ -1267,6 +1302,112 @@ fn passive_joints(
     }
     passive.sort_unstable();
     Ok(passive)
+}
+
+/// Each moving joint's index by its name.
+fn joint_index(model: &Model) -> HashMap<&str, usize> {
+    model
+        .joints
+        .iter()
+        .enumerate()
+        .map(|(i, j)| (j.name.as_str(), i))
+        .collect()
+}
+
+/// The coupling of every joint with the URDF's mimic tags honoured (see
+/// [`ModelOptions::mimic_joints`]): each mimic chain is followed to its root, an independent
+/// joint, whose coordinate the joint follows with the chain's multipliers multiplied and
+/// offsets composed. Coordinates are numbered in joint order.
+fn couplings(
+    model: &Model,
+    robot: &RobotDescription,
+    file: &str,
+) -> Result<Vec<Coupling>, ModelError> {
+    let index = joint_index(model);
+    let invalid = |joint: &str, leader: &str, reason: &str| ModelError::InvalidMimic {
+        file: file.into(),
+        joint: joint.into(),
+        leader: leader.into(),
+        reason: reason.into(),
+    };
+    // A mimic tag on a joint that does not move has nothing to follow with.
+    for joint in &robot.joints {
+        if let (Some(m), false) = (&joint.mimic, index.contains_key(joint.name.as_str())) {
+            let kind = match &joint.joint_type {
+                JointType::Unsupported(kind) => kind.clone(),
+                _ => "fixed".to_string(),
+            };
+            let reason = format!(
+                "but is a {kind} joint: only revolute, continuous and prismatic joints can mimic"
+            );
+            return Err(invalid(&joint.name, &m.joint, &reason));
+        }
+    }
+    // Each joint's direct leader.
+    let mut leader: Vec<Option<(usize, f64, f64)>> = Vec::with_capacity(model.joints.len());
+    for joint in &model.joints {
+        let Some(m) = &joint.mimic else {
+            leader.push(None);
+            continue;
+        };
+        let Some(&l) = index.get(m.joint.as_str()) else {
+            let reason = if robot.joints.iter().any(|j| j.name == m.joint) {
+                "which does not move (a fixed joint): only a moving joint can be mimicked"
+            } else {
+                "which does not exist"
+            };
+            return Err(invalid(&joint.name, &m.joint, reason));
+        };
+        leader.push(Some((l, m.multiplier, m.offset)));
+    }
+    // Independent joints are the coordinates, in joint order.
+    let mut coordinate = vec![usize::MAX; model.joints.len()];
+    let mut next = 0;
+    for (i, l) in leader.iter().enumerate() {
+        if l.is_none() {
+            coordinate[i] = next;
+            next += 1;
+        }
+    }
+    let mut out = Vec::with_capacity(model.joints.len());
+    for i in 0..model.joints.len() {
+        // Follow the chain: q_i = k q_l + o, q_l = k' q_m + o', ... down to an independent joint.
+        let (mut j, mut multiplier, mut offset) = (i, 1.0, 0.0);
+        let mut chain = vec![i];
+        while let Some((l, k, o)) = leader[j] {
+            // q = multiplier (k q_l + o) + offset.
+            offset += multiplier * o;
+            multiplier *= k;
+            if let Some(start) = chain.iter().position(|&c| c == l) {
+                let joints = chain[start..]
+                    .iter()
+                    .chain([&l])
+                    .map(|&c| model.joints[c].name.clone())
+                    .collect();
+                return Err(ModelError::MimicCycle {
+                    file: file.into(),
+                    joints,
+                });
+            }
+            chain.push(l);
+            j = l;
+        }
+        let culprit = || format!("joint `{}`", model.joints[i].name);
+        if !(multiplier.is_finite() && offset.is_finite()) {
+            return Err(ModelError::NonFinite {
+                file: file.into(),
+                culprit: culprit(),
+                field: "mimic multiplier or offset, composed along its mimic chain",
+            });
+        }
+        out.push(Coupling {
+            coordinate: coordinate[j],
+            leader: (j != i).then_some(j),
+            multiplier,
+            offset,
+        });
+    }
+    Ok(out)
 }
 
 /// The frame index of each contact link, in order.
@@ -1412,12 +1553,7 @@ fn reorder(
         reason,
     };
     let n = model.joints.len();
-    let index: HashMap<&str, usize> = model
-        .joints
-        .iter()
-        .enumerate()
-        .map(|(i, j)| (j.name.as_str(), i))
-        .collect();
+    let index = joint_index(model);
     let mut new_index: Vec<Option<usize>> = vec![None; n];
     for (k, name) in order.iter().enumerate() {
         let Some(&old) = index.get(name.as_str()) else {

@@ -94,12 +94,52 @@ pub struct Limits {
     pub velocity: f64,
 }
 
-/// A mimic relation, kept for information: eomgen treats mimic joints as independent.
+/// A URDF `<mimic>` relation: the joint's coordinate is `multiplier * (joint's) + offset`.
+/// Kept for information unless [`ModelOptions::mimic_joints`] is set, which makes the joint
+/// follow its leader (see [`Coupling`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Mimic {
     pub joint: String,
     pub multiplier: f64,
     pub offset: f64,
+}
+
+/// How a joint's coordinate follows the robot's independent coordinates:
+/// `q_joint = multiplier * q[coordinate] + offset`, so that `qd_joint = multiplier *
+/// qd[coordinate]` (and likewise for accelerations). An independent joint is its own
+/// coordinate with multiplier 1 and offset 0; a mimic joint
+/// ([`ModelOptions::mimic_joints`]) follows the coordinate of the joint at the root of its
+/// mimic chain.
+///
+/// The map from coordinates to joint velocities is the constant matrix `G` (one row per
+/// joint, `G[joint][coordinate] = multiplier`): every quantity in the coordinates is the
+/// joint tree's projected, `tau = G^T tau_joints`, `M = G^T M_joints G`, `J = J_joints G`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Coupling {
+    /// The coordinate (an index into the joints' part of `q`) the joint follows.
+    pub coordinate: usize,
+    /// The joint behind that coordinate (the root of the mimic chain), `None` for an
+    /// independent joint.
+    pub leader: Option<usize>,
+    pub multiplier: f64,
+    pub offset: f64,
+}
+
+impl Coupling {
+    /// An independent joint: coordinate `i` itself.
+    pub fn independent(i: usize) -> Coupling {
+        Coupling {
+            coordinate: i,
+            leader: None,
+            multiplier: 1.0,
+            offset: 0.0,
+        }
+    }
+
+    /// Whether the joint is its coordinate unchanged (multiplier 1, offset 0).
+    pub fn is_identity(&self) -> bool {
+        self.multiplier == 1.0 && self.offset == 0.0
+    }
 }
 
 /// A moving joint.
@@ -187,6 +227,9 @@ pub struct Model {
     pub coulomb_smoothing: f64,
     /// What loading had to guess, for the user to check (see [`ModelWarning`]).
     pub warnings: Vec<ModelWarning>,
+    /// Per joint, the coordinate it follows ([`Coupling`]): joint `i` is coordinate `i`
+    /// unless [`ModelOptions::mimic_joints`] makes mimic joints follow their leaders.
+    pub coupling: Vec<Coupling>,
 }
 
 impl Model {
@@ -200,6 +243,34 @@ impl Model {
     /// Degrees of freedom.
     pub fn dof(&self) -> usize {
         self.joints.len()
+    }
+
+    /// Whether some joints follow others ([`Model::coupling`]): the robot then has fewer
+    /// coordinates ([`Model::coordinates`]) than joints.
+    pub fn is_coupled(&self) -> bool {
+        self.coupling.iter().any(|c| c.leader.is_some())
+    }
+
+    /// The number of joint coordinates: one per independent joint ([`Model::dof`] without
+    /// mimic joints).
+    pub fn coordinates(&self) -> usize {
+        self.coordinate_joints().len()
+    }
+
+    /// The joint behind each coordinate, in coordinate order: the independent joints.
+    pub fn coordinate_joints(&self) -> Vec<usize> {
+        (0..self.joints.len())
+            .filter(|&i| self.coupling.get(i).is_none_or(|c| c.leader.is_none()))
+            .collect()
+    }
+
+    /// The URDF names of the coordinates' joints, in coordinate order (what `JOINT_NAMES`
+    /// lists).
+    pub fn coordinate_names(&self) -> Vec<&str> {
+        self.coordinate_joints()
+            .into_iter()
+            .map(|j| self.joints[j].name.as_str())
+            .collect()
     }
 
     /// Whether the root link moves freely ([`Model::base`]).

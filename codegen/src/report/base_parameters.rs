@@ -159,17 +159,36 @@ pub fn render_base_parameters(
             .into(),
     ));
     legend.extend(geometry);
+    let describe = |i: usize| {
+        let j = &model.joints[i];
+        format!(
+            "{}, {} about {}, moves body {}",
+            j.name,
+            kind_name(j.kind),
+            vec3(&j.axis, opts.digits),
+            id.body_names[i]
+        )
+    };
+    // One line per coordinate; a mimic joint is described with the coordinate it follows.
     let joints: Vec<String> = model
-        .joints
-        .iter()
-        .zip(&id.body_names)
-        .map(|(j, body)| {
-            format!(
-                "{}, {} about {}, moves body {body}",
-                j.name,
-                kind_name(j.kind),
-                vec3(&j.axis, opts.digits)
-            )
+        .coordinate_joints()
+        .into_iter()
+        .enumerate()
+        .map(|(c, i)| {
+            let mut line = describe(i);
+            for (m, k) in model.coupling.iter().enumerate() {
+                if k.leader.is_some() && k.coordinate == c {
+                    let _ = write!(
+                        line,
+                        "; mimic joint {} ({} q{} + {})",
+                        describe(m),
+                        format_number(k.multiplier, opts.digits),
+                        c + 1,
+                        format_number(k.offset, opts.digits)
+                    );
+                }
+            }
+            line
         })
         .collect();
     let doc = Document {

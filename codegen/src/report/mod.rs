@@ -870,13 +870,28 @@ pub fn render(model: &Model, d: &Derivation, opts: &ShowOptions) -> Result<Strin
         joints.extend(base.map(|(q, w)| (q, w.to_string())));
     }
     joints.extend(model.joints.iter().enumerate().map(|(i, j)| {
-        let q = g.print(d.q[q0 + i], style);
+        let coupling = model.coupling.get(i).copied();
+        let index = coupling.map_or(i, |c| c.coordinate);
+        let q = g.print(d.q[q0 + index], style);
         let mut what = format!(
             "{}, {} about {}",
             j.name,
             kind_name(j.kind),
             vec3(&j.axis, opts.digits)
         );
+        // A mimic joint follows its coordinate: no symbol of its own.
+        let q = match coupling {
+            Some(c) if c.leader.is_some() => {
+                let _ = write!(
+                    what,
+                    ", mimic joint: {} {q} + {}",
+                    format_number(c.multiplier, opts.digits),
+                    format_number(c.offset, opts.digits)
+                );
+                "mimic".to_string()
+            }
+            _ => q,
+        };
         if j.armature != 0.0 {
             let _ = write!(
                 what,
@@ -1017,7 +1032,7 @@ pub fn render(model: &Model, d: &Derivation, opts: &ShowOptions) -> Result<Strin
 
 /// What the equations of a floating-base robot are, for the introduction.
 fn floating_intro(model: &Model) -> Vec<String> {
-    let nv = model.nv();
+    let nv = model.base_nv() + model.coordinates();
     vec![
         format!(
             "Floating base (a free flyer): M(q) qdd + b(q, qd) + G(q) = S^T tau + J_c(q)^T F_c, with {nv} \

@@ -26,7 +26,8 @@
 //!   unless [`ModelOptions::joint_order`] gives an explicit order. A parent joint always comes
 //!   before its children.
 //! - Mimic joints are independent joints, as in Pinocchio; the [`Mimic`](crate::model::Mimic)
-//!   relation is kept for information only. Limits and `<dynamics damping friction>` are kept
+//!   relation is kept for information, unless [`ModelOptions::mimic_joints`] makes each follow
+//!   the joint it mimics ([`Model::coupling`](crate::model::Model::coupling)). Limits and `<dynamics damping friction>` are kept
 //!   (the friction enters the dynamics only with [`ModelOptions::friction`]).
 //! - `<collision>` boxes, cylinders and spheres give a link without `<inertial>` its inertia
 //!   only with [`ModelOptions::inertia_from_collision`]; otherwise such a link is massless.
