@@ -35,11 +35,12 @@
 //! 7-joint arm generated this way (`cargo run --example computed_torque`), and the `eomgen`
 //! command line (crate `eomgen-cli`) prints the same equations for people.
 //!
-//! The pipeline, one module per stage:
-//! [`urdf`] (the only module that sees XML) → [`model`] (kinematic tree, merged fixed links) →
-//! [`kinematics`] and [`dynamics`] (closed-form expressions in the [`cas`], with [`spatial`]
-//! algebra) → [`emit`] (Rust),
-//! or [`report`] (equations for people: text, LaTeX, Markdown; the `eomgen show` command).
+//! Beside [`Builder`], the public API is [`Error`], the [`model`] a builder loads
+//! ([`Builder::model`]: its joints, bodies and frames, and [`ModelError`]) and [`report`]
+//! (equations for people: text, LaTeX, Markdown; the `eomgen show` command). The stages in
+//! between (URDF reader, computer algebra, kinematics, derivation, emission) are public for
+//! the command line and the tests but hidden from this page: they change between minor
+//! versions. `docs/architecture.md` in the repository describes them.
 
 // Matrix code reads best with explicit indices.
 #![allow(clippy::needless_range_loop)]
@@ -49,15 +50,21 @@
 use std::path::{Path, PathBuf};
 
 mod builder;
+#[doc(hidden)]
 pub mod cas;
 mod debug_display;
+#[doc(hidden)]
 pub mod dynamics;
+#[doc(hidden)]
 pub mod emit;
+#[doc(hidden)]
 pub mod kinematics;
 pub mod model;
 mod regenerate;
 pub mod report;
+#[doc(hidden)]
 pub mod spatial;
+#[doc(hidden)]
 pub mod urdf;
 
 pub use builder::{Builder, DEFAULT_MAX_DOF, DEFAULT_MAX_GRAPH_NODES};
