@@ -1061,4 +1061,15 @@ fn show_other_forms() {
         "{err}"
     );
     assert!(err.contains("it is for small robots"), "{err}");
+    // With mimic joints the per-body shares are refused, not printed wrong.
+    let panda = robot("panda");
+    let err = bad_input(&[
+        "show",
+        &panda,
+        "--mimic",
+        "--form",
+        "projected-newton-euler",
+    ]);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains("not printed with mimic joints yet"), "{err}");
 }

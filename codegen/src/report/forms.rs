@@ -69,6 +69,13 @@ pub(super) fn projected_newton_euler(
     syntax: Syntax,
     dropped: &mut usize,
 ) -> Result<Vec<Section>, ReportError> {
+    if model.is_coupled() {
+        return Err(ReportError::TooLarge(format!(
+            "{}: the projected Newton-Euler form is not printed with mimic joints yet (drop \
+             --mimic to see each body's share in the joints' coordinates)",
+            model.name
+        )));
+    }
     let terms = projected::body_terms(g, model, &d.q, &d.qd);
     let all: Vec<Id> = terms
         .iter()
