@@ -47,29 +47,20 @@ pub fn derive(d: &mut Derivation, model: &Model) -> Derivatives {
     let m = &d.fast.mass_matrix.1;
     let n = d.dof;
     let parents = d.coordinate_parents.clone();
-    // Per velocity column of the joint tree: none on a floating base's six.
+    // Per velocity column of the joint tree (none on a floating base's six). With mimic joints
+    // the friction is differentiated in the coordinates instead, after the projection.
     let base = model.base_nv();
-    let mut joint_friction = vec![g.zero(); base];
-    joint_friction.extend(lagrangian::joint_friction(
-        g,
-        model,
-        &params,
-        &joint_qd[base..],
-    ));
+    let mut joint_friction = vec![g.zero(); joint_qd.len()];
+    if !map.is_coupled() {
+        let f = lagrangian::joint_friction(g, model, &params, &joint_qd[base..]);
+        joint_friction[base..].copy_from_slice(&f);
+    }
     let id = |g: &mut Graph, qdd: &[Id]| {
         let joint_qdd = map.rates(g, qdd);
+        let r = inverse_dynamics_derivatives(g, &lm, grav, &joint_qd, &joint_qdd, &joint_friction);
         if !map.is_coupled() {
-            return inverse_dynamics_derivatives(
-                g,
-                &lm,
-                grav,
-                &joint_qd,
-                &joint_qdd,
-                &joint_friction,
-            );
+            return r;
         }
-        let zeros = vec![g.zero(); joint_qd.len()];
-        let r = inverse_dynamics_derivatives(g, &lm, grav, &joint_qd, &joint_qdd, &zeros);
         let dq = map.project_matrix(g, &r.dq, false);
         let mut dqd = map.project_matrix(g, &r.dqd, false);
         for (i, row) in dqd.iter_mut().enumerate() {
