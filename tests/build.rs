@@ -44,6 +44,7 @@ fn main() {
     regressors();
     underactuated();
     mimic();
+    split();
     eomgen::Builder::new("robots/panda.urdf")
         .module_name("panda_selected")
         .type_name("PandaSelected")
@@ -351,4 +352,30 @@ fn mimic() {
     ] {
         builder.module_name(module).type_name(ty).compile().unwrap();
     }
+}
+
+/// Bodies split into many blocks (`Builder::max_function_ops`), for comparison with the same
+/// robots generated whole: the ur5's derivatives and anymal on its feet.
+fn split() {
+    eomgen::Builder::new("robots/ur5.urdf")
+        .module_name("ur5_split")
+        .type_name("Ur5Split")
+        .derivatives()
+        .max_function_ops(60)
+        .quantities([
+            "inverse_dynamics",
+            "inverse_dynamics_derivatives",
+            "forward_dynamics_derivatives",
+            "mass_matrix_inverse",
+        ])
+        .compile()
+        .unwrap();
+    eomgen::Builder::new("robots/floating/anymal.urdf")
+        .floating_base()
+        .contact_points(&["LF_FOOT", "RF_FOOT", "LH_FOOT", "RH_FOOT"])
+        .module_name("anymal_split")
+        .type_name("AnymalSplit")
+        .max_function_ops(150)
+        .compile()
+        .unwrap();
 }

@@ -60,6 +60,8 @@ pub struct Builder {
     derivatives: bool,
     /// Whether to add the regressor and the parameters ([`Builder::regressor`]).
     regressor: bool,
+    /// The most operations of one generated function body ([`Builder::max_function_ops`]).
+    max_function_ops: usize,
 }
 
 /// Robots with more joints than this are refused unless [`Builder::max_dof`] raises the limit:
@@ -70,6 +72,12 @@ pub const DEFAULT_MAX_DOF: usize = 64;
 /// The default of [`Builder::max_graph_nodes`]: 50 million expression nodes, a few gigabytes at
 /// the worst; a 40-joint chain needs a few million.
 pub const DEFAULT_MAX_GRAPH_NODES: usize = crate::cas::graph::DEFAULT_MAX_NODES;
+
+/// The default of [`Builder::max_function_ops`]. Longer bodies are split into non-inlined
+/// blocks, which bounds the compile time of each function: LLVM's cost for a straight-line
+/// block grows with the square of its length, above all for the native CPU
+/// (`-C target-cpu=native`).
+pub const DEFAULT_MAX_FUNCTION_OPS: usize = 3000;
 
 /// Type names the generated code cannot take: `T` is its generic parameter.
 const RESERVED_TYPE_NAMES: &[&str] = &["T"];
@@ -100,6 +108,7 @@ impl Builder {
             quantities: None,
             derivatives: false,
             regressor: false,
+            max_function_ops: DEFAULT_MAX_FUNCTION_OPS,
         }
     }
 
@@ -240,6 +249,24 @@ impl Builder {
     /// [`Error::Limit`] instead of exhausting memory. Each node takes some 60 bytes.
     pub fn max_graph_nodes(mut self, limit: usize) -> Builder {
         self.max_graph_nodes = limit;
+        self
+    }
+
+    /// The most arithmetic operations one generated function body may hold (default
+    /// [`DEFAULT_MAX_FUNCTION_OPS`]). A longer body, such as the derivatives of a legged robot
+    /// or a humanoid (tens of thousands of operations), is written as a chain of
+    /// `#[inline(never)]` blocks of at most this many operations that pass their intermediate
+    /// values through a small work array: the compile time of the generated module then grows
+    /// linearly with its size instead of with the square of its longest function. The
+    /// function's signature, results and operation count do not change. A larger budget gives
+    /// the optimizer longer stretches to schedule at a higher compile cost; `usize::MAX`
+    /// never splits.
+    ///
+    /// ```
+    /// let b = eomgen::Builder::new("robots/anymal.urdf").derivatives().max_function_ops(5000);
+    /// ```
+    pub fn max_function_ops(mut self, limit: usize) -> Builder {
+        self.max_function_ops = limit.max(1);
         self
     }
 
@@ -582,6 +609,7 @@ impl Builder {
             type_name,
             source_name,
             regenerate,
+            max_function_ops: self.max_function_ops,
         };
         let generated = emit::rust_module(&model, &derivation, &opts)?;
         Ok((generated, model, derivation))

@@ -211,10 +211,17 @@ impl_real!(
 /// the whole crate does not count as the caller's), nor fuse a multiply and an add any other
 /// way: this module is the crate's one exemption from `unsafe_code`, for two calls whose only
 /// precondition (the CPU has FMA) the `cfg` establishes.
+///
+/// The fused versions are `#[inline]`, not `#[inline(always)]`: LLVM inlines `always` functions
+/// before it simplifies them, so each call brought the intrinsics' unsimplified `__m128d`
+/// temporaries (about ten stack slots) into the caller, and promoting tens of thousands of them
+/// to registers in one long generated function took LLVM's `PromoteMemToReg` tens of minutes
+/// (anymal's derivatives, `-C target-cpu=native`). Inlined after simplification, each call is
+/// one `vfmadd` instruction, and the same crate builds in about 20 s.
 #[allow(unsafe_code)]
 mod fused {
     #[cfg(all(target_arch = "x86_64", target_feature = "fma"))]
-    #[inline(always)]
+    #[inline]
     pub fn f64(x: f64, a: f64, b: f64) -> f64 {
         use core::arch::x86_64::{_mm_cvtsd_f64, _mm_fmadd_sd, _mm_set_sd};
         // SAFETY: the `fma` target feature is enabled at compile time (the `cfg` above).
@@ -222,7 +229,7 @@ mod fused {
     }
 
     #[cfg(all(target_arch = "x86_64", target_feature = "fma"))]
-    #[inline(always)]
+    #[inline]
     pub fn f32(x: f32, a: f32, b: f32) -> f32 {
         use core::arch::x86_64::{_mm_cvtss_f32, _mm_fmadd_ss, _mm_set_ss};
         // SAFETY: the `fma` target feature is enabled at compile time (the `cfg` above).

@@ -322,6 +322,14 @@ pub mod robots {
         include!(concat!(env!("OUT_DIR"), "/allegro_derivatives.rs"));
     }
     /// `floating/anymal.urdf` with a floating base and point contacts at its four feet.
+    pub mod ur5_split {
+        include!(concat!(env!("OUT_DIR"), "/ur5_split.rs"));
+    }
+
+    pub mod anymal_split {
+        include!(concat!(env!("OUT_DIR"), "/anymal_split.rs"));
+    }
+
     pub mod anymal {
         include!(concat!(env!("OUT_DIR"), "/anymal.rs"));
     }

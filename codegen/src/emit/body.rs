@@ -6,6 +6,7 @@ use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote};
 
 use super::expr::Ctx;
+use super::split::{split_body, Split};
 use crate::cas::{Graph, Id, OpCount, Order, Program};
 use crate::dynamics::Shape;
 
@@ -17,19 +18,37 @@ const DEPTH_ORDER_MIN_OPS: usize = 6000;
 /// Temporaries per chunk of `let`s (see [`body`]).
 const LET_CHUNK: usize = 64;
 
-/// Straight-line body computing `outputs` in the given shape, and its operation count.
+/// A function body and what it costs.
+pub(super) struct Body {
+    /// Statements ending in the result.
+    pub code: TokenStream,
+    pub ops: OpCount,
+    /// The non-inlined blocks the body calls when it was split ([`split_body`]), for the
+    /// inherent impl.
+    pub blocks: Vec<TokenStream>,
+}
+
+/// Straight-line body computing `outputs` in the given shape, and its operation count; split
+/// into blocks of at most `split.budget` operations when over it.
 pub(super) fn body(
     g: &Graph,
     cx: &Ctx<'_>,
     outputs: &[Id],
     shape: Shape,
-) -> (TokenStream, OpCount) {
+    split: Option<&Split<'_>>,
+) -> Body {
     let program = Program::ordered(g, outputs, Order::Levels);
-    let program = if program.ops().total() > DEPTH_ORDER_MIN_OPS {
+    let ops = program.ops();
+    let over = split.filter(|s| ops.total() > s.budget);
+    let program = if ops.total() > DEPTH_ORDER_MIN_OPS || over.is_some() {
         Program::ordered(g, outputs, Order::Depth)
     } else {
         program
     };
+    if let Some(split) = over {
+        let (code, blocks) = split_body(cx, &program, shape, split);
+        return Body { code, ops, blocks };
+    }
     let mut trig = BTreeSet::new();
     let defs: Vec<(Ident, TokenStream)> = program
         .temps
@@ -45,14 +64,18 @@ pub(super) fn body(
         .collect();
     let pre = trig_lets(&trig);
     let result = shaped(&outs, shape);
-    (quote!(#(#pre)* #(#temps)* #result), program.ops())
+    Body {
+        code: quote!(#(#pre)* #(#temps)* #result),
+        ops,
+        blocks: Vec::new(),
+    }
 }
 
 /// Temporaries go in chunks: `let (t0, .., t63) = { let t0 = ..; ..; (t0, .., t63) };`.
 /// Every `let` opens a lexical scope nested in the previous one, and LLVM's debug-info writer
 /// recurses once per level: a few thousand plain `let`s in one function overflow rustc's stack
 /// in debug builds. Chunking bounds the depth at chunks + chunk size.
-fn chunked_lets(defs: &[(Ident, TokenStream)]) -> Vec<TokenStream> {
+pub(super) fn chunked_lets(defs: &[(Ident, TokenStream)]) -> Vec<TokenStream> {
     if defs.len() <= LET_CHUNK {
         return defs
             .iter()
@@ -69,7 +92,7 @@ fn chunked_lets(defs: &[(Ident, TokenStream)]) -> Vec<TokenStream> {
 }
 
 /// One `sin_cos` per joint angle the body uses, computed up front.
-fn trig_lets(trig: &BTreeSet<(usize, bool)>) -> Vec<TokenStream> {
+pub(super) fn trig_lets(trig: &BTreeSet<(usize, bool)>) -> Vec<TokenStream> {
     let joints: BTreeSet<usize> = trig.iter().map(|t| t.0).collect();
     joints
         .iter()
@@ -95,9 +118,14 @@ pub(super) fn factored_body(
     outputs: &[Id],
     pivots: &[Id],
     shape: Shape,
-) -> (TokenStream, OpCount) {
+    split: Option<&Split<'_>>,
+) -> Body {
     let all: Vec<Id> = outputs.iter().chain(pivots).copied().collect();
-    let (b, ops) = body(g, cx, &all, Shape::Vector(all.len()));
+    let Body {
+        code: b,
+        ops,
+        blocks,
+    } = body(g, cx, &all, Shape::Vector(all.len()), split);
     let len = Literal::usize_unsuffixed(all.len());
     let index = |k: usize| {
         let k = Literal::usize_unsuffixed(k);
@@ -115,11 +143,15 @@ pub(super) fn factored_body(
         }
         #result
     };
-    (checked, ops)
+    Body {
+        code: checked,
+        ops,
+        blocks,
+    }
 }
 
 /// A value of `shape` with `x` in every entry.
-fn filled(x: TokenStream, shape: Shape) -> TokenStream {
+pub(super) fn filled(x: TokenStream, shape: Shape) -> TokenStream {
     let lit = Literal::usize_unsuffixed;
     match shape {
         Shape::Scalar => x,
@@ -156,6 +188,27 @@ fn shaped(outs: &[TokenStream], shape: Shape) -> TokenStream {
                 .chunks((rows * cols).max(1))
                 .map(|m| shaped(m, Shape::Matrix(rows, cols)));
             quote!((#(#each),*))
+        }
+    }
+}
+
+/// The Rust type of a value of `shape`.
+pub(super) fn shape_type(shape: Shape) -> TokenStream {
+    let lit = Literal::usize_unsuffixed;
+    match shape {
+        Shape::Scalar => quote!(T),
+        Shape::Vector(n) => {
+            let n = lit(n);
+            quote!([T; #n])
+        }
+        Shape::Matrix(r, c) => {
+            let (r, c) = (lit(r), lit(c));
+            quote!([[T; #c]; #r])
+        }
+        Shape::Matrices(k, r, c) => {
+            let one = shape_type(Shape::Matrix(r, c));
+            let all = std::iter::repeat_n(one, k);
+            quote!((#(#all),*))
         }
     }
 }

@@ -9,6 +9,7 @@ mod expr;
 mod identification;
 pub mod names;
 mod rust;
+mod split;
 
 pub use rust::EmitOptions;
 

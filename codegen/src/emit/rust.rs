@@ -10,9 +10,10 @@ use std::collections::BTreeMap;
 use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote};
 
-use super::body::{body, factored_body};
+use super::body::{body, factored_body, shape_type, Body};
 use super::expr::{lit, Ctx};
 use super::names::{comment_text, snake, upper_camel, Scope};
+use super::split::Split;
 use crate::cas::{Graph, Id, OpCount};
 use crate::dynamics::{Craig, Derivation, Evaluation, Home, Input, Quantity, Shape};
 use crate::kinematics::snap;
@@ -28,6 +29,9 @@ pub struct EmitOptions {
     pub source_name: String,
     /// How to regenerate the file, for the banner.
     pub regenerate: String,
+    /// The most operations one generated function body may hold; longer bodies are split
+    /// into non-inlined blocks (`Builder::max_function_ops`).
+    pub max_function_ops: usize,
 }
 
 /// The lints generated code may trip: long literals, `x * -1.0` and the like.
@@ -100,6 +104,10 @@ struct Emitter<'a> {
     /// `try_forward_dynamics`, which stays inherent when `forward_dynamics` is the trait's.
     try_forward_dynamics: TokenStream,
     counts: Vec<(String, OpCount)>,
+    /// The most operations of one function body ([`Split`]).
+    budget: usize,
+    /// The blocks of split bodies, for the inherent impl.
+    blocks: Vec<TokenStream>,
 }
 
 /// How many methods the runtime's `Dynamics` trait has.
@@ -135,6 +143,8 @@ pub fn emit_tokens(
             == TRAIT_METHODS,
         try_forward_dynamics: TokenStream::new(),
         counts: Vec::new(),
+        budget: opts.max_function_ops,
+        blocks: Vec::new(),
     };
     let tokens = e.file(&fields, d);
     (tokens, e.counts)
@@ -202,6 +212,7 @@ impl Emitter<'_> {
             }
         };
         let sizes = self.sizes();
+        let blocks = &self.blocks;
         quote! {
             #strukt
             #links
@@ -215,6 +226,7 @@ impl Emitter<'_> {
                 #try_fd
                 #(#methods)*
                 #frames
+                #(#blocks)*
             }
             #trait_impl
             #floating_impls
@@ -354,30 +366,32 @@ impl Emitter<'_> {
             .collect()
     }
 
-    fn return_type(shape: Shape) -> TokenStream {
-        match shape {
-            Shape::Scalar => quote!(T),
-            Shape::Vector(n) => {
-                let n = usize_lit(n);
-                quote!([T; #n])
-            }
-            Shape::Matrix(r, c) => {
-                let (r, c) = (usize_lit(r), usize_lit(c));
-                quote!([[T; #c]; #r])
-            }
-            Shape::Matrices(k, r, c) => {
-                let one = Self::return_type(Shape::Matrix(r, c));
-                let all = std::iter::repeat_n(one, k);
-                quote!((#(#all),*))
-            }
+    /// Straight-line code for `outputs`, counted under `q`'s name.
+    fn straight(&mut self, q: &Quantity, outputs: &[Id], shape: Shape) -> (TokenStream, OpCount) {
+        let (params, args) = (self.args(q.inputs), Self::arg_names(q.inputs));
+        let split = self.split(q.name, &params, &args);
+        let b = body(self.graph, &self.cx, outputs, shape, Some(&split));
+        self.counts.push((q.name.to_string(), b.ops));
+        self.blocks.extend(b.blocks);
+        (b.code, b.ops)
+    }
+
+    /// How a body of the function `name` is split beyond the budget.
+    fn split<'s>(&self, name: &'s str, params: &'s [TokenStream], args: &'s [Ident]) -> Split<'s> {
+        Split {
+            name,
+            params,
+            args,
+            budget: self.budget,
         }
     }
 
-    /// Straight-line code for `outputs`, counted under `name`.
-    fn straight(&mut self, name: &str, outputs: &[Id], shape: Shape) -> (TokenStream, OpCount) {
-        let (b, ops) = body(self.graph, &self.cx, outputs, shape);
-        self.counts.push((name.to_string(), ops));
-        (b, ops)
+    /// The names `q, qd, ...` of a quantity's arguments.
+    fn arg_names(inputs: &[Input]) -> Vec<Ident> {
+        inputs
+            .iter()
+            .map(|i| format_ident!("{}", i.name()))
+            .collect()
     }
 
     fn quantity_doc(q: &Quantity, ops: Option<OpCount>) -> TokenStream {
@@ -408,14 +422,21 @@ impl Emitter<'_> {
     }
 
     fn exprs_fn(&mut self, q: &Quantity, ids: &[Id]) -> TokenStream {
-        let (b, ops) = self.straight(q.name, ids, q.shape);
+        let (b, ops) = self.straight(q, ids, q.shape);
         self.plain_fn(q, ops, b)
     }
 
     /// Straight-line code whose outputs hold when the factorization's pivots are positive.
     fn factored_fn(&mut self, q: &Quantity, outputs: &[Id], pivots: &[Id]) -> TokenStream {
-        let (b, ops) = factored_body(self.graph, &self.cx, outputs, pivots, q.shape);
+        let (params, args) = (self.args(q.inputs), Self::arg_names(q.inputs));
+        let split = self.split(q.name, &params, &args);
+        let Body {
+            code: b,
+            ops,
+            blocks,
+        } = factored_body(self.graph, &self.cx, outputs, pivots, q.shape, Some(&split));
         self.counts.push((q.name.to_string(), ops));
+        self.blocks.extend(blocks);
         self.plain_fn(q, ops, b)
     }
 
@@ -425,7 +446,7 @@ impl Emitter<'_> {
         let (name, args, ret) = (
             format_ident!("{}", q.name),
             self.args(q.inputs),
-            Self::return_type(q.shape),
+            shape_type(q.shape),
         );
         let vis = self.vis(q);
         quote! {
@@ -437,11 +458,7 @@ impl Emitter<'_> {
     /// Craig's `C(q)` or `B(q)` from `N` Christoffel columns of `coriolis_matrix`.
     fn craig_fn(&mut self, q: &Quantity, which: Craig) -> TokenStream {
         let docs = Self::quantity_doc(q, None);
-        let (name, ret, n) = (
-            format_ident!("{}", q.name),
-            Self::return_type(q.shape),
-            &self.n,
-        );
+        let (name, ret, n) = (format_ident!("{}", q.name), shape_type(q.shape), &self.n);
         let coriolis = if self.in_trait {
             quote!(<Self as ::eomgen_runtime::Dynamics<T, #n>>::coriolis_matrix)
         } else {
@@ -464,7 +481,7 @@ impl Emitter<'_> {
     fn unrolled_solve(&mut self, q: &Quantity, acc: &[Id], piv: &[Id]) -> (TokenStream, OpCount) {
         let dof = acc.len();
         let outputs: Vec<Id> = acc.iter().chain(piv).copied().collect();
-        let (b, ops) = self.straight(q.name, &outputs, Shape::Vector(2 * dof));
+        let (b, ops) = self.straight(q, &outputs, Shape::Vector(2 * dof));
         let len = usize_lit(2 * dof);
         let x = (0..dof).map(|i| {
             let i = usize_lit(i);
@@ -499,7 +516,7 @@ impl Emitter<'_> {
     /// The body of a `try_forward_dynamics` that solves at run time: `M` from `mass_matrix`,
     /// `h` straight-line, the runtime's tree `L^T D L` over the joints' parents.
     fn runtime_solve(&mut self, q: &Quantity, h: &[Id]) -> (TokenStream, OpCount) {
-        let (hb, ops) = self.straight(q.name, h, Shape::Vector(h.len()));
+        let (hb, ops) = self.straight(q, h, Shape::Vector(h.len()));
         let n = &self.n;
         let mass_matrix = self.call("mass_matrix");
         let body = quote! {
@@ -632,7 +649,7 @@ impl Emitter<'_> {
 
     /// `try_contact_forward_dynamics` and `contact_forward_dynamics` (NaN on failure).
     fn contact_forward_dynamics_fns(&mut self, q: &Quantity, h: &[Id]) -> TokenStream {
-        let (hb, ops) = self.straight(q.name, h, Shape::Vector(h.len()));
+        let (hb, ops) = self.straight(q, h, Shape::Vector(h.len()));
         let docs = Self::quantity_doc(q, Some(ops));
         let (n, nq) = (&self.n, &self.nq);
         let k3 = usize_lit(q.shape.len() - h.len());
@@ -729,7 +746,7 @@ impl Emitter<'_> {
             .map(|(j, t)| {
                 let mut outs: Vec<Id> = t.translation.to_vec();
                 outs.extend(t.rotation.iter().flatten());
-                let (b, _) = body(self.graph, &self.cx, &outs, Shape::Vector(12));
+                let b = body(self.graph, &self.cx, &outs, Shape::Vector(12), None).code;
                 let j = usize_lit(j);
                 quote!(#j => { let o = { #b }; ::eomgen_runtime::Pose { translation: [o[0], o[1], o[2]], rotation: [[o[3], o[4], o[5]], [o[6], o[7], o[8]], [o[9], o[10], o[11]]] } })
             })

@@ -1,0 +1,314 @@
+//! Bodies beyond the operation budget, as a chain of non-inlined blocks.
+//!
+//! LLVM's SLP vectorizer schedules every basic block as a whole, at a cost that grows with the
+//! square of the block's length; for the native CPU (`-C target-cpu=native`: wide vectors, and
+//! the FMA intrinsic behind `Real::mul_add`, whose vector operands seed it) a straight-line
+//! body of tens of thousands of operations took LLVM tens of minutes. A program over the budget
+//! is therefore cut into consecutive blocks of about `budget` operations, each an
+//! `#[inline(never)]` method, so that compile cost grows linearly with the program (RobCoGen's
+//! generated code does the same per link, with explicit intermediate state):
+//!
+//! - a block reads what it needs of earlier blocks from a work array `w` at its start, computes
+//!   its temporaries, writes the outputs it completes straight into the result `o`, and at its
+//!   end writes into `w` the values later blocks read;
+//! - a slot of `w` is reused once the last block reading its value has run, so that `w` holds
+//!   about as many values as cross one cut at a time;
+//! - each joint angle's sine and cosine are computed once, in the first block that uses them,
+//!   and travel like temporaries.
+
+use std::collections::{BTreeMap, BTreeSet};
+
+use proc_macro2::{Ident, Literal, TokenStream};
+use quote::{format_ident, quote};
+
+use super::body::{chunked_lets, filled, shape_type, trig_lets};
+use super::expr::Ctx;
+use crate::cas::{Expr, Program};
+use crate::dynamics::Shape;
+
+/// What a split body needs to know of the function it belongs to.
+pub(super) struct Split<'a> {
+    /// The function's name; its blocks are `{name}_block_{k}`.
+    pub name: &'a str,
+    /// The function's parameters (`q: &[T; 9]`, ...), which every block takes too.
+    pub params: &'a [TokenStream],
+    /// Their names, to pass them on.
+    pub args: &'a [Ident],
+    /// The most operations one block may hold (a block holds at least one temporary).
+    pub budget: usize,
+}
+
+/// A value crossing blocks: a temporary or a joint angle's sine or cosine.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+enum Value {
+    Temp(usize),
+    /// Joint `.0`'s sine (`true`) or cosine.
+    Trig(usize, bool),
+}
+
+impl Value {
+    fn ident(self) -> Ident {
+        match self {
+            Value::Temp(k) => format_ident!("t{}", k),
+            Value::Trig(i, true) => format_ident!("s{}", i),
+            Value::Trig(i, false) => format_ident!("c{}", i),
+        }
+    }
+}
+
+/// The temporaries an expression reads.
+fn temps_read(e: &Expr, out: &mut BTreeSet<usize>) {
+    match e {
+        Expr::Temp(t) => {
+            out.insert(*t);
+        }
+        Expr::Const(_) | Expr::Input(_) => {}
+        Expr::Add(_, ts) => ts.iter().for_each(|(t, _)| temps_read(t, out)),
+        Expr::Mul(fs) => fs.iter().for_each(|(f, _)| temps_read(f, out)),
+        Expr::Sin(a) | Expr::Cos(a) | Expr::Sqrt(a) | Expr::Sign(a) => temps_read(a, out),
+    }
+}
+
+/// Block of each temporary: consecutive runs of at most `budget` operations.
+fn cut(program: &Program, budget: usize) -> Vec<usize> {
+    let (mut block, mut ops) = (0, 0);
+    program
+        .temps
+        .iter()
+        .map(|e| {
+            let n = e.ops().total();
+            if ops > 0 && ops + n > budget {
+                block += 1;
+                ops = 0;
+            }
+            ops += n;
+            block
+        })
+        .collect()
+}
+
+/// One block's code before the values crossing blocks are placed in `w`.
+struct Block {
+    /// Temporaries and output assignments.
+    code: Vec<TokenStream>,
+    /// Trig values it reads.
+    trig: BTreeSet<(usize, bool)>,
+    /// Values of earlier blocks it reads.
+    reads: BTreeSet<Value>,
+}
+
+/// The blocks of an over-budget `program` and the body calling them in turn. The body ends in
+/// the result, of `shape`.
+pub(super) fn split_body(
+    cx: &Ctx<'_>,
+    program: &Program,
+    shape: Shape,
+    split: &Split<'_>,
+) -> (TokenStream, Vec<TokenStream>) {
+    let of_temp = cut(program, split.budget);
+    let count = of_temp.last().map_or(1, |b| b + 1);
+    let mut blocks: Vec<Block> = (0..count)
+        .map(|_| Block {
+            code: Vec::new(),
+            trig: BTreeSet::new(),
+            reads: BTreeSet::new(),
+        })
+        .collect();
+    // Temporaries, each in its block.
+    let mut defs: Vec<Vec<(Ident, TokenStream)>> = vec![Vec::new(); count];
+    for (k, e) in program.temps.iter().enumerate() {
+        let b = of_temp[k];
+        let ts = cx.expr(e, &mut blocks[b].trig).ts;
+        defs[b].push((format_ident!("t{}", k), ts));
+        let mut read = BTreeSet::new();
+        temps_read(e, &mut read);
+        blocks[b].reads.extend(
+            read.into_iter()
+                .filter(|&t| of_temp[t] < b)
+                .map(Value::Temp),
+        );
+    }
+    for (b, d) in defs.iter().enumerate() {
+        blocks[b].code = chunked_lets(d);
+    }
+    // Outputs, each in the block of the last temporary it reads.
+    for (j, e) in program.outputs.iter().enumerate() {
+        let mut read = BTreeSet::new();
+        temps_read(e, &mut read);
+        let b = read.iter().map(|&t| of_temp[t]).max().unwrap_or(0);
+        let ts = cx.expr(e, &mut blocks[b].trig).ts;
+        let place = output_place(shape, j);
+        blocks[b].code.push(quote!(#place = #ts;));
+        blocks[b].reads.extend(
+            read.into_iter()
+                .filter(|&t| of_temp[t] < b)
+                .map(Value::Temp),
+        );
+    }
+    let first_trig = trig_homes(&mut blocks);
+    let home = |v: Value| match v {
+        Value::Temp(t) => of_temp[t],
+        Value::Trig(i, _) => first_trig[&i],
+    };
+    let (slots, width) = place_values(&blocks, home);
+    let items = blocks
+        .iter()
+        .enumerate()
+        .map(|(b, block)| {
+            let writes: Vec<Value> = slots.keys().filter(|&&v| home(v) == b).copied().collect();
+            block_fn(b, block, &slots, &writes, width, shape, split)
+        })
+        .collect();
+    let args = split.args;
+    let calls = (0..count).map(|b| {
+        let f = block_name(split.name, b);
+        quote!(self.#f(#(#args,)* &mut w, &mut o);)
+    });
+    let zero = filled(quote!(T::zero()), shape);
+    let work = if width == 0 {
+        quote!(let mut w: [T; 0] = [];)
+    } else {
+        let width = Literal::usize_unsuffixed(width);
+        quote!(let mut w = [T::zero(); #width];)
+    };
+    let body = quote! {
+        #work
+        let mut o = #zero;
+        #(#calls)*
+        o
+    };
+    (body, items)
+}
+
+fn block_name(name: &str, b: usize) -> Ident {
+    format_ident!("{}_block_{}", name, b)
+}
+
+/// Each joint angle's first block (the one that computes its sine and cosine); the blocks
+/// after it read them.
+fn trig_homes(blocks: &mut [Block]) -> BTreeMap<usize, usize> {
+    let mut first = BTreeMap::new();
+    for (b, block) in blocks.iter().enumerate() {
+        for &(i, _) in &block.trig {
+            first.entry(i).or_insert(b);
+        }
+    }
+    for (b, block) in blocks.iter_mut().enumerate() {
+        let later: Vec<Value> = block
+            .trig
+            .iter()
+            .filter(|t| first[&t.0] < b)
+            .map(|&(i, s)| Value::Trig(i, s))
+            .collect();
+        block.reads.extend(later);
+    }
+    first
+}
+
+/// Slots of `w` for the values read by a later block than their own, reused once their last
+/// reader has run; and the number of slots.
+fn place_values(
+    blocks: &[Block],
+    home: impl Fn(Value) -> usize,
+) -> (BTreeMap<Value, usize>, usize) {
+    // Each crossing value's last reader.
+    let mut last: BTreeMap<Value, usize> = BTreeMap::new();
+    for (b, block) in blocks.iter().enumerate() {
+        for &v in &block.reads {
+            last.insert(v, b);
+        }
+    }
+    let mut by_home: BTreeMap<usize, Vec<Value>> = BTreeMap::new();
+    for &v in last.keys() {
+        by_home.entry(home(v)).or_default().push(v);
+    }
+    let (mut slots, mut free, mut busy) = (BTreeMap::new(), BTreeSet::new(), Vec::new());
+    let mut width = 0;
+    for (b, values) in by_home {
+        // Reads come first in a block, writes last: a slot read for the last time in block b
+        // can take a value block b writes.
+        busy.retain(|&(end, slot)| {
+            let done = end <= b;
+            if done {
+                free.insert(slot);
+            }
+            !done
+        });
+        for v in values {
+            let slot = free.pop_first().unwrap_or_else(|| {
+                width += 1;
+                width - 1
+            });
+            slots.insert(v, slot);
+            busy.push((last[&v], slot));
+        }
+    }
+    (slots, width)
+}
+
+/// Block `b` as an `#[inline(never)]` method.
+fn block_fn(
+    b: usize,
+    block: &Block,
+    slots: &BTreeMap<Value, usize>,
+    writes: &[Value],
+    width: usize,
+    shape: Shape,
+    split: &Split<'_>,
+) -> TokenStream {
+    let slot = |v: &Value| Literal::usize_unsuffixed(slots[v]);
+    let reads = block.reads.iter().map(|v| {
+        let (name, s) = (v.ident(), slot(v));
+        quote!(let #name = w[#s];)
+    });
+    // Sines and cosines computed here: those this block uses and does not read, and those it
+    // writes for later blocks.
+    let mut computed: BTreeSet<(usize, bool)> = block
+        .trig
+        .iter()
+        .filter(|&&(i, s)| !block.reads.contains(&Value::Trig(i, s)))
+        .copied()
+        .collect();
+    computed.extend(writes.iter().filter_map(|v| match *v {
+        Value::Trig(i, s) => Some((i, s)),
+        Value::Temp(_) => None,
+    }));
+    let trig = trig_lets(&computed);
+    let writes = writes.iter().map(|v| {
+        let (name, s) = (v.ident(), slot(v));
+        quote!(w[#s] = #name;)
+    });
+    let code = &block.code;
+    let (name, params) = (block_name(split.name, b), split.params);
+    let (width, ret) = (Literal::usize_unsuffixed(width), shape_type(shape));
+    quote! {
+        #[inline(never)]
+        fn #name(&self, #(#params,)* w: &mut [T; #width], o: &mut #ret) {
+            #(#reads)*
+            #(#trig)*
+            #(#code)*
+            #(#writes)*
+        }
+    }
+}
+
+/// Where flat output `j` of a result of `shape` goes in `o`.
+fn output_place(shape: Shape, j: usize) -> TokenStream {
+    let lit = Literal::usize_unsuffixed;
+    match shape {
+        Shape::Scalar => quote!(*o),
+        Shape::Vector(_) => {
+            let j = lit(j);
+            quote!(o[#j])
+        }
+        Shape::Matrix(_, c) => {
+            let (i, j) = (lit(j / c), lit(j % c));
+            quote!(o[#i][#j])
+        }
+        Shape::Matrices(_, r, c) => {
+            let (m, e) = (lit(j / (r * c)), j % (r * c));
+            let (i, j) = (lit(e / c), lit(e % c));
+            quote!(o.#m[#i][#j])
+        }
+    }
+}
