@@ -130,6 +130,8 @@ struct ModelArgs {
 
 impl ModelArgs {
     fn options(&self, symbolic: &Option<Vec<String>>) -> ModelOptions {
+        // Every field, without `..Default::default()`: a new option has to be given a flag
+        // (or a deliberate default) here.
         ModelOptions {
             gravity: self.gravity,
             joint_order: self.joint_order.clone(),
@@ -147,7 +149,6 @@ impl ModelArgs {
             contact_points: self.contacts.clone(),
             passive_joints: self.passive.clone(),
             mimic_joints: self.mimic,
-            ..ModelOptions::default()
         }
     }
 
