@@ -130,6 +130,8 @@ struct ModelArgs {
 
 impl ModelArgs {
     fn options(&self, symbolic: &Option<Vec<String>>) -> ModelOptions {
+        // Every field, without `..Default::default()`: a new option has to be given a flag
+        // (or a deliberate default) here.
         ModelOptions {
             gravity: self.gravity,
             joint_order: self.joint_order.clone(),
@@ -147,7 +149,6 @@ impl ModelArgs {
             contact_points: self.contacts.clone(),
             passive_joints: self.passive.clone(),
             mimic_joints: self.mimic,
-            ..ModelOptions::default()
         }
     }
 
@@ -418,8 +419,8 @@ struct SimulateArgs {
     /// The integration method (a floating base takes RK4 only).
     #[arg(long, value_enum, default_value_t = IntegratorArg::Rk4)]
     integrator: IntegratorArg,
-    /// Writes the CSV (t, q_*, qd_*, tau_* per joint) to FILE and a summary to stdout, instead
-    /// of the CSV to stdout.
+    /// Writes the CSV (t, q_*, qd_*, tau_* per joint; each number the shortest text that reads
+    /// back exactly) to FILE and a summary to stdout, instead of the CSV to stdout.
     #[arg(long, value_name = "FILE")]
     csv: Option<PathBuf>,
     /// Also plots the run, as SVG or PNG by FILE's extension: the joint positions against time

@@ -251,11 +251,26 @@ fn axpy(a: &[f64], h: f64, b: &[f64]) -> Vec<f64> {
 }
 
 fn row(out: &mut String, t: f64, q: &[f64], qd: &[f64], tau: &[f64]) {
-    let _ = write!(out, "{t}");
-    for x in q.iter().chain(qd).chain(tau) {
-        let _ = write!(out, ",{x}");
+    out.push_str(&csv_number(t));
+    for &x in q.iter().chain(qd).chain(tau) {
+        out.push(',');
+        out.push_str(&csv_number(x));
     }
     out.push('\n');
+}
+
+/// A number as the CSV writes it: the shortest decimal digits that read back to the same
+/// `f64`, in exponent form when that is shorter (`-3.074e-16`, `1e-5`, `2.5e20`) and positional
+/// otherwise (`0.25`, `-1.8`, `120`).
+pub fn csv_number(x: f64) -> String {
+    // Both forms print the shortest digits that round-trip; they differ only in layout.
+    let positional = format!("{x}");
+    let exponent = format!("{x:e}");
+    if exponent.len() < positional.len() {
+        exponent
+    } else {
+        positional
+    }
 }
 
 /// Runs the simulation: `round(duration / dt)` steps of the chosen integrator.
@@ -392,4 +407,36 @@ pub fn run(model: &Model, d: &Derivation, o: &Options) -> Result<Outcome, String
         let _ = writeln!(out.summary, "max |q - target| at the end: {err:.3e}");
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::csv_number;
+
+    #[test]
+    fn csv_numbers_are_shortest_and_read_back_exactly() {
+        assert_eq!(csv_number(-3.074e-16), "-3.074e-16");
+        assert_eq!(csv_number(1e-5), "1e-5");
+        assert_eq!(csv_number(2.5e20), "2.5e20");
+        assert_eq!(csv_number(0.25), "0.25");
+        assert_eq!(csv_number(-1.8), "-1.8");
+        assert_eq!(csv_number(120.0), "120");
+        assert_eq!(csv_number(0.0), "0");
+        assert_eq!(csv_number(0.1 + 0.2), "0.30000000000000004");
+        let mut x = 1.234_567_890_123_456_7e-300_f64;
+        let mut values = vec![0.0, -0.0, f64::MIN_POSITIVE, 5e-324, f64::MAX, -f64::MAX];
+        while x < 1e300 {
+            values.extend([x, -x, x * std::f64::consts::PI, 1.0 / x]);
+            x *= 7.3;
+        }
+        for v in values {
+            let s = csv_number(v);
+            let back: f64 = s.parse().expect("a number");
+            assert_eq!(back.to_bits(), v.to_bits(), "{v:?} printed as {s}");
+            assert!(
+                s.len() <= format!("{v}").len() && s.len() <= format!("{v:e}").len(),
+                "{s}"
+            );
+        }
+    }
 }

@@ -357,9 +357,10 @@ fn record(
     tau: &DVector<f64>,
     f: &DVector<f64>,
 ) {
-    let mut line = format!("{t}");
-    for x in q.iter().chain(v.iter()).chain(tau.iter()).chain(f.iter()) {
-        let _ = write!(line, ",{x}");
+    let mut line = crate::simulate::csv_number(t);
+    for &x in q.iter().chain(v.iter()).chain(tau.iter()).chain(f.iter()) {
+        line.push(',');
+        line.push_str(&crate::simulate::csv_number(x));
     }
     out.csv.push_str(&line);
     out.csv.push('\n');

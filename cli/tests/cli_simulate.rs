@@ -89,6 +89,37 @@ fn passive_double_pendulum_csv_and_energy() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// Every CSV field is the shortest text that reads back to its number, in exponent form when
+/// that is shorter: a pendulum starting from rest at its bottom moves by nanometres, printed
+/// as `-1.7656506192700173e-9`, not `-0.0000000017656506192700173`.
+#[test]
+fn csv_numbers_are_shortest_round_trip() {
+    let csv = ok(&[
+        "simulate",
+        "tests/robots/double_pendulum.urdf",
+        "--duration",
+        "0.01",
+        "--dt",
+        "1e-3",
+    ]);
+    let fields: Vec<&str> = csv.lines().skip(1).flat_map(|l| l.split(',')).collect();
+    assert_eq!(fields.len(), 11 * 7);
+    for field in &fields {
+        let x: f64 = field.parse().expect("a number");
+        let (positional, exponent) = (format!("{x}"), format!("{x:e}"));
+        let shortest = if exponent.len() < positional.len() {
+            exponent
+        } else {
+            positional
+        };
+        assert_eq!(*field, shortest, "not the shortest form");
+    }
+    assert!(
+        fields.iter().any(|f| f.contains("e-9")),
+        "tiny positions in exponent form: {csv}"
+    );
+}
+
 #[test]
 fn computed_torque_error_decays_as_critically_damped() {
     // From rest 0.2 rad off the target: e(t) = e0 (1 + w t) exp(-w t) in every joint.

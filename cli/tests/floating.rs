@@ -170,8 +170,16 @@ fn a_drone_hovers_to_its_target() {
         let svg = std::fs::read_to_string(dir.join(file)).unwrap();
         assert!(svg.contains(label), "{file}: {svg}");
     }
-    let header = std::fs::read_to_string(&csv).unwrap();
-    assert!(header.starts_with("t,base_x,base_y,base_z,base_qx,base_qy,base_qz,base_qw,base_vx"));
+    let text = std::fs::read_to_string(&csv).unwrap();
+    assert!(text.starts_with("t,base_x,base_y,base_z,base_qx,base_qy,base_qz,base_qw,base_vx"));
+    // Numbers in their shortest form: round-off is written as `1.2e-17`, not `0.000...012`.
+    for field in text.lines().skip(1).flat_map(|l| l.split(',')) {
+        let x: f64 = field.parse().expect("a number");
+        assert!(
+            field.len() <= format!("{x}").len().min(format!("{x:e}").len()),
+            "{field}"
+        );
+    }
 }
 
 #[test]

@@ -50,3 +50,30 @@ fn the_joint_limit_names_the_flag() {
         "{stderr}"
     );
 }
+
+/// The README states the limits the code has, in its table of limits and in the builder
+/// section.
+#[test]
+fn the_readme_states_the_limits_of_the_code() {
+    let readme = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../README.md"),
+    )
+    .expect("README.md");
+    let max = eomgen::DEFAULT_MAX_DOF;
+    let nodes = eomgen::DEFAULT_MAX_GRAPH_NODES / 1_000_000;
+    for line in [
+        format!("| degrees of freedom | {max} | `Builder::max_dof`, `--max-dof` |"),
+        format!("| expression graph nodes of the derivation | {nodes} million "),
+        format!(
+            "| XML element nesting | {} levels | fixed (`eomgen::urdf::MAX_DEPTH`) |",
+            eomgen::urdf::MAX_DEPTH
+        ),
+        format!(
+            "| magnitude of a number that enters the equations | {:e} | fixed",
+            eomgen::model::MAX_MAGNITUDE
+        ),
+        format!("than {max} joints are refused"),
+    ] {
+        assert!(readme.contains(&line), "the README lacks `{line}`");
+    }
+}

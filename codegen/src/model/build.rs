@@ -39,10 +39,6 @@ pub struct ModelOptions {
     pub joint_order: Option<Vec<String>>,
     /// Which inertial parameters (and joint offsets) become symbols.
     pub symbolic: SymbolicParams,
-    /// No effect any more, kept so that code setting it still compiles: the rotational inertia
-    /// of every moving body is now always checked for positive semi-definiteness and the
-    /// triangle inequality (see [`ModelOptions::repair_inertia`]).
-    pub strict_inertia: bool,
     /// Repairs the rotational inertia of a moving body that is not positive semi-definite or
     /// breaks the triangle inequality, instead of refusing the robot with
     /// [`ModelError::InvalidInertia`]: like MuJoCo's `balanceinertia`, its principal moments
@@ -108,7 +104,6 @@ impl Default for ModelOptions {
             gravity: [0.0, 0.0, -9.81],
             joint_order: None,
             symbolic: SymbolicParams::None,
-            strict_inertia: false,
             repair_inertia: false,
             armature: Vec::new(),
             friction: false,

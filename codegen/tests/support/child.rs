@@ -1,8 +1,11 @@
 //! Running a test of the current test binary in a separate process, to compare what two
 //! processes print (determinism checks).
 //!
-//! The child test prints its payload between `<<<` and `>>>` when `EOMGEN_CHILD` is set, and
-//! does nothing otherwise.
+//! The child is an ignored test, so that `cargo test` does not count it as a test that passed:
+//! its parent runs it with `--ignored --exact NAME` and `EOMGEN_CHILD` set, and the child
+//! prints its payload between `<<<` and `>>>`. Run any other way (`cargo test --
+//! --include-ignored`), the child runs its parent's checks instead, so that it never passes
+//! without checking anything.
 
 // A test that includes this module may use only part of it.
 #![allow(dead_code)]
@@ -15,19 +18,41 @@ pub fn is_child() -> bool {
     std::env::var_os(CHILD_VAR).is_some()
 }
 
-/// Prints a child's payload.
-pub fn emit(payload: &str) {
-    print!("<<<{payload}>>>");
+/// The body of a child test: in a child process started by [`run_child`], prints
+/// `payload()`; anywhere else, runs `parent`, the test that starts the child.
+pub fn child_main(payload: impl FnOnce() -> String, parent: impl FnOnce()) {
+    if is_child() {
+        print!("<<<{}>>>", payload());
+    } else {
+        parent();
+    }
 }
 
-/// Runs the test named `test` of this binary in a new process and returns its payload.
+/// Runs the ignored test named `test` of this binary in a new process and returns its
+/// payload.
+#[track_caller]
 pub fn run_child(test: &str) -> String {
     let out = std::process::Command::new(std::env::current_exe().expect("test binary"))
-        .args(["--exact", test, "--nocapture", "--test-threads=1"])
+        .args([
+            "--ignored",
+            "--exact",
+            test,
+            "--nocapture",
+            "--test-threads=1",
+        ])
         .env(CHILD_VAR, "1")
         .output()
         .expect("child runs");
     let text = String::from_utf8(out.stdout).expect("UTF-8 output");
+    assert!(
+        out.status.success(),
+        "child `{test}` failed: {text}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        text.contains("test result: ok. 1 passed"),
+        "child `{test}` did not run exactly once: {text}"
+    );
     let start = text.find("<<<").expect("child printed its payload") + 3;
     let end = text[start..].find(">>>").expect("payload end") + start;
     text[start..end].to_string()
