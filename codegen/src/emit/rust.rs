@@ -442,11 +442,7 @@ impl Emitter<'_> {
             Self::return_type(q.shape),
             &self.n,
         );
-        let coriolis = if self.in_trait {
-            quote!(<Self as ::eomgen_runtime::Dynamics<T, #n>>::coriolis_matrix)
-        } else {
-            quote!(Self::coriolis_matrix)
-        };
+        let coriolis = self.call("coriolis_matrix");
         let kernel = match which {
             Craig::Centrifugal => quote!(centrifugal_from_coriolis),
             Craig::CoriolisPairs => quote!(coriolis_pairs_from_coriolis),
@@ -550,8 +546,11 @@ impl Emitter<'_> {
     }
 
     /// The path that calls the generated function `name` from inside the impl: through the
-    /// trait when it is a trait method there.
+    /// trait when it is a trait method there. Every generated function that calls another does
+    /// so through here, and the callee is one of its `Quantity::needs`, so that a selection
+    /// (`catalogue::select`) brings it.
     fn call(&self, name: &str) -> TokenStream {
+        debug_assert!(self.has(name), "`{name}` is called but not generated");
         let (f, n) = (format_ident!("{}", name), &self.n);
         let in_trait = self
             .quantities
@@ -615,12 +614,14 @@ impl Emitter<'_> {
         let docs = Self::quantity_doc(q, None);
         let (n, nq) = (&self.n, &self.nq);
         let fd = self.call("forward_dynamics");
+        let id_derivatives = self.call("inverse_dynamics_derivatives");
+        let minv = self.call("mass_matrix_inverse");
         quote! {
             #docs
             pub fn forward_dynamics_derivatives(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n]) -> ([[T; #n]; #n], [[T; #n]; #n], [[T; #n]; #n]) {
                 let qdd = #fd(self, q, qd, tau);
-                let (dq, dqd) = self.inverse_dynamics_derivatives(q, qd, &qdd);
-                let minv = self.mass_matrix_inverse(q);
+                let (dq, dqd) = #id_derivatives(self, q, qd, &qdd);
+                let minv = #minv(self, q);
                 (
                     ::eomgen_runtime::tree::neg_mat_mul(&minv, &dq),
                     ::eomgen_runtime::tree::neg_mat_mul(&minv, &dqd),
