@@ -747,7 +747,13 @@ impl Emitter<'_> {
         });
         let link_arms = self.link_frame_arms();
         let link_ty = &self.link_ty;
-        let coupling = if self.model.is_coupled() {
+        // The joint axes and the coupling are read by `link_jacobian` alone: without it, a
+        // `link_pose` selection would carry unused constants (rustc's `dead_code` warning).
+        let jacobian = self
+            .quantities
+            .iter()
+            .any(|q| matches!(q.eval, Evaluation::LinkJacobian));
+        let coupling = if jacobian && self.model.is_coupled() {
             let v0 = self.model.base_nv();
             let base = (0..v0).map(|i| (i, 1.0));
             let joints = self
@@ -769,9 +775,16 @@ impl Emitter<'_> {
         } else {
             TokenStream::new()
         };
+        let tree_joints = if jacobian {
+            quote! {
+                /// Each joint's axis (in the frame of the body it moves) and motion.
+                const TREE_JOINTS: [::eomgen_runtime::tree::TreeJoint; #nj] = [#(#joints),*];
+            }
+        } else {
+            TokenStream::new()
+        };
         quote! {
-            /// Each joint's axis (in the frame of the body it moves) and motion.
-            const TREE_JOINTS: [::eomgen_runtime::tree::TreeJoint; #nj] = [#(#joints),*];
+            #tree_joints
             #coupling
 
             /// The pose of body `j` in its parent body's frame (a floating base is body 0).
