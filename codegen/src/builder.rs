@@ -282,8 +282,11 @@ impl Builder {
     /// [`Error::UnknownQuantity`].
     ///
     /// The `Dynamics` trait is implemented when all its eight methods are selected; otherwise
-    /// the selected ones are inherent methods of the generated type. Craig's `centrifugal` and
-    /// `coriolis_pairs` may call `coriolis_matrix`, which then comes along.
+    /// the selected ones are inherent methods of the generated type. A selected function brings
+    /// the generated functions it calls, and those they call: on a large robot Craig's
+    /// `centrifugal` and `coriolis_pairs` call `coriolis_matrix`, and
+    /// `forward_dynamics_derivatives` calls `forward_dynamics` and `mass_matrix_inverse`, which
+    /// call `mass_matrix`.
     ///
     /// ```
     /// # let urdf = r#"<robot name="pendulum"><link name="base"/>

@@ -67,7 +67,7 @@ pub mod spatial;
 #[doc(hidden)]
 pub mod urdf;
 
-pub use builder::{Builder, DEFAULT_MAX_DOF, DEFAULT_MAX_GRAPH_NODES};
+pub use builder::{Builder, DEFAULT_MAX_DOF, DEFAULT_MAX_FUNCTION_OPS, DEFAULT_MAX_GRAPH_NODES};
 pub use model::{ModelError, ModelOptions, SymbolicParams};
 
 /// Everything that can go wrong between a URDF and a written module.

@@ -188,8 +188,9 @@ pub fn names(quantities: &[Quantity]) -> Vec<&'static str> {
     quantities.iter().map(|q| q.name).collect()
 }
 
-/// Keeps the quantities named in `wanted` and those they need, in catalogue order; `Err` with
-/// the first unknown name.
+/// Keeps the quantities named in `wanted` and everything they need, transitively (a need of a
+/// need, such as the `mass_matrix` that a run-time `forward_dynamics` calls for
+/// `forward_dynamics_derivatives`), in catalogue order; `Err` with the first unknown name.
 pub fn select(quantities: Vec<Quantity>, wanted: &[String]) -> Result<Vec<Quantity>, String> {
     if let Some(bad) = wanted
         .iter()
@@ -197,14 +198,99 @@ pub fn select(quantities: Vec<Quantity>, wanted: &[String]) -> Result<Vec<Quanti
     {
         return Err(bad.clone());
     }
-    let mut keep: Vec<&str> = wanted.iter().map(String::as_str).collect();
-    for q in &quantities {
-        if keep.contains(&q.name) {
-            keep.extend(q.needs());
+    // The closure of `wanted` under `needs`: a worklist, each name visited once.
+    let mut keep: Vec<&str> = Vec::new();
+    let mut todo: Vec<&str> = wanted.iter().map(String::as_str).collect();
+    while let Some(name) = todo.pop() {
+        if keep.contains(&name) {
+            continue;
+        }
+        keep.push(name);
+        if let Some(q) = quantities.iter().find(|q| q.name == name) {
+            todo.extend(q.needs());
         }
     }
     Ok(quantities
         .into_iter()
         .filter(|q| keep.contains(&q.name))
         .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn quantity(name: &'static str, eval: Evaluation) -> Quantity {
+        Quantity {
+            name,
+            inputs: &[Input::Q],
+            shape: Shape::Scalar,
+            home: Home::Inherent,
+            doc: Vec::new(),
+            route: String::new(),
+            eval,
+        }
+    }
+
+    /// The catalogue's order of a large robot's entries that call each other at run time.
+    fn catalogue() -> Vec<Quantity> {
+        vec![
+            quantity("mass_matrix", Evaluation::Exprs(Vec::new())),
+            quantity("gravity", Evaluation::Exprs(Vec::new())),
+            quantity(
+                "forward_dynamics",
+                Evaluation::ForwardDynamicsSolve { h: Vec::new() },
+            ),
+            quantity(
+                "inverse_dynamics_derivatives",
+                Evaluation::Exprs(Vec::new()),
+            ),
+            quantity("mass_matrix_inverse", Evaluation::MassMatrixInverse),
+            quantity(
+                "forward_dynamics_derivatives",
+                Evaluation::ForwardDynamicsDerivatives,
+            ),
+        ]
+    }
+
+    fn selected(wanted: &[&str]) -> Vec<&'static str> {
+        let wanted: Vec<String> = wanted.iter().map(|w| w.to_string()).collect();
+        names(&select(catalogue(), &wanted).unwrap())
+    }
+
+    #[test]
+    fn a_need_of_a_need_is_selected() {
+        // `forward_dynamics_derivatives` calls `forward_dynamics` and `mass_matrix_inverse`,
+        // which both call `mass_matrix`, earlier in the catalogue.
+        assert_eq!(
+            selected(&["forward_dynamics_derivatives"]),
+            [
+                "mass_matrix",
+                "forward_dynamics",
+                "inverse_dynamics_derivatives",
+                "mass_matrix_inverse",
+                "forward_dynamics_derivatives",
+            ]
+        );
+        assert_eq!(
+            selected(&["mass_matrix_inverse"]),
+            ["mass_matrix", "mass_matrix_inverse"]
+        );
+    }
+
+    #[test]
+    fn the_selection_is_in_catalogue_order_whatever_the_order_asked() {
+        let order = ["mass_matrix", "gravity", "mass_matrix_inverse"];
+        assert_eq!(selected(&["mass_matrix_inverse", "gravity"]), order);
+        assert_eq!(
+            selected(&["gravity", "mass_matrix_inverse", "gravity"]),
+            order
+        );
+    }
+
+    #[test]
+    fn an_unknown_name_is_returned() {
+        let wanted = ["gravity".to_string(), "mass_matrx".to_string()];
+        assert_eq!(select(catalogue(), &wanted).unwrap_err(), "mass_matrx");
+    }
 }

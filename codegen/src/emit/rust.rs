@@ -458,12 +458,9 @@ impl Emitter<'_> {
     /// Craig's `C(q)` or `B(q)` from `N` Christoffel columns of `coriolis_matrix`.
     fn craig_fn(&mut self, q: &Quantity, which: Craig) -> TokenStream {
         let docs = Self::quantity_doc(q, None);
-        let (name, ret, n) = (format_ident!("{}", q.name), shape_type(q.shape), &self.n);
-        let coriolis = if self.in_trait {
-            quote!(<Self as ::eomgen_runtime::Dynamics<T, #n>>::coriolis_matrix)
-        } else {
-            quote!(Self::coriolis_matrix)
-        };
+        let (name, ret) = (format_ident!("{}", q.name), shape_type(q.shape));
+        let n = &self.n;
+        let coriolis = self.call("coriolis_matrix");
         let kernel = match which {
             Craig::Centrifugal => quote!(centrifugal_from_coriolis),
             Craig::CoriolisPairs => quote!(coriolis_pairs_from_coriolis),
@@ -567,8 +564,11 @@ impl Emitter<'_> {
     }
 
     /// The path that calls the generated function `name` from inside the impl: through the
-    /// trait when it is a trait method there.
+    /// trait when it is a trait method there. Every generated function that calls another does
+    /// so through here, and the callee is one of its `Quantity::needs`, so that a selection
+    /// (`catalogue::select`) brings it.
     fn call(&self, name: &str) -> TokenStream {
+        debug_assert!(self.has(name), "`{name}` is called but not generated");
         let (f, n) = (format_ident!("{}", name), &self.n);
         let in_trait = self
             .quantities
@@ -632,12 +632,14 @@ impl Emitter<'_> {
         let docs = Self::quantity_doc(q, None);
         let (n, nq) = (&self.n, &self.nq);
         let fd = self.call("forward_dynamics");
+        let id_derivatives = self.call("inverse_dynamics_derivatives");
+        let minv = self.call("mass_matrix_inverse");
         quote! {
             #docs
             pub fn forward_dynamics_derivatives(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n]) -> ([[T; #n]; #n], [[T; #n]; #n], [[T; #n]; #n]) {
                 let qdd = #fd(self, q, qd, tau);
-                let (dq, dqd) = self.inverse_dynamics_derivatives(q, qd, &qdd);
-                let minv = self.mass_matrix_inverse(q);
+                let (dq, dqd) = #id_derivatives(self, q, qd, &qdd);
+                let minv = #minv(self, q);
                 (
                     ::eomgen_runtime::tree::neg_mat_mul(&minv, &dq),
                     ::eomgen_runtime::tree::neg_mat_mul(&minv, &dqd),
@@ -763,7 +765,13 @@ impl Emitter<'_> {
         });
         let link_arms = self.link_frame_arms();
         let link_ty = &self.link_ty;
-        let coupling = if self.model.is_coupled() {
+        // The joint axes and the coupling are read by `link_jacobian` alone: without it, a
+        // `link_pose` selection would carry unused constants (rustc's `dead_code` warning).
+        let jacobian = self
+            .quantities
+            .iter()
+            .any(|q| matches!(q.eval, Evaluation::LinkJacobian));
+        let coupling = if jacobian && self.model.is_coupled() {
             let v0 = self.model.base_nv();
             let base = (0..v0).map(|i| (i, 1.0));
             let joints = self
@@ -785,9 +793,16 @@ impl Emitter<'_> {
         } else {
             TokenStream::new()
         };
+        let tree_joints = if jacobian {
+            quote! {
+                /// Each joint's axis (in the frame of the body it moves) and motion.
+                const TREE_JOINTS: [::eomgen_runtime::tree::TreeJoint; #nj] = [#(#joints),*];
+            }
+        } else {
+            TokenStream::new()
+        };
         quote! {
-            /// Each joint's axis (in the frame of the body it moves) and motion.
-            const TREE_JOINTS: [::eomgen_runtime::tree::TreeJoint; #nj] = [#(#joints),*];
+            #tree_joints
             #coupling
 
             /// The pose of body `j` in its parent body's frame (a floating base is body 0).
