@@ -69,22 +69,74 @@ fn temps_read(e: &Expr, out: &mut BTreeSet<usize>) {
     }
 }
 
-/// Block of each temporary: consecutive runs of at most `budget` operations.
+/// Block of each temporary: consecutive runs of at most `budget` operations, each cut where the
+/// fewest temporaries are live (computed before it and read after it) among the places that
+/// leave the block at least half the budget, so that little crosses through `w`.
 fn cut(program: &Program, budget: usize) -> Vec<usize> {
-    let (mut block, mut ops) = (0, 0);
-    program
-        .temps
-        .iter()
-        .map(|e| {
-            let n = e.ops().total();
-            if ops > 0 && ops + n > budget {
-                block += 1;
-                ops = 0;
+    let n = program.temps.len();
+    let ops: Vec<usize> = program.temps.iter().map(|e| e.ops().total()).collect();
+    let live = live_after(program);
+    let mut of_temp = vec![0; n];
+    let (mut start, mut block) = (0, 0);
+    while start < n {
+        // The block is start..=end: the end with the fewest live values once half full.
+        let (mut acc, mut end) = (0, start);
+        let mut best: Option<usize> = None;
+        for k in start..n {
+            if k > start && acc + ops[k] > budget {
+                break;
             }
-            ops += n;
-            block
-        })
-        .collect()
+            acc += ops[k];
+            end = k;
+            if 2 * acc >= budget && best.is_none_or(|b| live[k] <= live[b]) {
+                best = Some(k);
+            }
+        }
+        let end = if end + 1 == n {
+            end
+        } else {
+            best.unwrap_or(end)
+        };
+        of_temp[start..=end].iter_mut().for_each(|b| *b = block);
+        (start, block) = (end + 1, block + 1);
+    }
+    of_temp
+}
+
+/// For each temporary `k`, how many of `temps[..=k]` are read after it (by a later temporary
+/// or by an output, which comes after every temporary it reads).
+fn live_after(program: &Program) -> Vec<usize> {
+    let n = program.temps.len();
+    // The last temporary (or output, as the last temporary it reads) that reads each one.
+    let mut last: Vec<usize> = (0..n).collect();
+    let mut read = BTreeSet::new();
+    for (k, e) in program.temps.iter().enumerate() {
+        read.clear();
+        temps_read(e, &mut read);
+        read.iter().for_each(|&t| last[t] = last[t].max(k));
+    }
+    for e in &program.outputs {
+        read.clear();
+        temps_read(e, &mut read);
+        // An output goes in the block of the last temporary it reads: it extends nothing.
+        let at = read.iter().max().copied();
+        read.iter()
+            .for_each(|&t| last[t] = last[t].max(at.unwrap_or(t)));
+    }
+    let mut delta = vec![0i64; n + 1];
+    for (k, &l) in last.iter().enumerate() {
+        if l > k {
+            delta[k] += 1;
+            delta[l] -= 1;
+        }
+    }
+    let mut live = Vec::with_capacity(n);
+    let mut count = 0i64;
+    for d in &delta[..n] {
+        count += d;
+        live.push(count as usize);
+    }
+    live
 }
 
 /// One block's code before the values crossing blocks are placed in `w`.
