@@ -284,6 +284,11 @@ fn underactuated() {
 
 /// `file` with the derivatives of its dynamics, inverse dynamics and what those call.
 fn with_derivatives(file: &str, module: &str, ty: &str) {
+    derivatives_builder(file, module, ty).compile().unwrap();
+}
+
+/// The builder of [`with_derivatives`].
+fn derivatives_builder(file: &str, module: &str, ty: &str) -> eomgen::Builder {
     eomgen::Builder::new(file)
         .module_name(module)
         .type_name(ty)
@@ -294,8 +299,6 @@ fn with_derivatives(file: &str, module: &str, ty: &str) {
             "forward_dynamics_derivatives",
             "mass_matrix_inverse",
         ])
-        .compile()
-        .unwrap();
 }
 
 /// Mimic joints honoured (`Builder::mimic_joints`): the panda (its second finger follows the
@@ -357,17 +360,8 @@ fn mimic() {
 /// Bodies split into many blocks (`Builder::max_function_ops`), for comparison with the same
 /// robots generated whole: the ur5's derivatives and anymal on its feet.
 fn split() {
-    eomgen::Builder::new("robots/ur5.urdf")
-        .module_name("ur5_split")
-        .type_name("Ur5Split")
-        .derivatives()
+    derivatives_builder("robots/ur5.urdf", "ur5_split", "Ur5Split")
         .max_function_ops(60)
-        .quantities([
-            "inverse_dynamics",
-            "inverse_dynamics_derivatives",
-            "forward_dynamics_derivatives",
-            "mass_matrix_inverse",
-        ])
         .compile()
         .unwrap();
     eomgen::Builder::new("robots/floating/anymal.urdf")
