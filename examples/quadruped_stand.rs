@@ -12,6 +12,7 @@
 //! slip, the joints settle, and the contact forces carry the robot's weight.
 
 use eomgen_examples::anymal::{Anymal, STANDING};
+use eomgen_runtime::prelude::*;
 use eomgen_runtime::{rk4_step_floating, solve_spd, StandOnContacts};
 
 /// A velocity that moves the trunk at `base` (m/s, base axes) with the feet still: the joint

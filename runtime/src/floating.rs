@@ -12,8 +12,9 @@ use crate::{FactorError, Real};
 /// ```
 ///
 /// `tau`'s first six entries are the force and torque on the base in base axes (zero for a
-/// robot's own efforts), as Pinocchio's free flyer. Every method is also an inherent method of
-/// the generated type, reachable without this trait.
+/// robot's own efforts), as Pinocchio's free flyer. A generated type's methods of this trait
+/// (and of [`Contacts`]) live only in its impl: bring the trait into scope
+/// (`use eomgen_runtime::prelude::*;`) to call them.
 ///
 /// # Example
 /// One free body of mass 2 kg (a brick), written as generated code would be:

@@ -12,6 +12,7 @@
 use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion};
+use eomgen_runtime::prelude::*;
 use eomgen_tests::robots::anymal::Anymal;
 use eomgen_tests::robots::anymal_derivatives::AnymalDerivatives;
 

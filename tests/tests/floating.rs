@@ -5,6 +5,7 @@
 
 #![allow(clippy::needless_range_loop)]
 
+use eomgen_runtime::prelude::*;
 use eomgen_tests::robots::{anymal, anymal_derivatives, anymal_weightless, iris_simple};
 use serde_json::Value;
 

@@ -12,7 +12,7 @@
 
 #![allow(clippy::needless_range_loop)]
 
-use eomgen_runtime::{Dynamics, Pose};
+use eomgen_runtime::{Contacts, Dynamics, FloatingDynamics, Pose};
 use eomgen_tests::robots::{
     mimic_tree, mimic_tree_floating, mimic_tree_floating_full, mimic_tree_full, panda_mimic,
 };

@@ -2,6 +2,7 @@
 //! same robots generated whole compute, bit for bit: the blocks hold the same operations in the
 //! same expressions, and only pass intermediate values through memory.
 
+use eomgen_runtime::prelude::*;
 use eomgen_tests::robots::anymal::Anymal;
 use eomgen_tests::robots::anymal_split::{AnymalSplit, AnymalSplitLink};
 use eomgen_tests::robots::ur5_derivatives::Ur5Derivatives;

@@ -41,7 +41,8 @@ pub fn catalogue(model: &Model, d: &Derivation) -> Vec<Quantity> {
     out.push(link_jacobian(d.dof));
     out.extend(centroidal::quantities(model, d));
     if model.is_floating() {
-        // Without the `Dynamics` trait (whose arrays are all N long): inherent methods.
+        // Without the `Dynamics` trait (whose arrays are all N long): the emitter puts those of
+        // `FloatingDynamics` and `Contacts` in their impls, the others are inherent methods.
         for q in &mut out {
             q.home = Home::Inherent;
         }

@@ -103,6 +103,14 @@ struct Emitter<'a> {
     in_trait: bool,
     /// `try_forward_dynamics`, which stays inherent when `forward_dynamics` is the trait's.
     try_forward_dynamics: TokenStream,
+    /// Whether a floating base's six `FloatingDynamics` methods are all generated, so that the
+    /// trait is implemented (and its methods live there rather than in the inherent impl).
+    floating_trait: bool,
+    /// The number of contact rows (3K) when a floating base implements `Contacts` (its three
+    /// methods live there rather than in the inherent impl).
+    contacts_trait: Option<Literal>,
+    /// `try_contact_forward_dynamics`, for the `Contacts` impl.
+    try_contact_forward_dynamics: TokenStream,
     counts: Vec<(String, OpCount)>,
     /// The most operations of one function body ([`Split`]).
     budget: usize,
@@ -112,6 +120,34 @@ struct Emitter<'a> {
 
 /// How many methods the runtime's `Dynamics` trait has.
 const TRAIT_METHODS: usize = 8;
+
+/// The methods of the runtime's `FloatingDynamics` trait.
+const FLOATING_METHODS: [&str; 6] = [
+    "mass_matrix",
+    "gravity",
+    "bias",
+    "integrate",
+    "inverse_dynamics",
+    "forward_dynamics",
+];
+
+/// The methods of the runtime's `Contacts` trait.
+const CONTACT_METHODS: [&str; 3] = [
+    "contact_jacobian",
+    "contact_drift",
+    "try_contact_forward_dynamics",
+];
+
+/// The runtime trait whose impl holds a generated method.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Trait {
+    /// `Dynamics` (fixed base).
+    Dynamics,
+    /// `FloatingDynamics`.
+    Floating,
+    /// `Contacts` (floating base).
+    Contacts,
+}
 
 /// Emits the whole file (unformatted tokens; see [`super::format`]) and the operation count of
 /// each straight-line function.
@@ -142,6 +178,17 @@ pub fn emit_tokens(
             .count()
             == TRAIT_METHODS,
         try_forward_dynamics: TokenStream::new(),
+        floating_trait: model.is_floating()
+            && FLOATING_METHODS
+                .iter()
+                .all(|f| d.quantities.iter().any(|q| q.name == *f)),
+        contacts_trait: (model.is_floating()
+            && !d.centroidal.contact_drift.is_empty()
+            && d.quantities
+                .iter()
+                .any(|q| q.name == "contact_forward_dynamics"))
+        .then(|| usize_lit(d.centroidal.contact_drift.len())),
+        try_contact_forward_dynamics: TokenStream::new(),
         counts: Vec::new(),
         budget: opts.max_function_ops,
         blocks: Vec::new(),
@@ -167,21 +214,25 @@ impl Emitter<'_> {
         let quantities = self.quantities;
         let mut methods = Vec::new();
         let mut trait_methods = Vec::new();
+        let mut floating_methods = Vec::new();
+        let mut contact_methods = Vec::new();
         for q in quantities {
             let tokens = self.quantity_fn(q);
-            if self.in_trait && q.home == Home::Dynamics {
-                trait_methods.push(tokens);
-            } else {
-                methods.push(tokens);
+            match self.trait_of(q.name) {
+                Some(Trait::Dynamics) => trait_methods.push(tokens),
+                Some(Trait::Floating) => floating_methods.push(tokens),
+                Some(Trait::Contacts) => contact_methods.push(tokens),
+                None => methods.push(tokens),
             }
         }
+        contact_methods.push(self.try_contact_forward_dynamics.clone());
         let frames = if self.has_frames() {
             self.frame_support(d)
         } else {
             TokenStream::new()
         };
         let trait_impl = self.trait_impl(&trait_methods);
-        let floating_impls = self.floating_impls(d);
+        let floating_impls = self.floating_impls(&floating_methods, &contact_methods);
         let (ty, allow) = (&self.ty, allow_lints());
         let try_fd = &self.try_forward_dynamics;
         let parents = self.parents_const();
@@ -262,9 +313,29 @@ impl Emitter<'_> {
         }
     }
 
-    /// `pub` in the inherent impl; nothing in the trait's.
-    fn vis(&self, q: &Quantity) -> TokenStream {
-        if self.in_trait && q.home == Home::Dynamics {
+    /// The runtime trait whose impl holds the generated method `name`, if any (else it is
+    /// inherent).
+    fn trait_of(&self, name: &str) -> Option<Trait> {
+        if self.floating {
+            if self.floating_trait && FLOATING_METHODS.contains(&name) {
+                Some(Trait::Floating)
+            } else if self.contacts_trait.is_some() && CONTACT_METHODS.contains(&name) {
+                Some(Trait::Contacts)
+            } else {
+                None
+            }
+        } else {
+            let dynamics = self
+                .quantities
+                .iter()
+                .any(|q| q.name == name && q.home == Home::Dynamics);
+            (self.in_trait && dynamics).then_some(Trait::Dynamics)
+        }
+    }
+
+    /// `pub` in the inherent impl; nothing in a trait's.
+    fn vis(&self, name: &str) -> TokenStream {
+        if self.trait_of(name).is_some() {
             TokenStream::new()
         } else {
             quote!(pub)
@@ -448,7 +519,7 @@ impl Emitter<'_> {
             self.args(q.inputs),
             shape_type(q.shape),
         );
-        let vis = self.vis(q);
+        let vis = self.vis(q.name);
         quote! {
             #docs
             #vis fn #name(&self, #(#args),*) -> #ret { #body }
@@ -540,7 +611,7 @@ impl Emitter<'_> {
             _ => unreachable!("forward_dynamics_fns on another evaluation"),
         };
         let docs = Self::quantity_doc(q, Some(ops));
-        let (n, nq, vis) = (&self.n, &self.nq, self.vis(q));
+        let (n, nq, vis) = (&self.n, &self.nq, self.vis(q.name));
         self.try_forward_dynamics = quote! {
             /// Forward dynamics `qdd = M(q)^-1 (tau - b(q, qd) - G(q))`, or which pivot of the
             /// `L^T D L` factorization of M(q) was not positive (a non-physical model or
@@ -563,21 +634,28 @@ impl Emitter<'_> {
         }
     }
 
-    /// The path that calls the generated function `name` from inside the impl: through the
+    /// The path that calls the generated function `name` from inside the impls: through the
     /// trait when it is a trait method there. Every generated function that calls another does
     /// so through here, and the callee is one of its `Quantity::needs`, so that a selection
     /// (`catalogue::select`) brings it.
     fn call(&self, name: &str) -> TokenStream {
         debug_assert!(self.has(name), "`{name}` is called but not generated");
-        let (f, n) = (format_ident!("{}", name), &self.n);
-        let in_trait = self
-            .quantities
-            .iter()
-            .any(|q| q.name == name && q.home == Home::Dynamics);
-        if self.in_trait && in_trait {
-            quote!(<Self as ::eomgen_runtime::Dynamics<T, #n>>::#f)
-        } else {
-            quote!(Self::#f)
+        self.path(name)
+    }
+
+    /// The path of the generated method `name` (see [`Self::call`]).
+    fn path(&self, name: &str) -> TokenStream {
+        let (f, n, nq) = (format_ident!("{}", name), &self.n, &self.nq);
+        match self.trait_of(name) {
+            Some(Trait::Dynamics) => quote!(<Self as ::eomgen_runtime::Dynamics<T, #n>>::#f),
+            Some(Trait::Floating) => {
+                quote!(<Self as ::eomgen_runtime::FloatingDynamics<T, #nq, #n>>::#f)
+            }
+            Some(Trait::Contacts) => {
+                let k3 = self.contacts_trait.as_ref();
+                quote!(<Self as ::eomgen_runtime::Contacts<T, #nq, #n, #k3>>::#f)
+            }
+            None => quote!(Self::#f),
         }
     }
 
@@ -660,11 +738,13 @@ impl Emitter<'_> {
             self.call("contact_jacobian"),
             self.call("contact_drift"),
         );
-        quote! {
+        let try_vis = self.vis("try_contact_forward_dynamics");
+        let try_cfd = self.path("try_contact_forward_dynamics");
+        let try_fn = quote! {
             /// The accelerations and contact forces of `contact_forward_dynamics`, or why they
             /// do not exist: a pivot of M(q) (`pivot` < N) or of `J_c M^-1 J_c^T` (`pivot` - N,
             /// a rank-deficient contact Jacobian) that is not positive, or non-finite input.
-            pub fn try_contact_forward_dynamics(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n]) -> ::core::result::Result<([T; #n], [T; #k3]), ::eomgen_runtime::FactorError> {
+            #try_vis fn try_contact_forward_dynamics(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n]) -> ::core::result::Result<([T; #n], [T; #k3]), ::eomgen_runtime::FactorError> {
                 let mut m = #m(self, q);
                 let h: [T; #n] = { #hb };
                 let mut rhs = *tau;
@@ -673,10 +753,19 @@ impl Emitter<'_> {
                 }
                 ::eomgen_runtime::contact::solve(&mut m, &Self::PARENTS, &rhs, &#j(self, q), &#drift(self, q, qd))
             }
+        };
+        let inherent_try = if self.trait_of("try_contact_forward_dynamics").is_some() {
+            self.try_contact_forward_dynamics = try_fn;
+            TokenStream::new()
+        } else {
+            try_fn
+        };
+        quote! {
+            #inherent_try
 
             #docs
             pub fn contact_forward_dynamics(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n]) -> ([T; #n], [T; #k3]) {
-                match self.try_contact_forward_dynamics(q, qd, tau) {
+                match #try_cfd(self, q, qd, tau) {
                     Ok(x) => x,
                     Err(_) => ([T::nan(); #n], [T::nan(); #k3]),
                 }
@@ -686,10 +775,10 @@ impl Emitter<'_> {
 
     fn integrate_fn(&mut self, q: &Quantity) -> TokenStream {
         let docs = Self::quantity_doc(q, None);
-        let (n, nq) = (&self.n, &self.nq);
+        let (n, nq, vis) = (&self.n, &self.nq, self.vis(q.name));
         quote! {
             #docs
-            pub fn integrate(&self, q: &[T; #nq], qd: &[T; #n], dt: T) -> [T; #nq] {
+            #vis fn integrate(&self, q: &[T; #nq], qd: &[T; #n], dt: T) -> [T; #nq] {
                 ::eomgen_runtime::free_flyer::integrate(q, qd, dt)
             }
         }
@@ -871,45 +960,27 @@ impl Emitter<'_> {
     }
 
     /// A floating-base robot's `FloatingDynamics` implementation (when its methods are all
-    /// generated) and `Contacts` (with contact points), delegating to the inherent methods.
-    fn floating_impls(&self, d: &Derivation) -> TokenStream {
+    /// generated) and `Contacts` (with contact points and `contact_forward_dynamics`), holding
+    /// those methods.
+    fn floating_impls(&self, floating: &[TokenStream], contacts: &[TokenStream]) -> TokenStream {
         if !self.floating {
             return TokenStream::new();
         }
         let (ty, n, nq, allow) = (&self.ty, &self.n, &self.nq, allow_lints());
-        let needed = [
-            "mass_matrix",
-            "gravity",
-            "bias",
-            "integrate",
-            "inverse_dynamics",
-            "forward_dynamics",
-        ];
         let mut out = TokenStream::new();
-        if needed.iter().all(|q| self.has(q)) {
+        if self.floating_trait {
             out.extend(quote! {
                 #allow
                 impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::FloatingDynamics<T, #nq, #n> for #ty<T> {
-                    fn mass_matrix(&self, q: &[T; #nq]) -> [[T; #n]; #n] { Self::mass_matrix(self, q) }
-                    fn gravity(&self, q: &[T; #nq]) -> [T; #n] { Self::gravity(self, q) }
-                    fn bias(&self, q: &[T; #nq], v: &[T; #n]) -> [T; #n] { Self::bias(self, q, v) }
-                    fn integrate(&self, q: &[T; #nq], v: &[T; #n], dt: T) -> [T; #nq] { Self::integrate(self, q, v, dt) }
-                    fn inverse_dynamics(&self, q: &[T; #nq], v: &[T; #n], a: &[T; #n]) -> [T; #n] { Self::inverse_dynamics(self, q, v, a) }
-                    fn forward_dynamics(&self, q: &[T; #nq], v: &[T; #n], tau: &[T; #n]) -> [T; #n] { Self::forward_dynamics(self, q, v, tau) }
+                    #(#floating)*
                 }
             });
         }
-        let k3 = d.centroidal.contact_drift.len();
-        if k3 > 0 && self.has("contact_forward_dynamics") {
-            let k3 = usize_lit(k3);
+        if let Some(k3) = &self.contacts_trait {
             out.extend(quote! {
                 #allow
                 impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Contacts<T, #nq, #n, #k3> for #ty<T> {
-                    fn contact_jacobian(&self, q: &[T; #nq]) -> [[T; #n]; #k3] { Self::contact_jacobian(self, q) }
-                    fn contact_drift(&self, q: &[T; #nq], v: &[T; #n]) -> [T; #k3] { Self::contact_drift(self, q, v) }
-                    fn try_contact_forward_dynamics(&self, q: &[T; #nq], v: &[T; #n], tau: &[T; #n]) -> ::core::result::Result<([T; #n], [T; #k3]), ::eomgen_runtime::FactorError> {
-                        Self::try_contact_forward_dynamics(self, q, v, tau)
-                    }
+                    #(#contacts)*
                 }
             });
         }
