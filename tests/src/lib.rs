@@ -321,15 +321,15 @@ pub mod robots {
     pub mod allegro_derivatives {
         include!(concat!(env!("OUT_DIR"), "/allegro_derivatives.rs"));
     }
-    /// `floating/anymal.urdf` with a floating base and point contacts at its four feet.
+    /// `ur5.urdf`'s derivatives split into blocks of at most 60 operations.
     pub mod ur5_split {
         include!(concat!(env!("OUT_DIR"), "/ur5_split.rs"));
     }
-
+    /// `anymal` below with every body split into blocks of at most 150 operations.
     pub mod anymal_split {
         include!(concat!(env!("OUT_DIR"), "/anymal_split.rs"));
     }
-
+    /// `floating/anymal.urdf` with a floating base and point contacts at its four feet.
     pub mod anymal {
         include!(concat!(env!("OUT_DIR"), "/anymal.rs"));
     }
