@@ -118,7 +118,8 @@ fn live_after(program: &Program) -> Vec<usize> {
     for e in &program.outputs {
         read.clear();
         temps_read(e, &mut read);
-        // An output goes in the block of the last temporary it reads: it extends nothing.
+        // An output goes in the block of the last temporary it reads, so it keeps the others
+        // live until that one.
         let at = read.iter().max().copied();
         read.iter()
             .for_each(|&t| last[t] = last[t].max(at.unwrap_or(t)));
@@ -172,13 +173,7 @@ pub(super) fn split_body(
         let b = of_temp[k];
         let ts = cx.expr(e, &mut blocks[b].trig).ts;
         defs[b].push((format_ident!("t{}", k), ts));
-        let mut read = BTreeSet::new();
-        temps_read(e, &mut read);
-        blocks[b].reads.extend(
-            read.into_iter()
-                .filter(|&t| of_temp[t] < b)
-                .map(Value::Temp),
-        );
+        blocks[b].reads.extend(earlier_temps(e, b, &of_temp));
     }
     for (b, d) in defs.iter().enumerate() {
         blocks[b].code = chunked_lets(d);
@@ -191,11 +186,7 @@ pub(super) fn split_body(
         let ts = cx.expr(e, &mut blocks[b].trig).ts;
         let place = output_place(shape, j);
         blocks[b].code.push(quote!(#place = #ts;));
-        blocks[b].reads.extend(
-            read.into_iter()
-                .filter(|&t| of_temp[t] < b)
-                .map(Value::Temp),
-        );
+        blocks[b].reads.extend(earlier_temps(e, b, &of_temp));
     }
     let first_trig = trig_homes(&mut blocks);
     let home = |v: Value| match v {
@@ -230,6 +221,16 @@ pub(super) fn split_body(
         o
     };
     (body, items)
+}
+
+/// The temporaries `e` reads that blocks before block `b` compute.
+fn earlier_temps(e: &Expr, b: usize, of_temp: &[usize]) -> Vec<Value> {
+    let mut read = BTreeSet::new();
+    temps_read(e, &mut read);
+    read.into_iter()
+        .filter(|&t| of_temp[t] < b)
+        .map(Value::Temp)
+        .collect()
 }
 
 fn block_name(name: &str, b: usize) -> Ident {
