@@ -57,7 +57,7 @@ use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hprintln};
 use eomgen_generated::iris_simple::IrisSimple;
 use eomgen_generated::ur5::Ur5;
-use eomgen_runtime::{Dynamics, Real};
+use eomgen_runtime::prelude::*;
 use panic_semihosting as _;
 
 /// Joints of the UR5.
