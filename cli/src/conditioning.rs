@@ -6,11 +6,10 @@
 //! motion is (nearly) without inertia once its ancestors are accounted for. `info` looks at a
 //! few states spread over the joint ranges, `eval` at the state asked for.
 
-use eomgen::cas::format_number;
-use eomgen::dynamics::Derivation;
+use eomgen::evaluate::State;
 use eomgen::model::{JointKind, Model};
-
-use super::eval;
+use eomgen::report::format_number;
+use eomgen::Derived;
 
 /// Condition estimates above this are warned about: with 16 significant digits in `f64`,
 /// fewer than 6 are left in the accelerations.
@@ -88,12 +87,17 @@ pub fn warning(model: &Model, m: &[Vec<f64>], at: &str) -> Option<String> {
 }
 
 /// The warnings of `info`: the worst of the sampled states, if any is near singular.
-pub fn sampled_warnings(model: &Model, d: &Derivation) -> Vec<String> {
+pub fn sampled_warnings(derived: &Derived) -> Vec<String> {
+    let model = derived.model();
     // The joints' conditioning: a floating base's mass matrix is checked at evaluation.
     if model.is_floating() {
         return Vec::new();
     }
     let n = model.coordinates();
+    let mass = match derived.evaluator(&["mass_matrix"]) {
+        Ok(m) => m,
+        Err(e) => return vec![e.to_string()],
+    };
     let mut rng = 0x2545_f491_4f6c_dd1d_u64;
     let mut worst: Option<(f64, String)> = None;
     for k in 0..=SAMPLES {
@@ -106,15 +110,9 @@ pub fn sampled_warnings(model: &Model, d: &Derivation) -> Vec<String> {
                 .map(|j| sample(&model.joints[j], &mut rng))
                 .collect()
         };
-        let state = eval::State {
-            q,
-            qd: vec![0.0; n],
-            qdd: vec![0.0; n],
-            tau: vec![0.0; n],
-        };
-        let m = match eval::evaluate(model, d, &state) {
-            Ok(v) => v.mass_matrix,
-            Err(e) => return vec![e],
+        let m = match mass.evaluate(&State::at_rest(q, n)) {
+            Ok(v) => v[0].rows(),
+            Err(e) => return vec![e.to_string()],
         };
         let Some((estimate, _)) = near_singular(&m) else {
             continue;

@@ -3,10 +3,10 @@
 use std::fmt::Write as _;
 use std::time::Duration;
 
-use eomgen::cas::format_number;
 use eomgen::dynamics::Derivation;
 use eomgen::emit::Generated;
 use eomgen::model::{JointKind, Model};
+use eomgen::report::format_number;
 
 fn kind(k: JointKind) -> &'static str {
     match k {

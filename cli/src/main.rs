@@ -25,9 +25,10 @@ use clap::builder::PossibleValuesParser;
 use clap::{Args, CommandFactory, Parser, Subcommand, ValueEnum};
 
 use eomgen::dynamics::Derivation;
+use eomgen::evaluate::State;
 use eomgen::model::Model;
 use eomgen::report::{self, Form, Format, ShowOptions, Term};
-use eomgen::{Builder, ModelOptions, SymbolicParams};
+use eomgen::{Builder, Derived, ModelOptions, SymbolicParams};
 
 #[derive(Parser, Debug)]
 #[command(
@@ -323,10 +324,12 @@ struct InfoArgs {
 struct EvalArgs {
     /// The robot's URDF file.
     urdf: PathBuf,
-    /// Joint positions (rad or m), one per joint, separated by commas.
+    /// Joint positions (rad or m), one per joint, separated by commas; with --floating-base
+    /// the base's position and unit quaternion x, y, z, w first (NQ = 7 + joints).
     #[arg(long, value_name = "Q1,Q2,...", allow_hyphen_values = true, value_parser = parse_numbers)]
     q: Numbers,
-    /// Joint velocities [default: 0]
+    /// Joint velocities; with --floating-base the base's linear and angular velocity in its own
+    /// axes first [default: 0]
     #[arg(long, value_name = "QD1,...", allow_hyphen_values = true, value_parser = parse_numbers)]
     qd: Option<Numbers>,
     /// Joint accelerations for the inverse dynamics [default: 0]
@@ -589,6 +592,16 @@ fn derive(b: &Builder, model: &Model) -> Result<Derivation, Failure> {
     progress::run(&label, || b.derive(model)).map_err(cli_error)
 }
 
+/// [`derive`] for the evaluator (`eval`, `simulate`, `info`'s conditioning samples).
+fn derived(b: &Builder, model: Model) -> Result<Derived, Failure> {
+    let label = format!(
+        "deriving the equations of {} ({} joints)",
+        model.name,
+        model.dof()
+    );
+    progress::run(&label, || b.derived_from(model)).map_err(cli_error)
+}
+
 fn run(cli: Cli) -> Result<(), Failure> {
     match cli.command {
         Command::Generate(a) => generate(a),
@@ -734,7 +747,10 @@ fn info_cmd(a: InfoArgs) -> Result<(), Failure> {
         progress::run(&label, || b.generate_with_report()).map_err(cli_error)?;
     let derive: std::time::Duration = d.timings.iter().map(|t| t.1).sum();
     let emit_time = start.elapsed().saturating_sub(derive + load_time);
-    warn_lines(conditioning::sampled_warnings(&model, &d));
+    warn_lines(conditioning::sampled_warnings(&Derived::from_parts(
+        model.clone(),
+        d.clone(),
+    )));
     emit(&info::print(
         &model,
         &d,
@@ -743,18 +759,6 @@ fn info_cmd(a: InfoArgs) -> Result<(), Failure> {
         load_time,
         emit_time,
     ))
-}
-
-/// The commands that do not handle a floating base yet say so.
-fn fixed_base_only(model: &eomgen::model::Model, command: &str) -> Result<(), Failure> {
-    if model.is_floating() {
-        return Err(Failure(format!(
-            "{}: `eomgen {command}` does not handle a floating base yet: generate the code \
-             (eomgen generate --floating-base) and call it",
-            model.name
-        )));
-    }
-    Ok(())
 }
 
 /// The CSV to `path` and the summary to stdout, or the CSV to stdout.
@@ -857,8 +861,8 @@ fn simulate_floating_cmd(a: SimulateArgs, b: Builder, model: Model) -> Result<()
     if let Some(path) = &a.plot {
         plot::Format::of(path).map_err(Failure)?;
     }
-    let d = derive(&b, &model)?;
-    let outcome = simulate_floating::run(&model, &d, &options).map_err(Failure)?;
+    let derived = derived(&b, model.clone())?;
+    let outcome = simulate_floating::run(&derived, &options).map_err(Failure)?;
     if let Some(path) = &a.plot {
         floating_plots(path, &model, &options, &outcome).map_err(Failure)?;
     }
@@ -868,13 +872,21 @@ fn simulate_floating_cmd(a: SimulateArgs, b: Builder, model: Model) -> Result<()
 fn eval_cmd(a: EvalArgs) -> Result<(), Failure> {
     let b = a.model.builder(&a.urdf, &None);
     let model = load(&b)?;
-    fixed_base_only(&model, "eval")?;
-    let n = model.coordinates();
     let joints = model.coordinate_names().join(", ");
-    let check = |flag: &str, v: Option<Numbers>| -> Result<Vec<f64>, Failure> {
+    let floating = usize::from(model.is_floating());
+    let nv = model.coordinates() + 6 * floating;
+    let nq = nv + floating;
+    let check = |flag: &str, v: Option<Numbers>, n: usize| -> Result<Vec<f64>, Failure> {
         match v {
             None => Ok(vec![0.0; n]),
             Some(Numbers(v)) if v.len() == n => Ok(v),
+            Some(Numbers(v)) if floating == 1 => Err(Failure(format!(
+                "{flag} has {} value(s), but {} has {n} {} coordinates (the floating base's \
+                 first; joints: {joints})",
+                v.len(),
+                model.name,
+                if n == nq { "position" } else { "velocity" }
+            ))),
             Some(Numbers(v)) => Err(Failure(format!(
                 "{flag} has {} value(s), but {} has {n} joint(s): {joints}",
                 v.len(),
@@ -882,21 +894,24 @@ fn eval_cmd(a: EvalArgs) -> Result<(), Failure> {
             ))),
         }
     };
-    let state = eval::State {
-        q: check("--q", Some(a.q))?,
-        qd: check("--qd", a.qd)?,
-        qdd: check("--qdd", a.qdd)?,
-        tau: check("--tau", a.tau)?,
+    let state = State {
+        q: check("--q", Some(a.q), nq)?,
+        v: check("--qd", a.qd, nv)?,
+        a: check("--qdd", a.qdd, nv)?,
+        tau: check("--tau", a.tau, nv)?,
     };
-    let d = derive(&b, &model)?;
-    let values = eval::evaluate(&model, &d, &state).map_err(Failure)?;
-    warn_lines(conditioning::warning(
-        &model,
-        &values.mass_matrix,
-        "at this state",
-    ));
+    let derived = derived(&b, model)?;
+    let (values, qdd) = eval::evaluate(&derived, &state).map_err(Failure)?;
+    let model = derived.model();
+    if !model.is_floating() {
+        warn_lines(conditioning::warning(
+            model,
+            &values.mass_matrix,
+            "at this state",
+        ));
+    }
     let digits = (a.digits > 0).then_some(a.digits);
-    emit(&eval::print(&model, &state, &values, digits))
+    emit(&eval::print(model, &state, &values, &qdd, digits))
 }
 
 fn simulate_cmd(a: SimulateArgs) -> Result<(), Failure> {
@@ -970,8 +985,10 @@ fn simulate_cmd(a: SimulateArgs) -> Result<(), Failure> {
     if let Some(path) = &a.plot {
         plot::Format::of(path).map_err(Failure)?;
     }
-    let d = derive(&b, &model)?;
-    let outcome = simulate::run(&model, &d, &options).map_err(Failure)?;
+    let derived = derived(&b, model.clone())?;
+    let symplectic = matches!(options.integrator, simulate::Integrator::Symplectic(_));
+    let terms = eval::Terms::new(&derived, symplectic).map_err(Failure)?;
+    let outcome = simulate::run(&model, &terms, &options).map_err(Failure)?;
     if let Some(path) = &a.plot {
         fixed_plots(path, &model, &options, &outcome).map_err(Failure)?;
     }

@@ -1,6 +1,6 @@
 //! `eomgen simulate`: integrates the equation of motion with RK4 or a symplectic method,
-//! evaluating M, b and G through the CAS interpreter (the command line cannot compile the
-//! generated code), and writes the trajectory as CSV.
+//! evaluating M, b and G through the library's evaluator (`eomgen::evaluate`: the command
+//! line cannot compile the generated code), and writes the trajectory as CSV.
 //!
 //! The integrators and controllers mirror the runtime's (`rk4_step_closed_loop`, the
 //! symplectic steps of `symplectic.rs`, `PdGravity`, `ComputedTorque`, `CollocatedPfl` in
@@ -11,10 +11,11 @@
 
 use std::fmt::Write as _;
 
-use eomgen::dynamics::Derivation;
+use eomgen::evaluate::{EvalError, State};
 use eomgen::model::Model;
+use nalgebra::{DMatrix, DVector};
 
-use super::eval;
+use super::eval::{self, Terms};
 use super::symplectic::{self, Method};
 
 /// The controller closing the loop.
@@ -90,9 +91,9 @@ const DIVERGED: f64 = 1e8;
 
 /// Why the accelerations at a state could not be computed.
 enum StepError {
-    /// The mass matrix's factorization failed at this pivot (1-based) of `of`.
-    MassMatrix { pivot: usize, of: usize },
-    /// The interpreter failed.
+    /// The mass matrix's factorization failed (the evaluator's message names the pivot).
+    MassMatrix(Option<EvalError>),
+    /// The evaluator failed otherwise.
     Eval(String),
 }
 
@@ -103,11 +104,14 @@ enum StepError {
 fn step_message(e: StepError, name: &str, t: f64, dt: f64) -> String {
     match e {
         StepError::Eval(message) => message,
-        StepError::MassMatrix { pivot, of } if t == 0.0 => format!(
-            "{name}: the mass matrix is not positive definite at the initial state (pivot \
-             {pivot} of {of}): check the inertias and --q0"
+        StepError::MassMatrix(Some(e)) if t == 0.0 => {
+            format!("{e} (the initial state: check --q0)")
+        }
+        StepError::MassMatrix(None) if t == 0.0 => format!(
+            "{name}: the mass matrix is not positive definite at the initial state: check the \
+             inertias and --q0"
         ),
-        StepError::MassMatrix { .. } => diverged(t, dt),
+        StepError::MassMatrix(_) => diverged(t, dt),
     }
 }
 
@@ -120,19 +124,14 @@ pub(crate) fn diverged(t: f64, dt: f64) -> String {
     )
 }
 
-/// M, b, G and the energies at `(q, qd)`.
-fn terms(model: &Model, d: &Derivation, q: &[f64], qd: &[f64]) -> Result<eval::Values, String> {
-    let n = q.len();
-    eval::evaluate(
-        model,
-        d,
-        &eval::State {
-            q: q.to_vec(),
-            qd: qd.to_vec(),
-            qdd: vec![0.0; n],
-            tau: vec![0.0; n],
-        },
-    )
+/// The state `(q, qd)` with efforts `tau` (and no accelerations).
+fn state(q: &[f64], qd: &[f64], tau: Vec<f64>) -> State {
+    State {
+        q: q.to_vec(),
+        v: qd.to_vec(),
+        a: vec![0.0; qd.len()],
+        tau,
+    }
 }
 
 /// What one evaluation gives: the controller's effort, the resulting acceleration, the total
@@ -147,13 +146,15 @@ struct Step {
 /// The controller's effort and the resulting acceleration at `(q, qd)`.
 fn step_eval(
     model: &Model,
-    d: &Derivation,
+    terms: &Terms,
     o: &Options,
     q: &[f64],
     qd: &[f64],
 ) -> Result<Step, StepError> {
     let n = q.len();
-    let v = terms(model, d, q, qd).map_err(StepError::Eval)?;
+    let v = terms
+        .at(&state(q, qd, vec![0.0; n]))
+        .map_err(StepError::Eval)?;
     // The effort friction takes (zero unless the model includes it, `--friction`).
     let friction = &v.friction;
     let tau: Vec<f64> = match o.controller {
@@ -181,13 +182,12 @@ fn step_eval(
     for &p in &model.passive {
         tau[p] = 0.0;
     }
-    let rhs: Vec<f64> = (0..n)
-        .map(|i| tau[i] - v.bias[i] - v.gravity[i] - friction[i])
-        .collect();
-    let qdd = eval::cholesky_solve(&v.mass_matrix, &rhs).map_err(|k| StepError::MassMatrix {
-        pivot: k + 1,
-        of: n,
-    })?;
+    let qdd = terms
+        .forward_dynamics(&state(q, qd, tau.clone()))
+        .map_err(|e| match e {
+            EvalError::NotPositiveDefinite { .. } => StepError::MassMatrix(Some(e)),
+            e => StepError::Eval(e.to_string()),
+        })?;
     Ok(Step {
         tau,
         qdd,
@@ -223,27 +223,24 @@ fn pfl(model: &Model, o: &Options, v: &eval::Values, q: &[f64], qd: &[f64]) -> V
 type HamiltonTerms = (Vec<Vec<f64>>, Vec<f64>, Vec<Vec<f64>>);
 
 /// `M(q)` and the momentum rate `pd = tau - h + (C + C^T) qd` for the symplectic methods.
-fn hamilton_terms(
-    model: &Model,
-    d: &Derivation,
-    q: &[f64],
-    qd: &[f64],
-) -> Result<HamiltonTerms, StepError> {
+fn hamilton_terms(terms: &Terms, q: &[f64], qd: &[f64]) -> Result<HamiltonTerms, StepError> {
     let n = q.len();
-    let v = terms(model, d, q, qd).map_err(StepError::Eval)?;
-    let c_ids: Vec<_> = d.fast.coriolis_matrix.1.iter().flatten().copied().collect();
-    let state = eval::State {
-        q: q.to_vec(),
-        qd: qd.to_vec(),
-        qdd: vec![0.0; n],
-        tau: vec![0.0; n],
-    };
-    let c = eval::evaluate_ids(d, &state, &c_ids).map_err(StepError::Eval)?;
-    let c: Vec<Vec<f64>> = c.chunks(n).map(|r| r.to_vec()).collect();
+    let v = terms
+        .at(&state(q, qd, vec![0.0; n]))
+        .map_err(StepError::Eval)?;
     let h = (0..n)
         .map(|i| v.bias[i] + v.gravity[i] + v.friction[i])
         .collect();
-    Ok((v.mass_matrix, h, c))
+    Ok((v.mass_matrix, h, v.coriolis))
+}
+
+/// `x` with `M x = b`, by Cholesky (nalgebra).
+fn solve_mass(m: &[Vec<f64>], b: &[f64]) -> Result<Vec<f64>, StepError> {
+    let n = b.len();
+    let m = DMatrix::from_fn(n, n, |i, j| m[i][j]);
+    let chol = m.cholesky().ok_or(StepError::MassMatrix(None))?;
+    let x = chol.solve(&DVector::from_column_slice(b));
+    Ok(x.iter().copied().collect())
 }
 
 fn axpy(a: &[f64], h: f64, b: &[f64]) -> Vec<f64> {
@@ -274,7 +271,7 @@ pub fn csv_number(x: f64) -> String {
 }
 
 /// Runs the simulation: `round(duration / dt)` steps of the chosen integrator.
-pub fn run(model: &Model, d: &Derivation, o: &Options) -> Result<Outcome, String> {
+pub fn run(model: &Model, terms: &Terms, o: &Options) -> Result<Outcome, String> {
     let valid = o.dt > 0.0 && o.dt.is_finite() && o.duration >= 0.0 && o.duration.is_finite();
     if !valid {
         return Err("--dt must be positive and --duration non-negative".into());
@@ -318,14 +315,14 @@ pub fn run(model: &Model, d: &Derivation, o: &Options) -> Result<Outcome, String
     let fail = |e: StepError, t: f64| step_message(e, &model.name, t, h);
     for k in 0..steps {
         let t = k as f64 * h;
-        let first = step_eval(model, d, o, &q, &qd).map_err(|e| fail(e, t))?;
+        let first = step_eval(model, terms, o, &q, &qd).map_err(|e| fail(e, t))?;
         record(&mut out, t, &q, &qd, &first);
         match o.integrator {
             Integrator::Rk4 => {
                 let a1 = first.qdd;
                 let v1 = qd.clone();
                 let stage = |q: &[f64], v: &[f64]| {
-                    step_eval(model, d, o, q, v)
+                    step_eval(model, terms, o, q, v)
                         .map(|s| s.qdd)
                         .map_err(|e| fail(e, t + h))
                 };
@@ -343,10 +340,10 @@ pub fn run(model: &Model, d: &Derivation, o: &Options) -> Result<Outcome, String
             Integrator::Symplectic(method) => {
                 let n = q.len();
                 let mass = |q: &[f64]| -> Result<Vec<Vec<f64>>, StepError> {
-                    Ok(hamilton_terms(model, d, q, &vec![0.0; n])?.0)
+                    Ok(hamilton_terms(terms, q, &vec![0.0; n])?.0)
                 };
                 let rate = |q: &[f64], qd: &[f64], tau: &[f64]| -> Result<Vec<f64>, StepError> {
-                    let (_, hh, c) = hamilton_terms(model, d, q, qd)?;
+                    let (_, hh, c) = hamilton_terms(terms, q, qd)?;
                     Ok((0..n)
                         .map(|k| {
                             tau[k] - hh[k]
@@ -354,12 +351,7 @@ pub fn run(model: &Model, d: &Derivation, o: &Options) -> Result<Outcome, String
                         })
                         .collect())
                 };
-                let solve = |m: &[Vec<f64>], b: &[f64]| -> Result<Vec<f64>, StepError> {
-                    eval::cholesky_solve(m, b).map_err(|k| StepError::MassMatrix {
-                        pivot: k + 1,
-                        of: n,
-                    })
-                };
+                let solve = |m: &[Vec<f64>], b: &[f64]| solve_mass(m, b);
                 let sys = symplectic::System {
                     mass: &mass,
                     rate: &rate,
@@ -377,7 +369,7 @@ pub fn run(model: &Model, d: &Derivation, o: &Options) -> Result<Outcome, String
         }
     }
     let t_end = steps as f64 * h;
-    let last = step_eval(model, d, o, &q, &qd).map_err(|e| fail(e, t_end))?;
+    let last = step_eval(model, terms, o, &q, &qd).map_err(|e| fail(e, t_end))?;
     record(&mut out, t_end, &q, &qd, &last);
     let (e0, e_end) = (out.energy[0], last.energy);
     let fmt = |v: &[f64]| {

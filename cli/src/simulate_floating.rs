@@ -1,6 +1,6 @@
 //! `eomgen simulate` for a floating base (NQ = NV + 1): RK4 on the configuration manifold
 //! (stages integrated from the step's start with the runtime's SE(3) `integrate_into`), with
-//! M, b, G, the contact Jacobian and its drift evaluated through the CAS interpreter, and the
+//! M, b, G, the contact Jacobian and its drift from the library's evaluator, and the
 //! contact forward dynamics solved densely each stage (as `eomgen_runtime::contact::solve`
 //! does with fixed sizes).
 //!
@@ -12,9 +12,9 @@
 
 use std::fmt::Write as _;
 
-use eomgen::cas::SymbolKind;
-use eomgen::dynamics::Derivation;
+use eomgen::evaluate::{Evaluator, State, Value};
 use eomgen::model::Model;
+use eomgen::Derived;
 use nalgebra::{DMatrix, DVector};
 
 /// The controller closing the loop.
@@ -79,45 +79,54 @@ struct Terms {
     friction: bool,
 }
 
-fn terms(d: &Derivation, q: &[f64], v: &[f64]) -> Result<Terms, String> {
-    let nv = d.dof;
-    let c = &d.centroidal;
-    let k3 = c.contact_drift.len();
-    let mut outputs: Vec<_> = d.mass_matrix.iter().flatten().copied().collect();
-    outputs.extend(&d.bias);
-    outputs.extend(&d.gravity);
-    outputs.extend(&d.friction);
-    outputs.extend(c.contact_jacobian.iter().flatten());
-    outputs.extend(&c.contact_drift);
-    outputs.push(d.kinetic_energy);
-    outputs.push(d.potential_energy);
-    let x = d
-        .graph
-        .eval(&outputs, |sym| match sym.kind {
-            SymbolKind::Q(i) => q.get(i).copied(),
-            SymbolKind::Qd(i) => v.get(i).copied(),
-            SymbolKind::Param => d.params.iter().find(|p| p.0 == sym.name).map(|p| p.2),
-            _ => None,
-        })
-        .map_err(|e| format!("internal error while evaluating: {e}"))?;
-    let mut at = 0;
-    let mut take = |n: usize| {
-        let s = x[at..at + n].to_vec();
-        at += n;
-        s
+/// The quantities [`terms`] reads, compiled once.
+fn compile(derived: &Derived) -> Result<Evaluator, String> {
+    let model = derived.model();
+    let mut names = vec![
+        "mass_matrix",
+        "bias",
+        "gravity",
+        "kinetic_energy",
+        "potential_energy",
+    ];
+    names.extend(model.include_friction.then_some("friction"));
+    if !model.contacts.is_empty() {
+        names.extend(["contact_jacobian", "contact_drift"]);
+    }
+    derived.evaluator(&names).map_err(|e| e.to_string())
+}
+
+fn terms(ev: &Evaluator, q: &[f64], v: &[f64]) -> Result<Terms, String> {
+    let nv = v.len();
+    let state = State {
+        q: q.to_vec(),
+        v: v.to_vec(),
+        ..State::default()
     };
-    let m = DMatrix::from_row_slice(nv, nv, &take(nv * nv));
-    let (b, g, f) = (take(nv), take(nv), take(nv));
-    let j = DMatrix::from_row_slice(k3, nv, &take(k3 * nv));
-    let drift = DVector::from_vec(take(k3));
-    let e = take(2);
+    let values = ev.evaluate(&state).map_err(|e| e.to_string())?;
+    let get = |name: &str| -> Vec<f64> {
+        values
+            .iter()
+            .find(|x: &&Value| x.name == name)
+            .map_or_else(Vec::new, |x| x.data.clone())
+    };
+    let (b, g) = (get("bias"), get("gravity"));
+    let f = match get("friction") {
+        f if f.is_empty() => vec![0.0; nv],
+        f => f,
+    };
+    let drift = get("contact_drift");
+    let (e, k3) = (
+        get("kinetic_energy")[0] + get("potential_energy")[0],
+        drift.len(),
+    );
     Ok(Terms {
-        m,
+        m: DMatrix::from_row_slice(nv, nv, &get("mass_matrix")),
         h: DVector::from_fn(nv, |i, _| b[i] + g[i] + f[i]),
         gravity: DVector::from_vec(g),
-        j,
-        drift,
-        energy: e[0] + e[1],
+        j: DMatrix::from_row_slice(k3, nv, &get("contact_jacobian")),
+        drift: DVector::from_vec(drift),
+        energy: e,
         friction: f.iter().any(|x| *x != 0.0),
     })
 }
@@ -198,14 +207,14 @@ fn attitude_error(q: &[f64]) -> [f64; 3] {
 type Eval = (DVector<f64>, DVector<f64>, DVector<f64>, f64, bool);
 
 fn evaluate(
-    d: &Derivation,
+    ev: &Evaluator,
     o: &Options,
     name: &str,
     q: &[f64],
     v: &[f64],
     t: f64,
 ) -> Result<Eval, String> {
-    let terms = terms(d, q, v)?;
+    let terms = terms(ev, q, v)?;
     let tau = control(o, &terms, q, v);
     match accelerations(&terms, &tau) {
         Some((a, f)) if a.iter().chain(f.iter()).all(|x| x.is_finite()) => {
@@ -230,12 +239,13 @@ fn axpy(a: &DVector<f64>, h: f64, b: &DVector<f64>) -> DVector<f64> {
 }
 
 /// Runs the simulation.
-pub fn run(model: &Model, d: &Derivation, o: &Options) -> Result<Outcome, String> {
-    let nq = d.nq;
+pub fn run(derived: &Derived, o: &Options) -> Result<Outcome, String> {
+    let (model, ev) = (derived.model(), &compile(derived)?);
+    let nq = model.coordinates() + 7;
     let steps = (o.duration / o.dt).round().max(1.0) as usize;
     let mut q = o.q0.clone();
     let mut v = DVector::from_vec(o.v0.clone());
-    let k3 = d.centroidal.contact_drift.len();
+    let k3 = 3 * model.contacts.len();
     let mut out = Outcome {
         csv: header(model, nq, v.len(), k3),
         summary: String::new(),
@@ -251,7 +261,7 @@ pub fn run(model: &Model, d: &Derivation, o: &Options) -> Result<Outcome, String
     let (mut worst_contact, mut e0, mut e_end) = (0.0_f64, 0.0, 0.0);
     for step in 0..=steps {
         let t = step as f64 * o.dt;
-        let (a1, tau, f, energy, friction) = evaluate(d, o, &model.name, &q, v.as_slice(), t)?;
+        let (a1, tau, f, energy, friction) = evaluate(ev, o, &model.name, &q, v.as_slice(), t)?;
         if step == 0 {
             e0 = energy;
         }
@@ -259,7 +269,7 @@ pub fn run(model: &Model, d: &Derivation, o: &Options) -> Result<Outcome, String
         out.energy.push(energy);
         out.dissipative |= friction;
         if k3 > 0 {
-            let terms = terms(d, &q, v.as_slice())?;
+            let terms = terms(ev, &q, v.as_slice())?;
             let res = &terms.j * &a1 + &terms.drift;
             worst_contact = worst_contact.max(res.amax());
         }
@@ -270,7 +280,7 @@ pub fn run(model: &Model, d: &Derivation, o: &Options) -> Result<Outcome, String
         let h = o.dt;
         let v2 = axpy(&v, h / 2.0, &a1);
         let a2 = evaluate(
-            d,
+            ev,
             o,
             &model.name,
             &integrate(&q, v.as_slice(), h / 2.0),
@@ -280,7 +290,7 @@ pub fn run(model: &Model, d: &Derivation, o: &Options) -> Result<Outcome, String
         .0;
         let v3 = axpy(&v, h / 2.0, &a2);
         let a3 = evaluate(
-            d,
+            ev,
             o,
             &model.name,
             &integrate(&q, v2.as_slice(), h / 2.0),
@@ -290,7 +300,7 @@ pub fn run(model: &Model, d: &Derivation, o: &Options) -> Result<Outcome, String
         .0;
         let v4 = axpy(&v, h, &a3);
         let a4 = evaluate(
-            d,
+            ev,
             o,
             &model.name,
             &integrate(&q, v3.as_slice(), h),

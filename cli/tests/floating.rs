@@ -1,5 +1,5 @@
 //! Floating bases on the command line: `--floating-base`, `--contact`, a URDF `floating` joint
-//! from a world link, and the commands that do not take a floating base yet saying so.
+//! from a world link, `eval` on a floating base, and one-line errors for bad requests.
 
 mod support;
 
@@ -114,7 +114,92 @@ fn bad_floating_requests_get_one_line_errors() {
         "{e}"
     );
     let e = one_line_error(&eomgen(&["eval", "--floating-base", urdf, "--q", "0"]));
-    assert!(e.contains("does not handle a floating base yet"), "{e}");
+    assert!(
+        e.contains("--q has 1 value(s), but anymal has 19 position coordinates"),
+        "{e}"
+    );
+}
+
+/// `eval` on a floating base: Pinocchio's forward dynamics and bias, joints matched by name.
+#[test]
+fn eval_takes_a_floating_base() {
+    let urdf = robot("floating/anymal");
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(urdf.with_extension("json")).unwrap())
+            .unwrap();
+    let refs: Vec<&str> = doc["joints"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|j| j.as_str().unwrap())
+        .collect();
+    let sample = &doc["samples"][1];
+    let numbers = |k: &str| -> Vec<f64> {
+        sample[k]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect()
+    };
+    // The header names our joint order; the state is written in it.
+    let first = stdout(&eomgen(&[
+        "eval",
+        "--floating-base",
+        urdf.to_str().unwrap(),
+        "--q",
+        &vec!["0"; 19].join(","),
+    ]));
+    let order: Vec<usize> = first
+        .lines()
+        .next()
+        .unwrap()
+        .split("joint order: ")
+        .nth(1)
+        .unwrap()
+        .split(", ")
+        .map(|n| refs.iter().position(|r| *r == n).unwrap())
+        .collect();
+    let ours = |v: &[f64], base: usize| -> String {
+        let joints = order.iter().map(|&i| v[base + i]);
+        let all: Vec<String> = v[..base]
+            .iter()
+            .copied()
+            .chain(joints)
+            .map(|x| x.to_string())
+            .collect();
+        all.join(",")
+    };
+    let (q, v, tau) = (numbers("q"), numbers("v"), numbers("tau_in"));
+    let text = stdout(&eomgen(&[
+        "eval",
+        "--floating-base",
+        urdf.to_str().unwrap(),
+        "--q",
+        &ours(&q, 7),
+        "--qd",
+        &ours(&v, 6),
+        "--tau",
+        &ours(&tau, 6),
+    ]));
+    for (label, key) in [
+        (
+            "forward dynamics a = M^-1 (tau_in - b - G) = ",
+            "forward_dynamics",
+        ),
+        ("bias b(q, v) = ", "bias"),
+    ] {
+        let got = numbers_after(&text, label);
+        let want: Vec<f64> = ours(&numbers(key), 6)
+            .split(',')
+            .map(|x| x.parse().unwrap())
+            .collect();
+        let scale = want.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+        for (g, w) in got.iter().zip(&want) {
+            assert!((g - w).abs() <= 1e-9 * scale, "{key}: {got:?} vs {want:?}");
+        }
+        assert_eq!(got.len(), 18, "{text}");
+    }
 }
 
 /// The numbers after `label` in `text`, up to the end of the line.

@@ -582,6 +582,29 @@ impl Builder {
         Ok(d)
     }
 
+    /// Loads and derives, for numbers without compiling generated code: the catalogue's
+    /// quantities evaluated at any state ([`crate::evaluate`]).
+    ///
+    /// ```
+    /// let derived = eomgen::Builder::new("../generated/robots/double_pendulum.urdf")
+    ///     .derived()
+    ///     .unwrap();
+    /// let state = eomgen::evaluate::State::at_rest(vec![0.1, 0.2], 2);
+    /// let m = &derived.evaluate(&["mass_matrix"], &state).unwrap()[0];
+    /// assert_eq!(m.rows().len(), 2);
+    /// assert_eq!(m.rows()[0][1], m.rows()[1][0]);
+    /// ```
+    pub fn derived(&self) -> Result<crate::Derived, Error> {
+        self.derived_from(self.model()?)
+    }
+
+    /// [`Builder::derived`] for a model already loaded (say with
+    /// [`Builder::model_with_warnings`], to show its warnings first).
+    pub fn derived_from(&self, model: Model) -> Result<crate::Derived, Error> {
+        let derivation = self.derive(&model)?;
+        Ok(crate::Derived::from_parts(model, derivation))
+    }
+
     /// Derives and emits, returning the source and the operation counts.
     pub fn generate_with_report(&self) -> Result<(Generated, Model, Derivation), Error> {
         let model = self.model()?;

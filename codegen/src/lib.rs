@@ -57,6 +57,7 @@ mod debug_display;
 pub mod dynamics;
 #[doc(hidden)]
 pub mod emit;
+pub mod evaluate;
 #[doc(hidden)]
 pub mod kinematics;
 pub mod model;
@@ -68,6 +69,8 @@ pub mod spatial;
 pub mod urdf;
 
 pub use builder::{Builder, DEFAULT_MAX_DOF, DEFAULT_MAX_FUNCTION_OPS, DEFAULT_MAX_GRAPH_NODES};
+pub use dynamics::{Input, Shape};
+pub use evaluate::Derived;
 pub use model::{ModelError, ModelOptions, SymbolicParams};
 
 /// Everything that can go wrong between a URDF and a written module.

@@ -38,12 +38,15 @@ mod base_parameters;
 pub mod forms;
 mod trig;
 
+/// Numbers as the reports write them: `digits` significant digits, or the shortest exact
+/// decimals with `None`.
+pub use crate::cas::format_number;
 pub use base_parameters::render_base_parameters;
 
 use std::collections::BTreeSet;
 use std::fmt::Write as _;
 
-use crate::cas::{format_number, Graph, Id, Node, Program, Style, SymbolKind, Syntax};
+use crate::cas::{Graph, Id, Node, Program, Style, SymbolKind, Syntax};
 use crate::dynamics::{pairs, Derivation, Evaluation};
 use crate::model::{JointKind, Model};
 
