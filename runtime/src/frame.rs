@@ -94,10 +94,10 @@ impl<T: Real, F: Fn(usize) -> Pose<T>> Chain<'_, T, F> {
         }
     }
 
-    /// Body `b`'s state from its parent's.
-    fn step(&self, parent: &State<T>, b: usize, qd: &[T], qdd: &[T]) -> State<T> {
+    /// Body `b`'s state from its parent's; without `qdd`, its accelerations are left zero.
+    fn step(&self, parent: &State<T>, b: usize, qd: &[T], qdd: Option<&[T]>) -> State<T> {
         if self.floating && b == 0 {
-            return self.base(qd, qdd);
+            return self.base(qd, qdd.unwrap_or(&[]));
         }
         let pose = parent.pose.compose(&(self.transform)(b));
         let r = sub(&pose.translation, &parent.pose.translation);
@@ -106,32 +106,45 @@ impl<T: Real, F: Fn(usize) -> Pose<T>> Chain<'_, T, F> {
             pose,
             w: parent.w,
             v: add(&parent.v, &wr),
-            dw: parent.dw,
-            a: add(
+            ..State::rest()
+        };
+        if qdd.is_some() {
+            s.dw = parent.dw;
+            s.a = add(
                 &parent.a,
                 &add(&cross(&parent.dw, &r), &cross(&parent.w, &wr)),
-            ),
+            );
+        }
+        let Some((col, joint)) = self.joint(b) else {
+            return s;
         };
-        if let Some((col, joint)) = self.joint(b) {
-            let z = pose.transform_vector(&joint.axis.map(T::from_f64));
-            let (x, y) = (at(qd, col), at(qdd, col));
-            let wz = scale(&cross(&parent.w, &z), x);
-            match joint.motion {
-                Motion::Rotation => {
-                    s.w = add(&s.w, &scale(&z, x));
-                    s.dw = add(&s.dw, &add(&scale(&z, y), &wz));
-                }
-                Motion::Translation => {
-                    s.v = add(&s.v, &scale(&z, x));
-                    s.a = add(&s.a, &add(&scale(&z, y), &scale(&wz, T::from_f64(2.0))));
-                }
+        let z = pose.transform_vector(&joint.axis.map(T::from_f64));
+        let x = at(qd, col);
+        let (rotates, zx) = (joint.motion == Motion::Rotation, scale(&z, x));
+        if rotates {
+            s.w = add(&s.w, &zx);
+        } else {
+            s.v = add(&s.v, &zx);
+        }
+        if let Some(qdd) = qdd {
+            let zy = scale(&z, at(qdd, col));
+            let wz = cross(&parent.w, &zx);
+            if rotates {
+                s.dw = add(&s.dw, &add(&zy, &wz));
+            } else {
+                s.a = add(&s.a, &add(&zy, &scale(&wz, T::from_f64(2.0))));
             }
         }
         s
     }
 
     /// The last body's state, calling `visit(b, state)` for every body `b` of the path.
-    fn walk(&self, qd: &[T], qdd: &[T], mut visit: impl FnMut(usize, &State<T>)) -> State<T> {
+    fn walk(
+        &self,
+        qd: &[T],
+        qdd: Option<&[T]>,
+        mut visit: impl FnMut(usize, &State<T>),
+    ) -> State<T> {
         let mut s = State::rest();
         for &b in self.path {
             s = self.step(&s, b, qd, qdd);
@@ -159,7 +172,7 @@ impl<T: Real, F: Fn(usize) -> Pose<T>> Chain<'_, T, F> {
 /// assert_eq!(velocity(&chain, &[2.0]), [0.0, 2.0, 0.0, 0.0, 0.0, 2.0]);
 /// ```
 pub fn velocity<T: Real, F: Fn(usize) -> Pose<T>>(chain: &Chain<'_, T, F>, qd: &[T]) -> [T; 6] {
-    let s = chain.walk(qd, &[], |_, _| {});
+    let s = chain.walk(qd, None, |_, _| {});
     let v = add(&s.v, &cross(&s.w, &chain.lever(&s)));
     [v[0], v[1], v[2], s.w[0], s.w[1], s.w[2]]
 }
@@ -182,7 +195,7 @@ pub fn acceleration<T: Real, F: Fn(usize) -> Pose<T>>(
     qd: &[T],
     qdd: &[T],
 ) -> [T; 6] {
-    let s = chain.walk(qd, qdd, |_, _| {});
+    let s = chain.walk(qd, Some(qdd), |_, _| {});
     let r = chain.lever(&s);
     let wr = cross(&s.w, &r);
     let a = add(&s.a, &add(&cross(&s.dw, &r), &cross(&s.w, &wr)));
@@ -211,7 +224,7 @@ pub fn jacobian_time_variation<T: Real, F: Fn(usize) -> Pose<T>, const N: usize>
 ) -> [[T; N]; 6] {
     let mut bodies = [(0, State::rest()); N];
     let mut count = 0;
-    let last = chain.walk(qd, &[], |b, s| {
+    let last = chain.walk(qd, None, |b, s| {
         if let Some(slot) = bodies.get_mut(count) {
             *slot = (b, *s);
             count += 1;

@@ -13,6 +13,8 @@ use crate::Real;
 
 type M3<T> = [[T; 3]; 3];
 type M6<T> = [[T; 6]; 6];
+/// `(a, b, (a'/theta, b'/theta), c)` of [`coefficients`].
+type Coefficients<T> = (T, T, (T, T), T);
 
 /// `difference(q0, q1)`: the velocity that [`crate::free_flyer::integrate`] moves for unit time
 /// to get from `q0` to `q1`, `log6(M0^-1 M1)` for the base and `q1 - q0` for the joints. `q1`'s
@@ -67,9 +69,14 @@ pub fn integrate_jacobians<T: Real, const NQ: usize, const NV: usize>(
     let (quat, vmat) = exp_so3(&phi);
     let r = rotation(&quat);
     let t = mat_vec(&vmat, &rho);
-    let dq = embed(&inverse_action(&r, &t), T::one());
-    let dv = embed(&right_jacobian(&r, &rho, &phi), T::one());
-    (dq, dv)
+    // Built in place: the matrices are most of the cost.
+    let mut out = (identity(T::one()), identity(T::one()));
+    put(&mut out.0, &inverse_action(&r, &t));
+    put(
+        &mut out.1,
+        &right_jacobian(&r, &rho, &phi, &coefficients(&phi)),
+    );
+    out
 }
 
 /// Pinocchio's `dDifference(q0, q1)` in `q0` and in `q1`. With `M = M0^-1 M1` and
@@ -90,15 +97,16 @@ pub fn difference_jacobians<T: Real, const NQ: usize, const NV: usize>(
         return (identity(-T::one()), identity(T::one()));
     }
     let (rho, phi, r, t) = relative_log(q0, q1);
-    let jlog = inverse_right_jacobian(&r, &rho, &phi);
+    let jlog = inverse_right_jacobian(&r, &rho, &phi, &coefficients(&phi));
     let adinv = inverse_action(&r, &t);
-    let mut d0 = [[T::zero(); 6]; 6];
-    for (i, row) in d0.iter_mut().enumerate() {
-        for (j, x) in row.iter_mut().enumerate() {
-            *x = -(0..6).fold(T::zero(), |s, k| s + jlog[i][k] * adinv[k][j]);
+    let mut out = (identity(-T::one()), identity(T::one()));
+    for (row, j) in out.0.iter_mut().zip(&jlog) {
+        for (c, x) in row.iter_mut().take(6).enumerate() {
+            *x = -(0..6).fold(T::zero(), |s, k| s + j[k] * adinv[k][c]);
         }
     }
-    (embed(&d0, -T::one()), embed(&jlog, T::one()))
+    put(&mut out.1, &jlog);
+    out
 }
 
 /// A fixed base's `difference`: `q1 - q0`.
@@ -125,15 +133,13 @@ fn identity<T: Real, const N: usize>(d: T) -> [[T; N]; N] {
     m
 }
 
-/// The base's 6 x 6 block in the top left corner, `d` on the rest of the diagonal.
-fn embed<T: Real, const N: usize>(block: &M6<T>, d: T) -> [[T; N]; N] {
-    let mut m = identity(d);
+/// Writes the base's 6 x 6 block into the top left corner of `m`.
+fn put<T: Real, const N: usize>(m: &mut [[T; N]; N], block: &M6<T>) {
     for (row, b) in m.iter_mut().zip(block) {
         for (x, y) in row.iter_mut().zip(b) {
             *x = *y;
         }
     }
-    m
 }
 
 /// `log6(M0^-1 M1)` of the bases of `q0` and `q1` as (translation part, rotation vector), and
@@ -163,8 +169,15 @@ fn relative_log<T: Real, const NQ: usize>(
     let r0 = rotation(&a);
     let dp = [q1[0] - q0[0], q1[1] - q0[1], q1[2] - q0[2]];
     let t = [0, 1, 2].map(|c| r0[0][c] * dp[0] + r0[1][c] * dp[1] + r0[2][c] * dp[2]);
-    let (_, _, _, c) = coefficients(&phi);
-    // rho = V(phi)^-1 t, V^-1 = I - phi^/2 + c phi^2.
+    // rho = V(phi)^-1 t, V^-1 = I - phi^/2 + c phi^2, c = 1/theta^2 - (1 + cos)/(2 theta sin)
+    // = 1/theta^2 - w/(2 theta s) from the half angle (no trigonometry).
+    let theta = k * s;
+    let c = if s2 < T::from_f64(1e-4) {
+        let t2 = theta * theta;
+        T::from_f64(1.0 / 12.0) + t2 / T::from_f64(720.0) + t2 * t2 / T::from_f64(30240.0)
+    } else {
+        T::one() / (theta * theta) - rel[3] / (T::from_f64(2.0) * theta * s)
+    };
     let h = hat(&phi);
     let h2 = mat_mul(&h, &h);
     let rho = [0, 1, 2].map(|i| {
@@ -178,7 +191,7 @@ fn relative_log<T: Real, const NQ: usize>(
 /// For the rotation vector `phi` of angle `theta`: `a = (1 - cos)/theta^2`,
 /// `b = (theta - sin)/theta^3`, their derivatives in `theta` over `theta`, and
 /// `c = 1/theta^2 - (1 + cos)/(2 theta sin)` (`V^-1 = I - phi^/2 + c phi^2`); series near 0.
-fn coefficients<T: Real>(phi: &[T; 3]) -> (T, T, (T, T), T) {
+fn coefficients<T: Real>(phi: &[T; 3]) -> Coefficients<T> {
     let t2 = phi[0] * phi[0] + phi[1] * phi[1] + phi[2] * phi[2];
     let f = T::from_f64;
     if t2 < f(1e-4) {
@@ -207,23 +220,28 @@ fn coefficients<T: Real>(phi: &[T; 3]) -> (T, T, (T, T), T) {
 /// The right Jacobian of `exp6` at `(rho, phi)`, whose rotation is `r`:
 /// `[[Jr3, R^T D], [0, Jr3]]`, `Jr3 = I - a phi^ + b phi^2` and `D` the derivative of
 /// `V(phi) rho` in `phi`.
-fn right_jacobian<T: Real>(r: &M3<T>, rho: &[T; 3], phi: &[T; 3]) -> M6<T> {
-    let (a, b, _, _) = coefficients(phi);
+fn right_jacobian<T: Real>(r: &M3<T>, rho: &[T; 3], phi: &[T; 3], k: &Coefficients<T>) -> M6<T> {
+    let (a, b) = (k.0, k.1);
     let h = hat(phi);
     let h2 = mat_mul(&h, &h);
     let jr = combine(&h, &h2, -a, b);
-    let q = mat_mul(&transpose(r), &dv_dphi(rho, phi));
+    let q = mat_mul(&transpose(r), &dv_dphi(rho, phi, k));
     blocks(&jr, &q, &jr)
 }
 
 /// The inverse of [`right_jacobian`]: `[[Jr3^-1, -Jr3^-1 Q Jr3^-1], [0, Jr3^-1]]`, with
 /// `Jr3^-1 = I + phi^/2 + c phi^2`.
-fn inverse_right_jacobian<T: Real>(r: &M3<T>, rho: &[T; 3], phi: &[T; 3]) -> M6<T> {
-    let (_, _, _, c) = coefficients(phi);
+fn inverse_right_jacobian<T: Real>(
+    r: &M3<T>,
+    rho: &[T; 3],
+    phi: &[T; 3],
+    k: &Coefficients<T>,
+) -> M6<T> {
+    let c = k.3;
     let h = hat(phi);
     let h2 = mat_mul(&h, &h);
     let inv = combine(&h, &h2, T::from_f64(0.5), c);
-    let q = mat_mul(&transpose(r), &dv_dphi(rho, phi));
+    let q = mat_mul(&transpose(r), &dv_dphi(rho, phi, k));
     let top = mat_mul(&mat_mul(&inv, &q), &inv).map(|row| row.map(|x| -x));
     blocks(&inv, &top, &inv)
 }
@@ -231,8 +249,8 @@ fn inverse_right_jacobian<T: Real>(r: &M3<T>, rho: &[T; 3], phi: &[T; 3]) -> M6<
 /// `d (V(phi) rho) / d phi` with `V = I + a phi^ + b phi^2`:
 /// `-a rho^ + (a'/theta) (phi x rho) phi^T + b ((phi.rho) I + phi rho^T - 2 rho phi^T)
 /// + (b'/theta) (phi x (phi x rho)) phi^T`.
-fn dv_dphi<T: Real>(rho: &[T; 3], phi: &[T; 3]) -> M3<T> {
-    let (a, b, (da, db), _) = coefficients(phi);
+fn dv_dphi<T: Real>(rho: &[T; 3], phi: &[T; 3], k: &Coefficients<T>) -> M3<T> {
+    let (a, b, (da, db), _) = *k;
     let h = hat(phi);
     let pr = mat_vec(&h, rho);
     let ppr = mat_vec(&h, &pr);
