@@ -69,14 +69,12 @@ pub fn integrate_jacobians<T: Real, const NQ: usize, const NV: usize>(
     let (quat, vmat) = exp_so3(&phi);
     let r = rotation(&quat);
     let t = mat_vec(&vmat, &rho);
-    // Built in place: the matrices are most of the cost.
-    let mut out = (identity(T::one()), identity(T::one()));
-    put(&mut out.0, &inverse_action(&r, &t));
-    put(
-        &mut out.1,
+    let dq = embed(&inverse_action(&r, &t), T::one());
+    let dv = embed(
         &right_jacobian(&r, &rho, &phi, &coefficients(&phi)),
+        T::one(),
     );
-    out
+    (dq, dv)
 }
 
 /// Pinocchio's `dDifference(q0, q1)` in `q0` and in `q1`. With `M = M0^-1 M1` and
@@ -99,14 +97,13 @@ pub fn difference_jacobians<T: Real, const NQ: usize, const NV: usize>(
     let (rho, phi, r, t) = relative_log(q0, q1);
     let jlog = inverse_right_jacobian(&r, &rho, &phi, &coefficients(&phi));
     let adinv = inverse_action(&r, &t);
-    let mut out = (identity(-T::one()), identity(T::one()));
-    for (row, j) in out.0.iter_mut().zip(&jlog) {
-        for (c, x) in row.iter_mut().take(6).enumerate() {
+    let mut d0 = [[T::zero(); 6]; 6];
+    for (row, j) in d0.iter_mut().zip(&jlog) {
+        for (c, x) in row.iter_mut().enumerate() {
             *x = -(0..6).fold(T::zero(), |s, k| s + j[k] * adinv[k][c]);
         }
     }
-    put(&mut out.1, &jlog);
-    out
+    (embed(&d0, -T::one()), embed(&jlog, T::one()))
 }
 
 /// A fixed base's `difference`: `q1 - q0`.
@@ -133,13 +130,15 @@ fn identity<T: Real, const N: usize>(d: T) -> [[T; N]; N] {
     m
 }
 
-/// Writes the base's 6 x 6 block into the top left corner of `m`.
-fn put<T: Real, const N: usize>(m: &mut [[T; N]; N], block: &M6<T>) {
+/// The base's 6 x 6 block in the top left corner, `d` on the rest of the diagonal.
+fn embed<T: Real, const N: usize>(block: &M6<T>, d: T) -> [[T; N]; N] {
+    let mut m = identity(d);
     for (row, b) in m.iter_mut().zip(block) {
         for (x, y) in row.iter_mut().zip(b) {
             *x = *y;
         }
     }
+    m
 }
 
 /// `log6(M0^-1 M1)` of the bases of `q0` and `q1` as (translation part, rotation vector), and
