@@ -45,6 +45,7 @@ fn main() {
     underactuated();
     mimic();
     split();
+    mpc_kinematics();
     eomgen::Builder::new("robots/panda.urdf")
         .module_name("panda_selected")
         .type_name("PandaSelected")
@@ -370,6 +371,34 @@ fn split() {
         .module_name("anymal_split")
         .type_name("AnymalSplit")
         .max_function_ops(150)
+        .compile()
+        .unwrap();
+}
+
+/// The MPC kit's kinematics (frame motion, the configuration manifold, the centroidal momentum
+/// rate) of the panda and anymal, with the functions their checks compare with.
+fn mpc_kinematics() {
+    let kit = [
+        "link_jacobian",
+        "link_velocity",
+        "link_acceleration",
+        "link_jacobian_time_variation",
+        "difference",
+        "integrate_jacobians",
+        "difference_jacobians",
+    ];
+    eomgen::Builder::new("robots/panda.urdf")
+        .module_name("panda_mpc")
+        .type_name("PandaMpc")
+        .quantities(kit)
+        .compile()
+        .unwrap();
+    let floating = ["integrate", "centroidal_map", "centroidal_momentum_rate"];
+    eomgen::Builder::new("robots/floating/anymal.urdf")
+        .floating_base()
+        .module_name("anymal_mpc")
+        .type_name("AnymalMpc")
+        .quantities(kit.iter().chain(&floating).copied())
         .compile()
         .unwrap();
 }

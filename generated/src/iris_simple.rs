@@ -81,6 +81,12 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dimensions for IrisSimple<T> {
 impl<T: ::eomgen_runtime::Real> IrisSimple<T> {
     ///The URDF names of the joints, in the order of the joint part of every array (after the base's coordinates).
     pub const JOINT_NAMES: [&'static str; 0] = [];
+    /// Each joint coordinate's position limits `(lower, upper)` (rad or m) from the URDF's `<limit>`, in `JOINT_NAMES` order (the joints only: entry `i` is velocity coordinate `6 + i`); infinite for `continuous` joints and joints without `<limit>`.
+    pub const POSITION_LIMITS: [(f64, f64); 0] = [];
+    /// Each joint coordinate's velocity limit (rad/s or m/s) from the URDF's `<limit velocity>`, in `JOINT_NAMES` order (the joints only: entry `i` is velocity coordinate `6 + i`); infinite without `<limit>`.
+    pub const VELOCITY_LIMITS: [f64; 0] = [];
+    /// Each joint coordinate's effort limit (N m or N) from the URDF's `<limit effort>`, in `JOINT_NAMES` order (the joints only: entry `i` is velocity coordinate `6 + i`); infinite without `<limit>`.
+    pub const EFFORT_LIMITS: [f64; 0] = [];
     /// Forward dynamics `qdd = M(q)^-1 (tau - b(q, qd) - G(q))`, or which pivot of the
     /// `L^T D L` factorization of M(q) was not positive (a non-physical model or
     /// non-finite input); see `forward_dynamics` for the route and operation count.
@@ -802,6 +808,280 @@ impl<T: ::eomgen_runtime::Real> IrisSimple<T> {
                     ),
                 ),
             ],
+        ]
+    }
+    /// The spatial velocity of a link frame: the velocity of its origin, then its angular velocity,
+    /// world axes (Pinocchio's `getFrameVelocity`, LOCAL_WORLD_ALIGNED); `link_jacobian` times `qd`.
+    ///
+    /// Route: each body's pose, velocity and acceleration walked along the link's chain from the same transforms as `link_pose` (eomgen_runtime::frame).
+    pub fn link_velocity(
+        &self,
+        link: IrisSimpleLink,
+        q: &[T; 7],
+        qd: &[T; 6],
+    ) -> [T; 6] {
+        let (path, placement) = Self::link_frame(link);
+        let chain = ::eomgen_runtime::frame::Chain {
+            path,
+            joints: &Self::TREE_JOINTS,
+            floating: true,
+            transform: |j| self.joint_transform(j, q),
+            placement,
+        };
+        ::eomgen_runtime::frame::velocity(&chain, qd)
+    }
+    /// The classical acceleration of a link frame: the acceleration of its origin, then its angular
+    /// acceleration, world axes (Pinocchio's `getFrameClassicalAcceleration`, LOCAL_WORLD_ALIGNED);
+    /// `J qdd + dJ/dt qd`.
+    ///
+    /// Route: each body's pose, velocity and acceleration walked along the link's chain from the same transforms as `link_pose` (eomgen_runtime::frame).
+    pub fn link_acceleration(
+        &self,
+        link: IrisSimpleLink,
+        q: &[T; 7],
+        qd: &[T; 6],
+        qdd: &[T; 6],
+    ) -> [T; 6] {
+        let (path, placement) = Self::link_frame(link);
+        let chain = ::eomgen_runtime::frame::Chain {
+            path,
+            joints: &Self::TREE_JOINTS,
+            floating: true,
+            transform: |j| self.joint_transform(j, q),
+            placement,
+        };
+        ::eomgen_runtime::frame::acceleration(&chain, qd, qdd)
+    }
+    /// The time derivative of `link_jacobian` at velocity `qd`, 6 x N, rows as `link_jacobian`
+    /// (Pinocchio's `getFrameJacobianTimeVariation`, LOCAL_WORLD_ALIGNED).
+    ///
+    /// Route: each body's pose, velocity and acceleration walked along the link's chain from the same transforms as `link_pose` (eomgen_runtime::frame).
+    pub fn link_jacobian_time_variation(
+        &self,
+        link: IrisSimpleLink,
+        q: &[T; 7],
+        qd: &[T; 6],
+    ) -> [[T; 6]; 6] {
+        let (path, placement) = Self::link_frame(link);
+        let chain = ::eomgen_runtime::frame::Chain {
+            path,
+            joints: &Self::TREE_JOINTS,
+            floating: true,
+            transform: |j| self.joint_transform(j, q),
+            placement,
+        };
+        ::eomgen_runtime::frame::jacobian_time_variation(&chain, qd)
+    }
+    /// `difference(q0, q1)`: the velocity that moves `q0` to `q1` in unit time, so that
+    /// `integrate(q0, difference(q0, q1), 1) = q1` (Pinocchio's `difference`). A floating base's
+    /// quaternions may have either sign.
+    ///
+    /// The base moves along the SE(3) exponential (`integrate(q, v, 1) = q exp6(v)`), the joints as a vector space.
+    ///
+    /// Route: the base's block in closed form (SE(3) logarithm, adjoint, right Jacobian of exp6 and its inverse), identity for the joints (eomgen_runtime::manifold).
+    pub fn difference(&self, q0: &[T; 7], q1: &[T; 7]) -> [T; 6] {
+        ::eomgen_runtime::manifold::difference(q0, q1)
+    }
+    /// The Jacobians of `integrate(q, v, 1)` in `q` and in `v`, q perturbed in its tangent space
+    /// (Pinocchio's `dIntegrate`, ARG0 and ARG1); element `[i][j]` = d out_i / d in_j.
+    ///
+    /// The base moves along the SE(3) exponential (`integrate(q, v, 1) = q exp6(v)`), the joints as a vector space.
+    ///
+    /// Route: the base's block in closed form (SE(3) logarithm, adjoint, right Jacobian of exp6 and its inverse), identity for the joints (eomgen_runtime::manifold).
+    pub fn integrate_jacobians(
+        &self,
+        q: &[T; 7],
+        v: &[T; 6],
+    ) -> ([[T; 6]; 6], [[T; 6]; 6]) {
+        ::eomgen_runtime::manifold::integrate_jacobians(q, v)
+    }
+    /// The Jacobians of `difference(q0, q1)` in `q0` and in `q1`, both perturbed in their tangent
+    /// spaces (Pinocchio's `dDifference`, ARG0 and ARG1); element `[i][j]` = d out_i / d in_j.
+    ///
+    /// The base moves along the SE(3) exponential (`integrate(q, v, 1) = q exp6(v)`), the joints as a vector space.
+    ///
+    /// Route: the base's block in closed form (SE(3) logarithm, adjoint, right Jacobian of exp6 and its inverse), identity for the joints (eomgen_runtime::manifold).
+    pub fn difference_jacobians(
+        &self,
+        q0: &[T; 7],
+        q1: &[T; 7],
+    ) -> ([[T; 6]; 6], [[T; 6]; 6]) {
+        ::eomgen_runtime::manifold::difference_jacobians(q0, q1)
+    }
+    /// The rate of the centroidal momentum, `dh/dt = A_g qdd + dA_g/dt qd`: the rate of the linear
+    /// momentum, then of the angular momentum about the centre of mass, world axes (Pinocchio's
+    /// `computeCentroidalMomentumTimeVariation`, its `dhg`).
+    ///
+    /// Route: Newton-Euler without gravity gives the base's rows, the rate of the robot's momentum at the base origin in base axes, moved to the world and the centre of mass.
+    /// Operations: 86 mul, 69 add, 0 div, 0 sin, 0 cos.
+    pub fn centroidal_momentum_rate(
+        &self,
+        q: &[T; 7],
+        qd: &[T; 6],
+        qdd: &[T; 6],
+    ) -> [T; 6] {
+        let t0 = q[3] * q[3];
+        let t1 = q[4] * q[4];
+        let t2 = q[5] * q[5];
+        let t3 = q[3] * q[4];
+        let t4 = q[3] * q[5];
+        let t5 = q[4] * q[5];
+        let t6 = q[3] * q[6];
+        let t7 = q[4] * q[6];
+        let t8 = q[5] * q[6];
+        let t9 = qd[2] * qd[4];
+        let t10 = qd[1] * qd[5];
+        let t11 = qd[0] * qd[5];
+        let t12 = qd[2] * qd[3];
+        let t13 = T::mul_add(
+            -T::from_f64(0.000000000000000000005082197683525802),
+            qd[5],
+            T::from_f64(0.030033480000000005) * qd[3],
+        );
+        let t14 = T::mul_add(
+            -T::from_f64(0.000000000000000000006776263578034403),
+            qd[5],
+            T::from_f64(0.030575996) * qd[4],
+        );
+        let t15 = T::mul_add(
+            -T::from_f64(0.057553016000000005),
+            qd[5],
+            T::mul_add(
+                T::from_f64(0.000000000000000000006776263578034403),
+                qd[4],
+                T::from_f64(0.000000000000000000005082197683525802) * qd[3],
+            ),
+        );
+        let t16 = T::from_f64(2.0) * (t3 - t8);
+        let t17 = T::from_f64(2.0) * (t4 + t7);
+        let t18 = T::from_f64(2.0) * (t3 + t8);
+        let t19 = T::from_f64(2.0) * (t5 - t6);
+        let t20 = T::from_f64(2.0) * (t4 - t7);
+        let t21 = T::from_f64(2.0) * (t5 + t6);
+        let t22 = T::mul_add(T::from_f64(2.0), t1 + t2, -T::one());
+        let t23 = T::mul_add(T::from_f64(2.0), t0 + t2, -T::one());
+        let t24 = T::mul_add(T::from_f64(2.0), t0 + t1, -T::one());
+        let t25 = T::mul_add(
+            T::from_f64(0.00045999999999999996),
+            T::mul_add(qd[3], qd[5], qdd[4]),
+            T::from_f64(1.5349999999999995) * (qdd[0] + t9 - t10),
+        );
+        let t26 = T::mul_add(
+            T::from_f64(0.00045999999999999996),
+            T::mul_add(qd[4], qd[5], -qdd[3]),
+            T::from_f64(1.5349999999999995) * (qdd[1] + t11 - t12),
+        );
+        let t27 = T::mul_add(
+            -T::from_f64(0.00045999999999999996),
+            T::mul_add(qd[4], qd[4], qd[3] * qd[3]),
+            T::from_f64(1.5349999999999995)
+                * (T::mul_add(-qd[0], qd[4], T::mul_add(qd[1], qd[3], qdd[2]))),
+        );
+        let t28 = T::mul_add(
+            -T::from_f64(0.0005993485342019545),
+            t4 + t7,
+            T::from_f64(0.00000000000000011102230246251565) * q[0],
+        );
+        let t29 = T::mul_add(
+            T::from_f64(0.0005993485342019545),
+            t6 - t5,
+            T::from_f64(0.00000000000000011102230246251565) * q[1],
+        );
+        let t30 = T::mul_add(
+            T::from_f64(0.0005993485342019545),
+            t0 + t1,
+            T::mul_add(
+                T::from_f64(0.00000000000000011102230246251565),
+                q[2],
+                -T::from_f64(0.00029967426710097723),
+            ),
+        );
+        let t31 = T::mul_add(
+            qd[3],
+            t15,
+            T::mul_add(
+                qd[5],
+                t13,
+                T::mul_add(
+                    -T::from_f64(0.000000000000000000006776263578034403),
+                    qdd[5],
+                    T::mul_add(
+                        T::from_f64(0.030575996),
+                        qdd[4],
+                        T::from_f64(0.00045999999999999996) * (qdd[0] + t9 - t10),
+                    ),
+                ),
+            ),
+        );
+        let t32 = T::mul_add(
+            qd[5],
+            t14,
+            T::mul_add(
+                qd[4],
+                t15,
+                T::mul_add(
+                    T::from_f64(0.000000000000000000005082197683525802),
+                    qdd[5],
+                    T::mul_add(
+                        -T::from_f64(0.030033480000000005),
+                        qdd[3],
+                        T::from_f64(0.00045999999999999996) * (qdd[1] + t11 - t12),
+                    ),
+                ),
+            ),
+        );
+        let t33 = T::mul_add(
+            qd[4],
+            t13,
+            T::mul_add(
+                -qd[3],
+                t14,
+                T::mul_add(
+                    -T::from_f64(0.057553016000000005),
+                    qdd[5],
+                    T::mul_add(
+                        T::from_f64(0.000000000000000000006776263578034403),
+                        qdd[4],
+                        T::from_f64(0.000000000000000000005082197683525802) * qdd[3],
+                    ),
+                ),
+            ),
+        );
+        let t34 = T::mul_add(t17, t27, T::mul_add(t16, t26, -t22 * t25));
+        let t35 = T::mul_add(t19, t27, T::mul_add(-t23, t26, t18 * t25));
+        let t36 = T::mul_add(-t24, t27, T::mul_add(t21, t26, t20 * t25));
+        let t37 = -t34;
+        [
+            t34,
+            t35,
+            t36,
+            T::mul_add(
+                -t35,
+                t30,
+                T::mul_add(
+                    t36,
+                    t29,
+                    T::mul_add(-t17, t33, T::mul_add(t16, t31, t22 * t32)),
+                ),
+            ),
+            T::mul_add(
+                -t36,
+                t28,
+                T::mul_add(
+                    -t30,
+                    t37,
+                    T::mul_add(-t19, t33, T::mul_add(-t23, t31, -t18 * t32)),
+                ),
+            ),
+            T::mul_add(
+                t29,
+                t37,
+                T::mul_add(
+                    t35,
+                    t28,
+                    T::mul_add(t24, t33, T::mul_add(t21, t31, -t20 * t32)),
+                ),
+            ),
         ]
     }
     /// Each joint's axis (in the frame of the body it moves) and motion.

@@ -85,6 +85,19 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dimensions for Ur5<T> {
     clippy::type_complexity
 )]
 impl<T: ::eomgen_runtime::Real> Ur5<T> {
+    /// Each joint coordinate's position limits `(lower, upper)` (rad or m) from the URDF's `<limit>`, in `JOINT_NAMES` order; infinite for `continuous` joints and joints without `<limit>`.
+    pub const POSITION_LIMITS: [(f64, f64); 6] = [
+        (-6.28318530718, 6.28318530718),
+        (-6.28318530718, 6.28318530718),
+        (-3.14159265359, 3.14159265359),
+        (-6.28318530718, 6.28318530718),
+        (-6.28318530718, 6.28318530718),
+        (-6.28318530718, 6.28318530718),
+    ];
+    /// Each joint coordinate's velocity limit (rad/s or m/s) from the URDF's `<limit velocity>`, in `JOINT_NAMES` order; infinite without `<limit>`.
+    pub const VELOCITY_LIMITS: [f64; 6] = [3.15, 3.15, 3.15, 3.2, 3.2, 3.2];
+    /// Each joint coordinate's effort limit (N m or N) from the URDF's `<limit effort>`, in `JOINT_NAMES` order; infinite without `<limit>`.
+    pub const EFFORT_LIMITS: [f64; 6] = [150.0, 150.0, 150.0, 28.0, 28.0, 28.0];
     /// Forward dynamics `qdd = M(q)^-1 (tau - b(q, qd) - G(q))`, or which pivot of the
     /// `L^T D L` factorization of M(q) was not positive (a non-physical model or
     /// non-finite input); see `forward_dynamics` for the route and operation count.
@@ -3830,6 +3843,99 @@ impl<T: ::eomgen_runtime::Real> Ur5<T> {
                 T::zero(),
             ],
         ]
+    }
+    /// The spatial velocity of a link frame: the velocity of its origin, then its angular velocity,
+    /// world axes (Pinocchio's `getFrameVelocity`, LOCAL_WORLD_ALIGNED); `link_jacobian` times `qd`.
+    ///
+    /// Route: each body's pose, velocity and acceleration walked along the link's chain from the same transforms as `link_pose` (eomgen_runtime::frame).
+    pub fn link_velocity(&self, link: Ur5Link, q: &[T; 6], qd: &[T; 6]) -> [T; 6] {
+        let (path, placement) = Self::link_frame(link);
+        let chain = ::eomgen_runtime::frame::Chain {
+            path,
+            joints: &Self::TREE_JOINTS,
+            floating: false,
+            transform: |j| self.joint_transform(j, q),
+            placement,
+        };
+        ::eomgen_runtime::frame::velocity(&chain, qd)
+    }
+    /// The classical acceleration of a link frame: the acceleration of its origin, then its angular
+    /// acceleration, world axes (Pinocchio's `getFrameClassicalAcceleration`, LOCAL_WORLD_ALIGNED);
+    /// `J qdd + dJ/dt qd`.
+    ///
+    /// Route: each body's pose, velocity and acceleration walked along the link's chain from the same transforms as `link_pose` (eomgen_runtime::frame).
+    pub fn link_acceleration(
+        &self,
+        link: Ur5Link,
+        q: &[T; 6],
+        qd: &[T; 6],
+        qdd: &[T; 6],
+    ) -> [T; 6] {
+        let (path, placement) = Self::link_frame(link);
+        let chain = ::eomgen_runtime::frame::Chain {
+            path,
+            joints: &Self::TREE_JOINTS,
+            floating: false,
+            transform: |j| self.joint_transform(j, q),
+            placement,
+        };
+        ::eomgen_runtime::frame::acceleration(&chain, qd, qdd)
+    }
+    /// The time derivative of `link_jacobian` at velocity `qd`, 6 x N, rows as `link_jacobian`
+    /// (Pinocchio's `getFrameJacobianTimeVariation`, LOCAL_WORLD_ALIGNED).
+    ///
+    /// Route: each body's pose, velocity and acceleration walked along the link's chain from the same transforms as `link_pose` (eomgen_runtime::frame).
+    pub fn link_jacobian_time_variation(
+        &self,
+        link: Ur5Link,
+        q: &[T; 6],
+        qd: &[T; 6],
+    ) -> [[T; 6]; 6] {
+        let (path, placement) = Self::link_frame(link);
+        let chain = ::eomgen_runtime::frame::Chain {
+            path,
+            joints: &Self::TREE_JOINTS,
+            floating: false,
+            transform: |j| self.joint_transform(j, q),
+            placement,
+        };
+        ::eomgen_runtime::frame::jacobian_time_variation(&chain, qd)
+    }
+    /// `difference(q0, q1)`: the velocity that moves `q0` to `q1` in unit time, so that
+    /// `integrate(q0, difference(q0, q1), 1) = q1` (Pinocchio's `difference`). A floating base's
+    /// quaternions may have either sign.
+    ///
+    /// The configurations of a fixed base form a vector space.
+    ///
+    /// Route: the vector space's (eomgen_runtime::manifold).
+    pub fn difference(&self, q0: &[T; 6], q1: &[T; 6]) -> [T; 6] {
+        ::eomgen_runtime::manifold::vector_difference(q0, q1)
+    }
+    /// The Jacobians of `integrate(q, v, 1)` in `q` and in `v`, q perturbed in its tangent space
+    /// (Pinocchio's `dIntegrate`, ARG0 and ARG1); element `[i][j]` = d out_i / d in_j.
+    ///
+    /// The configurations of a fixed base form a vector space.
+    ///
+    /// Route: the vector space's (eomgen_runtime::manifold).
+    pub fn integrate_jacobians(
+        &self,
+        q: &[T; 6],
+        v: &[T; 6],
+    ) -> ([[T; 6]; 6], [[T; 6]; 6]) {
+        ::eomgen_runtime::manifold::vector_integrate_jacobians()
+    }
+    /// The Jacobians of `difference(q0, q1)` in `q0` and in `q1`, both perturbed in their tangent
+    /// spaces (Pinocchio's `dDifference`, ARG0 and ARG1); element `[i][j]` = d out_i / d in_j.
+    ///
+    /// The configurations of a fixed base form a vector space.
+    ///
+    /// Route: the vector space's (eomgen_runtime::manifold).
+    pub fn difference_jacobians(
+        &self,
+        q0: &[T; 6],
+        q1: &[T; 6],
+    ) -> ([[T; 6]; 6], [[T; 6]; 6]) {
+        ::eomgen_runtime::manifold::vector_difference_jacobians()
     }
     /// Each joint's axis (in the frame of the body it moves) and motion.
     const TREE_JOINTS: [::eomgen_runtime::tree::TreeJoint; 6] = [

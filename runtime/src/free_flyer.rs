@@ -83,7 +83,7 @@ pub fn rotation<T: Real>(q: &[T; 4]) -> [[T; 3]; 3] {
 
 /// The unit quaternion of the rotation vector `w` and the left Jacobian `V(w)` of SO(3)
 /// (series near zero).
-fn exp_so3<T: Real>(w: &[T; 3]) -> ([T; 4], [[T; 3]; 3]) {
+pub(crate) fn exp_so3<T: Real>(w: &[T; 3]) -> ([T; 4], [[T; 3]; 3]) {
     let t2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
     let t = t2.sqrt();
     let half = T::from_f64(0.5);
@@ -116,7 +116,7 @@ fn exp_so3<T: Real>(w: &[T; 3]) -> ([T; 4], [[T; 3]; 3]) {
     (quat, v)
 }
 
-fn quat_mul<T: Real>(a: &[T; 4], b: &[T; 4]) -> [T; 4] {
+pub(crate) fn quat_mul<T: Real>(a: &[T; 4], b: &[T; 4]) -> [T; 4] {
     let (ax, ay, az, aw) = (a[0], a[1], a[2], a[3]);
     let (bx, by, bz, bw) = (b[0], b[1], b[2], b[3]);
     [

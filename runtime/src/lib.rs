@@ -47,6 +47,9 @@
 //!   manipulability [`Ellipsoid`]s and the [`SymmetricEigen`] solver behind them;
 //! - kernels that generated code loops over (module [`tree`]): poses and Jacobians along a
 //!   kinematic chain, Craig's `B(q)` and `C(q)` from the Christoffel-form Coriolis matrix;
+//!   a link frame's velocity, acceleration and Jacobian time variation (module [`frame`]);
+//! - the configuration manifold (module [`manifold`]): `difference` and the Jacobians of
+//!   `integrate` and `difference`, for fixed and floating bases;
 //! - [`WithJointEffects`]: rotor inertia (armature), viscous and Coulomb joint friction added
 //!   to any [`Dynamics`];
 //! - with the `nalgebra` feature, conversions between the plain arrays used here and nalgebra's
@@ -74,10 +77,12 @@ pub mod control;
 mod dimensions;
 mod dynamics;
 mod floating;
+pub mod frame;
 pub mod free_flyer;
 mod hamiltonian;
 mod joint_effects;
 mod linalg;
+pub mod manifold;
 mod pose;
 pub mod prelude;
 mod real;

@@ -299,6 +299,16 @@ pub mod robots {
     pub mod panda_selected {
         include!(concat!(env!("OUT_DIR"), "/panda_selected.rs"));
     }
+    /// `panda.urdf` with the MPC kit's kinematics (link velocities, accelerations, Jacobian
+    /// time variations, the configuration manifold) and `link_jacobian`.
+    pub mod panda_mpc {
+        include!(concat!(env!("OUT_DIR"), "/panda_mpc.rs"));
+    }
+    /// anymal (floating base) with the MPC kit's kinematics, `link_jacobian`, `integrate`,
+    /// `centroidal_map` and `centroidal_momentum_rate`.
+    pub mod anymal_mpc {
+        include!(concat!(env!("OUT_DIR"), "/anymal_mpc.rs"));
+    }
     /// A synthetic 24-joint serial chain with only forward and inverse dynamics: forward
     /// dynamics solves at run time (`eomgen_runtime::tree::ltdl_solve`).
     pub mod chain24 {

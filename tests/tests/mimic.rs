@@ -23,6 +23,17 @@ type Tree = mimic_tree::MimicTree<f64>;
 type Full = mimic_tree_full::MimicTreeFull<f64>;
 type Panda = panda_mimic::PandaMimic<f64>;
 
+/// A link's [`Motion`] at `(q, v, a)`.
+macro_rules! motion {
+    ($robot:expr, $link:expr, $q:expr, $v:expr, $a:expr) => {
+        (
+            $robot.link_velocity($link, $q, $v),
+            $robot.link_acceleration($link, $q, $v, $a),
+            $robot.link_jacobian_time_variation($link, $q, $v),
+        )
+    };
+}
+
 fn floats(v: &Value) -> Vec<f64> {
     v.as_array()
         .expect("array")
@@ -303,6 +314,9 @@ fn the_tree_with_mimic_joints_is_the_full_tree_projected() {
                 &tree.link_jacobian(*link, &q),
                 &columns(&gm, &full.link_jacobian(full_link, &qf)),
             );
+            let ours = motion!(tree, *link, &q, &qd, &qdd);
+            let want = motion!(full, full_link, &qf, &qdf, &qddf);
+            same_motion(&mut c, &format!("#{s} {}", link.name()), ours, want, &gm);
         }
         let (com, want_com) = (tree.center_of_mass(&q), full.center_of_mass(&qf));
         let jc = tree.center_of_mass_jacobian(&q);
@@ -689,6 +703,18 @@ fn the_floating_tree_with_mimic_joints_is_the_full_floating_tree_projected() {
                 &tree.link_jacobian(*link, &q),
                 &columns(&gm, &full.link_jacobian(full_link, &qf)),
             );
+            let ours = motion!(tree, *link, &q, &v, &a);
+            let want = motion!(full, full_link, &qf, &vf, &af);
+            same_motion(&mut c, &format!("#{s} {}", link.name()), ours, want, &gm);
+        }
+        let rate = tree.centroidal_momentum_rate(&q, &v, &a);
+        let want_rate = full.centroidal_momentum_rate(&qf, &vf, &af);
+        for r in 0..6 {
+            c.check(
+                || format!("#{s} centroidal momentum rate[{r}]"),
+                rate[r],
+                want_rate[r],
+            );
         }
         // Integration moves the coordinates by v dt (the base on SE(3), as the full tree's).
         let (qn, want_qn) = (tree.integrate(&q, &v, 0.01), full.integrate(&qf, &vf, 0.01));
@@ -697,4 +723,26 @@ fn the_floating_tree_with_mimic_joints_is_the_full_floating_tree_projected() {
         }
     }
     c.finish("floating mimic tree against the full floating tree projected");
+}
+
+/// A link's velocity, classical acceleration and Jacobian time variation.
+type Motion<const N: usize> = ([f64; 6], [f64; 6], [[f64; N]; 6]);
+
+/// Checks a link's motion against the full tree's at the joints' rates `G v`, `G a`
+/// (Jacobian time variation projected, `dJ G`).
+fn same_motion<const N: usize, const F: usize>(
+    c: &mut Checker,
+    what: &str,
+    (vel, acc, dj): Motion<N>,
+    (want_vel, want_acc, want_dj): Motion<F>,
+    g: &[Vec<f64>],
+) {
+    let want_dj: [[f64; N]; 6] = columns(g, &want_dj);
+    for r in 0..6 {
+        c.check(|| format!("{what} velocity[{r}]"), vel[r], want_vel[r]);
+        c.check(|| format!("{what} acceleration[{r}]"), acc[r], want_acc[r]);
+        for k in 0..N {
+            c.check(|| format!("{what} dJ[{r}][{k}]"), dj[r][k], want_dj[r][k]);
+        }
+    }
 }

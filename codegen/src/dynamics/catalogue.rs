@@ -117,6 +117,11 @@ pub enum Evaluation {
     ContactForwardDynamics { h: Vec<Id> },
     /// A floating base's `q (+) v dt` (`eomgen_runtime::free_flyer::integrate`).
     Integrate,
+    /// A link frame's velocity, acceleration or Jacobian time variation, walked along its
+    /// chain at run time (`eomgen_runtime::frame`).
+    FrameMotion(super::FrameMotion),
+    /// `difference` or a Jacobian of `integrate` or `difference` (`eomgen_runtime::manifold`).
+    Manifold(super::Manifold),
 }
 
 /// One generated function.

@@ -224,7 +224,8 @@ fn contacts(
 
 const Q: &[Input] = &[Input::Q];
 
-fn quantity(
+/// A catalogue entry with an inherent home and a one-sentence route.
+pub(super) fn quantity(
     name: &'static str,
     inputs: &'static [Input],
     shape: Shape,

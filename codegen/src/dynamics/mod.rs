@@ -19,6 +19,7 @@ mod derivatives;
 mod floating;
 pub mod identification;
 mod lagrangian;
+mod mpc;
 pub mod newton_euler;
 pub mod projected;
 mod quantities;
@@ -36,6 +37,7 @@ pub use centroidal::Centroidal;
 pub use coupling::CoordinateMap;
 pub use identification::Identification;
 pub use lagrangian::pairs;
+pub use mpc::{FrameMotion, Manifold};
 
 /// The pose of a body in its parent body's frame (the root's for a body whose parent is the
 /// root), as expressions in the body's joint coordinate: `p_parent = rotation p + translation`.
@@ -451,6 +453,7 @@ impl Derivation {
 /// `d` with its catalogue and the stage timings.
 fn finish(mut d: Derivation, model: &Model, mut clock: Clock) -> Derivation {
     d.quantities = quantities::catalogue(model, &d);
+    mpc::add(&mut d, model);
     clock.lap("catalogue");
     d.timings = clock.laps;
     d

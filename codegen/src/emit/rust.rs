@@ -20,6 +20,8 @@ use crate::kinematics::snap;
 use crate::model::{Model, Transform};
 use crate::spatial::snap_rotation;
 
+mod mpc;
+
 /// What the emitted file is called and says about itself.
 #[derive(Clone, Debug)]
 pub struct EmitOptions {
@@ -199,9 +201,12 @@ pub fn emit_tokens(
 
 impl Emitter<'_> {
     fn has_frames(&self) -> bool {
-        self.quantities
-            .iter()
-            .any(|q| matches!(q.eval, Evaluation::LinkPose | Evaluation::LinkJacobian))
+        self.quantities.iter().any(|q| {
+            matches!(
+                q.eval,
+                Evaluation::LinkPose | Evaluation::LinkJacobian | Evaluation::FrameMotion(_)
+            )
+        })
     }
 
     fn file(&mut self, fields: &Fields, d: &Derivation) -> TokenStream {
@@ -263,6 +268,7 @@ impl Emitter<'_> {
             }
         };
         let sizes = self.sizes();
+        let limits = mpc::limit_constants(self.model);
         let blocks = &self.blocks;
         quote! {
             #strukt
@@ -272,6 +278,7 @@ impl Emitter<'_> {
             impl<T: ::eomgen_runtime::Real> #ty<T> {
                 #parents
                 #joint_names
+                #limits
                 #identification
                 #actuation
                 #try_fd
@@ -488,6 +495,8 @@ impl Emitter<'_> {
             Evaluation::ForwardDynamicsDerivatives => self.forward_dynamics_derivatives_fn(q),
             Evaluation::ContactForwardDynamics { h } => self.contact_forward_dynamics_fns(q, h),
             Evaluation::Integrate => self.integrate_fn(q),
+            Evaluation::FrameMotion(m) => self.frame_motion_fn(q, *m),
+            Evaluation::Manifold(m) => self.manifold_fn(q, *m),
             Evaluation::Factored { outputs, pivots } => self.factored_fn(q, outputs, pivots),
         }
     }
@@ -854,12 +863,15 @@ impl Emitter<'_> {
         });
         let link_arms = self.link_frame_arms();
         let link_ty = &self.link_ty;
-        // The joint axes and the coupling are read by `link_jacobian` alone: without it, a
-        // `link_pose` selection would carry unused constants (rustc's `dead_code` warning).
-        let jacobian = self
-            .quantities
-            .iter()
-            .any(|q| matches!(q.eval, Evaluation::LinkJacobian));
+        // The joint axes and the coupling are read by `link_jacobian` and the frames' motion
+        // alone: without them, a `link_pose` selection would carry unused constants (rustc's
+        // `dead_code` warning).
+        let jacobian = self.quantities.iter().any(|q| {
+            matches!(
+                q.eval,
+                Evaluation::LinkJacobian | Evaluation::FrameMotion(_)
+            )
+        });
         let coupling = if jacobian && self.model.is_coupled() {
             let v0 = self.model.base_nv();
             let base = (0..v0).map(|i| (i, 1.0));

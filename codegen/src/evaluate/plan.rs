@@ -111,12 +111,20 @@ impl Plan {
                 j: exprs_of("contact_jacobian")?,
                 drift: exprs_of("contact_drift")?,
             },
-            Evaluation::LinkPose | Evaluation::LinkJacobian | Evaluation::Integrate => {
+            Evaluation::LinkPose
+            | Evaluation::LinkJacobian
+            | Evaluation::FrameMotion(_)
+            | Evaluation::Integrate => {
                 return Err(EvalError::NotEvaluable {
                     name: q.name.to_string(),
                     why: "it takes a link or a time step besides the state",
                 })
             }
+            Evaluation::Manifold(_) => return Err(EvalError::NotEvaluable {
+                name: q.name.to_string(),
+                why:
+                    "it is the configuration space's geometry, computed by eomgen_runtime::manifold",
+            }),
         })
     }
 

@@ -1,0 +1,160 @@
+//! The emitter's methods for the MPC kit's run-time kernels: link frames' motion
+//! (`eomgen_runtime::frame`) and the configuration manifold (`eomgen_runtime::manifold`).
+
+use proc_macro2::TokenStream;
+use quote::quote;
+
+use super::{usize_lit, Emitter};
+use crate::dynamics::{FrameMotion, Manifold, Quantity};
+use crate::model::{Joint, JointKind, Limits, Model};
+
+impl Emitter<'_> {
+    /// `link_velocity`, `link_acceleration` or `link_jacobian_time_variation`: the link's chain
+    /// from `link_frame`, walked by the runtime. With mimic joints the coordinates' rates are
+    /// first spread over the joint tree's columns (`COUPLING`), and a Jacobian's columns summed
+    /// back (`J G`).
+    pub(super) fn frame_motion_fn(&mut self, q: &Quantity, motion: FrameMotion) -> TokenStream {
+        let docs = Self::quantity_doc(q, None);
+        let (link_ty, n, nq, floating) = (&self.link_ty, &self.n, &self.nq, self.floating);
+        let coupled = self.model.is_coupled();
+        let nj = usize_lit(self.model.nv());
+        let spread = |x: TokenStream| {
+            if coupled {
+                quote!(let #x: [T; #nj] = ::eomgen_runtime::frame::tree_rates(#x, &Self::COUPLING); let #x = &#x;)
+            } else {
+                TokenStream::new()
+            }
+        };
+        let (qd_rates, qdd_rates) = (spread(quote!(qd)), spread(quote!(qdd)));
+        let chain = quote! {
+            let (path, placement) = Self::link_frame(link);
+            let chain = ::eomgen_runtime::frame::Chain { path, joints: &Self::TREE_JOINTS, floating: #floating, transform: |j| self.joint_transform(j, q), placement };
+        };
+        match motion {
+            FrameMotion::Velocity => quote! {
+                #docs
+                pub fn link_velocity(&self, link: #link_ty, q: &[T; #nq], qd: &[T; #n]) -> [T; 6] {
+                    #chain
+                    #qd_rates
+                    ::eomgen_runtime::frame::velocity(&chain, qd)
+                }
+            },
+            FrameMotion::Acceleration => quote! {
+                #docs
+                pub fn link_acceleration(&self, link: #link_ty, q: &[T; #nq], qd: &[T; #n], qdd: &[T; #n]) -> [T; 6] {
+                    #chain
+                    #qd_rates
+                    #qdd_rates
+                    ::eomgen_runtime::frame::acceleration(&chain, qd, qdd)
+                }
+            },
+            FrameMotion::JacobianTimeVariation => {
+                let body = if coupled {
+                    quote! {
+                        let joints: [[T; #nj]; 6] = ::eomgen_runtime::frame::jacobian_time_variation(&chain, qd);
+                        ::eomgen_runtime::tree::couple_columns(&joints, &Self::COUPLING)
+                    }
+                } else {
+                    quote!(::eomgen_runtime::frame::jacobian_time_variation(&chain, qd))
+                };
+                quote! {
+                    #docs
+                    pub fn link_jacobian_time_variation(&self, link: #link_ty, q: &[T; #nq], qd: &[T; #n]) -> [[T; #n]; 6] {
+                        #chain
+                        #qd_rates
+                        #body
+                    }
+                }
+            }
+        }
+    }
+
+    /// `difference`, `integrate_jacobians` or `difference_jacobians` from the runtime's
+    /// kernels: a floating base's, or a vector space's.
+    pub(super) fn manifold_fn(&mut self, q: &Quantity, which: Manifold) -> TokenStream {
+        let docs = Self::quantity_doc(q, None);
+        let (n, nq) = (&self.n, &self.nq);
+        let m = quote!(::eomgen_runtime::manifold);
+        let jacobians = quote!(([[T; #n]; #n], [[T; #n]; #n]));
+        let (floating, fixed) = match which {
+            Manifold::Difference => (
+                quote!(#m::difference(q0, q1)),
+                quote!(#m::vector_difference(q0, q1)),
+            ),
+            Manifold::IntegrateJacobians => (
+                quote!(#m::integrate_jacobians(q, v)),
+                quote!(#m::vector_integrate_jacobians()),
+            ),
+            Manifold::DifferenceJacobians => (
+                quote!(#m::difference_jacobians(q0, q1)),
+                quote!(#m::vector_difference_jacobians()),
+            ),
+        };
+        let body = if self.floating { floating } else { fixed };
+        match which {
+            Manifold::Difference => quote! {
+                #docs
+                pub fn difference(&self, q0: &[T; #nq], q1: &[T; #nq]) -> [T; #n] { #body }
+            },
+            Manifold::IntegrateJacobians => quote! {
+                #docs
+                pub fn integrate_jacobians(&self, q: &[T; #nq], v: &[T; #n]) -> #jacobians { #body }
+            },
+            Manifold::DifferenceJacobians => quote! {
+                #docs
+                pub fn difference_jacobians(&self, q0: &[T; #nq], q1: &[T; #nq]) -> #jacobians { #body }
+            },
+        }
+    }
+}
+
+/// `POSITION_LIMITS`, `VELOCITY_LIMITS` and `EFFORT_LIMITS`: the URDF's `<limit>` of each
+/// joint coordinate (`JOINT_NAMES` order, without a floating base's six), infinite where it
+/// sets none (a `continuous` joint's position, a joint without `<limit>`).
+pub(super) fn limit_constants(model: &Model) -> TokenStream {
+    let joints: Vec<&Joint> = model
+        .coordinate_joints()
+        .into_iter()
+        .map(|j| &model.joints[j])
+        .collect();
+    let n = usize_lit(joints.len());
+    let limit =
+        |j: &Joint, f: fn(&Limits) -> f64| j.limits.as_ref().map(f).unwrap_or(f64::INFINITY);
+    let positions = joints.iter().map(|j| {
+        let (lower, upper) = match (&j.limits, j.kind) {
+            (Some(l), JointKind::Revolute | JointKind::Prismatic) => (l.lower, l.upper),
+            _ => (f64::NEG_INFINITY, f64::INFINITY),
+        };
+        let (lower, upper) = (bound(lower), bound(upper));
+        quote!((#lower, #upper))
+    });
+    let velocities = joints.iter().map(|j| bound(limit(j, |l| l.velocity)));
+    let efforts = joints.iter().map(|j| bound(limit(j, |l| l.effort)));
+    let base = if model.is_floating() {
+        " (the joints only: entry `i` is velocity coordinate `6 + i`)"
+    } else {
+        ""
+    };
+    let position_doc = format!(" Each joint coordinate's position limits `(lower, upper)` (rad or m) from the URDF's `<limit>`, in `JOINT_NAMES` order{base}; infinite for `continuous` joints and joints without `<limit>`.");
+    let velocity_doc = format!(" Each joint coordinate's velocity limit (rad/s or m/s) from the URDF's `<limit velocity>`, in `JOINT_NAMES` order{base}; infinite without `<limit>`.");
+    let effort_doc = format!(" Each joint coordinate's effort limit (N m or N) from the URDF's `<limit effort>`, in `JOINT_NAMES` order{base}; infinite without `<limit>`.");
+    quote! {
+        #[doc = #position_doc]
+        pub const POSITION_LIMITS: [(f64, f64); #n] = [#(#positions),*];
+        #[doc = #velocity_doc]
+        pub const VELOCITY_LIMITS: [f64; #n] = [#(#velocities),*];
+        #[doc = #effort_doc]
+        pub const EFFORT_LIMITS: [f64; #n] = [#(#efforts),*];
+    }
+}
+
+/// An `f64` constant, infinities by name.
+fn bound(x: f64) -> TokenStream {
+    if x == f64::INFINITY {
+        quote!(f64::INFINITY)
+    } else if x == f64::NEG_INFINITY {
+        quote!(f64::NEG_INFINITY)
+    } else {
+        super::f64_literal(x)
+    }
+}

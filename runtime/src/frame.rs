@@ -1,0 +1,293 @@
+//! A link frame's velocity, classical acceleration and Jacobian time variation, walked along
+//! its chain at run time from the per-joint transforms generated code supplies (as
+//! [`crate::tree::chain_jacobian`] does for the Jacobian), in Pinocchio's
+//! `LOCAL_WORLD_ALIGNED` convention: spatial vectors are [linear (3), angular (3)] at the
+//! frame's origin, in world axes.
+//!
+//! The rates are those of the joint tree's velocity columns: a floating base's six (linear,
+//! then angular velocity in base axes) and one per joint.
+
+use crate::tree::{cross, Motion, TreeJoint};
+use crate::{Pose, Real};
+
+/// A frame on a kinematic chain, as generated code describes it.
+///
+/// With a floating base, body 0 is the base (moved by the free flyer, velocity columns 0 to 5)
+/// and body `b >= 1` is moved by `joints[b - 1]` (column `5 + b`); without one, body `j` is
+/// moved by `joints[j]` (column `j`).
+#[derive(Clone, Copy, Debug)]
+pub struct Chain<'a, T, F> {
+    /// The bodies from the root to the frame's body.
+    pub path: &'a [usize],
+    /// Every joint's axis and motion.
+    pub joints: &'a [TreeJoint],
+    /// Whether body 0 is a floating base.
+    pub floating: bool,
+    /// The pose of body `b` in its parent body's frame (a floating base's in the world).
+    pub transform: F,
+    /// The frame's pose in the last body of `path`.
+    pub placement: Pose<T>,
+}
+
+/// A body's world pose, angular velocity, velocity of its origin, angular acceleration and
+/// classical acceleration of its origin, all in world axes.
+#[derive(Clone, Copy, Debug)]
+struct State<T> {
+    pose: Pose<T>,
+    w: [T; 3],
+    v: [T; 3],
+    dw: [T; 3],
+    a: [T; 3],
+}
+
+impl<T: Real> State<T> {
+    /// The world (or a fixed root): at rest.
+    fn rest() -> State<T> {
+        let z = [T::zero(); 3];
+        State {
+            pose: Pose::identity(),
+            w: z,
+            v: z,
+            dw: z,
+            a: z,
+        }
+    }
+}
+
+fn add<T: Real>(a: &[T; 3], b: &[T; 3]) -> [T; 3] {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
+fn sub<T: Real>(a: &[T; 3], b: &[T; 3]) -> [T; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn scale<T: Real>(a: &[T; 3], k: T) -> [T; 3] {
+    [a[0] * k, a[1] * k, a[2] * k]
+}
+
+/// Entry `i` of `x`, zero beyond its end.
+fn at<T: Real>(x: &[T], i: usize) -> T {
+    x.get(i).copied().unwrap_or_else(T::zero)
+}
+
+impl<T: Real, F: Fn(usize) -> Pose<T>> Chain<'_, T, F> {
+    /// The velocity column and joint of body `b`, unless it is a floating base.
+    fn joint(&self, b: usize) -> Option<(usize, TreeJoint)> {
+        let j = if self.floating { b.checked_sub(1)? } else { b };
+        Some((j + 6 * usize::from(self.floating), *self.joints.get(j)?))
+    }
+
+    /// The floating base's state from its rates (base axes) `qd`, `qdd`.
+    fn base(&self, qd: &[T], qdd: &[T]) -> State<T> {
+        let pose = (self.transform)(0);
+        let lin = [at(qd, 0), at(qd, 1), at(qd, 2)];
+        let ang = [at(qd, 3), at(qd, 4), at(qd, 5)];
+        let dlin = [at(qdd, 0), at(qdd, 1), at(qdd, 2)];
+        let dang = [at(qdd, 3), at(qdd, 4), at(qdd, 5)];
+        State {
+            pose,
+            w: pose.transform_vector(&ang),
+            v: pose.transform_vector(&lin),
+            dw: pose.transform_vector(&dang),
+            a: pose.transform_vector(&add(&dlin, &cross(&ang, &lin))),
+        }
+    }
+
+    /// Body `b`'s state from its parent's; without `qdd`, its accelerations are left zero.
+    fn step(&self, parent: &State<T>, b: usize, qd: &[T], qdd: Option<&[T]>) -> State<T> {
+        if self.floating && b == 0 {
+            return self.base(qd, qdd.unwrap_or(&[]));
+        }
+        let pose = parent.pose.compose(&(self.transform)(b));
+        let r = sub(&pose.translation, &parent.pose.translation);
+        let wr = cross(&parent.w, &r);
+        let mut s = State {
+            pose,
+            w: parent.w,
+            v: add(&parent.v, &wr),
+            ..State::rest()
+        };
+        if qdd.is_some() {
+            s.dw = parent.dw;
+            s.a = add(
+                &parent.a,
+                &add(&cross(&parent.dw, &r), &cross(&parent.w, &wr)),
+            );
+        }
+        let Some((col, joint)) = self.joint(b) else {
+            return s;
+        };
+        let z = pose.transform_vector(&joint.axis.map(T::from_f64));
+        let x = at(qd, col);
+        let (rotates, zx) = (joint.motion == Motion::Rotation, scale(&z, x));
+        if rotates {
+            s.w = add(&s.w, &zx);
+        } else {
+            s.v = add(&s.v, &zx);
+        }
+        if let Some(qdd) = qdd {
+            let zy = scale(&z, at(qdd, col));
+            let wz = cross(&parent.w, &zx);
+            if rotates {
+                s.dw = add(&s.dw, &add(&zy, &wz));
+            } else {
+                s.a = add(&s.a, &add(&zy, &scale(&wz, T::from_f64(2.0))));
+            }
+        }
+        s
+    }
+
+    /// The last body's state, calling `visit(b, state)` for every body `b` of the path.
+    fn walk(
+        &self,
+        qd: &[T],
+        qdd: Option<&[T]>,
+        mut visit: impl FnMut(usize, &State<T>),
+    ) -> State<T> {
+        let mut s = State::rest();
+        for &b in self.path {
+            s = self.step(&s, b, qd, qdd);
+            visit(b, &s);
+        }
+        s
+    }
+
+    /// The frame's origin relative to the last body's origin, world axes.
+    fn lever(&self, last: &State<T>) -> [T; 3] {
+        last.pose.transform_vector(&self.placement.translation)
+    }
+}
+
+/// The frame's spatial velocity (Pinocchio's `getFrameVelocity`, `LOCAL_WORLD_ALIGNED`) at the
+/// tree rates `qd`.
+///
+/// ```
+/// use eomgen_runtime::frame::{velocity, Chain};
+/// use eomgen_runtime::tree::{Motion, TreeJoint};
+/// use eomgen_runtime::Pose;
+/// // one revolute joint about z, the frame 1 m along the body's x axis, turning at 2 rad/s
+/// let joints = [TreeJoint { axis: [0.0, 0.0, 1.0], motion: Motion::Rotation }];
+/// let chain = Chain { path: &[0], joints: &joints, floating: false, transform: |_| Pose::identity(), placement: Pose::from_translation([1.0_f64, 0.0, 0.0]) };
+/// assert_eq!(velocity(&chain, &[2.0]), [0.0, 2.0, 0.0, 0.0, 0.0, 2.0]);
+/// ```
+pub fn velocity<T: Real, F: Fn(usize) -> Pose<T>>(chain: &Chain<'_, T, F>, qd: &[T]) -> [T; 6] {
+    let s = chain.walk(qd, None, |_, _| {});
+    let v = add(&s.v, &cross(&s.w, &chain.lever(&s)));
+    [v[0], v[1], v[2], s.w[0], s.w[1], s.w[2]]
+}
+
+/// The frame's classical acceleration (Pinocchio's `getFrameClassicalAcceleration`,
+/// `LOCAL_WORLD_ALIGNED`): the acceleration of its origin and its angular acceleration, at
+/// the tree rates `qd` and their derivatives `qdd`.
+///
+/// ```
+/// use eomgen_runtime::frame::{acceleration, Chain};
+/// use eomgen_runtime::tree::{Motion, TreeJoint};
+/// use eomgen_runtime::Pose;
+/// // turning at 2 rad/s, 1 m from the axis: 4 m/s^2 towards it
+/// let joints = [TreeJoint { axis: [0.0, 0.0, 1.0], motion: Motion::Rotation }];
+/// let chain = Chain { path: &[0], joints: &joints, floating: false, transform: |_| Pose::identity(), placement: Pose::from_translation([1.0_f64, 0.0, 0.0]) };
+/// assert_eq!(acceleration(&chain, &[2.0], &[0.0]), [-4.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
+/// ```
+pub fn acceleration<T: Real, F: Fn(usize) -> Pose<T>>(
+    chain: &Chain<'_, T, F>,
+    qd: &[T],
+    qdd: &[T],
+) -> [T; 6] {
+    let s = chain.walk(qd, Some(qdd), |_, _| {});
+    let r = chain.lever(&s);
+    let wr = cross(&s.w, &r);
+    let a = add(&s.a, &add(&cross(&s.dw, &r), &cross(&s.w, &wr)));
+    [a[0], a[1], a[2], s.dw[0], s.dw[1], s.dw[2]]
+}
+
+/// The time derivative of the frame's 6 x N Jacobian (Pinocchio's
+/// `getFrameJacobianTimeVariation`, `LOCAL_WORLD_ALIGNED`) at the tree rates `qd`: a column
+/// `(z x (p - o); z)` of a rotation about the axis `z` through `o` changes at
+/// `(dz x (p - o) + z x (dp - do); dz)`, one `(z; 0)` of a translation at `(dz; 0)`, with
+/// `dz = w x z` (`w` the angular velocity of the body moved).
+///
+/// ```
+/// use eomgen_runtime::frame::{jacobian_time_variation, Chain};
+/// use eomgen_runtime::tree::{Motion, TreeJoint};
+/// use eomgen_runtime::Pose;
+/// // the column (-y, x, 0; 0, 0, 1) of a point at angle t turns: its rate is (-x, -y, 0) w
+/// let joints = [TreeJoint { axis: [0.0, 0.0, 1.0], motion: Motion::Rotation }];
+/// let chain = Chain { path: &[0], joints: &joints, floating: false, transform: |_| Pose::identity(), placement: Pose::from_translation([1.0_f64, 0.0, 0.0]) };
+/// let dj: [[f64; 1]; 6] = jacobian_time_variation(&chain, &[2.0]);
+/// assert_eq!(dj, [[-2.0], [0.0], [0.0], [0.0], [0.0], [0.0]]);
+/// ```
+pub fn jacobian_time_variation<T: Real, F: Fn(usize) -> Pose<T>, const N: usize>(
+    chain: &Chain<'_, T, F>,
+    qd: &[T; N],
+) -> [[T; N]; 6] {
+    let mut bodies = [(0, State::rest()); N];
+    let mut count = 0;
+    let last = chain.walk(qd, None, |b, s| {
+        if let Some(slot) = bodies.get_mut(count) {
+            *slot = (b, *s);
+            count += 1;
+        }
+    });
+    let lever = chain.lever(&last);
+    let p = add(&last.pose.translation, &lever);
+    let dp = add(&last.v, &cross(&last.w, &lever));
+    let mut out = [[T::zero(); N]; 6];
+    let mut put = |col: usize, lin: [T; 3], ang: [T; 3]| {
+        for k in 0..3 {
+            if let Some(x) = out[k].get_mut(col) {
+                *x = lin[k];
+            }
+            if let Some(x) = out[3 + k].get_mut(col) {
+                *x = ang[k];
+            }
+        }
+    };
+    // A rotation's column about the axis `z` through the origin of `s`.
+    let rotation = |s: &State<T>, z: &[T; 3]| {
+        let dz = cross(&s.w, z);
+        let r = sub(&p, &s.pose.translation);
+        let lin = add(&cross(&dz, &r), &cross(z, &sub(&dp, &s.v)));
+        (lin, dz)
+    };
+    let zero = [T::zero(); 3];
+    for (b, s) in bodies.iter().take(count) {
+        if chain.floating && *b == 0 {
+            for k in 0..3 {
+                let e = [
+                    s.pose.rotation[0][k],
+                    s.pose.rotation[1][k],
+                    s.pose.rotation[2][k],
+                ];
+                put(k, cross(&s.w, &e), zero);
+                let (lin, ang) = rotation(s, &e);
+                put(3 + k, lin, ang);
+            }
+        } else if let Some((col, joint)) = chain.joint(*b) {
+            let z = s.pose.transform_vector(&joint.axis.map(T::from_f64));
+            match joint.motion {
+                Motion::Rotation => {
+                    let (lin, ang) = rotation(s, &z);
+                    put(col, lin, ang);
+                }
+                Motion::Translation => put(col, cross(&s.w, &z), zero),
+            }
+        }
+    }
+    out
+}
+
+/// The joint tree's rates from a robot's coordinates when some joints follow others (URDF
+/// mimic joints, the `COUPLING` table of generated code): velocity column `j` moves at
+/// `coupling[j].1` times the rate of coordinate `coupling[j].0`.
+///
+/// ```
+/// use eomgen_runtime::frame::tree_rates;
+/// // three joints; the third follows the first at twice its rate
+/// let rates: [f64; 3] = tree_rates(&[1.0, 5.0], &[(0, 1.0), (1, 1.0), (0, 2.0)]);
+/// assert_eq!(rates, [1.0, 5.0, 2.0]);
+/// ```
+pub fn tree_rates<T: Real, const N: usize>(qd: &[T], coupling: &[(usize, f64); N]) -> [T; N] {
+    coupling.map(|(c, k)| T::from_f64(k) * at(qd, c))
+}
