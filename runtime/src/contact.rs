@@ -2,12 +2,13 @@
 //! of `M a + h = tau + J^T F`, `J a + drift = 0`.
 //!
 //! `M` is factorized once with the tree's sparse `L^T D L` ([`crate::tree::ltdl_factor`]);
-//! then `Y = M^-1 J^T` (one substitution per contact row), the contact-space inverse inertia
+//! then `Y = M^-1 J^T` (one substitution of all contact rows at once,
+//! [`crate::tree::ltdl_substitute_rows`]), the contact-space inverse inertia
 //! `J M^-1 J^T` by Cholesky ([`Cholesky`]), `F = -(J M^-1 J^T)^-1 (drift + J M^-1 (tau - h))`
 //! and `a = M^-1 (tau - h) + Y F`. Everything is in fixed-size arrays on the stack.
 
 use crate::linalg::{Cholesky, FactorError};
-use crate::tree::{ltdl_factor, ltdl_substitute};
+use crate::tree::{ltdl_factor, ltdl_substitute, ltdl_substitute_rows};
 use crate::Real;
 
 /// Solves the contact forward dynamics for `rhs = tau - h` (`h = b + G`, friction included),
@@ -37,15 +38,43 @@ pub fn solve<T: Real, const N: usize, const K: usize>(
 ) -> Result<([T; N], [T; K]), FactorError> {
     ltdl_factor(m, parent)?;
     let free = ltdl_substitute(m, parent, rhs);
-    // Y = M^-1 J^T, column k of Y is M^-1 times row k of J.
-    let mut y = [[T::zero(); N]; K];
-    for (yk, jk) in y.iter_mut().zip(j) {
-        *yk = ltdl_substitute(m, parent, jk);
+    solve_factored(m, parent, &free, j, drift)
+}
+
+/// [`solve`] after its first steps: `m` holds the factors of [`ltdl_factor`] and `free` is
+/// `M^-1 (tau - h)`, the accelerations without contacts (generated code factorizes with its
+/// own unrolled copy of [`ltdl_factor`]). Fails like [`solve`], without the pivots of `M`.
+///
+/// ```
+/// use eomgen_runtime::contact::solve_factored;
+/// // The point mass of `solve`, M = I already factorized: free = tau - h.
+/// let m = [[1.0_f64, 0.0], [0.0, 1.0]];
+/// let j = [[1.0, 0.0], [0.0, 1.0]];
+/// let (a, f) = solve_factored(&m, &[None, None], &[0.0, -9.81], &j, &[0.0, 0.0]).unwrap();
+/// assert_eq!(a, [0.0, 0.0]);
+/// assert!((f[1] - 9.81).abs() < 1e-12);
+/// ```
+pub fn solve_factored<T: Real, const N: usize, const K: usize>(
+    m: &[[T; N]; N],
+    parent: &[Option<usize>; N],
+    free: &[T; N],
+    j: &[[T; N]; K],
+    drift: &[T; K],
+) -> Result<([T; N], [T; K]), FactorError> {
+    // Y = M^-1 J^T (N x K), all K columns in one substitution.
+    let mut y = [[T::zero(); K]; N];
+    for (i, yi) in y.iter_mut().enumerate() {
+        for (yik, jk) in yi.iter_mut().zip(j) {
+            *yik = jk[i];
+        }
     }
+    ltdl_substitute_rows(m, parent, &mut y);
     let mut lambda = [[T::zero(); K]; K];
-    for r in 0..K {
-        for c in 0..K {
-            lambda[r][c] = dot(&j[r], &y[c]);
+    for (jr, lr) in j.iter().zip(lambda.iter_mut()) {
+        for (jri, yi) in jr.iter().zip(&y) {
+            for (l, yic) in lr.iter_mut().zip(yi) {
+                *l = jri.mul_add(*yic, *l);
+            }
         }
     }
     let shift = |e: FactorError| match e {
@@ -57,13 +86,13 @@ pub fn solve<T: Real, const N: usize, const K: usize>(
     let chol = Cholesky::new(lambda).map_err(shift)?;
     let mut b = [T::zero(); K];
     for k in 0..K {
-        b[k] = -(drift[k] + dot(&j[k], &free));
+        b[k] = -(drift[k] + dot(&j[k], free));
     }
     let f = chol.solve(&b);
-    let mut a = free;
-    for (yk, fk) in y.iter().zip(&f) {
-        for (ai, yi) in a.iter_mut().zip(yk) {
-            *ai += *yi * *fk;
+    let mut a = *free;
+    for (ai, yi) in a.iter_mut().zip(&y) {
+        for (yik, fk) in yi.iter().zip(&f) {
+            *ai = yik.mul_add(*fk, *ai);
         }
     }
     if let Some(pivot) = a.iter().position(|x| !x.is_finite()) {

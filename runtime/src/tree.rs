@@ -216,6 +216,8 @@ pub fn ltdl_factor<T: Real, const N: usize>(
     {
         return Err(FactorError::NonFinite { pivot: 0 });
     }
+    let mut anc = [0_usize; N];
+    let mut row = [T::zero(); N];
     for k in (0..N).rev() {
         let d = m[k][k];
         if !d.is_finite() {
@@ -224,17 +226,25 @@ pub fn ltdl_factor<T: Real, const N: usize>(
         if d <= T::zero() {
             return Err(FactorError::NotPositiveDefinite { pivot: k });
         }
+        // k's ancestors, nearest first, and row k's entries there: gathered once, so that the
+        // updates below are independent of each other (no walk up the tree inside them).
+        let mut len = 0;
         let mut i = parent[k];
         while let Some(ii) = i {
-            let a = m[k][ii] / d;
-            let mut j = Some(ii);
-            while let Some(jj) = j {
-                let v = m[k][jj] * a;
-                m[ii][jj] -= v;
-                j = parent[jj];
+            anc[len] = ii;
+            row[len] = m[k][ii];
+            len += 1;
+            i = parent[ii];
+        }
+        for s in 0..len {
+            let ii = anc[s];
+            let a = row[s] / d;
+            let target = &mut m[ii];
+            for t in s..len {
+                let v = row[t] * a;
+                target[anc[t]] -= v;
             }
             m[k][ii] = a;
-            i = parent[ii];
         }
     }
     Ok(())
@@ -293,8 +303,8 @@ pub fn ltdl_solve<T: Real, const N: usize>(
     }
 }
 
-/// The inverse of a tree's mass matrix: one factorization, then `N` substitutions. `m` is
-/// overwritten by the factors. Fails like [`ltdl_factor`].
+/// The inverse of a tree's mass matrix: one factorization ([`ltdl_factor`]), then
+/// [`ltdl_inverse_factored`]. `m` is overwritten by the factors. Fails like [`ltdl_factor`].
 ///
 /// ```
 /// use eomgen_runtime::tree::ltdl_inverse;
@@ -306,17 +316,155 @@ pub fn ltdl_inverse<T: Real, const N: usize>(
     parent: &[Option<usize>; N],
 ) -> Result<[[T; N]; N], FactorError> {
     ltdl_factor(m, parent)?;
-    let mut inv = [[T::zero(); N]; N];
-    let mut e = [T::zero(); N];
-    for j in 0..N {
-        e[j] = T::one();
-        let col = ltdl_substitute(m, parent, &e);
-        e[j] = T::zero();
-        for (i, row) in inv.iter_mut().enumerate() {
-            row[j] = col[i];
+    Ok(ltdl_inverse_factored(m, parent))
+}
+
+/// For each coordinate `i`, one past the largest coordinate of its subtree: the subtree of `i`
+/// lies within `i..ends[i]` (parents precede children; other coordinates may lie in between).
+fn subtree_ends<const N: usize>(parent: &[Option<usize>; N]) -> [usize; N] {
+    let mut ends: [usize; N] = core::array::from_fn(|i| i + 1);
+    for i in (0..N).rev() {
+        let end = ends[i];
+        if let Some(e) = parent[i].and_then(|p| ends.get_mut(p)) {
+            *e = (*e).max(end);
         }
     }
-    Ok(inv)
+    ends
+}
+
+/// Row `dst` (to change) and row `src` (to read) of `rows`, `None` when they are the same row or
+/// out of range.
+#[inline(always)]
+fn row_pair<R>(rows: &mut [R], dst: usize, src: usize) -> Option<(&mut R, &R)> {
+    if dst.max(src) >= rows.len() || dst == src {
+        return None;
+    }
+    if dst < src {
+        let (head, tail) = rows.split_at_mut(src);
+        Some((&mut head[dst], &tail[0]))
+    } else {
+        let (head, tail) = rows.split_at_mut(dst);
+        Some((&mut tail[0], &head[src]))
+    }
+}
+
+/// `dst -= k src`, entry by entry (a loop the compiler vectorizes).
+#[inline(always)]
+fn sub_scaled<T: Real>(dst: &mut [T], src: &[T], k: T) {
+    let k = -k;
+    for (x, y) in dst.iter_mut().zip(src) {
+        *x = k.mul_add(*y, *x);
+    }
+}
+
+/// `M^-1` from the factors of [`ltdl_factor`] (`m` as it left it), `L^-1 D^-1 L^-T` with the
+/// tree's structure: `L^-T` has row `i` nonzero only over `i`'s subtree, and only the upper
+/// triangle of `L^-1 (D^-1 L^-T)` is formed, row by row from the root, then mirrored (the
+/// result is exactly symmetric). Every step is a scaled row subtracted from another row, so the
+/// cost is about `N` times the sum of the coordinates' depths, in vector operations.
+///
+/// ```
+/// use eomgen_runtime::tree::{ltdl_factor, ltdl_inverse_factored};
+/// let parent = [None, Some(0)];
+/// let mut m = [[2.0_f64, 0.5], [0.5, 1.0]];
+/// ltdl_factor(&mut m, &parent).unwrap();
+/// let inv = ltdl_inverse_factored(&m, &parent);
+/// let expected = [[1.0 / 1.75, -0.5 / 1.75], [-0.5 / 1.75, 2.0 / 1.75]];
+/// for (row, e) in inv.iter().zip(&expected) {
+///     assert!(row.iter().zip(e).all(|(x, y)| (x - y).abs() < 1e-15));
+/// }
+/// ```
+pub fn ltdl_inverse_factored<T: Real, const N: usize>(
+    m: &[[T; N]; N],
+    parent: &[Option<usize>; N],
+) -> [[T; N]; N] {
+    let ends = subtree_ends(parent);
+    let mut x = [[T::zero(); N]; N];
+    for (i, row) in x.iter_mut().enumerate() {
+        row[i] = T::one();
+    }
+    // L^-T, then D^-1: row i is nonzero over i..ends[i] only.
+    for i in (0..N).rev() {
+        let span = i..ends[i];
+        let mut a = parent[i];
+        while let Some(aa) = a {
+            if let Some((dst, src)) = row_pair(&mut x, aa, i) {
+                sub_scaled(&mut dst[span.clone()], &src[span.clone()], m[i][aa]);
+            }
+            a = parent.get(aa).copied().flatten();
+        }
+    }
+    for (i, row) in x.iter_mut().enumerate() {
+        let d = m[i][i];
+        for v in &mut row[i..ends[i]] {
+            *v /= d;
+        }
+    }
+    // L^-1 on the upper triangle: row i's columns from i on need only its ancestors' (a < i),
+    // which are final by then.
+    for i in 0..N {
+        let mut a = parent[i];
+        while let Some(aa) = a {
+            if let Some((dst, src)) = row_pair(&mut x, i, aa) {
+                sub_scaled(&mut dst[i..], &src[i..], m[i][aa]);
+            }
+            a = parent.get(aa).copied().flatten();
+        }
+    }
+    for i in 1..N {
+        let (upper, lower) = x.split_at_mut(i);
+        for (j, above) in upper.iter().enumerate() {
+            lower[0][j] = above[i];
+        }
+    }
+    x
+}
+
+/// Solves `M X = B` for the `C` columns of `x` (`B` on entry, `X` on return), with the factors
+/// of [`ltdl_factor`] (`m` as it left it): [`ltdl_substitute`] on all columns at once, each
+/// step a scaled row of `x` subtracted from another (vector operations over the `C` columns).
+///
+/// ```
+/// use eomgen_runtime::tree::{ltdl_factor, ltdl_substitute_rows};
+/// let parent = [None, Some(0)];
+/// let mut m = [[2.0_f64, 0.5], [0.5, 1.0]];
+/// ltdl_factor(&mut m, &parent).unwrap();
+/// let mut x = [[2.5, 2.0, 0.0], [1.5, 0.5, 1.75]];
+/// ltdl_substitute_rows(&m, &parent, &mut x);
+/// let expected = [[1.0, 1.0, -0.5], [1.0, 0.0, 2.0]];
+/// for (row, e) in x.iter().zip(&expected) {
+///     assert!(row.iter().zip(e).all(|(x, y)| (x - y).abs() < 1e-15));
+/// }
+/// ```
+pub fn ltdl_substitute_rows<T: Real, const N: usize, const C: usize>(
+    m: &[[T; N]; N],
+    parent: &[Option<usize>; N],
+    x: &mut [[T; C]; N],
+) {
+    for i in (0..N).rev() {
+        let mut a = parent[i];
+        while let Some(aa) = a {
+            if let Some((dst, src)) = row_pair(x, aa, i) {
+                sub_scaled(dst, src, m[i][aa]);
+            }
+            a = parent.get(aa).copied().flatten();
+        }
+    }
+    for (i, row) in x.iter_mut().enumerate() {
+        let d = m[i][i];
+        for v in row.iter_mut() {
+            *v /= d;
+        }
+    }
+    for i in 0..N {
+        let mut a = parent[i];
+        while let Some(aa) = a {
+            if let Some((dst, src)) = row_pair(x, i, aa) {
+                sub_scaled(dst, src, m[i][aa]);
+            }
+            a = parent.get(aa).copied().flatten();
+        }
+    }
 }
 
 /// `-a b` for square matrices, the product forward-dynamics derivatives need

@@ -1,10 +1,13 @@
 //! The tree kernels: the sparse `L^T D L` solve against the dense Cholesky solve, on a chain
-//! (dense) and a branched tree (zeros between branches), and its failures.
+//! (dense) and branched trees (zeros between branches, subtrees interleaved), its failures, and
+//! the inverse and the many-column solve built on the same factors.
 
 // Matrix code reads best with explicit indices.
 #![allow(clippy::needless_range_loop)]
 
-use eomgen_runtime::tree::ltdl_solve;
+use eomgen_runtime::tree::{
+    ltdl_factor, ltdl_inverse, ltdl_solve, ltdl_substitute, ltdl_substitute_rows,
+};
 use eomgen_runtime::{solve_spd, FactorError};
 use proptest::prelude::*;
 
@@ -41,6 +44,8 @@ fn tree_spd<const N: usize>(a: &[[f64; N]; N], parent: &[Option<usize>; N]) -> [
 
 const BRANCHED: [Option<usize>; 6] = [None, Some(0), Some(1), Some(0), Some(3), Some(0)];
 const CHAIN: [Option<usize>; 6] = [None, Some(0), Some(1), Some(2), Some(3), Some(4)];
+/// Two branches whose coordinates alternate: the subtree of 1 is {1, 3, 5}, of 2 is {2, 4}.
+const INTERLEAVED: [Option<usize>; 6] = [None, Some(0), Some(0), Some(1), Some(2), Some(3)];
 
 proptest! {
     #[test]
@@ -54,6 +59,45 @@ proptest! {
             for i in 0..6 {
                 prop_assert!((dense[i] - sparse[i]).abs() <= 1e-10 * (1.0 + dense[i].abs()),
                     "{parent:?}: {dense:?} vs {sparse:?}");
+            }
+        }
+    }
+}
+
+proptest! {
+    #[test]
+    fn the_inverse_is_symmetric_and_inverts(
+        a in prop::array::uniform6(prop::array::uniform6(-2.0..2.0_f64))) {
+        for parent in [BRANCHED, CHAIN, INTERLEAVED] {
+            let m = tree_spd(&a, &parent);
+            let mut f = m;
+            let inv = ltdl_inverse(&mut f, &parent).unwrap();
+            for i in 0..6 {
+                for j in 0..6 {
+                    prop_assert_eq!(inv[i][j], inv[j][i]);
+                    let p: f64 = (0..6).map(|k| m[i][k] * inv[k][j]).sum();
+                    let e = if i == j { 1.0 } else { 0.0 };
+                    prop_assert!((p - e).abs() <= 1e-12, "{parent:?}: (M M^-1)[{i}][{j}] = {p}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn many_columns_solve_like_one(
+        a in prop::array::uniform6(prop::array::uniform6(-2.0..2.0_f64)),
+        b in prop::array::uniform6(prop::array::uniform3(-5.0..5.0_f64))) {
+        for parent in [BRANCHED, CHAIN, INTERLEAVED] {
+            let mut f = tree_spd(&a, &parent);
+            ltdl_factor(&mut f, &parent).unwrap();
+            let mut x = b;
+            ltdl_substitute_rows(&f, &parent, &mut x);
+            for c in 0..3 {
+                let col = ltdl_substitute(&f, &parent, &core::array::from_fn(|i| b[i][c]));
+                for i in 0..6 {
+                    prop_assert!((x[i][c] - col[i]).abs() <= 1e-12 * (1.0 + col[i].abs()),
+                        "{parent:?}: column {c}: {x:?} vs {col:?}");
+                }
             }
         }
     }

@@ -310,7 +310,7 @@ pub mod robots {
         include!(concat!(env!("OUT_DIR"), "/anymal_mpc.rs"));
     }
     /// A synthetic 24-joint serial chain with only forward and inverse dynamics: forward
-    /// dynamics solves at run time (`eomgen_runtime::tree::ltdl_solve`).
+    /// dynamics solves at run time (the tree `L^T D L` factorization, unrolled).
     pub mod chain24 {
         include!(concat!(env!("OUT_DIR"), "/chain24.rs"));
     }

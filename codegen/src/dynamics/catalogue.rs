@@ -95,21 +95,24 @@ pub enum Evaluation {
         pivots: Vec<Id>,
     },
     /// The same solve at run time: `M` from `mass_matrix`, `h = b + G + F` as straight-line
-    /// code, then the runtime's sparse `L^T D L` (`tree::ltdl_solve`) over the joint tree, for
+    /// code, then the sparse `L^T D L` over the joint tree (unrolled for the robot, as
+    /// `tree::ltdl_factor` and `tree::ltdl_substitute` do it at run time), for
     /// robots whose unrolled solve (and second copy of `M`) would be large.
     ForwardDynamicsSolve { h: Vec<Id> },
     /// A link frame's world pose: per-joint transforms composed along the link's chain.
     LinkPose,
     /// A link frame's 6 x N Jacobian, from the same per-joint transforms.
     LinkJacobian,
-    /// `M^-1`: `M` from `mass_matrix`, factorized once at run time and solved for each column
-    /// (`tree::ltdl_inverse`).
+    /// `M^-1`: `M` from `mass_matrix`, factorized by the unrolled tree `L^T D L`, then
+    /// `L^-1 D^-1 L^-T` with the tree's structure at run time (`tree::ltdl_inverse_factored`).
     MassMatrixInverse,
     /// Straight-line expressions that hold when every pivot of the unrolled `L^T D L`
     /// factorization of `M` is positive (checked at run time: NaN in every entry otherwise).
     Factored { outputs: Vec<Id>, pivots: Vec<Id> },
-    /// `(d qdd/dq, d qdd/dqd, M^-1)` at run time: `qdd` from `forward_dynamics`, then
-    /// `-M^-1` times `inverse_dynamics_derivatives` at `(q, qd, qdd)`.
+    /// `(d qdd/dq, d qdd/dqd, M^-1)` at run time through one tree factorization of
+    /// `mass_matrix`: `qdd` from it and `inverse_dynamics(q, qd, 0)`, then `-M^-1` times
+    /// `inverse_dynamics_derivatives` at `(q, qd, qdd)` (`tree::ltdl_substitute_rows`), and
+    /// `M^-1` from the same factors (`tree::ltdl_inverse_factored`).
     ForwardDynamicsDerivatives,
     /// The accelerations and contact forces with the contact points held, solved at run time:
     /// `M` from `mass_matrix`, `h = b + G + F` straight-line, `J_c` and its drift from
@@ -179,9 +182,9 @@ impl Quantity {
                 &["mass_matrix", "contact_jacobian", "contact_drift"]
             }
             Evaluation::ForwardDynamicsDerivatives => &[
-                "forward_dynamics",
+                "mass_matrix",
+                "inverse_dynamics",
                 "inverse_dynamics_derivatives",
-                "mass_matrix_inverse",
             ],
             _ => &[],
         }
@@ -242,6 +245,7 @@ mod tests {
         vec![
             quantity("mass_matrix", Evaluation::Exprs(Vec::new())),
             quantity("gravity", Evaluation::Exprs(Vec::new())),
+            quantity("inverse_dynamics", Evaluation::Exprs(Vec::new())),
             quantity(
                 "forward_dynamics",
                 Evaluation::ForwardDynamicsSolve { h: Vec::new() },
@@ -264,18 +268,22 @@ mod tests {
     }
 
     #[test]
-    fn a_need_of_a_need_is_selected() {
-        // `forward_dynamics_derivatives` calls `forward_dynamics` and `mass_matrix_inverse`,
-        // which both call `mass_matrix`, earlier in the catalogue.
+    fn the_needs_are_selected() {
+        // `forward_dynamics_derivatives` calls `mass_matrix`, `inverse_dynamics` and
+        // `inverse_dynamics_derivatives`, earlier in the catalogue; not `forward_dynamics` or
+        // `mass_matrix_inverse`.
         assert_eq!(
             selected(&["forward_dynamics_derivatives"]),
             [
                 "mass_matrix",
-                "forward_dynamics",
+                "inverse_dynamics",
                 "inverse_dynamics_derivatives",
-                "mass_matrix_inverse",
                 "forward_dynamics_derivatives",
             ]
+        );
+        assert_eq!(
+            selected(&["forward_dynamics"]),
+            ["mass_matrix", "forward_dynamics"]
         );
         assert_eq!(
             selected(&["mass_matrix_inverse"]),

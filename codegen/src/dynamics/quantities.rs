@@ -204,7 +204,7 @@ fn forward_dynamics(d: &Derivation, notes: &Notes) -> Quantity {
         )
     } else {
         (
-            "Route: M from `mass_matrix`, b + G by Newton-Euler, then a sparse L^T D L solve over the joint tree at run time (eomgen_runtime::tree::ltdl_solve).",
+            "Route: M from `mass_matrix`, b + G by Newton-Euler, then the sparse L^T D L factorization over the joint tree, unrolled for this robot, and its substitution.",
             Evaluation::ForwardDynamicsSolve {
                 h: d.fast.bias_gravity_friction.clone(),
             },
@@ -392,11 +392,11 @@ pub fn derivatives(d: &Derivation, x: &Derivatives) -> Vec<Quantity> {
     };
     let (minv_route, minv_eval) = match factored(minv) {
         Some(e) => ("Route: M as in `mass_matrix`, an unrolled L^T D L factorization without fill-in, one substitution per column.", e),
-        None => ("Route: M from `mass_matrix`, one sparse L^T D L factorization over the joint tree, N substitutions (eomgen_runtime::tree::ltdl_inverse).", Evaluation::MassMatrixInverse),
+        None => ("Route: M from `mass_matrix`, the sparse L^T D L factorization over the joint tree, unrolled for this robot, then L^-1 D^-1 L^-T with the tree's structure at run time (eomgen_runtime::tree::ltdl_inverse_factored).", Evaluation::MassMatrixInverse),
     };
     let (fd_route, fd_eval) = match factored(fd) {
         Some(e) => ("Route: qdd as in `forward_dynamics`, `inverse_dynamics_derivatives` at (q, qd, qdd), then -M^-1 times them by substitutions through the one unrolled factorization of M, all in one straight-line body.", e),
-        None => ("Route: qdd from `forward_dynamics`, then -M^-1 times `inverse_dynamics_derivatives` at (q, qd, qdd).", Evaluation::ForwardDynamicsDerivatives),
+        None => ("Route: one factorization of M (from `mass_matrix`, the tree L^T D L unrolled): qdd from it and `inverse_dynamics` at zero acceleration, `inverse_dynamics_derivatives` at (q, qd, qdd), then -M^-1 times them by substitutions of all columns at once (eomgen_runtime::tree::ltdl_substitute_rows), and M^-1 from the same factors.", Evaluation::ForwardDynamicsDerivatives),
     };
     vec![
         Quantity {

@@ -603,7 +603,12 @@ impl Emitter<'_> {
             for (r, h) in rhs.iter_mut().zip(h) {
                 *r -= h;
             }
-            ::eomgen_runtime::tree::ltdl_solve(&mut m, &Self::PARENTS, &rhs)
+            Self::ltdl_factor_unrolled(&mut m)?;
+            let x = Self::ltdl_substitute_unrolled(&m, &rhs);
+            match x.iter().position(|v| !v.is_finite()) {
+                Some(pivot) => Err(::eomgen_runtime::FactorError::NonFinite { pivot }),
+                None => Ok(x),
+            }
         };
         (body, ops)
     }
@@ -675,6 +680,7 @@ impl Emitter<'_> {
                 q.eval,
                 Evaluation::ForwardDynamicsSolve { .. }
                     | Evaluation::MassMatrixInverse
+                    | Evaluation::ForwardDynamicsDerivatives
                     | Evaluation::ContactForwardDynamics { .. }
             )
         })
@@ -693,10 +699,25 @@ impl Emitter<'_> {
             }
             None => quote!(None),
         });
+        let factor = super::tree_solve::factor_fn(&self.parents, n);
+        let substitute = if self.quantities.iter().any(|q| {
+            matches!(
+                q.eval,
+                Evaluation::ForwardDynamicsSolve { .. }
+                    | Evaluation::ContactForwardDynamics { .. }
+                    | Evaluation::ForwardDynamicsDerivatives
+            )
+        }) {
+            super::tree_solve::substitute_fn(&self.parents, n)
+        } else {
+            TokenStream::new()
+        };
         quote! {
             /// Each coordinate's parent coordinate (`None`: the root), parents first: the
             /// joints' parents (a floating base's six coordinates form a chain).
             const PARENTS: [Option<usize>; #n] = [#(#parents),*];
+            #factor
+            #substitute
         }
     }
 
@@ -707,31 +728,44 @@ impl Emitter<'_> {
             #docs
             pub fn mass_matrix_inverse(&self, q: &[T; #nq]) -> [[T; #n]; #n] {
                 let mut m = #mass_matrix(self, q);
-                match ::eomgen_runtime::tree::ltdl_inverse(&mut m, &Self::PARENTS) {
-                    Ok(inv) => inv,
+                match Self::ltdl_factor_unrolled(&mut m) {
+                    Ok(()) => ::eomgen_runtime::tree::ltdl_inverse_factored(&m, &Self::PARENTS),
                     Err(_) => [[T::nan(); #n]; #n],
                 }
             }
         }
     }
 
+    /// `(d qdd/dq, d qdd/dqd, M^-1)` through one factorization of `M`: `qdd` solves
+    /// `M qdd = tau - h` with `h = inverse_dynamics(q, qd, 0)`, then `d tau/dq` and `d tau/dqd`
+    /// there from `inverse_dynamics_derivatives`, both solves at once per matrix
+    /// (`tree::ltdl_substitute_rows`), and `M^-1` from the same factors.
     fn forward_dynamics_derivatives_fn(&mut self, q: &Quantity) -> TokenStream {
         let docs = Self::quantity_doc(q, None);
         let (n, nq) = (&self.n, &self.nq);
-        let fd = self.call("forward_dynamics");
+        let id = self.call("inverse_dynamics");
         let id_derivatives = self.call("inverse_dynamics_derivatives");
-        let minv = self.call("mass_matrix_inverse");
+        let mass_matrix = self.call("mass_matrix");
         quote! {
             #docs
             pub fn forward_dynamics_derivatives(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n]) -> ([[T; #n]; #n], [[T; #n]; #n], [[T; #n]; #n]) {
-                let qdd = #fd(self, q, qd, tau);
-                let (dq, dqd) = #id_derivatives(self, q, qd, &qdd);
-                let minv = #minv(self, q);
-                (
-                    ::eomgen_runtime::tree::neg_mat_mul(&minv, &dq),
-                    ::eomgen_runtime::tree::neg_mat_mul(&minv, &dqd),
-                    minv,
-                )
+                let mut m = #mass_matrix(self, q);
+                if Self::ltdl_factor_unrolled(&mut m).is_err() {
+                    return ([[T::nan(); #n]; #n], [[T::nan(); #n]; #n], [[T::nan(); #n]; #n]);
+                }
+                let mut rhs = *tau;
+                for (r, h) in rhs.iter_mut().zip(#id(self, q, qd, &[T::zero(); #n])) {
+                    *r -= h;
+                }
+                let qdd = Self::ltdl_substitute_unrolled(&m, &rhs);
+                let (mut dq, mut dqd) = #id_derivatives(self, q, qd, &qdd);
+                for x in [&mut dq, &mut dqd] {
+                    ::eomgen_runtime::tree::ltdl_substitute_rows(&m, &Self::PARENTS, x);
+                    for v in x.iter_mut().flatten() {
+                        *v = -*v;
+                    }
+                }
+                (dq, dqd, ::eomgen_runtime::tree::ltdl_inverse_factored(&m, &Self::PARENTS))
             }
         }
     }
@@ -760,7 +794,9 @@ impl Emitter<'_> {
                 for (r, h) in rhs.iter_mut().zip(h) {
                     *r -= h;
                 }
-                ::eomgen_runtime::contact::solve(&mut m, &Self::PARENTS, &rhs, &#j(self, q), &#drift(self, q, qd))
+                Self::ltdl_factor_unrolled(&mut m)?;
+                let free = Self::ltdl_substitute_unrolled(&m, &rhs);
+                ::eomgen_runtime::contact::solve_factored(&m, &Self::PARENTS, &free, &#j(self, q), &#drift(self, q, qd))
             }
         };
         let inherent_try = if self.trait_of("try_contact_forward_dynamics").is_some() {
