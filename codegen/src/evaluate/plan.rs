@@ -21,7 +21,8 @@ pub(super) enum Plan {
     /// Craig's matrices from `C(q, e_k)`, `k = 0..N`.
     Craig { coriolis: Tape, which: Craig },
     /// `(-M^-1 dtau/dq, -M^-1 dtau/dqd, M^-1)` at `qdd = FD(q, qd, tau)`.
-    FdDerivatives { fd: Box<Plan>, dtau: Tape, m: Tape },
+    /// (`qdd = M^-1 (tau - h)` with `h` inverse dynamics at zero acceleration.)
+    FdDerivatives { m: Tape, id: Tape, dtau: Tape },
     /// `(a, F)` with the contacts held.
     Contact {
         m: Tape,
@@ -96,15 +97,11 @@ impl Plan {
                 coriolis: exprs_of("coriolis_matrix")?,
                 which: *which,
             },
-            Evaluation::ForwardDynamicsDerivatives => {
-                let fd = find("forward_dynamics")
-                    .ok_or_else(|| EvalError::Internal("no forward_dynamics".into()))?;
-                Plan::FdDerivatives {
-                    fd: Box::new(Plan::new(d, layout, fd, find)?),
-                    dtau: exprs_of("inverse_dynamics_derivatives")?,
-                    m: exprs_of("mass_matrix")?,
-                }
-            }
+            Evaluation::ForwardDynamicsDerivatives => Plan::FdDerivatives {
+                m: exprs_of("mass_matrix")?,
+                id: exprs_of("inverse_dynamics")?,
+                dtau: exprs_of("inverse_dynamics_derivatives")?,
+            },
             Evaluation::ContactForwardDynamics { h } => Plan::Contact {
                 m: exprs_of("mass_matrix")?,
                 h: tape(h)?,
@@ -159,10 +156,13 @@ impl Plan {
             }
             Plan::Inverse(m) => Ok(m_factor(m)?.inverse()),
             Plan::Craig { coriolis, which } => Ok(craig(coriolis, x, *which)),
-            Plan::FdDerivatives { fd, dtau, m } => {
-                let qdd = fd.run(x)?;
-                let dtau = dtau.run(&x.with_accelerations(&qdd));
+            Plan::FdDerivatives { m, id, dtau } => {
                 let f = m_factor(m)?;
+                let h = id.run(&x.with_accelerations(&vec![0.0; n]));
+                let at = x.layout.tau();
+                let rhs: Vec<f64> = (0..n).map(|i| x.values[at + i] - h[i]).collect();
+                let qdd = f.solve(&rhs);
+                let dtau = dtau.run(&x.with_accelerations(&qdd));
                 let mut out: Vec<f64> = f.solve_matrix(&dtau, n).iter().map(|v| -v).collect();
                 out.extend(f.inverse());
                 Ok(out)
