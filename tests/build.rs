@@ -41,6 +41,7 @@ fn main() {
     deep_chain();
     derivatives();
     floating();
+    contact_dynamics();
     regressors();
     underactuated();
     mimic();
@@ -155,6 +156,29 @@ fn floating() {
         .floating_base()
         .module_name("iris_simple")
         .type_name("IrisSimple")
+        .compile()
+        .unwrap();
+}
+
+/// Contact and impulse dynamics with their derivatives (anymal on its four feet), only what
+/// `tests/contact_dynamics.rs` calls.
+fn contact_dynamics() {
+    eomgen::Builder::new("robots/floating/anymal.urdf")
+        .floating_base()
+        .contact_points(&["LF_FOOT", "RF_FOOT", "LH_FOOT", "RH_FOOT"])
+        .derivatives()
+        .module_name("anymal_mpc")
+        .type_name("AnymalMpc")
+        .quantities([
+            "contact_forward_dynamics",
+            "contact_forward_dynamics_derivatives",
+            "impulse_dynamics",
+            "impulse_dynamics_derivatives",
+            "integrate",
+            "centroidal_map",
+            "center_of_mass",
+            "link_pose",
+        ])
         .compile()
         .unwrap();
 }

@@ -3,11 +3,11 @@
 //!
 //! `M` is factorized once with the tree's sparse `L^T D L` ([`crate::tree::ltdl_factor`]);
 //! then `Y = M^-1 J^T` (one substitution per contact row), the contact-space inverse inertia
-//! `J M^-1 J^T` by Cholesky ([`Cholesky`]), `F = -(J M^-1 J^T)^-1 (drift + J M^-1 (tau - h))`
+//! `J M^-1 J^T` by Cholesky (through [`ContactKkt`]), `F = -(J M^-1 J^T)^-1 (drift + J M^-1 (tau - h))`
 //! and `a = M^-1 (tau - h) + Y F`. Everything is in fixed-size arrays on the stack.
 
-use crate::linalg::{Cholesky, FactorError};
-use crate::tree::{ltdl_factor, ltdl_substitute};
+use crate::kkt::ContactKkt;
+use crate::linalg::FactorError;
 use crate::Real;
 
 /// Solves the contact forward dynamics for `rhs = tau - h` (`h = b + G`, friction included),
@@ -35,50 +35,7 @@ pub fn solve<T: Real, const N: usize, const K: usize>(
     j: &[[T; N]; K],
     drift: &[T; K],
 ) -> Result<([T; N], [T; K]), FactorError> {
-    ltdl_factor(m, parent)?;
-    let free = ltdl_substitute(m, parent, rhs);
-    // Y = M^-1 J^T, column k of Y is M^-1 times row k of J.
-    let mut y = [[T::zero(); N]; K];
-    for (yk, jk) in y.iter_mut().zip(j) {
-        *yk = ltdl_substitute(m, parent, jk);
-    }
-    let mut lambda = [[T::zero(); K]; K];
-    for r in 0..K {
-        for c in 0..K {
-            lambda[r][c] = dot(&j[r], &y[c]);
-        }
-    }
-    let shift = |e: FactorError| match e {
-        FactorError::NotPositiveDefinite { pivot } => {
-            FactorError::NotPositiveDefinite { pivot: N + pivot }
-        }
-        FactorError::NonFinite { pivot } => FactorError::NonFinite { pivot: N + pivot },
-    };
-    let chol = Cholesky::new(lambda).map_err(shift)?;
-    let mut b = [T::zero(); K];
-    for k in 0..K {
-        b[k] = -(drift[k] + dot(&j[k], &free));
-    }
-    let f = chol.solve(&b);
-    let mut a = free;
-    for (yk, fk) in y.iter().zip(&f) {
-        for (ai, yi) in a.iter_mut().zip(yk) {
-            *ai += *yi * *fk;
-        }
-    }
-    if let Some(pivot) = a.iter().position(|x| !x.is_finite()) {
-        return Err(FactorError::NonFinite { pivot });
-    }
-    if let Some(k) = f.iter().position(|x| !x.is_finite()) {
-        return Err(FactorError::NonFinite { pivot: N + k });
-    }
-    Ok((a, f))
-}
-
-fn dot<T: Real, const N: usize>(a: &[T; N], b: &[T; N]) -> T {
-    let mut s = T::zero();
-    for (x, y) in a.iter().zip(b) {
-        s += *x * *y;
-    }
-    s
+    let kkt = ContactKkt::new(*m, parent, *j)?;
+    *m = kkt.factors;
+    kkt.solve(rhs, &drift.map(|x| -x))
 }

@@ -224,7 +224,8 @@ fn contacts(
 
 const Q: &[Input] = &[Input::Q];
 
-fn quantity(
+/// A catalogue entry of an inherent method.
+pub(super) fn quantity(
     name: &'static str,
     inputs: &'static [Input],
     shape: Shape,
