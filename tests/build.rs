@@ -181,6 +181,23 @@ fn contact_dynamics() {
         ])
         .compile()
         .unwrap();
+    // 6D contacts at both soles (a humanoid: only what the test calls).
+    eomgen::Builder::new("robots/floating/g1_29dof.urdf")
+        .floating_base()
+        .contact_frames(&["left_ankle_roll_link", "right_ankle_roll_link"])
+        .derivatives()
+        .module_name("g1_mpc")
+        .type_name("G1Mpc")
+        .quantities([
+            "contact_jacobian",
+            "contact_drift",
+            "contact_forward_dynamics",
+            "contact_forward_dynamics_derivatives",
+            "impulse_dynamics",
+            "impulse_dynamics_derivatives",
+        ])
+        .compile()
+        .unwrap();
 }
 
 fn derivatives() {

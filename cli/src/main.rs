@@ -111,6 +111,10 @@ struct ModelArgs {
     /// contact_jacobian, contact_drift and contact_forward_dynamics
     #[arg(long = "contact", value_name = "LINK")]
     contacts: Vec<String>,
+    /// A 6D contact at the frame of this link (repeatable, in order, after the points): its
+    /// spatial acceleration is held, 6 rows (linear, then angular, world axes)
+    #[arg(long = "contact-frame", value_name = "LINK")]
+    contact_frames: Vec<String>,
     /// A joint without an actuator (repeatable): adds selection, ACTUATED_JOINT_NAMES and
     /// forward_dynamics_actuated; simulate applies no effort to it
     #[arg(long = "passive", value_name = "JOINT")]
@@ -147,6 +151,7 @@ impl ModelArgs {
             repair_inertia: self.repair_inertia,
             floating_base: self.floating_base,
             contact_points: self.contacts.clone(),
+            contact_frames: self.contact_frames.clone(),
             passive_joints: self.passive.clone(),
             mimic_joints: self.mimic,
         }

@@ -370,6 +370,18 @@ impl Builder {
         self
     }
 
+    /// A 6D contact at each named link's frame (a sole held flat), in this order, after the
+    /// points of [`Builder::contact_points`]: the frame's spatial acceleration is held
+    /// (Pinocchio's `getFrameAcceleration` in LOCAL_WORLD_ALIGNED: the linear part is the
+    /// origin's classical acceleration minus `omega x` its velocity), 6 rows (linear, then
+    /// angular, world axes at the link origin) in `contact_jacobian` and `contact_drift`, and a
+    /// force then a torque about the origin in the contact forces. An unknown link is
+    /// [`crate::model::ModelError::UnknownContactLink`].
+    pub fn contact_frames<S: AsRef<str>>(mut self, links: &[S]) -> Builder {
+        self.options.contact_frames = links.iter().map(|l| l.as_ref().to_string()).collect();
+        self
+    }
+
     /// Honours the URDF's mimic joints (`<mimic joint=".." multiplier=".." offset=".."/>`,
     /// as grippers and hands couple their fingers): a mimic joint is then no coordinate of
     /// its own but follows the joint it mimics, `q_mimic = multiplier q_joint + offset`, for

@@ -112,6 +112,9 @@ fn flags(o: &ModelOptions) -> Vec<(&'static str, Option<String>)> {
     for link in &o.contact_points {
         f.push(("contact", Some(link.clone())));
     }
+    for link in &o.contact_frames {
+        f.push(("contact-frame", Some(link.clone())));
+    }
     for joint in &o.passive_joints {
         f.push(("passive", Some(joint.clone())));
     }

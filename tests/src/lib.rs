@@ -242,6 +242,11 @@ pub mod robots {
     pub mod anymal_mpc {
         include!(concat!(env!("OUT_DIR"), "/anymal_mpc.rs"));
     }
+    /// g1_29dof with 6D contacts at both soles: contact and impulse dynamics with their
+    /// derivatives.
+    pub mod g1_mpc {
+        include!(concat!(env!("OUT_DIR"), "/g1_mpc.rs"));
+    }
 
     /// `double_pendulum.urdf`.
     pub mod double_pendulum {

@@ -10,11 +10,11 @@
 use eomgen_runtime::prelude::*;
 use eomgen_tests::floating_reference::{flat, normwise, numbers, pick, reference, Order};
 use eomgen_tests::robots::anymal_mpc::{AnymalMpc, AnymalMpcLink};
+use eomgen_tests::robots::g1_mpc::G1Mpc;
 use serde_json::Value;
 
 const NQ: usize = 19;
 const NV: usize = 18;
-const K: usize = 12;
 
 /// The worst error of each quantity over the samples, checked against its tolerance.
 #[derive(Default)]
@@ -41,72 +41,96 @@ impl Worst {
     }
 }
 
-/// Derivatives 1e-7 normwise, the dynamics themselves 1e-8.
+/// Derivatives 1e-7 normwise, the dynamics themselves 1e-8, the contact Jacobian and drift
+/// (kinematics) 1e-9.
 fn tolerance(what: &str) -> f64 {
     if what.contains('/') {
         1e-7
+    } else if what.starts_with("contact_") {
+        1e-9
     } else {
         1e-8
     }
 }
 
+/// Every contact and impulse quantity of `$ty` at every sample of `$file`, against the
+/// reference (the contact Jacobian and drift too).
+macro_rules! check_mpc {
+    ($file:literal, $ty:ty, $nq:literal, $nv:literal, $k:literal) => {{
+        let doc = reference($file);
+        let r = <$ty>::default();
+        let o = Order::new(&doc, &<$ty>::JOINT_NAMES);
+        let rows: Vec<usize> = (0..$k).collect();
+        let mut worst = Worst::default();
+        for s in doc["samples"].as_array().unwrap() {
+            let q: [f64; $nq] = Order::arr(&o.q, &s["q"]);
+            let v: [f64; $nv] = Order::arr(&o.v, &s["v"]);
+            let tau: [f64; $nv] = Order::arr(&o.v, &s["tau"]);
+            let rv = |x: &Value| o.v.iter().map(|&i| numbers(x)[i]).collect::<Vec<_>>();
+            let jc = pick(&s["contact_jacobian"], &rows, &o.v);
+            worst.note(
+                "contact_jacobian",
+                normwise(&flat(&r.contact_jacobian(&q)), &jc),
+            );
+            let drift = numbers(&s["contact_drift"]);
+            worst.note("contact_drift", normwise(&r.contact_drift(&q, &v), &drift));
+            let cfd = &s["contact_forward_dynamics"];
+            let (a, f) = r.contact_forward_dynamics(&q, &v, &tau);
+            worst.note("a", normwise(&a, &rv(&cfd["a"])));
+            worst.note("forces", normwise(&f, &numbers(&cfd["forces"])));
+            let d = r.contact_forward_dynamics_derivatives(&q, &v, &tau);
+            let rd = &s["contact_forward_dynamics_derivatives"];
+            for (name, ours) in [
+                ("da/dq", &d.da_dq),
+                ("da/dv", &d.da_dv),
+                ("da/dtau", &d.da_dtau),
+            ] {
+                let key = name.replace('/', "_");
+                worst.note(name, normwise(&flat(ours), &pick(&rd[&key], &o.v, &o.v)));
+            }
+            for (name, ours) in [
+                ("df/dq", &d.df_dq),
+                ("df/dv", &d.df_dv),
+                ("df/dtau", &d.df_dtau),
+            ] {
+                let key = name.replace('/', "_");
+                worst.note(name, normwise(&flat(ours), &pick(&rd[&key], &rows, &o.v)));
+            }
+            let impulses = s["impulse_dynamics"].as_array().unwrap();
+            let derivatives = s["impulse_dynamics_derivatives"].as_array().unwrap();
+            for (i, di) in impulses.iter().zip(derivatives) {
+                let e = i["restitution"].as_f64().unwrap();
+                let (after, p) = r.impulse_dynamics(&q, &v, e);
+                worst.note("v_after", normwise(&after, &rv(&i["v_after"])));
+                worst.note("impulses", normwise(&p, &numbers(&i["impulses"])));
+                let d = r.impulse_dynamics_derivatives(&q, &v, e);
+                worst.note(
+                    "dv/dq",
+                    normwise(&flat(&d.dv_dq), &pick(&di["dv_dq"], &o.v, &o.v)),
+                );
+                worst.note(
+                    "dv/dv",
+                    normwise(&flat(&d.dv_dv), &pick(&di["dv_dv"], &o.v, &o.v)),
+                );
+                let dp_dq = pick(&di["dimpulse_dq"], &rows, &o.v);
+                worst.note("dimpulse/dq", normwise(&flat(&d.dimpulse_dq), &dp_dq));
+                let dp_dv = pick(&di["dimpulse_dv"], &rows, &o.v);
+                worst.note("dimpulse/dv", normwise(&flat(&d.dimpulse_dv), &dp_dv));
+            }
+        }
+        worst.check($file, tolerance, 16);
+    }};
+}
+
 #[test]
 fn anymal_contact_and_impulse_dynamics_match_pinocchio() {
-    let doc = reference("anymal.mpc.json");
-    let r = AnymalMpc::<f64>::default();
-    let o = Order::new(&doc, &AnymalMpc::<f64>::JOINT_NAMES);
-    let rows: Vec<usize> = (0..K).collect();
-    let mut worst = Worst::default();
-    for s in doc["samples"].as_array().unwrap() {
-        let q: [f64; NQ] = Order::arr(&o.q, &s["q"]);
-        let v: [f64; NV] = Order::arr(&o.v, &s["v"]);
-        let tau: [f64; NV] = Order::arr(&o.v, &s["tau"]);
-        let rv = |x: &Value| o.v.iter().map(|&i| numbers(x)[i]).collect::<Vec<_>>();
-        let cfd = &s["contact_forward_dynamics"];
-        let (a, f) = r.contact_forward_dynamics(&q, &v, &tau);
-        worst.note("a", normwise(&a, &rv(&cfd["a"])));
-        worst.note("forces", normwise(&f, &numbers(&cfd["forces"])));
-        let d = r.contact_forward_dynamics_derivatives(&q, &v, &tau);
-        let rd = &s["contact_forward_dynamics_derivatives"];
-        for (name, ours) in [
-            ("da/dq", &d.da_dq),
-            ("da/dv", &d.da_dv),
-            ("da/dtau", &d.da_dtau),
-        ] {
-            let key = name.replace('/', "_");
-            worst.note(name, normwise(&flat(ours), &pick(&rd[&key], &o.v, &o.v)));
-        }
-        for (name, ours) in [
-            ("df/dq", &d.df_dq),
-            ("df/dv", &d.df_dv),
-            ("df/dtau", &d.df_dtau),
-        ] {
-            let key = name.replace('/', "_");
-            worst.note(name, normwise(&flat(ours), &pick(&rd[&key], &rows, &o.v)));
-        }
-        let impulses = s["impulse_dynamics"].as_array().unwrap();
-        let derivatives = s["impulse_dynamics_derivatives"].as_array().unwrap();
-        for (i, di) in impulses.iter().zip(derivatives) {
-            let e = i["restitution"].as_f64().unwrap();
-            let (after, p) = r.impulse_dynamics(&q, &v, e);
-            worst.note("v_after", normwise(&after, &rv(&i["v_after"])));
-            worst.note("impulses", normwise(&p, &numbers(&i["impulses"])));
-            let d = r.impulse_dynamics_derivatives(&q, &v, e);
-            worst.note(
-                "dv/dq",
-                normwise(&flat(&d.dv_dq), &pick(&di["dv_dq"], &o.v, &o.v)),
-            );
-            worst.note(
-                "dv/dv",
-                normwise(&flat(&d.dv_dv), &pick(&di["dv_dv"], &o.v, &o.v)),
-            );
-            let dp_dq = pick(&di["dimpulse_dq"], &rows, &o.v);
-            worst.note("dimpulse/dq", normwise(&flat(&d.dimpulse_dq), &dp_dq));
-            let dp_dv = pick(&di["dimpulse_dv"], &rows, &o.v);
-            worst.note("dimpulse/dv", normwise(&flat(&d.dimpulse_dv), &dp_dv));
-        }
-    }
-    worst.check("anymal", tolerance, 14);
+    check_mpc!("anymal.mpc.json", AnymalMpc<f64>, 19, 18, 12);
+}
+
+/// 6D contacts at both soles.
+#[test]
+fn g1_contact_and_impulse_dynamics_match_pinocchio() {
+    check_mpc!("g1_29dof.mpc.json", G1Mpc<f64>, 36, 35, 12);
 }
 
 /// A repeatable state: base position and joints in [-1, 1], a unit quaternion, velocities and

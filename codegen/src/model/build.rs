@@ -81,6 +81,10 @@ pub struct ModelOptions {
     /// (`contact_jacobian` rows, contact forces). Links merged into their parent by fixed joints
     /// keep their own names (feet usually are such links). Empty by default.
     pub contact_points: Vec<String>,
+    /// Links with a 6D contact (a foot's sole held flat): the link frame's spatial acceleration
+    /// is held (6 rows: linear, then angular, world axes at the link origin). Their rows come
+    /// after the points'. Empty by default.
+    pub contact_frames: Vec<String>,
     /// Moving joints without an actuator, by URDF name (the acrobot's elbow, a cart-pole's
     /// pole, a passive wrist or toe): the equation of motion becomes `M qdd + b + G = S^T
     /// tau_a` with `S` the `NA x N` selection matrix of the actuated joints
@@ -111,6 +115,7 @@ impl Default for ModelOptions {
             inertia_from_collision: None,
             floating_base: false,
             contact_points: Vec::new(),
+            contact_frames: Vec::new(),
             mimic_joints: false,
             passive_joints: Vec::new(),
         }
@@ -402,7 +407,8 @@ pub enum ModelError {
     /// [`SymbolicParams::Links`] names a link that does not exist.
     #[error("{file}: symbolic parameters requested for link `{link}`, which does not exist")]
     UnknownSymbolicLink { file: String, link: String },
-    /// [`ModelOptions::contact_points`] names a link that does not exist.
+    /// [`ModelOptions::contact_points`] or [`ModelOptions::contact_frames`] names a link that
+    /// does not exist.
     #[error("{file}: contact point requested at link `{link}`, which does not exist")]
     UnknownContactLink { file: String, link: String },
     /// [`ModelOptions::armature`] names a joint that does not exist or is fixed, or gives a
@@ -599,6 +605,7 @@ pub(crate) fn build_model(
     }
     mark_symbolic(&mut model, &options.symbolic, file)?;
     model.contacts = contact_frames(&model, &options.contact_points, file)?;
+    model.contact_frames = contact_frames(&model, &options.contact_frames, file)?;
     model.passive = passive_joints(&model, robot, &options.passive_joints, file)?;
     if options.mimic_joints {
         model.coupling = couplings(&model, robot, file)?;
@@ -1247,6 +1254,7 @@ fn merge(
         base,
         frames,
         contacts: Vec::new(),
+        contact_frames: Vec::new(),
         passive: Vec::new(),
         include_friction: options.friction,
         coulomb_smoothing: options.coulomb_smoothing,

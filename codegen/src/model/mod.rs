@@ -216,6 +216,9 @@ pub struct Model {
     /// The frames (indices into [`Model::frames`]) with a 3D point contact at their origin
     /// ([`ModelOptions::contact_points`]), in order.
     pub contacts: Vec<usize>,
+    /// The frames with a 6D contact ([`ModelOptions::contact_frames`]), in order: their rows
+    /// follow the points'.
+    pub contact_frames: Vec<usize>,
     /// The joints without an actuator ([`ModelOptions::passive_joints`]), as indices into
     /// [`Model::joints`], ascending; empty when every joint is actuated.
     pub passive: Vec<usize>,
