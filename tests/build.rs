@@ -181,6 +181,22 @@ fn contact_dynamics() {
         ])
         .compile()
         .unwrap();
+    // Contact points away from a link's origin: the last foot's 5 cm off.
+    eomgen::Builder::new("robots/floating/anymal.urdf")
+        .floating_base()
+        .contact_points(&["LF_FOOT", "RF_FOOT"])
+        .contact_point_at("LH_FOOT", [0.0; 3])
+        .contact_point_at("RH_FOOT", [0.05, -0.02, 0.01])
+        .module_name("anymal_at")
+        .type_name("AnymalAt")
+        .quantities([
+            "contact_forward_dynamics",
+            "link_jacobian",
+            "link_pose",
+            "integrate",
+        ])
+        .compile()
+        .unwrap();
     // 6D contacts at both soles (a humanoid: only what the test calls).
     eomgen::Builder::new("robots/floating/g1_29dof.urdf")
         .floating_base()

@@ -115,6 +115,10 @@ struct ModelArgs {
     /// spatial acceleration is held, 6 rows (linear, then angular, world axes)
     #[arg(long = "contact-frame", value_name = "LINK")]
     contact_frames: Vec<String>,
+    /// A 3D point contact at a position (m) in the frame of this link (repeatable, in order,
+    /// after the --contact points)
+    #[arg(long = "contact-at", value_name = "LINK:X,Y,Z", allow_hyphen_values = true, value_parser = parse_contact_at)]
+    contacts_at: Vec<(String, [f64; 3])>,
     /// A joint without an actuator (repeatable): adds selection, ACTUATED_JOINT_NAMES and
     /// forward_dynamics_actuated; simulate applies no effort to it
     #[arg(long = "passive", value_name = "JOINT")]
@@ -152,6 +156,7 @@ impl ModelArgs {
             floating_base: self.floating_base,
             contact_points: self.contacts.clone(),
             contact_frames: self.contact_frames.clone(),
+            contact_points_at: self.contacts_at.clone(),
             passive_joints: self.passive.clone(),
             mimic_joints: self.mimic,
         }
@@ -190,6 +195,13 @@ fn cli_error(e: eomgen::Error) -> Failure {
         .into(),
         e => e.into(),
     }
+}
+
+fn parse_contact_at(s: &str) -> Result<(String, [f64; 3]), String> {
+    let Some((link, at)) = s.rsplit_once(':') else {
+        return Err(format!("expected LINK:X,Y,Z, got `{s}`"));
+    };
+    Ok((link.to_string(), parse_vec3(at)?))
 }
 
 fn parse_armature(s: &str) -> Result<(String, f64), String> {

@@ -382,6 +382,17 @@ impl Builder {
         self
     }
 
+    /// A 3D point contact at `position` (metres, in the link's frame) on the link `link`, such
+    /// as a corner of a sole; repeatable, in order. Its rows come after those of
+    /// [`Builder::contact_points`] and before the frames of [`Builder::contact_frames`]. An
+    /// unknown link is [`crate::model::ModelError::UnknownContactLink`].
+    pub fn contact_point_at(mut self, link: &str, position: [f64; 3]) -> Builder {
+        self.options
+            .contact_points_at
+            .push((link.to_string(), position));
+        self
+    }
+
     /// Honours the URDF's mimic joints (`<mimic joint=".." multiplier=".." offset=".."/>`,
     /// as grippers and hands couple their fingers): a mimic joint is then no coordinate of
     /// its own but follows the joint it mimics, `q_mimic = multiplier q_joint + offset`, for

@@ -242,6 +242,10 @@ pub mod robots {
     pub mod anymal_mpc {
         include!(concat!(env!("OUT_DIR"), "/anymal_mpc.rs"));
     }
+    /// anymal with contact points at positions in its feet's frames.
+    pub mod anymal_at {
+        include!(concat!(env!("OUT_DIR"), "/anymal_at.rs"));
+    }
     /// g1_29dof with 6D contacts at both soles: contact and impulse dynamics with their
     /// derivatives.
     pub mod g1_mpc {

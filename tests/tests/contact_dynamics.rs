@@ -9,6 +9,7 @@
 
 use eomgen_runtime::prelude::*;
 use eomgen_tests::floating_reference::{flat, normwise, numbers, pick, reference, Order};
+use eomgen_tests::robots::anymal_at::{AnymalAt, AnymalAtLink};
 use eomgen_tests::robots::anymal_mpc::{AnymalMpc, AnymalMpcLink};
 use eomgen_tests::robots::g1_mpc::G1Mpc;
 use serde_json::Value;
@@ -303,4 +304,71 @@ fn anymal_non_finite_state_is_reported() {
     assert!(r.contact_forward_dynamics_derivatives(&q, &v, &tau).da_dq[0][0].is_nan());
     assert!(r.impulse_dynamics(&q, &v, 0.0).1[0].is_nan());
     assert!(r.impulse_dynamics_derivatives(&q, &v, 0.0).dimpulse_dv[0][0].is_nan());
+}
+
+/// Contact points at a position in a link frame (`Builder::contact_point_at`): at the origin
+/// they are the link's point contact; elsewhere the point moves with the link (`v_p = v_o +
+/// omega x r`), and the drift is the time derivative of `J v` along the motion.
+#[test]
+fn anymal_contact_points_at_positions_in_link_frames() {
+    let (r, at) = (AnymalMpc::<f64>::default(), AnymalAt::<f64>::default());
+    let rh = *AnymalAtLink::ALL
+        .iter()
+        .find(|l| l.name() == "RH_FOOT")
+        .unwrap();
+    let offset = [0.05, -0.02, 0.01];
+    for seed in 12..16 {
+        let (q, v, tau) = state(seed);
+        let (j, ja) = (r.contact_jacobian(&q), at.contact_jacobian(&q));
+        let (drift, drift_at) = (r.contact_drift(&q, &v), at.contact_drift(&q, &v));
+        // The first three feet: at their origins.
+        assert!(normwise(&flat(&ja)[..9 * NV], &flat(&j)[..9 * NV]) < 1e-14);
+        assert!(normwise(&drift_at[..9], &drift[..9]) < 1e-14);
+        // The fourth: its velocity is the link origin's plus omega x (R offset).
+        let (link_j, pose) = (at.link_jacobian(rh, &q), at.link_pose(rh, &q));
+        let rp: Vec<f64> = (0..3)
+            .map(|i| (0..3).map(|k| pose.rotation[i][k] * offset[k]).sum())
+            .collect();
+        for c in 0..NV {
+            let w = [link_j[3][c], link_j[4][c], link_j[5][c]];
+            let wr = [
+                w[1] * rp[2] - w[2] * rp[1],
+                w[2] * rp[0] - w[0] * rp[2],
+                w[0] * rp[1] - w[1] * rp[0],
+            ];
+            for i in 0..3 {
+                let want = link_j[i][c] + wr[i];
+                assert!(
+                    (ja[9 + i][c] - want).abs() < 1e-13,
+                    "seed {seed}: J[{}][{c}]",
+                    9 + i
+                );
+            }
+        }
+        // Jdot v by central differences of J v along q moving at v.
+        let h = 1e-6;
+        let jv = |q: &[f64; NQ]| -> Vec<f64> {
+            at.contact_jacobian(q)
+                .iter()
+                .map(|row| (0..NV).map(|c| row[c] * v[c]).sum())
+                .collect()
+        };
+        let (plus, minus) = (jv(&at.integrate(&q, &v, h)), jv(&at.integrate(&q, &v, -h)));
+        let fd: Vec<f64> = plus
+            .iter()
+            .zip(&minus)
+            .map(|(p, m)| (p - m) / (2.0 * h))
+            .collect();
+        let e = normwise(&drift_at, &fd);
+        assert!(e < 1e-6, "seed {seed}: drift off by {e:e}");
+        // The contact forces hold the offset point.
+        let (a, _) = at.contact_forward_dynamics(&q, &v, &tau);
+        for k in 9..12 {
+            let acc: f64 = (0..NV).map(|c| ja[k][c] * a[c]).sum::<f64>() + drift_at[k];
+            assert!(
+                acc.abs() < 1e-9,
+                "seed {seed}: row {k} accelerates at {acc}"
+            );
+        }
+    }
 }

@@ -12,7 +12,7 @@ use super::newton_euler::{self, LocalModel, Terms};
 use super::{flat, Derivation};
 use crate::cas::{Graph, Id};
 use crate::kinematics::{cross, mat_vec, vec_add, vec_scale, vec_sub, WorldKinematics, M3, V3};
-use crate::model::Model;
+use crate::model::{Model, Transform};
 
 /// World rotation and origin of every body of the local model (the floating base first when
 /// there is one).
@@ -201,13 +201,20 @@ fn contacts(
         },
         |_, _, _| {},
     );
-    let all = model.contacts.iter().map(|&f| (f, false));
-    let frames = model.contact_frames.iter().map(|&f| (f, true));
+    let origin = [0.0; 3];
+    let points = model.contacts.iter().map(|&f| (f, origin, false));
+    let at = model.contact_points_at.iter().map(|&(f, p)| (f, p, false));
+    let frames = model.contact_frames.iter().map(|&f| (f, origin, true));
     let (mut jac, mut drift) = (Vec::new(), Vec::new());
-    for (f, six) in all.chain(frames) {
+    for (f, offset, six) in points.chain(at).chain(frames) {
         let rows = if six { 6 } else { 3 };
         let frame = &model.frames[f];
-        let (_, position) = wk.frame_pose(g, frame.body, &frame.placement);
+        let placement = Transform {
+            rotation: frame.placement.rotation,
+            translation: frame.placement.translation
+                + frame.placement.rotation * nalgebra::Vector3::from(offset),
+        };
+        let (_, position) = wk.frame_pose(g, frame.body, &placement);
         let full = wk.point_jacobian(g, model, frame.body, &position);
         let Some(body) = frame.body.map(|b| b + shift).or((shift == 1).then_some(0)) else {
             // On a fixed root: the frame never moves.
@@ -216,7 +223,7 @@ fn contacts(
             continue;
         };
         let m = &motions[body];
-        let t = [0, 1, 2].map(|k| g.constant(frame.placement.translation[k]));
+        let t = [0, 1, 2].map(|k| g.constant(placement.translation[k]));
         let dwt = cross(g, &m.dw, &t);
         let wt = cross(g, &m.w, &t);
         let wwt = cross(g, &m.w, &wt);
@@ -309,6 +316,21 @@ pub(super) fn quantities(model: &Model, d: &Derivation) -> Vec<Quantity> {
             order = format!(
                 "Contact points, 3 rows each, in this order: {}.",
                 names(&model.contacts)
+            );
+        }
+        if !model.contact_points_at.is_empty() {
+            let at: Vec<String> = model
+                .contact_points_at
+                .iter()
+                .map(|&(f, p)| {
+                    let name = model.frames[f].name.replace('`', "'");
+                    format!("`{name}` at ({}, {}, {})", p[0], p[1], p[2])
+                })
+                .collect();
+            order += &format!(
+                "{}ontact points in link frames, 3 rows each: {}.",
+                if order.is_empty() { "C" } else { " Then c" },
+                at.join(", ")
             );
         }
         if !model.contact_frames.is_empty() {

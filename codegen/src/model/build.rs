@@ -85,6 +85,10 @@ pub struct ModelOptions {
     /// is held (6 rows: linear, then angular, world axes at the link origin). Their rows come
     /// after the points'. Empty by default.
     pub contact_frames: Vec<String>,
+    /// 3D point contacts at a position in a link's frame (a sole's corners), in order: their
+    /// rows come after those of [`ModelOptions::contact_points`], before the frames'. Empty by
+    /// default.
+    pub contact_points_at: Vec<(String, [f64; 3])>,
     /// Moving joints without an actuator, by URDF name (the acrobot's elbow, a cart-pole's
     /// pole, a passive wrist or toe): the equation of motion becomes `M qdd + b + G = S^T
     /// tau_a` with `S` the `NA x N` selection matrix of the actuated joints
@@ -116,6 +120,7 @@ impl Default for ModelOptions {
             floating_base: false,
             contact_points: Vec::new(),
             contact_frames: Vec::new(),
+            contact_points_at: Vec::new(),
             mimic_joints: false,
             passive_joints: Vec::new(),
         }
@@ -606,6 +611,16 @@ pub(crate) fn build_model(
     mark_symbolic(&mut model, &options.symbolic, file)?;
     model.contacts = contact_frames(&model, &options.contact_points, file)?;
     model.contact_frames = contact_frames(&model, &options.contact_frames, file)?;
+    let at: Vec<String> = options
+        .contact_points_at
+        .iter()
+        .map(|(l, _)| l.clone())
+        .collect();
+    let offsets = options.contact_points_at.iter().map(|(_, p)| *p);
+    model.contact_points_at = contact_frames(&model, &at, file)?
+        .into_iter()
+        .zip(offsets)
+        .collect();
     model.passive = passive_joints(&model, robot, &options.passive_joints, file)?;
     if options.mimic_joints {
         model.coupling = couplings(&model, robot, file)?;
@@ -1255,6 +1270,7 @@ fn merge(
         frames,
         contacts: Vec::new(),
         contact_frames: Vec::new(),
+        contact_points_at: Vec::new(),
         passive: Vec::new(),
         include_friction: options.friction,
         coulomb_smoothing: options.coulomb_smoothing,
