@@ -41,6 +41,7 @@ fn main() {
     deep_chain();
     derivatives();
     floating();
+    contact_dynamics();
     regressors();
     underactuated();
     mimic();
@@ -156,6 +157,62 @@ fn floating() {
         .floating_base()
         .module_name("iris_simple")
         .type_name("IrisSimple")
+        .compile()
+        .unwrap();
+}
+
+/// Contact and impulse dynamics with their derivatives (anymal on its four feet), only what
+/// `tests/contact_dynamics.rs` calls.
+fn contact_dynamics() {
+    eomgen::Builder::new("robots/floating/anymal.urdf")
+        .floating_base()
+        .contact_points(&["LF_FOOT", "RF_FOOT", "LH_FOOT", "RH_FOOT"])
+        .derivatives()
+        .module_name("anymal_mpc")
+        .type_name("AnymalMpc")
+        .quantities([
+            "contact_forward_dynamics",
+            "contact_forward_dynamics_derivatives",
+            "impulse_dynamics",
+            "impulse_dynamics_derivatives",
+            "integrate",
+            "centroidal_map",
+            "center_of_mass",
+            "link_pose",
+        ])
+        .compile()
+        .unwrap();
+    // Contact points away from a link's origin: the last foot's 5 cm off.
+    eomgen::Builder::new("robots/floating/anymal.urdf")
+        .floating_base()
+        .contact_points(&["LF_FOOT", "RF_FOOT"])
+        .contact_point_at("LH_FOOT", [0.0; 3])
+        .contact_point_at("RH_FOOT", [0.05, -0.02, 0.01])
+        .module_name("anymal_at")
+        .type_name("AnymalAt")
+        .quantities([
+            "contact_forward_dynamics",
+            "link_jacobian",
+            "link_pose",
+            "integrate",
+        ])
+        .compile()
+        .unwrap();
+    // 6D contacts at both soles (a humanoid: only what the test calls).
+    eomgen::Builder::new("robots/floating/g1_29dof.urdf")
+        .floating_base()
+        .contact_frames(&["left_ankle_roll_link", "right_ankle_roll_link"])
+        .derivatives()
+        .module_name("g1_mpc")
+        .type_name("G1Mpc")
+        .quantities([
+            "contact_jacobian",
+            "contact_drift",
+            "contact_forward_dynamics",
+            "contact_forward_dynamics_derivatives",
+            "impulse_dynamics",
+            "impulse_dynamics_derivatives",
+        ])
         .compile()
         .unwrap();
 }

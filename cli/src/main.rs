@@ -112,6 +112,14 @@ struct ModelArgs {
     /// contact_jacobian, contact_drift and contact_forward_dynamics
     #[arg(long = "contact", value_name = "LINK")]
     contacts: Vec<String>,
+    /// A 6D contact at the frame of this link (repeatable, in order, after the points): its
+    /// spatial acceleration is held, 6 rows (linear, then angular, world axes)
+    #[arg(long = "contact-frame", value_name = "LINK")]
+    contact_frames: Vec<String>,
+    /// A 3D point contact at a position (m) in the frame of this link (repeatable, in order,
+    /// after the --contact points)
+    #[arg(long = "contact-at", value_name = "LINK:X,Y,Z", allow_hyphen_values = true, value_parser = parse_contact_at)]
+    contacts_at: Vec<(String, [f64; 3])>,
     /// A joint without an actuator (repeatable): adds selection, ACTUATED_JOINT_NAMES and
     /// forward_dynamics_actuated; simulate applies no effort to it
     #[arg(long = "passive", value_name = "JOINT")]
@@ -148,6 +156,8 @@ impl ModelArgs {
             repair_inertia: self.repair_inertia,
             floating_base: self.floating_base,
             contact_points: self.contacts.clone(),
+            contact_frames: self.contact_frames.clone(),
+            contact_points_at: self.contacts_at.clone(),
             passive_joints: self.passive.clone(),
             mimic_joints: self.mimic,
         }
@@ -186,6 +196,13 @@ fn cli_error(e: eomgen::Error) -> Failure {
         .into(),
         e => e.into(),
     }
+}
+
+fn parse_contact_at(s: &str) -> Result<(String, [f64; 3]), String> {
+    let Some((link, at)) = s.rsplit_once(':') else {
+        return Err(format!("expected LINK:X,Y,Z, got `{s}`"));
+    };
+    Ok((link.to_string(), parse_vec3(at)?))
 }
 
 fn parse_armature(s: &str) -> Result<(String, f64), String> {

@@ -370,6 +370,29 @@ impl Builder {
         self
     }
 
+    /// A 6D contact at each named link's frame (a sole held flat), in this order, after the
+    /// points of [`Builder::contact_points`]: the frame's spatial acceleration is held
+    /// (Pinocchio's `getFrameAcceleration` in LOCAL_WORLD_ALIGNED: the linear part is the
+    /// origin's classical acceleration minus `omega x` its velocity), 6 rows (linear, then
+    /// angular, world axes at the link origin) in `contact_jacobian` and `contact_drift`, and a
+    /// force then a torque about the origin in the contact forces. An unknown link is
+    /// [`crate::model::ModelError::UnknownContactLink`].
+    pub fn contact_frames<S: AsRef<str>>(mut self, links: &[S]) -> Builder {
+        self.options.contact_frames = links.iter().map(|l| l.as_ref().to_string()).collect();
+        self
+    }
+
+    /// A 3D point contact at `position` (metres, in the link's frame) on the link `link`, such
+    /// as a corner of a sole; repeatable, in order. Its rows come after those of
+    /// [`Builder::contact_points`] and before the frames of [`Builder::contact_frames`]. An
+    /// unknown link is [`crate::model::ModelError::UnknownContactLink`].
+    pub fn contact_point_at(mut self, link: &str, position: [f64; 3]) -> Builder {
+        self.options
+            .contact_points_at
+            .push((link.to_string(), position));
+        self
+    }
+
     /// Honours the URDF's mimic joints (`<mimic joint=".." multiplier=".." offset=".."/>`,
     /// as grippers and hands couple their fingers): a mimic joint is then no coordinate of
     /// its own but follows the joint it mimics, `q_mimic = multiplier q_joint + offset`, for

@@ -112,6 +112,13 @@ fn flags(o: &ModelOptions) -> Vec<(&'static str, Option<String>)> {
     for link in &o.contact_points {
         f.push(("contact", Some(link.clone())));
     }
+    for (link, p) in &o.contact_points_at {
+        let at = format!("{link}:{},{},{}", p[0], p[1], p[2]);
+        f.push(("contact-at", Some(at)));
+    }
+    for link in &o.contact_frames {
+        f.push(("contact-frame", Some(link.clone())));
+    }
     for joint in &o.passive_joints {
         f.push(("passive", Some(joint.clone())));
     }

@@ -9,12 +9,14 @@
 //! `robot.hamilton(&q, &p, &tau)` on every robot that implements `Dynamics`), [`Real`] (the
 //! scalar trait, for code generic over `f32` and `f64`), and the types generated methods return: [`Pose`] (from `link_pose`) and
 //! [`FactorError`] (from `try_forward_dynamics`); for floating-base robots
-//! [`FloatingDynamics`] and, with contact points, [`Contacts`]; and [`Dimensions`] (`DOF`, `NQ`,
+//! [`FloatingDynamics`] and, with contact points, [`Contacts`] (and the derivatives' types
+//! [`ContactDynamicsDerivatives`], [`ImpulseDynamicsDerivatives`]); and [`Dimensions`] (`DOF`, `NQ`,
 //! `NV` for any scalar type).
 //!
 //! The prelude is part of the public API: items are added to it only in minor versions and
 //! never removed outside a major one.
 
 pub use crate::{
-    Contacts, Dimensions, Dynamics, FactorError, FloatingDynamics, Hamiltonian, Pose, Real,
+    ContactDynamicsDerivatives, Contacts, Dimensions, Dynamics, FactorError, FloatingDynamics,
+    Hamiltonian, ImpulseDynamicsDerivatives, Pose, Real,
 };

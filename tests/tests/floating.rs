@@ -6,48 +6,9 @@
 #![allow(clippy::needless_range_loop)]
 
 use eomgen_runtime::prelude::*;
+use eomgen_tests::floating_reference::{flat, normwise, numbers, pick, reference, Order};
 use eomgen_tests::robots::{anymal, anymal_derivatives, anymal_weightless, iris_simple};
 use serde_json::Value;
-
-fn reference(name: &str) -> Value {
-    let path = format!("{}/robots/floating/{name}.json", env!("CARGO_MANIFEST_DIR"));
-    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
-}
-
-fn numbers(v: &Value) -> Vec<f64> {
-    match v {
-        Value::Array(a) => a.iter().flat_map(numbers).collect(),
-        Value::Number(n) => vec![n.as_f64().unwrap()],
-        _ => panic!("not a number: {v}"),
-    }
-}
-
-/// Our coordinate `i` is the reference's `map[i]` (base first, joints matched by name).
-struct Order {
-    q: Vec<usize>,
-    v: Vec<usize>,
-}
-
-impl Order {
-    fn new(doc: &Value, ours: &[&str]) -> Order {
-        let refs: Vec<&str> = doc["joints"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|j| j.as_str().unwrap())
-            .collect();
-        let pos = |n: &&str| refs.iter().position(|r| r == n).unwrap();
-        Order {
-            q: (0..7).chain(ours.iter().map(|n| 7 + pos(n))).collect(),
-            v: (0..6).chain(ours.iter().map(|n| 6 + pos(n))).collect(),
-        }
-    }
-
-    fn arr<const N: usize>(map: &[usize], v: &Value) -> [f64; N] {
-        let v = numbers(v);
-        core::array::from_fn(|i| v[map[i]])
-    }
-}
 
 /// Elementwise `|a - b| / max(1, |b|)` of ours (in our order) against the reference's.
 fn elementwise(ours: &[f64], reference: &[f64]) -> f64 {
@@ -57,32 +18,9 @@ fn elementwise(ours: &[f64], reference: &[f64]) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// `max |a - b| / max(1, max |b|)`.
-fn normwise(ours: &[f64], reference: &[f64]) -> f64 {
-    let scale = reference.iter().fold(1.0_f64, |m, x| m.max(x.abs()));
-    ours.iter()
-        .zip(reference)
-        .map(|(a, b)| (a - b).abs())
-        .fold(0.0, f64::max)
-        / scale
-}
-
-/// Reorders a reference matrix (rows `rows`, columns `cols`) into a flat vector.
-fn pick(m: &Value, rows: &[usize], cols: &[usize]) -> Vec<f64> {
-    let m: Vec<Vec<f64>> = m.as_array().unwrap().iter().map(numbers).collect();
-    rows.iter()
-        .flat_map(|&r| cols.iter().map(move |&c| (r, c)))
-        .map(|(r, c)| m[r][c])
-        .collect()
-}
-
-fn flat<const R: usize, const C: usize>(m: &[[f64; C]; R]) -> Vec<f64> {
-    m.iter().flatten().copied().collect()
-}
-
 macro_rules! check_floating {
     ($name:literal, $module:ident, $ty:ident, $link:ident, $nq:literal, $nv:literal $(, $extra:ident)?) => {{
-        let doc = reference($name);
+        let doc = reference(&format!("{}.json", $name));
         let r = $module::$ty::<f64>::default();
         let o = Order::new(&doc, &$module::$ty::<f64>::JOINT_NAMES);
         let all3: Vec<usize> = (0..3).collect();
@@ -368,7 +306,7 @@ fn frobenius(ours: &[f64], reference: &[f64]) -> f64 {
 
 #[test]
 fn anymal_derivatives_match_pinocchio() {
-    let doc = reference("anymal");
+    let doc = reference("anymal.json");
     let r = anymal_derivatives::AnymalDerivatives::<f64>::default();
     let o = Order::new(
         &doc,

@@ -30,6 +30,24 @@ impl Graph {
         self.derive(roots, |_, s| if s == sx { one } else { zero })
     }
 
+    /// The derivatives of several expressions along a direction in which each symbol node
+    /// `x` of `rates` moves at the rate `dx` (an expression; symbols not listed stay fixed):
+    /// `sum_x de/dx dx`, for perturbations that are not along one coordinate (a floating
+    /// base's tangent space).
+    ///
+    /// # Panics
+    /// If a listed `x` is not a symbol.
+    pub fn derivative_along_many(&mut self, roots: &[Id], rates: &[(Id, Id)]) -> Vec<Id> {
+        let rates: Vec<(SymbolIndex, Id)> = rates
+            .iter()
+            .map(|&(x, dx)| (self.as_symbol(x).expect("derivative_along: a symbol"), dx))
+            .collect();
+        let zero = self.zero();
+        self.derive(roots, |_, s| {
+            rates.iter().find(|r| r.0 == s).map_or(zero, |r| r.1)
+        })
+    }
+
     /// The total time derivative, with `d q_i/dt = qd_i` and `d qd_i/dt = qdd_i`. Parameters are
     /// constant in time; accelerations have no derivative here (treated as constant).
     pub fn time_derivative(&mut self, e: Id) -> Id {

@@ -74,6 +74,13 @@ pub struct Symbol {
     pub kind: SymbolKind,
 }
 
+impl Symbol {
+    /// Whether this is a contact force of [`Graph::force`] rather than a joint effort.
+    pub fn is_force(&self) -> bool {
+        matches!(self.kind, SymbolKind::Tau(_)) && self.name.starts_with("force")
+    }
+}
+
 /// Index of a symbol in [`Graph::symbols`].
 pub type SymbolIndex = u32;
 
@@ -381,6 +388,13 @@ impl Graph {
     /// Joint effort `tau_i`, printed `tau{i+1}`.
     pub fn tau(&mut self, i: usize) -> Id {
         self.symbol(&format!("tau{}", i + 1), SymbolKind::Tau(i))
+    }
+
+    /// A contact force `F_i` (an input of the contact derivatives' partials), printed
+    /// `force{i+1}`: a symbol of kind `Tau(i)` under its own name, which generated code reads
+    /// from its `forces` argument ([`Symbol::is_force`]).
+    pub fn force(&mut self, i: usize) -> Id {
+        self.symbol(&format!("force{}", i + 1), SymbolKind::Tau(i))
     }
 
     /// A named parameter.

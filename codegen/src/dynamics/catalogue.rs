@@ -18,6 +18,8 @@ pub enum Input {
     Qdd,
     /// Joint efforts `tau`.
     Tau,
+    /// Contact forces (K, the contact rows), read by the symbols of `Graph::force`.
+    Forces,
 }
 
 impl Input {
@@ -28,6 +30,7 @@ impl Input {
             Input::Qd => "qd",
             Input::Qdd => "qdd",
             Input::Tau => "tau",
+            Input::Forces => "forces",
         }
     }
 }
@@ -125,6 +128,16 @@ pub enum Evaluation {
     FrameMotion(super::FrameMotion),
     /// `difference` or a Jacobian of `integrate` or `difference` (`eomgen_runtime::manifold`).
     Manifold(super::Manifold),
+    /// The derivatives of the contact forward dynamics, solved at run time: `h` straight-line,
+    /// then `eomgen_runtime::ContactKkt` from `mass_matrix` and `contact_jacobian`, the
+    /// accelerations and forces, `inverse_dynamics_derivatives` there and
+    /// `contact_dynamics_partials`.
+    ContactDynamicsDerivatives { h: Vec<Id> },
+    /// The velocity after an impact and the contact impulses, solved at run time
+    /// (`eomgen_runtime::ContactKkt::impulse` from `mass_matrix` and `contact_jacobian`).
+    ImpulseDynamics,
+    /// The derivatives of `ImpulseDynamics`, from `impulse_dynamics_partials`.
+    ImpulseDynamicsDerivatives,
 }
 
 /// One generated function.
@@ -156,9 +169,9 @@ impl Quantity {
                 accelerations,
                 pivots,
             } => accelerations.iter().chain(pivots).copied().collect(),
-            Evaluation::ForwardDynamicsSolve { h } | Evaluation::ContactForwardDynamics { h } => {
-                h.clone()
-            }
+            Evaluation::ForwardDynamicsSolve { h }
+            | Evaluation::ContactForwardDynamics { h }
+            | Evaluation::ContactDynamicsDerivatives { h } => h.clone(),
             Evaluation::Factored { outputs, pivots } => {
                 outputs.iter().chain(pivots).copied().collect()
             }
@@ -181,6 +194,19 @@ impl Quantity {
             Evaluation::ContactForwardDynamics { .. } => {
                 &["mass_matrix", "contact_jacobian", "contact_drift"]
             }
+            Evaluation::ContactDynamicsDerivatives { .. } => &[
+                "mass_matrix",
+                "contact_jacobian",
+                "contact_drift",
+                "inverse_dynamics_derivatives",
+                "contact_dynamics_partials",
+            ],
+            Evaluation::ImpulseDynamics => &["mass_matrix", "contact_jacobian"],
+            Evaluation::ImpulseDynamicsDerivatives => &[
+                "mass_matrix",
+                "contact_jacobian",
+                "impulse_dynamics_partials",
+            ],
             Evaluation::ForwardDynamicsDerivatives => &[
                 "mass_matrix",
                 "inverse_dynamics",

@@ -12,7 +12,7 @@ use super::newton_euler::{self, LocalModel, Terms};
 use super::{flat, Derivation};
 use crate::cas::{Graph, Id};
 use crate::kinematics::{cross, mat_vec, vec_add, vec_scale, vec_sub, WorldKinematics, M3, V3};
-use crate::model::Model;
+use crate::model::{Model, Transform};
 
 /// World rotation and origin of every body of the local model (the floating base first when
 /// there is one).
@@ -177,9 +177,11 @@ fn centroidal_map(
     (ag, jcom)
 }
 
-/// The contact points' Jacobian (3K x nv: linear rows of each contact link's Jacobian, world
-/// axes) and drift `Jdot v` (the classical acceleration of the points at zero generalized
-/// acceleration, world axes), with `q`, `v` the coordinate symbols.
+/// The contacts' Jacobian (K x nv, world axes: the linear rows of each contact point's link
+/// Jacobian, then all six of each 6D contact frame's) and drift, the constrained acceleration at
+/// zero generalized acceleration: a point's classical acceleration (`Jdot v`), a frame's spatial
+/// acceleration (linear part: the origin's classical acceleration minus `omega x` its
+/// velocity, as Pinocchio's `getFrameAcceleration`), with `q`, `v` the coordinate symbols.
 fn contacts(
     g: &mut Graph,
     model: &Model,
@@ -199,25 +201,45 @@ fn contacts(
         },
         |_, _, _| {},
     );
-    let mut jac = Vec::with_capacity(3 * model.contacts.len());
-    let mut drift = Vec::with_capacity(3 * model.contacts.len());
-    for &f in &model.contacts {
+    let origin = [0.0; 3];
+    let points = model.contacts.iter().map(|&f| (f, origin, false));
+    let at = model.contact_points_at.iter().map(|&(f, p)| (f, p, false));
+    let frames = model.contact_frames.iter().map(|&f| (f, origin, true));
+    let (mut jac, mut drift) = (Vec::new(), Vec::new());
+    for (f, offset, six) in points.chain(at).chain(frames) {
+        let rows = if six { 6 } else { 3 };
         let frame = &model.frames[f];
-        let (_, position) = wk.frame_pose(g, frame.body, &frame.placement);
+        let placement = Transform {
+            rotation: frame.placement.rotation,
+            translation: frame.placement.translation
+                + frame.placement.rotation * nalgebra::Vector3::from(offset),
+        };
+        let (_, position) = wk.frame_pose(g, frame.body, &placement);
         let full = wk.point_jacobian(g, model, frame.body, &position);
-        jac.extend(full.into_iter().take(3));
         let Some(body) = frame.body.map(|b| b + shift).or((shift == 1).then_some(0)) else {
-            // On a fixed root: the point never moves.
-            drift.extend([g.zero(); 3]);
+            // On a fixed root: the frame never moves.
+            jac.extend(full.into_iter().take(rows));
+            drift.extend(vec![g.zero(); rows]);
             continue;
         };
         let m = &motions[body];
-        let t = [0, 1, 2].map(|k| g.constant(frame.placement.translation[k]));
+        let t = [0, 1, 2].map(|k| g.constant(placement.translation[k]));
         let dwt = cross(g, &m.dw, &t);
         let wt = cross(g, &m.w, &t);
         let wwt = cross(g, &m.w, &wt);
         let a = [0, 1, 2].map(|k| g.add_all([m.acc[k], dwt[k], wwt[k]]));
-        drift.extend(mat_vec(g, &poses[body].0, &a));
+        let r = &poses[body].0;
+        let classical = mat_vec(g, r, &a);
+        if six {
+            let w = mat_vec(g, r, &m.w);
+            let velocity = [0, 1, 2].map(|k| g.dot(&full[k], v));
+            let wv = cross(g, &w, &velocity);
+            drift.extend(vec_sub(g, &classical, &wv));
+            drift.extend(mat_vec(g, r, &m.dw));
+        } else {
+            drift.extend(classical);
+        }
+        jac.extend(full.into_iter().take(rows));
     }
     (jac, drift)
 }
@@ -282,15 +304,42 @@ pub(super) fn quantities(model: &Model, d: &Derivation) -> Vec<Quantity> {
     }
     let k3 = c.contact_drift.len();
     if k3 > 0 {
-        let names: Vec<String> = model
-            .contacts
-            .iter()
-            .map(|&f| format!("`{}`", model.frames[f].name.replace('`', "'")))
-            .collect();
-        let order = format!(
-            "Contact points, 3 rows each, in this order: {}.",
+        let names = |frames: &[usize]| -> String {
+            let names: Vec<String> = frames
+                .iter()
+                .map(|&f| format!("`{}`", model.frames[f].name.replace('`', "'")))
+                .collect();
             names.join(", ")
-        );
+        };
+        let mut order = String::new();
+        if !model.contacts.is_empty() {
+            order = format!(
+                "Contact points, 3 rows each, in this order: {}.",
+                names(&model.contacts)
+            );
+        }
+        if !model.contact_points_at.is_empty() {
+            let at: Vec<String> = model
+                .contact_points_at
+                .iter()
+                .map(|&(f, p)| {
+                    let name = model.frames[f].name.replace('`', "'");
+                    format!("`{name}` at ({}, {}, {})", p[0], p[1], p[2])
+                })
+                .collect();
+            order += &format!(
+                "{}ontact points in link frames, 3 rows each: {}.",
+                if order.is_empty() { "C" } else { " Then c" },
+                at.join(", ")
+            );
+        }
+        if !model.contact_frames.is_empty() {
+            order += &format!(
+                "{}6D contact frames, 6 rows each (linear, then angular; the drift is the frame's spatial acceleration), in this order: {}.",
+                if order.is_empty() { "" } else { " Then " },
+                names(&model.contact_frames)
+            );
+        }
         out.push(quantity(
             "contact_jacobian",
             Q,

@@ -14,6 +14,7 @@
 pub mod base_parameters;
 pub mod catalogue;
 mod centroidal;
+mod contact_derivatives;
 pub mod coupling;
 mod derivatives;
 mod floating;
@@ -404,13 +405,21 @@ impl Derivation {
 
     /// Adds the derivatives of the dynamics to the catalogue: `inverse_dynamics_derivatives`
     /// by the recursive algorithm of [`rnea_derivatives`], `mass_matrix_inverse` and
-    /// `forward_dynamics_derivatives` through one factorization of `M` (see `derivatives.rs`).
+    /// `forward_dynamics_derivatives` through one factorization of `M` (see `derivatives.rs`);
+    /// with contacts, the derivatives of contact and impulse dynamics
+    /// (`contact_derivatives.rs`).
     /// Fails when the graph fills.
     pub fn add_derivatives(&mut self, model: &Model) -> Result<(), GraphFull> {
         let derived = derivatives::derive(self, model);
         self.graph.check()?;
         let extra = quantities::derivatives(self, &derived);
         self.quantities.extend(extra);
+        if !self.centroidal.contact_drift.is_empty() {
+            let partials = contact_derivatives::derive(self, model);
+            self.graph.check()?;
+            let extra = contact_derivatives::quantities(self, &partials);
+            self.quantities.extend(extra);
+        }
         Ok(())
     }
 

@@ -69,6 +69,10 @@ impl Ctx<'_> {
                 let i = idx(i);
                 quote!(qd[#i])
             }
+            (SymbolKind::Tau(i), None) if sym.is_force() => {
+                let i = idx(i);
+                quote!(forces[#i])
+            }
             (SymbolKind::Tau(i), None) => {
                 let i = idx(i);
                 quote!(tau[#i])

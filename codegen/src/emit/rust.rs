@@ -5,6 +5,8 @@
 //! One emitter method per generated item, as prost-build's code generator does it: the
 //! parameter fields, the link enum, each kind of [`Evaluation`], the trait implementation.
 
+mod contact;
+
 use std::collections::BTreeMap;
 
 use proc_macro2::{Ident, Literal, TokenStream};
@@ -98,6 +100,8 @@ struct Emitter<'a> {
     nq: Literal,
     /// Whether the root is a floating base.
     floating: bool,
+    /// The number of contact rows (the length of a `forces` argument).
+    k: Literal,
     /// Each velocity coordinate's parent coordinate.
     parents: Vec<Option<usize>>,
     /// Whether every `Dynamics` method is generated, so that the trait is implemented (and
@@ -172,6 +176,7 @@ pub fn emit_tokens(
         n: usize_lit(d.dof),
         nq: usize_lit(d.nq),
         floating: model.is_floating(),
+        k: usize_lit(d.centroidal.contact_drift.len()),
         parents: d.coordinate_parents.clone(),
         in_trait: d
             .quantities
@@ -438,7 +443,11 @@ impl Emitter<'_> {
             .iter()
             .map(|i| {
                 let name = format_ident!("{}", i.name());
-                let len = if *i == Input::Q { &self.nq } else { &self.n };
+                let len = match i {
+                    Input::Q => &self.nq,
+                    Input::Forces => &self.k,
+                    _ => &self.n,
+                };
                 quote!(#name: &[T; #len])
             })
             .collect()
@@ -497,6 +506,11 @@ impl Emitter<'_> {
             Evaluation::Integrate => self.integrate_fn(q),
             Evaluation::FrameMotion(m) => self.frame_motion_fn(q, *m),
             Evaluation::Manifold(m) => self.manifold_fn(q, *m),
+            Evaluation::ContactDynamicsDerivatives { h } => {
+                self.contact_dynamics_derivatives_fns(q, h)
+            }
+            Evaluation::ImpulseDynamics => self.impulse_dynamics_fns(q),
+            Evaluation::ImpulseDynamicsDerivatives => self.impulse_dynamics_derivatives_fns(q),
             Evaluation::Factored { outputs, pivots } => self.factored_fn(q, outputs, pivots),
         }
     }
@@ -682,6 +696,9 @@ impl Emitter<'_> {
                     | Evaluation::MassMatrixInverse
                     | Evaluation::ForwardDynamicsDerivatives
                     | Evaluation::ContactForwardDynamics { .. }
+                    | Evaluation::ContactDynamicsDerivatives { .. }
+                    | Evaluation::ImpulseDynamics
+                    | Evaluation::ImpulseDynamicsDerivatives
             )
         })
     }

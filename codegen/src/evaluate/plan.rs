@@ -75,6 +75,15 @@ impl Plan {
                 ))),
             }
         };
+        let not = |why: &'static str| {
+            Err(EvalError::NotEvaluable {
+                name: q.name.to_string(),
+                why,
+            })
+        };
+        if q.inputs.contains(&crate::dynamics::Input::Forces) {
+            return not("it takes contact forces besides the state");
+        }
         Ok(match &q.eval {
             Evaluation::Exprs(ids) => Plan::Exprs(tape(ids)?),
             Evaluation::Factored { outputs, pivots }
@@ -112,16 +121,17 @@ impl Plan {
             | Evaluation::LinkJacobian
             | Evaluation::FrameMotion(_)
             | Evaluation::Integrate => {
-                return Err(EvalError::NotEvaluable {
-                    name: q.name.to_string(),
-                    why: "it takes a link or a time step besides the state",
-                })
+                return not("it takes a link or a time step besides the state")
             }
-            Evaluation::Manifold(_) => return Err(EvalError::NotEvaluable {
-                name: q.name.to_string(),
-                why:
-                    "it is the configuration space's geometry, computed by eomgen_runtime::manifold",
-            }),
+            Evaluation::ImpulseDynamics | Evaluation::ImpulseDynamicsDerivatives => {
+                return not("it takes a restitution besides the state")
+            }
+            Evaluation::ContactDynamicsDerivatives { .. } => {
+                return not("the evaluator does not compose the contact KKT derivatives yet")
+            }
+            Evaluation::Manifold(_) => {
+                return not("it is the configuration space's geometry (eomgen_runtime::manifold)")
+            }
         })
     }
 

@@ -81,6 +81,14 @@ pub struct ModelOptions {
     /// (`contact_jacobian` rows, contact forces). Links merged into their parent by fixed joints
     /// keep their own names (feet usually are such links). Empty by default.
     pub contact_points: Vec<String>,
+    /// Links with a 6D contact (a foot's sole held flat): the link frame's spatial acceleration
+    /// is held (6 rows: linear, then angular, world axes at the link origin). Their rows come
+    /// after the points'. Empty by default.
+    pub contact_frames: Vec<String>,
+    /// 3D point contacts at a position in a link's frame (a sole's corners), in order: their
+    /// rows come after those of [`ModelOptions::contact_points`], before the frames'. Empty by
+    /// default.
+    pub contact_points_at: Vec<(String, [f64; 3])>,
     /// Moving joints without an actuator, by URDF name (the acrobot's elbow, a cart-pole's
     /// pole, a passive wrist or toe): the equation of motion becomes `M qdd + b + G = S^T
     /// tau_a` with `S` the `NA x N` selection matrix of the actuated joints
@@ -111,6 +119,8 @@ impl Default for ModelOptions {
             inertia_from_collision: None,
             floating_base: false,
             contact_points: Vec::new(),
+            contact_frames: Vec::new(),
+            contact_points_at: Vec::new(),
             mimic_joints: false,
             passive_joints: Vec::new(),
         }
@@ -402,7 +412,8 @@ pub enum ModelError {
     /// [`SymbolicParams::Links`] names a link that does not exist.
     #[error("{file}: symbolic parameters requested for link `{link}`, which does not exist")]
     UnknownSymbolicLink { file: String, link: String },
-    /// [`ModelOptions::contact_points`] names a link that does not exist.
+    /// [`ModelOptions::contact_points`] or [`ModelOptions::contact_frames`] names a link that
+    /// does not exist.
     #[error("{file}: contact point requested at link `{link}`, which does not exist")]
     UnknownContactLink { file: String, link: String },
     /// [`ModelOptions::armature`] names a joint that does not exist or is fixed, or gives a
@@ -599,6 +610,17 @@ pub(crate) fn build_model(
     }
     mark_symbolic(&mut model, &options.symbolic, file)?;
     model.contacts = contact_frames(&model, &options.contact_points, file)?;
+    model.contact_frames = contact_frames(&model, &options.contact_frames, file)?;
+    let at: Vec<String> = options
+        .contact_points_at
+        .iter()
+        .map(|(l, _)| l.clone())
+        .collect();
+    let offsets = options.contact_points_at.iter().map(|(_, p)| *p);
+    model.contact_points_at = contact_frames(&model, &at, file)?
+        .into_iter()
+        .zip(offsets)
+        .collect();
     model.passive = passive_joints(&model, robot, &options.passive_joints, file)?;
     if options.mimic_joints {
         model.coupling = couplings(&model, robot, file)?;
@@ -1247,6 +1269,8 @@ fn merge(
         base,
         frames,
         contacts: Vec::new(),
+        contact_frames: Vec::new(),
+        contact_points_at: Vec::new(),
         passive: Vec::new(),
         include_friction: options.friction,
         coulomb_smoothing: options.coulomb_smoothing,

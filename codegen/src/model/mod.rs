@@ -216,6 +216,13 @@ pub struct Model {
     /// The frames (indices into [`Model::frames`]) with a 3D point contact at their origin
     /// ([`ModelOptions::contact_points`]), in order.
     pub contacts: Vec<usize>,
+    /// The frames with a 6D contact ([`ModelOptions::contact_frames`]), in order: their rows
+    /// follow the points'.
+    pub contact_frames: Vec<usize>,
+    /// The point contacts at a position in a link's frame
+    /// ([`ModelOptions::contact_points_at`]): the link's frame and the position, in order; their
+    /// rows follow those of [`Model::contacts`].
+    pub contact_points_at: Vec<(usize, [f64; 3])>,
     /// The joints without an actuator ([`ModelOptions::passive_joints`]), as indices into
     /// [`Model::joints`], ascending; empty when every joint is actuated.
     pub passive: Vec<usize>,

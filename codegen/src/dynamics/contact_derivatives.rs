@@ -1,0 +1,235 @@
+//! Contact and impulse dynamics with their derivatives: the partial derivatives generated code
+//! needs, as straight-line expressions, and the catalogue entries that solve the contact
+//! problem's KKT system at run time (`eomgen_runtime::ContactKkt`).
+//!
+//! Contact forward dynamics solves `M a + h - J^T f = tau`, `J a + drift = 0`. Differentiating
+//! in `x` (`q` in its tangent space, or `v`) at the solution gives the KKT system
+//! `[M -J^T; J 0] [da; df] = -[d/dx (ID(q, v, a) - J^T f); d/dx (J a + drift)]`, the
+//! derivatives taken at fixed `a` and `f`. `d ID / dx` is `inverse_dynamics_derivatives`;
+//! the rest, `d(-J^T f)/dq`, `d(J a + drift)/dq` and `d drift/dv`, is generated here
+//! (`contact_dynamics_partials`) by differentiating the contact Jacobian and drift along each
+//! tangent direction of `q` ([`Graph::derivative_along_many`]), with the contact forces as
+//! symbols ([`Graph::force`]). They involve only the contacts' chains, so they are small.
+//!
+//! Impulse dynamics solves `M (v+ - v) - J^T p = 0`, `J (v+ + e v) = 0`; its `q`-partials
+//! (`impulse_dynamics_partials`) are `d(M x)/dq` (Newton-Euler's derivatives at zero velocity
+//! and gravity, `x = v+ - v`) plus `d(-J^T p)/dq`, and `d(J w)/dq` (`w = v+ + e v`).
+
+use super::catalogue::{Evaluation, Input, Quantity, Shape};
+use super::centroidal::quantity;
+use super::newton_euler::LocalModel;
+use super::rnea_derivatives::inverse_dynamics_derivatives;
+use super::{flat, CoordinateMap, Derivation};
+use crate::cas::{Graph, Id};
+use crate::kinematics::{joint, Params};
+use crate::model::Model;
+
+/// The partial derivatives of the contact and impulse problems, as stacked matrices (rows
+/// below, N columns: the velocity coordinates).
+#[derive(Clone, Debug)]
+pub struct ContactPartials {
+    /// `d(-J^T f)/dq` (N rows), `d(J qdd + drift)/dq` (K rows), `d drift/dqd` (K rows), with
+    /// `qdd` and `f` (the `force` symbols) held fixed.
+    pub contact: Vec<Vec<Id>>,
+    /// `d(M qdd - J^T f)/dq` (N rows), `d(J qd)/dq` (K rows), with `qdd`, `qd`, `f` fixed.
+    pub impulse: Vec<Vec<Id>>,
+}
+
+/// Per velocity coordinate, the rate of each position symbol when `q` moves along it as
+/// Pinocchio's `integrate` moves it: a floating base's translation in base axes (`dp = R e_k`)
+/// and rotation in base axes (`d quat = quat (x) (e_k / 2, 0)`), then the joints' coordinates.
+fn tangent_directions(g: &mut Graph, model: &Model, q: &[Id], nv: usize) -> Vec<Vec<(Id, Id)>> {
+    let mut out = Vec::with_capacity(nv);
+    let (base_nq, base_nv) = if model.is_floating() { (7, 6) } else { (0, 0) };
+    if model.is_floating() {
+        let r = joint::free_flyer_placement(g, &q[..7]).rotation;
+        for k in 0..3 {
+            out.push((0..3).map(|i| (q[i], r[i][k])).collect());
+        }
+        let v = [q[3], q[4], q[5]];
+        let w = q[6];
+        for k in 0..3 {
+            // vector part (w e_k + v x e_k) / 2, scalar part -v_k / 2
+            let mut rates: Vec<(Id, Id)> = (0..3)
+                .map(|i| {
+                    let (a, b) = ((i + 1) % 3, (i + 2) % 3);
+                    let cross = if b == k {
+                        g.scale(v[a], 0.5)
+                    } else if a == k {
+                        g.scale(v[b], -0.5)
+                    } else {
+                        g.zero()
+                    };
+                    let own = if i == k { g.scale(w, 0.5) } else { g.zero() };
+                    (v[i], g.add(cross, own))
+                })
+                .collect();
+            rates.push((w, g.scale(v[k], -0.5)));
+            out.push(rates);
+        }
+    }
+    for j in 0..nv - base_nv {
+        out.push(vec![(q[base_nq + j], g.one())]);
+    }
+    out
+}
+
+/// `d(M(q) x)/dq` for the symbols `x` (here `qdd`): Newton-Euler's derivatives at zero
+/// velocity and gravity, projected onto the coordinates when joints are coupled.
+fn mass_times_derivative(g: &mut Graph, model: &Model, q: &[Id], x: &[Id]) -> Vec<Vec<Id>> {
+    let params = Params::new(g, model);
+    let map = CoordinateMap::new(model);
+    let joint_q = map.positions(g, q);
+    let joint_x = map.rates(g, x);
+    let lm = LocalModel::new(g, model, &params, &joint_q);
+    let zero3 = [g.zero(); 3];
+    let zeros = vec![g.zero(); joint_x.len()];
+    let r = inverse_dynamics_derivatives(g, &lm, zero3, &zeros, &joint_x, &zeros);
+    if map.is_coupled() {
+        map.project_matrix(g, &r.dq, false)
+    } else {
+        r.dq
+    }
+}
+
+/// Derives the partials for `model`'s contacts in `d`'s graph.
+pub fn derive(d: &mut Derivation, model: &Model) -> ContactPartials {
+    let n = d.dof;
+    let jac = d.centroidal.contact_jacobian.clone();
+    let drift = d.centroidal.contact_drift.clone();
+    let k = drift.len();
+    let (q, qd, qdd) = (d.q.clone(), d.qd.clone(), d.qdd.clone());
+    let g = &mut d.graph;
+    let f: Vec<Id> = (0..k).map(|i| g.force(i)).collect();
+    let mut roots: Vec<Id> = (0..n)
+        .map(|c| {
+            let column: Vec<Id> = (0..k).map(|r| jac[r][c]).collect();
+            let jf = g.dot(&column, &f);
+            g.neg(jf)
+        })
+        .collect();
+    for r in 0..k {
+        let ja = g.dot(&jac[r], &qdd);
+        roots.push(g.add(ja, drift[r]));
+    }
+    for row in &jac {
+        roots.push(g.dot(row, &qd));
+    }
+    let zero = g.zero();
+    let mut contact = vec![vec![zero; n]; n + 2 * k];
+    let mut impulse = vec![vec![zero; n]; n + k];
+    for (c, direction) in tangent_directions(g, model, &q, n).iter().enumerate() {
+        let dr = g.derivative_along_many(&roots, direction);
+        for i in 0..n + k {
+            contact[i][c] = dr[i];
+        }
+        for r in 0..k {
+            impulse[n + r][c] = dr[n + k + r];
+        }
+    }
+    for (c, &v) in qd.iter().enumerate() {
+        let dr = g.diff_many(&drift, v);
+        for r in 0..k {
+            contact[n + k + r][c] = dr[r];
+        }
+    }
+    let mx = mass_times_derivative(g, model, &q, &qdd);
+    for i in 0..n {
+        for c in 0..n {
+            impulse[i][c] = g.add(mx[i][c], contact[i][c]);
+        }
+    }
+    ContactPartials { contact, impulse }
+}
+
+const PARTIAL_INPUTS: &[Input] = &[Input::Q, Input::Qd, Input::Qdd, Input::Forces];
+
+/// `impulse_dynamics` (robots with contacts), in the catalogue after the contact quantities.
+pub(super) fn impulse_dynamics(d: &Derivation) -> Option<Quantity> {
+    let (n, k) = (d.dof, d.centroidal.contact_drift.len());
+    (k > 0).then(|| quantity(
+        "impulse_dynamics",
+        &[Input::Q, Input::Qd],
+        Shape::Vector(n + k),
+        &[
+            "Impulse dynamics: the velocity after an impact at the contacts and the contact impulses",
+            "(on the robot, world axes) of `M (v_after - qd) = J_c^T p`, `J_c v_after = -e J_c qd`,",
+            "from the velocity before `qd` and the restitution `e` (0: the contacts stop).",
+            "",
+            "NaN in every entry when M(q) is not positive definite or J_c is rank-deficient;",
+            "`try_impulse_dynamics` says why.",
+        ],
+        "M from `mass_matrix`, J_c from `contact_jacobian`, then the runtime's sparse L^T D L of M and a Cholesky factorization of J_c M^-1 J_c^T (eomgen_runtime::ContactKkt::impulse)",
+        Evaluation::ImpulseDynamics,
+    ))
+}
+
+/// The derivative entries of robots with contacts ([`Derivation::add_derivatives`]).
+pub(super) fn quantities(d: &Derivation, p: &ContactPartials) -> Vec<Quantity> {
+    let (n, k) = (d.dof, d.centroidal.contact_drift.len());
+    if k == 0 {
+        return Vec::new();
+    }
+    let tangent = "q perturbed in its tangent space, as `integrate`.";
+    vec![
+        quantity(
+            "contact_dynamics_partials",
+            PARTIAL_INPUTS,
+            Shape::Matrix(n + 2 * k, n),
+            &[
+                "What `contact_forward_dynamics_derivatives` adds to `inverse_dynamics_derivatives`, stacked",
+                "(N + 2K) x N: d(-J_c^T forces)/dq (N rows), d(J_c qdd + Jdot_c qd)/dq (K rows) and",
+                "d(Jdot_c qd)/dqd (K rows), at fixed `qdd` and `forces` (world axes), with",
+                tangent,
+            ],
+            "the contact Jacobian and drift differentiated along each tangent direction",
+            Evaluation::Exprs(flat(&p.contact)),
+        ),
+        quantity(
+            "contact_forward_dynamics_derivatives",
+            &[Input::Q, Input::Qd, Input::Tau],
+            Shape::Matrices(3, n + k, n),
+            &[
+                "The derivatives of `contact_forward_dynamics` (accelerations `a` and forces `f`) in `q`",
+                "(tangent space, as `integrate`), `qd` and `tau`: Pinocchio's",
+                "`computeConstraintDynamicsDerivatives`, forces on the robot in world axes.",
+                "",
+                "NaN in every entry when M(q) is not positive definite or J_c is rank-deficient;",
+                "`try_contact_forward_dynamics_derivatives` says why.",
+            ],
+            "the accelerations and forces by `eomgen_runtime::ContactKkt`, `inverse_dynamics_derivatives` there plus `contact_dynamics_partials`, then the KKT system solved for every column",
+            Evaluation::ContactDynamicsDerivatives {
+                h: d.fast.bias_gravity_friction.clone(),
+            },
+        ),
+        quantity(
+            "impulse_dynamics_partials",
+            PARTIAL_INPUTS,
+            Shape::Matrix(n + k, n),
+            &[
+                "What `impulse_dynamics_derivatives` differentiates, stacked (N + K) x N:",
+                "d(M qdd - J_c^T forces)/dq (N rows) and d(J_c qd)/dq (K rows), at fixed `qdd`, `qd`,",
+                "`forces`, with",
+                tangent,
+            ],
+            "Newton-Euler's derivatives at zero velocity and gravity, and the contact Jacobian differentiated along each tangent direction",
+            Evaluation::Exprs(flat(&p.impulse)),
+        ),
+        quantity(
+            "impulse_dynamics_derivatives",
+            &[Input::Q, Input::Qd],
+            Shape::Matrices(2, n + k, n),
+            &[
+                "The derivatives of `impulse_dynamics` (velocity after the impact, impulses) in `q` (tangent",
+                "space, as `integrate`) and the velocity before: Pinocchio's",
+                "`computeImpulseDynamicsDerivatives`, except that `dv_dv` is d v_after / d v_before",
+                "(Pinocchio's derivative of the jump plus the identity).",
+                "",
+                "NaN in every entry when M(q) is not positive definite or J_c is rank-deficient;",
+                "`try_impulse_dynamics_derivatives` says why.",
+            ],
+            "`impulse_dynamics` by `eomgen_runtime::ContactKkt`, `impulse_dynamics_partials` there, then the KKT system solved for every column",
+            Evaluation::ImpulseDynamicsDerivatives,
+        ),
+    ]
+}

@@ -1,0 +1,70 @@
+//! Impulse dynamics: the velocity after an impact that the contacts absorb, and its
+//! derivatives, through the contact problem's KKT system ([`ContactKkt`]).
+//!
+//! With restitution `e`, the impulses `p` (on the robot, world axes) and the velocity after
+//! the impact `v+` satisfy `M (v+ - v) = J^T p` and `J v+ = -e J v`: the KKT system with
+//! `top = 0`, `bottom = -(1 + e) J v` gives `(v+ - v, p)`.
+
+use crate::kkt::{axpy, dot, finite_rows, negated, ContactKkt, ImpulseDynamicsDerivatives};
+use crate::{FactorError, Real};
+
+impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
+    /// The velocity after the impact and the impulses, from the velocity before `v` and the
+    /// restitution `e` (0: the contacts stop, 1: they bounce back at full speed).
+    pub fn impulse(&self, v: &[T; N], e: T) -> Result<([T; N], [T; K]), FactorError> {
+        let k = -(T::one() + e);
+        let bottom: [T; K] = core::array::from_fn(|r| k * dot(&self.jacobian()[r], v));
+        let (mut dv, p) = self.solve(&[T::zero(); N], &bottom)?;
+        for (x, vi) in dv.iter_mut().zip(v) {
+            *x += *vi;
+        }
+        Ok((dv, p))
+    }
+
+    /// The derivatives of [`ContactKkt::impulse`] at its solution, from the generated
+    /// `partials` (`R = N + K` rows: `d(M dv - J^T p)/dq` at fixed `dv = v+ - v` and `p`, then
+    /// `d(J w)/dq` at fixed `w = v+ + e v`). In `q`: `[M -J^T; J 0] [dv+; dp] = -partials`; in
+    /// `v`: `dp/dv = -(1 + e) (J M^-1 J^T)^-1 J` and `dv+/dv = I + M^-1 J^T dp/dv`.
+    ///
+    /// Errors: `NonFinite` at the first row of `dv` (`pivot < N`) or `dp` (`N + k`) with a
+    /// non-finite entry, or at `pivot` 0 when `R != N + K`.
+    pub fn impulse_derivatives<const R: usize>(
+        &self,
+        e: T,
+        partials: &[[T; N]; R],
+    ) -> Result<ImpulseDynamicsDerivatives<T, N, K>, FactorError> {
+        if R != N + K {
+            return Err(FactorError::NonFinite { pivot: 0 });
+        }
+        let top: [[T; N]; N] = core::array::from_fn(|i| partials[i]);
+        let bottom: [[T; N]; K] = core::array::from_fn(|k| partials[N + k]);
+        let (dv_dq, dimpulse_dq) = self.solve_columns(&negated(&top), &negated(&bottom));
+        let mut dimpulse_dv = *self.jacobian();
+        self.lambda_solve_columns(&mut dimpulse_dv);
+        let k = -(T::one() + e);
+        for row in dimpulse_dv.iter_mut() {
+            for x in row.iter_mut() {
+                *x *= k;
+            }
+        }
+        let mut dv_dv: [[T; N]; N] = core::array::from_fn(|i| {
+            core::array::from_fn(|j| if i == j { T::one() } else { T::zero() })
+        });
+        for (yk, pk) in self.inverse_inertia_rows().iter().zip(&dimpulse_dv) {
+            for (row, yki) in dv_dv.iter_mut().zip(yk) {
+                axpy(row, *yki, pk);
+            }
+        }
+        let d = ImpulseDynamicsDerivatives {
+            dv_dq,
+            dv_dv,
+            dimpulse_dq,
+            dimpulse_dv,
+        };
+        finite_rows(&d.dv_dq, 0)?;
+        finite_rows(&d.dv_dv, 0)?;
+        finite_rows(&d.dimpulse_dq, N)?;
+        finite_rows(&d.dimpulse_dv, N)?;
+        Ok(d)
+    }
+}

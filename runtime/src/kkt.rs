@@ -1,0 +1,379 @@
+//! The contact problem's KKT system, factorized once and solved for many right-hand sides:
+//! what contact dynamics, impulse dynamics and their derivatives share.
+//!
+//! With `M` the mass matrix and `J` the contact Jacobian (K rows, world axes), the system
+//!
+//! ```text
+//! [ M  -J^T ] [ x ]   [ top    ]
+//! [ J   0   ] [ f ] = [ bottom ]
+//! ```
+//!
+//! is solved as `x_free = M^-1 top`, `f = (J M^-1 J^T)^-1 (bottom - J x_free)`,
+//! `x = x_free + M^-1 J^T f`: one sparse `L^T D L` factorization of `M` over the joint tree
+//! ([`crate::tree::ltdl_factor`]), `Y = M^-1 J^T`, and a Cholesky factorization of
+//! `J M^-1 J^T` ([`Cholesky`]). Contact dynamics is one solve (`top = tau - h`,
+//! `bottom = -drift`); its derivatives solve for whole matrices of right-hand sides
+//! ([`ContactKkt::solve_columns`]), row by row so that the inner loops run over contiguous
+//! columns. Everything lives in fixed-size arrays on the stack.
+
+use crate::linalg::{Cholesky, FactorError};
+use crate::tree::{ltdl_factor, ltdl_substitute};
+use crate::Real;
+
+/// The derivatives of contact forward dynamics (`contact_forward_dynamics_derivatives`), as
+/// Pinocchio's `computeConstraintDynamicsDerivatives`: element `[i][j]` = d out_i / d in_j,
+/// `q` perturbed in the tangent space (as `integrate`), forces on the robot in world axes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactDynamicsDerivatives<T, const NV: usize, const K: usize> {
+    /// d a / d q, NV x NV.
+    pub da_dq: [[T; NV]; NV],
+    /// d a / d v, NV x NV.
+    pub da_dv: [[T; NV]; NV],
+    /// d a / d tau, NV x NV.
+    pub da_dtau: [[T; NV]; NV],
+    /// d f / d q, K x NV.
+    pub df_dq: [[T; NV]; K],
+    /// d f / d v, K x NV.
+    pub df_dv: [[T; NV]; K],
+    /// d f / d tau, K x NV.
+    pub df_dtau: [[T; NV]; K],
+}
+
+impl<T: Real, const NV: usize, const K: usize> ContactDynamicsDerivatives<T, NV, K> {
+    /// Every entry NaN (what the methods without `try_` return when the problem is singular).
+    pub fn nan() -> Self {
+        let (a, f) = ([[T::nan(); NV]; NV], [[T::nan(); NV]; K]);
+        ContactDynamicsDerivatives {
+            da_dq: a,
+            da_dv: a,
+            da_dtau: a,
+            df_dq: f,
+            df_dv: f,
+            df_dtau: f,
+        }
+    }
+}
+
+/// The derivatives of impulse dynamics (`impulse_dynamics_derivatives`), as Pinocchio's
+/// `computeImpulseDynamicsDerivatives` but of the velocity after the impact: `dv_dv` is
+/// d v_after / d v_before (Pinocchio's derivative of the jump plus the identity). Element
+/// `[i][j]` = d out_i / d in_j, `q` perturbed in the tangent space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ImpulseDynamicsDerivatives<T, const NV: usize, const K: usize> {
+    /// d v_after / d q, NV x NV.
+    pub dv_dq: [[T; NV]; NV],
+    /// d v_after / d v_before, NV x NV.
+    pub dv_dv: [[T; NV]; NV],
+    /// d impulses / d q, K x NV.
+    pub dimpulse_dq: [[T; NV]; K],
+    /// d impulses / d v_before, K x NV.
+    pub dimpulse_dv: [[T; NV]; K],
+}
+
+impl<T: Real, const NV: usize, const K: usize> ImpulseDynamicsDerivatives<T, NV, K> {
+    /// Every entry NaN.
+    pub fn nan() -> Self {
+        let (v, p) = ([[T::nan(); NV]; NV], [[T::nan(); NV]; K]);
+        ImpulseDynamicsDerivatives {
+            dv_dq: v,
+            dv_dv: v,
+            dimpulse_dq: p,
+            dimpulse_dv: p,
+        }
+    }
+}
+
+/// The factorized KKT system of `N` velocity coordinates and `K` contact rows (module
+/// documentation).
+#[derive(Clone, Copy, Debug)]
+pub struct ContactKkt<T, const N: usize, const K: usize> {
+    /// The `L^T D L` factors of `M` ([`ltdl_factor`]).
+    pub(crate) factors: [[T; N]; N],
+    parent: [Option<usize>; N],
+    /// The contact Jacobian.
+    j: [[T; N]; K],
+    /// Row `k` is `M^-1` times row `k` of `J` (a column of `Y = M^-1 J^T`).
+    y: [[T; N]; K],
+    /// `J M^-1 J^T`.
+    lambda: Cholesky<T, K>,
+}
+
+impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
+    /// Factorizes the system of the mass matrix `m`, whose coordinate `i` has the parent
+    /// coordinate `parent[i]`, and the contact Jacobian `j`.
+    ///
+    /// Errors: a pivot of `M` that is not positive (`pivot < N`), or of `J M^-1 J^T` (pivot
+    /// `N + k`: a rank-deficient `J`), or a non-finite one.
+    pub fn new(
+        mut m: [[T; N]; N],
+        parent: &[Option<usize>; N],
+        j: [[T; N]; K],
+    ) -> Result<Self, FactorError> {
+        ltdl_factor(&mut m, parent)?;
+        let mut y = [[T::zero(); N]; K];
+        for (yk, jk) in y.iter_mut().zip(&j) {
+            *yk = ltdl_substitute(&m, parent, jk);
+        }
+        let mut lambda = [[T::zero(); K]; K];
+        for r in 0..K {
+            for c in 0..=r {
+                lambda[r][c] = dot(&j[r], &y[c]);
+                lambda[c][r] = lambda[r][c];
+            }
+        }
+        let lambda = Cholesky::new(lambda).map_err(shift::<N>)?;
+        Ok(ContactKkt {
+            factors: m,
+            parent: *parent,
+            j,
+            y,
+            lambda,
+        })
+    }
+
+    /// The contact Jacobian the system was built with.
+    pub fn jacobian(&self) -> &[[T; N]; K] {
+        &self.j
+    }
+
+    /// Solves the system for one right-hand side `(top, bottom)`: `(x, f)`. Contact forward
+    /// dynamics is `solve(tau - h, -drift)`; a non-finite component of `x` (`pivot < N`) or
+    /// `f` (`N + k`) is an error.
+    pub fn solve(&self, top: &[T; N], bottom: &[T; K]) -> Result<([T; N], [T; K]), FactorError> {
+        let mut x = ltdl_substitute(&self.factors, &self.parent, top);
+        let mut b = *bottom;
+        for (bk, jk) in b.iter_mut().zip(&self.j) {
+            *bk -= dot(jk, &x);
+        }
+        let f = self.lambda.solve(&b);
+        for (yk, fk) in self.y.iter().zip(&f) {
+            for (xi, yi) in x.iter_mut().zip(yk) {
+                *xi += *yi * *fk;
+            }
+        }
+        if let Some(pivot) = x.iter().position(|v| !v.is_finite()) {
+            return Err(FactorError::NonFinite { pivot });
+        }
+        if let Some(k) = f.iter().position(|v| !v.is_finite()) {
+            return Err(FactorError::NonFinite { pivot: N + k });
+        }
+        Ok((x, f))
+    }
+
+    /// Solves the system for `C` right-hand sides at once, the columns of `top` (N x C) and
+    /// `bottom` (K x C): `(X, F)`, N x C and K x C, one solution per column.
+    pub fn solve_columns<const C: usize>(
+        &self,
+        top: &[[T; C]; N],
+        bottom: &[[T; C]; K],
+    ) -> ([[T; C]; N], [[T; C]; K]) {
+        let mut x = *top;
+        self.substitute_columns(&mut x);
+        // F = Lambda^-1 (bottom - J X)
+        let mut f = *bottom;
+        for (fk, jk) in f.iter_mut().zip(&self.j) {
+            for (jki, xi) in jk.iter().zip(&x) {
+                axpy(fk, -*jki, xi);
+            }
+        }
+        self.lambda_solve_columns(&mut f);
+        // X += Y F
+        for (yk, fk) in self.y.iter().zip(&f) {
+            for (xi, yki) in x.iter_mut().zip(yk) {
+                axpy(xi, *yki, fk);
+            }
+        }
+        (x, f)
+    }
+
+    /// `(J M^-1 J^T)^-1 B` for the K x C matrix `B`, in place.
+    pub fn lambda_solve_columns<const C: usize>(&self, b: &mut [[T; C]; K]) {
+        let l = self.lambda.l();
+        for i in 0..K {
+            for k in 0..i {
+                let (done, rest) = b.split_at_mut(i);
+                axpy(&mut rest[0], -l[i][k], &done[k]);
+            }
+            scale(&mut b[i], T::one() / l[i][i]);
+        }
+        for i in (0..K).rev() {
+            let (head, tail) = b.split_at_mut(i + 1);
+            for (lk, bk) in l[i + 1..].iter().zip(tail.iter()) {
+                axpy(&mut head[i], -lk[i], bk);
+            }
+            scale(&mut b[i], T::one() / l[i][i]);
+        }
+    }
+
+    /// `M^-1 X` for the N x C matrix `X`, in place, through the tree factors.
+    pub fn substitute_columns<const C: usize>(&self, x: &mut [[T; C]; N]) {
+        let (m, parent) = (&self.factors, &self.parent);
+        for i in (0..N).rev() {
+            let mut j = parent[i];
+            while let Some(jj) = j {
+                let (head, tail) = x.split_at_mut(i);
+                axpy(&mut head[jj], -m[i][jj], &tail[0]);
+                j = parent[jj];
+            }
+        }
+        for (i, xi) in x.iter_mut().enumerate() {
+            scale(xi, T::one() / m[i][i]);
+        }
+        for i in 0..N {
+            let mut j = parent[i];
+            while let Some(jj) = j {
+                let (head, tail) = x.split_at_mut(i);
+                axpy(&mut tail[0], -m[i][jj], &head[jj]);
+                j = parent[jj];
+            }
+        }
+    }
+
+    /// Row `k` of `J M^-1` (`Y^T`).
+    pub fn inverse_inertia_rows(&self) -> &[[T; N]; K] {
+        &self.y
+    }
+}
+
+/// Pivot `k` of `J M^-1 J^T` is pivot `N + k` of the system.
+fn shift<const N: usize>(e: FactorError) -> FactorError {
+    match e {
+        FactorError::NotPositiveDefinite { pivot } => {
+            FactorError::NotPositiveDefinite { pivot: N + pivot }
+        }
+        FactorError::NonFinite { pivot } => FactorError::NonFinite { pivot: N + pivot },
+    }
+}
+
+pub(crate) fn dot<T: Real, const N: usize>(a: &[T; N], b: &[T; N]) -> T {
+    let mut s = T::zero();
+    for (x, y) in a.iter().zip(b) {
+        s += *x * *y;
+    }
+    s
+}
+
+/// `y += a x`.
+pub(crate) fn axpy<T: Real, const C: usize>(y: &mut [T; C], a: T, x: &[T; C]) {
+    for (yi, xi) in y.iter_mut().zip(x) {
+        *yi += a * *xi;
+    }
+}
+
+fn scale<T: Real, const C: usize>(y: &mut [T; C], a: T) {
+    for yi in y.iter_mut() {
+        *yi *= a;
+    }
+}
+
+/// A matrix with every entry negated.
+pub(crate) fn negated<T: Real, const C: usize, const R: usize>(m: &[[T; C]; R]) -> [[T; C]; R] {
+    let mut out = *m;
+    for row in out.iter_mut() {
+        scale(row, -T::one());
+    }
+    out
+}
+
+/// `NonFinite` at `offset` plus the first row of `m` with a non-finite entry.
+pub(crate) fn finite_rows<T: Real, const C: usize, const R: usize>(
+    m: &[[T; C]; R],
+    offset: usize,
+) -> Result<(), FactorError> {
+    match m.iter().position(|row| row.iter().any(|x| !x.is_finite())) {
+        Some(i) => Err(FactorError::NonFinite { pivot: offset + i }),
+        None => Ok(()),
+    }
+}
+
+impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
+    /// The derivatives of contact forward dynamics at its solution `(a, f)`, from the
+    /// derivatives of inverse dynamics at `(q, v, a)` (`did_dq`, `did_dv`) and the generated
+    /// `partials` (`R = N + 2K` rows: `d(-J^T f)/dq` at fixed `f`, `d(J a + drift)/dq` at fixed
+    /// `a`, `d drift/dv`). Differentiating `M a + h - J^T f = tau`, `J a + drift = 0`:
+    /// `[M -J^T; J 0] [da; df] = [-(did_dx + d(-J^T f)/dx); -d(J a + drift)/dx]` for `x = q`,
+    /// `v`, and `[I; 0]` for `tau`.
+    ///
+    /// Errors: `NonFinite` at the first row of `da` (`pivot < N`) or `df` (`N + k`) with a
+    /// non-finite entry, or at `pivot` 0 when `R != N + 2K`.
+    pub fn contact_dynamics_derivatives<const R: usize>(
+        &self,
+        did_dq: &[[T; N]; N],
+        did_dv: &[[T; N]; N],
+        partials: &[[T; N]; R],
+    ) -> Result<ContactDynamicsDerivatives<T, N, K>, FactorError> {
+        if R != N + 2 * K {
+            return Err(FactorError::NonFinite { pivot: 0 });
+        }
+        let rows = |from: usize| -> [[T; N]; K] { core::array::from_fn(|k| partials[from + k]) };
+        let mut top_q = negated(did_dq);
+        for (t, p) in top_q.iter_mut().zip(partials) {
+            axpy(t, -T::one(), p);
+        }
+        let (da_dq, df_dq) = self.solve_columns(&top_q, &negated(&rows(N)));
+        let (da_dv, df_dv) = self.solve_columns(&negated(did_dv), &negated(&rows(N + K)));
+        let identity: [[T; N]; N] = core::array::from_fn(|i| {
+            core::array::from_fn(|j| if i == j { T::one() } else { T::zero() })
+        });
+        let (da_dtau, df_dtau) = self.solve_columns(&identity, &[[T::zero(); N]; K]);
+        let d = ContactDynamicsDerivatives {
+            da_dq,
+            da_dv,
+            da_dtau,
+            df_dq,
+            df_dv,
+            df_dtau,
+        };
+        for m in [&d.da_dq, &d.da_dv, &d.da_dtau] {
+            finite_rows(m, 0)?;
+        }
+        for m in [&d.df_dq, &d.df_dv, &d.df_dtau] {
+            finite_rows(m, N)?;
+        }
+        Ok(d)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A three-coordinate chain and two contact rows.
+    fn system() -> ContactKkt<f64, 3, 2> {
+        let m = [[4.0, 1.0, 0.5], [1.0, 3.0, 0.25], [0.5, 0.25, 2.0]];
+        let j = [[1.0, 0.0, 2.0], [0.0, 1.0, -1.0]];
+        ContactKkt::new(m, &[None, Some(0), Some(1)], j).unwrap()
+    }
+
+    #[test]
+    fn solving_columns_equals_solving_each() {
+        let kkt = system();
+        let top = [[1.0, -2.0], [0.5, 3.0], [-1.0, 0.25]];
+        let bottom = [[2.0, 0.0], [-1.0, 1.5]];
+        let (x, f) = kkt.solve_columns(&top, &bottom);
+        for c in 0..2 {
+            let (xc, fc) = kkt
+                .solve(&top.map(|r| r[c]), &bottom.map(|r| r[c]))
+                .unwrap();
+            for i in 0..3 {
+                assert!((x[i][c] - xc[i]).abs() < 1e-14);
+            }
+            for k in 0..2 {
+                assert!((f[k][c] - fc[k]).abs() < 1e-14);
+            }
+        }
+    }
+
+    #[test]
+    fn a_point_mass_bounces_off_the_ground() {
+        // Unit mass in the plane hitting the ground (y) at 2 m/s, restitution 0.5.
+        let kkt = ContactKkt::new([[1.0, 0.0], [0.0, 1.0]], &[None, None], [[0.0, 1.0]]).unwrap();
+        let (after, p) = kkt.impulse(&[1.0, -2.0], 0.5).unwrap();
+        assert_eq!((after, p), ([1.0, 1.0], [3.0]));
+        let singular = ContactKkt::new([[1.0, 0.0], [0.0, 1.0]], &[None, None], [[0.0; 2]]);
+        assert_eq!(
+            singular.unwrap_err(),
+            FactorError::NotPositiveDefinite { pivot: 2 }
+        );
+    }
+}
