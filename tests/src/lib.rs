@@ -238,7 +238,9 @@ pub mod robots {
         include!(concat!(env!("OUT_DIR"), "/ur5_passive_wrist.rs"));
     }
 
-    /// anymal on its four feet: contact and impulse dynamics with their derivatives.
+    /// anymal on its four feet: contact and impulse dynamics with their derivatives, and the
+    /// MPC kit's kinematics (link motion, the configuration manifold, the centroidal momentum
+    /// rate).
     pub mod anymal_mpc {
         include!(concat!(env!("OUT_DIR"), "/anymal_mpc.rs"));
     }
@@ -319,11 +321,6 @@ pub mod robots {
     /// time variations, the configuration manifold) and `link_jacobian`.
     pub mod panda_mpc {
         include!(concat!(env!("OUT_DIR"), "/panda_mpc.rs"));
-    }
-    /// anymal (floating base) with the MPC kit's kinematics, `link_jacobian`, `integrate`,
-    /// `centroidal_map` and `centroidal_momentum_rate`.
-    pub mod anymal_mpc {
-        include!(concat!(env!("OUT_DIR"), "/anymal_mpc.rs"));
     }
     /// A synthetic 24-joint serial chain with only forward and inverse dynamics: forward
     /// dynamics solves at run time (the tree `L^T D L` factorization, unrolled).

@@ -687,52 +687,64 @@ impl Emitter<'_> {
         }
     }
 
-    /// Whether any quantity needs the joints' parents at run time.
-    fn needs_parents(&self) -> bool {
-        self.quantities.iter().any(|q| {
-            matches!(
-                q.eval,
-                Evaluation::ForwardDynamicsSolve { .. }
-                    | Evaluation::MassMatrixInverse
-                    | Evaluation::ForwardDynamicsDerivatives
-                    | Evaluation::ContactForwardDynamics { .. }
-                    | Evaluation::ContactDynamicsDerivatives { .. }
-                    | Evaluation::ImpulseDynamics
-                    | Evaluation::ImpulseDynamicsDerivatives
-            )
-        })
+    /// Whether some quantity is evaluated in one of these ways.
+    fn any_eval(&self, which: impl Fn(&Evaluation) -> bool) -> bool {
+        self.quantities.iter().any(|q| which(&q.eval))
     }
 
-    /// `const PARENTS`: each joint's parent joint, for the run-time tree solves.
+    /// The run-time tree solves' helpers, each only where a quantity calls it: `const PARENTS`
+    /// (each joint's parent joint, for the runtime's tree kernels and `ContactKkt`), and the
+    /// robot's unrolled factorization and substitution (`emit/tree_solve.rs`).
     fn parents_const(&self) -> TokenStream {
-        if !self.needs_parents() {
-            return TokenStream::new();
-        }
+        use Evaluation as E;
         let n = &self.n;
-        let parents = self.parents.iter().map(|p| match p {
-            Some(p) => {
-                let p = usize_lit(*p);
-                quote!(Some(#p))
-            }
-            None => quote!(None),
-        });
-        let factor = super::tree_solve::factor_fn(&self.parents, n);
-        let substitute = if self.quantities.iter().any(|q| {
+        let table = self.any_eval(|e| {
             matches!(
-                q.eval,
-                Evaluation::ForwardDynamicsSolve { .. }
-                    | Evaluation::ContactForwardDynamics { .. }
-                    | Evaluation::ForwardDynamicsDerivatives
+                e,
+                E::MassMatrixInverse
+                    | E::ForwardDynamicsDerivatives
+                    | E::ContactForwardDynamics { .. }
+                    | E::ContactDynamicsDerivatives { .. }
+                    | E::ImpulseDynamics
+                    | E::ImpulseDynamicsDerivatives
             )
-        }) {
+        });
+        let table = if table {
+            let parents = self.parents.iter().map(|p| match p {
+                Some(p) => {
+                    let p = usize_lit(*p);
+                    quote!(Some(#p))
+                }
+                None => quote!(None),
+            });
+            quote! {
+                /// Each coordinate's parent coordinate (`None`: the root), parents first: the
+                /// joints' parents (a floating base's six coordinates form a chain).
+                const PARENTS: [Option<usize>; #n] = [#(#parents),*];
+            }
+        } else {
+            TokenStream::new()
+        };
+        let solves = |e: &Evaluation| {
+            matches!(
+                e,
+                E::ForwardDynamicsSolve { .. }
+                    | E::ContactForwardDynamics { .. }
+                    | E::ForwardDynamicsDerivatives
+            )
+        };
+        let factor = if self.any_eval(|e| solves(e) || matches!(e, E::MassMatrixInverse)) {
+            super::tree_solve::factor_fn(&self.parents, n)
+        } else {
+            TokenStream::new()
+        };
+        let substitute = if self.any_eval(solves) {
             super::tree_solve::substitute_fn(&self.parents, n)
         } else {
             TokenStream::new()
         };
         quote! {
-            /// Each coordinate's parent coordinate (`None`: the root), parents first: the
-            /// joints' parents (a floating base's six coordinates form a chain).
-            const PARENTS: [Option<usize>; #n] = [#(#parents),*];
+            #table
             #factor
             #substitute
         }
