@@ -6,7 +6,12 @@ use serde_json::Value;
 
 /// `robots/floating/{file}`, parsed.
 pub fn reference(file: &str) -> Value {
-    let path = format!("{}/robots/floating/{file}", env!("CARGO_MANIFEST_DIR"));
+    robot_file(&format!("floating/{file}"))
+}
+
+/// `robots/{path}`, parsed (a fixed-base robot's file, or one under `floating/`).
+pub fn robot_file(path: &str) -> Value {
+    let path = format!("{}/robots/{path}", env!("CARGO_MANIFEST_DIR"));
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
 
@@ -26,8 +31,13 @@ pub struct Order {
 }
 
 impl Order {
-    /// The order of a reference file's `joints` against ours (`JOINT_NAMES`).
+    /// The order of a floating-base reference file's `joints` against ours (`JOINT_NAMES`).
     pub fn new(doc: &Value, ours: &[&str]) -> Order {
+        Order::with_base(doc, ours, true)
+    }
+
+    /// [`Order::new`] for a floating (base coordinates first) or a fixed base.
+    pub fn with_base(doc: &Value, ours: &[&str], floating: bool) -> Order {
         let refs: Vec<&str> = doc["joints"]
             .as_array()
             .unwrap()
@@ -35,9 +45,10 @@ impl Order {
             .map(|j| j.as_str().unwrap())
             .collect();
         let pos = |n: &&str| refs.iter().position(|r| r == n).unwrap();
+        let (bq, bv) = if floating { (7, 6) } else { (0, 0) };
         Order {
-            q: (0..7).chain(ours.iter().map(|n| 7 + pos(n))).collect(),
-            v: (0..6).chain(ours.iter().map(|n| 6 + pos(n))).collect(),
+            q: (0..bq).chain(ours.iter().map(|n| bq + pos(n))).collect(),
+            v: (0..bv).chain(ours.iter().map(|n| bv + pos(n))).collect(),
         }
     }
 
@@ -71,4 +82,32 @@ pub fn pick(m: &Value, rows: &[usize], cols: &[usize]) -> Vec<f64> {
 /// A matrix, flat (row-major).
 pub fn flat<const R: usize, const C: usize>(m: &[[f64; C]; R]) -> Vec<f64> {
     m.iter().flatten().copied().collect()
+}
+
+/// The worst error of each quantity over the samples, checked against its tolerance.
+#[derive(Default)]
+pub struct Worst(pub Vec<(String, f64)>);
+
+impl Worst {
+    /// Keeps the larger of `e` and the worst so far of `what`.
+    pub fn note(&mut self, what: &str, e: f64) {
+        match self.0.iter_mut().find(|w| w.0 == what) {
+            Some(w) => w.1 = w.1.max(e),
+            None => self.0.push((what.to_string(), e)),
+        }
+    }
+
+    /// Prints each worst error and fails on one beyond `limit(quantity)` (NaN included) or on
+    /// fewer than `at_least` quantities checked.
+    pub fn check(&self, robot: &str, limit: impl Fn(&str) -> f64, at_least: usize) {
+        for (what, e) in &self.0 {
+            println!("{robot}: {what} {e:.2e}");
+            assert!(*e <= limit(what), "{robot}: {what} off by {e:e}");
+        }
+        assert!(
+            self.0.len() >= at_least,
+            "{robot}: only {} checked",
+            self.0.len()
+        );
+    }
 }

@@ -8,7 +8,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use eomgen_runtime::prelude::*;
-use eomgen_tests::floating_reference::{flat, normwise, numbers, pick, reference, Order};
+use eomgen_tests::floating_reference::{flat, normwise, numbers, pick, reference, Order, Worst};
 use eomgen_tests::robots::anymal_at::{AnymalAt, AnymalAtLink};
 use eomgen_tests::robots::anymal_mpc::{AnymalMpc, AnymalMpcLink};
 use eomgen_tests::robots::g1_mpc::G1Mpc;
@@ -16,31 +16,6 @@ use serde_json::Value;
 
 const NQ: usize = 19;
 const NV: usize = 18;
-
-/// The worst error of each quantity over the samples, checked against its tolerance.
-#[derive(Default)]
-struct Worst(Vec<(String, f64)>);
-
-impl Worst {
-    fn note(&mut self, what: &str, e: f64) {
-        match self.0.iter_mut().find(|w| w.0 == what) {
-            Some(w) => w.1 = w.1.max(e),
-            None => self.0.push((what.to_string(), e)),
-        }
-    }
-
-    fn check(&self, robot: &str, limit: impl Fn(&str) -> f64, at_least: usize) {
-        for (what, e) in &self.0 {
-            println!("{robot}: {what} {e:.2e}");
-            assert!(*e <= limit(what), "{robot}: {what} off by {e:e}");
-        }
-        assert!(
-            self.0.len() >= at_least,
-            "{robot}: only {} checked",
-            self.0.len()
-        );
-    }
-}
 
 /// Derivatives 1e-7 normwise, the dynamics themselves 1e-8, the contact Jacobian and drift
 /// (kinematics) 1e-9.

@@ -6,6 +6,7 @@
 
 #![allow(clippy::needless_range_loop)]
 
+use eomgen_tests::floating_reference::{flat, numbers, pick, robot_file, Order, Worst};
 use eomgen_tests::robots::{anymal_mpc::*, panda_mpc::*};
 use serde_json::Value;
 
@@ -14,23 +15,6 @@ const TOLERANCE: f64 = 1e-9;
 /// `1e-16 / STEP`, times the size of the derivatives.
 const STEP: f64 = 1e-5;
 const FD_TOLERANCE: f64 = 1e-6;
-
-fn reference(path: &str) -> Value {
-    let path = format!("{}/robots/{path}", env!("CARGO_MANIFEST_DIR"));
-    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
-}
-
-fn numbers(v: &Value) -> Vec<f64> {
-    match v {
-        Value::Array(a) => a.iter().flat_map(numbers).collect(),
-        Value::Number(n) => vec![n.as_f64().unwrap()],
-        _ => panic!("not a number: {v}"),
-    }
-}
-
-fn flat<const R: usize, const C: usize>(m: &[[f64; C]; R]) -> Vec<f64> {
-    m.iter().flatten().copied().collect()
-}
 
 /// Elementwise `|a - b| / max(1, |b|)`.
 fn elementwise(ours: &[f64], reference: &[f64]) -> f64 {
@@ -129,74 +113,12 @@ kit!(PandaMpc, PandaMpcLink, 9, 9, false, |_, q, v| {
 kit!(AnymalMpc, AnymalMpcLink, 19, 18, true, |r, q, v| r
     .integrate(q, v, 1.0));
 
-/// Our coordinate `i` is the reference's `q[i]`, `v[i]` (base first, joints matched by name).
-struct Order {
-    q: Vec<usize>,
-    v: Vec<usize>,
-}
-
-impl Order {
-    fn new(doc: &Value, ours: &[&str], floating: bool) -> Order {
-        let refs: Vec<&str> = doc["joints"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|j| j.as_str().unwrap())
-            .collect();
-        let pos = |n: &&str| refs.iter().position(|r| r == n).unwrap();
-        let (bq, bv) = if floating { (7, 6) } else { (0, 0) };
-        Order {
-            q: (0..bq).chain(ours.iter().map(|n| bq + pos(n))).collect(),
-            v: (0..bv).chain(ours.iter().map(|n| bv + pos(n))).collect(),
-        }
-    }
-
-    fn arr<const N: usize>(map: &[usize], v: &Value) -> [f64; N] {
-        let v = numbers(v);
-        core::array::from_fn(|i| v[map[i]])
-    }
-}
-
-/// A reference matrix's rows `rows` and columns `cols`, flat.
-fn pick(m: &Value, rows: &[usize], cols: &[usize]) -> Vec<f64> {
-    let m: Vec<Vec<f64>> = m.as_array().unwrap().iter().map(numbers).collect();
-    let m = &m;
-    rows.iter()
-        .flat_map(|&r| cols.iter().map(move |&c| m[r][c]))
-        .collect()
-}
-
-/// The worst error of each quantity over every sample, failing beyond `TOLERANCE`.
-#[derive(Default)]
-struct Worst(Vec<(String, f64)>);
-
-impl Worst {
-    fn note(&mut self, what: &str, e: f64) {
-        match self.0.iter_mut().find(|w| w.0 == what) {
-            Some(w) => w.1 = w.1.max(e),
-            None => self.0.push((what.to_string(), e)),
-        }
-    }
-
-    fn check(&self, robot: &str, tolerance: f64) {
-        for (what, e) in &self.0 {
-            println!("{robot} {what}: {e:.2e}");
-        }
-        let bad: Vec<_> = self
-            .0
-            .iter()
-            .filter(|w| w.1.is_nan() || w.1 > tolerance)
-            .collect();
-        assert!(bad.is_empty(), "{robot}: beyond {tolerance:e}: {bad:?}");
-    }
-}
-
 /// Every sample's link motion and manifold functions against the reference.
 fn against_reference<R: Kit<NQ, NV>, const NQ: usize, const NV: usize>(
     r: &R,
     doc: &Value,
 ) -> Worst {
-    let o = Order::new(doc, &R::joint_names(), R::FLOATING);
+    let o = Order::with_base(doc, &R::joint_names(), R::FLOATING);
     let all6: Vec<usize> = (0..6).collect();
     let mut worst = Worst::default();
     let samples = doc["samples"].as_array().unwrap();
@@ -252,17 +174,17 @@ fn against_reference<R: Kit<NQ, NV>, const NQ: usize, const NV: usize>(
 
 #[test]
 fn panda_matches_pinocchio() {
-    let doc = reference("panda.mpc.json");
+    let doc = robot_file("panda.mpc.json");
     let worst = against_reference(&PandaMpc::<f64>::default(), &doc);
-    worst.check("panda", TOLERANCE);
+    worst.check("panda", |_| TOLERANCE, 1);
 }
 
 #[test]
 fn anymal_matches_pinocchio() {
-    let doc = reference("floating/anymal.mpc.json");
+    let doc = robot_file("floating/anymal.mpc.json");
     let r = AnymalMpc::<f64>::default();
     let mut worst = against_reference(&r, &doc);
-    let o = Order::new(&doc, &AnymalMpc::<f64>::JOINT_NAMES, true);
+    let o = Order::new(&doc, &AnymalMpc::<f64>::JOINT_NAMES);
     for s in doc["samples"].as_array().unwrap() {
         let q: [f64; 19] = Order::arr(&o.q, &s["q"]);
         let v: [f64; 18] = Order::arr(&o.v, &s["v"]);
@@ -271,7 +193,7 @@ fn anymal_matches_pinocchio() {
         let reference = numbers(&s["centroidal_momentum_rate"]);
         worst.note("centroidal_momentum_rate", elementwise(&rate, &reference));
     }
-    worst.check("anymal", TOLERANCE);
+    worst.check("anymal", |_| TOLERANCE, 1);
 }
 
 /// The reference file's states in our order: (q, v, a, q1).
@@ -279,7 +201,7 @@ fn anymal_matches_pinocchio() {
 fn states<R: Kit<NQ, NV>, const NQ: usize, const NV: usize>(
     doc: &Value,
 ) -> Vec<([f64; NQ], [f64; NV], [f64; NV], [f64; NQ])> {
-    let o = Order::new(doc, &R::joint_names(), R::FLOATING);
+    let o = Order::with_base(doc, &R::joint_names(), R::FLOATING);
     doc["samples"]
         .as_array()
         .unwrap()
@@ -404,32 +326,32 @@ fn frame_checks<R: Kit<NQ, NV>, const NQ: usize, const NV: usize>(r: &R, doc: &V
 
 #[test]
 fn panda_manifold_matches_finite_differences() {
-    let doc = reference("panda.mpc.json");
-    manifold_checks(&PandaMpc::<f64>::default(), &doc).check("panda", FD_TOLERANCE);
+    let doc = robot_file("panda.mpc.json");
+    manifold_checks(&PandaMpc::<f64>::default(), &doc).check("panda", |_| FD_TOLERANCE, 1);
 }
 
 #[test]
 fn anymal_manifold_matches_finite_differences() {
-    let doc = reference("floating/anymal.mpc.json");
-    manifold_checks(&AnymalMpc::<f64>::default(), &doc).check("anymal", FD_TOLERANCE);
+    let doc = robot_file("floating/anymal.mpc.json");
+    manifold_checks(&AnymalMpc::<f64>::default(), &doc).check("anymal", |_| FD_TOLERANCE, 1);
 }
 
 #[test]
 fn panda_link_motion_matches_finite_differences() {
-    let doc = reference("panda.mpc.json");
-    frame_checks(&PandaMpc::<f64>::default(), &doc).check("panda", FD_TOLERANCE);
+    let doc = robot_file("panda.mpc.json");
+    frame_checks(&PandaMpc::<f64>::default(), &doc).check("panda", |_| FD_TOLERANCE, 1);
 }
 
 #[test]
 fn anymal_link_motion_matches_finite_differences() {
-    let doc = reference("floating/anymal.mpc.json");
-    frame_checks(&AnymalMpc::<f64>::default(), &doc).check("anymal", FD_TOLERANCE);
+    let doc = robot_file("floating/anymal.mpc.json");
+    frame_checks(&AnymalMpc::<f64>::default(), &doc).check("anymal", |_| FD_TOLERANCE, 1);
 }
 
 /// The centroidal momentum `h = A_g v` along the motion changes at `centroidal_momentum_rate`.
 #[test]
 fn anymal_centroidal_momentum_rate_matches_finite_differences() {
-    let doc = reference("floating/anymal.mpc.json");
+    let doc = robot_file("floating/anymal.mpc.json");
     let r = AnymalMpc::<f64>::default();
     let mut worst = Worst::default();
     for (q, v, a, _) in states::<AnymalMpc<f64>, 19, 18>(&doc) {
@@ -443,14 +365,14 @@ fn anymal_centroidal_momentum_rate_matches_finite_differences() {
         let rate = r.centroidal_momentum_rate(&q, &v, &a);
         worst.note("centroidal_momentum_rate", elementwise(&fd, &rate));
     }
-    worst.check("anymal", FD_TOLERANCE);
+    worst.check("anymal", |_| FD_TOLERANCE, 1);
 }
 
 /// `f32` instances compile and agree with `f64` (single precision).
 #[test]
 fn f32_instances_agree() {
     let (r32, r64) = (AnymalMpc::<f32>::default(), AnymalMpc::<f64>::default());
-    let doc = reference("floating/anymal.mpc.json");
+    let doc = robot_file("floating/anymal.mpc.json");
     let (q, v, a, q1) = states::<AnymalMpc<f64>, 19, 18>(&doc)[1];
     let (q32, v32, a32, q132) = (
         q.map(|x| x as f32),
