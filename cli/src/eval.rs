@@ -42,7 +42,8 @@ const NAMES: [&str; 6] = [
     "potential_energy",
 ];
 
-fn data<'a>(values: &'a [Value], name: &str) -> &'a [f64] {
+/// The numbers of the quantity `name` among `values` (empty if it was not asked for).
+pub fn data<'a>(values: &'a [Value], name: &str) -> &'a [f64] {
     values
         .iter()
         .find(|v| v.name == name)

@@ -182,12 +182,20 @@ fn step_eval(
     for &p in &model.passive {
         tau[p] = 0.0;
     }
-    let qdd = terms
-        .forward_dynamics(&state(q, qd, tau.clone()))
-        .map_err(|e| match e {
-            EvalError::NotPositiveDefinite { .. } => StepError::MassMatrix(Some(e)),
-            e => StepError::Eval(e.to_string()),
-        })?;
+    let rhs: Vec<f64> = (0..n)
+        .map(|i| tau[i] - v.bias[i] - v.gravity[i] - friction[i])
+        .collect();
+    let qdd = match solve_mass(&v.mass_matrix, &rhs) {
+        Ok(qdd) if qdd.iter().all(|x| x.is_finite()) => qdd,
+        // Only on failure: the evaluator's forward dynamics names the pivot and joint.
+        _ => {
+            return Err(match terms.forward_dynamics(&state(q, qd, tau)) {
+                Err(e @ EvalError::NotPositiveDefinite { .. }) => StepError::MassMatrix(Some(e)),
+                Err(e) => StepError::Eval(e.to_string()),
+                Ok(_) => StepError::MassMatrix(None),
+            })
+        }
+    };
     Ok(Step {
         tau,
         qdd,

@@ -12,7 +12,7 @@
 
 use std::fmt::Write as _;
 
-use eomgen::evaluate::{Evaluator, State, Value};
+use eomgen::evaluate::{Evaluator, State};
 use eomgen::model::Model;
 use eomgen::Derived;
 use nalgebra::{DMatrix, DVector};
@@ -104,12 +104,7 @@ fn terms(ev: &Evaluator, q: &[f64], v: &[f64]) -> Result<Terms, String> {
         ..State::default()
     };
     let values = ev.evaluate(&state).map_err(|e| e.to_string())?;
-    let get = |name: &str| -> Vec<f64> {
-        values
-            .iter()
-            .find(|x: &&Value| x.name == name)
-            .map_or_else(Vec::new, |x| x.data.clone())
-    };
+    let get = |name: &str| super::eval::data(&values, name).to_vec();
     let (b, g) = (get("bias"), get("gravity"));
     let f = match get("friction") {
         f if f.is_empty() => vec![0.0; nv],
