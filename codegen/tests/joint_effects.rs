@@ -64,7 +64,7 @@ fn eval(d: &Derivation, outputs: &[Id], s: &State) -> Vec<f64> {
             SymbolKind::Qd(i) => s.qd.get(i).copied(),
             SymbolKind::Qdd(i) => s.qdd.get(i).copied(),
             SymbolKind::Tau(i) => s.tau.get(i).copied(),
-            SymbolKind::Param => None,
+            SymbolKind::Force(_) | SymbolKind::Param => None,
         })
         .expect("numeric model")
 }
@@ -564,7 +564,7 @@ fn symbolic_parameters_include_the_joint_effects() {
                 SymbolKind::Qd(i) => Some(s.qd[i]),
                 SymbolKind::Qdd(i) => Some(s.qdd[i]),
                 SymbolKind::Param => d.params.iter().find(|p| p.0 == sym.name).map(|p| p.2),
-                SymbolKind::Tau(_) => None,
+                SymbolKind::Tau(_) | SymbolKind::Force(_) => None,
             })
             .unwrap()
     };

@@ -40,7 +40,7 @@ fn eval(d: &Derivation, outputs: &[Id], s: &[Vec<f64>; 3]) -> Vec<f64> {
             SymbolKind::Q(i) => Some(s[0][i]),
             SymbolKind::Qd(i) => Some(s[1][i]),
             SymbolKind::Qdd(i) => Some(s[2][i]),
-            SymbolKind::Tau(_) | SymbolKind::Param => None,
+            SymbolKind::Tau(_) | SymbolKind::Force(_) | SymbolKind::Param => None,
         })
         .expect("numeric model")
 }

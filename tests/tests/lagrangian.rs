@@ -20,7 +20,7 @@ fn run(p: &Program, q: &[f64], qd: &[f64], qdd: &[f64]) -> Vec<f64> {
         SymbolKind::Q(i) => Some(q[i]),
         SymbolKind::Qd(i) => Some(qd[i]),
         SymbolKind::Qdd(i) => Some(qdd[i]),
-        SymbolKind::Tau(_) | SymbolKind::Param => None,
+        SymbolKind::Tau(_) | SymbolKind::Force(_) | SymbolKind::Param => None,
     })
     .expect("numeric model")
 }
@@ -32,7 +32,7 @@ fn run_with_tau(p: &Program, q: &[f64], qd: &[f64], qdd: &[f64], tau: &[f64]) ->
         SymbolKind::Qd(i) => Some(qd[i]),
         SymbolKind::Qdd(i) => Some(qdd[i]),
         SymbolKind::Tau(i) => Some(tau[i]),
-        SymbolKind::Param => None,
+        SymbolKind::Force(_) | SymbolKind::Param => None,
     })
     .expect("numeric model")
 }

@@ -59,7 +59,9 @@ impl Graph {
         self.derive(roots, |g, s| match g.symbols()[s as usize].kind {
             SymbolKind::Q(i) => g.qd(i),
             SymbolKind::Qd(i) => g.qdd(i),
-            SymbolKind::Qdd(_) | SymbolKind::Tau(_) | SymbolKind::Param => g.zero(),
+            SymbolKind::Qdd(_) | SymbolKind::Tau(_) | SymbolKind::Force(_) | SymbolKind::Param => {
+                g.zero()
+            }
         })
     }
 

@@ -63,6 +63,8 @@ pub enum SymbolKind {
     Qdd(usize),
     /// Joint effort `tau_i` (an input of forward dynamics).
     Tau(usize),
+    /// Contact force `F_i` (an input of the contact derivatives' partials).
+    Force(usize),
     /// Any other named quantity: a mass, a length, an offset.
     Param,
 }
@@ -72,13 +74,6 @@ pub enum SymbolKind {
 pub struct Symbol {
     pub name: String,
     pub kind: SymbolKind,
-}
-
-impl Symbol {
-    /// Whether this is a contact force of [`Graph::force`] rather than a joint effort.
-    pub fn is_force(&self) -> bool {
-        matches!(self.kind, SymbolKind::Tau(_)) && self.name.starts_with("force")
-    }
 }
 
 /// Index of a symbol in [`Graph::symbols`].
@@ -391,10 +386,9 @@ impl Graph {
     }
 
     /// A contact force `F_i` (an input of the contact derivatives' partials), printed
-    /// `force{i+1}`: a symbol of kind `Tau(i)` under its own name, which generated code reads
-    /// from its `forces` argument ([`Symbol::is_force`]).
+    /// `force{i+1}`; generated code reads it from its `forces` argument.
     pub fn force(&mut self, i: usize) -> Id {
-        self.symbol(&format!("force{}", i + 1), SymbolKind::Tau(i))
+        self.symbol(&format!("force{}", i + 1), SymbolKind::Force(i))
     }
 
     /// A named parameter.

@@ -229,7 +229,7 @@ fn sampled_columns(
             SymbolKind::Q(i) => Some(state[i][0]),
             SymbolKind::Qd(i) => Some(state[i][1]),
             SymbolKind::Qdd(i) => Some(state[i][2]),
-            SymbolKind::Tau(_) => None,
+            SymbolKind::Tau(_) | SymbolKind::Force(_) => None,
             SymbolKind::Param => values.get(sym.name.as_str()).copied(),
         };
         let out = program

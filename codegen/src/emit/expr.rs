@@ -69,7 +69,7 @@ impl Ctx<'_> {
                 let i = idx(i);
                 quote!(qd[#i])
             }
-            (SymbolKind::Tau(i), None) if sym.is_force() => {
+            (SymbolKind::Force(i), None) => {
                 let i = idx(i);
                 quote!(forces[#i])
             }
