@@ -7,6 +7,7 @@
 //! `J M^-1 J^T` by Cholesky ([`Cholesky`]), `F = -(J M^-1 J^T)^-1 (drift + J M^-1 (tau - h))`
 //! and `a = M^-1 (tau - h) + Y F`. Everything is in fixed-size arrays on the stack.
 
+pub use crate::baumgarte::{log3, placement, Baumgarte};
 use crate::linalg::{Cholesky, FactorError};
 use crate::tree::{ltdl_factor, ltdl_substitute, ltdl_substitute_rows};
 use crate::Real;
@@ -61,16 +62,51 @@ pub fn solve_factored<T: Real, const N: usize, const K: usize>(
     j: &[[T; N]; K],
     drift: &[T; K],
 ) -> Result<([T; N], [T; K]), FactorError> {
-    // Y = M^-1 J^T (N x K), all K columns in one substitution.
+    solve_factored_active(m, parent, free, j, drift, &[true; K])
+}
+
+/// [`solve_factored`] with only the contact rows `k` where `active[k]` holds: the others
+/// are dropped from the problem (their rows of `J M^-1 J^T` and `J` replaced by the
+/// identity's and zero), so that `a` is what the same solve gives for the active rows alone,
+/// and the inactive rows' forces are zero. All rows inactive: `a = free`, the forward
+/// dynamics without contacts. Each contact's rows come from [`row_mask`]. With every row
+/// active it is [`solve_factored`], to the bit.
+///
+/// ```
+/// use eomgen_runtime::contact::solve_factored_active;
+/// // The point mass of `solve`, held only vertically: it falls freely along x.
+/// let m = [[1.0_f64, 0.0], [0.0, 1.0]];
+/// let j = [[1.0, 0.0], [0.0, 1.0]];
+/// let free = [2.0, -9.81];
+/// let (a, f) = solve_factored_active(&m, &[None, None], &free, &j, &[0.0; 2], &[false, true])
+///     .unwrap();
+/// assert_eq!((a[0], f[0]), (2.0, 0.0));
+/// assert!(a[1].abs() < 1e-12 && (f[1] - 9.81).abs() < 1e-12);
+/// ```
+pub fn solve_factored_active<T: Real, const N: usize, const K: usize>(
+    m: &[[T; N]; N],
+    parent: &[Option<usize>; N],
+    free: &[T; N],
+    j: &[[T; N]; K],
+    drift: &[T; K],
+    active: &[bool; K],
+) -> Result<([T; N], [T; K]), FactorError> {
+    // Y = M^-1 J^T (N x K), all K columns in one substitution; inactive columns zero.
     let mut y = [[T::zero(); K]; N];
     for (i, yi) in y.iter_mut().enumerate() {
-        for (yik, jk) in yi.iter_mut().zip(j) {
-            *yik = jk[i];
+        for ((yik, jk), on) in yi.iter_mut().zip(j).zip(active) {
+            if *on {
+                *yik = jk[i];
+            }
         }
     }
     ltdl_substitute_rows(m, parent, &mut y);
     let mut lambda = [[T::zero(); K]; K];
-    for (jr, lr) in j.iter().zip(lambda.iter_mut()) {
+    for (r, (jr, lr)) in j.iter().zip(lambda.iter_mut()).enumerate() {
+        if !active[r] {
+            lr[r] = T::one();
+            continue;
+        }
         for (jri, yi) in jr.iter().zip(&y) {
             for (l, yic) in lr.iter_mut().zip(yi) {
                 *l = jri.mul_add(*yic, *l);
@@ -86,7 +122,9 @@ pub fn solve_factored<T: Real, const N: usize, const K: usize>(
     let chol = Cholesky::new(lambda).map_err(shift)?;
     let mut b = [T::zero(); K];
     for k in 0..K {
-        b[k] = -(drift[k] + dot(&j[k], free));
+        if active[k] {
+            b[k] = -(drift[k] + dot(&j[k], free));
+        }
     }
     let f = chol.solve(&b);
     let mut a = *free;
@@ -102,6 +140,34 @@ pub fn solve_factored<T: Real, const N: usize, const K: usize>(
         return Err(FactorError::NonFinite { pivot: N + k });
     }
     Ok((a, f))
+}
+
+/// The contact rows (`K` of them) of the contacts (`C`) that `active` switches on, each
+/// contact `c` owning the next `rows[c]` rows (3 for a point, 6 for a frame: a generated
+/// robot's `CONTACT_ROWS`). Rows beyond the sum of `rows` stay inactive; contacts beyond `K`
+/// rows are cut.
+///
+/// ```
+/// use eomgen_runtime::contact::row_mask;
+/// let rows: [bool; 9] = row_mask(&[3, 6], &[false, true]);
+/// assert_eq!(rows, [false, false, false, true, true, true, true, true, true]);
+/// ```
+pub fn row_mask<const C: usize, const K: usize>(
+    rows: &[usize; C],
+    active: &[bool; C],
+) -> [bool; K] {
+    let mut out = [false; K];
+    let mut at: usize = 0;
+    for (n, on) in rows.iter().zip(active) {
+        let end = at.saturating_add(*n).min(K);
+        if *on {
+            for x in &mut out[at..end] {
+                *x = true;
+            }
+        }
+        at = end;
+    }
+    out
 }
 
 fn dot<T: Real, const N: usize>(a: &[T; N], b: &[T; N]) -> T {

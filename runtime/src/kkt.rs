@@ -94,8 +94,10 @@ pub struct ContactKkt<T, const N: usize, const K: usize> {
     j: [[T; N]; K],
     /// Row `k` is `M^-1` times row `k` of `J` (a column of `Y = M^-1 J^T`).
     y: [[T; N]; K],
-    /// `J M^-1 J^T`.
+    /// `J M^-1 J^T` (the identity's rows and columns for inactive rows).
     lambda: Cholesky<T, K>,
+    /// Which contact rows take part ([`ContactKkt::new_active`]).
+    active: [bool; K],
 }
 
 impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
@@ -105,20 +107,55 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
     /// Errors: a pivot of `M` that is not positive (`pivot < N`), or of `J M^-1 J^T` (pivot
     /// `N + k`: a rank-deficient `J`), or a non-finite one.
     pub fn new(
-        mut m: [[T; N]; N],
+        m: [[T; N]; N],
         parent: &[Option<usize>; N],
         j: [[T; N]; K],
     ) -> Result<Self, FactorError> {
+        Self::new_active(m, parent, j, &[true; K])
+    }
+
+    /// [`ContactKkt::new`] with only the contact rows `k` where `active[k]` holds (contacts
+    /// switched at run time; [`crate::contact::row_mask`] gives the rows of a set of
+    /// contacts): the inactive rows of `J` are zeroed and those of `J M^-1 J^T` replaced by
+    /// the identity's, and every solve gives them zero forces, so that the solutions are those
+    /// of the system of the active rows alone (inactive rows of `f` zero). Every row active:
+    /// [`ContactKkt::new`], to the bit.
+    ///
+    /// ```
+    /// use eomgen_runtime::ContactKkt;
+    /// // A unit point mass in the plane, held vertically only: free along x.
+    /// let j = [[1.0_f64, 0.0], [0.0, 1.0]];
+    /// let kkt = ContactKkt::new_active([[1.0, 0.0], [0.0, 1.0]], &[None, None], j, &[false, true])
+    ///     .unwrap();
+    /// let (a, f) = kkt.solve(&[2.0, -9.81], &[0.0, 0.0]).unwrap();
+    /// assert_eq!((a, f), ([2.0, 0.0], [0.0, 9.81]));
+    /// ```
+    pub fn new_active(
+        mut m: [[T; N]; N],
+        parent: &[Option<usize>; N],
+        mut j: [[T; N]; K],
+        active: &[bool; K],
+    ) -> Result<Self, FactorError> {
         ltdl_factor(&mut m, parent)?;
         let mut y = [[T::zero(); N]; K];
-        for (yk, jk) in y.iter_mut().zip(&j) {
-            *yk = ltdl_substitute(&m, parent, jk);
+        for ((yk, jk), on) in y.iter_mut().zip(j.iter_mut()).zip(active) {
+            if *on {
+                *yk = ltdl_substitute(&m, parent, jk);
+            } else {
+                *jk = [T::zero(); N];
+            }
         }
         let mut lambda = [[T::zero(); K]; K];
         for r in 0..K {
+            if !active[r] {
+                lambda[r][r] = T::one();
+                continue;
+            }
             for c in 0..=r {
-                lambda[r][c] = dot(&j[r], &y[c]);
-                lambda[c][r] = lambda[r][c];
+                if active[c] {
+                    lambda[r][c] = dot(&j[r], &y[c]);
+                    lambda[c][r] = lambda[r][c];
+                }
             }
         }
         let lambda = Cholesky::new(lambda).map_err(shift::<N>)?;
@@ -128,10 +165,16 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
             j,
             y,
             lambda,
+            active: *active,
         })
     }
 
-    /// The contact Jacobian the system was built with.
+    /// Which contact rows take part (all of them for [`ContactKkt::new`]).
+    pub fn active(&self) -> &[bool; K] {
+        &self.active
+    }
+
+    /// The contact Jacobian the system was built with (inactive rows zeroed).
     pub fn jacobian(&self) -> &[[T; N]; K] {
         &self.j
     }
@@ -142,8 +185,8 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
     pub fn solve(&self, top: &[T; N], bottom: &[T; K]) -> Result<([T; N], [T; K]), FactorError> {
         let mut x = ltdl_substitute(&self.factors, &self.parent, top);
         let mut b = *bottom;
-        for (bk, jk) in b.iter_mut().zip(&self.j) {
-            *bk -= dot(jk, &x);
+        for ((bk, jk), on) in b.iter_mut().zip(&self.j).zip(&self.active) {
+            *bk = if *on { *bk - dot(jk, &x) } else { T::zero() };
         }
         let f = self.lambda.solve(&b);
         for (yk, fk) in self.y.iter().zip(&f) {
@@ -171,7 +214,11 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
         self.substitute_columns(&mut x);
         // F = Lambda^-1 (bottom - J X)
         let mut f = *bottom;
-        for (fk, jk) in f.iter_mut().zip(&self.j) {
+        for ((fk, jk), on) in f.iter_mut().zip(&self.j).zip(&self.active) {
+            if !*on {
+                *fk = [T::zero(); C];
+                continue;
+            }
             for (jki, xi) in jk.iter().zip(&x) {
                 axpy(fk, -*jki, xi);
             }
@@ -362,6 +409,42 @@ mod tests {
                 assert!((f[k][c] - fc[k]).abs() < 1e-14);
             }
         }
+    }
+
+    /// An inactive row drops out: the solutions of the remaining row's system alone, with
+    /// zero force on the inactive one, for one and many right-hand sides and the impulse.
+    #[test]
+    fn inactive_rows_solve_the_system_of_the_active_ones() {
+        let m = [[4.0, 1.0, 0.5], [1.0, 3.0, 0.25], [0.5, 0.25, 2.0]];
+        let parent = [None, Some(0), Some(1)];
+        let j = [[1.0, 0.0, 2.0], [0.0, 1.0, -1.0]];
+        let masked = ContactKkt::new_active(m, &parent, j, &[false, true]).unwrap();
+        let alone = ContactKkt::new(m, &parent, [j[1]]).unwrap();
+        let top = [1.0, 0.5, -1.0];
+        let (x, f) = masked.solve(&top, &[7.0, 2.0]).unwrap();
+        let (xa, fa) = alone.solve(&top, &[2.0]).unwrap();
+        assert_eq!(f[0], 0.0);
+        assert!((f[1] - fa[0]).abs() < 1e-14);
+        assert!(x.iter().zip(&xa).all(|(a, b)| (a - b).abs() < 1e-14));
+        let (xc, fc) = masked.solve_columns(&top.map(|t| [t, -t]), &[[3.0, 1.0], [2.0, -2.0]]);
+        assert_eq!(fc[0], [0.0, 0.0]);
+        assert!((0..3).all(|i| (xc[i][0] - x[i]).abs() < 1e-14));
+        let v = [0.3, -0.2, 0.5];
+        let ((after, p), (after_a, pa)) = (
+            masked.impulse(&v, 0.5).unwrap(),
+            alone.impulse(&v, 0.5).unwrap(),
+        );
+        assert_eq!(p[0], 0.0);
+        assert!((p[1] - pa[0]).abs() < 1e-14);
+        assert!(after
+            .iter()
+            .zip(&after_a)
+            .all(|(a, b)| (a - b).abs() < 1e-14));
+        // All rows inactive: the free solution.
+        let none = ContactKkt::new_active(m, &parent, j, &[false; 2]).unwrap();
+        let (free, zero) = none.solve(&top, &[1.0, 1.0]).unwrap();
+        let solo = ContactKkt::<f64, 3, 0>::new(m, &parent, []).unwrap();
+        assert_eq!((free, zero), (solo.solve(&top, &[]).unwrap().0, [0.0; 2]));
     }
 
     #[test]

@@ -72,6 +72,7 @@
 #[cfg(feature = "std")]
 extern crate std;
 
+mod baumgarte;
 pub mod contact;
 pub mod control;
 mod dimensions;
@@ -94,6 +95,7 @@ pub mod tree;
 #[cfg(feature = "nalgebra")]
 pub mod nalgebra_support;
 
+pub use baumgarte::Baumgarte;
 pub use control::{
     wrench_to_torque, CollocatedPfl, ComputedTorque, Ellipsoid, PdGravity, Setpoint, SymmetricEigen,
 };

@@ -10,13 +10,14 @@
 //! scalar trait, for code generic over `f32` and `f64`), and the types generated methods return: [`Pose`] (from `link_pose`) and
 //! [`FactorError`] (from `try_forward_dynamics`); for floating-base robots
 //! [`FloatingDynamics`] and, with contact points, [`Contacts`] (and the derivatives' types
-//! [`ContactDynamicsDerivatives`], [`ImpulseDynamicsDerivatives`]); and [`Dimensions`] (`DOF`, `NQ`,
+//! [`ContactDynamicsDerivatives`], [`ImpulseDynamicsDerivatives`], and [`Baumgarte`], the
+//! stabilization `contact_forward_dynamics_stabilized` takes); and [`Dimensions`] (`DOF`, `NQ`,
 //! `NV` for any scalar type).
 //!
 //! The prelude is part of the public API: items are added to it only in minor versions and
 //! never removed outside a major one.
 
 pub use crate::{
-    ContactDynamicsDerivatives, Contacts, Dimensions, Dynamics, FactorError, FloatingDynamics,
-    Hamiltonian, ImpulseDynamicsDerivatives, Pose, Real,
+    Baumgarte, ContactDynamicsDerivatives, Contacts, Dimensions, Dynamics, FactorError,
+    FloatingDynamics, Hamiltonian, ImpulseDynamicsDerivatives, Pose, Real,
 };
