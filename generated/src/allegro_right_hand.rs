@@ -115,6 +115,28 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dimensions for AllegroRightHan
     clippy::type_complexity
 )]
 impl<T: ::eomgen_runtime::Real> AllegroRightHand<T> {
+    /// Each coordinate's parent coordinate (`None`: the root), parents first: the
+    /// joints' parents (a floating base's six coordinates form a chain). The sparsity
+    /// of `mass_matrix` that the runtime's tree solves take (`eomgen_runtime::tree`,
+    /// `eomgen_runtime::contact::solve`, `eomgen_runtime::ContactKkt`).
+    pub const PARENTS: [Option<usize>; 16] = [
+        None,
+        Some(0),
+        Some(1),
+        Some(2),
+        None,
+        Some(4),
+        Some(5),
+        Some(6),
+        None,
+        Some(8),
+        Some(9),
+        Some(10),
+        None,
+        Some(12),
+        Some(13),
+        Some(14),
+    ];
     /// Each joint coordinate's position limits `(lower, upper)` (rad or m) from the URDF's `<limit>`, in `JOINT_NAMES` order; infinite for `continuous` joints and joints without `<limit>`.
     pub const POSITION_LIMITS: [(f64, f64); 16] = [
         (-0.47, 0.47),

@@ -79,6 +79,18 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dimensions for IrisSimple<T> {
     clippy::type_complexity
 )]
 impl<T: ::eomgen_runtime::Real> IrisSimple<T> {
+    /// Each coordinate's parent coordinate (`None`: the root), parents first: the
+    /// joints' parents (a floating base's six coordinates form a chain). The sparsity
+    /// of `mass_matrix` that the runtime's tree solves take (`eomgen_runtime::tree`,
+    /// `eomgen_runtime::contact::solve`, `eomgen_runtime::ContactKkt`).
+    pub const PARENTS: [Option<usize>; 6] = [
+        None,
+        Some(0),
+        Some(1),
+        Some(2),
+        Some(3),
+        Some(4),
+    ];
     ///The URDF names of the joints, in the order of the joint part of every array (after the base's coordinates).
     pub const JOINT_NAMES: [&'static str; 0] = [];
     /// Each joint coordinate's position limits `(lower, upper)` (rad or m) from the URDF's `<limit>`, in `JOINT_NAMES` order (the joints only: entry `i` is velocity coordinate `6 + i`); infinite for `continuous` joints and joints without `<limit>`.

@@ -91,6 +91,18 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dimensions for Kinova<T> {
     clippy::type_complexity
 )]
 impl<T: ::eomgen_runtime::Real> Kinova<T> {
+    /// Each coordinate's parent coordinate (`None`: the root), parents first: the
+    /// joints' parents (a floating base's six coordinates form a chain). The sparsity
+    /// of `mass_matrix` that the runtime's tree solves take (`eomgen_runtime::tree`,
+    /// `eomgen_runtime::contact::solve`, `eomgen_runtime::ContactKkt`).
+    pub const PARENTS: [Option<usize>; 6] = [
+        None,
+        Some(0),
+        Some(1),
+        Some(2),
+        Some(3),
+        Some(4),
+    ];
     /// Each joint coordinate's position limits `(lower, upper)` (rad or m) from the URDF's `<limit>`, in `JOINT_NAMES` order; infinite for `continuous` joints and joints without `<limit>`.
     pub const POSITION_LIMITS: [(f64, f64); 6] = [
         (f64::NEG_INFINITY, f64::INFINITY),

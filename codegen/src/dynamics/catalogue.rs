@@ -138,6 +138,26 @@ pub enum Evaluation {
     ImpulseDynamics,
     /// The derivatives of `ImpulseDynamics`, from `impulse_dynamics_partials`.
     ImpulseDynamicsDerivatives,
+    /// Contact or impulse dynamics (or their derivatives) with a set of active contacts given
+    /// at run time (`eomgen_runtime::contact::row_mask`, `ContactKkt::new_active`).
+    ActiveContacts(ActiveContacts),
+}
+
+/// The entries of [`Evaluation::ActiveContacts`]: each the entry of all contacts it extends,
+/// with an `active: &[bool; C]` argument after its inputs.
+#[derive(Clone, Debug)]
+pub enum ActiveContacts {
+    /// `contact_forward_dynamics_active`: `h` straight-line as `ContactForwardDynamics`.
+    Dynamics { h: Vec<Id> },
+    /// `contact_forward_dynamics_stabilized`: the same with an `eomgen_runtime::Baumgarte`
+    /// argument, from `contact_placements`.
+    Stabilized { h: Vec<Id> },
+    /// `contact_forward_dynamics_derivatives_active`.
+    Derivatives { h: Vec<Id> },
+    /// `impulse_dynamics_active`.
+    Impulse,
+    /// `impulse_dynamics_derivatives_active`.
+    ImpulseDerivatives,
 }
 
 /// One generated function.
@@ -171,7 +191,12 @@ impl Quantity {
             } => accelerations.iter().chain(pivots).copied().collect(),
             Evaluation::ForwardDynamicsSolve { h }
             | Evaluation::ContactForwardDynamics { h }
-            | Evaluation::ContactDynamicsDerivatives { h } => h.clone(),
+            | Evaluation::ContactDynamicsDerivatives { h }
+            | Evaluation::ActiveContacts(
+                ActiveContacts::Dynamics { h }
+                | ActiveContacts::Stabilized { h }
+                | ActiveContacts::Derivatives { h },
+            ) => h.clone(),
             Evaluation::Factored { outputs, pivots } => {
                 outputs.iter().chain(pivots).copied().collect()
             }
@@ -186,23 +211,35 @@ impl Quantity {
 
     /// Quantities whose generated code this one calls.
     pub fn needs(&self) -> &'static [&'static str] {
+        use ActiveContacts as A;
         match self.eval {
             Evaluation::CraigColumns(_) => &["coriolis_matrix"],
             Evaluation::ForwardDynamicsSolve { .. } | Evaluation::MassMatrixInverse => {
                 &["mass_matrix"]
             }
-            Evaluation::ContactForwardDynamics { .. } => {
+            Evaluation::ContactForwardDynamics { .. }
+            | Evaluation::ActiveContacts(A::Dynamics { .. }) => {
                 &["mass_matrix", "contact_jacobian", "contact_drift"]
             }
-            Evaluation::ContactDynamicsDerivatives { .. } => &[
+            Evaluation::ActiveContacts(A::Stabilized { .. }) => &[
+                "mass_matrix",
+                "contact_jacobian",
+                "contact_drift",
+                "contact_placements",
+            ],
+            Evaluation::ContactDynamicsDerivatives { .. }
+            | Evaluation::ActiveContacts(A::Derivatives { .. }) => &[
                 "mass_matrix",
                 "contact_jacobian",
                 "contact_drift",
                 "inverse_dynamics_derivatives",
                 "contact_dynamics_partials",
             ],
-            Evaluation::ImpulseDynamics => &["mass_matrix", "contact_jacobian"],
-            Evaluation::ImpulseDynamicsDerivatives => &[
+            Evaluation::ImpulseDynamics | Evaluation::ActiveContacts(A::Impulse) => {
+                &["mass_matrix", "contact_jacobian"]
+            }
+            Evaluation::ImpulseDynamicsDerivatives
+            | Evaluation::ActiveContacts(A::ImpulseDerivatives) => &[
                 "mass_matrix",
                 "contact_jacobian",
                 "impulse_dynamics_partials",

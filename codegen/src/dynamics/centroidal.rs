@@ -45,6 +45,9 @@ pub struct Centroidal {
     pub contact_jacobian: Vec<Vec<Id>>,
     /// `Jdot v`, 3K, world axes.
     pub contact_drift: Vec<Id>,
+    /// Each contact's world placement (points, then frames), 12 entries each: the position,
+    /// then the row-major rotation.
+    pub contact_placements: Vec<Id>,
 }
 
 impl Centroidal {
@@ -76,7 +79,8 @@ impl Centroidal {
             let (map, com_jacobian) = centroidal_map(g, lm, &poses, &com, inv);
             (mass, first_moment, com, map, com_jacobian)
         };
-        let (contact_jacobian, contact_drift) = contacts(g, model, lm, wk, &poses, v);
+        let (contact_jacobian, contact_drift, contact_placements) =
+            contacts(g, model, lm, wk, &poses, v);
         Centroidal {
             mass,
             first_moment,
@@ -85,6 +89,7 @@ impl Centroidal {
             map,
             contact_jacobian,
             contact_drift,
+            contact_placements,
         }
     }
 }
@@ -181,7 +186,9 @@ fn centroidal_map(
 /// Jacobian, then all six of each 6D contact frame's) and drift, the constrained acceleration at
 /// zero generalized acceleration: a point's classical acceleration (`Jdot v`), a frame's spatial
 /// acceleration (linear part: the origin's classical acceleration minus `omega x` its
-/// velocity, as Pinocchio's `getFrameAcceleration`), with `q`, `v` the coordinate symbols.
+/// velocity, as Pinocchio's `getFrameAcceleration`), with `q`, `v` the coordinate symbols;
+/// and each contact's world placement (position, then row-major rotation).
+#[allow(clippy::type_complexity)]
 fn contacts(
     g: &mut Graph,
     model: &Model,
@@ -189,7 +196,7 @@ fn contacts(
     wk: &WorldKinematics,
     poses: &[(M3, V3)],
     v: &[Id],
-) -> (Vec<Vec<Id>>, Vec<Id>) {
+) -> (Vec<Vec<Id>>, Vec<Id>, Vec<Id>) {
     let shift = usize::from(model.is_floating());
     let motions = newton_euler::forward_pass(
         g,
@@ -205,7 +212,7 @@ fn contacts(
     let points = model.contacts.iter().map(|&f| (f, origin, false));
     let at = model.contact_points_at.iter().map(|&(f, p)| (f, p, false));
     let frames = model.contact_frames.iter().map(|&f| (f, origin, true));
-    let (mut jac, mut drift) = (Vec::new(), Vec::new());
+    let (mut jac, mut drift, mut placements) = (Vec::new(), Vec::new(), Vec::new());
     for (f, offset, six) in points.chain(at).chain(frames) {
         let rows = if six { 6 } else { 3 };
         let frame = &model.frames[f];
@@ -214,7 +221,9 @@ fn contacts(
             translation: frame.placement.translation
                 + frame.placement.rotation * nalgebra::Vector3::from(offset),
         };
-        let (_, position) = wk.frame_pose(g, frame.body, &placement);
+        let (rotation, position) = wk.frame_pose(g, frame.body, &placement);
+        placements.extend(position);
+        placements.extend(rotation.iter().flatten());
         let full = wk.point_jacobian(g, model, frame.body, &position);
         let Some(body) = frame.body.map(|b| b + shift).or((shift == 1).then_some(0)) else {
             // On a fixed root: the frame never moves.
@@ -241,7 +250,7 @@ fn contacts(
         }
         jac.extend(full.into_iter().take(rows));
     }
-    (jac, drift)
+    (jac, drift, placements)
 }
 
 const Q: &[Input] = &[Input::Q];

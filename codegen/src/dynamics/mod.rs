@@ -11,6 +11,7 @@
 //! Rotor inertia (armature) adds to `M`'s diagonal; joint friction `F(qd)` (when the model
 //! includes it) adds to `tau` and enters forward dynamics, but not `b`.
 
+mod active_contacts;
 pub mod base_parameters;
 pub mod catalogue;
 mod centroidal;
@@ -33,7 +34,7 @@ use crate::cas::{Graph, GraphFull, Id, Limits, Program};
 use crate::kinematics::{const_v3, BodyKinematics, Params, WorldKinematics, M3, V3};
 use crate::model::Model;
 
-pub use catalogue::{Craig, Evaluation, Home, Input, Quantity, Shape};
+pub use catalogue::{ActiveContacts, Craig, Evaluation, Home, Input, Quantity, Shape};
 pub use centroidal::Centroidal;
 pub use coupling::CoordinateMap;
 pub use identification::Identification;
@@ -418,6 +419,8 @@ impl Derivation {
             let partials = contact_derivatives::derive(self, model);
             self.graph.check()?;
             let extra = contact_derivatives::quantities(self, &partials);
+            self.quantities.extend(extra);
+            let extra = active_contacts::derivatives(self);
             self.quantities.extend(extra);
         }
         Ok(())

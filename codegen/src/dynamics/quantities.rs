@@ -41,6 +41,7 @@ pub fn catalogue(model: &Model, d: &Derivation) -> Vec<Quantity> {
     out.push(link_jacobian(d.dof));
     out.extend(centroidal::quantities(model, d));
     out.extend(super::contact_derivatives::impulse_dynamics(d));
+    out.extend(super::active_contacts::quantities(d));
     if model.is_floating() {
         // Without the `Dynamics` trait (whose arrays are all N long): the emitter puts those of
         // `FloatingDynamics` and `Contacts` in their impls, the others are inherent methods.

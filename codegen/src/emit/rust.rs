@@ -17,7 +17,9 @@ use super::expr::{lit, Ctx};
 use super::names::{comment_text, snake, upper_camel, Scope};
 use super::split::Split;
 use crate::cas::{Graph, Id, OpCount};
-use crate::dynamics::{Craig, Derivation, Evaluation, Home, Input, Quantity, Shape};
+use crate::dynamics::{
+    ActiveContacts, Craig, Derivation, Evaluation, Home, Input, Quantity, Shape,
+};
 use crate::kinematics::snap;
 use crate::model::{Model, Transform};
 use crate::spatial::snap_rotation;
@@ -104,6 +106,8 @@ struct Emitter<'a> {
     k: Literal,
     /// Each velocity coordinate's parent coordinate.
     parents: Vec<Option<usize>>,
+    /// Each contact's number of rows (3: a point, 6: a frame), in the contacts' order.
+    contact_rows: Vec<usize>,
     /// Whether every `Dynamics` method is generated, so that the trait is implemented (and
     /// its methods live there rather than in the inherent impl).
     in_trait: bool,
@@ -155,6 +159,16 @@ enum Trait {
     Contacts,
 }
 
+/// Each contact's number of rows: 3 for the points (at link origins, then at positions), 6 for
+/// the frames.
+fn contact_rows(model: &Model) -> Vec<usize> {
+    let points = model.contacts.len() + model.contact_points_at.len();
+    let frames = model.contact_frames.len();
+    std::iter::repeat_n(3, points)
+        .chain(std::iter::repeat_n(6, frames))
+        .collect()
+}
+
 /// Emits the whole file (unformatted tokens; see [`super::format`]) and the operation count of
 /// each straight-line function.
 pub fn emit_tokens(
@@ -178,6 +192,7 @@ pub fn emit_tokens(
         floating: model.is_floating(),
         k: usize_lit(d.centroidal.contact_drift.len()),
         parents: d.coordinate_parents.clone(),
+        contact_rows: contact_rows(model),
         in_trait: d
             .quantities
             .iter()
@@ -507,11 +522,25 @@ impl Emitter<'_> {
             Evaluation::FrameMotion(m) => self.frame_motion_fn(q, *m),
             Evaluation::Manifold(m) => self.manifold_fn(q, *m),
             Evaluation::ContactDynamicsDerivatives { h } => {
-                self.contact_dynamics_derivatives_fns(q, h)
+                self.contact_dynamics_derivatives_fns(q, h, false)
             }
-            Evaluation::ImpulseDynamics => self.impulse_dynamics_fns(q),
-            Evaluation::ImpulseDynamicsDerivatives => self.impulse_dynamics_derivatives_fns(q),
+            Evaluation::ImpulseDynamics => self.impulse_dynamics_fns(q, false),
+            Evaluation::ImpulseDynamicsDerivatives => {
+                self.impulse_dynamics_derivatives_fns(q, false)
+            }
+            Evaluation::ActiveContacts(a) => self.active_contacts_fns(q, a),
             Evaluation::Factored { outputs, pivots } => self.factored_fn(q, outputs, pivots),
+        }
+    }
+
+    /// The methods of a set of active contacts ([`ActiveContacts`]).
+    fn active_contacts_fns(&mut self, q: &Quantity, a: &ActiveContacts) -> TokenStream {
+        match a {
+            ActiveContacts::Dynamics { h } => self.contact_active_fns(q, h, false),
+            ActiveContacts::Stabilized { h } => self.contact_active_fns(q, h, true),
+            ActiveContacts::Derivatives { h } => self.contact_dynamics_derivatives_fns(q, h, true),
+            ActiveContacts::Impulse => self.impulse_dynamics_fns(q, true),
+            ActiveContacts::ImpulseDerivatives => self.impulse_dynamics_derivatives_fns(q, true),
         }
     }
 
@@ -692,23 +721,26 @@ impl Emitter<'_> {
         self.quantities.iter().any(|q| which(&q.eval))
     }
 
-    /// The run-time tree solves' helpers, each only where a quantity calls it: `const PARENTS`
-    /// (each joint's parent joint, for the runtime's tree kernels and `ContactKkt`), and the
-    /// robot's unrolled factorization and substitution (`emit/tree_solve.rs`).
+    /// The run-time tree solves' helpers, each only where a quantity calls it: `PARENTS`
+    /// (each joint's parent joint, for the runtime's tree kernels and `ContactKkt`; public with
+    /// `mass_matrix`, for users' own solves), `CONTACT_ROWS` (with `contact_jacobian`), and
+    /// the robot's unrolled factorization and substitution (`emit/tree_solve.rs`).
     fn parents_const(&self) -> TokenStream {
         use Evaluation as E;
         let n = &self.n;
-        let table = self.any_eval(|e| {
-            matches!(
-                e,
-                E::MassMatrixInverse
-                    | E::ForwardDynamicsDerivatives
-                    | E::ContactForwardDynamics { .. }
-                    | E::ContactDynamicsDerivatives { .. }
-                    | E::ImpulseDynamics
-                    | E::ImpulseDynamicsDerivatives
-            )
-        });
+        let table = self.has("mass_matrix")
+            || self.any_eval(|e| {
+                matches!(
+                    e,
+                    E::MassMatrixInverse
+                        | E::ForwardDynamicsDerivatives
+                        | E::ContactForwardDynamics { .. }
+                        | E::ContactDynamicsDerivatives { .. }
+                        | E::ImpulseDynamics
+                        | E::ImpulseDynamicsDerivatives
+                        | E::ActiveContacts(_)
+                )
+            });
         let table = if table {
             let parents = self.parents.iter().map(|p| match p {
                 Some(p) => {
@@ -719,8 +751,23 @@ impl Emitter<'_> {
             });
             quote! {
                 /// Each coordinate's parent coordinate (`None`: the root), parents first: the
-                /// joints' parents (a floating base's six coordinates form a chain).
-                const PARENTS: [Option<usize>; #n] = [#(#parents),*];
+                /// joints' parents (a floating base's six coordinates form a chain). The sparsity
+                /// of `mass_matrix` that the runtime's tree solves take (`eomgen_runtime::tree`,
+                /// `eomgen_runtime::contact::solve`, `eomgen_runtime::ContactKkt`).
+                pub const PARENTS: [Option<usize>; #n] = [#(#parents),*];
+            }
+        } else {
+            TokenStream::new()
+        };
+        let rows = if self.has("contact_jacobian") {
+            let c = usize_lit(self.contact_rows.len());
+            let rows = self.contact_rows.iter().map(|r| usize_lit(*r));
+            quote! {
+                /// Each contact's number of rows in `contact_jacobian`, `contact_drift` and the
+                /// forces (3: a point, 6: a frame), in the contacts' order: points, then frames.
+                /// The `active` flags of the `_active` methods follow this order
+                /// (`eomgen_runtime::contact::row_mask` turns them into rows).
+                pub const CONTACT_ROWS: [usize; #c] = [#(#rows),*];
             }
         } else {
             TokenStream::new()
@@ -731,6 +778,9 @@ impl Emitter<'_> {
                 E::ForwardDynamicsSolve { .. }
                     | E::ContactForwardDynamics { .. }
                     | E::ForwardDynamicsDerivatives
+                    | E::ActiveContacts(
+                        ActiveContacts::Dynamics { .. } | ActiveContacts::Stabilized { .. }
+                    )
             )
         };
         let factor = if self.any_eval(|e| solves(e) || matches!(e, E::MassMatrixInverse)) {
@@ -745,6 +795,7 @@ impl Emitter<'_> {
         };
         quote! {
             #table
+            #rows
             #factor
             #substitute
         }
@@ -799,17 +850,31 @@ impl Emitter<'_> {
         }
     }
 
+    /// `let mut m = ...; let free = ...;`: `M(q)` factorized by the unrolled tree `L^T D L`
+    /// (returning its error) and the accelerations without contacts `M^-1 (tau - h)`, `h` by
+    /// the straight-line block `hb`.
+    fn free_accelerations(&self, hb: &TokenStream) -> TokenStream {
+        let (n, m) = (&self.n, self.call("mass_matrix"));
+        quote! {
+            let mut m = #m(self, q);
+            let h: [T; #n] = { #hb };
+            let mut rhs = *tau;
+            for (r, h) in rhs.iter_mut().zip(h) {
+                *r -= h;
+            }
+            Self::ltdl_factor_unrolled(&mut m)?;
+            let free = Self::ltdl_substitute_unrolled(&m, &rhs);
+        }
+    }
+
     /// `try_contact_forward_dynamics` and `contact_forward_dynamics` (NaN on failure).
     fn contact_forward_dynamics_fns(&mut self, q: &Quantity, h: &[Id]) -> TokenStream {
         let (hb, ops) = self.straight(q, h, Shape::Vector(h.len()));
         let docs = Self::quantity_doc(q, Some(ops));
         let (n, nq) = (&self.n, &self.nq);
         let k3 = usize_lit(q.shape.len() - h.len());
-        let (m, j, drift) = (
-            self.call("mass_matrix"),
-            self.call("contact_jacobian"),
-            self.call("contact_drift"),
-        );
+        let free = self.free_accelerations(&hb);
+        let (j, drift) = (self.call("contact_jacobian"), self.call("contact_drift"));
         let try_vis = self.vis("try_contact_forward_dynamics");
         let try_cfd = self.path("try_contact_forward_dynamics");
         let try_fn = quote! {
@@ -817,14 +882,7 @@ impl Emitter<'_> {
             /// do not exist: a pivot of M(q) (`pivot` < N) or of `J_c M^-1 J_c^T` (`pivot` - N,
             /// a rank-deficient contact Jacobian) that is not positive, or non-finite input.
             #try_vis fn try_contact_forward_dynamics(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n]) -> ::core::result::Result<([T; #n], [T; #k3]), ::eomgen_runtime::FactorError> {
-                let mut m = #m(self, q);
-                let h: [T; #n] = { #hb };
-                let mut rhs = *tau;
-                for (r, h) in rhs.iter_mut().zip(h) {
-                    *r -= h;
-                }
-                Self::ltdl_factor_unrolled(&mut m)?;
-                let free = Self::ltdl_substitute_unrolled(&m, &rhs);
+                #free
                 ::eomgen_runtime::contact::solve_factored(&m, &Self::PARENTS, &free, &#j(self, q), &#drift(self, q, qd))
             }
         };

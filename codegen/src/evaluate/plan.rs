@@ -126,6 +126,9 @@ impl Plan {
             Evaluation::ImpulseDynamics | Evaluation::ImpulseDynamicsDerivatives => {
                 return not("it takes a restitution besides the state")
             }
+            Evaluation::ActiveContacts(_) => {
+                return not("it takes the set of active contacts besides the state")
+            }
             Evaluation::ContactDynamicsDerivatives { .. } => {
                 return not("the evaluator does not compose the contact KKT derivatives yet")
             }

@@ -1,41 +1,142 @@
 //! The methods of contact and impulse dynamics that solve the contact problem's KKT system at
-//! run time (`eomgen_runtime::ContactKkt`), each with its `try_` variant.
+//! run time (`eomgen_runtime::ContactKkt`), each with its `try_` variant; and their `_active`
+//! variants, which take the set of active contacts (`active: &[bool; C]`).
 
-use proc_macro2::TokenStream;
-use quote::quote;
+use proc_macro2::{Ident, TokenStream};
+use quote::{format_ident, quote};
 
-use super::Emitter;
+use super::{usize_lit, Emitter};
 use crate::cas::Id;
 use crate::dynamics::{Quantity, Shape};
 
+/// The names and extra argument of a method with or without a set of active contacts.
+struct Signature {
+    name: Ident,
+    try_name: Ident,
+    /// `, active: &[bool; C]` or nothing.
+    param: TokenStream,
+    /// `, active` or nothing.
+    arg: TokenStream,
+    /// The first line of the `try_` method's documentation.
+    why: String,
+}
+
 impl Emitter<'_> {
-    /// `let kkt = ...?;`: the KKT system at `q` from `mass_matrix` and `contact_jacobian`.
-    fn kkt(&self) -> TokenStream {
-        let (m, j) = (self.call("mass_matrix"), self.call("contact_jacobian"));
-        quote! {
-            let kkt = ::eomgen_runtime::ContactKkt::new(#m(self, q), &Self::PARENTS, #j(self, q))?;
+    /// The method `q.name` and its `try_` variant; with `active: &[bool; C]` last when `active`.
+    /// The `try_` method's documentation starts with `before`, the name, then `after`.
+    fn signature(&self, q: &Quantity, active: bool, (before, after): (&str, &str)) -> Signature {
+        let c = usize_lit(self.contact_rows.len());
+        let (param, arg) = if active {
+            (quote!(, active: &[bool; #c]), quote!(, active))
+        } else {
+            (TokenStream::new(), TokenStream::new())
+        };
+        Signature {
+            name: format_ident!("{}", q.name),
+            try_name: format_ident!("try_{}", q.name),
+            param,
+            arg,
+            why: format!(" {before} `{}`{after}", q.name),
         }
     }
 
-    /// `try_contact_forward_dynamics_derivatives` and `contact_forward_dynamics_derivatives`
-    /// (NaN on failure).
-    pub(super) fn contact_dynamics_derivatives_fns(
+    /// `let kkt = ...?;`: the KKT system at `q` from `mass_matrix` and `contact_jacobian`, of
+    /// the contacts of `active` when `active` (`ContactKkt::new_active`).
+    fn kkt(&self, active: bool) -> TokenStream {
+        let (m, j) = (self.call("mass_matrix"), self.call("contact_jacobian"));
+        if active {
+            quote! {
+                let rows = ::eomgen_runtime::contact::row_mask(&Self::CONTACT_ROWS, active);
+                let kkt = ::eomgen_runtime::ContactKkt::new_active(#m(self, q), &Self::PARENTS, #j(self, q), &rows)?;
+            }
+        } else {
+            quote! {
+                let kkt = ::eomgen_runtime::ContactKkt::new(#m(self, q), &Self::PARENTS, #j(self, q))?;
+            }
+        }
+    }
+
+    /// `try_contact_forward_dynamics_active` and `contact_forward_dynamics_active` (NaN on
+    /// failure), or with `stabilized` the same of `contact_forward_dynamics_stabilized`, which
+    /// takes an `eomgen_runtime::Baumgarte` after `active`.
+    pub(super) fn contact_active_fns(
         &mut self,
         q: &Quantity,
         h: &[Id],
+        stabilized: bool,
     ) -> TokenStream {
         let (hb, ops) = self.straight(q, h, Shape::Vector(h.len()));
         let docs = Self::quantity_doc(q, Some(ops));
         let (n, nq, k) = (&self.n, &self.nq, &self.k);
-        let kkt = self.kkt();
+        let c = usize_lit(self.contact_rows.len());
+        let s = self.signature(
+            q,
+            true,
+            (
+                "The accelerations and contact forces of",
+                ", or why they do not exist: a pivot of M(q) (`pivot` < N) or of the active rows' `J_c M^-1 J_c^T` (`pivot` - N) that is not positive, or non-finite input.",
+            ),
+        );
+        let free = self.free_accelerations(&hb);
+        let (j, drift) = (self.call("contact_jacobian"), self.call("contact_drift"));
+        let (param, arg, drift) = if stabilized {
+            let placements = self.call("contact_placements");
+            (
+                quote!(, baumgarte: &::eomgen_runtime::Baumgarte<T, #c>),
+                quote!(, baumgarte),
+                quote! {
+                    let mut drift = #drift(self, q, qd);
+                    baumgarte.correct_drift(&Self::CONTACT_ROWS, &#placements(self, q), &j, qd, &mut drift);
+                },
+            )
+        } else {
+            let drift = quote!(let drift = #drift(self, q, qd););
+            (TokenStream::new(), TokenStream::new(), drift)
+        };
+        let (name, try_name, active, active_arg, why) =
+            (&s.name, &s.try_name, &s.param, &s.arg, &s.why);
+        quote! {
+            #[doc = #why]
+            pub fn #try_name(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n] #active #param) -> ::core::result::Result<([T; #n], [T; #k]), ::eomgen_runtime::FactorError> {
+                #free
+                let j = #j(self, q);
+                #drift
+                let rows = ::eomgen_runtime::contact::row_mask(&Self::CONTACT_ROWS, active);
+                ::eomgen_runtime::contact::solve_factored_active(&m, &Self::PARENTS, &free, &j, &drift, &rows)
+            }
+
+            #docs
+            pub fn #name(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n] #active #param) -> ([T; #n], [T; #k]) {
+                match self.#try_name(q, qd, tau #active_arg #arg) {
+                    Ok(x) => x,
+                    Err(_) => ([T::nan(); #n], [T::nan(); #k]),
+                }
+            }
+        }
+    }
+
+    /// `try_contact_forward_dynamics_derivatives` and `contact_forward_dynamics_derivatives`
+    /// (NaN on failure), or their `_active` variants.
+    pub(super) fn contact_dynamics_derivatives_fns(
+        &mut self,
+        q: &Quantity,
+        h: &[Id],
+        active: bool,
+    ) -> TokenStream {
+        let (hb, ops) = self.straight(q, h, Shape::Vector(h.len()));
+        let docs = Self::quantity_doc(q, Some(ops));
+        let (n, nq, k) = (&self.n, &self.nq, &self.k);
+        let kkt = self.kkt(active);
+        let s = self.signature(q, active, ("The derivatives of", ", or why they do not"));
+        let (name, try_name, param, arg, why) = (&s.name, &s.try_name, &s.param, &s.arg, &s.why);
         let drift = self.call("contact_drift");
         let idd = self.call("inverse_dynamics_derivatives");
         let partials = self.call("contact_dynamics_partials");
         quote! {
-            /// The derivatives of `contact_forward_dynamics_derivatives`, or why they do not
+            #[doc = #why]
             /// exist: a pivot of M(q) (`pivot` < N) or of `J_c M^-1 J_c^T` (`pivot` - N, a
             /// rank-deficient contact Jacobian) that is not positive, or a non-finite result.
-            pub fn try_contact_forward_dynamics_derivatives(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n]) -> ::core::result::Result<::eomgen_runtime::ContactDynamicsDerivatives<T, #n, #k>, ::eomgen_runtime::FactorError> {
+            pub fn #try_name(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n] #param) -> ::core::result::Result<::eomgen_runtime::ContactDynamicsDerivatives<T, #n, #k>, ::eomgen_runtime::FactorError> {
                 let h: [T; #n] = { #hb };
                 let mut rhs = *tau;
                 for (r, h) in rhs.iter_mut().zip(h) {
@@ -49,31 +150,41 @@ impl Emitter<'_> {
             }
 
             #docs
-            pub fn contact_forward_dynamics_derivatives(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n]) -> ::eomgen_runtime::ContactDynamicsDerivatives<T, #n, #k> {
-                self.try_contact_forward_dynamics_derivatives(q, qd, tau)
+            pub fn #name(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n] #param) -> ::eomgen_runtime::ContactDynamicsDerivatives<T, #n, #k> {
+                self.#try_name(q, qd, tau #arg)
                     .unwrap_or_else(|_| ::eomgen_runtime::ContactDynamicsDerivatives::nan())
             }
         }
     }
 
-    /// `try_impulse_dynamics` and `impulse_dynamics` (NaN on failure).
-    pub(super) fn impulse_dynamics_fns(&mut self, q: &Quantity) -> TokenStream {
+    /// `try_impulse_dynamics` and `impulse_dynamics` (NaN on failure), or their `_active`
+    /// variants.
+    pub(super) fn impulse_dynamics_fns(&mut self, q: &Quantity, active: bool) -> TokenStream {
         let docs = Self::quantity_doc(q, None);
         let (n, nq, k) = (&self.n, &self.nq, &self.k);
-        let kkt = self.kkt();
+        let kkt = self.kkt(active);
+        let s = self.signature(
+            q,
+            active,
+            (
+                "The velocity after the impact and the impulses of",
+                ", or why",
+            ),
+        );
+        let (name, try_name, param, arg, why) = (&s.name, &s.try_name, &s.param, &s.arg, &s.why);
         quote! {
-            /// The velocity after the impact and the impulses of `impulse_dynamics`, or why
+            #[doc = #why]
             /// they do not exist: a pivot of M(q) (`pivot` < N) or of `J_c M^-1 J_c^T`
             /// (`pivot` - N, a rank-deficient contact Jacobian) that is not positive, or a
             /// non-finite result.
-            pub fn try_impulse_dynamics(&self, q: &[T; #nq], qd: &[T; #n], restitution: T) -> ::core::result::Result<([T; #n], [T; #k]), ::eomgen_runtime::FactorError> {
+            pub fn #try_name(&self, q: &[T; #nq], qd: &[T; #n], restitution: T #param) -> ::core::result::Result<([T; #n], [T; #k]), ::eomgen_runtime::FactorError> {
                 #kkt
                 kkt.impulse(qd, restitution)
             }
 
             #docs
-            pub fn impulse_dynamics(&self, q: &[T; #nq], qd: &[T; #n], restitution: T) -> ([T; #n], [T; #k]) {
-                match self.try_impulse_dynamics(q, qd, restitution) {
+            pub fn #name(&self, q: &[T; #nq], qd: &[T; #n], restitution: T #param) -> ([T; #n], [T; #k]) {
+                match self.#try_name(q, qd, restitution #arg) {
                     Ok(x) => x,
                     Err(_) => ([T::nan(); #n], [T::nan(); #k]),
                 }
@@ -81,16 +192,27 @@ impl Emitter<'_> {
         }
     }
 
-    /// `try_impulse_dynamics_derivatives` and `impulse_dynamics_derivatives` (NaN on failure).
-    pub(super) fn impulse_dynamics_derivatives_fns(&mut self, q: &Quantity) -> TokenStream {
+    /// `try_impulse_dynamics_derivatives` and `impulse_dynamics_derivatives` (NaN on
+    /// failure), or their `_active` variants.
+    pub(super) fn impulse_dynamics_derivatives_fns(
+        &mut self,
+        q: &Quantity,
+        active: bool,
+    ) -> TokenStream {
         let docs = Self::quantity_doc(q, None);
         let (n, nq, k) = (&self.n, &self.nq, &self.k);
-        let kkt = self.kkt();
+        let kkt = self.kkt(active);
         let partials = self.call("impulse_dynamics_partials");
+        let s = self.signature(
+            q,
+            active,
+            ("The derivatives of", ", or why they do not exist (as"),
+        );
+        let (name, try_name, param, arg, why) = (&s.name, &s.try_name, &s.param, &s.arg, &s.why);
         quote! {
-            /// The derivatives of `impulse_dynamics_derivatives`, or why they do not exist (as
+            #[doc = #why]
             /// `try_impulse_dynamics`).
-            pub fn try_impulse_dynamics_derivatives(&self, q: &[T; #nq], qd: &[T; #n], restitution: T) -> ::core::result::Result<::eomgen_runtime::ImpulseDynamicsDerivatives<T, #n, #k>, ::eomgen_runtime::FactorError> {
+            pub fn #try_name(&self, q: &[T; #nq], qd: &[T; #n], restitution: T #param) -> ::core::result::Result<::eomgen_runtime::ImpulseDynamicsDerivatives<T, #n, #k>, ::eomgen_runtime::FactorError> {
                 #kkt
                 let (after, p) = kkt.impulse(qd, restitution)?;
                 let jump: [T; #n] = ::core::array::from_fn(|i| after[i] - qd[i]);
@@ -99,8 +221,8 @@ impl Emitter<'_> {
             }
 
             #docs
-            pub fn impulse_dynamics_derivatives(&self, q: &[T; #nq], qd: &[T; #n], restitution: T) -> ::eomgen_runtime::ImpulseDynamicsDerivatives<T, #n, #k> {
-                self.try_impulse_dynamics_derivatives(q, qd, restitution)
+            pub fn #name(&self, q: &[T; #nq], qd: &[T; #n], restitution: T #param) -> ::eomgen_runtime::ImpulseDynamicsDerivatives<T, #n, #k> {
+                self.#try_name(q, qd, restitution #arg)
                     .unwrap_or_else(|_| ::eomgen_runtime::ImpulseDynamicsDerivatives::nan())
             }
         }
