@@ -179,10 +179,34 @@ fn contact_dynamics() {
                 "integrate",
                 "center_of_mass",
                 "link_pose",
+                // Contacts switched at run time (tests/active_contacts.rs).
+                "forward_dynamics",
+                "inverse_dynamics",
+                "contact_forward_dynamics_active",
+                "contact_forward_dynamics_stabilized",
+                "contact_forward_dynamics_derivatives_active",
+                "impulse_dynamics_active",
+                "impulse_dynamics_derivatives_active",
             ]
             .into_iter()
             .chain(ANYMAL_KINEMATICS),
         )
+        .compile()
+        .unwrap();
+    // Two of the four feet (the first and the last), what `AnymalMpc`'s `_active` methods
+    // must reproduce with the other two switched off.
+    eomgen::Builder::new("robots/floating/anymal.urdf")
+        .floating_base()
+        .contact_points(&["LF_FOOT", "RH_FOOT"])
+        .derivatives()
+        .module_name("anymal_two_feet")
+        .type_name("AnymalTwoFeet")
+        .quantities([
+            "contact_forward_dynamics",
+            "contact_forward_dynamics_derivatives",
+            "impulse_dynamics",
+            "impulse_dynamics_derivatives",
+        ])
         .compile()
         .unwrap();
     // Contact points away from a link's origin: the last foot's 5 cm off.
@@ -215,6 +239,7 @@ fn contact_dynamics() {
             "contact_forward_dynamics_derivatives",
             "impulse_dynamics",
             "impulse_dynamics_derivatives",
+            "contact_forward_dynamics_stabilized",
         ])
         .compile()
         .unwrap();

@@ -70,6 +70,28 @@ pub fn normwise(ours: &[f64], reference: &[f64]) -> f64 {
         / scale
 }
 
+/// A repeatable floating-base state: base position and joints in [-1, 1], a unit quaternion
+/// (entries 3..7), velocities in [-1, 1] and efforts in [-10, 10].
+pub fn random_state<const NQ: usize, const NV: usize>(
+    seed: u64,
+) -> ([f64; NQ], [f64; NV], [f64; NV]) {
+    let mut x = seed;
+    let mut next = move || {
+        x = x
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (x >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+    };
+    let mut q: [f64; NQ] = core::array::from_fn(|_| next());
+    let n = (q[3] * q[3] + q[4] * q[4] + q[5] * q[5] + q[6] * q[6]).sqrt();
+    for k in 3..7 {
+        q[k] /= n;
+    }
+    let v = core::array::from_fn(|_| next());
+    let tau = core::array::from_fn(|_| 10.0 * next());
+    (q, v, tau)
+}
+
 /// A reference matrix's rows `rows` and columns `cols`, flat.
 pub fn pick(m: &Value, rows: &[usize], cols: &[usize]) -> Vec<f64> {
     let m: Vec<Vec<f64>> = m.as_array().unwrap().iter().map(numbers).collect();

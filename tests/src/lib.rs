@@ -244,6 +244,11 @@ pub mod robots {
     pub mod anymal_mpc {
         include!(concat!(env!("OUT_DIR"), "/anymal_mpc.rs"));
     }
+    /// anymal on two feet (`LF_FOOT`, `RH_FOOT`): what `anymal_mpc`'s `_active` methods give
+    /// with the other two switched off.
+    pub mod anymal_two_feet {
+        include!(concat!(env!("OUT_DIR"), "/anymal_two_feet.rs"));
+    }
     /// anymal with contact points at positions in its feet's frames.
     pub mod anymal_at {
         include!(concat!(env!("OUT_DIR"), "/anymal_at.rs"));

@@ -8,7 +8,9 @@
 #![allow(clippy::needless_range_loop)]
 
 use eomgen_runtime::prelude::*;
-use eomgen_tests::floating_reference::{flat, normwise, numbers, pick, reference, Order, Worst};
+use eomgen_tests::floating_reference::{
+    flat, normwise, numbers, pick, random_state, reference, Order, Worst,
+};
 use eomgen_tests::robots::anymal_at::{AnymalAt, AnymalAtLink};
 use eomgen_tests::robots::anymal_mpc::{AnymalMpc, AnymalMpcLink};
 use eomgen_tests::robots::g1_mpc::G1Mpc;
@@ -109,24 +111,9 @@ fn g1_contact_and_impulse_dynamics_match_pinocchio() {
     check_mpc!("g1_29dof.mpc.json", G1Mpc<f64>, 36, 35, 12);
 }
 
-/// A repeatable state: base position and joints in [-1, 1], a unit quaternion, velocities and
-/// efforts in [-1, 1].
+/// A repeatable state (`random_state`).
 fn state(seed: u64) -> ([f64; NQ], [f64; NV], [f64; NV]) {
-    let mut x = seed;
-    let mut next = move || {
-        x = x
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (x >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-    };
-    let mut q: [f64; NQ] = core::array::from_fn(|_| next());
-    let n = (q[3] * q[3] + q[4] * q[4] + q[5] * q[5] + q[6] * q[6]).sqrt();
-    for k in 3..7 {
-        q[k] /= n;
-    }
-    let v = core::array::from_fn(|_| next());
-    let tau = core::array::from_fn(|_| 10.0 * next());
-    (q, v, tau)
+    random_state(seed)
 }
 
 /// Central differences of `f` (R outputs) in each tangent direction of `q`, in `v` and in

@@ -119,21 +119,11 @@ fn iris_simple_matches_pinocchio() {
     check_floating!("iris_simple", iris_simple, IrisSimple, IrisSimpleLink, 7, 6);
 }
 
-/// A repeatable state: joints and base velocity in [-1, 1], a unit quaternion.
+/// A repeatable state: joints and base velocity in [-1, 1], a unit quaternion
+/// (`random_state`, the same numbers).
 fn state(seed: u64) -> ([f64; 19], [f64; 18]) {
-    let mut x = seed;
-    let mut next = move || {
-        x = x
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (x >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-    };
-    let mut q: [f64; 19] = core::array::from_fn(|_| next());
-    let n = (q[3] * q[3] + q[4] * q[4] + q[5] * q[5] + q[6] * q[6]).sqrt();
-    for k in 3..7 {
-        q[k] /= n;
-    }
-    (q, core::array::from_fn(|_| next()))
+    let (q, v, _) = eomgen_tests::floating_reference::random_state(seed);
+    (q, v)
 }
 
 /// One classical RK4 step on the configuration manifold (stages integrated from `q`).
