@@ -8,6 +8,7 @@
 //! cargo run --example gravity_compensation  # hold a pose against gravity (f32)
 //! cargo run --example task_space_force      # push with the hand: tau = J^T F
 //! cargo run --example quadruped_stand       # a floating-base quadruped standing on its feet
+//! cargo run --example quadruped_mpc         # an MPC step (iLQR) lifting a foot of the quadruped
 //! cargo run --example identify              # base inertial parameters of a UR5 from noisy torques
 //! ```
 //!
@@ -39,6 +40,13 @@ pub mod anymal {
         0.0, 0.0, 0.5, 0.0, 0.0, 0.0, 1.0, // base position, quaternion x y z w
         0.0, 0.6, -1.2, 0.0, -0.6, 1.2, 0.0, 0.6, -1.2, 0.0, -0.6, 1.2, // LF, LH, RF, RH
     ];
+}
+
+/// ANYmal again, generated with only what an MPC step calls (`Builder::quantities`): contact
+/// forward dynamics and its derivatives for a set of active feet (the same feet, in the same
+/// order), `integrate`, `difference` and their Jacobians.
+pub mod anymal_mpc {
+    include!(concat!(env!("OUT_DIR"), "/anymal_mpc.rs"));
 }
 
 /// The UR5 arm with identification, generated from `robots/ur5.urdf`.
