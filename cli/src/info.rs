@@ -62,6 +62,34 @@ fn mimic_note(model: &Model) -> Option<String> {
     })
 }
 
+/// One line per generated function: its straight-line operations, or `run time` for one
+/// composed at run time from the others (a solve, a loop, a runtime kernel), in catalogue
+/// order; functions with both list their straight-line part.
+fn operation_counts(d: &Derivation, generated: &Generated) -> String {
+    let mut rows: Vec<(&str, Option<&eomgen::cas::OpCount>)> = d
+        .quantities
+        .iter()
+        .map(|q| {
+            let ops = generated.op_counts.iter().find(|(n, _)| n == q.name);
+            (q.name, ops.map(|(_, o)| o))
+        })
+        .collect();
+    for (name, ops) in &generated.op_counts {
+        if !rows.iter().any(|(n, _)| n == name) {
+            rows.push((name, Some(ops)));
+        }
+    }
+    let width = rows.iter().map(|(n, _)| n.len()).max().unwrap_or(0);
+    let mut out = String::new();
+    for (name, ops) in rows {
+        let _ = match ops {
+            Some(ops) => writeln!(out, "  {name:width$}  {:>7} total: {ops}", ops.total()),
+            None => writeln!(out, "  {name:width$}  run time"),
+        };
+    }
+    out
+}
+
 /// The report. `load` and `emit` are the times of reading the URDF and of emitting code.
 pub fn print(
     model: &Model,
@@ -242,15 +270,7 @@ pub fn print(
     }
 
     let _ = writeln!(out, "\noperations per call of each generated function:");
-    let width = generated
-        .op_counts
-        .iter()
-        .map(|(n, _)| n.len())
-        .max()
-        .unwrap_or(0);
-    for (name, ops) in &generated.op_counts {
-        let _ = writeln!(out, "  {name:width$}  {:>7} total: {ops}", ops.total());
-    }
+    let _ = write!(out, "{}", operation_counts(d, generated));
 
     let derive: Duration = d.timings.iter().map(|t| t.1).sum();
     let stages: Vec<String> = d

@@ -412,6 +412,38 @@ fn info_describes_every_robot() {
     assert!(kinova.contains(": continuous about "));
 }
 
+/// With contacts, `info` lists the functions composed at run time (contact and impulse
+/// dynamics for a set of active contacts, the configuration manifold) as `run time`, and the
+/// straight-line part of the others with its count.
+#[test]
+fn info_lists_the_run_time_functions() {
+    let urdf = workspace().join("tests/robots/floating/anymal.urdf");
+    let out = ok(&[
+        "info",
+        urdf.to_str().unwrap(),
+        "--floating-base",
+        "--contact",
+        "LF_FOOT",
+        "--contact",
+        "RH_FOOT",
+    ]);
+    let line = |name: &str| -> &str {
+        out.lines()
+            .find(|l| l.split_whitespace().next() == Some(name))
+            .unwrap_or_else(|| panic!("no line for {name}:\n{out}"))
+    };
+    for name in ["impulse_dynamics_active", "impulse_dynamics", "difference"] {
+        assert!(line(name).ends_with("  run time"), "{}", line(name));
+    }
+    for name in [
+        "contact_forward_dynamics_active",
+        "contact_forward_dynamics_stabilized",
+        "contact_placements",
+    ] {
+        assert!(line(name).contains(" total: "), "{}", line(name));
+    }
+}
+
 fn numbers(v: &serde_json::Value) -> Vec<f64> {
     v.as_array()
         .expect("array")
