@@ -108,6 +108,8 @@ struct Emitter<'a> {
     parents: Vec<Option<usize>>,
     /// Each contact's number of rows (3: a point, 6: a frame), in the contacts' order.
     contact_rows: Vec<usize>,
+    /// The operations of `active_contact_bias`, once it is emitted (`rust/contact.rs`).
+    active_bias_ops: Option<OpCount>,
     /// Whether every `Dynamics` method is generated, so that the trait is implemented (and
     /// its methods live there rather than in the inherent impl).
     in_trait: bool,
@@ -193,6 +195,7 @@ pub fn emit_tokens(
         k: usize_lit(d.centroidal.contact_drift.len()),
         parents: d.coordinate_parents.clone(),
         contact_rows: contact_rows(model),
+        active_bias_ops: None,
         in_trait: d
             .quantities
             .iter()

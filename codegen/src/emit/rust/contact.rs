@@ -6,7 +6,7 @@ use proc_macro2::{Ident, TokenStream};
 use quote::{format_ident, quote};
 
 use super::{usize_lit, Emitter};
-use crate::cas::Id;
+use crate::cas::{Id, OpCount};
 use crate::dynamics::{Quantity, Shape};
 
 /// The names and extra argument of a method with or without a set of active contacts.
@@ -56,6 +56,26 @@ impl Emitter<'_> {
         }
     }
 
+    /// `h` (`b + G`, and friction) of the `_active` contact methods: its straight-line code is
+    /// emitted once, in the private `active_contact_bias(q, qd, tau)` that they all call, and
+    /// counted under each method's name. The block calling it, and the operations.
+    fn active_bias(&mut self, q: &Quantity, h: &[Id]) -> (TokenStream, OpCount) {
+        let call = quote!(Self::active_contact_bias(self, q, qd, tau));
+        if let Some(ops) = self.active_bias_ops {
+            self.counts.push((q.name.to_string(), ops));
+            return (call, ops);
+        }
+        let (hb, ops) = self.straight(q, h, Shape::Vector(h.len()));
+        let (n, nq) = (&self.n, &self.nq);
+        self.blocks.push(quote! {
+            /// `b + G` (and joint friction) at `(q, qd)`: what the `_active` contact methods
+            /// subtract from `tau` (`tau` unused but by split blocks).
+            fn active_contact_bias(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n]) -> [T; #n] { #hb }
+        });
+        self.active_bias_ops = Some(ops);
+        (call, ops)
+    }
+
     /// `try_contact_forward_dynamics_active` and `contact_forward_dynamics_active` (NaN on
     /// failure), or with `stabilized` the same of `contact_forward_dynamics_stabilized`, which
     /// takes an `eomgen_runtime::Baumgarte` after `active`.
@@ -65,7 +85,7 @@ impl Emitter<'_> {
         h: &[Id],
         stabilized: bool,
     ) -> TokenStream {
-        let (hb, ops) = self.straight(q, h, Shape::Vector(h.len()));
+        let (hb, ops) = self.active_bias(q, h);
         let docs = Self::quantity_doc(q, Some(ops));
         let (n, nq, k) = (&self.n, &self.nq, &self.k);
         let c = usize_lit(self.contact_rows.len());
@@ -123,7 +143,11 @@ impl Emitter<'_> {
         h: &[Id],
         active: bool,
     ) -> TokenStream {
-        let (hb, ops) = self.straight(q, h, Shape::Vector(h.len()));
+        let (hb, ops) = if active {
+            self.active_bias(q, h)
+        } else {
+            self.straight(q, h, Shape::Vector(h.len()))
+        };
         let docs = Self::quantity_doc(q, Some(ops));
         let (n, nq, k) = (&self.n, &self.nq, &self.k);
         let kkt = self.kkt(active);
