@@ -333,9 +333,11 @@ fn subtree_ends<const N: usize>(parent: &[Option<usize>; N]) -> [usize; N] {
 }
 
 /// `M^-1` from the factors of [`ltdl_factor`] (`m` as it left it): [`ltdl_substitute_rows`] on
-/// the identity, then the upper triangle mirrored (the result is exactly symmetric). Every step
-/// is a scaled row gathered into another, so the cost is about `N` times the sum of the
-/// coordinates' depths, in vector operations.
+/// the identity, with the structure it keeps (`L^-T` has row `i` nonzero only over `i`'s
+/// subtree, and only the upper triangle of the result is formed, then mirrored: the result is
+/// exactly symmetric). Every step is a scaled row, in chunks of eight columns, gathered into
+/// another, so the cost is at most `N` times the sum of the coordinates' depths, in vector
+/// operations.
 ///
 /// ```
 /// use eomgen_runtime::tree::{ltdl_factor, ltdl_inverse_factored};
@@ -378,7 +380,8 @@ pub fn ltdl_inverse_factored_into<T: Real, const N: usize>(
         row.iter_mut().for_each(|v| *v = T::zero());
         row[i] = T::one();
     }
-    ltdl_substitute_rows(m, parent, x);
+    pull_from_subtrees::<T, N, N, true>(m, parent, x);
+    pull_from_ancestors::<T, N, N, true>(m, parent, x);
     // The upper triangle mirrored, so that the result is exactly symmetric.
     for i in 1..N {
         let (upper, lower) = x.split_at_mut(i);
@@ -409,8 +412,8 @@ pub fn ltdl_substitute_rows<T: Real, const N: usize, const C: usize>(
     parent: &[Option<usize>; N],
     x: &mut [[T; C]; N],
 ) {
-    pull_from_subtrees(m, parent, x);
-    pull_from_ancestors(m, parent, x);
+    pull_from_subtrees::<T, N, C, false>(m, parent, x);
+    pull_from_ancestors::<T, N, C, false>(m, parent, x);
 }
 
 /// `L^-T`: row `a` of `x` less `L[k][a]` times row `k` for every `k` of its subtree, from the
@@ -418,7 +421,10 @@ pub fn ltdl_substitute_rows<T: Real, const N: usize, const C: usize>(
 /// and written once ("pull"), rather than updated once per descendant ("push"): repeated
 /// read-modify-writes of the same row stall on store forwarding, and on a 50-DoF humanoid the
 /// push form took twice as long.
-fn pull_from_subtrees<T: Real, const N: usize, const C: usize>(
+///
+/// `SPARSE`: row `k` of `x` is zero outside columns `k..ends[k]` (the identity, whose rows keep
+/// that support through this pass), so only the chunks of columns there are gathered.
+fn pull_from_subtrees<T: Real, const N: usize, const C: usize, const SPARSE: bool>(
     m: &[[T; N]; N],
     parent: &[Option<usize>; N],
     x: &mut [[T; C]; N],
@@ -433,7 +439,9 @@ fn pull_from_subtrees<T: Real, const N: usize, const C: usize>(
             let below =
                 parent[k].is_some_and(|p| p == a || (p > a && inside.get(p) == Some(&true)));
             inside[k] = below;
-            if below {
+            if below && SPARSE {
+                sub_scaled_chunks(&mut acc, &x[k], m[k][a], k..ends[k]);
+            } else if below {
                 sub_scaled_row(&mut acc, &x[k], m[k][a]);
             }
         }
@@ -444,7 +452,11 @@ fn pull_from_subtrees<T: Real, const N: usize, const C: usize>(
 /// `D^-1`, then `L^-1`: row `i` of `x` less `L[i][a]` times row `a` for every
 /// ancestor `a`, from the first row down, gathered in one accumulator per row (see
 /// [`pull_from_subtrees`]).
-fn pull_from_ancestors<T: Real, const N: usize, const C: usize>(
+///
+/// `UPPER`: only the columns from `i` on are needed in row `i` (a symmetric result, mirrored
+/// afterwards), so only the chunks of columns there are gathered; the columns before `i` in
+/// the first chunk hold partial sums.
+fn pull_from_ancestors<T: Real, const N: usize, const C: usize, const UPPER: bool>(
     m: &[[T; N]; N],
     parent: &[Option<usize>; N],
     x: &mut [[T; C]; N],
@@ -456,10 +468,37 @@ fn pull_from_ancestors<T: Real, const N: usize, const C: usize>(
         let mut a = parent[i];
         while let Some(row) = a.and_then(|aa| x.get(aa)) {
             let aa = a.unwrap_or(0);
-            sub_scaled_row(&mut acc, row, m[i][aa]);
+            if UPPER {
+                sub_scaled_chunks(&mut acc, row, m[i][aa], i..C);
+            } else {
+                sub_scaled_row(&mut acc, row, m[i][aa]);
+            }
             a = parent.get(aa).copied().flatten();
         }
         x[i] = acc;
+    }
+}
+
+/// Columns per chunk of [`sub_scaled_chunks`]: a vector register of `f64` with AVX-512.
+const CHUNK: usize = 8;
+
+/// [`sub_scaled_row`] on the chunks of [`CHUNK`] columns that overlap `columns` only (a loop of
+/// constant length, so that the compiler still unrolls it and keeps `acc` in registers).
+#[inline(always)]
+fn sub_scaled_chunks<T: Real, const C: usize>(
+    acc: &mut [T; C],
+    row: &[T; C],
+    k: T,
+    columns: core::ops::Range<usize>,
+) {
+    let k = -k;
+    for c in 0..C.div_ceil(CHUNK) {
+        let lo = c * CHUNK;
+        if lo + CHUNK > columns.start && lo < columns.end {
+            for j in lo..(lo + CHUNK).min(C) {
+                acc[j] = k.mul_add(row[j], acc[j]);
+            }
+        }
     }
 }
 
