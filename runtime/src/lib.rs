@@ -60,6 +60,10 @@
 //! `use eomgen_runtime::prelude::*;` brings [`Dynamics`], [`Hamiltonian`], [`Real`], [`Pose`]
 //! and [`FactorError`] into scope (module [`prelude`]).
 //!
+//! The crate's `unsafe` code is confined to two places, each with its soundness argument: the
+//! fused multiply-add intrinsics of [`Real::mul_add`], and [`place`], which lets generated
+//! functions write a large result where the caller keeps it.
+//!
 //! # Cargo features
 //! - `nalgebra`: conversions to and from `nalgebra` (no_std compatible; uses nalgebra's `libm`).
 //! - `std`: implements `std::error::Error` for [`FactorError`]. Off by default; the crate is
@@ -86,6 +90,7 @@ mod joint_effects;
 pub mod kkt;
 mod linalg;
 pub mod manifold;
+pub mod place;
 mod pose;
 pub mod prelude;
 mod real;

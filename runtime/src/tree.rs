@@ -332,36 +332,12 @@ fn subtree_ends<const N: usize>(parent: &[Option<usize>; N]) -> [usize; N] {
     ends
 }
 
-/// Row `dst` (to change) and row `src` (to read) of `rows`, `None` when they are the same row or
-/// out of range.
-#[inline(always)]
-fn row_pair<R>(rows: &mut [R], dst: usize, src: usize) -> Option<(&mut R, &R)> {
-    if dst.max(src) >= rows.len() || dst == src {
-        return None;
-    }
-    if dst < src {
-        let (head, tail) = rows.split_at_mut(src);
-        Some((&mut head[dst], &tail[0]))
-    } else {
-        let (head, tail) = rows.split_at_mut(dst);
-        Some((&mut tail[0], &head[src]))
-    }
-}
-
-/// `dst -= k src`, entry by entry (a loop the compiler vectorizes).
-#[inline(always)]
-fn sub_scaled<T: Real>(dst: &mut [T], src: &[T], k: T) {
-    let k = -k;
-    for (x, y) in dst.iter_mut().zip(src) {
-        *x = k.mul_add(*y, *x);
-    }
-}
-
-/// `M^-1` from the factors of [`ltdl_factor`] (`m` as it left it), `L^-1 D^-1 L^-T` with the
-/// tree's structure: `L^-T` has row `i` nonzero only over `i`'s subtree, and only the upper
-/// triangle of `L^-1 (D^-1 L^-T)` is formed, row by row from the root, then mirrored (the
-/// result is exactly symmetric). Every step is a scaled row subtracted from another row, so the
-/// cost is about `N` times the sum of the coordinates' depths, in vector operations.
+/// `M^-1` from the factors of [`ltdl_factor`] (`m` as it left it): [`ltdl_substitute_rows`] on
+/// the identity, with the structure it keeps (`L^-T` has row `i` nonzero only over `i`'s
+/// subtree, and only the upper triangle of the result is formed, then mirrored: the result is
+/// exactly symmetric). Every step is a scaled row, in chunks of eight columns, gathered into
+/// another, so the cost is at most `N` times the sum of the coordinates' depths, in vector
+/// operations.
 ///
 /// ```
 /// use eomgen_runtime::tree::{ltdl_factor, ltdl_inverse_factored};
@@ -378,46 +354,41 @@ pub fn ltdl_inverse_factored<T: Real, const N: usize>(
     m: &[[T; N]; N],
     parent: &[Option<usize>; N],
 ) -> [[T; N]; N] {
-    let ends = subtree_ends(parent);
     let mut x = [[T::zero(); N]; N];
+    ltdl_inverse_factored_into(m, parent, &mut x);
+    x
+}
+
+/// [`ltdl_inverse_factored`] written into `x` (whatever it held), for callers that keep the
+/// result in place rather than on their stack twice.
+///
+/// ```
+/// use eomgen_runtime::tree::{ltdl_factor, ltdl_inverse_factored, ltdl_inverse_factored_into};
+/// let parent = [None, Some(0)];
+/// let mut m = [[2.0_f64, 0.5], [0.5, 1.0]];
+/// ltdl_factor(&mut m, &parent).unwrap();
+/// let mut x = [[f64::NAN; 2]; 2];
+/// ltdl_inverse_factored_into(&m, &parent, &mut x);
+/// assert_eq!(x, ltdl_inverse_factored(&m, &parent));
+/// ```
+pub fn ltdl_inverse_factored_into<T: Real, const N: usize>(
+    m: &[[T; N]; N],
+    parent: &[Option<usize>; N],
+    x: &mut [[T; N]; N],
+) {
     for (i, row) in x.iter_mut().enumerate() {
+        row.iter_mut().for_each(|v| *v = T::zero());
         row[i] = T::one();
     }
-    // L^-T, then D^-1: row i is nonzero over i..ends[i] only.
-    for i in (0..N).rev() {
-        let span = i..ends[i];
-        let mut a = parent[i];
-        while let Some(aa) = a {
-            if let Some((dst, src)) = row_pair(&mut x, aa, i) {
-                sub_scaled(&mut dst[span.clone()], &src[span.clone()], m[i][aa]);
-            }
-            a = parent.get(aa).copied().flatten();
-        }
-    }
-    for (i, row) in x.iter_mut().enumerate() {
-        let d = m[i][i];
-        for v in &mut row[i..ends[i]] {
-            *v /= d;
-        }
-    }
-    // L^-1 on the upper triangle: row i's columns from i on need only its ancestors' (a < i),
-    // which are final by then.
-    for i in 0..N {
-        let mut a = parent[i];
-        while let Some(aa) = a {
-            if let Some((dst, src)) = row_pair(&mut x, i, aa) {
-                sub_scaled(&mut dst[i..], &src[i..], m[i][aa]);
-            }
-            a = parent.get(aa).copied().flatten();
-        }
-    }
+    pull_from_subtrees::<T, N, N, true>(m, parent, x);
+    pull_from_ancestors::<T, N, N, true>(m, parent, x);
+    // The upper triangle mirrored, so that the result is exactly symmetric.
     for i in 1..N {
         let (upper, lower) = x.split_at_mut(i);
         for (j, above) in upper.iter().enumerate() {
             lower[0][j] = above[i];
         }
     }
-    x
 }
 
 /// Solves `M X = B` for the `C` columns of `x` (`B` on entry, `X` on return), with the factors
@@ -441,29 +412,102 @@ pub fn ltdl_substitute_rows<T: Real, const N: usize, const C: usize>(
     parent: &[Option<usize>; N],
     x: &mut [[T; C]; N],
 ) {
-    for i in (0..N).rev() {
-        let mut a = parent[i];
-        while let Some(aa) = a {
-            if let Some((dst, src)) = row_pair(x, aa, i) {
-                sub_scaled(dst, src, m[i][aa]);
+    pull_from_subtrees::<T, N, C, false>(m, parent, x);
+    pull_from_ancestors::<T, N, C, false>(m, parent, x);
+}
+
+/// `L^-T`: row `a` of `x` less `L[k][a]` times row `k` for every `k` of its subtree, from the
+/// last row up (those rows final by then). Each row is gathered in one accumulator, read once
+/// and written once ("pull"), rather than updated once per descendant ("push"): repeated
+/// read-modify-writes of the same row stall on store forwarding, and on a 50-DoF humanoid the
+/// push form took twice as long.
+///
+/// `SPARSE`: row `k` of `x` is zero outside columns `k..ends[k]` (the identity, whose rows keep
+/// that support through this pass), so only the chunks of columns there are gathered.
+fn pull_from_subtrees<T: Real, const N: usize, const C: usize, const SPARSE: bool>(
+    m: &[[T; N]; N],
+    parent: &[Option<usize>; N],
+    x: &mut [[T; C]; N],
+) {
+    let ends = subtree_ends(parent);
+    // `inside[k]`: `k` lies in the subtree of the row being gathered (rows between `a` and
+    // `ends[a]` may belong to other subtrees when the order is not depth first).
+    let mut inside = [false; N];
+    for a in (0..N).rev() {
+        let mut acc = x[a];
+        for k in a + 1..ends[a] {
+            let below =
+                parent[k].is_some_and(|p| p == a || (p > a && inside.get(p) == Some(&true)));
+            inside[k] = below;
+            if below && SPARSE {
+                sub_scaled_chunks(&mut acc, &x[k], m[k][a], k..ends[k]);
+            } else if below {
+                sub_scaled_row(&mut acc, &x[k], m[k][a]);
             }
-            a = parent.get(aa).copied().flatten();
         }
+        x[a] = acc;
     }
-    for (i, row) in x.iter_mut().enumerate() {
-        let d = m[i][i];
-        for v in row.iter_mut() {
-            *v /= d;
-        }
-    }
+}
+
+/// `D^-1`, then `L^-1`: row `i` of `x` less `L[i][a]` times row `a` for every
+/// ancestor `a`, from the first row down, gathered in one accumulator per row (see
+/// [`pull_from_subtrees`]).
+///
+/// `UPPER`: only the columns from `i` on are needed in row `i` (a symmetric result, mirrored
+/// afterwards), so only the chunks of columns there are gathered; the columns before `i` in
+/// the first chunk hold partial sums.
+fn pull_from_ancestors<T: Real, const N: usize, const C: usize, const UPPER: bool>(
+    m: &[[T; N]; N],
+    parent: &[Option<usize>; N],
+    x: &mut [[T; C]; N],
+) {
     for i in 0..N {
+        let mut acc = x[i];
+        let d = m[i][i];
+        acc.iter_mut().for_each(|v| *v /= d);
         let mut a = parent[i];
-        while let Some(aa) = a {
-            if let Some((dst, src)) = row_pair(x, i, aa) {
-                sub_scaled(dst, src, m[i][aa]);
+        while let Some(row) = a.and_then(|aa| x.get(aa)) {
+            let aa = a.unwrap_or(0);
+            if UPPER {
+                sub_scaled_chunks(&mut acc, row, m[i][aa], i..C);
+            } else {
+                sub_scaled_row(&mut acc, row, m[i][aa]);
             }
             a = parent.get(aa).copied().flatten();
         }
+        x[i] = acc;
+    }
+}
+
+/// Columns per chunk of [`sub_scaled_chunks`]: a vector register of `f64` with AVX-512.
+const CHUNK: usize = 8;
+
+/// [`sub_scaled_row`] on the chunks of [`CHUNK`] columns that overlap `columns` only (a loop of
+/// constant length, so that the compiler still unrolls it and keeps `acc` in registers).
+#[inline(always)]
+fn sub_scaled_chunks<T: Real, const C: usize>(
+    acc: &mut [T; C],
+    row: &[T; C],
+    k: T,
+    columns: core::ops::Range<usize>,
+) {
+    let k = -k;
+    for c in 0..C.div_ceil(CHUNK) {
+        let lo = c * CHUNK;
+        if lo + CHUNK > columns.start && lo < columns.end {
+            for j in lo..(lo + CHUNK).min(C) {
+                acc[j] = k.mul_add(row[j], acc[j]);
+            }
+        }
+    }
+}
+
+/// `acc -= k row`, entry by entry (the compiler vectorizes it and keeps `acc` in registers).
+#[inline(always)]
+fn sub_scaled_row<T: Real, const C: usize>(acc: &mut [T; C], row: &[T; C], k: T) {
+    let k = -k;
+    for (x, y) in acc.iter_mut().zip(row) {
+        *x = k.mul_add(*y, *x);
     }
 }
 

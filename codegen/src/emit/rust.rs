@@ -7,7 +7,7 @@
 
 mod contact;
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 
 use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote};
@@ -128,6 +128,8 @@ struct Emitter<'a> {
     budget: usize,
     /// The blocks of split bodies, for the inherent impl.
     blocks: Vec<TokenStream>,
+    /// The quantities whose bodies were split, which have a `{name}_fill` method.
+    split: BTreeSet<String>,
 }
 
 /// How many methods the runtime's `Dynamics` trait has.
@@ -217,6 +219,7 @@ pub fn emit_tokens(
         counts: Vec::new(),
         budget: opts.max_function_ops,
         blocks: Vec::new(),
+        split: BTreeSet::new(),
     };
     let tokens = e.file(&fields, d);
     (tokens, e.counts)
@@ -477,6 +480,9 @@ impl Emitter<'_> {
         let split = self.split(q.name, &params, &args);
         let b = body(self.graph, &self.cx, outputs, shape, Some(&split));
         self.counts.push((q.name.to_string(), b.ops));
+        if !b.blocks.is_empty() {
+            self.split.insert(q.name.to_string());
+        }
         self.blocks.extend(b.blocks);
         (b.code, b.ops)
     }
@@ -807,14 +813,22 @@ impl Emitter<'_> {
     fn mass_matrix_inverse_fn(&mut self, q: &Quantity) -> TokenStream {
         let docs = Self::quantity_doc(q, None);
         let (n, nq, mass_matrix) = (&self.n, &self.nq, self.call("mass_matrix"));
+        self.blocks.push(quote! {
+            #[inline(never)]
+            fn mass_matrix_inverse_in_place<'b>(&self, q: &[T; #nq], slot: ::eomgen_runtime::place::Slot<'b, [[T; #n]; #n]>) -> ::eomgen_runtime::place::Filled<'b> {
+                let (o, filled) = slot.fill();
+                let mut m = #mass_matrix(self, q);
+                match Self::ltdl_factor_unrolled(&mut m) {
+                    Ok(()) => ::eomgen_runtime::tree::ltdl_inverse_factored_into(&m, &Self::PARENTS, o),
+                    Err(_) => o.iter_mut().flatten().for_each(|v| *v = T::nan()),
+                }
+                filled
+            }
+        });
         quote! {
             #docs
             pub fn mass_matrix_inverse(&self, q: &[T; #nq]) -> [[T; #n]; #n] {
-                let mut m = #mass_matrix(self, q);
-                match Self::ltdl_factor_unrolled(&mut m) {
-                    Ok(()) => ::eomgen_runtime::tree::ltdl_inverse_factored(&m, &Self::PARENTS),
-                    Err(_) => [[T::nan(); #n]; #n],
-                }
+                ::eomgen_runtime::place::build(|slot| self.mass_matrix_inverse_in_place(q, slot))
             }
         }
     }
@@ -822,33 +836,57 @@ impl Emitter<'_> {
     /// `(d qdd/dq, d qdd/dqd, M^-1)` through one factorization of `M`: `qdd` solves
     /// `M qdd = tau - h` with `h = inverse_dynamics(q, qd, 0)`, then `d tau/dq` and `d tau/dqd`
     /// there from `inverse_dynamics_derivatives`, both solves at once per matrix
-    /// (`tree::ltdl_substitute_rows`), and `M^-1` from the same factors.
+    /// (`tree::ltdl_substitute_rows`), and `M^-1` from the same factors. Everything is written
+    /// into the caller's storage (`eomgen_runtime::place`), the derivatives of tau by
+    /// `inverse_dynamics_derivatives_fill` where that function was split.
     fn forward_dynamics_derivatives_fn(&mut self, q: &Quantity) -> TokenStream {
         let docs = Self::quantity_doc(q, None);
         let (n, nq) = (&self.n, &self.nq);
         let id = self.call("inverse_dynamics");
-        let id_derivatives = self.call("inverse_dynamics_derivatives");
         let mass_matrix = self.call("mass_matrix");
-        quote! {
-            #docs
-            pub fn forward_dynamics_derivatives(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n]) -> ([[T; #n]; #n], [[T; #n]; #n], [[T; #n]; #n]) {
+        let id_derivatives = if self.split.contains("inverse_dynamics_derivatives") {
+            let fill = super::split::fill_name("inverse_dynamics_derivatives");
+            quote!(self.#fill(q, qd, &qdd, dq, dqd);)
+        } else {
+            debug_assert!(self
+                .counts
+                .iter()
+                .any(|(c, _)| c == "inverse_dynamics_derivatives"));
+            let f = self.call("inverse_dynamics_derivatives");
+            quote!((*dq, *dqd) = #f(self, q, qd, &qdd);)
+        };
+        let matrix = quote!([[T; #n]; #n]);
+        self.blocks.push(quote! {
+            #[inline(never)]
+            fn forward_dynamics_derivatives_in_place<'b>(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n], slot: ::eomgen_runtime::place::Slot<'b, (#matrix, #matrix, #matrix)>) -> ::eomgen_runtime::place::Filled<'b> {
+                let ((dq, dqd, inverse), filled) = slot.fill();
                 let mut m = #mass_matrix(self, q);
                 if Self::ltdl_factor_unrolled(&mut m).is_err() {
-                    return ([[T::nan(); #n]; #n], [[T::nan(); #n]; #n], [[T::nan(); #n]; #n]);
+                    for v in dq.iter_mut().chain(dqd.iter_mut()).chain(inverse.iter_mut()).flatten() {
+                        *v = T::nan();
+                    }
+                    return filled;
                 }
                 let mut rhs = *tau;
                 for (r, h) in rhs.iter_mut().zip(#id(self, q, qd, &[T::zero(); #n])) {
                     *r -= h;
                 }
                 let qdd = Self::ltdl_substitute_unrolled(&m, &rhs);
-                let (mut dq, mut dqd) = #id_derivatives(self, q, qd, &qdd);
-                for x in [&mut dq, &mut dqd] {
+                #id_derivatives
+                for x in [&mut *dq, &mut *dqd] {
                     ::eomgen_runtime::tree::ltdl_substitute_rows(&m, &Self::PARENTS, x);
                     for v in x.iter_mut().flatten() {
                         *v = -*v;
                     }
                 }
-                (dq, dqd, ::eomgen_runtime::tree::ltdl_inverse_factored(&m, &Self::PARENTS))
+                ::eomgen_runtime::tree::ltdl_inverse_factored_into(&m, &Self::PARENTS, inverse);
+                filled
+            }
+        });
+        quote! {
+            #docs
+            pub fn forward_dynamics_derivatives(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n]) -> (#matrix, #matrix, #matrix) {
+                ::eomgen_runtime::place::build(|slot| self.forward_dynamics_derivatives_in_place(q, qd, tau, slot))
             }
         }
     }

@@ -14,7 +14,11 @@
 //! - a slot of `w` is reused once the last block reading its value has run, so that `w` holds
 //!   about as many values as cross one cut at a time;
 //! - each joint angle's sine and cosine are computed once, in the first block that uses them,
-//!   and travel like temporaries.
+//!   and travel like temporaries;
+//! - the blocks write the caller's storage for the result (`eomgen_runtime::place`), not a
+//!   local copied out at the end, and a quantity built on this one (forward-dynamics
+//!   derivatives on inverse-dynamics derivatives) has them fill its own result's matrices
+//!   (`{name}_fill`).
 
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -194,7 +198,7 @@ pub(super) fn split_body(
         Value::Trig(i, _) => first_trig[&i],
     };
     let (slots, width) = place_values(&blocks, home);
-    let items = blocks
+    let mut items: Vec<TokenStream> = blocks
         .iter()
         .enumerate()
         .map(|(b, block)| {
@@ -202,25 +206,103 @@ pub(super) fn split_body(
             block_fn(b, block, &slots, &writes, width, shape, split)
         })
         .collect();
-    let args = split.args;
+    let (body, drivers) = drive(split, count, width, shape);
+    items.extend(drivers);
+    (body, items)
+}
+
+/// The body of a split function and the methods calling its blocks in turn: `{name}_fill`
+/// (given the result's storage, every output of which the blocks write) and, where the result
+/// is an array or a pair or triple of matrices, `{name}_in_place`, which fills the caller's
+/// storage through `eomgen_runtime::place` so that the result is not built in a local and
+/// copied out (a derivative of a 50-DoF robot is 40 kB).
+fn drive(
+    split: &Split<'_>,
+    count: usize,
+    width: usize,
+    shape: Shape,
+) -> (TokenStream, Vec<TokenStream>) {
+    let (args, params) = (split.args, split.params);
+    let (outs, out_params) = out_params(shape);
     let calls = (0..count).map(|b| {
         let f = block_name(split.name, b);
-        quote!(self.#f(#(#args,)* &mut w, &mut o);)
+        quote!(self.#f(#(#args,)* &mut w, #(#outs),*);)
     });
-    let zero = filled(quote!(T::zero()), shape);
     let work = if width == 0 {
         quote!(let mut w: [T; 0] = [];)
     } else {
         let width = Literal::usize_unsuffixed(width);
         quote!(let mut w = [T::zero(); #width];)
     };
-    let body = quote! {
-        #work
-        let mut o = #zero;
-        #(#calls)*
-        o
+    let fill = fill_name(split.name);
+    let fill_fn = quote! {
+        #[inline]
+        fn #fill(&self, #(#params,)* #(#out_params),*) {
+            #work
+            #(#calls)*
+        }
     };
-    (body, items)
+    if !in_place(shape) {
+        let zero = filled(quote!(T::zero()), shape);
+        let body = quote! {
+            let mut o = #zero;
+            self.#fill(#(#args,)* &mut o);
+            o
+        };
+        return (body, vec![fill_fn]);
+    }
+    let in_place = format_ident!("{}_in_place", split.name);
+    let ret = shape_type(shape);
+    let bind = match shape {
+        Shape::Matrices(..) => quote!(let (#(#outs),*) = o;),
+        _ => TokenStream::new(),
+    };
+    let in_place_fn = quote! {
+        #[inline(never)]
+        fn #in_place<'b>(&self, #(#params,)* slot: ::eomgen_runtime::place::Slot<'b, #ret>) -> ::eomgen_runtime::place::Filled<'b> {
+            let (o, filled) = slot.fill();
+            #bind
+            self.#fill(#(#args,)* #(#outs),*);
+            filled
+        }
+    };
+    let body = quote!(::eomgen_runtime::place::build(|slot| self.#in_place(#(#args,)* slot)));
+    (body, vec![fill_fn, in_place_fn])
+}
+
+/// Whether `eomgen_runtime::place` can hold a result of `shape` (its `Zeroed` types).
+fn in_place(shape: Shape) -> bool {
+    match shape {
+        Shape::Scalar => false,
+        Shape::Vector(_) | Shape::Matrix(..) => true,
+        Shape::Matrices(k, ..) => (2..=3).contains(&k),
+    }
+}
+
+/// The method filling the result of the split function `name` in place (see [`drive`]): its
+/// parameters are the function's, then one `&mut` per matrix of a [`Shape::Matrices`] result
+/// (`o0`, `o1`, ...) or the whole result (`o`).
+pub(super) fn fill_name(name: &str) -> Ident {
+    format_ident!("{}_fill", name)
+}
+
+/// The output parameters of blocks and of `{name}_fill`: their names and declarations.
+fn out_params(shape: Shape) -> (Vec<Ident>, Vec<TokenStream>) {
+    match shape {
+        Shape::Matrices(k, r, c) => {
+            let one = shape_type(Shape::Matrix(r, c));
+            (0..k)
+                .map(|m| {
+                    let o = format_ident!("o{}", m);
+                    (o.clone(), quote!(#o: &mut #one))
+                })
+                .unzip()
+        }
+        _ => {
+            let ret = shape_type(shape);
+            (vec![format_ident!("o")], vec![quote!(o: &mut #ret)])
+        }
+    }
 }
 
 /// The temporaries `e` reads that blocks before block `b` compute.
@@ -333,10 +415,10 @@ fn block_fn(
     });
     let code = &block.code;
     let (name, params) = (block_name(split.name, b), split.params);
-    let (width, ret) = (Literal::usize_unsuffixed(width), shape_type(shape));
+    let (width, (_, outs)) = (Literal::usize_unsuffixed(width), out_params(shape));
     quote! {
         #[inline(never)]
-        fn #name(&self, #(#params,)* w: &mut [T; #width], o: &mut #ret) {
+        fn #name(&self, #(#params,)* w: &mut [T; #width], #(#outs),*) {
             #(#reads)*
             #(#trig)*
             #(#code)*
@@ -359,9 +441,9 @@ fn output_place(shape: Shape, j: usize) -> TokenStream {
             quote!(o[#i][#j])
         }
         Shape::Matrices(_, r, c) => {
-            let (m, e) = (lit(j / (r * c)), j % (r * c));
+            let (m, e) = (format_ident!("o{}", j / (r * c)), j % (r * c));
             let (i, j) = (lit(e / c), lit(e % c));
-            quote!(o.#m[#i][#j])
+            quote!(#m[#i][#j])
         }
     }
 }

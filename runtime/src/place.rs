@@ -1,0 +1,196 @@
+//! Large results written where the caller keeps them, not built in a local and copied out.
+//!
+//! Rust returns a large value through a pointer to the caller's storage, but a function that
+//! fills its result through `&mut` (as generated code split into blocks does) builds it in a
+//! local first and copies it out at the end: a derivative of a 50-DoF robot (40 kB) then takes
+//! twice its size of stack. [`build`] hands the filling function a [`Slot`] (the caller's
+//! storage, not yet initialized) instead: when that function is not inlined, the compiler
+//! passes the caller's storage through, with no local copy and no second zero fill.
+//!
+//! A [`Slot`] can only be filled with zeros first ([`Slot::fill`]), which returns the
+//! [`Filled`] proof that [`build`] requires back, so safe code cannot observe uninitialized
+//! memory.
+//!
+//! ```
+//! use eomgen_runtime::place::{build, Filled, Slot};
+//!
+//! #[inline(never)]
+//! fn squares<'b>(slot: Slot<'b, [[f64; 3]; 3]>) -> Filled<'b> {
+//!     let (m, filled) = slot.fill();
+//!     for (i, row) in m.iter_mut().enumerate() {
+//!         row[i] = (i * i) as f64;
+//!     }
+//!     filled
+//! }
+//!
+//! let m = build(squares);
+//! assert_eq!(m, [[0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 4.0]]);
+//! ```
+//!
+//! A proof fits only its own slot, so a filling function cannot skip the fill by returning
+//! another's:
+//!
+//! ```compile_fail
+//! use eomgen_runtime::place::{Filled, Slot};
+//! fn steal<'a, 'b>(slot: Slot<'a, [f64; 1]>) -> Filled<'b> {
+//!     slot.fill().1
+//! }
+//! ```
+#![allow(unsafe_code)]
+
+use core::marker::PhantomData;
+use core::mem::MaybeUninit;
+use core::ptr::addr_of_mut;
+
+use crate::Real;
+
+/// An invariant lifetime: `'b` names one call of [`build`] and no other.
+type Brand<'b> = PhantomData<fn(&'b ()) -> &'b ()>;
+
+/// The caller's storage for a result of type `R`, not yet initialized; [`Slot::fill`] gives
+/// access to it. Only [`build`] makes one.
+pub struct Slot<'b, R> {
+    value: &'b mut MaybeUninit<R>,
+    brand: Brand<'b>,
+}
+
+/// Proof that the [`Slot`] of the same `'b` was filled: what a filling function returns.
+pub struct Filled<'b> {
+    brand: Brand<'b>,
+}
+
+impl<'b, R: Zeroed> Slot<'b, R> {
+    /// Fills the storage with zeros, in place, and gives it back initialized, with the proof
+    /// that [`build`] needs.
+    #[inline]
+    pub fn fill(self) -> (&'b mut R, Filled<'b>) {
+        let value = R::zero_in(self.value);
+        (value, Filled { brand: self.brand })
+    }
+}
+
+/// The result `fill` writes into the caller's storage.
+///
+/// `fill` receives the storage as a [`Slot`] and must return the [`Filled`] of that slot,
+/// which only [`Slot::fill`] gives; mark `fill` (or the function it calls with the slot)
+/// `#[inline(never)]` so that the storage is the caller's and is not copied.
+#[inline(always)]
+pub fn build<R: Zeroed>(fill: impl for<'b> FnOnce(Slot<'b, R>) -> Filled<'b>) -> R {
+    let mut value = MaybeUninit::uninit();
+    let _filled = fill(Slot {
+        value: &mut value,
+        brand: PhantomData,
+    });
+    // SAFETY: `fill` returned a `Filled<'b>` for a lifetime `'b` of its own (the closure is
+    // generic over it, and `Brand` is invariant), which only `Slot::fill` on the slot made
+    // above creates; `Slot::fill` initialized every byte of `value` through `Zeroed::zero_in`.
+    unsafe { value.assume_init() }
+}
+
+mod sealed {
+    pub trait Sealed {}
+}
+
+/// Results [`build`] can fill: arrays and matrices of a [`Real`], and pairs and triples of
+/// them. Sealed: [`build`] relies on `zero_in` initializing everything.
+pub trait Zeroed: sealed::Sealed + Sized {
+    /// Writes zeros over all of `slot` and returns it initialized.
+    fn zero_in(slot: &mut MaybeUninit<Self>) -> &mut Self;
+}
+
+impl<T: Real, const N: usize> sealed::Sealed for [T; N] {}
+impl<T: Real, const N: usize> Zeroed for [T; N] {
+    #[inline]
+    fn zero_in(slot: &mut MaybeUninit<Self>) -> &mut Self {
+        let p = slot.as_mut_ptr().cast::<T>();
+        for k in 0..N {
+            // SAFETY: `[T; N]` is N consecutive `T`s, so `p.add(k)` stays inside the slot.
+            unsafe { p.add(k).write(T::zero()) };
+        }
+        // SAFETY: every element was written above.
+        unsafe { slot.assume_init_mut() }
+    }
+}
+
+impl<T: Real, const R: usize, const C: usize> sealed::Sealed for [[T; C]; R] {}
+impl<T: Real, const R: usize, const C: usize> Zeroed for [[T; C]; R] {
+    #[inline]
+    fn zero_in(slot: &mut MaybeUninit<Self>) -> &mut Self {
+        let p = slot.as_mut_ptr().cast::<T>();
+        for k in 0..R * C {
+            // SAFETY: `[[T; C]; R]` is R * C consecutive `T`s (arrays have no padding).
+            unsafe { p.add(k).write(T::zero()) };
+        }
+        // SAFETY: every element was written above.
+        unsafe { slot.assume_init_mut() }
+    }
+}
+
+/// Field `$f` of the tuple behind `$p` (a `*mut` tuple) as an uninitialized slot.
+macro_rules! field_slot {
+    ($p:expr, $f:tt) => {
+        // SAFETY: the field lies inside the tuple `$p` points to, which is borrowed mutably
+        // for as long as the slot lives; `MaybeUninit<X>` has the layout of `X`.
+        unsafe { &mut *addr_of_mut!((*$p).$f).cast::<MaybeUninit<_>>() }
+    };
+}
+
+impl<A: Zeroed, B: Zeroed> sealed::Sealed for (A, B) {}
+impl<A: Zeroed, B: Zeroed> Zeroed for (A, B) {
+    #[inline]
+    fn zero_in(slot: &mut MaybeUninit<Self>) -> &mut Self {
+        let p = slot.as_mut_ptr();
+        A::zero_in(field_slot!(p, 0));
+        B::zero_in(field_slot!(p, 1));
+        // SAFETY: both fields were initialized above (a pair of these types has no padding
+        // that needs initializing: padding bytes are never read as values).
+        unsafe { slot.assume_init_mut() }
+    }
+}
+
+impl<A: Zeroed, B: Zeroed, C: Zeroed> sealed::Sealed for (A, B, C) {}
+impl<A: Zeroed, B: Zeroed, C: Zeroed> Zeroed for (A, B, C) {
+    #[inline]
+    fn zero_in(slot: &mut MaybeUninit<Self>) -> &mut Self {
+        let p = slot.as_mut_ptr();
+        A::zero_in(field_slot!(p, 0));
+        B::zero_in(field_slot!(p, 1));
+        C::zero_in(field_slot!(p, 2));
+        // SAFETY: every field was initialized above.
+        unsafe { slot.assume_init_mut() }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[inline(never)]
+    fn pair<'b>(slot: Slot<'b, ([f64; 2], [[f32; 2]; 3])>) -> Filled<'b> {
+        let ((v, m), filled) = slot.fill();
+        v[1] = 2.0;
+        m[2][0] = 5.0;
+        filled
+    }
+
+    #[test]
+    fn a_pair_is_zero_where_not_written() {
+        let (v, m) = build(pair);
+        assert_eq!(v, [0.0, 2.0]);
+        assert_eq!(m, [[0.0, 0.0], [0.0, 0.0], [5.0, 0.0]]);
+    }
+
+    type Triple = ([f64; 1], [f64; 2], [[f64; 1]; 1]);
+
+    #[test]
+    fn a_triple_is_filled_in_place() {
+        let (a, b, c) = build(|slot: Slot<'_, Triple>| {
+            let ((a, b, c), filled) = slot.fill();
+            a[0] = 1.0;
+            b[1] = 2.0;
+            c[0][0] = 3.0;
+            filled
+        });
+        assert_eq!((a, b, c), ([1.0], [0.0, 2.0], [[3.0]]));
+    }
+}
