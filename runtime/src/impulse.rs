@@ -5,7 +5,7 @@
 //! the impact `v+` satisfy `M (v+ - v) = J^T p` and `J v+ = -e J v`: the KKT system with
 //! `top = 0`, `bottom = -(1 + e) J v` gives `(v+ - v, p)`.
 
-use crate::kkt::{axpy, dot, finite_rows, negated, ContactKkt, ImpulseDynamicsDerivatives};
+use crate::kkt::{axpy, dot, finite_rows, negate, ContactKkt, ImpulseDynamicsDerivatives};
 use crate::{FactorError, Real};
 
 impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
@@ -33,38 +33,47 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
         e: T,
         partials: &[[T; N]; R],
     ) -> Result<ImpulseDynamicsDerivatives<T, N, K>, FactorError> {
-        if R != N + K {
-            return Err(FactorError::NonFinite { pivot: 0 });
-        }
-        let top: [[T; N]; N] = core::array::from_fn(|i| partials[i]);
-        let bottom: [[T; N]; K] = core::array::from_fn(|k| partials[N + k]);
-        let (dv_dq, dimpulse_dq) = self.solve_columns(&negated(&top), &negated(&bottom));
-        let mut dimpulse_dv = *self.jacobian();
-        self.lambda_solve_columns(&mut dimpulse_dv);
+        let mut d = ImpulseDynamicsDerivatives {
+            dv_dq: [[T::zero(); N]; N],
+            dv_dv: [[T::zero(); N]; N],
+            dimpulse_dq: [[T::zero(); N]; K],
+            dimpulse_dv: [[T::zero(); N]; K],
+        };
+        d.set_partials(partials)?;
+        self.impulse_derivatives_in_place(e, &mut d)?;
+        Ok(d)
+    }
+
+    /// [`ContactKkt::impulse_derivatives`] in `d`, which holds on entry what
+    /// [`ImpulseDynamicsDerivatives::set_partials`] leaves: no matrix is copied, so that a caller
+    /// can have them written straight into its result.
+    pub fn impulse_derivatives_in_place(
+        &self,
+        e: T,
+        d: &mut ImpulseDynamicsDerivatives<T, N, K>,
+    ) -> Result<(), FactorError> {
+        negate(&mut d.dv_dq);
+        negate(&mut d.dimpulse_dq);
+        self.solve_columns_in_place(&mut d.dv_dq, &mut d.dimpulse_dq);
+        d.dimpulse_dv = *self.jacobian();
+        self.lambda_solve_columns(&mut d.dimpulse_dv);
         let k = -(T::one() + e);
-        for row in dimpulse_dv.iter_mut() {
-            for x in row.iter_mut() {
-                *x *= k;
-            }
+        for x in d.dimpulse_dv.iter_mut().flatten() {
+            *x *= k;
         }
-        let mut dv_dv: [[T; N]; N] = core::array::from_fn(|i| {
-            core::array::from_fn(|j| if i == j { T::one() } else { T::zero() })
-        });
-        for (yk, pk) in self.inverse_inertia_rows().iter().zip(&dimpulse_dv) {
-            for (row, yki) in dv_dv.iter_mut().zip(yk) {
+        for (i, row) in d.dv_dv.iter_mut().enumerate() {
+            row.iter_mut().for_each(|x| *x = T::zero());
+            row[i] = T::one();
+        }
+        for (yk, pk) in self.inverse_inertia_rows().iter().zip(&d.dimpulse_dv) {
+            for (row, yki) in d.dv_dv.iter_mut().zip(yk) {
                 axpy(row, *yki, pk);
             }
         }
-        let d = ImpulseDynamicsDerivatives {
-            dv_dq,
-            dv_dv,
-            dimpulse_dq,
-            dimpulse_dv,
-        };
         finite_rows(&d.dv_dq, 0)?;
         finite_rows(&d.dv_dv, 0)?;
         finite_rows(&d.dimpulse_dq, N)?;
         finite_rows(&d.dimpulse_dv, N)?;
-        Ok(d)
+        Ok(())
     }
 }

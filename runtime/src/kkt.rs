@@ -40,6 +40,37 @@ pub struct ContactDynamicsDerivatives<T, const NV: usize, const K: usize> {
 }
 
 impl<T: Real, const NV: usize, const K: usize> ContactDynamicsDerivatives<T, NV, K> {
+    /// Sets every entry to NaN, in place.
+    pub fn fill_nan(&mut self) {
+        let (a, f) = (T::nan(), T::nan());
+        for m in [&mut self.da_dq, &mut self.da_dv, &mut self.da_dtau] {
+            m.iter_mut().flatten().for_each(|x| *x = a);
+        }
+        for m in [&mut self.df_dq, &mut self.df_dv, &mut self.df_dtau] {
+            m.iter_mut().flatten().for_each(|x| *x = f);
+        }
+    }
+
+    /// Adds the generated partials of contact forward dynamics (`R = NV + 2K` rows, see
+    /// [`ContactKkt::contact_dynamics_derivatives`]) where
+    /// [`ContactKkt::contact_dynamics_derivatives_in_place`] expects them: rows `0..NV` onto
+    /// `da_dq` (which holds `d tau / dq` of inverse dynamics), rows `NV..NV + K` into `df_dq`,
+    /// the last `K` into `df_dv`. Errors (`NonFinite` at pivot 0) when `R != NV + 2K`.
+    pub fn add_partials<const R: usize>(
+        &mut self,
+        partials: &[[T; NV]; R],
+    ) -> Result<(), FactorError> {
+        if R != NV + 2 * K {
+            return Err(FactorError::NonFinite { pivot: 0 });
+        }
+        for (t, p) in self.da_dq.iter_mut().zip(partials) {
+            axpy(t, T::one(), p);
+        }
+        self.df_dq.copy_from_slice(&partials[NV..NV + K]);
+        self.df_dv.copy_from_slice(&partials[NV + K..]);
+        Ok(())
+    }
+
     /// Every entry NaN (what the methods without `try_` return when the problem is singular).
     pub fn nan() -> Self {
         let (a, f) = ([[T::nan(); NV]; NV], [[T::nan(); NV]; K]);
@@ -71,6 +102,32 @@ pub struct ImpulseDynamicsDerivatives<T, const NV: usize, const K: usize> {
 }
 
 impl<T: Real, const NV: usize, const K: usize> ImpulseDynamicsDerivatives<T, NV, K> {
+    /// Sets every entry to NaN, in place.
+    pub fn fill_nan(&mut self) {
+        for m in [&mut self.dv_dq, &mut self.dv_dv] {
+            m.iter_mut().flatten().for_each(|x| *x = T::nan());
+        }
+        for m in [&mut self.dimpulse_dq, &mut self.dimpulse_dv] {
+            m.iter_mut().flatten().for_each(|x| *x = T::nan());
+        }
+    }
+
+    /// Sets the generated partials of impulse dynamics (`R = NV + K` rows, see
+    /// [`ContactKkt::impulse_derivatives`]) where
+    /// [`ContactKkt::impulse_derivatives_in_place`] expects them: rows `0..NV` into `dv_dq`, the
+    /// last `K` into `dimpulse_dq`. Errors (`NonFinite` at pivot 0) when `R != NV + K`.
+    pub fn set_partials<const R: usize>(
+        &mut self,
+        partials: &[[T; NV]; R],
+    ) -> Result<(), FactorError> {
+        if R != NV + K {
+            return Err(FactorError::NonFinite { pivot: 0 });
+        }
+        self.dv_dq.copy_from_slice(&partials[..NV]);
+        self.dimpulse_dq.copy_from_slice(&partials[NV..]);
+        Ok(())
+    }
+
     /// Every entry NaN.
     pub fn nan() -> Self {
         let (v, p) = ([[T::nan(); NV]; NV], [[T::nan(); NV]; K]);
@@ -210,27 +267,32 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
         top: &[[T; C]; N],
         bottom: &[[T; C]; K],
     ) -> ([[T; C]; N], [[T; C]; K]) {
-        let mut x = *top;
-        self.substitute_columns(&mut x);
+        let (mut x, mut f) = (*top, *bottom);
+        self.solve_columns_in_place(&mut x, &mut f);
+        (x, f)
+    }
+
+    /// [`ContactKkt::solve_columns`] in place: `x` holds `top` on entry and `X` on return,
+    /// `f` holds `bottom` and then `F`.
+    pub fn solve_columns_in_place<const C: usize>(&self, x: &mut [[T; C]; N], f: &mut [[T; C]; K]) {
+        self.substitute_columns(x);
         // F = Lambda^-1 (bottom - J X)
-        let mut f = *bottom;
         for ((fk, jk), on) in f.iter_mut().zip(&self.j).zip(&self.active) {
             if !*on {
                 *fk = [T::zero(); C];
                 continue;
             }
-            for (jki, xi) in jk.iter().zip(&x) {
+            for (jki, xi) in jk.iter().zip(x.iter()) {
                 axpy(fk, -*jki, xi);
             }
         }
-        self.lambda_solve_columns(&mut f);
+        self.lambda_solve_columns(f);
         // X += Y F
-        for (yk, fk) in self.y.iter().zip(&f) {
+        for (yk, fk) in self.y.iter().zip(f.iter()) {
             for (xi, yki) in x.iter_mut().zip(yk) {
                 axpy(xi, *yki, fk);
             }
         }
-        (x, f)
     }
 
     /// `(J M^-1 J^T)^-1 B` for the K x C matrix `B`, in place.
@@ -252,28 +314,10 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
         }
     }
 
-    /// `M^-1 X` for the N x C matrix `X`, in place, through the tree factors.
+    /// `M^-1 X` for the N x C matrix `X`, in place, through the tree factors
+    /// ([`crate::tree::ltdl_substitute_rows`]).
     pub fn substitute_columns<const C: usize>(&self, x: &mut [[T; C]; N]) {
-        let (m, parent) = (&self.factors, &self.parent);
-        for i in (0..N).rev() {
-            let mut j = parent[i];
-            while let Some(jj) = j {
-                let (head, tail) = x.split_at_mut(i);
-                axpy(&mut head[jj], -m[i][jj], &tail[0]);
-                j = parent[jj];
-            }
-        }
-        for (i, xi) in x.iter_mut().enumerate() {
-            scale(xi, T::one() / m[i][i]);
-        }
-        for i in 0..N {
-            let mut j = parent[i];
-            while let Some(jj) = j {
-                let (head, tail) = x.split_at_mut(i);
-                axpy(&mut tail[0], -m[i][jj], &head[jj]);
-                j = parent[jj];
-            }
-        }
+        crate::tree::ltdl_substitute_rows(&self.factors, &self.parent, x);
     }
 
     /// Row `k` of `J M^-1` (`Y^T`).
@@ -313,13 +357,11 @@ fn scale<T: Real, const C: usize>(y: &mut [T; C], a: T) {
     }
 }
 
-/// A matrix with every entry negated.
-pub(crate) fn negated<T: Real, const C: usize, const R: usize>(m: &[[T; C]; R]) -> [[T; C]; R] {
-    let mut out = *m;
-    for row in out.iter_mut() {
+/// Every entry of `m` negated, in place.
+pub(crate) fn negate<T: Real, const C: usize, const R: usize>(m: &mut [[T; C]; R]) {
+    for row in m.iter_mut() {
         scale(row, -T::one());
     }
-    out
 }
 
 /// `NonFinite` at `offset` plus the first row of `m` with a non-finite entry.
@@ -349,35 +391,48 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
         did_dv: &[[T; N]; N],
         partials: &[[T; N]; R],
     ) -> Result<ContactDynamicsDerivatives<T, N, K>, FactorError> {
-        if R != N + 2 * K {
-            return Err(FactorError::NonFinite { pivot: 0 });
-        }
-        let rows = |from: usize| -> [[T; N]; K] { core::array::from_fn(|k| partials[from + k]) };
-        let mut top_q = negated(did_dq);
-        for (t, p) in top_q.iter_mut().zip(partials) {
-            axpy(t, -T::one(), p);
-        }
-        let (da_dq, df_dq) = self.solve_columns(&top_q, &negated(&rows(N)));
-        let (da_dv, df_dv) = self.solve_columns(&negated(did_dv), &negated(&rows(N + K)));
-        let identity: [[T; N]; N] = core::array::from_fn(|i| {
-            core::array::from_fn(|j| if i == j { T::one() } else { T::zero() })
-        });
-        let (da_dtau, df_dtau) = self.solve_columns(&identity, &[[T::zero(); N]; K]);
-        let d = ContactDynamicsDerivatives {
-            da_dq,
-            da_dv,
-            da_dtau,
-            df_dq,
-            df_dv,
-            df_dtau,
+        let mut d = ContactDynamicsDerivatives {
+            da_dq: *did_dq,
+            da_dv: *did_dv,
+            da_dtau: [[T::zero(); N]; N],
+            df_dq: [[T::zero(); N]; K],
+            df_dv: [[T::zero(); N]; K],
+            df_dtau: [[T::zero(); N]; K],
         };
+        d.add_partials(partials)?;
+        self.contact_dynamics_derivatives_in_place(&mut d)?;
+        Ok(d)
+    }
+
+    /// [`ContactKkt::contact_dynamics_derivatives`] in `d`, which holds on entry what
+    /// [`ContactDynamicsDerivatives::add_partials`] leaves (after `d.da_dq` and `d.da_dv` were
+    /// set to the derivatives of inverse dynamics): no matrix is copied, so that a caller can
+    /// have them written straight into its result.
+    pub fn contact_dynamics_derivatives_in_place(
+        &self,
+        d: &mut ContactDynamicsDerivatives<T, N, K>,
+    ) -> Result<(), FactorError> {
+        for m in [&mut d.da_dq, &mut d.da_dv] {
+            negate(m);
+        }
+        for m in [&mut d.df_dq, &mut d.df_dv] {
+            negate(m);
+        }
+        self.solve_columns_in_place(&mut d.da_dq, &mut d.df_dq);
+        self.solve_columns_in_place(&mut d.da_dv, &mut d.df_dv);
+        for (i, row) in d.da_dtau.iter_mut().enumerate() {
+            row.iter_mut().for_each(|x| *x = T::zero());
+            row[i] = T::one();
+        }
+        d.df_dtau.iter_mut().flatten().for_each(|x| *x = T::zero());
+        self.solve_columns_in_place(&mut d.da_dtau, &mut d.df_dtau);
         for m in [&d.da_dq, &d.da_dv, &d.da_dtau] {
             finite_rows(m, 0)?;
         }
         for m in [&d.df_dq, &d.df_dv, &d.df_dtau] {
             finite_rows(m, N)?;
         }
-        Ok(d)
+        Ok(())
     }
 }
 

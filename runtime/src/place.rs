@@ -42,6 +42,7 @@ use core::marker::PhantomData;
 use core::mem::MaybeUninit;
 use core::ptr::addr_of_mut;
 
+use crate::kkt::{ContactDynamicsDerivatives, ImpulseDynamicsDerivatives};
 use crate::Real;
 
 /// An invariant lifetime: `'b` names one call of [`build`] and no other.
@@ -91,8 +92,9 @@ mod sealed {
     pub trait Sealed {}
 }
 
-/// Results [`build`] can fill: arrays and matrices of a [`Real`], and pairs and triples of
-/// them. Sealed: [`build`] relies on `zero_in` initializing everything.
+/// Results [`build`] can fill: arrays and matrices of a [`Real`], pairs and triples of them,
+/// and the derivatives of contact and impulse dynamics. Sealed: [`build`] relies on `zero_in`
+/// initializing everything.
 pub trait Zeroed: sealed::Sealed + Sized {
     /// Writes zeros over all of `slot` and returns it initialized.
     fn zero_in(slot: &mut MaybeUninit<Self>) -> &mut Self;
@@ -131,8 +133,17 @@ macro_rules! field_slot {
     ($p:expr, $f:tt) => {
         // SAFETY: the field lies inside the tuple `$p` points to, which is borrowed mutably
         // for as long as the slot lives; `MaybeUninit<X>` has the layout of `X`.
-        unsafe { &mut *addr_of_mut!((*$p).$f).cast::<MaybeUninit<_>>() }
+        unsafe { as_slot(addr_of_mut!((*$p).$f)) }
     };
+}
+
+/// The place `p` points to as an uninitialized slot of its type.
+///
+/// # Safety
+/// `p` points into storage that is mutably borrowed for `'a` and nothing else accesses.
+unsafe fn as_slot<'a, X>(p: *mut X) -> &'a mut MaybeUninit<X> {
+    // SAFETY: the caller's; `MaybeUninit<X>` has the layout of `X`.
+    unsafe { &mut *p.cast::<MaybeUninit<X>>() }
 }
 
 impl<A: Zeroed, B: Zeroed> sealed::Sealed for (A, B) {}
@@ -160,6 +171,37 @@ impl<A: Zeroed, B: Zeroed, C: Zeroed> Zeroed for (A, B, C) {
         unsafe { slot.assume_init_mut() }
     }
 }
+
+/// `Zeroed` for a struct of `Zeroed` fields, field by field.
+macro_rules! zeroed_struct {
+    ($name:ident { $($field:ident),* }) => {
+        impl<T: Real, const NV: usize, const K: usize> sealed::Sealed for $name<T, NV, K> {}
+        impl<T: Real, const NV: usize, const K: usize> Zeroed for $name<T, NV, K> {
+            #[inline]
+            fn zero_in(slot: &mut MaybeUninit<Self>) -> &mut Self {
+                let p = slot.as_mut_ptr();
+                $(Zeroed::zero_in(field_slot!(p, $field));)*
+                // SAFETY: every field was initialized above.
+                unsafe { slot.assume_init_mut() }
+            }
+        }
+    };
+}
+
+zeroed_struct!(ContactDynamicsDerivatives {
+    da_dq,
+    da_dv,
+    da_dtau,
+    df_dq,
+    df_dv,
+    df_dtau
+});
+zeroed_struct!(ImpulseDynamicsDerivatives {
+    dv_dq,
+    dv_dv,
+    dimpulse_dq,
+    dimpulse_dv
+});
 
 #[cfg(test)]
 mod tests {

@@ -149,18 +149,21 @@ impl Emitter<'_> {
             self.straight(q, h, Shape::Vector(h.len()))
         };
         let docs = Self::quantity_doc(q, Some(ops));
-        let (n, nq, k) = (&self.n, &self.nq, &self.k);
+        let (n, nq, k) = (self.n.clone(), self.nq.clone(), self.k.clone());
         let kkt = self.kkt(active);
         let s = self.signature(q, active, ("The derivatives of", ", or why they do not"));
         let (name, try_name, param, arg, why) = (&s.name, &s.try_name, &s.param, &s.arg, &s.why);
         let drift = self.call("contact_drift");
-        let idd = self.call("inverse_dynamics_derivatives");
+        let id_derivatives = self.id_derivatives_into(quote!(d.da_dq), quote!(d.da_dv));
         let partials = self.call("contact_dynamics_partials");
-        quote! {
-            #[doc = #why]
-            /// exist: a pivot of M(q) (`pivot` < N) or of `J_c M^-1 J_c^T` (`pivot` - N, a
-            /// rank-deficient contact Jacobian) that is not positive, or a non-finite result.
-            pub fn #try_name(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n] #param) -> ::core::result::Result<::eomgen_runtime::ContactDynamicsDerivatives<T, #n, #k>, ::eomgen_runtime::FactorError> {
+        let ty = quote!(::eomgen_runtime::ContactDynamicsDerivatives<T, #n, #k>);
+        let (into, stage) = (
+            format_ident!("{}_into", name),
+            format_ident!("{}_partials", name),
+        );
+        self.blocks.push(quote! {
+            /// The derivatives written into `d` (which holds garbage on failure).
+            fn #into(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n] #param, d: &mut #ty) -> ::core::result::Result<(), ::eomgen_runtime::FactorError> {
                 let h: [T; #n] = { #hb };
                 let mut rhs = *tau;
                 for (r, h) in rhs.iter_mut().zip(h) {
@@ -169,15 +172,99 @@ impl Emitter<'_> {
                 let drift = #drift(self, q, qd);
                 #kkt
                 let (a, f) = kkt.solve(&rhs, &drift.map(|x| -x))?;
-                let (did_dq, did_dv) = #idd(self, q, qd, &a);
-                kkt.contact_dynamics_derivatives(&did_dq, &did_dv, &#partials(self, q, qd, &a, &f))
+                #id_derivatives
+                self.#stage(q, qd, &a, &f, d)?;
+                kkt.contact_dynamics_derivatives_in_place(d)
+            }
+
+            /// The partials added to `d` in a frame of their own, not alongside the
+            /// inverse-dynamics derivatives' blocks.
+            #[inline(never)]
+            fn #stage(&self, q: &[T; #nq], qd: &[T; #n], a: &[T; #n], f: &[T; #k], d: &mut #ty) -> ::core::result::Result<(), ::eomgen_runtime::FactorError> {
+                d.add_partials(&#partials(self, q, qd, a, f))
+            }
+        });
+        let in_place = self.fill_in_place(
+            name,
+            &into,
+            &ty,
+            &[
+                quote!(q: &[T; #nq]),
+                quote!(qd: &[T; #n]),
+                quote!(tau: &[T; #n]),
+            ],
+            (param, arg),
+        );
+        let build = |err: TokenStream| quote!(::eomgen_runtime::place::build(|slot| self.#in_place(q, qd, tau, #err #arg, slot)));
+        let (with_err, without) = (build(quote!(&mut err)), build(quote!(&mut None)));
+        quote! {
+            #[doc = #why]
+            /// exist: a pivot of M(q) (`pivot` < N) or of `J_c M^-1 J_c^T` (`pivot` - N, a
+            /// rank-deficient contact Jacobian) that is not positive, or a non-finite result.
+            pub fn #try_name(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n] #param) -> ::core::result::Result<#ty, ::eomgen_runtime::FactorError> {
+                let mut err = None;
+                let d = #with_err;
+                match err {
+                    None => Ok(d),
+                    Some(e) => Err(e),
+                }
             }
 
             #docs
-            pub fn #name(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n] #param) -> ::eomgen_runtime::ContactDynamicsDerivatives<T, #n, #k> {
-                self.#try_name(q, qd, tau #arg)
-                    .unwrap_or_else(|_| ::eomgen_runtime::ContactDynamicsDerivatives::nan())
+            pub fn #name(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n] #param) -> #ty {
+                #without
             }
+        }
+    }
+
+    /// `{name}_in_place`, for the inherent impl, which fills the caller's storage for the
+    /// result of `into` (a fallible `fn(&self, params..., extra, d: &mut ty)`) through
+    /// `eomgen_runtime::place`: NaN, and the error in `err`, on failure. Returns its name; it
+    /// takes `params..., err, extra, slot`.
+    fn fill_in_place(
+        &mut self,
+        name: &Ident,
+        into: &Ident,
+        ty: &TokenStream,
+        params: &[TokenStream],
+        (param, arg): (&TokenStream, &TokenStream),
+    ) -> Ident {
+        let in_place = format_ident!("{}_in_place", name);
+        let args: Vec<TokenStream> = params
+            .iter()
+            .map(|p| {
+                let name = p.clone().into_iter().next();
+                quote!(#name)
+            })
+            .collect();
+        self.blocks.push(quote! {
+            #[inline(never)]
+            fn #in_place<'b>(&self, #(#params,)* err: &mut ::core::option::Option<::eomgen_runtime::FactorError> #param, slot: ::eomgen_runtime::place::Slot<'b, #ty>) -> ::eomgen_runtime::place::Filled<'b> {
+                let (d, filled) = slot.fill();
+                if let Err(e) = self.#into(#(#args),* #arg, d) {
+                    d.fill_nan();
+                    *err = Some(e);
+                }
+                filled
+            }
+        });
+        in_place
+    }
+
+    /// Statements writing `inverse_dynamics_derivatives` at `(q, qd, &a)` into the matrices
+    /// `dq` and `dqd` (places of type `[[T; N]; N]`): through its `_fill` method when its body
+    /// was split, so that it is not built in a local and copied.
+    fn id_derivatives_into(&self, dq: TokenStream, dqd: TokenStream) -> TokenStream {
+        if self.split.contains("inverse_dynamics_derivatives") {
+            let fill = crate::emit::split::fill_name("inverse_dynamics_derivatives");
+            quote!(self.#fill(q, qd, &a, &mut #dq, &mut #dqd);)
+        } else {
+            debug_assert!(self
+                .counts
+                .iter()
+                .any(|(c, _)| c == "inverse_dynamics_derivatives"));
+            let f = self.call("inverse_dynamics_derivatives");
+            quote!((#dq, #dqd) = #f(self, q, qd, &a);)
         }
     }
 
@@ -224,7 +311,7 @@ impl Emitter<'_> {
         active: bool,
     ) -> TokenStream {
         let docs = Self::quantity_doc(q, None);
-        let (n, nq, k) = (&self.n, &self.nq, &self.k);
+        let (n, nq, k) = (self.n.clone(), self.nq.clone(), self.k.clone());
         let kkt = self.kkt(active);
         let partials = self.call("impulse_dynamics_partials");
         let s = self.signature(
@@ -233,21 +320,56 @@ impl Emitter<'_> {
             ("The derivatives of", ", or why they do not exist (as"),
         );
         let (name, try_name, param, arg, why) = (&s.name, &s.try_name, &s.param, &s.arg, &s.why);
-        quote! {
-            #[doc = #why]
-            /// `try_impulse_dynamics`).
-            pub fn #try_name(&self, q: &[T; #nq], qd: &[T; #n], restitution: T #param) -> ::core::result::Result<::eomgen_runtime::ImpulseDynamicsDerivatives<T, #n, #k>, ::eomgen_runtime::FactorError> {
+        let ty = quote!(::eomgen_runtime::ImpulseDynamicsDerivatives<T, #n, #k>);
+        let (into, stage) = (
+            format_ident!("{}_into", name),
+            format_ident!("{}_partials", name),
+        );
+        self.blocks.push(quote! {
+            /// The derivatives written into `d` (which holds garbage on failure).
+            fn #into(&self, q: &[T; #nq], qd: &[T; #n], restitution: T #param, d: &mut #ty) -> ::core::result::Result<(), ::eomgen_runtime::FactorError> {
                 #kkt
                 let (after, p) = kkt.impulse(qd, restitution)?;
                 let jump: [T; #n] = ::core::array::from_fn(|i| after[i] - qd[i]);
                 let w: [T; #n] = ::core::array::from_fn(|i| after[i] + restitution * qd[i]);
-                kkt.impulse_derivatives(restitution, &#partials(self, q, &w, &jump, &p))
+                self.#stage(q, &w, &jump, &p, d)?;
+                kkt.impulse_derivatives_in_place(restitution, d)
+            }
+
+            /// The partials set in `d` in a frame of their own.
+            #[inline(never)]
+            fn #stage(&self, q: &[T; #nq], w: &[T; #n], jump: &[T; #n], p: &[T; #k], d: &mut #ty) -> ::core::result::Result<(), ::eomgen_runtime::FactorError> {
+                d.set_partials(&#partials(self, q, w, jump, p))
+            }
+        });
+        let in_place = self.fill_in_place(
+            name,
+            &into,
+            &ty,
+            &[
+                quote!(q: &[T; #nq]),
+                quote!(qd: &[T; #n]),
+                quote!(restitution: T),
+            ],
+            (param, arg),
+        );
+        let build = |err: TokenStream| quote!(::eomgen_runtime::place::build(|slot| self.#in_place(q, qd, restitution, #err #arg, slot)));
+        let (with_err, without) = (build(quote!(&mut err)), build(quote!(&mut None)));
+        quote! {
+            #[doc = #why]
+            /// `try_impulse_dynamics`).
+            pub fn #try_name(&self, q: &[T; #nq], qd: &[T; #n], restitution: T #param) -> ::core::result::Result<#ty, ::eomgen_runtime::FactorError> {
+                let mut err = None;
+                let d = #with_err;
+                match err {
+                    None => Ok(d),
+                    Some(e) => Err(e),
+                }
             }
 
             #docs
-            pub fn #name(&self, q: &[T; #nq], qd: &[T; #n], restitution: T #param) -> ::eomgen_runtime::ImpulseDynamicsDerivatives<T, #n, #k> {
-                self.#try_name(q, qd, restitution #arg)
-                    .unwrap_or_else(|_| ::eomgen_runtime::ImpulseDynamicsDerivatives::nan())
+            pub fn #name(&self, q: &[T; #nq], qd: &[T; #n], restitution: T #param) -> #ty {
+                #without
             }
         }
     }
