@@ -71,3 +71,26 @@ fn generated_functions_never_allocate() {
     });
     assert_eq!(a, 0);
 }
+
+/// Contact and impulse dynamics for a set of active contacts, stabilized or not, and their
+/// derivatives (anymal on its four feet): no heap either.
+#[test]
+fn active_contact_functions_never_allocate() {
+    use eomgen_runtime::{Baumgarte, Pose};
+    use eomgen_tests::robots::anymal_mpc::AnymalMpc;
+    let robot = AnymalMpc::<f64>::default();
+    let mut q: [f64; 19] = core::array::from_fn(|i| 0.1 * i as f64);
+    q[3..7].copy_from_slice(&[0.0, 0.0, 0.0, 1.0]);
+    let v: [f64; 18] = core::array::from_fn(|i| 0.2 - 0.05 * i as f64);
+    let active = [true, false, true, true];
+    let b = Baumgarte::new(100.0, 20.0, [Pose::identity(); 4]);
+    let a = allocations(|| {
+        black_box(robot.contact_forward_dynamics_active(&q, &v, &v, black_box(&active)));
+        black_box(robot.contact_forward_dynamics_stabilized(&q, &v, &v, &active, black_box(&b)));
+        black_box(robot.contact_forward_dynamics_derivatives_active(&q, &v, &v, &active));
+        black_box(robot.impulse_dynamics_active(&q, &v, 0.5, black_box(&active)));
+        black_box(robot.impulse_dynamics_derivatives_active(&q, &v, 0.5, &active));
+        black_box(robot.contact_placements(black_box(&q)));
+    });
+    assert_eq!(a, 0, "the active contact functions allocated {a} times");
+}
