@@ -188,18 +188,57 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
     /// assert_eq!((a, f), ([2.0, 0.0], [0.0, 9.81]));
     /// ```
     pub fn new_active(
-        mut m: [[T; N]; N],
+        m: [[T; N]; N],
         parent: &[Option<usize>; N],
-        mut j: [[T; N]; K],
+        j: [[T; N]; K],
         active: &[bool; K],
     ) -> Result<Self, FactorError> {
-        ltdl_factor(&mut m, parent)?;
-        let mut y = [[T::zero(); N]; K];
-        for ((yk, jk), on) in y.iter_mut().zip(j.iter_mut()).zip(active) {
+        let mut kkt = Self::zeroed();
+        kkt.set_up(
+            |mm, jj| {
+                *mm = m;
+                *jj = j;
+            },
+            parent,
+            active,
+        )?;
+        Ok(kkt)
+    }
+
+    /// A system of zeros, for [`ContactKkt::set_up`] to set up where it lies.
+    pub fn zeroed() -> Self {
+        ContactKkt {
+            factors: [[T::zero(); N]; N],
+            parent: [None; N],
+            j: [[T::zero(); N]; K],
+            y: [[T::zero(); N]; K],
+            lambda: Cholesky::identity(),
+            active: [true; K],
+        }
+    }
+
+    /// [`ContactKkt::new_active`] in place, so that a caller keeps one copy of the system
+    /// (about `8 N^2` bytes) rather than building it and moving it: `fill` writes the mass
+    /// matrix and the contact Jacobian into the storage it is given, then the system is
+    /// factorized there. On failure `self` holds a partial factorization and solves give
+    /// garbage; set it up again before use.
+    pub fn set_up(
+        &mut self,
+        fill: impl FnOnce(&mut [[T; N]; N], &mut [[T; N]; K]),
+        parent: &[Option<usize>; N],
+        active: &[bool; K],
+    ) -> Result<(), FactorError> {
+        fill(&mut self.factors, &mut self.j);
+        self.parent = *parent;
+        self.active = *active;
+        let m = &mut self.factors;
+        ltdl_factor(m, parent)?;
+        for ((yk, jk), on) in self.y.iter_mut().zip(self.j.iter_mut()).zip(active) {
             if *on {
-                *yk = ltdl_substitute(&m, parent, jk);
+                *yk = ltdl_substitute(m, parent, jk);
             } else {
                 *jk = [T::zero(); N];
+                *yk = [T::zero(); N];
             }
         }
         let mut lambda = [[T::zero(); K]; K];
@@ -210,20 +249,13 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
             }
             for c in 0..=r {
                 if active[c] {
-                    lambda[r][c] = dot(&j[r], &y[c]);
+                    lambda[r][c] = dot(&self.j[r], &self.y[c]);
                     lambda[c][r] = lambda[r][c];
                 }
             }
         }
-        let lambda = Cholesky::new(lambda).map_err(shift::<N>)?;
-        Ok(ContactKkt {
-            factors: m,
-            parent: *parent,
-            j,
-            y,
-            lambda,
-            active: *active,
-        })
+        self.lambda = Cholesky::new(lambda).map_err(shift::<N>)?;
+        Ok(())
     }
 
     /// Which contact rows take part (all of them for [`ContactKkt::new`]).

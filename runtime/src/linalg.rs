@@ -228,6 +228,18 @@ pub struct Cholesky<T, const N: usize> {
 }
 
 impl<T: Real, const N: usize> Cholesky<T, N> {
+    /// The factorization of the identity.
+    pub(crate) fn identity() -> Self {
+        let mut l = [[T::zero(); N]; N];
+        for (i, row) in l.iter_mut().enumerate() {
+            row[i] = T::one();
+        }
+        Cholesky {
+            l,
+            diag_inv: [T::one(); N],
+        }
+    }
+
     /// Factorizes `m` (lower triangle read). Errors on the first pivot `L_jj²` that is not
     /// finite or not strictly positive.
     pub fn new(m: [[T; N]; N]) -> Result<Self, FactorError> {

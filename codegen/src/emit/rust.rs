@@ -130,6 +130,8 @@ struct Emitter<'a> {
     blocks: Vec<TokenStream>,
     /// The quantities whose bodies were split, which have a `{name}_fill` method.
     split: BTreeSet<String>,
+    /// Private helper methods already in `blocks` (emitted once for several callers).
+    helpers: BTreeSet<&'static str>,
 }
 
 /// How many methods the runtime's `Dynamics` trait has.
@@ -220,6 +222,7 @@ pub fn emit_tokens(
         budget: opts.max_function_ops,
         blocks: Vec::new(),
         split: BTreeSet::new(),
+        helpers: BTreeSet::new(),
     };
     let tokens = e.file(&fields, d);
     (tokens, e.counts)

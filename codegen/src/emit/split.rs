@@ -235,8 +235,10 @@ fn drive(
         quote!(let mut w = [T::zero(); #width];)
     };
     let fill = fill_name(split.name);
+    // Not inlined: its work array then lives only while the blocks run, not in the frame of a
+    // caller that goes on to other work (contact dynamics derivatives).
     let fill_fn = quote! {
-        #[inline]
+        #[inline(never)]
         fn #fill(&self, #(#params,)* #(#out_params),*) {
             #work
             #(#calls)*

@@ -40,19 +40,55 @@ impl Emitter<'_> {
         }
     }
 
-    /// `let kkt = ...?;`: the KKT system at `q` from `mass_matrix` and `contact_jacobian`, of
-    /// the contacts of `active` when `active` (`ContactKkt::new_active`).
-    fn kkt(&self, active: bool) -> TokenStream {
+    /// `let kkt = ...;`, a reference to the KKT system at `q` from `mass_matrix` and
+    /// `contact_jacobian` (of the contacts of `active` when `active`), returning the error
+    /// from the enclosing function when it cannot be factorized. The system lies in the
+    /// caller's frame, set up there by a non-inlined `contact_kkt` (or `contact_kkt_active`)
+    /// with `ContactKkt::set_up`, so that it is neither moved nor held next to the mass matrix
+    /// it is made of.
+    fn kkt(&mut self, active: bool) -> TokenStream {
+        let (n, nq, k) = (self.n.clone(), self.nq.clone(), self.k.clone());
         let (m, j) = (self.call("mass_matrix"), self.call("contact_jacobian"));
-        if active {
-            quote! {
-                let rows = ::eomgen_runtime::contact::row_mask(&Self::CONTACT_ROWS, active);
-                let kkt = ::eomgen_runtime::ContactKkt::new_active(#m(self, q), &Self::PARENTS, #j(self, q), &rows)?;
-            }
+        let kkt_ty = quote!(::eomgen_runtime::ContactKkt<T, #n, #k>);
+        let fill = quote!(|m, j| {
+            *m = #m(self, q);
+            *j = #j(self, q);
+        });
+        let result = quote!(::core::result::Result<(), ::eomgen_runtime::FactorError>);
+        let (helper, call, item) = if active {
+            let c = usize_lit(self.contact_rows.len());
+            (
+                "contact_kkt_active",
+                quote!(self.contact_kkt_active(q, active, &mut kkt)),
+                quote! {
+                    /// Sets `kkt` up for the contacts of `active` at `q`.
+                    #[inline(never)]
+                    fn contact_kkt_active(&self, q: &[T; #nq], active: &[bool; #c], kkt: &mut #kkt_ty) -> #result {
+                        let rows = ::eomgen_runtime::contact::row_mask(&Self::CONTACT_ROWS, active);
+                        kkt.set_up(#fill, &Self::PARENTS, &rows)
+                    }
+                },
+            )
         } else {
-            quote! {
-                let kkt = ::eomgen_runtime::ContactKkt::new(#m(self, q), &Self::PARENTS, #j(self, q))?;
-            }
+            (
+                "contact_kkt",
+                quote!(self.contact_kkt(q, &mut kkt)),
+                quote! {
+                    /// Sets `kkt` up for every contact at `q`.
+                    #[inline(never)]
+                    fn contact_kkt(&self, q: &[T; #nq], kkt: &mut #kkt_ty) -> #result {
+                        kkt.set_up(#fill, &Self::PARENTS, &[true; #k])
+                    }
+                },
+            )
+        };
+        if self.helpers.insert(helper) {
+            self.blocks.push(item);
+        }
+        quote! {
+            let mut kkt = ::eomgen_runtime::ContactKkt::zeroed();
+            #call?;
+            let kkt = &kkt;
         }
     }
 
@@ -217,7 +253,8 @@ impl Emitter<'_> {
         }
     }
 
-    /// `{name}_in_place`, for the inherent impl, which fills the caller's storage for the
+    /// `{name}_in_slot` (not `_in_place`: a split body of `name` has that one), for the
+    /// inherent impl, which fills the caller's storage for the
     /// result of `into` (a fallible `fn(&self, params..., extra, d: &mut ty)`) through
     /// `eomgen_runtime::place`: NaN, and the error in `err`, on failure. Returns its name; it
     /// takes `params..., err, extra, slot`.
@@ -229,7 +266,7 @@ impl Emitter<'_> {
         params: &[TokenStream],
         (param, arg): (&TokenStream, &TokenStream),
     ) -> Ident {
-        let in_place = format_ident!("{}_in_place", name);
+        let in_place = format_ident!("{}_in_slot", name);
         let args: Vec<TokenStream> = params
             .iter()
             .map(|p| {
@@ -272,7 +309,7 @@ impl Emitter<'_> {
     /// variants.
     pub(super) fn impulse_dynamics_fns(&mut self, q: &Quantity, active: bool) -> TokenStream {
         let docs = Self::quantity_doc(q, None);
-        let (n, nq, k) = (&self.n, &self.nq, &self.k);
+        let (n, nq, k) = (self.n.clone(), self.nq.clone(), self.k.clone());
         let kkt = self.kkt(active);
         let s = self.signature(
             q,
