@@ -117,35 +117,36 @@ fn benches() -> Vec<Bench> {
         ];
         b.extend(d);
     }
+    #[cfg(all(contacts, derivatives))]
+    b.extend(contact_derivatives());
     b
 }
 
 /// The bytes of what `f` returns.
+#[cfg(all(contacts, derivatives))]
 fn result_size<R>(_: impl Fn(&Robot<f64>, &State) -> R) -> usize {
     core::mem::size_of::<R>()
 }
 
-/// Every function whose stack is measured: the timed ones, and those with large results that
-/// Pinocchio's benchmark does not time here (the contact and impulse derivatives).
-fn stack_functions() -> Vec<Bench> {
-    #[allow(unused_mut)]
-    let mut b = benches();
-    #[cfg(all(contacts, derivatives))]
-    {
-        let cfd = |r: &Robot<f64>, s: &State| r.contact_forward_dynamics_derivatives(&s.q, &s.v, &s.tau);
-        let idd = |r: &Robot<f64>, s: &State| r.impulse_dynamics_derivatives(&s.q, &s.v, 0.0);
-        b.push((
+/// The contact and impulse derivatives (Pinocchio's `constraintDynamics` +
+/// `computeConstraintDynamicsDerivatives` and `impulseDynamics` +
+/// `computeImpulseDynamicsDerivatives`, restitution 0).
+#[cfg(all(contacts, derivatives))]
+fn contact_derivatives() -> [Bench; 2] {
+    let cfd = |r: &Robot<f64>, s: &State| r.contact_forward_dynamics_derivatives(&s.q, &s.v, &s.tau);
+    let idd = |r: &Robot<f64>, s: &State| r.impulse_dynamics_derivatives(&s.q, &s.v, 0.0);
+    [
+        (
             "contact_forward_dynamics_derivatives",
             |r, s| r.contact_forward_dynamics_derivatives(&s.q, &s.v, &s.tau).da_dq[0][0],
             result_size(cfd),
-        ));
-        b.push((
+        ),
+        (
             "impulse_dynamics_derivatives",
             |r, s| r.impulse_dynamics_derivatives(&s.q, &s.v, 0.0).dv_dq[0][0],
             result_size(idd),
-        ));
-    }
-    b
+        ),
+    ]
 }
 
 /// pinbench's figure: the median over `repeats` of the mean ns per call over `calls` calls.
@@ -191,7 +192,7 @@ fn stack_use(f: &(dyn Fn() + Sync)) -> usize {
 /// Per function: the stack it uses below its caller, its result excluded (the caller's), and the
 /// result's bytes.
 fn stack(r: &Robot<f64>, states: &[State]) {
-    for (name, f, result) in stack_functions() {
+    for (name, f, result) in benches() {
         let s = &states[0];
         let bytes = std::thread::scope(|scope| {
             std::thread::Builder::new()
@@ -209,7 +210,7 @@ fn stack(r: &Robot<f64>, states: &[State]) {
 
 /// Runs `name` in a thread of `bytes` of stack plus its result's.
 fn run_on_stack(r: &Robot<f64>, states: &[State], bytes: usize, name: &str) {
-    let (_, f, result) = stack_functions()
+    let (_, f, result) = benches()
         .into_iter()
         .find(|(n, _, _)| *n == name)
         .unwrap_or_else(|| panic!("no function {name}"));
