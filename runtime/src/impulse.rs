@@ -61,14 +61,14 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
         for x in d.dimpulse_dv.iter_mut().flatten() {
             *x *= k;
         }
+        // I + Y dp/dv, each row gathered in a local accumulator.
         for (i, row) in d.dv_dv.iter_mut().enumerate() {
-            row.iter_mut().for_each(|x| *x = T::zero());
-            row[i] = T::one();
-        }
-        for (yk, pk) in self.inverse_inertia_rows().iter().zip(&d.dimpulse_dv) {
-            for (row, yki) in d.dv_dv.iter_mut().zip(yk) {
-                axpy(row, *yki, pk);
+            let mut acc = [T::zero(); N];
+            acc[i] = T::one();
+            for (yk, pk) in self.inverse_inertia_rows().iter().zip(&d.dimpulse_dv) {
+                axpy(&mut acc, yk[i], pk);
             }
+            *row = acc;
         }
         finite_rows(&d.dv_dq, 0)?;
         finite_rows(&d.dv_dv, 0)?;

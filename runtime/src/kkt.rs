@@ -17,7 +17,7 @@
 //! columns. Everything lives in fixed-size arrays on the stack.
 
 use crate::linalg::{Cholesky, FactorError};
-use crate::tree::{ltdl_factor, ltdl_substitute};
+use crate::tree::{ltdl_factor, ltdl_substitute, ltdl_substitute_rows};
 use crate::Real;
 
 /// The derivatives of contact forward dynamics (`contact_forward_dynamics_derivatives`), as
@@ -231,14 +231,23 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
         fill(&mut self.factors, &mut self.j);
         self.parent = *parent;
         self.active = *active;
-        let m = &mut self.factors;
-        ltdl_factor(m, parent)?;
-        for ((yk, jk), on) in self.y.iter_mut().zip(self.j.iter_mut()).zip(active) {
-            if *on {
-                *yk = ltdl_substitute(m, parent, jk);
-            } else {
+        ltdl_factor(&mut self.factors, parent)?;
+        for (jk, on) in self.j.iter_mut().zip(active) {
+            if !*on {
                 *jk = [T::zero(); N];
-                *yk = [T::zero(); N];
+            }
+        }
+        // Y^T = M^-1 J^T, all K columns in one substitution.
+        let mut yt = [[T::zero(); K]; N];
+        for (i, row) in yt.iter_mut().enumerate() {
+            for (x, jk) in row.iter_mut().zip(&self.j) {
+                *x = jk[i];
+            }
+        }
+        ltdl_substitute_rows(&self.factors, parent, &mut yt);
+        for (k, yk) in self.y.iter_mut().enumerate() {
+            for (y, row) in yk.iter_mut().zip(&yt) {
+                *y = row[k];
             }
         }
         let mut lambda = [[T::zero(); K]; K];
@@ -314,35 +323,46 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
                 *fk = [T::zero(); C];
                 continue;
             }
+            // Each row gathered in a local accumulator (kept in registers), not updated in
+            // memory once per term: that form was vectorized across rows, with gathers.
+            let mut acc = *fk;
             for (jki, xi) in jk.iter().zip(x.iter()) {
-                axpy(fk, -*jki, xi);
+                axpy(&mut acc, -*jki, xi);
             }
+            *fk = acc;
         }
         self.lambda_solve_columns(f);
-        // X += Y F
-        for (yk, fk) in self.y.iter().zip(f.iter()) {
-            for (xi, yki) in x.iter_mut().zip(yk) {
-                axpy(xi, *yki, fk);
+        // X += Y F, row by row likewise.
+        for (i, xi) in x.iter_mut().enumerate() {
+            let mut acc = *xi;
+            for (yk, fk) in self.y.iter().zip(f.iter()) {
+                axpy(&mut acc, yk[i], fk);
             }
+            *xi = acc;
         }
     }
 
     /// `(J M^-1 J^T)^-1 B` for the K x C matrix `B`, in place.
     pub fn lambda_solve_columns<const C: usize>(&self, b: &mut [[T; C]; K]) {
         let l = self.lambda.l();
-        for i in 0..K {
-            for k in 0..i {
-                let (done, rest) = b.split_at_mut(i);
-                axpy(&mut rest[0], -l[i][k], &done[k]);
+        // L y = b, then L^T x = y, each row gathered in a local accumulator.
+        for (i, li) in l.iter().enumerate() {
+            let (done, rest) = b.split_at_mut(i);
+            let mut acc = rest[0];
+            for (lik, bk) in li.iter().zip(done.iter()) {
+                axpy(&mut acc, -*lik, bk);
             }
-            scale(&mut b[i], T::one() / l[i][i]);
+            scale(&mut acc, T::one() / li[i]);
+            rest[0] = acc;
         }
         for i in (0..K).rev() {
             let (head, tail) = b.split_at_mut(i + 1);
+            let mut acc = head[i];
             for (lk, bk) in l[i + 1..].iter().zip(tail.iter()) {
-                axpy(&mut head[i], -lk[i], bk);
+                axpy(&mut acc, -lk[i], bk);
             }
-            scale(&mut b[i], T::one() / l[i][i]);
+            scale(&mut acc, T::one() / l[i][i]);
+            head[i] = acc;
         }
     }
 
@@ -379,7 +399,7 @@ pub(crate) fn dot<T: Real, const N: usize>(a: &[T; N], b: &[T; N]) -> T {
 /// `y += a x`.
 pub(crate) fn axpy<T: Real, const C: usize>(y: &mut [T; C], a: T, x: &[T; C]) {
     for (yi, xi) in y.iter_mut().zip(x) {
-        *yi += a * *xi;
+        *yi = a.mul_add(*xi, *yi);
     }
 }
 

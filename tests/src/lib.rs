@@ -426,23 +426,23 @@ pub mod robots {
 pub mod alloc_counter {
     use std::alloc::{GlobalAlloc, Layout, System};
     use std::cell::Cell;
-    use std::sync::atomic::{AtomicUsize, Ordering};
 
     /// Forwards to the system allocator and counts, on threads that are measuring.
     pub struct Counting;
 
-    static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
-
     thread_local! {
-        // Only this thread's allocations count: the test harness allocates on its own threads.
+        // Only this thread's allocations count, in this thread's counter: the test harness
+        // allocates on its own threads, and tests counting on two threads at once must not see
+        // each other's allocations.
         static COUNTING: Cell<bool> = const { Cell::new(false) };
+        static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
     }
 
     // SAFETY: forwards every call unchanged to the system allocator; only counts.
     unsafe impl GlobalAlloc for Counting {
         unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
             if COUNTING.with(Cell::get) {
-                ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+                ALLOCATIONS.with(|n| n.set(n.get() + 1));
             }
             unsafe { System.alloc(layout) }
         }
@@ -451,17 +451,17 @@ pub mod alloc_counter {
         }
         unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
             if COUNTING.with(Cell::get) {
-                ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+                ALLOCATIONS.with(|n| n.set(n.get() + 1));
             }
             unsafe { System.realloc(ptr, layout, new_size) }
         }
     }
     /// Allocations made by `f` on this thread (needs [`Counting`] as the global allocator).
     pub fn allocations(f: impl FnOnce()) -> usize {
-        let before = ALLOCATIONS.load(Ordering::SeqCst);
+        let before = ALLOCATIONS.with(Cell::get);
         COUNTING.with(|c| c.set(true));
         f();
         COUNTING.with(|c| c.set(false));
-        ALLOCATIONS.load(Ordering::SeqCst) - before
+        ALLOCATIONS.with(Cell::get) - before
     }
 }
