@@ -112,7 +112,8 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dimensions for AllegroRightHan
     clippy::identity_op,
     clippy::needless_range_loop,
     clippy::let_and_return,
-    clippy::type_complexity
+    clippy::type_complexity,
+    clippy::too_many_arguments
 )]
 impl<T: ::eomgen_runtime::Real> AllegroRightHand<T> {
     /// Each coordinate's parent coordinate (`None`: the root), parents first: the
@@ -11709,7 +11710,8 @@ impl<T: ::eomgen_runtime::Real> AllegroRightHand<T> {
     clippy::identity_op,
     clippy::needless_range_loop,
     clippy::let_and_return,
-    clippy::type_complexity
+    clippy::type_complexity,
+    clippy::too_many_arguments
 )]
 impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 16>
 for AllegroRightHand<T> {

@@ -58,7 +58,8 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dimensions for DoublePendulum<
     clippy::identity_op,
     clippy::needless_range_loop,
     clippy::let_and_return,
-    clippy::type_complexity
+    clippy::type_complexity,
+    clippy::too_many_arguments
 )]
 impl<T: ::eomgen_runtime::Real> DoublePendulum<T> {
     /// Each coordinate's parent coordinate (`None`: the root), parents first: the
@@ -608,7 +609,8 @@ impl<T: ::eomgen_runtime::Real> DoublePendulum<T> {
     clippy::identity_op,
     clippy::needless_range_loop,
     clippy::let_and_return,
-    clippy::type_complexity
+    clippy::type_complexity,
+    clippy::too_many_arguments
 )]
 impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 2> for DoublePendulum<T> {
     const JOINT_NAMES: [&'static str; 2] = ["joint1", "joint2"];

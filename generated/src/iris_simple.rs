@@ -76,7 +76,8 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dimensions for IrisSimple<T> {
     clippy::identity_op,
     clippy::needless_range_loop,
     clippy::let_and_return,
-    clippy::type_complexity
+    clippy::type_complexity,
+    clippy::too_many_arguments
 )]
 impl<T: ::eomgen_runtime::Real> IrisSimple<T> {
     /// Each coordinate's parent coordinate (`None`: the root), parents first: the
@@ -1251,7 +1252,8 @@ impl<T: ::eomgen_runtime::Real> IrisSimple<T> {
     clippy::identity_op,
     clippy::needless_range_loop,
     clippy::let_and_return,
-    clippy::type_complexity
+    clippy::type_complexity,
+    clippy::too_many_arguments
 )]
 impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::FloatingDynamics<T, 7, 6>
 for IrisSimple<T> {

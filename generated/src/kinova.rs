@@ -88,7 +88,8 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dimensions for Kinova<T> {
     clippy::identity_op,
     clippy::needless_range_loop,
     clippy::let_and_return,
-    clippy::type_complexity
+    clippy::type_complexity,
+    clippy::too_many_arguments
 )]
 impl<T: ::eomgen_runtime::Real> Kinova<T> {
     /// Each coordinate's parent coordinate (`None`: the root), parents first: the
@@ -10323,7 +10324,8 @@ impl<T: ::eomgen_runtime::Real> Kinova<T> {
     clippy::identity_op,
     clippy::needless_range_loop,
     clippy::let_and_return,
-    clippy::type_complexity
+    clippy::type_complexity,
+    clippy::too_many_arguments
 )]
 impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 6> for Kinova<T> {
     const JOINT_NAMES: [&'static str; 6] = [

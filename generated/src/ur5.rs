@@ -82,7 +82,8 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dimensions for Ur5<T> {
     clippy::identity_op,
     clippy::needless_range_loop,
     clippy::let_and_return,
-    clippy::type_complexity
+    clippy::type_complexity,
+    clippy::too_many_arguments
 )]
 impl<T: ::eomgen_runtime::Real> Ur5<T> {
     /// Each coordinate's parent coordinate (`None`: the root), parents first: the
@@ -4315,7 +4316,8 @@ impl<T: ::eomgen_runtime::Real> Ur5<T> {
     clippy::identity_op,
     clippy::needless_range_loop,
     clippy::let_and_return,
-    clippy::type_complexity
+    clippy::type_complexity,
+    clippy::too_many_arguments
 )]
 impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
     const JOINT_NAMES: [&'static str; 6] = [

@@ -42,7 +42,7 @@ pub struct EmitOptions {
 
 /// The lints generated code may trip: long literals, `x * -1.0` and the like.
 fn allow_lints() -> TokenStream {
-    quote!(#[allow(unused_variables, clippy::approx_constant, clippy::excessive_precision, clippy::unreadable_literal, clippy::neg_multiply, clippy::double_parens, clippy::identity_op, clippy::needless_range_loop, clippy::let_and_return, clippy::type_complexity)])
+    quote!(#[allow(unused_variables, clippy::approx_constant, clippy::excessive_precision, clippy::unreadable_literal, clippy::neg_multiply, clippy::double_parens, clippy::identity_op, clippy::needless_range_loop, clippy::let_and_return, clippy::type_complexity, clippy::too_many_arguments)])
 }
 
 fn doc(lines: &[String]) -> TokenStream {
@@ -480,7 +480,9 @@ impl Emitter<'_> {
     /// Straight-line code for `outputs`, counted under `q`'s name.
     fn straight(&mut self, q: &Quantity, outputs: &[Id], shape: Shape) -> (TokenStream, OpCount) {
         let (params, args) = (self.args(q.inputs), Self::arg_names(q.inputs));
-        let split = self.split(q.name, &params, &args);
+        let rows = Self::row_groups(q.name, shape);
+        let mut split = self.split(q.name, &params, &args);
+        split.rows = &rows;
         let b = body(self.graph, &self.cx, outputs, shape, Some(&split));
         self.counts.push((q.name.to_string(), b.ops));
         if !b.blocks.is_empty() {
@@ -497,6 +499,17 @@ impl Emitter<'_> {
             params,
             args,
             budget: self.budget,
+            rows: &[],
+        }
+    }
+
+    /// The row groups a split body of `name` fills separately ([`Split::rows`]): the impulse
+    /// partials' `N` rows in `q` and `K` contact rows, which `impulse_dynamics_derivatives`
+    /// has written straight into two matrices of its result.
+    fn row_groups(name: &str, shape: Shape) -> Vec<usize> {
+        match (name, shape) {
+            ("impulse_dynamics_partials", Shape::Matrix(r, c)) if r > c => vec![c, r - c],
+            _ => Vec::new(),
         }
     }
 

@@ -23,7 +23,7 @@
 use std::collections::{BTreeMap, BTreeSet};
 
 use proc_macro2::{Ident, Literal, TokenStream};
-use quote::{format_ident, quote};
+use quote::{format_ident, quote, ToTokens};
 
 use super::body::{chunked_lets, filled, shape_type, trig_lets};
 use super::expr::Ctx;
@@ -40,6 +40,10 @@ pub(super) struct Split<'a> {
     pub args: &'a [Ident],
     /// The most operations one block may hold (a block holds at least one temporary).
     pub budget: usize,
+    /// For a [`Shape::Matrix`] result, consecutive groups of its rows that `{name}_fill` takes
+    /// as separate matrices (`o0`, `o1`, ...), so that a caller can have them written into
+    /// different places; empty: the whole matrix (`o`).
+    pub rows: &'a [usize],
 }
 
 /// A value crossing blocks: a temporary or a joint angle's sine or cosine.
@@ -188,7 +192,7 @@ pub(super) fn split_body(
         temps_read(e, &mut read);
         let b = read.iter().map(|&t| of_temp[t]).max().unwrap_or(0);
         let ts = cx.expr(e, &mut blocks[b].trig).ts;
-        let place = output_place(shape, j);
+        let place = output_place(shape, j, split.rows);
         blocks[b].code.push(quote!(#place = #ts;));
         blocks[b].reads.extend(earlier_temps(e, b, &of_temp));
     }
@@ -223,7 +227,7 @@ fn drive(
     shape: Shape,
 ) -> (TokenStream, Vec<TokenStream>) {
     let (args, params) = (split.args, split.params);
-    let (outs, out_params) = out_params(shape);
+    let (outs, out_params) = out_params(shape, split.rows);
     let calls = (0..count).map(|b| {
         let f = block_name(split.name, b);
         quote!(self.#f(#(#args,)* &mut w, #(#outs),*);)
@@ -255,16 +259,17 @@ fn drive(
     }
     let in_place = format_ident!("{}_in_place", split.name);
     let ret = shape_type(shape);
-    let bind = match shape {
-        Shape::Matrices(..) => quote!(let (#(#outs),*) = o;),
-        _ => TokenStream::new(),
+    let call = quote!(self.#fill(#(#args,)* #(#outs),*););
+    let fill_call = match shape {
+        Shape::Matrices(..) => quote!(let (#(#outs),*) = o; #call),
+        Shape::Matrix(..) if !split.rows.is_empty() => row_groups(split.rows, call),
+        _ => call,
     };
     let in_place_fn = quote! {
         #[inline(never)]
         fn #in_place<'b>(&self, #(#params,)* slot: ::eomgen_runtime::place::Slot<'b, #ret>) -> ::eomgen_runtime::place::Filled<'b> {
             let (o, filled) = slot.fill();
-            #bind
-            self.#fill(#(#args,)* #(#outs),*);
+            #fill_call
             filled
         }
     };
@@ -288,9 +293,38 @@ pub(super) fn fill_name(name: &str) -> Ident {
     format_ident!("{}_fill", name)
 }
 
+/// `call` with `o0`, `o1`, ... bound to the consecutive groups of `rows` rows of the matrix
+/// `o` (`split_first_chunk_mut`, which cannot fail here: the groups sum to its rows).
+fn row_groups(rows: &[usize], call: TokenStream) -> TokenStream {
+    rows.iter().enumerate().rev().fold(call, |inner, (g, &n)| {
+        let (o, n) = (format_ident!("o{}", g), Literal::usize_unsuffixed(n));
+        let rest = if g == 0 {
+            quote!(o)
+        } else {
+            format_ident!("rest{}", g - 1).into_token_stream()
+        };
+        let next = format_ident!("rest{}", g);
+        quote! {
+            if let Some((#o, #next)) = #rest.split_first_chunk_mut::<#n>() {
+                let _ = &#next;
+                #inner
+            }
+        }
+    })
+}
+
 /// The output parameters of blocks and of `{name}_fill`: their names and declarations.
-fn out_params(shape: Shape) -> (Vec<Ident>, Vec<TokenStream>) {
+fn out_params(shape: Shape, rows: &[usize]) -> (Vec<Ident>, Vec<TokenStream>) {
     match shape {
+        Shape::Matrix(_, c) if !rows.is_empty() => rows
+            .iter()
+            .enumerate()
+            .map(|(g, &n)| {
+                let one = shape_type(Shape::Matrix(n, c));
+                let o = format_ident!("o{}", g);
+                (o.clone(), quote!(#o: &mut #one))
+            })
+            .unzip(),
         Shape::Matrices(k, r, c) => {
             let one = shape_type(Shape::Matrix(r, c));
             (0..k)
@@ -417,7 +451,10 @@ fn block_fn(
     });
     let code = &block.code;
     let (name, params) = (block_name(split.name, b), split.params);
-    let (width, (_, outs)) = (Literal::usize_unsuffixed(width), out_params(shape));
+    let (width, (_, outs)) = (
+        Literal::usize_unsuffixed(width),
+        out_params(shape, split.rows),
+    );
     quote! {
         #[inline(never)]
         fn #name(&self, #(#params,)* w: &mut [T; #width], #(#outs),*) {
@@ -430,9 +467,19 @@ fn block_fn(
 }
 
 /// Where flat output `j` of a result of `shape` goes in `o`.
-fn output_place(shape: Shape, j: usize) -> TokenStream {
+fn output_place(shape: Shape, j: usize, rows: &[usize]) -> TokenStream {
     let lit = Literal::usize_unsuffixed;
     match shape {
+        Shape::Matrix(_, c) if !rows.is_empty() => {
+            let (mut i, col) = (j / c, lit(j % c));
+            let mut g = 0;
+            while g + 1 < rows.len() && i >= rows[g] {
+                i -= rows[g];
+                g += 1;
+            }
+            let (o, i) = (format_ident!("o{}", g), lit(i));
+            quote!(#o[#i][#col])
+        }
         Shape::Scalar => quote!(*o),
         Shape::Vector(_) => {
             let j = lit(j);

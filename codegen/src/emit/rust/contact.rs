@@ -358,6 +358,16 @@ impl Emitter<'_> {
         );
         let (name, try_name, param, arg, why) = (&s.name, &s.try_name, &s.param, &s.arg, &s.why);
         let ty = quote!(::eomgen_runtime::ImpulseDynamicsDerivatives<T, #n, #k>);
+        // Split, the partials' blocks write their two row groups straight into `d`.
+        let set_partials = if self.split.contains("impulse_dynamics_partials") {
+            let fill = crate::emit::split::fill_name("impulse_dynamics_partials");
+            quote! {
+                self.#fill(q, w, jump, p, &mut d.dv_dq, &mut d.dimpulse_dq);
+                Ok(())
+            }
+        } else {
+            quote!(d.set_partials(&#partials(self, q, w, jump, p)))
+        };
         let (into, stage) = (
             format_ident!("{}_into", name),
             format_ident!("{}_partials", name),
@@ -376,7 +386,7 @@ impl Emitter<'_> {
             /// The partials set in `d` in a frame of their own.
             #[inline(never)]
             fn #stage(&self, q: &[T; #nq], w: &[T; #n], jump: &[T; #n], p: &[T; #k], d: &mut #ty) -> ::core::result::Result<(), ::eomgen_runtime::FactorError> {
-                d.set_partials(&#partials(self, q, w, jump, p))
+                #set_partials
             }
         });
         let in_place = self.fill_in_place(
