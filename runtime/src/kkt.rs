@@ -16,6 +16,7 @@
 //! ([`ContactKkt::solve_columns`]), row by row so that the inner loops run over contiguous
 //! columns. Everything lives in fixed-size arrays on the stack.
 
+pub(crate) use crate::linalg::axpy;
 use crate::linalg::{Cholesky, FactorError};
 use crate::tree::{ltdl_factor, ltdl_substitute, ltdl_substitute_rows};
 use crate::Real;
@@ -394,13 +395,6 @@ pub(crate) fn dot<T: Real, const N: usize>(a: &[T; N], b: &[T; N]) -> T {
         s += *x * *y;
     }
     s
-}
-
-/// `y += a x`.
-pub(crate) fn axpy<T: Real, const C: usize>(y: &mut [T; C], a: T, x: &[T; C]) {
-    for (yi, xi) in y.iter_mut().zip(x) {
-        *yi = a.mul_add(*xi, *yi);
-    }
 }
 
 fn scale<T: Real, const C: usize>(y: &mut [T; C], a: T) {

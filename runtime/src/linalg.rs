@@ -10,6 +10,15 @@
 use crate::Real;
 use core::fmt;
 
+/// `y += a x`, entry by entry, fused: the row operation of the tree and contact solves, which
+/// keep `y` in a local accumulator (registers) while they gather into it.
+#[inline(always)]
+pub(crate) fn axpy<T: Real, const C: usize>(y: &mut [T; C], a: T, x: &[T; C]) {
+    for (yi, xi) in y.iter_mut().zip(x) {
+        *yi = a.mul_add(*xi, *yi);
+    }
+}
+
 /// Why a matrix could not be factorized.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum FactorError {

@@ -6,6 +6,7 @@
 //! straight-line code, the joint axes, the chains from the root); the loops here are the same
 //! for every robot, so a 48-joint robot costs no more code than its joints.
 
+use crate::linalg::axpy;
 use crate::{FactorError, Pose, Real};
 
 /// How a joint moves its body, for Jacobian columns.
@@ -442,7 +443,7 @@ fn pull_from_subtrees<T: Real, const N: usize, const C: usize, const SPARSE: boo
             if below && SPARSE {
                 sub_scaled_chunks(&mut acc, &x[k], m[k][a], k..ends[k]);
             } else if below {
-                sub_scaled_row(&mut acc, &x[k], m[k][a]);
+                axpy(&mut acc, -m[k][a], &x[k]);
             }
         }
         x[a] = acc;
@@ -471,7 +472,7 @@ fn pull_from_ancestors<T: Real, const N: usize, const C: usize, const UPPER: boo
             if UPPER {
                 sub_scaled_chunks(&mut acc, row, m[i][aa], i..C);
             } else {
-                sub_scaled_row(&mut acc, row, m[i][aa]);
+                axpy(&mut acc, -m[i][aa], row);
             }
             a = parent.get(aa).copied().flatten();
         }
@@ -482,7 +483,7 @@ fn pull_from_ancestors<T: Real, const N: usize, const C: usize, const UPPER: boo
 /// Columns per chunk of [`sub_scaled_chunks`]: a vector register of `f64` with AVX-512.
 const CHUNK: usize = 8;
 
-/// [`sub_scaled_row`] on the chunks of [`CHUNK`] columns that overlap `columns` only (a loop of
+/// `acc -= k row` ([`axpy`]) on the chunks of [`CHUNK`] columns that overlap `columns` only (a loop of
 /// constant length, so that the compiler still unrolls it and keeps `acc` in registers).
 #[inline(always)]
 fn sub_scaled_chunks<T: Real, const C: usize>(
@@ -499,15 +500,6 @@ fn sub_scaled_chunks<T: Real, const C: usize>(
                 acc[j] = k.mul_add(row[j], acc[j]);
             }
         }
-    }
-}
-
-/// `acc -= k row`, entry by entry (the compiler vectorizes it and keeps `acc` in registers).
-#[inline(always)]
-fn sub_scaled_row<T: Real, const C: usize>(acc: &mut [T; C], row: &[T; C], k: T) {
-    let k = -k;
-    for (x, y) in acc.iter_mut().zip(row) {
-        *x = k.mul_add(*y, *x);
     }
 }
 

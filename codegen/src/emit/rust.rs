@@ -860,17 +860,7 @@ impl Emitter<'_> {
         let (n, nq) = (&self.n, &self.nq);
         let id = self.call("inverse_dynamics");
         let mass_matrix = self.call("mass_matrix");
-        let id_derivatives = if self.split.contains("inverse_dynamics_derivatives") {
-            let fill = super::split::fill_name("inverse_dynamics_derivatives");
-            quote!(self.#fill(q, qd, &qdd, dq, dqd);)
-        } else {
-            debug_assert!(self
-                .counts
-                .iter()
-                .any(|(c, _)| c == "inverse_dynamics_derivatives"));
-            let f = self.call("inverse_dynamics_derivatives");
-            quote!((*dq, *dqd) = #f(self, q, qd, &qdd);)
-        };
+        let id_derivatives = self.id_derivatives_into(quote!(*dq), quote!(*dqd), quote!(qdd));
         let matrix = quote!([[T; #n]; #n]);
         self.blocks.push(quote! {
             #[inline(never)]
@@ -921,6 +911,29 @@ impl Emitter<'_> {
             }
             Self::ltdl_factor_unrolled(&mut m)?;
             let free = Self::ltdl_substitute_unrolled(&m, &rhs);
+        }
+    }
+
+    /// Statements writing `inverse_dynamics_derivatives` at `(q, qd, &qdd)` into the places
+    /// `dq` and `dqd` (of type `[[T; N]; N]`): through its `_fill` method when its body was
+    /// split, so that it is not built in a local and copied. It is emitted before the
+    /// quantities that call this (catalogue order).
+    fn id_derivatives_into(
+        &self,
+        dq: TokenStream,
+        dqd: TokenStream,
+        qdd: TokenStream,
+    ) -> TokenStream {
+        if self.split.contains("inverse_dynamics_derivatives") {
+            let fill = super::split::fill_name("inverse_dynamics_derivatives");
+            quote!(self.#fill(q, qd, &#qdd, &mut #dq, &mut #dqd);)
+        } else {
+            debug_assert!(self
+                .counts
+                .iter()
+                .any(|(c, _)| c == "inverse_dynamics_derivatives"));
+            let f = self.call("inverse_dynamics_derivatives");
+            quote!((#dq, #dqd) = #f(self, q, qd, &#qdd);)
         }
     }
 

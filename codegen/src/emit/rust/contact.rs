@@ -190,7 +190,7 @@ impl Emitter<'_> {
         let s = self.signature(q, active, ("The derivatives of", ", or why they do not"));
         let (name, try_name, param, arg, why) = (&s.name, &s.try_name, &s.param, &s.arg, &s.why);
         let drift = self.call("contact_drift");
-        let id_derivatives = self.id_derivatives_into(quote!(d.da_dq), quote!(d.da_dv));
+        let id_derivatives = self.id_derivatives_into(quote!(d.da_dq), quote!(d.da_dv), quote!(a));
         let partials = self.call("contact_dynamics_partials");
         let ty = quote!(::eomgen_runtime::ContactDynamicsDerivatives<T, #n, #k>);
         let (into, stage) = (
@@ -220,19 +220,17 @@ impl Emitter<'_> {
                 d.add_partials(&#partials(self, q, qd, a, f))
             }
         });
-        let in_place = self.fill_in_place(
+        let (with_err, without) = self.fill_in_place(
             name,
             &into,
             &ty,
             &[
-                quote!(q: &[T; #nq]),
-                quote!(qd: &[T; #n]),
-                quote!(tau: &[T; #n]),
+                ("q", quote!(&[T; #nq])),
+                ("qd", quote!(&[T; #n])),
+                ("tau", quote!(&[T; #n])),
             ],
             (param, arg),
         );
-        let build = |err: TokenStream| quote!(::eomgen_runtime::place::build(|slot| self.#in_place(q, qd, tau, #err #arg, slot)));
-        let (with_err, without) = (build(quote!(&mut err)), build(quote!(&mut None)));
         quote! {
             #[doc = #why]
             /// exist: a pivot of M(q) (`pivot` < N) or of `J_c M^-1 J_c^T` (`pivot` - N, a
@@ -254,29 +252,24 @@ impl Emitter<'_> {
     }
 
     /// `{name}_in_slot` (not `_in_place`: a split body of `name` has that one), for the
-    /// inherent impl, which fills the caller's storage for the
-    /// result of `into` (a fallible `fn(&self, params..., extra, d: &mut ty)`) through
-    /// `eomgen_runtime::place`: NaN, and the error in `err`, on failure. Returns its name; it
-    /// takes `params..., err, extra, slot`.
+    /// inherent impl, which fills the caller's storage for the result of `into` (a fallible
+    /// `fn(&self, params..., extra, d: &mut ty)`) through `eomgen_runtime::place`: NaN, and the
+    /// error in `err`, on failure. `params` are `(name, type)`. Returns the calls of it for the
+    /// `try_` method (the error in a local `err`) and for the plain one.
     fn fill_in_place(
         &mut self,
         name: &Ident,
         into: &Ident,
         ty: &TokenStream,
-        params: &[TokenStream],
+        params: &[(&str, TokenStream)],
         (param, arg): (&TokenStream, &TokenStream),
-    ) -> Ident {
+    ) -> (TokenStream, TokenStream) {
         let in_place = format_ident!("{}_in_slot", name);
-        let args: Vec<TokenStream> = params
-            .iter()
-            .map(|p| {
-                let name = p.clone().into_iter().next();
-                quote!(#name)
-            })
-            .collect();
+        let args: Vec<Ident> = params.iter().map(|(n, _)| format_ident!("{}", n)).collect();
+        let decls = params.iter().zip(&args).map(|((_, t), a)| quote!(#a: #t));
         self.blocks.push(quote! {
             #[inline(never)]
-            fn #in_place<'b>(&self, #(#params,)* err: &mut ::core::option::Option<::eomgen_runtime::FactorError> #param, slot: ::eomgen_runtime::place::Slot<'b, #ty>) -> ::eomgen_runtime::place::Filled<'b> {
+            fn #in_place<'b>(&self, #(#decls,)* err: &mut ::core::option::Option<::eomgen_runtime::FactorError> #param, slot: ::eomgen_runtime::place::Slot<'b, #ty>) -> ::eomgen_runtime::place::Filled<'b> {
                 let (d, filled) = slot.fill();
                 if let Err(e) = self.#into(#(#args),* #arg, d) {
                     d.fill_nan();
@@ -285,24 +278,8 @@ impl Emitter<'_> {
                 filled
             }
         });
-        in_place
-    }
-
-    /// Statements writing `inverse_dynamics_derivatives` at `(q, qd, &a)` into the matrices
-    /// `dq` and `dqd` (places of type `[[T; N]; N]`): through its `_fill` method when its body
-    /// was split, so that it is not built in a local and copied.
-    fn id_derivatives_into(&self, dq: TokenStream, dqd: TokenStream) -> TokenStream {
-        if self.split.contains("inverse_dynamics_derivatives") {
-            let fill = crate::emit::split::fill_name("inverse_dynamics_derivatives");
-            quote!(self.#fill(q, qd, &a, &mut #dq, &mut #dqd);)
-        } else {
-            debug_assert!(self
-                .counts
-                .iter()
-                .any(|(c, _)| c == "inverse_dynamics_derivatives"));
-            let f = self.call("inverse_dynamics_derivatives");
-            quote!((#dq, #dqd) = #f(self, q, qd, &a);)
-        }
+        let build = |err: TokenStream| quote!(::eomgen_runtime::place::build(|slot| self.#in_place(#(#args,)* #err #arg, slot)));
+        (build(quote!(&mut err)), build(quote!(&mut None)))
     }
 
     /// `try_impulse_dynamics` and `impulse_dynamics` (NaN on failure), or their `_active`
@@ -389,19 +366,17 @@ impl Emitter<'_> {
                 #set_partials
             }
         });
-        let in_place = self.fill_in_place(
+        let (with_err, without) = self.fill_in_place(
             name,
             &into,
             &ty,
             &[
-                quote!(q: &[T; #nq]),
-                quote!(qd: &[T; #n]),
-                quote!(restitution: T),
+                ("q", quote!(&[T; #nq])),
+                ("qd", quote!(&[T; #n])),
+                ("restitution", quote!(T)),
             ],
             (param, arg),
         );
-        let build = |err: TokenStream| quote!(::eomgen_runtime::place::build(|slot| self.#in_place(q, qd, restitution, #err #arg, slot)));
-        let (with_err, without) = (build(quote!(&mut err)), build(quote!(&mut None)));
         quote! {
             #[doc = #why]
             /// `try_impulse_dynamics`).
