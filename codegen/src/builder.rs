@@ -609,7 +609,7 @@ impl Builder {
     /// quantities evaluated at any state ([`crate::evaluate`]).
     ///
     /// ```
-    /// let derived = eomgen::Builder::new("../generated/robots/double_pendulum.urdf")
+    /// let derived = eomgen::Builder::new("../tests/robots/double_pendulum.urdf")
     ///     .derived()
     ///     .unwrap();
     /// let state = eomgen::evaluate::State::at_rest(vec![0.1, 0.2], 2);
