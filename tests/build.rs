@@ -7,8 +7,44 @@
 mod chain;
 
 fn main() {
-    // Bad-input robots: an ill-conditioned mass matrix, and names that try to break out of
-    // comments and strings (compiled for real here, with rustc's default lints).
+    // Independent of each other, so run on every core (the largest first): after a change to
+    // eomgen, this script is on the path of every test of the crate.
+    run_parallel(&[
+        contact_dynamics,
+        derivatives,
+        floating,
+        mimic,
+        split,
+        regressors,
+        joint_effects,
+        deep_chain,
+        underactuated,
+        mpc_kinematics,
+        bad_input,
+        selected,
+    ]);
+}
+
+/// Runs each of `parts` once, on as many threads as the machine has cores; a panic in one is
+/// the build script's.
+fn run_parallel(parts: &[fn()]) {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    let next = AtomicUsize::new(0);
+    let workers = std::thread::available_parallelism().map_or(1, |n| n.get());
+    std::thread::scope(|s| {
+        for _ in 0..workers.min(parts.len()) {
+            s.spawn(|| {
+                while let Some(part) = parts.get(next.fetch_add(1, Ordering::Relaxed)) {
+                    part();
+                }
+            });
+        }
+    });
+}
+
+/// Bad-input robots: an ill-conditioned mass matrix, and names that try to break out of
+/// comments and strings (compiled for real here, with rustc's default lints).
+fn bad_input() {
     for (file, module, ty) in [
         ("urdf/light_tip.urdf", "light_tip", "LightTip"),
         (
@@ -23,18 +59,11 @@ fn main() {
             .compile()
             .unwrap();
     }
-    joint_effects();
-    // What a firmware that needs inverse dynamics alone generates (plus Craig's B, which
-    // brings the Coriolis matrix it loops over).
-    deep_chain();
-    derivatives();
-    floating();
-    contact_dynamics();
-    regressors();
-    underactuated();
-    mimic();
-    split();
-    mpc_kinematics();
+}
+
+/// What a firmware that needs inverse dynamics alone generates (plus Craig's B, which brings
+/// the Coriolis matrix it loops over).
+fn selected() {
     eomgen::Builder::new("robots/panda.urdf")
         .module_name("panda_selected")
         .type_name("PandaSelected")
