@@ -34,9 +34,10 @@ use crate::dynamics::regressor::Owner;
 use crate::dynamics::Derivation;
 use crate::model::Model;
 
-use super::{
-    aligned, describe_param, kind_name, md_escape, style_of, tex_escape, value_source, vec3,
-};
+use super::document::{describe_param, kind_name, value_source, vec3};
+use super::latex::{align, aligned, tex_escape};
+use super::markdown::md_escape;
+use super::style_of;
 use super::{Format, ReportError, ShowOptions};
 
 /// Numeric coefficients at most this large are rounding noise of the geometry and are not
@@ -262,7 +263,7 @@ impl Document {
                 ("Values from the URDF", &self.values),
             ] {
                 let _ = writeln!(out, "\\section*{{{title}}}");
-                super::align(&mut out, lines);
+                align(&mut out, lines);
             }
             let _ = writeln!(out, "\\section*{{Legend}}");
             for (a, b) in &self.legend {
