@@ -5,17 +5,18 @@ use std::time::Instant;
 
 use clap::{CommandFactory, ValueEnum};
 
+use eomgen::catalogue::{self, Layout};
 use eomgen::evaluate::State;
 use eomgen::model::Model;
-use eomgen::report::{self, Form, Format, ShowOptions, Term};
-use eomgen::{Builder, Derived};
+use eomgen::report::{self, Form, Format, ShowOptions};
+use eomgen::Builder;
 
 use crate::flags::{
     cli_error, Cli, ControllerArg, EvalArgs, FormArg, FormatArg, GenerateArgs, InfoArgs,
     IntegratorArg, Numbers, ShowArgs, SimulateArgs,
 };
 use crate::{
-    conditioning, derive, derived, emit, eval, file_name, info, load, plot, progress, simulate,
+    conditioning, derived, emit, eval, file_name, info, load, plot, progress, simulate,
     simulate_floating, symplectic, warn_lines, Failure,
 };
 
@@ -55,24 +56,19 @@ pub(crate) fn generate(a: GenerateArgs) -> Result<(), Failure> {
 }
 
 pub(crate) fn show(a: ShowArgs) -> Result<(), Failure> {
-    let mut terms = Vec::new();
-    for t in &a.term {
-        match Term::parse(t) {
-            Some(t) => terms.push(t),
-            None => terms.extend(Term::ALL),
-        }
-    }
+    let mut terms = a.term.clone();
     if a.derivatives {
         if a.term == ["all"] {
             terms.clear();
         }
-        terms.push(Term::DtauDq);
+        terms.push("inverse_dynamics_derivatives".to_string());
     }
-    // Each term once, in the order asked.
-    let mut seen = Vec::new();
+    // Each quantity once, in the order asked.
+    let mut seen: Vec<String> = Vec::new();
     terms.retain(|t| {
-        let new = !seen.contains(t);
-        seen.push(*t);
+        let name = catalogue::canonical(t).to_string();
+        let new = !seen.contains(&name);
+        seen.push(name);
         new
     });
     if a.standalone && !matches!(a.format, FormatArg::Latex) {
@@ -83,7 +79,7 @@ pub(crate) fn show(a: ShowArgs) -> Result<(), Failure> {
             )
             .exit();
     }
-    if a.entry.is_some() && terms.len() != 1 {
+    if a.entry.is_some() && (terms.len() != 1 || terms[0] == "all") {
         Cli::command()
             .error(
                 clap::error::ErrorKind::ArgumentConflict,
@@ -95,11 +91,13 @@ pub(crate) fn show(a: ShowArgs) -> Result<(), Failure> {
     if a.base_parameters {
         b = b.regressor();
     }
-    if terms.contains(&Term::DtauDq) {
+    let partials =
+        |t: &String| catalogue::notation(t).is_some_and(|n| n.layout == Layout::Partials);
+    if terms.iter().any(partials) {
         b = b.derivatives();
     }
     let model = load(&b)?;
-    let d = derive(&b, &model)?;
+    let derived = derived(&b, model)?;
     let opts = ShowOptions {
         terms,
         entry: a.entry.map(|e| e.0),
@@ -121,9 +119,9 @@ pub(crate) fn show(a: ShowArgs) -> Result<(), Failure> {
     };
     let text = progress::run("printing the equations", || {
         if a.base_parameters {
-            report::render_base_parameters(&model, &d, &opts)
+            report::print_base_parameters(&derived, &opts)
         } else {
-            report::render(&model, &d, &opts)
+            report::print(&derived, &opts)
         }
     })
     .map_err(|e| match e {
@@ -150,17 +148,12 @@ pub(crate) fn info_cmd(a: InfoArgs) -> Result<(), Failure> {
         model.dof()
     );
     let start = Instant::now();
-    let (generated, model, d) =
-        progress::run(&label, || b.generate_with_report()).map_err(cli_error)?;
-    let derive: std::time::Duration = d.timings.iter().map(|t| t.1).sum();
+    let (generated, derived) = progress::run(&label, || b.generate_derived()).map_err(cli_error)?;
+    let derive: std::time::Duration = derived.timings().iter().map(|t| t.1).sum();
     let emit_time = start.elapsed().saturating_sub(derive + load_time);
-    warn_lines(conditioning::sampled_warnings(&Derived::from_parts(
-        model.clone(),
-        d.clone(),
-    )));
+    warn_lines(conditioning::sampled_warnings(&derived));
     emit(&info::print(
-        &model,
-        &d,
+        &derived,
         &generated,
         &file_name(&a.urdf),
         load_time,

@@ -3,10 +3,9 @@
 use std::fmt::Write as _;
 use std::time::Duration;
 
-use eomgen::dynamics::Derivation;
-use eomgen::emit::Generated;
 use eomgen::model::{JointKind, Model};
 use eomgen::report::format_number;
+use eomgen::{Derived, Generated, OpCount};
 
 fn kind(k: JointKind) -> &'static str {
     match k {
@@ -65,13 +64,13 @@ fn mimic_note(model: &Model) -> Option<String> {
 /// One line per generated function: its straight-line operations, or `run time` for one
 /// composed at run time from the others (a solve, a loop, a runtime kernel), in catalogue
 /// order; functions with both list their straight-line part.
-fn operation_counts(d: &Derivation, generated: &Generated) -> String {
-    let mut rows: Vec<(&str, Option<&eomgen::cas::OpCount>)> = d
-        .quantities
-        .iter()
-        .map(|q| {
-            let ops = generated.op_counts.iter().find(|(n, _)| n == q.name);
-            (q.name, ops.map(|(_, o)| o))
+fn operation_counts(derived: &Derived, generated: &Generated) -> String {
+    let mut rows: Vec<(&str, Option<&OpCount>)> = derived
+        .quantity_names()
+        .into_iter()
+        .map(|name| {
+            let ops = generated.op_counts.iter().find(|(n, _)| n == name);
+            (name, ops.map(|(_, o)| o))
         })
         .collect();
     for (name, ops) in &generated.op_counts {
@@ -92,13 +91,13 @@ fn operation_counts(d: &Derivation, generated: &Generated) -> String {
 
 /// The report. `load` and `emit` are the times of reading the URDF and of emitting code.
 pub fn print(
-    model: &Model,
-    d: &Derivation,
+    derived: &Derived,
     generated: &Generated,
     source: &str,
     load: Duration,
     emit: Duration,
 ) -> String {
+    let model = derived.model();
     let mut out = String::new();
     let total_mass: f64 = model.bodies.iter().chain(&model.base).map(|b| b.mass).sum();
     let _ = writeln!(out, "robot: {} ({source})", model.name);
@@ -107,8 +106,8 @@ pub fn print(
             out,
             "degrees of freedom: {} joints + 6 of the floating base (NQ {}, NV {})",
             model.coordinates(),
-            d.nq,
-            d.dof
+            model.nq(),
+            model.nv()
         );
     } else if model.is_coupled() {
         let _ = writeln!(
@@ -270,11 +269,11 @@ pub fn print(
     }
 
     let _ = writeln!(out, "\noperations per call of each generated function:");
-    let _ = write!(out, "{}", operation_counts(d, generated));
+    let _ = write!(out, "{}", operation_counts(derived, generated));
 
-    let derive: Duration = d.timings.iter().map(|t| t.1).sum();
-    let stages: Vec<String> = d
-        .timings
+    let derive: Duration = derived.timings().iter().map(|t| t.1).sum();
+    let stages: Vec<String> = derived
+        .timings()
         .iter()
         .map(|(n, t)| format!("{n} {}", ms(*t)))
         .collect();
@@ -285,7 +284,7 @@ pub fn print(
         "  derivation: {} ({}); expression graph: {} nodes",
         ms(derive),
         stages.join(", "),
-        d.graph.len()
+        derived.graph_nodes()
     );
     let _ = writeln!(out, "  code generation: {}", ms(emit));
     out

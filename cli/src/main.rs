@@ -24,7 +24,6 @@ use std::process::ExitCode;
 
 use clap::Parser;
 
-use eomgen::dynamics::Derivation;
 use eomgen::model::Model;
 use eomgen::{Builder, Derived};
 
@@ -79,7 +78,7 @@ fn main() -> ExitCode {
 /// in a URDF must not drive the terminal: each is written as an escape such as `\u{1b}`.
 fn terminal_safe(text: &str) -> String {
     text.split('\n')
-        .map(eomgen::emit::names::comment_text)
+        .map(eomgen::report::escape_controls)
         .collect::<Vec<_>>()
         .join("\n")
 }
@@ -123,17 +122,8 @@ fn warn_lines(warnings: impl IntoIterator<Item = String>) {
     }
 }
 
-/// Derives within the limits of `b` (degrees of freedom, graph size).
-fn derive(b: &Builder, model: &Model) -> Result<Derivation, Failure> {
-    let label = format!(
-        "deriving the equations of {} ({} joints)",
-        model.name,
-        model.dof()
-    );
-    progress::run(&label, || b.derive(model)).map_err(cli_error)
-}
-
-/// [`derive`] for the evaluator (`eval`, `simulate`, `info`'s conditioning samples).
+/// Derives within the limits of `b` (degrees of freedom, graph size), for the evaluator
+/// (`eval`, `simulate`) and the reports (`show`).
 fn derived(b: &Builder, model: Model) -> Result<Derived, Failure> {
     let label = format!(
         "deriving the equations of {} ({} joints)",

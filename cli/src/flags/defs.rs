@@ -6,6 +6,7 @@ use std::path::PathBuf;
 
 use clap::builder::PossibleValuesParser;
 use clap::{Args, Parser, Subcommand, ValueEnum};
+use eomgen::catalogue::NOTATIONS;
 
 use super::values::{
     parse_armature, parse_contact_at, parse_indices, parse_numbers, parse_vec3, Indices, Numbers,
@@ -176,25 +177,40 @@ pub(crate) enum FormArg {
     Hamiltonian,
 }
 
-/// The names `show --term` accepts.
-pub(crate) const TERMS: [&str; 11] = [
-    "M", "B", "C", "G", "b", "coriolis", "tau", "T", "V", "dtau_dq", "all",
-];
+/// The names `show --term` accepts: every printed quantity's name and symbols, and `all`.
+fn term_names() -> Vec<&'static str> {
+    let mut names: Vec<&'static str> = NOTATIONS
+        .iter()
+        .flat_map(|n| std::iter::once(n.name).chain(n.aliases.iter().copied()))
+        .collect();
+    names.push("all");
+    names
+}
+
+/// `show --term`'s help: the quantities with their symbols, from the catalogue.
+fn term_help() -> String {
+    let list: Vec<String> = NOTATIONS
+        .iter()
+        .map(|n| format!("{} ({})", n.name, n.aliases.join(", ")))
+        .collect();
+    format!(
+        "What to print, one or several separated by commas, by name or symbol: {}; or all \
+         (every one but the derivatives, which --derivatives adds)",
+        list.join(", ")
+    )
+}
 
 #[derive(Args, Debug)]
 pub(crate) struct ShowArgs {
     /// The robot's URDF file.
     pub(crate) urdf: PathBuf,
-    /// What to print, one or several separated by commas: M (mass matrix), B (Craig's
-    /// Coriolis matrix), C (Craig's centrifugal matrix), G (gravity), b (bias), coriolis
-    /// (Coriolis matrix C(q, qd)), tau (inverse dynamics), T and V (energies), dtau_dq (see
-    /// --derivatives), or all.
     #[arg(
         long,
+        help = term_help(),
         value_name = "TERM",
         default_value = "all",
         value_delimiter = ',',
-        value_parser = PossibleValuesParser::new(TERMS),
+        value_parser = PossibleValuesParser::new(term_names()),
         hide_possible_values = true
     )]
     pub(crate) term: Vec<String>,

@@ -24,7 +24,7 @@ use crate::cas::{Graph, OpCount};
 use crate::dynamics::{Derivation, Evaluation, Home, Quantity};
 use crate::model::Model;
 use items::{fields, Fields};
-use traits::{Trait, FLOATING_METHODS, TRAIT_METHODS};
+use traits::{Trait, FLOATING_METHODS};
 
 /// What the emitted file is called and says about itself.
 #[derive(Clone, Debug)]
@@ -140,12 +140,8 @@ pub fn emit_tokens(
         parents: d.coordinate_parents.clone(),
         contact_rows: contact_rows(model),
         active_bias_ops: None,
-        in_trait: d
-            .quantities
-            .iter()
-            .filter(|q| q.home == Home::Dynamics)
-            .count()
-            == TRAIT_METHODS,
+        // The catalogue leaves a trait's methods in it only when all are generated.
+        in_trait: d.quantities.iter().any(|q| q.home == Home::Dynamics),
         try_forward_dynamics: TokenStream::new(),
         floating_trait: model.is_floating()
             && FLOATING_METHODS

@@ -2,7 +2,7 @@
 //! combination of standard parameters, in text, LaTeX or Markdown.
 //!
 //! ```
-//! use eomgen::report::{render_base_parameters, ShowOptions};
+//! use eomgen::report::{print_base_parameters, ShowOptions};
 //! let urdf = r#"<robot name="pendulum">
 //!   <link name="base"/>
 //!   <link name="arm">
@@ -15,10 +15,11 @@
 //!     <parent link="base"/> <child link="arm"/> <axis xyz="0 1 0"/>
 //!   </joint>
 //! </robot>"#;
-//! let model = eomgen::urdf::load_str(urdf, "pendulum.urdf", &Default::default()).unwrap();
-//! let mut d = eomgen::dynamics::Derivation::new(&model);
-//! d.add_regressor(&model).unwrap();
-//! let text = render_base_parameters(&model, &d, &ShowOptions::default()).unwrap();
+//! let derived = eomgen::Builder::from_urdf_str(urdf, "pendulum.urdf")
+//!     .regressor()
+//!     .derived()
+//!     .unwrap();
+//! let text = print_base_parameters(&derived, &ShowOptions::default()).unwrap();
 //! // Swinging about y under gravity along z: YY (about the pivot) and the first moments
 //! // across the axis, MX and MZ.
 //! assert!(text.contains("  MX_arm = MX_arm\n"));
@@ -48,6 +49,7 @@ const NOISE: f64 = 1e-12;
 /// combination of standard parameters, with its value from the URDF, the joints, the standard
 /// parameters that have no effect at all, and a legend. Honours the format, digits, source
 /// and standalone options of `opts`; its terms, entry and form do not apply.
+#[doc(hidden)]
 pub fn render_base_parameters(
     model: &Model,
     d: &Derivation,

@@ -11,6 +11,7 @@ use super::{ShowOptions, NOISE};
 use crate::cas::{format_number, Graph, Id, Node, Program, Style, SymbolKind, Syntax};
 use crate::dynamics::Derivation;
 use crate::model::{JointKind, Model};
+pub(super) use crate::wording::value_source;
 
 /// What is printed, in the document's syntax.
 pub(super) struct Document {
@@ -280,15 +281,7 @@ pub(super) fn describe_param(name: &str) -> String {
     }
 }
 
-/// Where a parameter's default value comes from: the URDF, or an option for rotor inertia.
-pub(crate) fn value_source(name: &str) -> &'static str {
-    if name.starts_with("Ia_") {
-        "armature option value"
-    } else {
-        "URDF value"
-    }
-}
-
+/// The name of a kind of joint.
 pub(super) fn kind_name(k: JointKind) -> &'static str {
     match k {
         JointKind::Revolute => "revolute",

@@ -12,7 +12,7 @@
 //! Output is deterministic: it depends only on the model and the options.
 //!
 //! ```
-//! use eomgen::report::{render, Form, Format, ShowOptions, Term};
+//! use eomgen::report::{print, ShowOptions};
 //! let urdf = r#"<robot name="pendulum">
 //!   <link name="base"/>
 //!   <link name="arm">
@@ -25,10 +25,10 @@
 //!     <parent link="base"/> <child link="arm"/> <axis xyz="0 1 0"/>
 //!   </joint>
 //! </robot>"#;
-//! let model = eomgen::urdf::load_str(urdf, "pendulum.urdf", &Default::default()).unwrap();
-//! let d = eomgen::dynamics::Derivation::new(&model);
-//! let opts = ShowOptions { terms: vec![Term::MassMatrix, Term::Gravity], ..Default::default() };
-//! let text = render(&model, &d, &opts).unwrap();
+//! let derived = eomgen::Builder::from_urdf_str(urdf, "pendulum.urdf").derived().unwrap();
+//! let terms = vec!["mass_matrix".to_string(), "G".to_string()]; // a name or a symbol
+//! let opts = ShowOptions { terms, ..Default::default() };
+//! let text = print(&derived, &opts).unwrap();
 //! assert!(text.contains("M11 = 0.51\n"));
 //! assert!(text.contains("G1 = 9.81*s1\n"));
 //! assert!(text.contains("s1 = sin(q1)"));
@@ -47,13 +47,14 @@ mod trig;
 /// Numbers as the reports write them: `digits` significant digits, or the shortest exact
 /// decimals with `None`.
 pub use crate::cas::format_number;
+/// Text from a URDF (names) made safe for a terminal: control and bidirectional-text
+/// characters written as escapes such as `\u{1b}`.
+pub use crate::wording::escape_controls;
 pub use base_parameters::render_base_parameters;
-pub use term::Term;
 
 use crate::cas::{Graph, Style, Syntax};
 use crate::dynamics::Derivation;
 use crate::model::Model;
-pub(crate) use document::value_source;
 use document::Document;
 use section::{build_section, section, Entry, Section};
 use term::entry_name;
@@ -89,8 +90,11 @@ pub enum Form {
 /// What [`render`] prints.
 #[derive(Clone, Debug)]
 pub struct ShowOptions {
-    /// The terms, printed in this order.
-    pub terms: Vec<Term>,
+    /// The quantities, printed in this order: their generated names (`mass_matrix`) or symbols
+    /// (`M`, `tau`; see the catalogue's notations), `all` for every one but the derivatives,
+    /// `inverse_dynamics_derivatives` (or `dtau_dq`) for `d tau / d q`. A quantity the
+    /// derivation does not have (Craig's matrices with a floating base) is left out.
+    pub terms: Vec<String>,
     /// One entry only, 1-based: `[i, j]` for matrices (for `B`, `[i, column]` or `[i, j, k]`
     /// with the pair `j < k`), `[i]` for vectors. Needs exactly one term; not for `T` and `V`.
     pub entry: Option<Vec<usize>>,
@@ -113,7 +117,7 @@ impl Default for ShowOptions {
     /// Every term, plain text, expanded, 6 significant digits, at most 100 terms per entry.
     fn default() -> Self {
         ShowOptions {
-            terms: Term::ALL.to_vec(),
+            terms: vec!["all".to_string()],
             entry: None,
             format: Format::Text,
             form: Form::Expanded,
@@ -134,6 +138,9 @@ pub enum ReportError {
     /// `d tau / d q` was asked for but not derived, or is too large to print.
     #[error("{0}")]
     Derivatives(String),
+    /// [`ShowOptions::terms`] names no quantity with a notation.
+    #[error("unknown quantity `{0}` to print")]
+    UnknownQuantity(String),
     /// Expanding the equations for print ran into the expression graph's node limit.
     #[error("{0} while expanding the equations for print: try --form program")]
     GraphFull(#[from] crate::cas::GraphFull),
@@ -178,7 +185,29 @@ fn invalid_entry(opts: &ShowOptions, reason: &str) -> ReportError {
     }
 }
 
-/// Prints the chosen terms of a derived robot.
+/// Prints the chosen quantities of a derived robot ([`crate::Builder::derived`]); see
+/// [`render`] for what is printed and when it fails.
+///
+/// ```
+/// let derived = eomgen::Builder::new("../generated/robots/double_pendulum.urdf").derived().unwrap();
+/// let opts = eomgen::report::ShowOptions { terms: vec!["tau".into()], ..Default::default() };
+/// let text = eomgen::report::print(&derived, &opts).unwrap();
+/// assert!(text.contains("Inverse dynamics tau = M(q) qdd + b(q, qd) + G(q)"));
+/// ```
+pub fn print(derived: &crate::Derived, opts: &ShowOptions) -> Result<String, ReportError> {
+    render(derived.model(), derived.derivation(), opts)
+}
+
+/// The base parameters of a derived robot (derived with [`crate::Builder::regressor`]); see
+/// [`render_base_parameters`].
+pub fn print_base_parameters(
+    derived: &crate::Derived,
+    opts: &ShowOptions,
+) -> Result<String, ReportError> {
+    render_base_parameters(derived.model(), derived.derivation(), opts)
+}
+
+/// Prints the chosen terms of a model and its derivation; prefer [`print`].
 ///
 /// The heading lists the joints (`q1` is the first joint of the model's order); then each
 /// term, under a heading with its definition; then a legend of the short names and symbolic
@@ -192,8 +221,9 @@ fn invalid_entry(opts: &ShowOptions, reason: &str) -> ReportError {
 /// Fails when [`ShowOptions::entry`] names no entry of the term (or is given with other than
 /// exactly one term, or with another form), and when expanding the entries for print fills the
 /// expression graph ([`ReportError::GraphFull`]).
+#[doc(hidden)]
 pub fn render(model: &Model, d: &Derivation, opts: &ShowOptions) -> Result<String, ReportError> {
-    if opts.entry.is_some() && opts.terms.len() != 1 {
+    if opts.entry.is_some() && (opts.terms.len() != 1 || opts.terms[0] == "all") {
         return Err(invalid_entry(opts, "needs exactly one term"));
     }
     let style = style_of(opts);
@@ -232,8 +262,7 @@ pub fn render(model: &Model, d: &Derivation, opts: &ShowOptions) -> Result<Strin
     })
 }
 
-/// The sections of [`ShowOptions::terms`], in order (Craig's matrices left out with a
-/// floating base), the friction of `tau` noted.
+/// The sections of [`ShowOptions::terms`], in order, the friction of `tau` noted.
 fn term_sections(
     g: &mut Graph,
     model: &Model,
@@ -242,16 +271,16 @@ fn term_sections(
     syntax: Syntax,
     dropped: &mut usize,
 ) -> Result<Vec<Section>, ReportError> {
-    let mut sections = Vec::with_capacity(opts.terms.len());
-    // Craig's velocity products need qd = dq/dt, which a floating base's velocities are not.
-    let craig = |t: &Term| matches!(t, Term::CoriolisPairs | Term::Centrifugal);
-    for &term in opts
-        .terms
-        .iter()
-        .filter(|t| !(model.is_floating() && craig(t)))
-    {
+    let notations = term::resolve(&opts.terms).map_err(ReportError::UnknownQuantity)?;
+    let mut sections = Vec::with_capacity(notations.len());
+    for term in notations {
+        // Not generated for this robot (Craig's matrices need qd = dq/dt, which a floating
+        // base's velocities are not); the derivatives, when not derived, say so.
+        if d.quantity(term.name).is_none() && (term.printed)(d).is_some() {
+            continue;
+        }
         let mut s = section(g, d, term, opts, syntax, dropped)?;
-        if term == Term::Tau && model.include_friction {
+        if term.name == "inverse_dynamics" && model.include_friction {
             let sign = if model.coulomb_smoothing > 0.0 {
                 format!(
                     "qd_i / sqrt(qd_i^2 + {}^2)",

@@ -1,9 +1,10 @@
 //! A printed term: its entries expanded with the trigonometric identities (rounding noise
 //! dropped), or as a straight-line program when an expansion grows too large.
 
-use super::term::{all_entries, entry_name, one_entry, Term};
+use super::term::{all_entries, entry_name, one_entry};
 use super::{Form, ReportError, ShowOptions, NOISE};
 use crate::cas::{Graph, Id, Node, SymbolKind, Syntax};
+use crate::dynamics::catalogue::{Layout, Notation};
 use crate::dynamics::Derivation;
 
 /// True when `e` contains a parameter symbol.
@@ -76,7 +77,7 @@ impl Section {
 pub(super) fn section(
     g: &mut Graph,
     d: &Derivation,
-    term: Term,
+    term: &Notation,
     opts: &ShowOptions,
     syntax: Syntax,
     dropped: &mut usize,
@@ -87,9 +88,9 @@ pub(super) fn section(
         None => all_entries(d, term)?,
     };
     let mut notes = Vec::new();
-    let (_, definition) = term.title();
+    let definition = term.definition;
     // A single entry of M needs no word on its symmetry.
-    let skip = definition.is_empty() || (single && term == Term::MassMatrix);
+    let skip = definition.is_empty() || (single && term.layout == Layout::Symmetric);
     if !skip {
         notes.push(definition.to_string());
     }
@@ -103,7 +104,7 @@ pub(super) fn section(
         })
         .collect();
     let omitted_zero = !single && structural.len() < all_entries(d, term)?.len();
-    let title = term.title().0.to_string();
+    let title = term.title.to_string();
     build_section(
         g,
         title,

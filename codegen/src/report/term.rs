@@ -1,296 +1,169 @@
-//! The quantities `show` prints as terms: their names, headings, and entries (`M12`,
-//! `B1_23`, `tau2`) with the expressions of a derivation.
+//! The quantities `show` prints, from their catalogue [`Notation`]: which are asked for, and
+//! their entries (`M12`, `B1_23`, `tau2`, `dtau1/dq2`) with the expressions of a derivation.
 
 use super::{ReportError, DTAU_DQ_MAX_OPS};
 use crate::cas::{Id, Program, Syntax};
-use crate::dynamics::{pairs, Derivation, Evaluation};
+use crate::dynamics::catalogue::{Layout, Notation, NOTATIONS};
+use crate::dynamics::{pairs, Derivation};
 
-/// A derived quantity that can be printed.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub enum Term {
-    /// `M(q)`, printed as its upper triangle.
-    MassMatrix,
-    /// Craig's Coriolis matrix `B(q)`, N x N(N-1)/2.
-    CoriolisPairs,
-    /// Craig's centrifugal matrix `C(q)`, N x N.
-    Centrifugal,
-    /// `G(q)`.
-    Gravity,
-    /// `b(q, qd)`: Coriolis and centrifugal terms without gravity.
-    Bias,
-    /// The Christoffel-form Coriolis matrix `C(q, qd)`.
-    CoriolisMatrix,
-    /// `tau = M qdd + b + G`.
-    Tau,
-    /// Kinetic energy `T`.
-    KineticEnergy,
-    /// Potential energy `V`.
-    PotentialEnergy,
-    /// The derivatives of inverse dynamics in the joint positions, `d tau / d q` (needs a
-    /// derivation with [`Derivation::add_derivatives`]; not in [`Term::ALL`]).
-    DtauDq,
-}
-
-impl Term {
-    /// Every term, in print order.
-    pub const ALL: [Term; 9] = [
-        Term::MassMatrix,
-        Term::CoriolisPairs,
-        Term::Centrifugal,
-        Term::Gravity,
-        Term::Bias,
-        Term::CoriolisMatrix,
-        Term::Tau,
-        Term::KineticEnergy,
-        Term::PotentialEnergy,
-    ];
-
-    /// The command-line name: `M`, `B`, `C`, `G`, `b`, `coriolis`, `tau`, `T`, `V`, `dtau_dq`.
-    pub fn label(self) -> &'static str {
-        match self {
-            Term::MassMatrix => "M",
-            Term::CoriolisPairs => "B",
-            Term::Centrifugal => "C",
-            Term::Gravity => "G",
-            Term::Bias => "b",
-            Term::CoriolisMatrix => "coriolis",
-            Term::Tau => "tau",
-            Term::KineticEnergy => "T",
-            Term::PotentialEnergy => "V",
-            Term::DtauDq => "dtau_dq",
+/// The printed quantities named in `names` (generated names or their symbols, `all` for every
+/// quantity but the derivatives), each once, in the order asked; `Err` with the first unknown
+/// name.
+pub fn resolve(names: &[String]) -> Result<Vec<&'static Notation>, String> {
+    let mut out: Vec<&'static Notation> = Vec::new();
+    for name in names {
+        let found: Vec<&'static Notation> = if name == "all" {
+            NOTATIONS
+                .iter()
+                .filter(|n| n.layout != Layout::Partials)
+                .collect()
+        } else {
+            let n = NOTATIONS.iter().find(|n| n.is_named(name));
+            vec![n.ok_or_else(|| name.clone())?]
+        };
+        for n in found {
+            if !out.iter().any(|o| o.name == n.name) {
+                out.push(n);
+            }
         }
     }
-
-    /// Parses a [`Term::label`] (case matters: `B` and `b` differ) or a long name such as
-    /// `mass_matrix`, `coriolis_pairs`, `centrifugal`, `gravity`, `bias`, `coriolis_matrix`,
-    /// `kinetic_energy`, `potential_energy`; and `dtau_dq`.
-    pub fn parse(s: &str) -> Option<Term> {
-        let long = [
-            "mass_matrix",
-            "coriolis_pairs",
-            "centrifugal",
-            "gravity",
-            "bias",
-            "coriolis_matrix",
-            "tau",
-            "kinetic_energy",
-            "potential_energy",
-        ];
-        Term::ALL
-            .iter()
-            .zip(long)
-            .find(|(t, l)| t.label() == s || *l == s)
-            .map(|(t, _)| *t)
-            .or((s == Term::DtauDq.label()).then_some(Term::DtauDq))
-    }
-
-    /// Heading and the sentence that defines the term.
-    pub(super) fn title(self) -> (&'static str, &'static str) {
-        match self {
-            Term::MassMatrix => (
-                "Mass matrix M(q)",
-                "Symmetric: entries below the diagonal are not shown.",
-            ),
-            Term::CoriolisPairs => (
-                "Craig's Coriolis matrix B(q)",
-                "B_i,jk multiplies qd_j qd_k (j < k): b = B(q) [qd qd] + C(q) [qd^2].",
-            ),
-            Term::Centrifugal => ("Craig's centrifugal matrix C(q)", "C_ij multiplies qd_j^2."),
-            Term::Gravity => ("Gravity G(q) = dV/dq", ""),
-            Term::Bias => (
-                "Bias b(q, qd) = B(q) [qd qd] + C(q) [qd^2]",
-                "Coriolis and centrifugal terms, without gravity.",
-            ),
-            Term::CoriolisMatrix => (
-                "Coriolis matrix C(q, qd), Christoffel form",
-                "Cqd_ij = sum_k Gamma_ijk qd_k: b = C(q, qd) qd, and dM/dt - 2 C(q, qd) is \
-                 skew-symmetric.",
-            ),
-            Term::Tau => ("Inverse dynamics tau = M(q) qdd + b(q, qd) + G(q)", ""),
-            Term::KineticEnergy => ("Kinetic energy T = qd^T M(q) qd / 2", ""),
-            Term::PotentialEnergy => ("Potential energy V = -sum over bodies of m g.c", ""),
-            Term::DtauDq => (
-                "Derivatives of inverse dynamics d tau / d q (q, qd, qdd)",
-                "dtau_i/dq_j: how joint effort i changes with joint position j.",
-            ),
-        }
-    }
+    Ok(out)
 }
 
-/// `d tau / d q` of a derivation with derivatives, row-major, or why it cannot be printed.
-fn dtau_dq(d: &Derivation) -> Result<Vec<Vec<Id>>, ReportError> {
-    let n = d.dof;
-    let Some(Evaluation::Exprs(ids)) = d.quantity("inverse_dynamics_derivatives").map(|q| &q.eval)
-    else {
+/// The printed expressions of `n`, or why they cannot be printed: not derived (derivatives
+/// without `Builder::derivatives`), or too large (derivatives over [`DTAU_DQ_MAX_OPS`]).
+fn printed(d: &Derivation, n: &Notation) -> Result<Vec<Id>, ReportError> {
+    let Some(ids) = (n.printed)(d) else {
         return Err(ReportError::Derivatives(
             "d tau / d q was not derived: derive with Builder::derivatives (show --derivatives)"
                 .to_string(),
         ));
     };
-    let dq = &ids[..n * n];
-    let ops = Program::new(&d.graph, dq).ops().total();
-    if ops > DTAU_DQ_MAX_OPS {
-        return Err(ReportError::Derivatives(format!(
-            "d tau / d q is too large to print ({ops} operations, more than {DTAU_DQ_MAX_OPS}): \
-             generate it as code with `eomgen generate --derivatives`"
-        )));
+    if n.layout == Layout::Partials {
+        let ops = Program::new(&d.graph, &ids).ops().total();
+        if ops > DTAU_DQ_MAX_OPS {
+            return Err(ReportError::Derivatives(format!(
+                "d tau / d q is too large to print ({ops} operations, more than {DTAU_DQ_MAX_OPS}): \
+                 generate it as code with `eomgen generate --derivatives`"
+            )));
+        }
     }
-    Ok(dq.chunks(n.max(1)).map(|r| r.to_vec()).collect())
+    Ok(ids)
 }
 
-/// Every entry of a term: 0-based indices (`[i, j, k]` for `B`) and expression.
+/// The number of columns of `n`'s printed matrix for `dof` joints.
+fn columns(n: &Notation, dof: usize) -> usize {
+    match n.layout {
+        Layout::Pairs => dof * dof.saturating_sub(1) / 2,
+        _ => dof,
+    }
+}
+
+/// Every entry of a quantity: 0-based indices (`[i, j, k]` for Craig's pairs) and expression.
 pub(super) fn all_entries(
     d: &Derivation,
-    term: Term,
+    n: &Notation,
 ) -> Result<Vec<(Vec<usize>, Id)>, ReportError> {
-    let n = d.dof;
-    let square = |m: &Vec<Vec<Id>>, upper: bool| -> Vec<(Vec<usize>, Id)> {
-        (0..n)
-            .flat_map(|i| {
-                let from = if upper { i } else { 0 };
-                (from..n).map(move |j| (vec![i, j], m[i][j]))
-            })
-            .collect()
-    };
-    let vector = |v: &Vec<Id>| -> Vec<(Vec<usize>, Id)> {
-        v.iter().enumerate().map(|(i, &e)| (vec![i], e)).collect()
-    };
-    Ok(match term {
-        Term::MassMatrix => square(&d.mass_matrix, true),
-        Term::Centrifugal => square(&d.centrifugal, false),
-        Term::CoriolisMatrix => square(&d.coriolis_matrix, false),
-        Term::CoriolisPairs => {
-            let pl = pairs(n);
-            (0..n)
+    let ids = printed(d, n)?;
+    let (dof, cols) = (d.dof, columns(n, d.dof));
+    let at = |i: usize, j: usize| ids[i * cols + j];
+    Ok(match n.layout {
+        Layout::Scalar => vec![(vec![], ids[0])],
+        Layout::Vector => ids.iter().enumerate().map(|(i, &e)| (vec![i], e)).collect(),
+        Layout::Symmetric | Layout::Square | Layout::Partials => {
+            let upper = n.layout == Layout::Symmetric;
+            (0..dof)
                 .flat_map(|i| {
-                    pl.iter()
-                        .enumerate()
-                        .map(move |(p, &(j, k))| (vec![i, j, k], d.coriolis_pairs[i][p]))
+                    let from = if upper { i } else { 0 };
+                    (from..dof).map(move |j| (vec![i, j], at(i, j)))
                 })
                 .collect()
         }
-        Term::Gravity => vector(&d.gravity),
-        Term::Bias => vector(&d.bias),
-        Term::Tau => vector(&d.tau),
-        Term::KineticEnergy => vec![(vec![], d.kinetic_energy)],
-        Term::PotentialEnergy => vec![(vec![], d.potential_energy)],
-        Term::DtauDq => square(&dtau_dq(d)?, false),
+        Layout::Pairs => {
+            let pl = pairs(dof);
+            (0..dof)
+                .flat_map(|i| {
+                    let pl = &pl;
+                    (0..cols).map(move |p| (vec![i, pl[p].0, pl[p].1], at(i, p)))
+                })
+                .collect()
+        }
     })
 }
 
 /// The one entry named by a 1-based `entry`.
 pub(super) fn one_entry(
     d: &Derivation,
-    term: Term,
+    n: &Notation,
     entry: &[usize],
 ) -> Result<(Vec<usize>, Id), ReportError> {
-    let n = d.dof;
-    let text = entry
-        .iter()
-        .map(|i| i.to_string())
-        .collect::<Vec<_>>()
-        .join(",");
+    let dof = d.dof;
     let err = |reason: String| ReportError::InvalidEntry {
-        entry: text.clone(),
+        entry: entry
+            .iter()
+            .map(|i| i.to_string())
+            .collect::<Vec<_>>()
+            .join(","),
         reason,
     };
-    let np = n * n.saturating_sub(1) / 2;
+    let np = columns(n, dof);
     let in_range = |i: usize, len: usize| (1..=len).contains(&i);
     let idx: Vec<usize> = entry.iter().map(|i| i.wrapping_sub(1)).collect();
-    match (term, entry) {
-        (Term::KineticEnergy | Term::PotentialEnergy, _) => Err(err(format!(
-            "given, but {} is a scalar: leave out --entry",
-            term.label()
+    let label = n.aliases.first().copied().unwrap_or(n.name);
+    match (n.layout, entry) {
+        (Layout::Scalar, _) => Err(err(format!(
+            "given, but {label} is a scalar: leave out --entry"
         ))),
-        (Term::Gravity | Term::Bias | Term::Tau, &[i]) if in_range(i, n) => {
-            let v = match term {
-                Term::Gravity => &d.gravity,
-                Term::Bias => &d.bias,
-                _ => &d.tau,
-            };
-            Ok((idx.clone(), v[idx[0]]))
-        }
-        (Term::Gravity | Term::Bias | Term::Tau, _) => Err(err(format!(
-            "is not an entry of {}: give one index from 1 to {n}",
-            term.label()
+        (Layout::Vector, &[i]) if in_range(i, dof) => Ok((idx.clone(), printed(d, n)?[idx[0]])),
+        (Layout::Vector, _) => Err(err(format!(
+            "is not an entry of {label}: give one index from 1 to {dof}"
         ))),
-        (Term::MassMatrix | Term::Centrifugal | Term::CoriolisMatrix, &[i, j])
-            if in_range(i, n) && in_range(j, n) =>
+        (Layout::Symmetric | Layout::Square | Layout::Partials, &[i, j])
+            if in_range(i, dof) && in_range(j, dof) =>
         {
-            let m = match term {
-                Term::MassMatrix => &d.mass_matrix,
-                Term::Centrifugal => &d.centrifugal,
-                _ => &d.coriolis_matrix,
-            };
-            Ok((idx.clone(), m[idx[0]][idx[1]]))
+            Ok((idx.clone(), printed(d, n)?[idx[0] * dof + idx[1]]))
         }
-        (Term::DtauDq, &[i, j]) if in_range(i, n) && in_range(j, n) => {
-            Ok((idx.clone(), dtau_dq(d)?[idx[0]][idx[1]]))
+        (Layout::Symmetric | Layout::Square | Layout::Partials, _) => Err(err(format!(
+            "is not an entry of {label}: give I,J with both from 1 to {dof}"
+        ))),
+        (Layout::Pairs, &[i, p]) if in_range(i, dof) && in_range(p, np) => {
+            let (j, k) = pairs(dof)[p - 1];
+            Ok((vec![i - 1, j, k], printed(d, n)?[(i - 1) * np + p - 1]))
         }
-        (Term::MassMatrix | Term::Centrifugal | Term::CoriolisMatrix | Term::DtauDq, _) => {
-            Err(err(format!(
-                "is not an entry of {}: give I,J with both from 1 to {n}",
-                term.label()
-            )))
-        }
-        (Term::CoriolisPairs, &[i, p]) if in_range(i, n) && in_range(p, np) => {
-            let (j, k) = pairs(n)[p - 1];
-            Ok((vec![i - 1, j, k], d.coriolis_pairs[i - 1][p - 1]))
-        }
-        (Term::CoriolisPairs, &[i, j, k])
-            if in_range(i, n) && in_range(j, n) && in_range(k, n) && j != k =>
+        (Layout::Pairs, &[i, j, k])
+            if in_range(i, dof) && in_range(j, dof) && in_range(k, dof) && j != k =>
         {
             let (j, k) = (j.min(k) - 1, j.max(k) - 1);
-            let p = pairs(n).iter().position(|&x| x == (j, k)).expect("a pair");
-            Ok((vec![i - 1, j, k], d.coriolis_pairs[i - 1][p]))
+            let p = pairs(dof)
+                .iter()
+                .position(|&x| x == (j, k))
+                .expect("a pair");
+            Ok((vec![i - 1, j, k], printed(d, n)?[(i - 1) * np + p]))
         }
-        (Term::CoriolisPairs, _) => Err(err(format!(
-            "is not an entry of B: give I,P (row 1 to {n}, column 1 to {np}) or I,J,K (the \
-             pair J < K)"
+        (Layout::Pairs, _) => Err(err(format!(
+            "is not an entry of {label}: give I,P (row 1 to {dof}, column 1 to {np}) or I,J,K \
+             (the pair J < K)"
         ))),
     }
 }
 
 /// The printed name of an entry: `M12`, `B1_23`, `G1`, `tau2`, `T` (text) or `M_{12}` (LaTeX);
 /// with more than 9 joints, matrix indices are separated (`M1,12`).
-pub(super) fn entry_name(term: Term, idx: &[usize], dof: usize, syntax: Syntax) -> String {
+pub(super) fn entry_name(n: &Notation, idx: &[usize], dof: usize, syntax: Syntax) -> String {
     let latex = syntax == Syntax::Latex;
+    if n.layout == Layout::Partials {
+        return partial_name(idx, latex);
+    }
     let compact = dof <= 9;
-    let one = |i: usize| (i + 1).to_string();
-    let pair = |a: usize, b: usize| {
-        if compact {
-            format!("{}{}", a + 1, b + 1)
-        } else {
-            format!("{},{}", a + 1, b + 1)
-        }
-    };
-    let base = match (term, latex) {
-        (Term::MassMatrix, _) => "M",
-        (Term::CoriolisPairs, _) => "B",
-        (Term::Centrifugal, _) => "C",
-        (Term::CoriolisMatrix, false) => "Cqd",
-        (Term::CoriolisMatrix, true) => "C^{\\dot{q}}",
-        (Term::Gravity, _) => "G",
-        (Term::Bias, _) => "b",
-        (Term::Tau, false) => "tau",
-        (Term::Tau, true) => "\\tau",
-        (Term::KineticEnergy, _) => "T",
-        (Term::PotentialEnergy, _) => "V",
-        (Term::DtauDq, _) => return dtau_dq_name(idx, latex),
-    };
+    let base = if latex { n.latex } else { n.text };
     let sub = match idx {
         [] => return base.to_string(),
-        [i] => one(*i),
-        [i, j] => pair(*i, *j),
-        [i, j, k] => {
-            if compact && !latex {
-                format!("{}_{}{}", i + 1, j + 1, k + 1)
-            } else if compact {
-                format!("{},{}{}", i + 1, j + 1, k + 1)
-            } else {
-                format!("{},({},{})", i + 1, j + 1, k + 1)
-            }
-        }
+        [i] => (i + 1).to_string(),
+        [i, j] if compact => format!("{}{}", i + 1, j + 1),
+        [i, j] => format!("{},{}", i + 1, j + 1),
+        [i, j, k] if compact && !latex => format!("{}_{}{}", i + 1, j + 1, k + 1),
+        [i, j, k] if compact => format!("{},{}{}", i + 1, j + 1, k + 1),
+        [i, j, k] => format!("{},({},{})", i + 1, j + 1, k + 1),
         _ => unreachable!("entries have at most three indices"),
     };
     if latex {
@@ -301,7 +174,7 @@ pub(super) fn entry_name(term: Term, idx: &[usize], dof: usize, syntax: Syntax) 
 }
 
 /// `dtau1/dq2` (text) or `\partial\tau_{1}/\partial q_{2}` (LaTeX).
-fn dtau_dq_name(idx: &[usize], latex: bool) -> String {
+fn partial_name(idx: &[usize], latex: bool) -> String {
     let (i, j) = (idx[0] + 1, idx[1] + 1);
     if latex {
         format!("\\partial\\tau_{{{i}}}/\\partial q_{{{j}}}")

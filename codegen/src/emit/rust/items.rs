@@ -34,7 +34,7 @@ pub(super) fn fields(d: &Derivation) -> Fields {
         let docline = format!(
             " `{}` ({} {}).",
             comment_text(&name.replace('`', "'")),
-            crate::report::value_source(name),
+            crate::wording::value_source(name),
             value
         );
         f.defs.push(quote!(#[doc = #docline] pub #field: T,));

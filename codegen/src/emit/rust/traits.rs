@@ -8,9 +8,6 @@ use quote::{format_ident, quote};
 use super::{allow_lints, Emitter};
 use crate::dynamics::Home;
 
-/// How many methods the runtime's `Dynamics` trait has.
-pub(super) const TRAIT_METHODS: usize = 8;
-
 /// The methods of the runtime's `FloatingDynamics` trait.
 pub(super) const FLOATING_METHODS: [&str; 6] = [
     "mass_matrix",
