@@ -98,6 +98,18 @@ pub fn print(
     emit: Duration,
 ) -> String {
     let model = derived.model();
+    let mut out = summary(model, source);
+    tree(&mut out, model);
+    limits_and_effects(&mut out, model);
+    let _ = writeln!(out, "\noperations per call of each generated function:");
+    let _ = write!(out, "{}", operation_counts(derived, generated));
+    times(&mut out, derived, load, emit);
+    out
+}
+
+/// The robot, its degrees of freedom, mass and gravity, and the notes on its base and mimic
+/// tags.
+fn summary(model: &Model, source: &str) -> String {
     let mut out = String::new();
     let total_mass: f64 = model.bodies.iter().chain(&model.base).map(|b| b.mass).sum();
     let _ = writeln!(out, "robot: {} ({source})", model.name);
@@ -134,7 +146,11 @@ pub fn print(
         let _ = writeln!(out, "note: {note}");
     }
 
-    // The tree, depth first with an explicit stack (no recursion on user input).
+    out
+}
+
+/// The kinematic tree, depth first with an explicit stack (no recursion on user input).
+fn tree(out: &mut String, model: &Model) {
     let _ = writeln!(
         out,
         "\ntree (coordinate, joint: type about its axis in the joint frame -> body, mass):"
@@ -176,56 +192,65 @@ pub fn print(
     };
     push(&mut stack, children(None), "");
     while let Some((j, prefix, last)) = stack.pop() {
-        let joint = &model.joints[j];
-        let body = &model.bodies[j];
-        let _ = write!(
-            out,
-            "{prefix}{} {} {}: {} about {} -> {}, {} kg",
-            if last { "└──" } else { "├──" },
-            label(model, j),
-            joint.name,
-            kind(joint.kind),
-            vec3(&joint.axis),
-            body.name,
-            format_number(body.mass, Some(6))
-        );
-        let merged: Vec<&str> = body
-            .merged_links
-            .iter()
-            .skip(1)
-            .map(|s| s.as_str())
-            .collect();
-        if !merged.is_empty() {
-            let _ = write!(out, " (merged: {})", merged.join(", "));
-        }
-        let coupling = model.coupling.get(j).filter(|c| c.leader.is_some());
-        match (&joint.mimic, coupling) {
-            (Some(m), Some(c)) => {
-                let _ = write!(
-                    out,
-                    " (mimics {}: follows q{} x {} + {})",
-                    m.joint,
-                    c.coordinate + 1,
-                    format_number(c.multiplier, Some(6)),
-                    format_number(c.offset, Some(6))
-                );
-            }
-            (Some(m), None) => {
-                let _ = write!(
-                    out,
-                    " (mimics {} x {} + {}, treated as independent)",
-                    m.joint,
-                    format_number(m.multiplier, Some(6)),
-                    format_number(m.offset, Some(6))
-                );
-            }
-            _ => {}
-        }
-        out.push('\n');
+        tree_line(out, model, j, &prefix, last);
         let deeper = format!("{prefix}{}", if last { "    " } else { "│   " });
         push(&mut stack, children(Some(j)), &deeper);
     }
+}
 
+/// Joint `j`'s line of the tree: its coordinate, name, kind, axis, body and mass, merged
+/// links and mimic tag.
+fn tree_line(out: &mut String, model: &Model, j: usize, prefix: &str, last: bool) {
+    let joint = &model.joints[j];
+    let body = &model.bodies[j];
+    let _ = write!(
+        out,
+        "{prefix}{} {} {}: {} about {} -> {}, {} kg",
+        if last { "└──" } else { "├──" },
+        label(model, j),
+        joint.name,
+        kind(joint.kind),
+        vec3(&joint.axis),
+        body.name,
+        format_number(body.mass, Some(6))
+    );
+    let merged: Vec<&str> = body
+        .merged_links
+        .iter()
+        .skip(1)
+        .map(|s| s.as_str())
+        .collect();
+    if !merged.is_empty() {
+        let _ = write!(out, " (merged: {})", merged.join(", "));
+    }
+    let coupling = model.coupling.get(j).filter(|c| c.leader.is_some());
+    match (&joint.mimic, coupling) {
+        (Some(m), Some(c)) => {
+            let _ = write!(
+                out,
+                " (mimics {}: follows q{} x {} + {})",
+                m.joint,
+                c.coordinate + 1,
+                format_number(c.multiplier, Some(6)),
+                format_number(c.offset, Some(6))
+            );
+        }
+        (Some(m), None) => {
+            let _ = write!(
+                out,
+                " (mimics {} x {} + {}, treated as independent)",
+                m.joint,
+                format_number(m.multiplier, Some(6)),
+                format_number(m.offset, Some(6))
+            );
+        }
+        _ => {}
+    }
+    out.push('\n');
+}
+
+/// The joint limits, and the joint effects when the URDF has any.
+fn limits_and_effects(out: &mut String, model: &Model) {
     let _ = writeln!(out, "\njoint limits (lower, upper, effort, velocity):");
     for (i, j) in model.joints.iter().enumerate() {
         let limits = match &j.limits {
@@ -267,10 +292,10 @@ pub fn print(
             );
         }
     }
+}
 
-    let _ = writeln!(out, "\noperations per call of each generated function:");
-    let _ = write!(out, "{}", operation_counts(derived, generated));
-
+/// How long reading, deriving (per stage) and emitting took, and the graph's size.
+fn times(out: &mut String, derived: &Derived, load: Duration, emit: Duration) {
     let derive: Duration = derived.timings().iter().map(|t| t.1).sum();
     let stages: Vec<String> = derived
         .timings()
@@ -287,5 +312,4 @@ pub fn print(
         derived.graph_nodes()
     );
     let _ = writeln!(out, "  code generation: {}", ms(emit));
-    out
 }
