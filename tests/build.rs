@@ -47,6 +47,11 @@ fn main() {
     mimic();
     split();
     mpc_kinematics();
+    // Planar and floating joints below the root (tests/joints.rs).
+    for name in ["mobile_manipulator", "crane_payload", "rover_pods"] {
+        let urdf = format!("robots/joints/{name}.urdf");
+        eomgen::Builder::new(&urdf).derivatives().compile().unwrap();
+    }
     eomgen::Builder::new("robots/panda.urdf")
         .module_name("panda_selected")
         .type_name("PandaSelected")

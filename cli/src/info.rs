@@ -9,11 +9,7 @@ use eomgen::model::{JointKind, Model};
 use eomgen::report::format_number;
 
 fn kind(k: JointKind) -> &'static str {
-    match k {
-        JointKind::Revolute => "revolute",
-        JointKind::Continuous => "continuous",
-        JointKind::Prismatic => "prismatic",
-    }
+    k.urdf_name()
 }
 
 fn vec3(v: &nalgebra::Vector3<f64>) -> String {
@@ -117,6 +113,12 @@ pub fn print(
             model.coordinates(),
             model.dof(),
             model.dof() - model.coordinates()
+        );
+    } else if !model.velocities_are_rates() {
+        let _ = writeln!(
+            out,
+            "degrees of freedom: {} (floating joints: NQ {}, NV {})",
+            d.dof, d.nq, d.dof
         );
     } else {
         let _ = writeln!(out, "degrees of freedom: {}", model.dof());

@@ -30,7 +30,7 @@ pub fn catalogue(model: &Model, d: &Derivation) -> Vec<Quantity> {
         kinetic_energy(d, &notes),
         potential_energy(d),
     ];
-    if !model.is_floating() {
+    if model.velocities_are_rates() {
         out.push(craig(d, Craig::Centrifugal));
         out.push(craig(d, Craig::CoriolisPairs));
     }
@@ -42,7 +42,7 @@ pub fn catalogue(model: &Model, d: &Derivation) -> Vec<Quantity> {
     out.extend(centroidal::quantities(model, d));
     out.extend(super::contact_derivatives::impulse_dynamics(d));
     out.extend(super::active_contacts::quantities(d));
-    if model.is_floating() {
+    if !model.velocities_are_rates() {
         // Without the `Dynamics` trait (whose arrays are all N long): the emitter puts those of
         // `FloatingDynamics` and `Contacts` in their impls, the others are inherent methods.
         for q in &mut out {

@@ -21,7 +21,7 @@ use crate::dynamics::{
     ActiveContacts, Craig, Derivation, Evaluation, Home, Input, Quantity, Shape,
 };
 use crate::kinematics::snap;
-use crate::model::{Model, Transform};
+use crate::model::{JointKind, Model, Transform};
 use crate::spatial::snap_rotation;
 
 mod mpc;
@@ -285,7 +285,7 @@ impl Emitter<'_> {
                 .model
                 .coordinate_names()
                 .into_iter()
-                .map(Literal::string);
+                .map(|name| Literal::string(&name));
             let what = if self.floating {
                 "The URDF names of the joints, in the order of the joint part of every array (after the base's coordinates)."
             } else {
@@ -330,6 +330,13 @@ impl Emitter<'_> {
                 /// Number of position coordinates: the base's 7 (position, unit quaternion x, y, z, w), then the joints'.
                 pub const NQ: usize = #nq;
                 /// Number of velocity coordinates: the base's 6 (linear, then angular velocity, base axes), then the joints'.
+                pub const NV: usize = #n;
+            }
+        } else if !self.model.velocities_are_rates() {
+            quote! {
+                /// Number of position coordinates: 7 per floating joint (position, unit quaternion x, y, z, w), 1 per other joint.
+                pub const NQ: usize = #nq;
+                /// Number of velocity coordinates: 6 per floating joint (linear, then angular velocity, its body's axes), 1 per other joint.
                 pub const NV: usize = #n;
             }
         } else {
@@ -387,6 +394,15 @@ impl Emitter<'_> {
         )];
         if self.model.is_coupled() {
             lines.extend(coupling_doc(self.model));
+        }
+        if !self.floating && !self.model.velocities_are_rates() {
+            lines.extend([
+                String::new(),
+                "Floating joints (as Pinocchio's free flyer, below the root): each has `q` = [position of its".into(),
+                "child in the joint frame (3), unit quaternion x, y, z, w (4)] (`NQ` in all) and velocities =".into(),
+                "[linear (3), angular (3)] in the child's axes (`NV` in all); `JOINT_NAMES` has one entry per".into(),
+                "velocity coordinate. Move along them with `integrate`.".into(),
+            ]);
         }
         if self.floating {
             lines.extend([
@@ -978,10 +994,20 @@ impl Emitter<'_> {
     fn integrate_fn(&mut self, q: &Quantity) -> TokenStream {
         let docs = Self::quantity_doc(q, None);
         let (n, nq, vis) = (&self.n, &self.nq, self.vis(q.name));
+        let body = if self.floating {
+            quote!(::eomgen_runtime::free_flyer::integrate(q, qd, dt))
+        } else {
+            let (q_at, v_at) = (self.model.q_offsets(), self.model.v_offsets());
+            let blocks = self.model.floating_joints().into_iter().map(|j| {
+                let (a, b) = (usize_lit(q_at[j]), usize_lit(v_at[j]));
+                quote!((#a, #b))
+            });
+            quote!(::eomgen_runtime::free_flyer::integrate_blocks(q, qd, dt, &[#(#blocks),*]))
+        };
         quote! {
             #docs
             #vis fn integrate(&self, q: &[T; #nq], qd: &[T; #n], dt: T) -> [T; #nq] {
-                ::eomgen_runtime::free_flyer::integrate(q, qd, dt)
+                #body
             }
         }
     }
@@ -1006,6 +1032,19 @@ impl Emitter<'_> {
         } else {
             quote!(::eomgen_runtime::tree::chain_jacobian)
         };
+        if !self.model.floating_joints().is_empty() {
+            // Joints of several columns: each joint's first column from a table.
+            let columns = self.model.v_offsets().into_iter().map(usize_lit);
+            let nj = usize_lit(self.model.joints.len());
+            return quote! {
+                #docs
+                pub fn link_jacobian(&self, link: #link_ty, q: &[T; #nq]) -> [[T; #n]; 6] {
+                    const COLUMNS: [usize; #nj] = [#(#columns),*];
+                    let (path, placement) = Self::link_frame(link);
+                    ::eomgen_runtime::tree::chain_jacobian_columns(path, &Self::TREE_JOINTS, &COLUMNS, |j| self.joint_transform(j, q), &placement)
+                }
+            };
+        }
         if self.model.is_coupled() {
             // Columns per joint (after a floating base's six), then summed into the
             // coordinates' (`J G`).
@@ -1047,10 +1086,10 @@ impl Emitter<'_> {
         let joints = self.model.joints.iter().map(|j| {
             let axis = j.axis.map(snap);
             let [x, y, z] = [0, 1, 2].map(|k| f64_literal(axis[k]));
-            let motion = if crate::kinematics::joint::rotates(j) {
-                quote!(Rotation)
-            } else {
-                quote!(Translation)
+            let motion = match j.kind {
+                JointKind::Floating => quote!(Free),
+                JointKind::Revolute | JointKind::Continuous => quote!(Rotation),
+                JointKind::Prismatic => quote!(Translation),
             };
             quote!(::eomgen_runtime::tree::TreeJoint { axis: [#x, #y, #z], motion: ::eomgen_runtime::tree::Motion::#motion })
         });
@@ -1147,7 +1186,7 @@ impl Emitter<'_> {
             .model
             .coordinate_names()
             .into_iter()
-            .map(Literal::string);
+            .map(|name| Literal::string(&name));
         let (ty, n, allow) = (&self.ty, &self.n, allow_lints());
         quote! {
             #allow

@@ -14,6 +14,7 @@ use nalgebra::{Matrix3, Vector3};
 use thiserror::Error;
 
 use super::inertia_check;
+use super::joint_kinds;
 use super::shapes::{mass_properties, Shape};
 use super::{Body, Coupling, Frame, Joint, JointKind, Limits, Mimic, Model, Transform};
 
@@ -289,6 +290,16 @@ pub enum ModelError {
         issues: Vec<FormatIssue>,
         more: usize,
     },
+    /// A joint of a kind that an option cannot handle yet (a floating joint below the root
+    /// with mimic joints, passive joints, contacts, rotor inertia or friction; a planar joint
+    /// whose plane is not its frame's xy plane).
+    #[error("{file}: joint `{joint}` is {kind}: {reason}")]
+    UnsupportedJointUse {
+        file: String,
+        joint: String,
+        kind: &'static str,
+        reason: String,
+    },
     /// The robot has no links at all.
     #[error("{file}: the robot has no links")]
     NoLinks { file: String },
@@ -305,10 +316,10 @@ pub enum ModelError {
     /// Two joints have the same name.
     #[error("{file}: joint `{joint}` is defined more than once")]
     DuplicateJoint { file: String, joint: String },
-    /// A floating, planar or spherical joint: not supported yet.
+    /// A spherical joint: not supported yet.
     #[error(
         "{file}: joint `{joint}` is {joint_type}, which is not supported \
-         (only revolute, continuous, prismatic and fixed joints are)"
+         (only revolute, continuous, prismatic, planar, floating and fixed joints are)"
     )]
     UnsupportedJoint {
         file: String,
@@ -544,7 +555,10 @@ pub(crate) struct LinkDescription {
 pub(crate) enum JointType {
     Fixed,
     Moving(JointKind),
-    /// A type we cannot model yet, by its URDF name (`floating`, `planar`, ...).
+    /// A URDF `planar` joint: the model holds it as the chain of one-coordinate joints that
+    /// the joint model gives (`kinematics::joint::planar_steps`).
+    Planar,
+    /// A type we cannot model yet, by its URDF name (`spherical`).
     Unsupported(String),
 }
 
@@ -585,6 +599,7 @@ pub(crate) fn build_model(
     let robot = unwelded.as_ref().unwrap_or(robot);
     let floating = options.floating_base || floating_joint;
     let tree = Tree::new(robot, file)?;
+    joint_kinds::check_description(robot, file)?;
     check_numbers(robot, file)?;
     check_options(options, file)?;
     let filled;
@@ -604,6 +619,7 @@ pub(crate) fn build_model(
     }
     inertia_check::check_bodies(&mut model, file, options.repair_inertia, warnings)?;
     set_armature(&mut model, robot, &options.armature, file)?;
+    joint_kinds::check_options(&model, options, file)?;
     check_singular(&model, robot, options, file)?;
     if let Some(order) = &options.joint_order {
         reorder(&mut model, robot, order, file)?;
@@ -1147,39 +1163,72 @@ fn merge(
         let above = attach[parent].clone();
         let placement = above.placement.compose(&joint.origin.to_transform());
         let child_link = &robot.links[child];
-        match &joint.joint_type {
-            JointType::Moving(kind) => {
+        let steps = match &joint.joint_type {
+            JointType::Moving(kind) => vec![joint_kinds::Step {
+                suffix: None,
+                kind: *kind,
+                axis: normalized(joint.axis),
+            }],
+            JointType::Planar => joint_kinds::planar_steps(),
+            JointType::Fixed | JointType::Unsupported(_) => Vec::new(),
+        };
+        if !steps.is_empty() {
+            let last = steps.len() - 1;
+            let mut parent = above.body;
+            for (k, step) in steps.into_iter().enumerate() {
                 let b = joints.len();
+                // The steps of a planar joint: the first at the joint's origin, each next one
+                // at its predecessor's body origin; the last body is the child link's.
                 joints.push(Joint {
-                    name: joint.name.clone(),
-                    kind: *kind,
-                    parent: above.body,
-                    origin: placement,
-                    axis: normalized(joint.axis),
-                    limits: joint.limits.clone(),
+                    name: match step.suffix {
+                        Some(suffix) => format!("{}.{suffix}", joint.name),
+                        None => joint.name.clone(),
+                    },
+                    kind: step.kind,
+                    parent,
+                    origin: if k == 0 {
+                        placement.clone()
+                    } else {
+                        Transform::identity()
+                    },
+                    axis: step.axis,
+                    limits: (last == 0).then(|| joint.limits.clone()).flatten(),
                     damping: joint.damping,
                     friction: joint.friction,
                     armature: 0.0,
                     mimic: joint.mimic.clone(),
                     symbolic_origin: false,
                 });
+                let links = if k == last {
+                    vec![child_link.name.clone()]
+                } else {
+                    Vec::new()
+                };
                 bodies.push(Body {
                     name: child_link.name.clone(),
                     mass: 0.0,
                     com: Vector3::zeros(),
                     inertia: Matrix3::zeros(),
-                    merged_links: vec![child_link.name.clone()],
+                    merged_links: links,
                     symbolic: false,
                 });
-                inertias.push(Inertia::of_link(
-                    &child_link.inertial,
-                    &Transform::identity(),
-                ));
-                attach[child] = Attachment {
-                    body: Some(b),
-                    placement: Transform::identity(),
+                let empty = InertialDescription::default();
+                let inertial = if k == last {
+                    &child_link.inertial
+                } else {
+                    &empty
                 };
+                inertias.push(Inertia::of_link(inertial, &Transform::identity()));
+                parent = Some(b);
             }
+            attach[child] = Attachment {
+                body: parent,
+                placement: Transform::identity(),
+            };
+            continue;
+        }
+        match &joint.joint_type {
+            JointType::Moving(_) | JointType::Planar => {}
             JointType::Fixed | JointType::Unsupported(_) => {
                 let part = Inertia::of_link(&child_link.inertial, &placement);
                 match above.body {
@@ -1452,7 +1501,7 @@ fn contact_frames(model: &Model, links: &[String], file: &str) -> Result<Vec<usi
 fn without_world_floating_joint(robot: &RobotDescription) -> (Option<RobotDescription>, bool) {
     let is_child = |link: &str| robot.joints.iter().any(|j| j.child == link);
     let floating = robot.joints.iter().position(|j| {
-        matches!(&j.joint_type, JointType::Unsupported(k) if k == "floating")
+        j.joint_type == JointType::Moving(JointKind::Floating)
             && !is_child(&j.parent)
             && robot.joints.iter().filter(|o| o.parent == j.parent).count() == 1
     });
@@ -1510,6 +1559,10 @@ fn check_singular(
             let about = inertia.about_origin();
             let axial = (joint.axis.transpose() * about * joint.axis)[0];
             axial > SINGULAR_TOLERANCE * about.trace()
+        } else if joint.kind == JointKind::Floating {
+            // Every direction of rotation about the centre of mass must meet inertia.
+            let tolerance = SINGULAR_TOLERANCE * inertia.inertia.trace();
+            inertia.mass > 0.0 && inertia.inertia.symmetric_eigenvalues().min() > tolerance
         } else {
             inertia.mass > 0.0
         };

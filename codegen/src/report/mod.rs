@@ -657,11 +657,7 @@ pub(crate) fn value_source(name: &str) -> &'static str {
 }
 
 fn kind_name(k: JointKind) -> &'static str {
-    match k {
-        JointKind::Revolute => "revolute",
-        JointKind::Continuous => "continuous",
-        JointKind::Prismatic => "prismatic",
-    }
+    k.urdf_name()
 }
 
 /// A vector as `(1, 0, 0)`.
