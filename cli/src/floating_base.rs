@@ -72,7 +72,9 @@ mod tests {
             }
         }
         let text = format!("<robot name=\"dog\">{}</robot>", parts.concat());
-        eomgen::urdf::load_str(&text, "dog.urdf", &Default::default()).unwrap()
+        eomgen::Builder::from_urdf_str(&text, "dog.urdf")
+            .model()
+            .unwrap()
     }
 
     #[test]

@@ -3,10 +3,9 @@
 use std::fmt::Write as _;
 use std::time::Duration;
 
-use eomgen::dynamics::Derivation;
-use eomgen::emit::Generated;
 use eomgen::model::{JointKind, Model};
 use eomgen::report::format_number;
+use eomgen::{Derived, Generated, OpCount};
 
 fn kind(k: JointKind) -> &'static str {
     k.urdf_name()
@@ -61,13 +60,13 @@ fn mimic_note(model: &Model) -> Option<String> {
 /// One line per generated function: its straight-line operations, or `run time` for one
 /// composed at run time from the others (a solve, a loop, a runtime kernel), in catalogue
 /// order; functions with both list their straight-line part.
-fn operation_counts(d: &Derivation, generated: &Generated) -> String {
-    let mut rows: Vec<(&str, Option<&eomgen::cas::OpCount>)> = d
-        .quantities
-        .iter()
-        .map(|q| {
-            let ops = generated.op_counts.iter().find(|(n, _)| n == q.name);
-            (q.name, ops.map(|(_, o)| o))
+fn operation_counts(derived: &Derived, generated: &Generated) -> String {
+    let mut rows: Vec<(&str, Option<&OpCount>)> = derived
+        .quantity_names()
+        .into_iter()
+        .map(|name| {
+            let ops = generated.op_counts.iter().find(|(n, _)| n == name);
+            (name, ops.map(|(_, o)| o))
         })
         .collect();
     for (name, ops) in &generated.op_counts {
@@ -88,13 +87,25 @@ fn operation_counts(d: &Derivation, generated: &Generated) -> String {
 
 /// The report. `load` and `emit` are the times of reading the URDF and of emitting code.
 pub fn print(
-    model: &Model,
-    d: &Derivation,
+    derived: &Derived,
     generated: &Generated,
     source: &str,
     load: Duration,
     emit: Duration,
 ) -> String {
+    let model = derived.model();
+    let mut out = summary(model, source);
+    tree(&mut out, model);
+    limits_and_effects(&mut out, model);
+    let _ = writeln!(out, "\noperations per call of each generated function:");
+    let _ = write!(out, "{}", operation_counts(derived, generated));
+    times(&mut out, derived, load, emit);
+    out
+}
+
+/// The robot, its degrees of freedom, mass and gravity, and the notes on its base and mimic
+/// tags.
+fn summary(model: &Model, source: &str) -> String {
     let mut out = String::new();
     let total_mass: f64 = model.bodies.iter().chain(&model.base).map(|b| b.mass).sum();
     let _ = writeln!(out, "robot: {} ({source})", model.name);
@@ -103,8 +114,8 @@ pub fn print(
             out,
             "degrees of freedom: {} joints + 6 of the floating base (NQ {}, NV {})",
             model.coordinates(),
-            d.nq,
-            d.dof
+            model.nq(),
+            model.nv()
         );
     } else if model.is_coupled() {
         let _ = writeln!(
@@ -118,7 +129,9 @@ pub fn print(
         let _ = writeln!(
             out,
             "degrees of freedom: {} (floating joints: NQ {}, NV {})",
-            d.dof, d.nq, d.dof
+            model.nv(),
+            model.nq(),
+            model.nv()
         );
     } else {
         let _ = writeln!(out, "degrees of freedom: {}", model.dof());
@@ -137,7 +150,11 @@ pub fn print(
         let _ = writeln!(out, "note: {note}");
     }
 
-    // The tree, depth first with an explicit stack (no recursion on user input).
+    out
+}
+
+/// The kinematic tree, depth first with an explicit stack (no recursion on user input).
+fn tree(out: &mut String, model: &Model) {
     let _ = writeln!(
         out,
         "\ntree (coordinate, joint: type about its axis in the joint frame -> body, mass):"
@@ -179,56 +196,65 @@ pub fn print(
     };
     push(&mut stack, children(None), "");
     while let Some((j, prefix, last)) = stack.pop() {
-        let joint = &model.joints[j];
-        let body = &model.bodies[j];
-        let _ = write!(
-            out,
-            "{prefix}{} {} {}: {} about {} -> {}, {} kg",
-            if last { "└──" } else { "├──" },
-            label(model, j),
-            joint.name,
-            kind(joint.kind),
-            vec3(&joint.axis),
-            body.name,
-            format_number(body.mass, Some(6))
-        );
-        let merged: Vec<&str> = body
-            .merged_links
-            .iter()
-            .skip(1)
-            .map(|s| s.as_str())
-            .collect();
-        if !merged.is_empty() {
-            let _ = write!(out, " (merged: {})", merged.join(", "));
-        }
-        let coupling = model.coupling.get(j).filter(|c| c.leader.is_some());
-        match (&joint.mimic, coupling) {
-            (Some(m), Some(c)) => {
-                let _ = write!(
-                    out,
-                    " (mimics {}: follows q{} x {} + {})",
-                    m.joint,
-                    c.coordinate + 1,
-                    format_number(c.multiplier, Some(6)),
-                    format_number(c.offset, Some(6))
-                );
-            }
-            (Some(m), None) => {
-                let _ = write!(
-                    out,
-                    " (mimics {} x {} + {}, treated as independent)",
-                    m.joint,
-                    format_number(m.multiplier, Some(6)),
-                    format_number(m.offset, Some(6))
-                );
-            }
-            _ => {}
-        }
-        out.push('\n');
+        tree_line(out, model, j, &prefix, last);
         let deeper = format!("{prefix}{}", if last { "    " } else { "│   " });
         push(&mut stack, children(Some(j)), &deeper);
     }
+}
 
+/// Joint `j`'s line of the tree: its coordinate, name, kind, axis, body and mass, merged
+/// links and mimic tag.
+fn tree_line(out: &mut String, model: &Model, j: usize, prefix: &str, last: bool) {
+    let joint = &model.joints[j];
+    let body = &model.bodies[j];
+    let _ = write!(
+        out,
+        "{prefix}{} {} {}: {} about {} -> {}, {} kg",
+        if last { "└──" } else { "├──" },
+        label(model, j),
+        joint.name,
+        kind(joint.kind),
+        vec3(&joint.axis),
+        body.name,
+        format_number(body.mass, Some(6))
+    );
+    let merged: Vec<&str> = body
+        .merged_links
+        .iter()
+        .skip(1)
+        .map(|s| s.as_str())
+        .collect();
+    if !merged.is_empty() {
+        let _ = write!(out, " (merged: {})", merged.join(", "));
+    }
+    let coupling = model.coupling.get(j).filter(|c| c.leader.is_some());
+    match (&joint.mimic, coupling) {
+        (Some(m), Some(c)) => {
+            let _ = write!(
+                out,
+                " (mimics {}: follows q{} x {} + {})",
+                m.joint,
+                c.coordinate + 1,
+                format_number(c.multiplier, Some(6)),
+                format_number(c.offset, Some(6))
+            );
+        }
+        (Some(m), None) => {
+            let _ = write!(
+                out,
+                " (mimics {} x {} + {}, treated as independent)",
+                m.joint,
+                format_number(m.multiplier, Some(6)),
+                format_number(m.offset, Some(6))
+            );
+        }
+        _ => {}
+    }
+    out.push('\n');
+}
+
+/// The joint limits, and the joint effects when the URDF has any.
+fn limits_and_effects(out: &mut String, model: &Model) {
     let _ = writeln!(out, "\njoint limits (lower, upper, effort, velocity):");
     for (i, j) in model.joints.iter().enumerate() {
         let limits = match &j.limits {
@@ -270,13 +296,13 @@ pub fn print(
             );
         }
     }
+}
 
-    let _ = writeln!(out, "\noperations per call of each generated function:");
-    let _ = write!(out, "{}", operation_counts(d, generated));
-
-    let derive: Duration = d.timings.iter().map(|t| t.1).sum();
-    let stages: Vec<String> = d
-        .timings
+/// How long reading, deriving (per stage) and emitting took, and the graph's size.
+fn times(out: &mut String, derived: &Derived, load: Duration, emit: Duration) {
+    let derive: Duration = derived.timings().iter().map(|t| t.1).sum();
+    let stages: Vec<String> = derived
+        .timings()
         .iter()
         .map(|(n, t)| format!("{n} {}", ms(*t)))
         .collect();
@@ -287,8 +313,7 @@ pub fn print(
         "  derivation: {} ({}); expression graph: {} nodes",
         ms(derive),
         stages.join(", "),
-        d.graph.len()
+        derived.graph_nodes()
     );
     let _ = writeln!(out, "  code generation: {}", ms(emit));
-    out
 }

@@ -272,16 +272,32 @@ impl Builder {
 
     /// Generates only the named functions (and those they call), for a firmware that needs
     /// inverse dynamics alone, say; by default every one is generated. The names are those of
-    /// the generated methods: `mass_matrix`, `gravity`, `bias`, `coriolis_matrix`,
-    /// `inverse_dynamics`, `forward_dynamics` (with `try_forward_dynamics`), `kinetic_energy`,
-    /// `potential_energy`, `centrifugal`, `coriolis_pairs`, `friction` (with
-    /// [`Builder::friction`]), `link_pose` and `link_jacobian`; with [`Builder::derivatives`],
-    /// `inverse_dynamics_derivatives`, `forward_dynamics_derivatives` and
-    /// `mass_matrix_inverse`; with [`Builder::regressor`], `regressor`, `parameters`,
-    /// `base_regressor` and `base_parameters`. An unknown name fails generation with
-    /// [`Error::UnknownQuantity`].
+    /// the generated methods, or the symbols of [`crate::catalogue::NOTATIONS`] (`M`, `tau`):
     ///
-    /// The `Dynamics` trait is implemented when all its eight methods are selected; otherwise
+    /// - the dynamics: `mass_matrix`, `gravity`, `bias`, `coriolis_matrix`,
+    ///   `inverse_dynamics`, `forward_dynamics` (with `try_forward_dynamics`),
+    ///   `kinetic_energy`, `potential_energy`; Craig's `centrifugal` and `coriolis_pairs`
+    ///   (fixed base); `friction` (with [`Builder::friction`]);
+    /// - kinematics: `link_pose`, `link_jacobian`, `link_velocity`, `link_acceleration`,
+    ///   `link_jacobian_time_variation`, `center_of_mass`, `center_of_mass_jacobian`,
+    ///   `centroidal_map`, `centroidal_momentum_rate`; the configuration space: `integrate`
+    ///   (floating base), `difference`, `integrate_jacobians`, `difference_jacobians`;
+    /// - contacts ([`Builder::contact_points`], [`Builder::contact_frames`]):
+    ///   `contact_jacobian`, `contact_drift`, `contact_placements`,
+    ///   `contact_forward_dynamics`, `contact_forward_dynamics_active`,
+    ///   `contact_forward_dynamics_stabilized`, `impulse_dynamics`, `impulse_dynamics_active`;
+    /// - with [`Builder::derivatives`]: `inverse_dynamics_derivatives`,
+    ///   `forward_dynamics_derivatives`, `mass_matrix_inverse`, and with contacts
+    ///   `contact_dynamics_partials`, `contact_forward_dynamics_derivatives`,
+    ///   `contact_forward_dynamics_derivatives_active`, `impulse_dynamics_partials`,
+    ///   `impulse_dynamics_derivatives`, `impulse_dynamics_derivatives_active`;
+    /// - with [`Builder::regressor`]: `regressor`, `parameters`, `base_regressor` and
+    ///   `base_parameters`.
+    ///
+    /// An unknown name fails generation with [`Error::UnknownQuantity`]. A unit test checks
+    /// that this list names every quantity of the catalogue.
+    ///
+    /// The `Dynamics` trait is implemented when all its methods are selected; otherwise
     /// the selected ones are inherent methods of the generated type. A selected function brings
     /// the generated functions it calls, and those they call: on a large robot Craig's
     /// `centrifugal` and `coriolis_pairs` call `coriolis_matrix`, and
@@ -307,7 +323,8 @@ impl Builder {
     /// assert!(err.to_string().contains("unknown quantity `mass_matrx`"));
     /// ```
     pub fn quantities<S: Into<String>>(mut self, names: impl IntoIterator<Item = S>) -> Builder {
-        self.quantities = Some(names.into_iter().map(Into::into).collect());
+        let canonical = |s: String| crate::catalogue::canonical(&s).to_string();
+        self.quantities = Some(names.into_iter().map(Into::into).map(canonical).collect());
         self
     }
 
@@ -560,7 +577,9 @@ impl Builder {
     }
 
     /// Derives the equations of `model` (usually from [`Builder::model`]) within the limits
-    /// of [`Builder::max_dof`] and [`Builder::max_graph_nodes`].
+    /// of [`Builder::max_dof`] and [`Builder::max_graph_nodes`]; [`Builder::derived_from`]
+    /// gives them as a [`crate::Derived`].
+    #[doc(hidden)]
     pub fn derive(&self, model: &Model) -> Result<Derivation, Error> {
         let file = self.urdf.display().to_string();
         if model.dof() > self.max_dof {
@@ -636,7 +655,25 @@ impl Builder {
         Ok(crate::Derived::from_parts(model, derivation))
     }
 
-    /// Derives and emits, returning the source and the operation counts.
+    /// Derives and emits: the source and operation counts, and the derived robot (to evaluate
+    /// or print its equations without deriving again).
+    ///
+    /// ```
+    /// let (generated, derived) = eomgen::Builder::new("../generated/robots/double_pendulum.urdf")
+    ///     .generate_derived()
+    ///     .unwrap();
+    /// assert!(generated.source.contains("pub struct"));
+    /// assert!(generated.op_counts.iter().any(|(name, _)| name == "mass_matrix"));
+    /// assert_eq!(derived.model().dof(), 2);
+    /// ```
+    pub fn generate_derived(&self) -> Result<(Generated, crate::Derived), Error> {
+        let (generated, model, derivation) = self.generate_with_report()?;
+        Ok((generated, crate::Derived::from_parts(model, derivation)))
+    }
+
+    /// Derives and emits, returning the source and the operation counts; prefer
+    /// [`Builder::generate_derived`].
+    #[doc(hidden)]
     pub fn generate_with_report(&self) -> Result<(Generated, Model, Derivation), Error> {
         let model = self.model()?;
         let (type_name, module_name) = self.names(&model)?;
@@ -700,5 +737,47 @@ impl Builder {
         let path = out_dir.join(format!("{module_name}.rs"));
         crate::write_if_changed(&path, generated.source.as_bytes())?;
         Ok(path)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Builder;
+
+    /// The documentation of [`Builder::quantities`].
+    fn quantities_doc() -> &'static str {
+        let source = include_str!("builder.rs");
+        let start = source
+            .find("/// Generates only the named functions")
+            .expect("the docs");
+        let end = source.find("pub fn quantities<").expect("the method");
+        &source[start..end]
+    }
+
+    /// Every quantity a catalogue can hold, fixed base and floating, with every option, is
+    /// named in `Builder::quantities`'s documentation: the list follows the catalogue.
+    #[test]
+    fn the_quantities_docs_name_every_quantity_of_the_catalogue() {
+        let urdf = "../generated/robots/double_pendulum.urdf";
+        let fixed = Builder::new(urdf).friction(true).derivatives().regressor();
+        let floating = Builder::new(urdf)
+            .floating_base()
+            .derivatives()
+            .contact_points(&["link2"])
+            .contact_frames(&["link1"]);
+        let doc = quantities_doc();
+        let mut missing: Vec<&str> = Vec::new();
+        for b in [fixed, floating] {
+            for name in b.derived().unwrap().quantity_names() {
+                if !doc.contains(&format!("`{name}`")) && !missing.contains(&name) {
+                    missing.push(name);
+                }
+            }
+        }
+        assert!(
+            missing.is_empty(),
+            "not in Builder::quantities's documentation: {}",
+            missing.join(", ")
+        );
     }
 }

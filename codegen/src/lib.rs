@@ -36,8 +36,11 @@
 //! command line (crate `eomgen-cli`) prints the same equations for people.
 //!
 //! Beside [`Builder`], the public API is [`Error`], the [`model`] a builder loads
-//! ([`Builder::model`]: its joints, bodies and frames, and [`ModelError`]) and [`report`]
-//! (equations for people: text, LaTeX, Markdown; the `eomgen show` command). The stages in
+//! ([`Builder::model`]: its joints, bodies and frames, and [`ModelError`]), the [`catalogue`]
+//! of quantities (one name each, symbols as aliases), [`Derived`] and [`evaluate`] (numbers
+//! at any state without compiling, [`Builder::derived`]), [`Generated`] (the source and
+//! operation counts) and [`report`] (equations for people: text, LaTeX, Markdown; the
+//! `eomgen show` command). The `eomgen` command line uses nothing else. The stages in
 //! between (URDF reader, computer algebra, kinematics, derivation, emission) are public for
 //! the command line and the tests but hidden from this page: they change between minor
 //! versions. `docs/architecture.md` in the repository describes them.
@@ -52,6 +55,7 @@ use std::path::{Path, PathBuf};
 mod builder;
 #[doc(hidden)]
 pub mod cas;
+pub mod catalogue;
 mod debug_display;
 #[doc(hidden)]
 pub mod dynamics;
@@ -67,9 +71,12 @@ pub mod report;
 pub mod spatial;
 #[doc(hidden)]
 pub mod urdf;
+mod wording;
 
 pub use builder::{Builder, DEFAULT_MAX_DOF, DEFAULT_MAX_FUNCTION_OPS, DEFAULT_MAX_GRAPH_NODES};
+pub use cas::OpCount;
 pub use dynamics::{Input, Shape};
+pub use emit::Generated;
 pub use evaluate::Derived;
 pub use model::{ModelError, ModelOptions, SymbolicParams};
 

@@ -160,6 +160,71 @@ pub enum ActiveContacts {
     ImpulseDerivatives,
 }
 
+/// How the entries of a printed quantity are indexed and named.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Layout {
+    /// One number (`T`).
+    Scalar,
+    /// `N` entries (`G1`).
+    Vector,
+    /// `N x N`, symmetric: the upper triangle is printed (`M12`).
+    Symmetric,
+    /// `N x N` (`C12`).
+    Square,
+    /// Craig's `N x N(N-1)/2`, a row per joint and a column per pair `j < k` (`B1_23`).
+    Pairs,
+    /// `N x N` partial derivatives of joint efforts in joint positions (`dtau1/dq2`).
+    Partials,
+}
+
+/// How people name and write a quantity: its generated method's name (its one name
+/// everywhere), the symbols printed by `eomgen show` and accepted as aliases by every command,
+/// the heading and definition of its printed section, and the expressions printed (the
+/// readable closed forms, which may differ from the route generated code takes).
+///
+/// [`NOTATIONS`](super::quantities::NOTATIONS) lists them; `show --term`, `eval`, the command
+/// line's help, `Builder::quantities` and the reports read it.
+#[derive(Clone, Copy, Debug)]
+pub struct Notation {
+    /// The generated method's name.
+    pub name: &'static str,
+    /// The symbol in plain text, the prefix of printed entries (`M` gives `M12`).
+    pub text: &'static str,
+    /// The symbol in LaTeX (`\tau` gives `\tau_{1}`).
+    pub latex: &'static str,
+    /// Other names accepted for it: textbook symbols and earlier names.
+    pub aliases: &'static [&'static str],
+    /// The heading of its printed section.
+    pub title: &'static str,
+    /// The sentence under the heading, or empty.
+    pub definition: &'static str,
+    /// How its entries are indexed.
+    pub layout: Layout,
+    /// The expressions printed, row-major (`None`: not derived for this robot).
+    pub(crate) printed: fn(&super::Derivation) -> Option<Vec<Id>>,
+}
+
+impl Notation {
+    /// Whether `s` names this quantity: its name or one of its aliases (case matters: `B` and
+    /// `b` differ).
+    pub fn is_named(&self, s: &str) -> bool {
+        self.name == s || self.aliases.contains(&s)
+    }
+}
+
+pub use super::quantities::NOTATIONS;
+
+/// The notation of the quantity named `s` (its name or an alias).
+pub fn notation(s: &str) -> Option<&'static Notation> {
+    NOTATIONS.iter().find(|n| n.is_named(s))
+}
+
+/// The generated name of the quantity named `s` (a name or an alias); `s` itself when no
+/// notation has it.
+pub fn canonical(s: &str) -> &str {
+    notation(s).map_or(s, |n| n.name)
+}
+
 /// One generated function.
 #[derive(Clone, Debug)]
 pub struct Quantity {
@@ -180,6 +245,11 @@ pub struct Quantity {
 }
 
 impl Quantity {
+    /// How people write it, when it has symbols ([`Notation`]).
+    pub fn notation(&self) -> Option<&'static Notation> {
+        NOTATIONS.iter().find(|n| n.name == self.name)
+    }
+
     /// The expressions a straight-line body evaluates (for a forward dynamics, the
     /// accelerations and then the pivots); empty for loop kernels.
     pub fn exprs(&self) -> Vec<Id> {
@@ -262,6 +332,8 @@ pub fn names(quantities: &[Quantity]) -> Vec<&'static str> {
 /// Keeps the quantities named in `wanted` and everything they need, transitively (a need of a
 /// need, such as the `mass_matrix` that a run-time `forward_dynamics` calls for
 /// `forward_dynamics_derivatives`), in catalogue order; `Err` with the first unknown name.
+/// The runtime's `Dynamics` trait is implemented only with all its methods: when the
+/// selection leaves some out, the ones kept become inherent ([`Home::Inherent`]).
 pub fn select(quantities: Vec<Quantity>, wanted: &[String]) -> Result<Vec<Quantity>, String> {
     if let Some(bad) = wanted
         .iter()
@@ -281,10 +353,18 @@ pub fn select(quantities: Vec<Quantity>, wanted: &[String]) -> Result<Vec<Quanti
             todo.extend(q.needs());
         }
     }
-    Ok(quantities
+    let in_trait = |qs: &[Quantity]| qs.iter().filter(|q| q.home == Home::Dynamics).count();
+    let all = in_trait(&quantities);
+    let mut kept: Vec<Quantity> = quantities
         .into_iter()
         .filter(|q| keep.contains(&q.name))
-        .collect())
+        .collect();
+    if in_trait(&kept) < all {
+        for q in kept.iter_mut().filter(|q| q.home == Home::Dynamics) {
+            q.home = Home::Inherent;
+        }
+    }
+    Ok(kept)
 }
 
 #[cfg(test)]
@@ -362,6 +442,36 @@ mod tests {
             selected(&["gravity", "mass_matrix_inverse", "gravity"]),
             order
         );
+    }
+
+    #[test]
+    fn a_trait_keeps_its_methods_only_when_all_are_selected() {
+        let mut all = catalogue();
+        for q in all.iter_mut().take(3) {
+            q.home = Home::Dynamics;
+        }
+        let some = select(all.clone(), &["gravity".to_string()]).unwrap();
+        assert!(some.iter().all(|q| q.home == Home::Inherent));
+        let every = ["mass_matrix", "gravity", "inverse_dynamics"].map(String::from);
+        let kept = select(all, &every).unwrap();
+        assert!(kept.iter().all(|q| q.home == Home::Dynamics));
+    }
+
+    #[test]
+    fn names_and_symbols_are_one_quantity() {
+        assert_eq!(canonical("tau"), "inverse_dynamics");
+        assert_eq!(canonical("M"), "mass_matrix");
+        assert_eq!(canonical("coriolis"), "coriolis_matrix");
+        assert_eq!(canonical("mass_matrix"), "mass_matrix");
+        assert_eq!(canonical("link_pose"), "link_pose");
+        // Every name and alias is one quantity's only.
+        let mut seen = Vec::new();
+        for n in NOTATIONS.iter() {
+            for s in std::iter::once(n.name).chain(n.aliases.iter().copied()) {
+                assert!(!seen.contains(&s), "`{s}` names two quantities");
+                seen.push(s);
+            }
+        }
     }
 
     #[test]

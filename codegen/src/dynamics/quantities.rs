@@ -1,7 +1,7 @@
 //! The catalogue's entries: what each generated function is, how it is computed, and its
 //! expressions. One function per quantity; [`catalogue`] lists them in file order.
 
-use super::catalogue::{Craig, Evaluation, Home, Input, Quantity, Shape};
+use super::catalogue::{Craig, Evaluation, Home, Input, Layout, Notation, Quantity, Shape};
 use super::derivatives::Derivatives;
 use super::{centroidal, flat, Derivation, Route};
 use crate::cas::{Graph, Id, Program};
@@ -16,6 +16,120 @@ pub const CRAIG_FLAT_MAX_OPS: usize = 8000;
 const Q: &[Input] = &[Input::Q];
 const Q_QD: &[Input] = &[Input::Q, Input::Qd];
 const QD: &[Input] = &[Input::Qd];
+
+/// The readable closed form of `m`, flattened, or of `v`.
+fn matrix(m: &[Vec<Id>]) -> Option<Vec<Id>> {
+    Some(flat(m))
+}
+
+/// How people write the quantities that have symbols, in the order `eomgen show` prints them.
+pub static NOTATIONS: [Notation; 10] = [
+    Notation {
+        name: "mass_matrix",
+        text: "M",
+        latex: "M",
+        aliases: &["M"],
+        title: "Mass matrix M(q)",
+        definition: "Symmetric: entries below the diagonal are not shown.",
+        layout: Layout::Symmetric,
+        printed: |d| matrix(&d.mass_matrix),
+    },
+    Notation {
+        name: "coriolis_pairs",
+        text: "B",
+        latex: "B",
+        aliases: &["B"],
+        title: "Craig's Coriolis matrix B(q)",
+        definition: "B_i,jk multiplies qd_j qd_k (j < k): b = B(q) [qd qd] + C(q) [qd^2].",
+        layout: Layout::Pairs,
+        printed: |d| matrix(&d.coriolis_pairs),
+    },
+    Notation {
+        name: "centrifugal",
+        text: "C",
+        latex: "C",
+        aliases: &["C"],
+        title: "Craig's centrifugal matrix C(q)",
+        definition: "C_ij multiplies qd_j^2.",
+        layout: Layout::Square,
+        printed: |d| matrix(&d.centrifugal),
+    },
+    Notation {
+        name: "gravity",
+        text: "G",
+        latex: "G",
+        aliases: &["G"],
+        title: "Gravity G(q) = dV/dq",
+        definition: "",
+        layout: Layout::Vector,
+        printed: |d| Some(d.gravity.clone()),
+    },
+    Notation {
+        name: "bias",
+        text: "b",
+        latex: "b",
+        aliases: &["b"],
+        title: "Bias b(q, qd) = B(q) [qd qd] + C(q) [qd^2]",
+        definition: "Coriolis and centrifugal terms, without gravity.",
+        layout: Layout::Vector,
+        printed: |d| Some(d.bias.clone()),
+    },
+    Notation {
+        name: "coriolis_matrix",
+        text: "Cqd",
+        latex: "C^{\\dot{q}}",
+        aliases: &["coriolis"],
+        title: "Coriolis matrix C(q, qd), Christoffel form",
+        definition: "Cqd_ij = sum_k Gamma_ijk qd_k: b = C(q, qd) qd, and dM/dt - 2 C(q, qd) is \
+                     skew-symmetric.",
+        layout: Layout::Square,
+        printed: |d| matrix(&d.coriolis_matrix),
+    },
+    Notation {
+        name: "inverse_dynamics",
+        text: "tau",
+        latex: "\\tau",
+        aliases: &["tau"],
+        title: "Inverse dynamics tau = M(q) qdd + b(q, qd) + G(q)",
+        definition: "",
+        layout: Layout::Vector,
+        printed: |d| Some(d.tau.clone()),
+    },
+    Notation {
+        name: "kinetic_energy",
+        text: "T",
+        latex: "T",
+        aliases: &["T"],
+        title: "Kinetic energy T = qd^T M(q) qd / 2",
+        definition: "",
+        layout: Layout::Scalar,
+        printed: |d| Some(vec![d.kinetic_energy]),
+    },
+    Notation {
+        name: "potential_energy",
+        text: "V",
+        latex: "V",
+        aliases: &["V"],
+        title: "Potential energy V = -sum over bodies of m g.c",
+        definition: "",
+        layout: Layout::Scalar,
+        printed: |d| Some(vec![d.potential_energy]),
+    },
+    Notation {
+        name: "inverse_dynamics_derivatives",
+        text: "dtau_dq",
+        latex: "\\partial\\tau",
+        aliases: &["dtau_dq"],
+        title: "Derivatives of inverse dynamics d tau / d q (q, qd, qdd)",
+        definition: "dtau_i/dq_j: how joint effort i changes with joint position j.",
+        layout: Layout::Partials,
+        // d tau / d q, the first N x N of (d tau / d q, d tau / d qd).
+        printed: |d| match d.quantity("inverse_dynamics_derivatives").map(|q| &q.eval) {
+            Some(Evaluation::Exprs(ids)) => Some(ids[..d.dof * d.dof].to_vec()),
+            _ => None,
+        },
+    },
+];
 
 /// Every quantity generated code can evaluate for `model`, in file order.
 pub fn catalogue(model: &Model, d: &Derivation) -> Vec<Quantity> {

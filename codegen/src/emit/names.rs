@@ -119,21 +119,9 @@ pub fn snake(name: &str, fallback: &str) -> String {
     finish(s, fallback)
 }
 
-/// `text` made safe for a comment (doc comments included): control characters other than tab
-/// (newlines, carriage returns) and the bidirectional-text controls that rustc refuses in
-/// comments (`text_direction_codepoint_in_comment`, deny by default) are written as escapes
-/// such as `\u{202e}`; everything else, `*/` included, is harmless in a line comment.
+/// `text` made safe for a comment (see [`crate::wording::escape_controls`]).
 pub fn comment_text(text: &str) -> String {
-    let bidi = |c: char| matches!(c, '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}');
-    text.chars()
-        .map(|c| {
-            if (c.is_control() && c != '\t') || bidi(c) {
-                format!("\\u{{{:x}}}", c as u32)
-            } else {
-                c.to_string()
-            }
-        })
-        .collect()
+    crate::wording::escape_controls(text)
 }
 
 /// Hands out identifiers unique within one scope, suffixing `_2`, `_3`, ... on collision.

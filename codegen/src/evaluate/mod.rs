@@ -173,13 +173,30 @@ impl Derived {
         &self.model
     }
 
+    /// The derivation, for the reports and the tests.
+    #[doc(hidden)]
+    pub fn derivation(&self) -> &Derivation {
+        &self.derivation
+    }
+
+    /// How long each stage of the derivation took, in order.
+    pub fn timings(&self) -> &[(&'static str, std::time::Duration)] {
+        &self.derivation.timings
+    }
+
+    /// The number of nodes of the expression graph the derivation built.
+    pub fn graph_nodes(&self) -> usize {
+        self.derivation.graph.len()
+    }
+
     /// The catalogue: every quantity generated code has for this robot and these options, in
     /// file order, by name.
     pub fn quantity_names(&self) -> Vec<&'static str> {
         self.derivation.quantities.iter().map(|q| q.name).collect()
     }
 
-    /// Compiles the quantities `names` (catalogue names, as the generated methods).
+    /// Compiles the quantities `names` (catalogue names, as the generated methods, or their
+    /// symbols: `M`, `tau`; see [`crate::catalogue`]).
     pub fn evaluator(&self, names: &[&str]) -> Result<Evaluator, EvalError> {
         let d = &self.derivation;
         let layout = Layout {
@@ -191,10 +208,11 @@ impl Derived {
         let plans = names
             .iter()
             .map(|&name| {
-                let q = find(name).ok_or_else(|| EvalError::Unknown {
-                    name: name.to_string(),
-                    known: self.quantity_names().join(", "),
-                })?;
+                let q =
+                    find(crate::catalogue::canonical(name)).ok_or_else(|| EvalError::Unknown {
+                        name: name.to_string(),
+                        known: self.quantity_names().join(", "),
+                    })?;
                 let plan = Plan::new(d, layout, q, &find)?;
                 Ok((q.name, q.shape, q.inputs.to_vec(), plan))
             })

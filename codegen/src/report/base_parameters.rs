@@ -2,7 +2,7 @@
 //! combination of standard parameters, in text, LaTeX or Markdown.
 //!
 //! ```
-//! use eomgen::report::{render_base_parameters, ShowOptions};
+//! use eomgen::report::{print_base_parameters, ShowOptions};
 //! let urdf = r#"<robot name="pendulum">
 //!   <link name="base"/>
 //!   <link name="arm">
@@ -15,10 +15,11 @@
 //!     <parent link="base"/> <child link="arm"/> <axis xyz="0 1 0"/>
 //!   </joint>
 //! </robot>"#;
-//! let model = eomgen::urdf::load_str(urdf, "pendulum.urdf", &Default::default()).unwrap();
-//! let mut d = eomgen::dynamics::Derivation::new(&model);
-//! d.add_regressor(&model).unwrap();
-//! let text = render_base_parameters(&model, &d, &ShowOptions::default()).unwrap();
+//! let derived = eomgen::Builder::from_urdf_str(urdf, "pendulum.urdf")
+//!     .regressor()
+//!     .derived()
+//!     .unwrap();
+//! let text = print_base_parameters(&derived, &ShowOptions::default()).unwrap();
 //! // Swinging about y under gravity along z: YY (about the pivot) and the first moments
 //! // across the axis, MX and MZ.
 //! assert!(text.contains("  MX_arm = MX_arm\n"));
@@ -34,9 +35,10 @@ use crate::dynamics::regressor::Owner;
 use crate::dynamics::Derivation;
 use crate::model::Model;
 
-use super::{
-    aligned, describe_param, kind_name, md_escape, style_of, tex_escape, value_source, vec3,
-};
+use super::document::{describe_param, kind_name, value_source, vec3};
+use super::latex::{align, aligned, tex_escape};
+use super::markdown::md_escape;
+use super::style_of;
 use super::{Format, ReportError, ShowOptions};
 
 /// Numeric coefficients at most this large are rounding noise of the geometry and are not
@@ -47,6 +49,7 @@ const NOISE: f64 = 1e-12;
 /// combination of standard parameters, with its value from the URDF, the joints, the standard
 /// parameters that have no effect at all, and a legend. Honours the format, digits, source
 /// and standalone options of `opts`; its terms, entry and form do not apply.
+#[doc(hidden)]
 pub fn render_base_parameters(
     model: &Model,
     d: &Derivation,
@@ -262,7 +265,7 @@ impl Document {
                 ("Values from the URDF", &self.values),
             ] {
                 let _ = writeln!(out, "\\section*{{{title}}}");
-                super::align(&mut out, lines);
+                align(&mut out, lines);
             }
             let _ = writeln!(out, "\\section*{{Legend}}");
             for (a, b) in &self.legend {

@@ -2,8 +2,9 @@
 //! `--form hamiltonian`): sections for [`super::render`] built from the per-body terms of
 //! [`crate::dynamics::projected`] and from Hamilton's equations.
 
-use super::{build_section, entry_name, Entry, ReportError, Section, ShowOptions, Term};
+use super::{build_section, entry_name, Entry, ReportError, Section, ShowOptions};
 use crate::cas::{Graph, Id, Program, Syntax};
+use crate::dynamics::catalogue::notation;
 use crate::dynamics::{projected, Derivation};
 use crate::model::Model;
 
@@ -25,13 +26,14 @@ fn refuse_large(g: &Graph, model: &Model, ids: &[Id], form: &str) -> Result<(), 
 }
 
 fn matrix_entries(g: &Graph, m: &[Vec<Id>], dof: usize, syntax: Syntax) -> Vec<Entry> {
+    let mass_matrix = notation("mass_matrix").expect("the mass matrix's notation");
     let mut out = Vec::new();
     for (i, row) in m.iter().enumerate() {
         for (j, &e) in row.iter().enumerate().skip(i) {
             if g.as_const(e) != Some(0.0) {
                 out.push(Entry {
-                    name: entry_name(Term::MassMatrix, &[i, j], dof, syntax),
-                    text: entry_name(Term::MassMatrix, &[i, j], dof, Syntax::Text),
+                    name: entry_name(mass_matrix, &[i, j], dof, syntax),
+                    text: entry_name(mass_matrix, &[i, j], dof, Syntax::Text),
                     expr: e,
                 });
             }
@@ -201,7 +203,12 @@ pub(super) fn hamiltonian(
         dropped,
     )?];
     let v = Entry {
-        name: entry_name(Term::PotentialEnergy, &[], n, syntax),
+        name: entry_name(
+            notation("potential_energy").expect("the potential energy's notation"),
+            &[],
+            n,
+            syntax,
+        ),
         text: "V".to_string(),
         expr: d.potential_energy,
     };

@@ -155,6 +155,6 @@ fn bound(x: f64) -> TokenStream {
     } else if x == f64::NEG_INFINITY {
         quote!(f64::NEG_INFINITY)
     } else {
-        super::f64_literal(x)
+        super::links::f64_literal(x)
     }
 }

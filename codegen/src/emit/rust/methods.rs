@@ -1,0 +1,209 @@
+//! One method per quantity: the dispatch on its [`Evaluation`], its signature and
+//! documentation, and the straight-line bodies (split beyond the budget, `emit/split.rs`).
+
+use proc_macro2::{Ident, TokenStream};
+use quote::{format_ident, quote};
+
+use super::{doc, usize_lit, Emitter};
+use crate::cas::{Id, OpCount};
+use crate::dynamics::{ActiveContacts, Craig, Evaluation, Input, Quantity, Shape};
+use crate::emit::body::{body, factored_body, shape_type, Body};
+use crate::emit::split::Split;
+
+impl Emitter<'_> {
+    pub(super) fn quantity_fn(&mut self, q: &Quantity) -> TokenStream {
+        match &q.eval {
+            Evaluation::Exprs(ids) => self.exprs_fn(q, ids),
+            Evaluation::CraigColumns(which) => self.craig_fn(q, *which),
+            Evaluation::ForwardDynamics { .. } | Evaluation::ForwardDynamicsSolve { .. } => {
+                self.forward_dynamics_fns(q)
+            }
+            Evaluation::LinkPose => self.link_pose_fn(q),
+            Evaluation::LinkJacobian => self.link_jacobian_fn(q),
+            Evaluation::MassMatrixInverse => self.mass_matrix_inverse_fn(q),
+            Evaluation::ForwardDynamicsDerivatives => self.forward_dynamics_derivatives_fn(q),
+            Evaluation::ContactForwardDynamics { h } => self.contact_forward_dynamics_fns(q, h),
+            Evaluation::Integrate => self.integrate_fn(q),
+            Evaluation::FrameMotion(m) => self.frame_motion_fn(q, *m),
+            Evaluation::Manifold(m) => self.manifold_fn(q, *m),
+            Evaluation::ContactDynamicsDerivatives { h } => {
+                self.contact_dynamics_derivatives_fns(q, h, false)
+            }
+            Evaluation::ImpulseDynamics => self.impulse_dynamics_fns(q, false),
+            Evaluation::ImpulseDynamicsDerivatives => {
+                self.impulse_dynamics_derivatives_fns(q, false)
+            }
+            Evaluation::ActiveContacts(a) => self.active_contacts_fns(q, a),
+            Evaluation::Factored { outputs, pivots } => self.factored_fn(q, outputs, pivots),
+        }
+    }
+
+    /// The methods of a set of active contacts ([`ActiveContacts`]).
+    pub(super) fn active_contacts_fns(&mut self, q: &Quantity, a: &ActiveContacts) -> TokenStream {
+        match a {
+            ActiveContacts::Dynamics { h } => self.contact_active_fns(q, h, false),
+            ActiveContacts::Stabilized { h } => self.contact_active_fns(q, h, true),
+            ActiveContacts::Derivatives { h } => self.contact_dynamics_derivatives_fns(q, h, true),
+            ActiveContacts::Impulse => self.impulse_dynamics_fns(q, true),
+            ActiveContacts::ImpulseDerivatives => self.impulse_dynamics_derivatives_fns(q, true),
+        }
+    }
+
+    /// The arguments `q: &[T; N], ...` of a quantity.
+    pub(super) fn args(&self, inputs: &[Input]) -> Vec<TokenStream> {
+        inputs
+            .iter()
+            .map(|i| {
+                let name = format_ident!("{}", i.name());
+                let len = match i {
+                    Input::Q => &self.nq,
+                    Input::Forces => &self.k,
+                    _ => &self.n,
+                };
+                quote!(#name: &[T; #len])
+            })
+            .collect()
+    }
+
+    /// The names `q, qd, ...` of a quantity's arguments.
+    pub(super) fn arg_names(inputs: &[Input]) -> Vec<Ident> {
+        inputs
+            .iter()
+            .map(|i| format_ident!("{}", i.name()))
+            .collect()
+    }
+
+    pub(super) fn quantity_doc(q: &Quantity, ops: Option<OpCount>) -> TokenStream {
+        let mut lines = q.doc.clone();
+        lines.push(String::new());
+        lines.push(q.route.clone());
+        if let Some(ops) = ops {
+            lines.push(format!("Operations: {ops}."));
+        }
+        doc(&lines)
+    }
+
+    /// Straight-line code for `outputs`, counted under `q`'s name.
+    pub(super) fn straight(
+        &mut self,
+        q: &Quantity,
+        outputs: &[Id],
+        shape: Shape,
+    ) -> (TokenStream, OpCount) {
+        let (params, args) = (self.args(q.inputs), Self::arg_names(q.inputs));
+        let rows = Self::row_groups(q.name, shape);
+        let mut split = self.split(q.name, &params, &args);
+        split.rows = &rows;
+        let b = body(self.graph, &self.cx, outputs, shape, Some(&split));
+        self.counts.push((q.name.to_string(), b.ops));
+        if !b.blocks.is_empty() {
+            self.split.insert(q.name.to_string());
+        }
+        self.blocks.extend(b.blocks);
+        (b.code, b.ops)
+    }
+
+    /// How a body of the function `name` is split beyond the budget.
+    pub(super) fn split<'s>(
+        &self,
+        name: &'s str,
+        params: &'s [TokenStream],
+        args: &'s [Ident],
+    ) -> Split<'s> {
+        Split {
+            name,
+            params,
+            args,
+            budget: self.budget,
+            rows: &[],
+        }
+    }
+
+    /// The row groups a split body of `name` fills separately ([`Split::rows`]): the impulse
+    /// partials' `N` rows in `q` and `K` contact rows, which `impulse_dynamics_derivatives`
+    /// has written straight into two matrices of its result.
+    pub(super) fn row_groups(name: &str, shape: Shape) -> Vec<usize> {
+        match (name, shape) {
+            ("impulse_dynamics_partials", Shape::Matrix(r, c)) if r > c => vec![c, r - c],
+            _ => Vec::new(),
+        }
+    }
+
+    pub(super) fn exprs_fn(&mut self, q: &Quantity, ids: &[Id]) -> TokenStream {
+        let (b, ops) = self.straight(q, ids, q.shape);
+        self.plain_fn(q, ops, b)
+    }
+
+    /// Straight-line code whose outputs hold when the factorization's pivots are positive.
+    pub(super) fn factored_fn(
+        &mut self,
+        q: &Quantity,
+        outputs: &[Id],
+        pivots: &[Id],
+    ) -> TokenStream {
+        let (params, args) = (self.args(q.inputs), Self::arg_names(q.inputs));
+        let split = self.split(q.name, &params, &args);
+        let Body {
+            code: b,
+            ops,
+            blocks,
+        } = factored_body(self.graph, &self.cx, outputs, pivots, q.shape, Some(&split));
+        self.counts.push((q.name.to_string(), ops));
+        self.blocks.extend(blocks);
+        self.plain_fn(q, ops, b)
+    }
+
+    /// The method of `q` taking its inputs, with `body` (counted `ops`).
+    pub(super) fn plain_fn(&self, q: &Quantity, ops: OpCount, body: TokenStream) -> TokenStream {
+        let docs = Self::quantity_doc(q, Some(ops));
+        let (name, args, ret) = (
+            format_ident!("{}", q.name),
+            self.args(q.inputs),
+            shape_type(q.shape),
+        );
+        let vis = self.vis(q.name);
+        quote! {
+            #docs
+            #vis fn #name(&self, #(#args),*) -> #ret { #body }
+        }
+    }
+
+    /// Craig's `C(q)` or `B(q)` from `N` Christoffel columns of `coriolis_matrix`.
+    pub(super) fn craig_fn(&mut self, q: &Quantity, which: Craig) -> TokenStream {
+        let docs = Self::quantity_doc(q, None);
+        let (name, ret) = (format_ident!("{}", q.name), shape_type(q.shape));
+        let n = &self.n;
+        let coriolis = self.call("coriolis_matrix");
+        let kernel = match which {
+            Craig::Centrifugal => quote!(centrifugal_from_coriolis),
+            Craig::CoriolisPairs => quote!(coriolis_pairs_from_coriolis),
+        };
+        quote! {
+            #docs
+            pub fn #name(&self, q: &[T; #n]) -> #ret {
+                ::eomgen_runtime::tree::#kernel(|v: &[T; #n]| #coriolis(self, q, v))
+            }
+        }
+    }
+
+    pub(super) fn integrate_fn(&mut self, q: &Quantity) -> TokenStream {
+        let docs = Self::quantity_doc(q, None);
+        let (n, nq, vis) = (&self.n, &self.nq, self.vis(q.name));
+        let body = if self.floating {
+            quote!(::eomgen_runtime::free_flyer::integrate(q, qd, dt))
+        } else {
+            let (q_at, v_at) = (self.model.q_offsets(), self.model.v_offsets());
+            let blocks = self.model.floating_joints().into_iter().map(|j| {
+                let (a, b) = (usize_lit(q_at[j]), usize_lit(v_at[j]));
+                quote!((#a, #b))
+            });
+            quote!(::eomgen_runtime::free_flyer::integrate_blocks(q, qd, dt, &[#(#blocks),*]))
+        };
+        quote! {
+            #docs
+            #vis fn integrate(&self, q: &[T; #nq], qd: &[T; #n], dt: T) -> [T; #nq] {
+                #body
+            }
+        }
+    }
+}

@@ -1,0 +1,347 @@
+//! The methods that solve with `M(q)`: forward dynamics (unrolled, or the tree `L^T D L` at
+//! run time), `M^-1`, the forward-dynamics derivatives and contact forward dynamics; and the
+//! constants and helpers those solves read (`PARENTS`, `CONTACT_ROWS`, the unrolled
+//! factorization).
+
+use proc_macro2::TokenStream;
+use quote::quote;
+
+use super::{usize_lit, Emitter};
+use crate::cas::{Id, OpCount};
+use crate::dynamics::{ActiveContacts, Evaluation, Quantity, Shape};
+
+impl Emitter<'_> {
+    /// `try_forward_dynamics`, which reports a failed pivot, and `forward_dynamics`, which
+    /// gives NaN then.
+    pub(super) fn forward_dynamics_fns(&mut self, q: &Quantity) -> TokenStream {
+        let (body, ops) = match &q.eval {
+            Evaluation::ForwardDynamics {
+                accelerations,
+                pivots,
+            } => self.unrolled_solve(q, accelerations, pivots),
+            Evaluation::ForwardDynamicsSolve { h } => self.runtime_solve(q, h),
+            _ => unreachable!("forward_dynamics_fns on another evaluation"),
+        };
+        let docs = Self::quantity_doc(q, Some(ops));
+        let (n, nq, vis) = (&self.n, &self.nq, self.vis(q.name));
+        self.try_forward_dynamics = quote! {
+            /// Forward dynamics `qdd = M(q)^-1 (tau - b(q, qd) - G(q))`, or which pivot of the
+            /// `L^T D L` factorization of M(q) was not positive (a non-physical model or
+            /// non-finite input); see `forward_dynamics` for the route and operation count.
+            /// `Ok` holds only finite numbers: a non-finite component `i` of the solution (from
+            /// a non-finite `qd` or `tau`, or a `q` that leaves M(q) finite) is reported as
+            /// `FactorError::NonFinite { pivot: i }`.
+            pub fn try_forward_dynamics(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n]) -> ::core::result::Result<[T; #n], ::eomgen_runtime::FactorError> {
+                #body
+            }
+        };
+        quote! {
+            #docs
+            #vis fn forward_dynamics(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n]) -> [T; #n] {
+                match self.try_forward_dynamics(q, qd, tau) {
+                    Ok(qdd) => qdd,
+                    Err(_) => [T::nan(); #n],
+                }
+            }
+        }
+    }
+
+    /// The body of an unrolled `try_forward_dynamics`: accelerations and pivots in one
+    /// straight-line program, the pivots checked.
+    pub(super) fn unrolled_solve(
+        &mut self,
+        q: &Quantity,
+        acc: &[Id],
+        piv: &[Id],
+    ) -> (TokenStream, OpCount) {
+        let dof = acc.len();
+        let outputs: Vec<Id> = acc.iter().chain(piv).copied().collect();
+        let (b, ops) = self.straight(q, &outputs, Shape::Vector(2 * dof));
+        let len = usize_lit(2 * dof);
+        let x = (0..dof).map(|i| {
+            let i = usize_lit(i);
+            quote!(o[#i])
+        });
+        let pivots = (0..dof).map(|i| {
+            let i = usize_lit(dof + i);
+            quote!(o[#i])
+        });
+        let body = quote! {
+            let o: [T; #len] = { #b };
+            let pivots = [#(#pivots),*];
+            for (pivot, d) in pivots.iter().enumerate() {
+                if !d.is_finite() {
+                    return Err(::eomgen_runtime::FactorError::NonFinite { pivot });
+                }
+                if *d <= T::zero() {
+                    return Err(::eomgen_runtime::FactorError::NotPositiveDefinite { pivot });
+                }
+            }
+            let qdd = [#(#x),*];
+            for (pivot, x) in qdd.iter().enumerate() {
+                if !x.is_finite() {
+                    return Err(::eomgen_runtime::FactorError::NonFinite { pivot });
+                }
+            }
+            Ok(qdd)
+        };
+        (body, ops)
+    }
+
+    /// The body of a `try_forward_dynamics` that solves at run time: `M` from `mass_matrix`,
+    /// `h` straight-line, the runtime's tree `L^T D L` over the joints' parents.
+    pub(super) fn runtime_solve(&mut self, q: &Quantity, h: &[Id]) -> (TokenStream, OpCount) {
+        let (hb, ops) = self.straight(q, h, Shape::Vector(h.len()));
+        let n = &self.n;
+        let mass_matrix = self.call("mass_matrix");
+        let body = quote! {
+            let mut m = #mass_matrix(self, q);
+            let h: [T; #n] = { #hb };
+            let mut rhs = *tau;
+            for (r, h) in rhs.iter_mut().zip(h) {
+                *r -= h;
+            }
+            Self::ltdl_factor_unrolled(&mut m)?;
+            let x = Self::ltdl_substitute_unrolled(&m, &rhs);
+            match x.iter().position(|v| !v.is_finite()) {
+                Some(pivot) => Err(::eomgen_runtime::FactorError::NonFinite { pivot }),
+                None => Ok(x),
+            }
+        };
+        (body, ops)
+    }
+
+    /// Whether some quantity is evaluated in one of these ways.
+    pub(super) fn any_eval(&self, which: impl Fn(&Evaluation) -> bool) -> bool {
+        self.quantities.iter().any(|q| which(&q.eval))
+    }
+
+    /// The run-time tree solves' helpers, each only where a quantity calls it: `PARENTS`
+    /// (each joint's parent joint, for the runtime's tree kernels and `ContactKkt`; public with
+    /// `mass_matrix`, for users' own solves), `CONTACT_ROWS` (with `contact_jacobian`), and
+    /// the robot's unrolled factorization and substitution (`emit/tree_solve.rs`).
+    pub(super) fn parents_const(&self) -> TokenStream {
+        use Evaluation as E;
+        let n = &self.n;
+        let table = self.has("mass_matrix")
+            || self.any_eval(|e| {
+                matches!(
+                    e,
+                    E::MassMatrixInverse
+                        | E::ForwardDynamicsDerivatives
+                        | E::ContactForwardDynamics { .. }
+                        | E::ContactDynamicsDerivatives { .. }
+                        | E::ImpulseDynamics
+                        | E::ImpulseDynamicsDerivatives
+                        | E::ActiveContacts(_)
+                )
+            });
+        let table = if table {
+            let parents = self.parents.iter().map(|p| match p {
+                Some(p) => {
+                    let p = usize_lit(*p);
+                    quote!(Some(#p))
+                }
+                None => quote!(None),
+            });
+            quote! {
+                /// Each coordinate's parent coordinate (`None`: the root), parents first: the
+                /// joints' parents (a floating base's six coordinates form a chain). The sparsity
+                /// of `mass_matrix` that the runtime's tree solves take (`eomgen_runtime::tree`,
+                /// `eomgen_runtime::contact::solve`, `eomgen_runtime::ContactKkt`).
+                pub const PARENTS: [Option<usize>; #n] = [#(#parents),*];
+            }
+        } else {
+            TokenStream::new()
+        };
+        let rows = if self.has("contact_jacobian") {
+            let c = usize_lit(self.contact_rows.len());
+            let rows = self.contact_rows.iter().map(|r| usize_lit(*r));
+            quote! {
+                /// Each contact's number of rows in `contact_jacobian`, `contact_drift` and the
+                /// forces (3: a point, 6: a frame), in the contacts' order: points, then frames.
+                /// The `active` flags of the `_active` methods follow this order
+                /// (`eomgen_runtime::contact::row_mask` turns them into rows).
+                pub const CONTACT_ROWS: [usize; #c] = [#(#rows),*];
+            }
+        } else {
+            TokenStream::new()
+        };
+        let solves = |e: &Evaluation| {
+            matches!(
+                e,
+                E::ForwardDynamicsSolve { .. }
+                    | E::ContactForwardDynamics { .. }
+                    | E::ForwardDynamicsDerivatives
+                    | E::ActiveContacts(
+                        ActiveContacts::Dynamics { .. } | ActiveContacts::Stabilized { .. }
+                    )
+            )
+        };
+        let factor = if self.any_eval(|e| solves(e) || matches!(e, E::MassMatrixInverse)) {
+            crate::emit::tree_solve::factor_fn(&self.parents, n)
+        } else {
+            TokenStream::new()
+        };
+        let substitute = if self.any_eval(solves) {
+            crate::emit::tree_solve::substitute_fn(&self.parents, n)
+        } else {
+            TokenStream::new()
+        };
+        quote! {
+            #table
+            #rows
+            #factor
+            #substitute
+        }
+    }
+
+    pub(super) fn mass_matrix_inverse_fn(&mut self, q: &Quantity) -> TokenStream {
+        let docs = Self::quantity_doc(q, None);
+        let (n, nq, mass_matrix) = (&self.n, &self.nq, self.call("mass_matrix"));
+        self.blocks.push(quote! {
+            #[inline(never)]
+            fn mass_matrix_inverse_in_place<'b>(&self, q: &[T; #nq], slot: ::eomgen_runtime::place::Slot<'b, [[T; #n]; #n]>) -> ::eomgen_runtime::place::Filled<'b> {
+                let (o, filled) = slot.fill();
+                let mut m = #mass_matrix(self, q);
+                match Self::ltdl_factor_unrolled(&mut m) {
+                    Ok(()) => ::eomgen_runtime::tree::ltdl_inverse_factored_into(&m, &Self::PARENTS, o),
+                    Err(_) => o.iter_mut().flatten().for_each(|v| *v = T::nan()),
+                }
+                filled
+            }
+        });
+        quote! {
+            #docs
+            pub fn mass_matrix_inverse(&self, q: &[T; #nq]) -> [[T; #n]; #n] {
+                ::eomgen_runtime::place::build(|slot| self.mass_matrix_inverse_in_place(q, slot))
+            }
+        }
+    }
+
+    /// `(d qdd/dq, d qdd/dqd, M^-1)` through one factorization of `M`: `qdd` solves
+    /// `M qdd = tau - h` with `h = inverse_dynamics(q, qd, 0)`, then `d tau/dq` and `d tau/dqd`
+    /// there from `inverse_dynamics_derivatives`, both solves at once per matrix
+    /// (`tree::ltdl_substitute_rows`), and `M^-1` from the same factors. Everything is written
+    /// into the caller's storage (`eomgen_runtime::place`), the derivatives of tau by
+    /// `inverse_dynamics_derivatives_fill` where that function was split.
+    pub(super) fn forward_dynamics_derivatives_fn(&mut self, q: &Quantity) -> TokenStream {
+        let docs = Self::quantity_doc(q, None);
+        let (n, nq) = (&self.n, &self.nq);
+        let id = self.call("inverse_dynamics");
+        let mass_matrix = self.call("mass_matrix");
+        let id_derivatives = self.id_derivatives_into(quote!(*dq), quote!(*dqd), quote!(qdd));
+        let matrix = quote!([[T; #n]; #n]);
+        self.blocks.push(quote! {
+            #[inline(never)]
+            fn forward_dynamics_derivatives_in_place<'b>(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n], slot: ::eomgen_runtime::place::Slot<'b, (#matrix, #matrix, #matrix)>) -> ::eomgen_runtime::place::Filled<'b> {
+                let ((dq, dqd, inverse), filled) = slot.fill();
+                let mut m = #mass_matrix(self, q);
+                if Self::ltdl_factor_unrolled(&mut m).is_err() {
+                    for v in dq.iter_mut().chain(dqd.iter_mut()).chain(inverse.iter_mut()).flatten() {
+                        *v = T::nan();
+                    }
+                    return filled;
+                }
+                let mut rhs = *tau;
+                for (r, h) in rhs.iter_mut().zip(#id(self, q, qd, &[T::zero(); #n])) {
+                    *r -= h;
+                }
+                let qdd = Self::ltdl_substitute_unrolled(&m, &rhs);
+                #id_derivatives
+                for x in [&mut *dq, &mut *dqd] {
+                    ::eomgen_runtime::tree::ltdl_substitute_rows(&m, &Self::PARENTS, x);
+                    for v in x.iter_mut().flatten() {
+                        *v = -*v;
+                    }
+                }
+                ::eomgen_runtime::tree::ltdl_inverse_factored_into(&m, &Self::PARENTS, inverse);
+                filled
+            }
+        });
+        quote! {
+            #docs
+            pub fn forward_dynamics_derivatives(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n]) -> (#matrix, #matrix, #matrix) {
+                ::eomgen_runtime::place::build(|slot| self.forward_dynamics_derivatives_in_place(q, qd, tau, slot))
+            }
+        }
+    }
+
+    /// `let mut m = ...; let free = ...;`: `M(q)` factorized by the unrolled tree `L^T D L`
+    /// (returning its error) and the accelerations without contacts `M^-1 (tau - h)`, `h` by
+    /// the straight-line block `hb`.
+    pub(super) fn free_accelerations(&self, hb: &TokenStream) -> TokenStream {
+        let (n, m) = (&self.n, self.call("mass_matrix"));
+        quote! {
+            let mut m = #m(self, q);
+            let h: [T; #n] = { #hb };
+            let mut rhs = *tau;
+            for (r, h) in rhs.iter_mut().zip(h) {
+                *r -= h;
+            }
+            Self::ltdl_factor_unrolled(&mut m)?;
+            let free = Self::ltdl_substitute_unrolled(&m, &rhs);
+        }
+    }
+
+    /// Statements writing `inverse_dynamics_derivatives` at `(q, qd, &qdd)` into the places
+    /// `dq` and `dqd` (of type `[[T; N]; N]`): through its `_fill` method when its body was
+    /// split, so that it is not built in a local and copied. It is emitted before the
+    /// quantities that call this (catalogue order).
+    pub(super) fn id_derivatives_into(
+        &self,
+        dq: TokenStream,
+        dqd: TokenStream,
+        qdd: TokenStream,
+    ) -> TokenStream {
+        if self.split.contains("inverse_dynamics_derivatives") {
+            let fill = crate::emit::split::fill_name("inverse_dynamics_derivatives");
+            quote!(self.#fill(q, qd, &#qdd, &mut #dq, &mut #dqd);)
+        } else {
+            debug_assert!(self
+                .counts
+                .iter()
+                .any(|(c, _)| c == "inverse_dynamics_derivatives"));
+            let f = self.call("inverse_dynamics_derivatives");
+            quote!((#dq, #dqd) = #f(self, q, qd, &#qdd);)
+        }
+    }
+
+    /// `try_contact_forward_dynamics` and `contact_forward_dynamics` (NaN on failure).
+    pub(super) fn contact_forward_dynamics_fns(&mut self, q: &Quantity, h: &[Id]) -> TokenStream {
+        let (hb, ops) = self.straight(q, h, Shape::Vector(h.len()));
+        let docs = Self::quantity_doc(q, Some(ops));
+        let (n, nq) = (&self.n, &self.nq);
+        let k3 = usize_lit(q.shape.len() - h.len());
+        let free = self.free_accelerations(&hb);
+        let (j, drift) = (self.call("contact_jacobian"), self.call("contact_drift"));
+        let try_vis = self.vis("try_contact_forward_dynamics");
+        let try_cfd = self.path("try_contact_forward_dynamics");
+        let try_fn = quote! {
+            /// The accelerations and contact forces of `contact_forward_dynamics`, or why they
+            /// do not exist: a pivot of M(q) (`pivot` < N) or of `J_c M^-1 J_c^T` (`pivot` - N,
+            /// a rank-deficient contact Jacobian) that is not positive, or non-finite input.
+            #try_vis fn try_contact_forward_dynamics(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n]) -> ::core::result::Result<([T; #n], [T; #k3]), ::eomgen_runtime::FactorError> {
+                #free
+                ::eomgen_runtime::contact::solve_factored(&m, &Self::PARENTS, &free, &#j(self, q), &#drift(self, q, qd))
+            }
+        };
+        let inherent_try = if self.trait_of("try_contact_forward_dynamics").is_some() {
+            self.try_contact_forward_dynamics = try_fn;
+            TokenStream::new()
+        } else {
+            try_fn
+        };
+        quote! {
+            #inherent_try
+
+            #docs
+            pub fn contact_forward_dynamics(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n]) -> ([T; #n], [T; #k3]) {
+                match #try_cfd(self, q, qd, tau) {
+                    Ok(x) => x,
+                    Err(_) => ([T::nan(); #n], [T::nan(); #k3]),
+                }
+            }
+        }
+    }
+}
