@@ -15,7 +15,9 @@
 
 use nalgebra::Vector3;
 
-use super::build::{JointType, ModelError, ModelOptions, RobotDescription};
+use super::description::{JointType, RobotDescription};
+use super::errors::ModelError;
+use super::options::ModelOptions;
 use super::{JointKind, Model};
 
 /// One elementary joint of a joint kind's chain.

@@ -16,16 +16,26 @@
 use nalgebra::{Matrix3, Vector3};
 
 mod build;
+mod description;
+mod errors;
+mod inertia;
 mod inertia_check;
 mod joint_kinds;
+mod merge;
+mod mimic;
+mod options;
+mod ordering;
+mod selections;
 pub mod shapes;
-pub use build::{
-    FormatIssue, ModelError, ModelOptions, ModelWarning, SymbolicParams, MAX_MAGNITUDE,
-};
+mod tree;
+mod validation;
+pub use errors::{FormatIssue, ModelError, ModelWarning};
+pub use options::{ModelOptions, SymbolicParams, MAX_MAGNITUDE};
 // The format-neutral description that readers (`crate::urdf`) fill in.
-pub(crate) use build::{
-    build_model, CollisionDescription, InertialDescription, JointDescription, JointType,
-    LinkDescription, Pose, RobotDescription,
+pub(crate) use build::build_model;
+pub(crate) use description::{
+    CollisionDescription, InertialDescription, JointDescription, JointType, LinkDescription, Pose,
+    RobotDescription,
 };
 
 /// A rigid transform: `p_parent = rotation * p_child + translation`.
