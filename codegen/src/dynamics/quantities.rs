@@ -101,7 +101,8 @@ pub static NOTATIONS: [Notation; 11] = [
         latex: "F",
         aliases: &["F"],
         title: "Joint friction F(qd)",
-        definition: "F_i = damping_i qd_i + friction_i sign(qd_i): the effort the actuators supply \
+        definition:
+            "F_i = damping_i qd_i + friction_i sign(qd_i): the effort the actuators supply \
                      against friction (with --friction).",
         layout: Layout::Vector,
         printed: |d| Some(d.friction.clone()),
