@@ -10,12 +10,12 @@ fn main() {
     eomgen::Builder::new("robots/panda_arm.urdf")
         .compile()
         .unwrap();
-    eomgen::Builder::new("robots/anymal.urdf")
+    eomgen::Builder::new("../tests/robots/floating/anymal.urdf")
         .floating_base()
         .contact_points(&["LF_FOOT", "RF_FOOT", "LH_FOOT", "RH_FOOT"])
         .compile()
         .unwrap();
-    eomgen::Builder::new("robots/anymal.urdf")
+    eomgen::Builder::new("../tests/robots/floating/anymal.urdf")
         .floating_base()
         .contact_points(&["LF_FOOT", "RF_FOOT", "LH_FOOT", "RH_FOOT"])
         .derivatives()

@@ -1,27 +1,52 @@
-//! Generates the reference robots exactly as a user's build script would, a small arm with
-//! joint friction, rotor inertia and an inertia filled from its collision box, and two
-//! bad-input robots.
+//! Generates, exactly as a user's build script would, the robots the tests call: the reference
+//! robots with each option under test (the reference robots themselves are generated once, in
+//! `eomgen-generated`), a small arm with joint friction, rotor inertia and an inertia filled from
+//! its collision box, and two bad-input robots.
 
 #[path = "../codegen/tests/support/chain.rs"]
 mod chain;
 
 fn main() {
+    // Independent of each other, so run on every core (the largest first): after a change to
+    // eomgen, this script is on the path of every test of the crate.
+    run_parallel(&[
+        contact_dynamics,
+        derivatives,
+        floating,
+        mimic,
+        split,
+        regressors,
+        joint_effects,
+        deep_chain,
+        underactuated,
+        mpc_kinematics,
+        bad_input,
+        selected,
+        joint_kinds,
+    ]);
+}
+
+/// Runs each of `parts` once, on as many threads as the machine has cores; a panic in one is
+/// the build script's.
+fn run_parallel(parts: &[fn()]) {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    let next = AtomicUsize::new(0);
+    let workers = std::thread::available_parallelism().map_or(1, |n| n.get());
+    std::thread::scope(|s| {
+        for _ in 0..workers.min(parts.len()) {
+            s.spawn(|| {
+                while let Some(part) = parts.get(next.fetch_add(1, Ordering::Relaxed)) {
+                    part();
+                }
+            });
+        }
+    });
+}
+
+/// Bad-input robots: an ill-conditioned mass matrix, and names that try to break out of
+/// comments and strings (compiled for real here, with rustc's default lints).
+fn bad_input() {
     for (file, module, ty) in [
-        (
-            "robots/double_pendulum.urdf",
-            "double_pendulum",
-            "DoublePendulum",
-        ),
-        ("robots/ur5.urdf", "ur5", "Ur5"),
-        ("robots/panda.urdf", "panda", "Panda"),
-        ("robots/kinova.urdf", "kinova", "Kinova"),
-        (
-            "robots/allegro_right_hand.urdf",
-            "allegro_right_hand",
-            "AllegroRightHand",
-        ),
-        // Bad-input robots: an ill-conditioned mass matrix, and names that try to break out
-        // of comments and strings (compiled for real here, with rustc's default lints).
         ("urdf/light_tip.urdf", "light_tip", "LightTip"),
         (
             "../codegen/tests/urdf/hostile/names.urdf",
@@ -35,23 +60,11 @@ fn main() {
             .compile()
             .unwrap();
     }
-    joint_effects();
-    // What a firmware that needs inverse dynamics alone generates (plus Craig's B, which
-    // brings the Coriolis matrix it loops over).
-    deep_chain();
-    derivatives();
-    floating();
-    contact_dynamics();
-    regressors();
-    underactuated();
-    mimic();
-    split();
-    mpc_kinematics();
-    // Planar and floating joints below the root (tests/joints.rs).
-    for name in ["mobile_manipulator", "crane_payload", "rover_pods"] {
-        let urdf = format!("robots/joints/{name}.urdf");
-        eomgen::Builder::new(&urdf).derivatives().compile().unwrap();
-    }
+}
+
+/// What a firmware that needs inverse dynamics alone generates (plus Craig's B, which brings
+/// the Coriolis matrix it loops over).
+fn selected() {
     eomgen::Builder::new("robots/panda.urdf")
         .module_name("panda_selected")
         .type_name("PandaSelected")
@@ -114,9 +127,9 @@ fn deep_chain() {
         .unwrap();
 }
 
-/// The reference robots with the derivatives of their dynamics and what those call.
-/// The floating-base reference robots: anymal standing on its four feet (contacts), the same
-/// without gravity (for momentum conservation), and the iris drone (a free body, no joints).
+/// The floating-base reference robots: anymal standing on its four feet (contacts), and the same
+/// without gravity (for momentum conservation); the iris drone (a free body, no joints) is in
+/// `eomgen-generated`.
 fn floating() {
     let feet = ["LF_FOOT", "RF_FOOT", "LH_FOOT", "RH_FOOT"];
     let anymal = || {
@@ -156,12 +169,6 @@ fn floating() {
             "forward_dynamics_derivatives",
             "mass_matrix_inverse",
         ])
-        .compile()
-        .unwrap();
-    eomgen::Builder::new("robots/floating/iris_simple.urdf")
-        .floating_base()
-        .module_name("iris_simple")
-        .type_name("IrisSimple")
         .compile()
         .unwrap();
 }
@@ -230,7 +237,16 @@ fn contact_dynamics() {
         ])
         .compile()
         .unwrap();
-    // 6D contacts at both soles (a humanoid: only what the test calls).
+    humanoid_contacts();
+}
+
+/// Opt-in (`EOMGEN_TEST_HEAVY=1`, sets `cfg(heavy)`): 6D contacts at both soles of the g1
+/// humanoid (only what the tests call). Its module is the largest of the tests (8.9 MB, 36 % of
+/// all the generated code they compiled): too slow to compile on every test run.
+fn humanoid_contacts() {
+    if !opt_in("EOMGEN_TEST_HEAVY", "heavy") {
+        return;
+    }
     eomgen::Builder::new("robots/floating/g1_29dof.urdf")
         .floating_base()
         .contact_frames(&["left_ankle_roll_link", "right_ankle_roll_link"])
@@ -250,6 +266,7 @@ fn contact_dynamics() {
         .unwrap();
 }
 
+/// The reference robots with the derivatives of their dynamics and what those call.
 fn derivatives() {
     for (file, module, ty) in [
         ("robots/ur5.urdf", "ur5_derivatives", "Ur5Derivatives"),
@@ -345,13 +362,22 @@ fn regressors() {
 /// are rotated by `rpy="1.5708 0 0"`, four decimals, so no entry is exactly 0 and its module is
 /// large (110,000 lines, 10 MB): too slow to compile on every test run.
 fn unshipped_derivatives() {
-    println!("cargo::rustc-check-cfg=cfg(unshipped)");
-    println!("cargo:rerun-if-env-changed=EOMGEN_TEST_UNSHIPPED");
-    if std::env::var_os("EOMGEN_TEST_UNSHIPPED").is_none() {
+    if !opt_in("EOMGEN_TEST_UNSHIPPED", "unshipped") {
         return;
     }
-    println!("cargo:rustc-cfg=unshipped");
     with_derivatives("robots/xarm7.urdf", "xarm7_derivatives", "Xarm7Derivatives");
+}
+
+/// Whether the environment variable `var` asks for an opt-in part of the tests; if so, the
+/// crate is compiled with `cfg(name)` (declared either way, for rustc's `unexpected_cfgs`).
+fn opt_in(var: &str, name: &str) -> bool {
+    println!("cargo::rustc-check-cfg=cfg({name})");
+    println!("cargo:rerun-if-env-changed={var}");
+    let on = std::env::var_os(var).is_some();
+    if on {
+        println!("cargo:rustc-cfg={name}");
+    }
+    on
 }
 
 /// Robots with passive joints (`Builder::passive_joints`): the acrobot with its elbow passive,
@@ -499,3 +525,11 @@ const ANYMAL_KINEMATICS: [&str; 9] = [
     "centroidal_map",
     "centroidal_momentum_rate",
 ];
+
+/// Planar joints and floating joints below the root (`tests/joints.rs`).
+fn joint_kinds() {
+    for name in ["mobile_manipulator", "crane_payload", "rover_pods"] {
+        let urdf = format!("robots/joints/{name}.urdf");
+        eomgen::Builder::new(&urdf).derivatives().compile().unwrap();
+    }
+}

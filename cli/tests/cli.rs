@@ -977,12 +977,7 @@ fn readme_quick_start_works() {
     let out = ok(&args);
     assert!(out.contains("  M11 = "), "{out}");
     // The sample in the README is what the binary prints.
-    let sample = ok(&[
-        "show",
-        "generated/robots/double_pendulum.urdf",
-        "--term",
-        "M,G",
-    ]);
+    let sample = ok(&["show", "tests/robots/double_pendulum.urdf", "--term", "M,G"]);
     for line in sample
         .lines()
         .filter(|l| l.starts_with("  M") || l.starts_with("  G"))

@@ -636,7 +636,7 @@ impl Builder {
     /// quantities evaluated at any state ([`crate::evaluate`]).
     ///
     /// ```
-    /// let derived = eomgen::Builder::new("../generated/robots/double_pendulum.urdf")
+    /// let derived = eomgen::Builder::new("../tests/robots/double_pendulum.urdf")
     ///     .derived()
     ///     .unwrap();
     /// let state = eomgen::evaluate::State::at_rest(vec![0.1, 0.2], 2);
@@ -659,7 +659,7 @@ impl Builder {
     /// or print its equations without deriving again).
     ///
     /// ```
-    /// let (generated, derived) = eomgen::Builder::new("../generated/robots/double_pendulum.urdf")
+    /// let (generated, derived) = eomgen::Builder::new("../tests/robots/double_pendulum.urdf")
     ///     .generate_derived()
     ///     .unwrap();
     /// assert!(generated.source.contains("pub struct"));
@@ -758,7 +758,7 @@ mod tests {
     /// named in `Builder::quantities`'s documentation: the list follows the catalogue.
     #[test]
     fn the_quantities_docs_name_every_quantity_of_the_catalogue() {
-        let urdf = "../generated/robots/double_pendulum.urdf";
+        let urdf = "../tests/robots/double_pendulum.urdf";
         let fixed = Builder::new(urdf).friction(true).derivatives().regressor();
         let floating = Builder::new(urdf)
             .floating_base()

@@ -31,7 +31,8 @@
 include!(concat!(env!("OUT_DIR"), "/panda_arm.rs"));
 
 /// ANYmal, a quadruped, with a floating base and a point contact at each foot (`LF_FOOT`,
-/// `RF_FOOT`, `LH_FOOT`, `RH_FOOT`, in that order), generated from `robots/anymal.urdf`.
+/// `RF_FOOT`, `LH_FOOT`, `RH_FOOT`, in that order), generated from the workspace's
+/// `tests/robots/floating/anymal.urdf`.
 pub mod anymal {
     include!(concat!(env!("OUT_DIR"), "/anymal.rs"));
 

@@ -1,6 +1,7 @@
 //! eomgen's checked-in output for the five reference robots, a `#![no_std]` crate.
 //!
-//! Each module is generated from the URDF of the same name in `robots/`. Do not edit them:
+//! Each module is generated from the URDF of the same name in the workspace's `tests/robots/`
+//! (beside Pinocchio's reference values for it, which `tests/` checks it against). Do not edit them:
 //! `tests/golden.rs` regenerates every file in memory and fails on any difference; refresh
 //! them with `EOMGEN_BLESS=1 cargo test -p eomgen-generated --test golden`.
 //!
@@ -32,11 +33,11 @@ pub mod panda;
 pub mod ur5;
 
 /// The floating-base robots of this crate (generated with `Builder::floating_base`): (module,
-/// type name, URDF file in `robots/`).
+/// type name, URDF file in the workspace's `tests/robots/`).
 pub const FLOATING_ROBOTS: [(&str, &str, &str); 1] =
-    [("iris_simple", "IrisSimple", "iris_simple.urdf")];
+    [("iris_simple", "IrisSimple", "floating/iris_simple.urdf")];
 
-/// The robots of this crate: (module, type name, URDF file in `robots/`).
+/// The robots of this crate: (module, type name, URDF file in the workspace's `tests/robots/`).
 pub const ROBOTS: [(&str, &str, &str); 5] = [
     ("double_pendulum", "DoublePendulum", "double_pendulum.urdf"),
     ("ur5", "Ur5", "ur5.urdf"),

@@ -7,6 +7,11 @@ use eomgen_generated::{FLOATING_ROBOTS, ROBOTS};
 
 const REFRESH: &str = "EOMGEN_BLESS=1 cargo test -p eomgen-generated --test golden";
 
+/// The reference robots' URDFs: the workspace's `tests/robots/`, beside Pinocchio's values.
+fn robots() -> PathBuf {
+    root().join("../tests/robots")
+}
+
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
@@ -43,7 +48,7 @@ fn checked_in_code_is_what_eomgen_generates() {
     let fixed = ROBOTS.iter().map(|r| (r, false));
     let floating = FLOATING_ROBOTS.iter().map(|r| (r, true));
     for ((module, ty, urdf), floats) in fixed.chain(floating) {
-        let builder = eomgen::Builder::new(root().join("robots").join(urdf));
+        let builder = eomgen::Builder::new(robots().join(urdf));
         let builder = if floats {
             builder.floating_base()
         } else {
@@ -85,7 +90,7 @@ fn checked_in_equations_are_what_eomgen_prints() {
     let bless = std::env::var_os("EOMGEN_BLESS").is_some();
     let mut stale = Vec::new();
     for (module, _, urdf) in ROBOTS {
-        let model = eomgen::urdf::load_file(root().join("robots").join(urdf), &Default::default())
+        let model = eomgen::urdf::load_file(robots().join(urdf), &Default::default())
             .unwrap_or_else(|e| panic!("{urdf}: {e}"));
         let derivation = eomgen::dynamics::Derivation::new(&model);
         let (form, flag, formats) = if module == "double_pendulum" {
@@ -107,7 +112,7 @@ fn checked_in_equations_are_what_eomgen_prints() {
                 _ => ("txt", ""),
             };
             let banner = format!(
-                "Printed by `eomgen show robots/{urdf} --term M,B,C,G{flag}{format_flag}`. Do not \
+                "Printed by `eomgen show tests/robots/{urdf} --term M,B,C,G{flag}{format_flag}`. Do not \
                  edit: refresh with `{REFRESH}`."
             );
             let generated = match format {

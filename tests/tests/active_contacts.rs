@@ -11,6 +11,7 @@ use eomgen_runtime::prelude::*;
 use eomgen_tests::floating_reference::{flat, normwise, random_state};
 use eomgen_tests::robots::anymal_mpc::AnymalMpc;
 use eomgen_tests::robots::anymal_two_feet::AnymalTwoFeet;
+#[cfg(heavy)]
 use eomgen_tests::robots::g1_mpc::G1Mpc;
 
 const NQ: usize = 19;
@@ -187,6 +188,7 @@ fn anymal_baumgarte_pulls_displaced_feet_back() {
 /// reference accelerates at `-kp` times that error (linear and angular, world axes); the right
 /// sole, inactive, gets no wrench.
 #[test]
+#[cfg(heavy)] // EOMGEN_TEST_HEAVY=1: g1 is the largest module of the tests
 fn g1_baumgarte_turns_a_sole_back() {
     let r = G1Mpc::<f64>::default();
     let (q, _, tau) = random_state::<36, 35>(21);

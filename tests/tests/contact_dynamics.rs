@@ -13,6 +13,7 @@ use eomgen_tests::floating_reference::{
 };
 use eomgen_tests::robots::anymal_at::{AnymalAt, AnymalAtLink};
 use eomgen_tests::robots::anymal_mpc::{AnymalMpc, AnymalMpcLink};
+#[cfg(heavy)]
 use eomgen_tests::robots::g1_mpc::G1Mpc;
 use serde_json::Value;
 
@@ -107,6 +108,7 @@ fn anymal_contact_and_impulse_dynamics_match_pinocchio() {
 
 /// 6D contacts at both soles.
 #[test]
+#[cfg(heavy)] // EOMGEN_TEST_HEAVY=1: g1 is the largest module of the tests
 fn g1_contact_and_impulse_dynamics_match_pinocchio() {
     check_mpc!("g1_29dof.mpc.json", G1Mpc<f64>, 36, 35, 12);
 }

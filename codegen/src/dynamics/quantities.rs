@@ -23,7 +23,7 @@ fn matrix(m: &[Vec<Id>]) -> Option<Vec<Id>> {
 }
 
 /// How people write the quantities that have symbols, in the order `eomgen show` prints them.
-pub static NOTATIONS: [Notation; 10] = [
+pub static NOTATIONS: [Notation; 11] = [
     Notation {
         name: "mass_matrix",
         text: "M",
@@ -94,6 +94,18 @@ pub static NOTATIONS: [Notation; 10] = [
         definition: "",
         layout: Layout::Vector,
         printed: |d| Some(d.tau.clone()),
+    },
+    Notation {
+        name: "friction",
+        text: "F",
+        latex: "F",
+        aliases: &["F"],
+        title: "Joint friction F(qd)",
+        definition:
+            "F_i = damping_i qd_i + friction_i sign(qd_i): the effort the actuators supply \
+                     against friction (with --friction).",
+        layout: Layout::Vector,
+        printed: |d| Some(d.friction.clone()),
     },
     Notation {
         name: "kinetic_energy",

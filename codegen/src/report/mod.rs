@@ -189,7 +189,7 @@ fn invalid_entry(opts: &ShowOptions, reason: &str) -> ReportError {
 /// [`render`] for what is printed and when it fails.
 ///
 /// ```
-/// let derived = eomgen::Builder::new("../generated/robots/double_pendulum.urdf").derived().unwrap();
+/// let derived = eomgen::Builder::new("../tests/robots/double_pendulum.urdf").derived().unwrap();
 /// let opts = eomgen::report::ShowOptions { terms: vec!["tau".into()], ..Default::default() };
 /// let text = eomgen::report::print(&derived, &opts).unwrap();
 /// assert!(text.contains("Inverse dynamics tau = M(q) qdd + b(q, qd) + G(q)"));

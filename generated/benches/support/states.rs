@@ -7,10 +7,11 @@ use std::path::{Path, PathBuf};
 
 use criterion::BenchmarkGroup;
 
-/// A reference robot's URDF in the including crate's `robots/`.
+/// A reference robot's URDF, in the workspace's `tests/robots/` (the including crate is one of
+/// the workspace's).
 pub fn robot(urdf: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("robots")
+        .join("../tests/robots")
         .join(urdf)
 }
 
