@@ -169,13 +169,23 @@ pub fn catalogue(model: &Model, d: &Derivation) -> Vec<Quantity> {
     out.extend(super::contact_derivatives::impulse_dynamics(d));
     out.extend(super::active_contacts::quantities(d));
     if model.is_floating() {
-        // Without the `Dynamics` trait (whose arrays are all N long): the emitter puts those of
-        // `FloatingDynamics` and `Contacts` in their impls, the others are inherent methods.
         for q in &mut out {
-            q.home = Home::Inherent;
+            q.home = floating_home(q.name);
         }
     }
     out
+}
+
+/// Where a floating base's quantity lives: not in the `Dynamics` trait (whose arrays are all
+/// N long), but the runtime's `FloatingDynamics` and `Contacts` traits hold these; the others
+/// are inherent methods.
+fn floating_home(name: &str) -> Home {
+    match name {
+        "mass_matrix" | "gravity" | "bias" | "integrate" | "inverse_dynamics"
+        | "forward_dynamics" => Home::FloatingDynamics,
+        "contact_jacobian" | "contact_drift" | "contact_forward_dynamics" => Home::Contacts,
+        _ => Home::Inherent,
+    }
 }
 
 /// Remarks about joint effects that change what some functions mean.
