@@ -23,7 +23,7 @@ fn matrix(m: &[Vec<Id>]) -> Option<Vec<Id>> {
 }
 
 /// How people write the quantities that have symbols, in the order `eomgen show` prints them.
-pub static NOTATIONS: [Notation; 11] = [
+pub static NOTATIONS: &[Notation] = &[
     Notation {
         name: "mass_matrix",
         text: "M",
@@ -101,9 +101,7 @@ pub static NOTATIONS: [Notation; 11] = [
         latex: "F",
         aliases: &["F"],
         title: "Joint friction F(qd)",
-        definition:
-            "F_i = damping_i qd_i + friction_i sign(qd_i): the effort the actuators supply \
-                     against friction (with --friction).",
+        definition: "F_i = damping_i qd_i + friction_i sign(qd_i), supplied by the actuators.",
         layout: Layout::Vector,
         printed: |d| Some(d.friction.clone()),
     },
