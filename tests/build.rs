@@ -22,6 +22,7 @@ fn main() {
         mpc_kinematics,
         bad_input,
         selected,
+        joint_kinds,
     ]);
 }
 
@@ -524,3 +525,11 @@ const ANYMAL_KINEMATICS: [&str; 9] = [
     "centroidal_map",
     "centroidal_momentum_rate",
 ];
+
+/// Planar joints and floating joints below the root (`tests/joints.rs`).
+fn joint_kinds() {
+    for name in ["mobile_manipulator", "crane_payload", "rover_pods"] {
+        let urdf = format!("robots/joints/{name}.urdf");
+        eomgen::Builder::new(&urdf).derivatives().compile().unwrap();
+    }
+}

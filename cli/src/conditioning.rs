@@ -89,8 +89,9 @@ pub fn warning(model: &Model, m: &[Vec<f64>], at: &str) -> Option<String> {
 /// The warnings of `info`: the worst of the sampled states, if any is near singular.
 pub fn sampled_warnings(derived: &Derived) -> Vec<String> {
     let model = derived.model();
-    // The joints' conditioning: a floating base's mass matrix is checked at evaluation.
-    if model.is_floating() {
+    // The joints' conditioning: a floating base's (or floating joint's) mass matrix is
+    // checked at evaluation.
+    if !model.velocities_are_rates() {
         return Vec::new();
     }
     let n = model.coordinates();

@@ -8,11 +8,7 @@ use eomgen::report::format_number;
 use eomgen::{Derived, Generated, OpCount};
 
 fn kind(k: JointKind) -> &'static str {
-    match k {
-        JointKind::Revolute => "revolute",
-        JointKind::Continuous => "continuous",
-        JointKind::Prismatic => "prismatic",
-    }
+    k.urdf_name()
 }
 
 fn vec3(v: &nalgebra::Vector3<f64>) -> String {
@@ -128,6 +124,14 @@ fn summary(model: &Model, source: &str) -> String {
             model.coordinates(),
             model.dof(),
             model.dof() - model.coordinates()
+        );
+    } else if !model.velocities_are_rates() {
+        let _ = writeln!(
+            out,
+            "degrees of freedom: {} (floating joints: NQ {}, NV {})",
+            model.nv(),
+            model.nq(),
+            model.nv()
         );
     } else {
         let _ = writeln!(out, "degrees of freedom: {}", model.dof());

@@ -57,8 +57,8 @@ fn cases() -> Vec<(&'static str, String)> {
         ),
         ("many_roots", urdf(&names, "")),
         (
-            "floating_joint",
-            urdf(&["a", "b"], &joint("j", "floating", "a", "b")),
+            "spherical_joint",
+            urdf(&["a", "b"], &joint("j", "spherical", "a", "b")),
         ),
         ("revolute_chain_10000", urdf(&names, &chain)),
         ("terminal_escapes", urdf(&[escape, escape], "")),

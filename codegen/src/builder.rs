@@ -7,7 +7,7 @@ use crate::cas::Limits;
 use crate::dynamics::{catalogue, Derivation};
 use crate::emit::names::{snake, upper_camel};
 use crate::emit::{self, EmitOptions, Generated};
-use crate::model::{Model, ModelOptions, ModelWarning, SymbolicParams};
+use crate::model::{Model, ModelError, ModelOptions, ModelWarning, SymbolicParams};
 use crate::Error;
 
 /// Configures and runs code generation for one robot.
@@ -607,6 +607,14 @@ impl Builder {
                 file,
                 what: "the regressor of a floating-base robot is not generated yet",
             });
+        }
+        if let (true, Some(&j)) = (self.regressor, model.floating_joints().first()) {
+            return Err(Error::Model(ModelError::UnsupportedJointUse {
+                file,
+                joint: model.joints[j].name.clone(),
+                kind: "floating (a free flyer below the root)",
+                reason: "the regressor (Builder::regressor) is not generated with it yet".into(),
+            }));
         }
         let mut d = Derivation::try_new(model, limits).map_err(full)?;
         if self.derivatives {

@@ -420,7 +420,8 @@ fn catalogue() -> Vec<(&'static str, String, Expect)> {
                 link("tip"),
                 joint("free", "floating", "base", "tip", ""),
             ]),
-            Error(&["joint `free` is floating", "not supported"]),
+            // A free flyer below a root welded to the world (the root has mass).
+            Code,
         ),
         (
             "planar_joint",
@@ -429,7 +430,25 @@ fn catalogue() -> Vec<(&'static str, String, Expect)> {
                 link("tip"),
                 joint("flat", "planar", "base", "tip", ""),
             ]),
-            Error(&["joint `flat` is planar", "not supported"]),
+            Code,
+        ),
+        (
+            "planar_joint_off_axis",
+            robot(&[
+                link("base"),
+                link("tip"),
+                joint("flat", "planar", "base", "tip", r#"<axis xyz="1 0 0"/>"#),
+            ]),
+            Error(&["joint `flat` is planar", "axis (1 0 0) is not 0 0 1"]),
+        ),
+        (
+            "spherical_joint",
+            robot(&[
+                link("base"),
+                link("tip"),
+                joint("ball", "spherical", "base", "tip", ""),
+            ]),
+            Error(&["joint `ball` is spherical", "not supported"]),
         ),
         (
             "unknown_joint_type",

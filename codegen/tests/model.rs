@@ -88,11 +88,7 @@ fn reference_robots_have_the_reference_joints_in_the_reference_order() {
             .map(|j| j.as_str().unwrap())
             .collect();
         for (joint, ty) in model.joints.iter().zip(types) {
-            let kind = match joint.kind {
-                JointKind::Revolute => "revolute",
-                JointKind::Continuous => "continuous",
-                JointKind::Prismatic => "prismatic",
-            };
+            let kind = joint.kind.urdf_name();
             assert_eq!(kind, ty, "{robot} {}", joint.name);
         }
     }
@@ -1090,13 +1086,52 @@ fn error_moving_joint_with_nothing_to_move() {
 
 #[test]
 fn error_unsupported_joint_types() {
-    for kind in ["floating", "planar", "spherical"] {
+    let mut parts = valid();
+    parts.push(link("l2"));
+    parts.push(joint("free", "spherical", "l1", "l2"));
+    let err = bad(&robot(&parts), &["`free`", "spherical"]);
+    assert!(matches!(err, ModelError::UnsupportedJoint { .. }), "{err}");
+}
+
+#[test]
+fn planar_and_floating_joints_load_with_their_coordinates() {
+    for (kind, names, nq) in [
+        ("planar", vec!["j1", "free.x", "free.y", "free.theta"], 4),
+        (
+            "floating",
+            vec![
+                "j1", "free.vx", "free.vy", "free.vz", "free.wx", "free.wy", "free.wz",
+            ],
+            8,
+        ),
+    ] {
         let mut parts = valid();
         parts.push(link("l2"));
         parts.push(joint("free", kind, "l1", "l2"));
-        let err = bad(&robot(&parts), &["`free`", kind]);
-        assert!(matches!(err, ModelError::UnsupportedJoint { .. }), "{err}");
+        let model = load(&robot(&parts)).unwrap();
+        assert_eq!(model.coordinate_names(), names, "{kind}");
+        assert_eq!((model.nq(), model.nv()), (nq, names.len()), "{kind}");
+        assert_eq!(model.velocities_are_rates(), kind == "planar");
+        // The link frame moves with the joint's last step.
+        let l2 = model.frames.iter().find(|f| f.name == "l2").unwrap();
+        assert_eq!(l2.body, Some(model.dof() - 1));
     }
+}
+
+#[test]
+fn error_floating_joint_with_an_unsupported_option() {
+    let mut parts = valid();
+    parts.push(link("l2"));
+    parts.push(joint("free", "floating", "l1", "l2"));
+    let options = ModelOptions {
+        passive_joints: vec!["j1".into()],
+        ..ModelOptions::default()
+    };
+    let err = error(&robot(&parts), &options, &["`free`", "passive_joints"]);
+    assert!(
+        matches!(err, ModelError::UnsupportedJointUse { .. }),
+        "{err}"
+    );
 }
 
 #[test]

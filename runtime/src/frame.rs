@@ -272,6 +272,8 @@ pub fn jacobian_time_variation<T: Real, F: Fn(usize) -> Pose<T>, const N: usize>
                     put(col, lin, ang);
                 }
                 Motion::Translation => put(col, cross(&s.w, &z), zero),
+                // Link motions are not generated for floating joints below the root.
+                Motion::Free => {}
             }
         }
     }

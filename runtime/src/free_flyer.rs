@@ -57,6 +57,45 @@ pub fn integrate_into<T: Real>(q: &[T], v: &[T], dt: T, out: &mut [T]) {
     }
 }
 
+/// [`integrate`] for free flyers anywhere in `q`: each `(q0, v0)` of `free` (ascending) is a
+/// free flyer whose 7 position coordinates start at `q0` and 6 velocity coordinates at `v0`
+/// (floating joints below the root); every other coordinate moves by `v dt`.
+///
+/// ```
+/// use eomgen_runtime::free_flyer::integrate_blocks;
+/// // a revolute joint, then a free flyer at rest
+/// let q = [0.5_f64, 1.0, 2.0, 3.0, 0.0, 0.0, 0.0, 1.0];
+/// let v = [0.1, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+/// let q1: [f64; 8] = integrate_blocks(&q, &v, 2.0, &[(1, 1)]);
+/// assert_eq!(q1, [0.7, 1.0, 2.0, 3.0, 0.0, 0.0, 0.0, 1.0]);
+/// ```
+pub fn integrate_blocks<T: Real, const NQ: usize, const NV: usize>(
+    q: &[T; NQ],
+    v: &[T; NV],
+    dt: T,
+    free: &[(usize, usize)],
+) -> [T; NQ] {
+    let mut out = *q;
+    let (mut qi, mut vi) = (0, 0);
+    let vector_part = |out: &mut [T; NQ], qi: &mut usize, vi: &mut usize, end: usize| {
+        while *vi < end && *qi < NQ && *vi < NV {
+            out[*qi] = q[*qi] + v[*vi] * dt;
+            *qi += 1;
+            *vi += 1;
+        }
+    };
+    for &(q0, v0) in free {
+        vector_part(&mut out, &mut qi, &mut vi, v0);
+        if q0 + 7 > NQ || v0 + 6 > NV {
+            return out;
+        }
+        integrate_into(&q[q0..q0 + 7], &v[v0..v0 + 6], dt, &mut out[q0..q0 + 7]);
+        (qi, vi) = (q0 + 7, v0 + 6);
+    }
+    vector_part(&mut out, &mut qi, &mut vi, NV);
+    out
+}
+
 /// The rotation of a unit quaternion (x, y, z, w).
 pub fn rotation<T: Real>(q: &[T; 4]) -> [[T; 3]; 3] {
     let (x, y, z, w) = (q[0], q[1], q[2], q[3]);
@@ -178,6 +217,8 @@ pub fn chain_jacobian<T: Real, const NJ: usize, const NV: usize>(
         let (lin, ang) = match joint.motion {
             Motion::Rotation => (cross(&z, &lever(&poses[k].translation)), z),
             Motion::Translation => (z, [T::zero(); 3]),
+            // Floating joints below a floating base are refused at generation.
+            Motion::Free => continue,
         };
         for row in 0..3 {
             jac[row][col] = lin[row];

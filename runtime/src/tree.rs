@@ -16,6 +16,10 @@ pub enum Motion {
     Rotation,
     /// Translation along the axis (prismatic joints).
     Translation,
+    /// A free flyer (a floating joint below the root): six velocity columns, the body's linear
+    /// velocity then its angular velocity, both in its own axes; the axis is not used. Only
+    /// [`chain_jacobian_columns`] places its columns.
+    Free,
 }
 
 /// A moving joint as the tree kernels see it: its unit axis in its body's frame and how it
@@ -46,6 +50,23 @@ pub fn chain_pose<T: Real>(path: &[usize], transform: impl Fn(usize) -> Pose<T>)
     pose
 }
 
+/// The world pose of each body along `path` (at most `N`), and the world position of a frame at
+/// `placement` in the last one.
+#[inline]
+fn chain_poses<T: Real, const N: usize>(
+    path: &[usize],
+    transform: impl Fn(usize) -> Pose<T>,
+    placement: &Pose<T>,
+) -> ([Pose<T>; N], [T; 3]) {
+    let mut bodies = [Pose::identity(); N];
+    let mut pose = Pose::identity();
+    for (k, &j) in path.iter().enumerate().take(N) {
+        pose = pose.compose(&transform(j));
+        bodies[k] = pose;
+    }
+    (bodies, pose.transform_point(&placement.translation))
+}
+
 /// `a x b`.
 pub(crate) fn cross<T: Real>(a: &[T; 3], b: &[T; 3]) -> [T; 3] {
     [
@@ -74,13 +95,7 @@ pub fn chain_jacobian<T: Real, const N: usize>(
     transform: impl Fn(usize) -> Pose<T>,
     placement: &Pose<T>,
 ) -> [[T; N]; 6] {
-    let mut bodies = [Pose::identity(); N];
-    let mut pose = Pose::identity();
-    for (k, &j) in path.iter().enumerate().take(N) {
-        pose = pose.compose(&transform(j));
-        bodies[k] = pose;
-    }
-    let point = pose.transform_point(&placement.translation);
+    let (bodies, point) = chain_poses::<T, N>(path, transform, placement);
     let mut jac = [[T::zero(); N]; 6];
     for (k, &j) in path.iter().enumerate().take(N) {
         let Some(joint) = joints.get(j) else { continue };
@@ -93,10 +108,78 @@ pub fn chain_jacobian<T: Real, const N: usize>(
                 (cross(&z, &r), z)
             }
             Motion::Translation => (z, [T::zero(); 3]),
+            // One column per joint cannot hold a free flyer's six.
+            Motion::Free => continue,
         };
         for r in 0..3 {
             jac[r][j] = lin[r];
             jac[3 + r][j] = ang[r];
+        }
+    }
+    jac
+}
+
+/// [`chain_jacobian`] for joints of any kind: joint `j`'s velocity columns start at
+/// `columns[j]` (one for a revolute or prismatic joint, six for a [`Motion::Free`] joint:
+/// its body's linear velocity, then its angular velocity about the body origin, both in body
+/// axes).
+///
+/// ```
+/// use eomgen_runtime::tree::{chain_jacobian_columns, Motion, TreeJoint};
+/// use eomgen_runtime::Pose;
+/// // a revolute joint about z, then a free flyer 1 m along x; the frame at the flyer's origin
+/// let joints = [
+///     TreeJoint { axis: [0.0, 0.0, 1.0], motion: Motion::Rotation },
+///     TreeJoint { axis: [0.0; 3], motion: Motion::Free },
+/// ];
+/// let step = |j: usize| if j == 1 { Pose::from_translation([1.0_f64, 0.0, 0.0]) } else { Pose::identity() };
+/// let j: [[f64; 7]; 6] = chain_jacobian_columns(&[0, 1], &joints, &[0, 1], step, &Pose::identity());
+/// assert_eq!(j[1][0], 1.0); // the revolute joint moves the point along y
+/// assert_eq!(j[0][1], 1.0); // the flyer's linear x column
+/// assert_eq!(j[5][6], 1.0); // its angular z column
+/// ```
+pub fn chain_jacobian_columns<T: Real, const NJ: usize, const NV: usize>(
+    path: &[usize],
+    joints: &[TreeJoint; NJ],
+    columns: &[usize; NJ],
+    transform: impl Fn(usize) -> Pose<T>,
+    placement: &Pose<T>,
+) -> [[T; NV]; 6] {
+    let (bodies, point) = chain_poses::<T, NJ>(path, transform, placement);
+    let mut jac = [[T::zero(); NV]; 6];
+    let mut put = |col: usize, lin: [T; 3], ang: [T; 3]| {
+        if col < NV {
+            for r in 0..3 {
+                jac[r][col] = lin[r];
+                jac[3 + r][col] = ang[r];
+            }
+        }
+    };
+    for (k, &j) in path.iter().enumerate().take(NJ) {
+        let (Some(joint), Some(&col)) = (joints.get(j), columns.get(j)) else {
+            continue;
+        };
+        let body = &bodies[k];
+        let o = body.translation;
+        let lever = [point[0] - o[0], point[1] - o[1], point[2] - o[2]];
+        let zero = [T::zero(); 3];
+        match joint.motion {
+            Motion::Rotation => {
+                let z = body.transform_vector(&joint.axis.map(T::from_f64));
+                put(col, cross(&z, &lever), z);
+            }
+            Motion::Translation => put(
+                col,
+                body.transform_vector(&joint.axis.map(T::from_f64)),
+                zero,
+            ),
+            Motion::Free => {
+                for a in 0..3 {
+                    let e = [0, 1, 2].map(|r| body.rotation[r][a]);
+                    put(col + a, e, zero);
+                    put(col + 3 + a, cross(&e, &lever), e);
+                }
+            }
         }
     }
     jac

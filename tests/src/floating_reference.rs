@@ -15,6 +15,15 @@ pub fn robot_file(path: &str) -> Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
 
+/// Elementwise `|a - b| / max(1, |b|)` of ours against the reference's (equal lengths).
+pub fn elementwise(ours: &[f64], reference: &[f64]) -> f64 {
+    assert_eq!(ours.len(), reference.len());
+    ours.iter()
+        .zip(reference)
+        .map(|(a, b)| (a - b).abs() / b.abs().max(1.0))
+        .fold(0.0, f64::max)
+}
+
 /// Every number of a (nested) array, in order.
 pub fn numbers(v: &Value) -> Vec<f64> {
     match v {

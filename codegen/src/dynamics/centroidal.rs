@@ -382,18 +382,34 @@ pub(super) fn quantities(model: &Model, d: &Derivation) -> Vec<Quantity> {
             },
         ));
     }
-    if model.is_floating() {
-        out.push(quantity(
-            "integrate",
-            &[Input::Q, Input::Qd],
-            Shape::Vector(d.nq),
-            &[
-                "`q (+) qd dt`: the configuration reached from `q` moving at constant velocity `qd` for `dt`:",
-                "the base along the SE(3) exponential (the quaternion stays unit), the joints by `qd dt`.",
-            ],
-            "eomgen_runtime::free_flyer::integrate",
-            Evaluation::Integrate,
-        ));
+    if !model.velocities_are_rates() {
+        out.push(integrate(model, d));
     }
     out
+}
+
+/// `integrate`: the floating base's SE(3) exponential, or each floating joint's.
+fn integrate(model: &Model, d: &Derivation) -> Quantity {
+    let (what, how) = if model.is_floating() {
+        (
+            "the base along the SE(3) exponential (the quaternion stays unit), the joints by `qd dt`.",
+            "eomgen_runtime::free_flyer::integrate",
+        )
+    } else {
+        (
+            "each floating joint along the SE(3) exponential (its quaternion stays unit), the others by `qd dt`.",
+            "eomgen_runtime::free_flyer::integrate_blocks over the floating joints' coordinates",
+        )
+    };
+    quantity(
+        "integrate",
+        &[Input::Q, Input::Qd],
+        Shape::Vector(d.nq),
+        &[
+            "`q (+) qd dt`: the configuration reached from `q` moving at constant velocity `qd` for `dt`:",
+            what,
+        ],
+        how,
+        Evaluation::Integrate,
+    )
 }

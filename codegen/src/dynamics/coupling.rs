@@ -25,6 +25,9 @@ pub struct CoordinateMap {
     /// none), never coupled.
     base_q: usize,
     base_v: usize,
+    /// The number of position coordinates (7 per free flyer, then one per coordinate: mimic
+    /// joints never involve a floating joint).
+    positions: usize,
     /// Whether some joint follows another.
     coupled: bool,
 }
@@ -38,6 +41,7 @@ impl CoordinateMap {
             coordinates: model.coordinates(),
             base_q: model.base_nq(),
             base_v: model.base_nv(),
+            positions: model.nq() - (model.dof() - model.coordinate_joints().len()),
             coupled: model.is_coupled(),
         }
     }
@@ -54,7 +58,7 @@ impl CoordinateMap {
 
     /// The number of position coordinates (a floating base's seven, then the joints').
     pub fn positions_len(&self) -> usize {
-        self.base_q + self.coordinates
+        self.positions
     }
 
     /// The joints' positions for the coordinates' positions `q`: `k q[c] + o` (a floating

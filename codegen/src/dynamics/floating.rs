@@ -36,12 +36,13 @@ pub(super) fn derive(model: &Model, limits: Limits) -> Result<Derivation, GraphF
     g.check()?;
     clock.lap("kinematics");
     let grav = const_v3(&mut g, &model.gravity);
-    let mut joint_friction = vec![g.zero(); 6];
+    let base = model.base_nv();
+    let mut joint_friction = vec![g.zero(); base];
     joint_friction.extend(lagrangian::joint_friction(
         &mut g,
         model,
         &params,
-        &joint_qd[6..],
+        &joint_qd[base..],
     ));
     let friction = map.project(&mut g, &joint_friction);
     let joint_rec = recursive(&mut g, &lm, grav, &joint_qd, &joint_qdd, &joint_friction)?;

@@ -162,24 +162,27 @@ fn craig_bias(g: &mut Graph, centrifugal: &[Vec<Id>], pairs_b: &[Vec<Id>], qd: &
 /// includes friction.
 pub(super) fn joint_friction(g: &mut Graph, model: &Model, params: &Params, qd: &[Id]) -> Vec<Id> {
     let eps = model.coulomb_smoothing;
-    (0..model.dof())
-        .map(|i| {
-            if !model.include_friction {
-                return g.zero();
-            }
-            let viscous = g.mul(params.damping[i], qd[i]);
-            let s = if eps > 0.0 {
-                let v2 = g.powi(qd[i], 2);
-                let r = g.sum(eps * eps, [(v2, 1.0)]);
-                let root = g.sqrt(r);
-                g.div(qd[i], root)
-            } else {
-                g.sign(qd[i])
-            };
-            let coulomb = g.mul(params.coulomb[i], s);
-            g.add(viscous, coulomb)
-        })
-        .collect()
+    let mut out = Vec::with_capacity(qd.len());
+    for (i, joint) in model.joints.iter().enumerate() {
+        let at = out.len();
+        if !model.include_friction || joint.kind.nv() != 1 {
+            // A floating joint has no friction (the model refuses one that asks for it).
+            out.extend((0..joint.kind.nv()).map(|_| g.zero()));
+            continue;
+        }
+        let viscous = g.mul(params.damping[i], qd[at]);
+        let s = if eps > 0.0 {
+            let v2 = g.powi(qd[at], 2);
+            let r = g.sum(eps * eps, [(v2, 1.0)]);
+            let root = g.sqrt(r);
+            g.div(qd[at], root)
+        } else {
+            g.sign(qd[at])
+        };
+        let coulomb = g.mul(params.coulomb[i], s);
+        out.push(g.add(viscous, coulomb));
+    }
+    out
 }
 
 /// `M_jk = sum_b m_b v_bj . v_bk + u_bj^T I_b u_bk` over bodies `b` below both joints, with

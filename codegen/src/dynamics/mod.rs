@@ -272,7 +272,7 @@ impl Derivation {
     /// the graph is full (checked after every stage and every joint's step within a stage, so
     /// that a robot too large for the limit costs little time and at most the limit's memory).
     pub fn try_new(model: &Model, limits: Limits) -> Result<Derivation, GraphFull> {
-        if model.is_floating() {
+        if !model.velocities_are_rates() {
             return floating::derive(model, limits);
         }
         let mut clock = Clock::new();

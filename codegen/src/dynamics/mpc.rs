@@ -44,6 +44,11 @@ pub(super) fn add(d: &mut Derivation, model: &Model) {
         .is_floating()
         .then(|| centroidal_momentum_rate(d, model));
     let n = d.dof;
+    if !model.floating_joints().is_empty() {
+        // The run-time kernels of the link motions and the manifold know a free flyer at the
+        // root only: not generated for floating joints below it yet.
+        return;
+    }
     let mut out = frame_motions(n);
     out.extend(manifold(model, n));
     if let Some(rate) = rate {

@@ -11,7 +11,7 @@
 
 use crate::cas::{Graph, Id};
 use crate::kinematics::{joint, Params};
-use crate::model::Model;
+use crate::model::{JointKind, Model};
 use crate::spatial::{
     cross, cross_force, mat_add, mat_mul, mat_t_vec, mat_vec, motion_cross, skew_mul, skew_times,
     spatial_add, spatial_dot, spatial_scale, spatial_sub, transpose, vec_add, vec_scale, Spatial,
@@ -100,21 +100,20 @@ impl LocalModel {
             lm.column.push(0);
             lm.parent.push(None);
         }
-        let (q0, v0) = (model.base_nq(), model.base_nv());
+        let (q_at, v_at) = (model.q_offsets(), model.v_offsets());
         for (i, joint) in model.joints.iter().enumerate() {
-            let coords = &q[q0 + i..q0 + i + 1];
+            let coords = &q[q_at[i]..q_at[i] + joint.kind.nq()];
             let placed = joint::body_in_parent(g, joint, &params.origin[i], coords);
             let inertial = (params.mass[i], params.com[i], params.inertia[i]);
             lm.push_body(g, placed, inertial, params.armature[i]);
             lm.axis.push(joint::axis(g, joint));
-            let rotates = joint::rotates(joint);
-            lm.step.push(if rotates {
-                Step::Revolute
-            } else {
-                Step::Prismatic
+            lm.step.push(match joint.kind {
+                JointKind::Floating => Step::Free,
+                JointKind::Revolute | JointKind::Continuous => Step::Revolute,
+                JointKind::Prismatic => Step::Prismatic,
             });
             lm.subspace.push(joint::subspace(g, joint));
-            lm.column.push(v0 + i);
+            lm.column.push(v_at[i]);
             lm.parent.push(match joint.parent {
                 Some(p) => Some(p + shift),
                 None if shift == 1 => Some(0),
@@ -248,7 +247,7 @@ pub fn forward_pass(
             mat_t_vec(g, r, &s)
         };
         let (wi, dwi, ai) = if lm.step[i] == Step::Free {
-            free_step(g, lm, i, terms, a_origin)
+            free_step(g, lm, i, terms, (wp_b, dwp_b, a_origin))
         } else if lm.step[i] == Step::Revolute {
             let wi = match qd {
                 Some(v) => {
@@ -350,18 +349,20 @@ pub fn rnea(g: &mut Graph, lm: &LocalModel, terms: Terms<'_>) -> Vec<Id> {
     tau
 }
 
-/// Newton-Euler's forward step for a free flyer on the world (a floating base, whose parent is
-/// at rest): angular velocity and acceleration from its coordinates, and the classical
-/// acceleration of its origin in its axes, `a_origin + dv/dt + w x v` (`a_origin`: gravity's
-/// upward acceleration, moved to base axes).
+/// Newton-Euler's forward step for a free flyer (a floating base, or a floating joint below
+/// the root), from its parent's motion in its axes: angular velocity `w_p`, angular
+/// acceleration `dw_p`, and `a_origin`, the classical acceleration of the parent's point at
+/// the body origin (for a floating base, gravity's upward acceleration). With the joint's
+/// velocity `(v, w)` and acceleration `(dv, dw)` in body axes (relative to the parent):
+/// `w_b = w_p + w`, `dw_b = dw_p + dw + w_p x w`, and the origin's classical acceleration
+/// `a_origin + dv + (w + 2 w_p) x v` (relative, then Coriolis).
 fn free_step(
     g: &mut Graph,
     lm: &LocalModel,
     i: usize,
     terms: Terms<'_>,
-    a_origin: V3,
+    (wp, dwp, a_origin): (V3, V3, V3),
 ) -> (V3, V3, V3) {
-    debug_assert!(lm.parent[i].is_none(), "a free flyer on another body");
     let col = lm.column[i];
     let zero = [g.zero(); 3];
     let part = |x: Option<&[Id]>, k: usize| {
@@ -369,9 +370,15 @@ fn free_step(
     };
     let (v, w) = (part(terms.qd, 0), part(terms.qd, 3));
     let (dv, dw) = (part(terms.qdd, 0), part(terms.qdd, 3));
-    let wv = cross(g, &w, &v);
+    let wb = vec_add(g, &wp, &w);
+    let pw = cross(g, &wp, &w);
+    let dwb = [0, 1, 2].map(|k| g.add_all([dwp[k], dw[k], pw[k]]));
+    let two = g.constant(2.0);
+    let wp2 = vec_scale(g, &wp, two);
+    let turn = vec_add(g, &w, &wp2);
+    let wv = cross(g, &turn, &v);
     let acc = [0, 1, 2].map(|k| g.add_all([a_origin[k], dv[k], wv[k]]));
-    (w, dw, acc)
+    (wb, dwb, acc)
 }
 
 /// A force `f` and moment `n` (about body `c`'s origin, in its axes) expressed in the parent's

@@ -13,13 +13,14 @@
 //! |---|---|---|---|---|
 //! | revolute, continuous | 1 | 1 | rotation by `q` about `a` | `(a; 0)` |
 //! | prismatic | 1 | 1 | translation by `q a` | `(0; a)` |
-//!
-//! | free flyer (a floating base) | 7 | 6 | translation `q[0..3]`, rotation by the unit quaternion `q[3..7]` (x, y, z, w) | the six unit columns, linear first |
+//! | floating (free flyer, a floating base or below the root) | 7 | 6 | translation `q[0..3]`, rotation by the unit quaternion `q[3..7]` (x, y, z, w) | the six unit columns, linear first |
+//! | planar | 3 | 3 | the chain prismatic `x`, prismatic `y`, revolute about `z` (`model::joint_kinds`) | one column per step |
 //!
 //! Revolute and prismatic joints integrate as `q + v dt`; a continuous joint's coordinate is
-//! its angle. The free flyer's velocity is the base's own (linear velocity of its origin, then
-//! angular velocity, both in base axes), as Pinocchio's `JointModelFreeFlyer`; it integrates on
-//! SE(3) (`eomgen_runtime::free_flyer::integrate`).
+//! its angle. The free flyer's velocity is its body's own (linear velocity of its origin, then
+//! angular velocity, both in the body's axes, relative to the joint frame), as Pinocchio's
+//! `JointModelFreeFlyer`; it integrates on SE(3) (`eomgen_runtime::free_flyer::integrate`,
+//! `integrate_blocks` below the root).
 
 use crate::cas::{Graph, Id};
 use crate::model::{Joint, JointKind};
@@ -65,6 +66,7 @@ pub fn motion(g: &mut Graph, joint: &Joint, q: &[Id]) -> Placement {
                 translation: vec_scale(g, &a, q[0]),
             }
         }
+        JointKind::Floating => free_flyer_placement(g, q),
     }
 }
 
@@ -93,6 +95,7 @@ pub fn subspace(g: &mut Graph, joint: &Joint) -> Vec<Spatial> {
     match joint.kind {
         JointKind::Revolute | JointKind::Continuous => vec![(a, zero)],
         JointKind::Prismatic => vec![(zero, a)],
+        JointKind::Floating => free_flyer_subspace(g),
     }
 }
 
@@ -100,7 +103,7 @@ pub fn subspace(g: &mut Graph, joint: &Joint) -> Vec<Spatial> {
 /// that still treat rotation and translation apart ask, instead of matching joint kinds.
 pub fn rotates(joint: &Joint) -> bool {
     match joint.kind {
-        JointKind::Revolute | JointKind::Continuous => true,
+        JointKind::Revolute | JointKind::Continuous | JointKind::Floating => true,
         JointKind::Prismatic => false,
     }
 }

@@ -55,7 +55,7 @@ impl WorldKinematics {
                 translation: [g.zero(); 3],
             }
         };
-        let q = &q[model.base_nq()..];
+        let offsets = model.q_offsets();
         let mut wk = WorldKinematics {
             rotation: Vec::with_capacity(n),
             position: Vec::with_capacity(n),
@@ -76,7 +76,7 @@ impl WorldKinematics {
             let origin = joint::origin(g, j, &params.origin[i]);
             // The joint frame in the world, then the body in it.
             let frame = joint::compose(g, &parent, &origin);
-            let motion = joint::motion(g, j, &q[i..i + 1]);
+            let motion = joint::motion(g, j, &q[offsets[i]..offsets[i] + j.kind.nq()]);
             let body = joint::compose(g, &frame, &motion);
             let a = joint::axis(g, j);
             let z = mat_vec(g, &frame.rotation, &a);
@@ -120,7 +120,7 @@ impl WorldKinematics {
         body: Option<usize>,
         p: &V3,
     ) -> Vec<Vec<Id>> {
-        let (nv, v0) = (model.nv(), model.base_nv());
+        let nv = model.nv();
         let mut jac = vec![vec![g.zero(); nv]; 6];
         if model.is_floating() {
             // The base's columns: its linear velocity, then its angular velocity about its
@@ -137,7 +137,23 @@ impl WorldKinematics {
             }
         }
         let Some(b) = body else { return jac };
+        let columns = model.v_offsets();
         for j in model.path_to_root(b) {
+            if model.joints[j].kind == crate::model::JointKind::Floating {
+                // A free flyer's columns: its body's linear velocity, then its angular
+                // velocity about the body origin, both in body axes.
+                let r = vec_sub(g, p, &self.position[j]);
+                for k in 0..3 {
+                    let e = [0, 1, 2].map(|row| self.rotation[j][row][k]);
+                    let lin = cross(g, &e, &r);
+                    for row in 0..3 {
+                        jac[row][columns[j] + k] = e[row];
+                        jac[row][columns[j] + 3 + k] = lin[row];
+                        jac[3 + row][columns[j] + 3 + k] = e[row];
+                    }
+                }
+                continue;
+            }
             let z = self.axis[j];
             let (lin, ang) = if joint::rotates(&model.joints[j]) {
                 let r = vec_sub(g, p, &self.origin[j]);
@@ -146,8 +162,8 @@ impl WorldKinematics {
                 (z, [g.zero(); 3])
             };
             for k in 0..3 {
-                jac[k][v0 + j] = lin[k];
-                jac[3 + k][v0 + j] = ang[k];
+                jac[k][columns[j]] = lin[k];
+                jac[3 + k][columns[j]] = ang[k];
             }
         }
         jac
@@ -171,8 +187,9 @@ impl BodyKinematics {
         let n = model.dof();
         let mut axis: Vec<Vec<Option<V3>>> = vec![vec![None; n]; n];
         let mut offset: Vec<Vec<Option<V3>>> = vec![vec![None; n]; n];
+        let offsets = model.q_offsets();
         for (b, j) in model.joints.iter().enumerate() {
-            let coords = &q[b..b + 1];
+            let coords = &q[offsets[b]..offsets[b] + j.kind.nq()];
             let rel = joint::body_in_parent(g, j, &params.origin[b], coords);
             if let Some(p) = j.parent {
                 for k in model.path_to_root(p) {

@@ -8,7 +8,9 @@
 
 use nalgebra::{Matrix3, SymmetricEigen};
 
-use super::build::{inertia_matrix, moments_text, ModelError, ModelWarning, RobotDescription};
+use super::description::RobotDescription;
+use super::errors::{moments_text, ModelError, ModelWarning};
+use super::inertia::inertia_matrix;
 use super::Model;
 
 /// Relative tolerance (of the trace) of the checks.

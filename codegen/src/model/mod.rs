@@ -16,15 +16,26 @@
 use nalgebra::{Matrix3, Vector3};
 
 mod build;
+mod description;
+mod errors;
+mod inertia;
 mod inertia_check;
+mod joint_kinds;
+mod merge;
+mod mimic;
+mod options;
+mod ordering;
+mod selections;
 pub mod shapes;
-pub use build::{
-    FormatIssue, ModelError, ModelOptions, ModelWarning, SymbolicParams, MAX_MAGNITUDE,
-};
+mod tree;
+mod validation;
+pub use errors::{FormatIssue, ModelError, ModelWarning};
+pub use options::{ModelOptions, SymbolicParams, MAX_MAGNITUDE};
 // The format-neutral description that readers (`crate::urdf`) fill in.
-pub(crate) use build::{
-    build_model, CollisionDescription, InertialDescription, JointDescription, JointType,
-    LinkDescription, Pose, RobotDescription,
+pub(crate) use build::build_model;
+pub(crate) use description::{
+    CollisionDescription, InertialDescription, JointDescription, JointType, LinkDescription, Pose,
+    RobotDescription,
 };
 
 /// A rigid transform: `p_parent = rotation * p_child + translation`.
@@ -60,9 +71,25 @@ pub enum JointKind {
     Continuous,
     /// Translation along `axis`.
     Prismatic,
+    /// A free flyer below the root (URDF `floating`): the child moves freely in the joint
+    /// frame, `q` = [position (3), unit quaternion x, y, z, w (4)] of the child in the joint
+    /// frame, velocity = [linear (3), angular (3)] in the child's axes (Pinocchio's
+    /// `JointModelFreeFlyer`). `axis` is not used.
+    Floating,
 }
 
 impl JointKind {
+    /// The URDF `type` the kind comes from (`revolute`, ...; a planar joint's steps are
+    /// prismatic and continuous joints).
+    pub fn urdf_name(self) -> &'static str {
+        match self {
+            JointKind::Revolute => "revolute",
+            JointKind::Continuous => "continuous",
+            JointKind::Prismatic => "prismatic",
+            JointKind::Floating => "floating",
+        }
+    }
+
     /// Whether the joint rotates its body (revolute and continuous joints).
     pub fn is_revolute(self) -> bool {
         matches!(self, JointKind::Revolute | JointKind::Continuous)
@@ -73,6 +100,7 @@ impl JointKind {
     pub fn nq(self) -> usize {
         match self {
             JointKind::Revolute | JointKind::Continuous | JointKind::Prismatic => 1,
+            JointKind::Floating => 7,
         }
     }
 
@@ -81,6 +109,16 @@ impl JointKind {
     pub fn nv(self) -> usize {
         match self {
             JointKind::Revolute | JointKind::Continuous | JointKind::Prismatic => 1,
+            JointKind::Floating => 6,
+        }
+    }
+
+    /// The names of the joint's velocity coordinates after its own name (`name.vx`, ...),
+    /// empty for a joint of one coordinate, which is called by its name alone.
+    pub fn coordinate_suffixes(self) -> &'static [&'static str] {
+        match self {
+            JointKind::Revolute | JointKind::Continuous | JointKind::Prismatic => &[],
+            JointKind::Floating => &["vx", "vy", "vz", "wx", "wy", "wz"],
         }
     }
 }
@@ -258,10 +296,13 @@ impl Model {
         self.coupling.iter().any(|c| c.leader.is_some())
     }
 
-    /// The number of joint coordinates: one per independent joint ([`Model::dof`] without
-    /// mimic joints).
+    /// The number of the joints' velocity coordinates: one per independent joint of one
+    /// coordinate ([`Model::dof`] without mimic joints), six per floating joint.
     pub fn coordinates(&self) -> usize {
-        self.coordinate_joints().len()
+        self.coordinate_joints()
+            .into_iter()
+            .map(|j| self.joints[j].kind.nv())
+            .sum()
     }
 
     /// The joint behind each coordinate, in coordinate order: the independent joints.
@@ -271,12 +312,54 @@ impl Model {
             .collect()
     }
 
-    /// The URDF names of the coordinates' joints, in coordinate order (what `JOINT_NAMES`
-    /// lists).
-    pub fn coordinate_names(&self) -> Vec<&str> {
-        self.coordinate_joints()
-            .into_iter()
-            .map(|j| self.joints[j].name.as_str())
+    /// The names of the joints' velocity coordinates, in coordinate order (what `JOINT_NAMES`
+    /// lists): a joint's URDF name, or for a joint of several coordinates one entry per
+    /// coordinate, `name.suffix` ([`JointKind::coordinate_suffixes`]).
+    pub fn coordinate_names(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        for j in self.coordinate_joints() {
+            let joint = &self.joints[j];
+            match joint.kind.coordinate_suffixes() {
+                [] => out.push(joint.name.clone()),
+                suffixes => out.extend(suffixes.iter().map(|s| format!("{}.{s}", joint.name))),
+            }
+        }
+        out
+    }
+
+    /// Whether the velocity coordinates are the time derivatives of the position coordinates
+    /// (no floating base, no floating joint): the closed Lagrangian forms then apply.
+    pub fn velocities_are_rates(&self) -> bool {
+        self.nq() == self.nv()
+    }
+
+    /// The joints of several velocity coordinates that move on a manifold (floating joints
+    /// below the root), by index.
+    pub fn floating_joints(&self) -> Vec<usize> {
+        (0..self.joints.len())
+            .filter(|&j| self.joints[j].kind == JointKind::Floating)
+            .collect()
+    }
+
+    /// Each joint's first position coordinate in `q` (after a floating base's seven).
+    pub fn q_offsets(&self) -> Vec<usize> {
+        self.offsets(self.base_nq(), JointKind::nq)
+    }
+
+    /// Each joint's first velocity coordinate in `qd` (after a floating base's six).
+    pub fn v_offsets(&self) -> Vec<usize> {
+        self.offsets(self.base_nv(), JointKind::nv)
+    }
+
+    /// The running sum of `size` over the joints, from `start`.
+    fn offsets(&self, start: usize, size: fn(JointKind) -> usize) -> Vec<usize> {
+        let mut at = start;
+        self.joints
+            .iter()
+            .map(|j| {
+                at += size(j.kind);
+                at - size(j.kind)
+            })
             .collect()
     }
 

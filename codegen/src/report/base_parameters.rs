@@ -32,7 +32,7 @@ use std::fmt::Write as _;
 
 use crate::cas::{format_number, Id};
 use crate::dynamics::regressor::Owner;
-use crate::dynamics::Derivation;
+use crate::dynamics::{Derivation, Identification};
 use crate::model::Model;
 
 use super::document::{describe_param, kind_name, value_source, vec3};
@@ -106,6 +106,33 @@ pub fn render_base_parameters(
         })
         .collect();
 
+    let intro = intro(model, d, id, &idle, opts);
+    let legend = legend(id, geometry);
+    let joints = joint_lines(model, id, opts);
+    let doc = Document {
+        title: format!("{}: base parameters", model.name),
+        intro,
+        joints,
+        formulas,
+        values,
+        legend,
+    };
+    Ok(match opts.format {
+        Format::Text => doc.text(),
+        Format::Latex => doc.latex(opts.standalone),
+        Format::Markdown => doc.markdown(),
+    })
+}
+
+/// The introduction: the robot, how many base parameters of how many, how numbers are printed,
+/// and the standard parameters without effect (`idle`).
+fn intro(
+    model: &Model,
+    d: &Derivation,
+    id: &Identification,
+    idle: &[String],
+    opts: &ShowOptions,
+) -> Vec<String> {
     let (p, pb) = (id.parameters.len(), id.base.len());
     let numbers = match opts.digits {
         Some(k) => format!("{k} significant digits"),
@@ -134,6 +161,11 @@ pub fn render_base_parameters(
             idle.join(", ")
         ));
     }
+    intro
+}
+
+/// The legend: the standard parameters' names, and the geometry's symbols (`geometry`).
+fn legend(id: &Identification, geometry: Vec<(String, String)>) -> Vec<(String, String)> {
     let mut legend: Vec<(String, String)> = vec![
         (
             "M_b, MX_b, MY_b, MZ_b".into(),
@@ -162,6 +194,11 @@ pub fn render_base_parameters(
             .into(),
     ));
     legend.extend(geometry);
+    legend
+}
+
+/// One line per coordinate; a mimic joint is described with the coordinate it follows.
+fn joint_lines(model: &Model, id: &Identification, opts: &ShowOptions) -> Vec<String> {
     let describe = |i: usize| {
         let j = &model.joints[i];
         format!(
@@ -172,8 +209,7 @@ pub fn render_base_parameters(
             id.body_names[i]
         )
     };
-    // One line per coordinate; a mimic joint is described with the coordinate it follows.
-    let joints: Vec<String> = model
+    model
         .coordinate_joints()
         .into_iter()
         .enumerate()
@@ -193,20 +229,7 @@ pub fn render_base_parameters(
             }
             line
         })
-        .collect();
-    let doc = Document {
-        title: format!("{}: base parameters", model.name),
-        intro,
-        joints,
-        formulas,
-        values,
-        legend,
-    };
-    Ok(match opts.format {
-        Format::Text => doc.text(),
-        Format::Latex => doc.latex(opts.standalone),
-        Format::Markdown => doc.markdown(),
-    })
+        .collect()
 }
 
 /// What is printed, before formatting.

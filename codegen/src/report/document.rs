@@ -283,11 +283,7 @@ pub(super) fn describe_param(name: &str) -> String {
 
 /// The name of a kind of joint.
 pub(super) fn kind_name(k: JointKind) -> &'static str {
-    match k {
-        JointKind::Revolute => "revolute",
-        JointKind::Continuous => "continuous",
-        JointKind::Prismatic => "prismatic",
-    }
+    k.urdf_name()
 }
 
 /// A vector as `(1, 0, 0)`.

@@ -29,12 +29,17 @@ pub(super) fn read(node: Node, report: &mut Report) -> Option<JointDescription> 
     let parent = link_of(node, "parent", &ctx, report);
     let child = link_of(node, "child", &ctx, report);
     let origin = element::origin(node, &ctx, report);
+    // A planar joint without an axis moves in its frame's xy plane (as Pinocchio reads it).
+    let default_axis = match joint_type {
+        Some(JointType::Planar) => [0.0, 0.0, 1.0],
+        _ => [1.0, 0.0, 0.0],
+    };
     let axis = match single(node, "axis", &ctx, report) {
         Some(a) => {
             element::warn_unknown(a, &[], &ctx, report);
-            vector(a, "xyz", Some([1.0, 0.0, 0.0]), &ctx, report)
+            vector(a, "xyz", Some(default_axis), &ctx, report)
         }
-        None => Some([1.0, 0.0, 0.0]),
+        None => Some(default_axis),
     };
     let limits = single(node, "limit", &ctx, report).map(|l| limit(l, &ctx, report));
     let (damping, friction) = match single(node, "dynamics", &ctx, report) {
@@ -76,7 +81,9 @@ fn joint_type(node: Node, ctx: &Context, report: &mut Report) -> Option<JointTyp
         "continuous" => JointType::Moving(JointKind::Continuous),
         "prismatic" => JointType::Moving(JointKind::Prismatic),
         "fixed" => JointType::Fixed,
-        "floating" | "planar" | "spherical" => JointType::Unsupported(text.into()),
+        "floating" => JointType::Moving(JointKind::Floating),
+        "planar" => JointType::Planar,
+        "spherical" => JointType::Unsupported(text.into()),
         other => {
             let at = node
                 .attribute_node("type")

@@ -57,7 +57,7 @@ impl Emitter<'_> {
                 .model
                 .coordinate_names()
                 .into_iter()
-                .map(Literal::string);
+                .map(|name| Literal::string(&name));
             let what = if self.floating {
                 "The URDF names of the joints, in the order of the joint part of every array (after the base's coordinates)."
             } else {
@@ -80,6 +80,13 @@ impl Emitter<'_> {
                 /// Number of position coordinates: the base's 7 (position, unit quaternion x, y, z, w), then the joints'.
                 pub const NQ: usize = #nq;
                 /// Number of velocity coordinates: the base's 6 (linear, then angular velocity, base axes), then the joints'.
+                pub const NV: usize = #n;
+            }
+        } else if !self.model.velocities_are_rates() {
+            quote! {
+                /// Number of position coordinates: 7 per floating joint (position, unit quaternion x, y, z, w), 1 per other joint.
+                pub const NQ: usize = #nq;
+                /// Number of velocity coordinates: 6 per floating joint (linear, then angular velocity, its body's axes), 1 per other joint.
                 pub const NV: usize = #n;
             }
         } else {
@@ -108,6 +115,15 @@ impl Emitter<'_> {
         )];
         if self.model.is_coupled() {
             lines.extend(coupling_doc(self.model));
+        }
+        if !self.floating && !self.model.velocities_are_rates() {
+            lines.extend([
+                String::new(),
+                "Floating joints (as Pinocchio's free flyer, below the root): each has `q` = [position of its".into(),
+                "child in the joint frame (3), unit quaternion x, y, z, w (4)] (`NQ` in all) and velocities =".into(),
+                "[linear (3), angular (3)] in the child's axes (`NV` in all); `JOINT_NAMES` has one entry per".into(),
+                "velocity coordinate. Move along them with `integrate`.".into(),
+            ]);
         }
         if self.floating {
             lines.extend([

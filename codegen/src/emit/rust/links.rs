@@ -10,7 +10,7 @@ use crate::dynamics::{Derivation, Evaluation, Quantity, Shape};
 use crate::emit::body::body;
 use crate::emit::expr::lit;
 use crate::kinematics::snap;
-use crate::model::Transform;
+use crate::model::{JointKind, Transform};
 use crate::spatial::snap_rotation;
 
 impl Emitter<'_> {
@@ -34,6 +34,19 @@ impl Emitter<'_> {
         } else {
             quote!(::eomgen_runtime::tree::chain_jacobian)
         };
+        if !self.model.floating_joints().is_empty() {
+            // Joints of several columns: each joint's first column from a table.
+            let columns = self.model.v_offsets().into_iter().map(usize_lit);
+            let nj = usize_lit(self.model.joints.len());
+            return quote! {
+                #docs
+                pub fn link_jacobian(&self, link: #link_ty, q: &[T; #nq]) -> [[T; #n]; 6] {
+                    const COLUMNS: [usize; #nj] = [#(#columns),*];
+                    let (path, placement) = Self::link_frame(link);
+                    ::eomgen_runtime::tree::chain_jacobian_columns(path, &Self::TREE_JOINTS, &COLUMNS, |j| self.joint_transform(j, q), &placement)
+                }
+            };
+        }
         if self.model.is_coupled() {
             // Columns per joint (after a floating base's six), then summed into the
             // coordinates' (`J G`).
@@ -100,10 +113,10 @@ impl Emitter<'_> {
         let joints = self.model.joints.iter().map(|j| {
             let axis = j.axis.map(snap);
             let [x, y, z] = [0, 1, 2].map(|k| f64_literal(axis[k]));
-            let motion = if crate::kinematics::joint::rotates(j) {
-                quote!(Rotation)
-            } else {
-                quote!(Translation)
+            let motion = match j.kind {
+                JointKind::Floating => quote!(Free),
+                JointKind::Revolute | JointKind::Continuous => quote!(Rotation),
+                JointKind::Prismatic => quote!(Translation),
             };
             quote!(::eomgen_runtime::tree::TreeJoint { axis: [#x, #y, #z], motion: ::eomgen_runtime::tree::Motion::#motion })
         });

@@ -4,7 +4,7 @@
 use proc_macro2::{Ident, TokenStream};
 use quote::{format_ident, quote};
 
-use super::{doc, Emitter};
+use super::{doc, usize_lit, Emitter};
 use crate::cas::{Id, OpCount};
 use crate::dynamics::{ActiveContacts, Craig, Evaluation, Input, Quantity, Shape};
 use crate::emit::body::{body, factored_body, shape_type, Body};
@@ -189,10 +189,20 @@ impl Emitter<'_> {
     pub(super) fn integrate_fn(&mut self, q: &Quantity) -> TokenStream {
         let docs = Self::quantity_doc(q, None);
         let (n, nq, vis) = (&self.n, &self.nq, self.vis(q.name));
+        let body = if self.floating {
+            quote!(::eomgen_runtime::free_flyer::integrate(q, qd, dt))
+        } else {
+            let (q_at, v_at) = (self.model.q_offsets(), self.model.v_offsets());
+            let blocks = self.model.floating_joints().into_iter().map(|j| {
+                let (a, b) = (usize_lit(q_at[j]), usize_lit(v_at[j]));
+                quote!((#a, #b))
+            });
+            quote!(::eomgen_runtime::free_flyer::integrate_blocks(q, qd, dt, &[#(#blocks),*]))
+        };
         quote! {
             #docs
             #vis fn integrate(&self, q: &[T; #nq], qd: &[T; #n], dt: T) -> [T; #nq] {
-                ::eomgen_runtime::free_flyer::integrate(q, qd, dt)
+                #body
             }
         }
     }
