@@ -278,8 +278,8 @@ pub fn csv_number(x: f64) -> String {
     }
 }
 
-/// Runs the simulation: `round(duration / dt)` steps of the chosen integrator.
-pub fn run(model: &Model, terms: &Terms, o: &Options) -> Result<Outcome, String> {
+/// The number of steps, `round(duration / dt)`, or why the options are invalid.
+fn step_count(o: &Options) -> Result<u64, String> {
     let valid = o.dt > 0.0 && o.dt.is_finite() && o.duration >= 0.0 && o.duration.is_finite();
     if !valid {
         return Err("--dt must be positive and --duration non-negative".into());
@@ -290,85 +290,157 @@ pub fn run(model: &Model, terms: &Terms, o: &Options) -> Result<Outcome, String>
             "{steps} steps: choose a larger --dt or a shorter --duration"
         ));
     }
-    let steps = steps as u64;
-    let names = model.coordinate_names();
-    let mut csv = String::from("t");
-    for prefix in ["q", "qd", "tau"] {
-        for name in &names {
-            let _ = write!(csv, ",{prefix}_{name}");
+    Ok(steps as u64)
+}
+
+impl Outcome {
+    /// An empty outcome whose CSV holds the header row for the model's coordinates.
+    fn new(model: &Model) -> Outcome {
+        let names = model.coordinate_names();
+        let mut csv = String::from("t");
+        for prefix in ["q", "qd", "tau"] {
+            for name in &names {
+                let _ = write!(csv, ",{prefix}_{name}");
+            }
+        }
+        csv.push('\n');
+        Outcome {
+            csv,
+            summary: String::new(),
+            times: Vec::new(),
+            positions: Vec::new(),
+            velocities: Vec::new(),
+            efforts: Vec::new(),
+            energy: Vec::new(),
+            dissipative: false,
         }
     }
-    csv.push('\n');
+
+    /// Appends the sample at `t`: a CSV row and the trajectories.
+    fn record(&mut self, t: f64, q: &[f64], qd: &[f64], s: &Step) {
+        row(&mut self.csv, t, q, qd, &s.tau);
+        self.times.push(t);
+        self.positions.push(q.to_vec());
+        self.velocities.push(qd.to_vec());
+        self.efforts.push(s.tau.clone());
+        self.energy.push(s.energy);
+        self.dissipative |= s.friction;
+    }
+}
+
+/// One RK4 step of `h` from `(q, qd)`, whose first stage `first` is already evaluated.
+fn rk4_step(
+    model: &Model,
+    terms: &Terms,
+    o: &Options,
+    (q, qd): (&mut [f64], &mut [f64]),
+    first: Step,
+    h: f64,
+) -> Result<(), StepError> {
+    let a1 = first.qdd;
+    let v1 = qd.to_vec();
+    let stage = |q: &[f64], v: &[f64]| step_eval(model, terms, o, q, v).map(|s| s.qdd);
+    let (q2, v2) = (axpy(q, h / 2.0, &v1), axpy(qd, h / 2.0, &a1));
+    let a2 = stage(&q2, &v2)?;
+    let (q3, v3) = (axpy(q, h / 2.0, &v2), axpy(qd, h / 2.0, &a2));
+    let a3 = stage(&q3, &v3)?;
+    let (q4, v4) = (axpy(q, h, &v3), axpy(qd, h, &a3));
+    let a4 = stage(&q4, &v4)?;
+    for i in 0..q.len() {
+        q[i] += h / 6.0 * (v1[i] + 2.0 * (v2[i] + v3[i]) + v4[i]);
+        qd[i] += h / 6.0 * (a1[i] + 2.0 * (a2[i] + a3[i]) + a4[i]);
+    }
+    Ok(())
+}
+
+/// One step of the symplectic `method` of `h` from `(q, qd)` with the effort `tau` held.
+fn symplectic_step(
+    terms: &Terms,
+    method: Method,
+    q: &[f64],
+    qd: &[f64],
+    tau: &[f64],
+    h: f64,
+) -> Result<(Vec<f64>, Vec<f64>), StepError> {
+    let n = q.len();
+    let mass = |q: &[f64]| -> Result<Vec<Vec<f64>>, StepError> {
+        Ok(hamilton_terms(terms, q, &vec![0.0; n])?.0)
+    };
+    let rate = |q: &[f64], qd: &[f64], tau: &[f64]| -> Result<Vec<f64>, StepError> {
+        let (_, hh, c) = hamilton_terms(terms, q, qd)?;
+        Ok((0..n)
+            .map(|k| tau[k] - hh[k] + (0..n).map(|j| (c[k][j] + c[j][k]) * qd[j]).sum::<f64>())
+            .collect())
+    };
+    let solve = |m: &[Vec<f64>], b: &[f64]| solve_mass(m, b);
+    let sys = symplectic::System {
+        mass: &mass,
+        rate: &rate,
+        solve: &solve,
+    };
+    symplectic::step(&sys, method, q, qd, tau, h)
+}
+
+/// The summary: the final state, and the energy drift (no controller or PFL) or the final
+/// tracking error (the other controllers).
+fn summary(
+    model: &Model,
+    o: &Options,
+    steps: u64,
+    q: &[f64],
+    qd: &[f64],
+    energy: (f64, f64),
+) -> String {
+    let h = o.dt;
+    let t_end = steps as f64 * h;
+    let (e0, e_end) = energy;
+    let fmt = |v: &[f64]| {
+        v.iter()
+            .map(|x| format!("{x:.6}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let mut summary = format!(
+        "{}: {} {} steps of {h} s to t = {t_end} s\nq  = [{}]\nqd = [{}]\n",
+        model.name,
+        steps,
+        o.integrator.name(),
+        fmt(q),
+        fmt(qd)
+    );
+    if matches!(o.controller, Controller::None | Controller::Pfl) {
+        let _ = writeln!(
+            summary,
+            "energy: {e0:.9e} J at t = 0, {e_end:.9e} J at the end (change {:.3e} J)",
+            e_end - e0
+        );
+    } else {
+        let err = (0..q.len())
+            .map(|i| (q[i] - o.target[i]).abs())
+            .fold(0.0, f64::max);
+        let _ = writeln!(summary, "max |q - target| at the end: {err:.3e}");
+    }
+    summary
+}
+
+/// Runs the simulation: `round(duration / dt)` steps of the chosen integrator.
+pub fn run(model: &Model, terms: &Terms, o: &Options) -> Result<Outcome, String> {
+    let steps = step_count(o)?;
     let (mut q, mut qd) = (o.q0.clone(), o.qd0.clone());
     let h = o.dt;
-    let mut out = Outcome {
-        csv,
-        summary: String::new(),
-        times: Vec::new(),
-        positions: Vec::new(),
-        velocities: Vec::new(),
-        efforts: Vec::new(),
-        energy: Vec::new(),
-        dissipative: false,
-    };
-    let record = |out: &mut Outcome, t: f64, q: &[f64], qd: &[f64], s: &Step| {
-        row(&mut out.csv, t, q, qd, &s.tau);
-        out.times.push(t);
-        out.positions.push(q.to_vec());
-        out.velocities.push(qd.to_vec());
-        out.efforts.push(s.tau.clone());
-        out.energy.push(s.energy);
-        out.dissipative |= s.friction;
-    };
+    let mut out = Outcome::new(model);
     let fail = |e: StepError, t: f64| step_message(e, &model.name, t, h);
     for k in 0..steps {
         let t = k as f64 * h;
         let first = step_eval(model, terms, o, &q, &qd).map_err(|e| fail(e, t))?;
-        record(&mut out, t, &q, &qd, &first);
+        out.record(t, &q, &qd, &first);
         match o.integrator {
-            Integrator::Rk4 => {
-                let a1 = first.qdd;
-                let v1 = qd.clone();
-                let stage = |q: &[f64], v: &[f64]| {
-                    step_eval(model, terms, o, q, v)
-                        .map(|s| s.qdd)
-                        .map_err(|e| fail(e, t + h))
-                };
-                let (q2, v2) = (axpy(&q, h / 2.0, &v1), axpy(&qd, h / 2.0, &a1));
-                let a2 = stage(&q2, &v2)?;
-                let (q3, v3) = (axpy(&q, h / 2.0, &v2), axpy(&qd, h / 2.0, &a2));
-                let a3 = stage(&q3, &v3)?;
-                let (q4, v4) = (axpy(&q, h, &v3), axpy(&qd, h, &a3));
-                let a4 = stage(&q4, &v4)?;
-                for i in 0..q.len() {
-                    q[i] += h / 6.0 * (v1[i] + 2.0 * (v2[i] + v3[i]) + v4[i]);
-                    qd[i] += h / 6.0 * (a1[i] + 2.0 * (a2[i] + a3[i]) + a4[i]);
-                }
-            }
+            Integrator::Rk4 => rk4_step(model, terms, o, (&mut q, &mut qd), first, h),
             Integrator::Symplectic(method) => {
-                let n = q.len();
-                let mass = |q: &[f64]| -> Result<Vec<Vec<f64>>, StepError> {
-                    Ok(hamilton_terms(terms, q, &vec![0.0; n])?.0)
-                };
-                let rate = |q: &[f64], qd: &[f64], tau: &[f64]| -> Result<Vec<f64>, StepError> {
-                    let (_, hh, c) = hamilton_terms(terms, q, qd)?;
-                    Ok((0..n)
-                        .map(|k| {
-                            tau[k] - hh[k]
-                                + (0..n).map(|j| (c[k][j] + c[j][k]) * qd[j]).sum::<f64>()
-                        })
-                        .collect())
-                };
-                let solve = |m: &[Vec<f64>], b: &[f64]| solve_mass(m, b);
-                let sys = symplectic::System {
-                    mass: &mass,
-                    rate: &rate,
-                    solve: &solve,
-                };
-                (q, qd) = symplectic::step(&sys, method, &q, &qd, &first.tau, h)
-                    .map_err(|e| fail(e, t + h))?;
+                symplectic_step(terms, method, &q, &qd, &first.tau, h).map(|next| (q, qd) = next)
             }
         }
+        .map_err(|e| fail(e, t + h))?;
         if q.iter()
             .chain(&qd)
             .any(|x| !x.is_finite() || x.abs() >= DIVERGED)
@@ -378,34 +450,8 @@ pub fn run(model: &Model, terms: &Terms, o: &Options) -> Result<Outcome, String>
     }
     let t_end = steps as f64 * h;
     let last = step_eval(model, terms, o, &q, &qd).map_err(|e| fail(e, t_end))?;
-    record(&mut out, t_end, &q, &qd, &last);
-    let (e0, e_end) = (out.energy[0], last.energy);
-    let fmt = |v: &[f64]| {
-        v.iter()
-            .map(|x| format!("{x:.6}"))
-            .collect::<Vec<_>>()
-            .join(", ")
-    };
-    out.summary = format!(
-        "{}: {} {} steps of {h} s to t = {t_end} s\nq  = [{}]\nqd = [{}]\n",
-        model.name,
-        steps,
-        o.integrator.name(),
-        fmt(&q),
-        fmt(&qd)
-    );
-    if matches!(o.controller, Controller::None | Controller::Pfl) {
-        let _ = writeln!(
-            out.summary,
-            "energy: {e0:.9e} J at t = 0, {e_end:.9e} J at the end (change {:.3e} J)",
-            e_end - e0
-        );
-    } else {
-        let err = (0..q.len())
-            .map(|i| (q[i] - o.target[i]).abs())
-            .fold(0.0, f64::max);
-        let _ = writeln!(out.summary, "max |q - target| at the end: {err:.3e}");
-    }
+    out.record(t_end, &q, &qd, &last);
+    out.summary = summary(model, o, steps, &q, &qd, (out.energy[0], last.energy));
     Ok(out)
 }
 

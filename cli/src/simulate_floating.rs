@@ -233,6 +233,39 @@ fn axpy(a: &DVector<f64>, h: f64, b: &DVector<f64>) -> DVector<f64> {
     a + b * h
 }
 
+/// One RK4 step of `h` on the configuration manifold from `(q, v)`, whose first stage's
+/// accelerations `a1` are already evaluated; the stages are evaluated at time `t`.
+fn rk4_step(
+    ev: &Evaluator,
+    o: &Options,
+    name: &str,
+    (q, v): (&[f64], &DVector<f64>),
+    a1: &DVector<f64>,
+    t: f64,
+    h: f64,
+) -> Result<(Vec<f64>, DVector<f64>), String> {
+    let stage = |dq: &DVector<f64>, dt: f64, v: &DVector<f64>| {
+        evaluate(
+            ev,
+            o,
+            name,
+            &integrate(q, dq.as_slice(), dt),
+            v.as_slice(),
+            t,
+        )
+        .map(|e| e.0)
+    };
+    let v2 = axpy(v, h / 2.0, a1);
+    let a2 = stage(v, h / 2.0, &v2)?;
+    let v3 = axpy(v, h / 2.0, &a2);
+    let a3 = stage(&v2, h / 2.0, &v3)?;
+    let v4 = axpy(v, h, &a3);
+    let a4 = stage(&v3, h, &v4)?;
+    let mean_v = (v + &v2 * 2.0 + &v3 * 2.0 + &v4) / 6.0;
+    let mean_a = (a1 + &a2 * 2.0 + &a3 * 2.0 + &a4) / 6.0;
+    Ok((integrate(q, mean_v.as_slice(), h), axpy(v, h, &mean_a)))
+}
+
 /// Runs the simulation.
 pub fn run(derived: &Derived, o: &Options) -> Result<Outcome, String> {
     let (model, ev) = (derived.model(), &compile(derived)?);
@@ -273,40 +306,7 @@ pub fn run(derived: &Derived, o: &Options) -> Result<Outcome, String> {
             break;
         }
         let h = o.dt;
-        let v2 = axpy(&v, h / 2.0, &a1);
-        let a2 = evaluate(
-            ev,
-            o,
-            &model.name,
-            &integrate(&q, v.as_slice(), h / 2.0),
-            v2.as_slice(),
-            t,
-        )?
-        .0;
-        let v3 = axpy(&v, h / 2.0, &a2);
-        let a3 = evaluate(
-            ev,
-            o,
-            &model.name,
-            &integrate(&q, v2.as_slice(), h / 2.0),
-            v3.as_slice(),
-            t,
-        )?
-        .0;
-        let v4 = axpy(&v, h, &a3);
-        let a4 = evaluate(
-            ev,
-            o,
-            &model.name,
-            &integrate(&q, v3.as_slice(), h),
-            v4.as_slice(),
-            t,
-        )?
-        .0;
-        let mean_v = (&v + &v2 * 2.0 + &v3 * 2.0 + &v4) / 6.0;
-        let mean_a = (&a1 + &a2 * 2.0 + &a3 * 2.0 + &a4) / 6.0;
-        q = integrate(&q, mean_v.as_slice(), h);
-        v = axpy(&v, h, &mean_a);
+        (q, v) = rk4_step(ev, o, &model.name, (&q, &v), &a1, t, h)?;
         if q.iter()
             .chain(v.iter())
             .any(|x| !x.is_finite() || x.abs() > 1e8)
