@@ -55,7 +55,9 @@ pub(crate) fn generate(a: GenerateArgs) -> Result<(), Failure> {
     }
 }
 
-pub(crate) fn show(a: ShowArgs) -> Result<(), Failure> {
+/// The quantities `show` prints: `--term` (plus the inverse dynamics derivatives with
+/// `--derivatives`), each once in the order asked. Exits on flags that conflict with them.
+fn show_terms(a: &ShowArgs) -> Vec<String> {
     let mut terms = a.term.clone();
     if a.derivatives {
         if a.term == ["all"] {
@@ -87,20 +89,14 @@ pub(crate) fn show(a: ShowArgs) -> Result<(), Failure> {
             )
             .exit();
     }
-    let mut b = a.model.builder(&a.urdf, &a.symbolic);
-    if a.base_parameters {
-        b = b.regressor();
-    }
-    let partials =
-        |t: &String| catalogue::notation(t).is_some_and(|n| n.layout == Layout::Partials);
-    if terms.iter().any(partials) {
-        b = b.derivatives();
-    }
-    let model = load(&b)?;
-    let derived = derived(&b, model)?;
-    let opts = ShowOptions {
+    terms
+}
+
+/// The report's options from `show`'s flags, for the quantities `terms`.
+fn show_options(a: &ShowArgs, terms: Vec<String>) -> ShowOptions {
+    ShowOptions {
         terms,
-        entry: a.entry.map(|e| e.0),
+        entry: a.entry.as_ref().map(|e| e.0.clone()),
         format: match a.format {
             FormatArg::Text => Format::Text,
             FormatArg::Latex => Format::Latex,
@@ -116,7 +112,37 @@ pub(crate) fn show(a: ShowArgs) -> Result<(), Failure> {
         max_terms: a.max_terms,
         source: Some(file_name(&a.urdf)),
         standalone: a.standalone,
-    };
+    }
+}
+
+/// A report's failure, naming the URDF and what to do about it.
+fn show_failure(urdf: &Path, e: report::ReportError) -> Failure {
+    match e {
+        report::ReportError::GraphFull(full) => Failure(format!(
+            "{}: {full} while expanding the equations for print: raise it with \
+             --max-graph-nodes, or print with --form program",
+            urdf.display()
+        )),
+        report::ReportError::Derivatives(why) => Failure(format!("{}: {why}", urdf.display())),
+        report::ReportError::TooLarge(why) => Failure(format!("{}: {why}", urdf.display())),
+        e => e.into(),
+    }
+}
+
+pub(crate) fn show(a: ShowArgs) -> Result<(), Failure> {
+    let terms = show_terms(&a);
+    let mut b = a.model.builder(&a.urdf, &a.symbolic);
+    if a.base_parameters {
+        b = b.regressor();
+    }
+    let partials =
+        |t: &String| catalogue::notation(t).is_some_and(|n| n.layout == Layout::Partials);
+    if terms.iter().any(partials) {
+        b = b.derivatives();
+    }
+    let model = load(&b)?;
+    let derived = derived(&b, model)?;
+    let opts = show_options(&a, terms);
     let text = progress::run("printing the equations", || {
         if a.base_parameters {
             report::print_base_parameters(&derived, &opts)
@@ -124,16 +150,7 @@ pub(crate) fn show(a: ShowArgs) -> Result<(), Failure> {
             report::print(&derived, &opts)
         }
     })
-    .map_err(|e| match e {
-        report::ReportError::GraphFull(full) => Failure(format!(
-            "{}: {full} while expanding the equations for print: raise it with \
-             --max-graph-nodes, or print with --form program",
-            a.urdf.display()
-        )),
-        report::ReportError::Derivatives(why) => Failure(format!("{}: {why}", a.urdf.display())),
-        report::ReportError::TooLarge(why) => Failure(format!("{}: {why}", a.urdf.display())),
-        e => e.into(),
-    })?;
+    .map_err(|e| show_failure(&a.urdf, e))?;
     emit(&text)
 }
 
