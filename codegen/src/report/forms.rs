@@ -87,43 +87,78 @@ pub(super) fn projected_newton_euler(
     let mut sections = Vec::new();
     let count = terms.len();
     for (k, t) in terms.iter().enumerate() {
-        let body = format!("body {} of {count}, link `{}`", k + 1, t.link);
-        let notes = vec![format!(
-            "M^({}) = J_P^T m J_P + J_R^T Theta J_R: J_P the Jacobian of the centre of mass, \
+        let ctx = (d.dof, opts, syntax);
+        sections.extend(body_sections(g, t, (k, count), ctx, dropped)?);
+    }
+    let notes = sum_notes(model, count);
+    sections.push(build_section(
+        g,
+        "Sum over the bodies".to_string(),
+        notes,
+        Vec::new(),
+        opts,
+        false,
+        false,
+        dropped,
+    )?);
+    // An empty section's note says "Every entry is 0.": not meant here.
+    if let Some(last) = sections.last_mut() {
+        last.notes.retain(|n| n != "Every entry is 0.");
+    }
+    Ok(sections)
+}
+
+/// The sections of body `k` (0-based) of `count`: its share of `M` and of `b`. `ctx` holds the
+/// joint count, the options and the syntax.
+fn body_sections(
+    g: &mut Graph,
+    t: &projected::BodyTerms,
+    (k, count): (usize, usize),
+    (dof, opts, syntax): (usize, &ShowOptions, Syntax),
+    dropped: &mut usize,
+) -> Result<[Section; 2], ReportError> {
+    let body = format!("body {} of {count}, link `{}`", k + 1, t.link);
+    let notes = vec![format!(
+        "M^({}) = J_P^T m J_P + J_R^T Theta J_R: J_P the Jacobian of the centre of mass, \
              J_R the angular Jacobian, Theta the inertia about the centre of mass in world axes \
              (symmetric: the upper triangle is listed).",
-            k + 1
-        )];
-        let entries = matrix_entries(g, &t.mass_matrix, d.dof, syntax);
-        let omitted = entries.len() < d.dof * (d.dof + 1) / 2;
-        sections.push(build_section(
-            g,
-            format!("Mass matrix, share of {body}"),
-            notes,
-            entries,
-            opts,
-            false,
-            omitted,
-            dropped,
-        )?);
-        let notes = vec![format!(
-            "b^({}) = J_P^T m Jdot_P qd + J_R^T (Theta Jdot_R qd + omega x Theta omega), \
+        k + 1
+    )];
+    let entries = matrix_entries(g, &t.mass_matrix, dof, syntax);
+    let omitted = entries.len() < dof * (dof + 1) / 2;
+    let mass = build_section(
+        g,
+        format!("Mass matrix, share of {body}"),
+        notes,
+        entries,
+        opts,
+        false,
+        omitted,
+        dropped,
+    )?;
+    let notes = vec![format!(
+        "b^({}) = J_P^T m Jdot_P qd + J_R^T (Theta Jdot_R qd + omega x Theta omega), \
              omega = J_R qd.",
-            k + 1
-        )];
-        let entries = vector_entries(g, &t.bias, ("b", "b"), syntax);
-        let omitted = entries.len() < d.dof;
-        sections.push(build_section(
-            g,
-            format!("Bias, share of {body}"),
-            notes,
-            entries,
-            opts,
-            false,
-            omitted,
-            dropped,
-        )?);
-    }
+        k + 1
+    )];
+    let entries = vector_entries(g, &t.bias, ("b", "b"), syntax);
+    let omitted = entries.len() < dof;
+    let bias = build_section(
+        g,
+        format!("Bias, share of {body}"),
+        notes,
+        entries,
+        opts,
+        false,
+        omitted,
+        dropped,
+    )?;
+    Ok([mass, bias])
+}
+
+/// The notes of the closing section: `M` and `b` as the sums of the bodies' shares, and the
+/// rotor inertias.
+fn sum_notes(model: &Model, count: usize) -> Vec<String> {
     let shares: Vec<String> = (1..=count).map(|k| format!("M^({k})")).collect();
     let biases: Vec<String> = (1..=count).map(|k| format!("b^({k})")).collect();
     let armature: Vec<String> = model
@@ -144,21 +179,7 @@ pub(super) fn projected_newton_euler(
         ));
     }
     notes.push("The equation of motion: M qdd + b + G = tau (print G with --term G).".to_string());
-    sections.push(build_section(
-        g,
-        "Sum over the bodies".to_string(),
-        notes,
-        Vec::new(),
-        opts,
-        false,
-        false,
-        dropped,
-    )?);
-    // An empty section's note says "Every entry is 0.": not meant here.
-    if let Some(last) = sections.last_mut() {
-        last.notes.retain(|n| n != "Every entry is 0.");
-    }
-    Ok(sections)
+    notes
 }
 
 /// `H(q, p) = 1/2 p^T M^-1 p + V`, and Hamilton's equations with `pd` written out in `q` and
@@ -174,14 +195,7 @@ pub(super) fn hamiltonian(
     let n = d.dof;
     let m = &d.mass_matrix;
     let momentum: Vec<Id> = m.iter().map(|row| g.dot(row, &d.qd)).collect();
-    let pd: Vec<Id> = (0..n)
-        .map(|k| {
-            let dt = g.diff(d.kinetic_energy, d.q[k]);
-            let tau = g.tau(k);
-            let with_tau = g.add(tau, dt);
-            g.sub(with_tau, d.gravity[k])
-        })
-        .collect();
+    let pd = momentum_rate(g, d);
     let mut all: Vec<Id> = m.iter().flatten().copied().collect();
     all.extend(&pd);
     all.push(d.potential_energy);
@@ -202,21 +216,11 @@ pub(super) fn hamiltonian(
         omitted,
         dropped,
     )?];
-    let v = Entry {
-        name: entry_name(
-            notation("potential_energy").expect("the potential energy's notation"),
-            &[],
-            n,
-            syntax,
-        ),
-        text: "V".to_string(),
-        expr: d.potential_energy,
-    };
     sections.push(build_section(
         g,
         "Potential energy".to_string(),
         Vec::new(),
-        vec![v],
+        vec![potential_entry(d, syntax)],
         opts,
         true,
         false,
@@ -249,4 +253,30 @@ pub(super) fn hamiltonian(
         dropped,
     )?);
     Ok(sections)
+}
+
+/// Hamilton's `pd_k = tau_k + dT/dq_k - dV/dq_k` in `q` and `qd`.
+fn momentum_rate(g: &mut Graph, d: &Derivation) -> Vec<Id> {
+    (0..d.dof)
+        .map(|k| {
+            let dt = g.diff(d.kinetic_energy, d.q[k]);
+            let tau = g.tau(k);
+            let with_tau = g.add(tau, dt);
+            g.sub(with_tau, d.gravity[k])
+        })
+        .collect()
+}
+
+/// The potential energy `V` as an entry.
+fn potential_entry(d: &Derivation, syntax: Syntax) -> Entry {
+    Entry {
+        name: entry_name(
+            notation("potential_energy").expect("the potential energy's notation"),
+            &[],
+            d.dof,
+            syntax,
+        ),
+        text: "V".to_string(),
+        expr: d.potential_energy,
+    }
 }
