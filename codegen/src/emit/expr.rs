@@ -154,54 +154,58 @@ impl Ctx<'_> {
                 }
             }
             Expr::Add(c, terms) => self.sum(*c, terms, trig),
-            Expr::Mul(factors) => {
-                let mut num: Vec<TokenStream> = Vec::new();
-                let mut den: Vec<TokenStream> = Vec::new();
-                for (f, x) in factors {
-                    let ft = self.expr(f, trig);
-                    let raw = ft.ts.clone();
-                    let base = if ft.sum { paren(ft.ts) } else { ft.ts };
-                    let n = x.unsigned_abs() as usize;
-                    let power = if n == 1 {
-                        base
-                    } else if ft.atom && *x > 0 {
-                        join_mul(std::iter::repeat_n(base, n).collect())
-                    } else if ft.atom {
-                        // A divisor `t * t * t` needs its parentheses: `a / (t * t * t)`.
-                        paren(join_mul(std::iter::repeat_n(base, n).collect()))
-                    } else {
-                        // Evaluate a compound base once.
-                        let prod = join_mul(std::iter::repeat_n(quote!(b), n).collect());
-                        quote!({ let b = #raw; #prod })
-                    };
-                    if *x > 0 {
-                        num.push(power);
-                    } else {
-                        den.push(power);
-                    }
-                }
-                let n = if num.is_empty() {
-                    quote!(T::one())
-                } else {
-                    join_mul(num)
-                };
-                let ts = match den.len() {
-                    0 => n,
-                    1 => {
-                        let d = &den[0];
-                        quote!(#n / #d)
-                    }
-                    _ => {
-                        let d = join_mul(den);
-                        quote!(#n / (#d))
-                    }
-                };
-                Tok {
-                    ts,
-                    sum: false,
-                    atom: false,
-                }
+            Expr::Mul(factors) => self.product(factors, trig),
+        }
+    }
+
+    /// A product of integer powers: the factors with a positive exponent over those with a
+    /// negative one.
+    fn product(&self, factors: &[(Expr, i32)], trig: &mut BTreeSet<(usize, bool)>) -> Tok {
+        let mut num: Vec<TokenStream> = Vec::new();
+        let mut den: Vec<TokenStream> = Vec::new();
+        for (f, x) in factors {
+            let ft = self.expr(f, trig);
+            let raw = ft.ts.clone();
+            let base = if ft.sum { paren(ft.ts) } else { ft.ts };
+            let n = x.unsigned_abs() as usize;
+            let power = if n == 1 {
+                base
+            } else if ft.atom && *x > 0 {
+                join_mul(std::iter::repeat_n(base, n).collect())
+            } else if ft.atom {
+                // A divisor `t * t * t` needs its parentheses: `a / (t * t * t)`.
+                paren(join_mul(std::iter::repeat_n(base, n).collect()))
+            } else {
+                // Evaluate a compound base once.
+                let prod = join_mul(std::iter::repeat_n(quote!(b), n).collect());
+                quote!({ let b = #raw; #prod })
+            };
+            if *x > 0 {
+                num.push(power);
+            } else {
+                den.push(power);
             }
+        }
+        let n = if num.is_empty() {
+            quote!(T::one())
+        } else {
+            join_mul(num)
+        };
+        let ts = match den.len() {
+            0 => n,
+            1 => {
+                let d = &den[0];
+                quote!(#n / #d)
+            }
+            _ => {
+                let d = join_mul(den);
+                quote!(#n / (#d))
+            }
+        };
+        Tok {
+            ts,
+            sum: false,
+            atom: false,
         }
     }
 
