@@ -118,41 +118,32 @@ fn body_sections(
     dropped: &mut usize,
 ) -> Result<[Section; 2], ReportError> {
     let body = format!("body {} of {count}, link `{}`", k + 1, t.link);
-    let notes = vec![format!(
+    let mut section = |g: &mut Graph, title: String, note: String, entries: Vec<Entry>, omitted| {
+        build_section(g, title, vec![note], entries, opts, false, omitted, dropped)
+    };
+    let note = format!(
         "M^({}) = J_P^T m J_P + J_R^T Theta J_R: J_P the Jacobian of the centre of mass, \
-             J_R the angular Jacobian, Theta the inertia about the centre of mass in world axes \
-             (symmetric: the upper triangle is listed).",
+         J_R the angular Jacobian, Theta the inertia about the centre of mass in world axes \
+         (symmetric: the upper triangle is listed).",
         k + 1
-    )];
+    );
     let entries = matrix_entries(g, &t.mass_matrix, dof, syntax);
     let omitted = entries.len() < dof * (dof + 1) / 2;
-    let mass = build_section(
+    let mass = section(
         g,
         format!("Mass matrix, share of {body}"),
-        notes,
+        note,
         entries,
-        opts,
-        false,
         omitted,
-        dropped,
     )?;
-    let notes = vec![format!(
+    let note = format!(
         "b^({}) = J_P^T m Jdot_P qd + J_R^T (Theta Jdot_R qd + omega x Theta omega), \
-             omega = J_R qd.",
+         omega = J_R qd.",
         k + 1
-    )];
+    );
     let entries = vector_entries(g, &t.bias, ("b", "b"), syntax);
     let omitted = entries.len() < dof;
-    let bias = build_section(
-        g,
-        format!("Bias, share of {body}"),
-        notes,
-        entries,
-        opts,
-        false,
-        omitted,
-        dropped,
-    )?;
+    let bias = section(g, format!("Bias, share of {body}"), note, entries, omitted)?;
     Ok([mass, bias])
 }
 
