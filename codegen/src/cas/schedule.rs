@@ -189,165 +189,31 @@ impl Program {
 
     /// Schedules `outputs` of `graph` with its temporaries in `order`.
     pub fn ordered(graph: &Graph, outputs: &[Id], order_by: Order) -> Program {
-        let order = graph.reachable(outputs);
-        let slot = |id: Id| order.binary_search(&id).expect("reachable");
-        // Sums that are unit combinations, `a + b - c`, are reused by other sums that hold the
-        // same terms with one coefficient magnitude: `k a + k b - k c + d` (the graph
-        // distributes constant factors into sums and flattens sums into sums) becomes
-        // `k t + d`, saving the additions.
-        let units = UnitSums::new(graph, &order);
-        let plans: Vec<Option<Vec<(Id, f64)>>> = order
-            .iter()
-            .map(|&id| match graph.node(id) {
-                Node::Add(_, ts) => Some(units.plan(id, ts.iter().map(|t| (t.0, t.1.get())))),
-                _ => None,
-            })
-            .collect();
-        let kids = |k: usize| -> Vec<Id> {
-            match &plans[k] {
-                Some(terms) => terms.iter().map(|t| t.0).collect(),
-                None => graph.node(order[k]).children().collect(),
-            }
+        let nodes = Nodes::new(graph, outputs);
+        let visit = nodes.visit(outputs, order_by);
+        let uses = nodes.uses(outputs);
+        let mut w = Writer {
+            repr: vec![None; nodes.order.len()],
+            temps: Vec::new(),
+            den_uses: shared_denominators(graph, &nodes.order),
+            recips: HashMap::new(),
         };
-        let mut uses = vec![0u32; order.len()];
-        for k in 0..order.len() {
-            for c in kids(k) {
-                uses[slot(c)] += 1;
-            }
-        }
-        // Scheduling order: by `Id` (children first), except that a reused unit sum created
-        // after its user moves just before it, after whatever it reuses in turn.
-        let mut visit: Vec<usize> = Vec::with_capacity(order.len());
-        let mut placed = vec![false; order.len()];
-        let starts: Vec<usize> = match order_by {
-            Order::Depth => outputs.iter().map(|&o| slot(o)).collect(),
-            _ => (0..order.len()).collect(),
-        };
-        for k in starts {
-            let mut stack = vec![(k, false)];
-            while let Some((j, ready)) = stack.pop() {
-                if placed[j] {
-                    continue;
-                }
-                if ready {
-                    placed[j] = true;
-                    visit.push(j);
-                    continue;
-                }
-                stack.push((j, true));
-                for c in kids(j) {
-                    let sc = slot(c);
-                    if !placed[sc] {
-                        stack.push((sc, false));
-                    }
-                }
-            }
-        }
-        for &o in outputs {
-            uses[slot(o)] += 1;
-        }
-        // Denominators shared by several products get one reciprocal temporary: a division
-        // costs as much as ten multiplications.
-        let den_key = |fs: &[(Id, i32)]| -> Vec<(Id, i32)> {
-            fs.iter().filter(|f| f.1 < 0).copied().collect()
-        };
-        let mut den_uses: HashMap<Vec<(Id, i32)>, usize> = HashMap::new();
-        for &id in &order {
-            if let Node::Mul(fs) = graph.node(id) {
-                let key = den_key(fs);
-                if !key.is_empty() && key.len() < fs.len() {
-                    *den_uses.entry(key).or_insert(0) += 1;
-                }
-            }
-        }
-        let mut recips: HashMap<Vec<(Id, i32)>, usize> = HashMap::new();
-        // For each reachable node: its expression when used (a leaf, a temp, or inline), and
-        // the nesting depth of that inline expression.
-        let mut repr: Vec<Option<(Expr, u32)>> = vec![None; order.len()];
-        let mut temps = Vec::new();
-        if order_by == Order::Levels {
-            let mut level = vec![0u32; order.len()];
-            let mut position = vec![0usize; order.len()];
-            for (p, &k) in visit.iter().enumerate() {
-                let deepest = kids(k).iter().map(|&c| level[slot(c)]).max();
-                level[k] = deepest.map_or(0, |l| l + 1);
-                position[k] = p;
-            }
-            visit.sort_by_key(|&k| (level[k], position[k]));
-        }
         for k in visit {
-            let id = order[k];
-            let sub =
-                |c: Id| -> (Expr, u32) { repr[slot(c)].clone().expect("child before parent") };
-            let (e, depth) = match graph.node(id) {
-                Node::Const(c) => (Expr::Const(c.get()), 0),
-                Node::Sym(s) => (Expr::Input(*s), 0),
-                Node::Add(c, _) => {
-                    let parts: Vec<((Expr, u32), f64)> = plans[k]
-                        .iter()
-                        .flatten()
-                        .map(|&(t, k)| (sub(t), k))
-                        .collect();
-                    let d = parts.iter().map(|p| p.0 .1).max().unwrap_or(0) + 1;
-                    (
-                        factor_coefficients(
-                            c.get(),
-                            parts.into_iter().map(|((e, _), k)| (e, k)).collect(),
-                        ),
-                        d + 1,
-                    )
-                }
-                Node::Mul(fs) if den_uses.get(&den_key(fs)).is_some_and(|&u| u >= 2) => {
-                    let key = den_key(fs);
-                    let r = match recips.get(&key) {
-                        Some(&r) => r,
-                        None => {
-                            let den = key.iter().map(|(f, e)| (sub(*f).0, *e)).collect();
-                            temps.push(Expr::Mul(den));
-                            recips.insert(key, temps.len() - 1);
-                            temps.len() - 1
-                        }
-                    };
-                    let mut parts: Vec<((Expr, u32), i32)> = fs
-                        .iter()
-                        .filter(|f| f.1 > 0)
-                        .map(|(f, e)| (sub(*f), *e))
-                        .collect();
-                    parts.push(((Expr::Temp(r), 0), 1));
-                    let d = parts.iter().map(|p| p.0 .1).max().unwrap_or(0) + 1;
-                    (
-                        Expr::Mul(parts.into_iter().map(|((e, _), x)| (e, x)).collect()),
-                        d,
-                    )
-                }
-                Node::Mul(fs) => {
-                    let parts: Vec<((Expr, u32), i32)> =
-                        fs.iter().map(|(f, e)| (sub(*f), *e)).collect();
-                    let d = parts.iter().map(|p| p.0 .1).max().unwrap_or(0) + 1;
-                    (
-                        Expr::Mul(parts.into_iter().map(|((e, _), x)| (e, x)).collect()),
-                        d,
-                    )
-                }
-                Node::Sin(a) => unary(sub(*a), Expr::Sin),
-                Node::Cos(a) => unary(sub(*a), Expr::Cos),
-                Node::Sqrt(a) => unary(sub(*a), Expr::Sqrt),
-                Node::Sign(a) => unary(sub(*a), Expr::Sign),
-            };
+            let (e, depth) = w.node_expr(&nodes, k);
             let is_leaf = depth == 0;
-            repr[k] = Some(if is_leaf || (uses[k] <= 1 && depth <= MAX_INLINE_DEPTH) {
+            w.repr[k] = Some(if is_leaf || (uses[k] <= 1 && depth <= MAX_INLINE_DEPTH) {
                 (e, depth)
             } else {
-                temps.push(e);
-                (Expr::Temp(temps.len() - 1), 0)
+                w.temps.push(e);
+                (Expr::Temp(w.temps.len() - 1), 0)
             });
         }
         let outputs = outputs
             .iter()
-            .map(|&o| repr[slot(o)].clone().expect("reachable").0)
+            .map(|&o| w.repr[nodes.slot(o)].clone().expect("reachable").0)
             .collect();
         Program {
-            temps,
+            temps: w.temps,
             outputs,
             symbols: graph.symbols().to_vec(),
         }
@@ -556,6 +422,220 @@ fn factor_coefficients(constant: f64, terms: Vec<(Expr, f64)>) -> Expr {
         }
     }
     Expr::Add(constant, out)
+}
+
+/// The nodes reachable from a program's outputs, with the terms each sum is written with.
+struct Nodes<'g> {
+    graph: &'g Graph,
+    /// The reachable nodes by `Id` (children first).
+    order: Vec<Id>,
+    /// Per node of `order`: a sum's terms once it reuses unit sums; `None` for other nodes.
+    plans: Vec<Option<Vec<(Id, f64)>>>,
+}
+
+impl<'g> Nodes<'g> {
+    fn new(graph: &'g Graph, outputs: &[Id]) -> Nodes<'g> {
+        let order = graph.reachable(outputs);
+        // Sums that are unit combinations, `a + b - c`, are reused by other sums that hold the
+        // same terms with one coefficient magnitude: `k a + k b - k c + d` (the graph
+        // distributes constant factors into sums and flattens sums into sums) becomes
+        // `k t + d`, saving the additions.
+        let units = UnitSums::new(graph, &order);
+        let plans = order
+            .iter()
+            .map(|&id| match graph.node(id) {
+                Node::Add(_, ts) => Some(units.plan(id, ts.iter().map(|t| (t.0, t.1.get())))),
+                _ => None,
+            })
+            .collect();
+        Nodes {
+            graph,
+            order,
+            plans,
+        }
+    }
+
+    /// The position of reachable node `id` in `order`.
+    fn slot(&self, id: Id) -> usize {
+        self.order.binary_search(&id).expect("reachable")
+    }
+
+    /// The children of node `k` of `order` as written: a sum's planned terms.
+    fn kids(&self, k: usize) -> Vec<Id> {
+        match &self.plans[k] {
+            Some(terms) => terms.iter().map(|t| t.0).collect(),
+            None => self.graph.node(self.order[k]).children().collect(),
+        }
+    }
+
+    /// How often each node is used: by its parents and as an output.
+    fn uses(&self, outputs: &[Id]) -> Vec<u32> {
+        let mut uses = vec![0u32; self.order.len()];
+        for k in 0..self.order.len() {
+            for c in self.kids(k) {
+                uses[self.slot(c)] += 1;
+            }
+        }
+        for &o in outputs {
+            uses[self.slot(o)] += 1;
+        }
+        uses
+    }
+
+    /// The nodes (positions in `order`) in the order their expressions are written.
+    fn visit(&self, outputs: &[Id], order_by: Order) -> Vec<usize> {
+        let len = self.order.len();
+        // Scheduling order: by `Id` (children first), except that a reused unit sum created
+        // after its user moves just before it, after whatever it reuses in turn.
+        let mut visit: Vec<usize> = Vec::with_capacity(len);
+        let mut placed = vec![false; len];
+        let starts: Vec<usize> = match order_by {
+            Order::Depth => outputs.iter().map(|&o| self.slot(o)).collect(),
+            _ => (0..len).collect(),
+        };
+        for k in starts {
+            let mut stack = vec![(k, false)];
+            while let Some((j, ready)) = stack.pop() {
+                if placed[j] {
+                    continue;
+                }
+                if ready {
+                    placed[j] = true;
+                    visit.push(j);
+                    continue;
+                }
+                stack.push((j, true));
+                for c in self.kids(j) {
+                    let sc = self.slot(c);
+                    if !placed[sc] {
+                        stack.push((sc, false));
+                    }
+                }
+            }
+        }
+        if order_by == Order::Levels {
+            let mut level = vec![0u32; len];
+            let mut position = vec![0usize; len];
+            for (p, &k) in visit.iter().enumerate() {
+                let deepest = self.kids(k).iter().map(|&c| level[self.slot(c)]).max();
+                level[k] = deepest.map_or(0, |l| l + 1);
+                position[k] = p;
+            }
+            visit.sort_by_key(|&k| (level[k], position[k]));
+        }
+        visit
+    }
+}
+
+/// The denominator of a product: its factors with a negative exponent.
+fn den_key(fs: &[(Id, i32)]) -> Vec<(Id, i32)> {
+    fs.iter().filter(|f| f.1 < 0).copied().collect()
+}
+
+/// How many products of `order` share each denominator. Denominators shared by several
+/// products get one reciprocal temporary: a division costs as much as ten multiplications.
+fn shared_denominators(graph: &Graph, order: &[Id]) -> HashMap<Vec<(Id, i32)>, usize> {
+    let mut den_uses: HashMap<Vec<(Id, i32)>, usize> = HashMap::new();
+    for &id in order {
+        if let Node::Mul(fs) = graph.node(id) {
+            let key = den_key(fs);
+            if !key.is_empty() && key.len() < fs.len() {
+                *den_uses.entry(key).or_insert(0) += 1;
+            }
+        }
+    }
+    den_uses
+}
+
+/// A program being written.
+struct Writer {
+    /// For each reachable node: its expression when used (a leaf, a temp, or inline), and
+    /// the nesting depth of that inline expression.
+    repr: Vec<Option<(Expr, u32)>>,
+    temps: Vec<Expr>,
+    /// How many products share each denominator, and the temporaries holding the
+    /// reciprocals written so far.
+    den_uses: HashMap<Vec<(Id, i32)>, usize>,
+    recips: HashMap<Vec<(Id, i32)>, usize>,
+}
+
+impl Writer {
+    /// The expression of child `c`, written before its parent.
+    fn sub(&self, nodes: &Nodes, c: Id) -> (Expr, u32) {
+        self.repr[nodes.slot(c)]
+            .clone()
+            .expect("child before parent")
+    }
+
+    /// The expression of node `k` of `nodes.order` and its nesting depth.
+    fn node_expr(&mut self, nodes: &Nodes, k: usize) -> (Expr, u32) {
+        let sub = |c: Id| self.sub(nodes, c);
+        match nodes.graph.node(nodes.order[k]) {
+            Node::Const(c) => (Expr::Const(c.get()), 0),
+            Node::Sym(s) => (Expr::Input(*s), 0),
+            Node::Add(c, _) => {
+                let parts: Vec<((Expr, u32), f64)> = nodes.plans[k]
+                    .iter()
+                    .flatten()
+                    .map(|&(t, k)| (sub(t), k))
+                    .collect();
+                let d = parts.iter().map(|p| p.0 .1).max().unwrap_or(0) + 1;
+                (
+                    factor_coefficients(
+                        c.get(),
+                        parts.into_iter().map(|((e, _), k)| (e, k)).collect(),
+                    ),
+                    d + 1,
+                )
+            }
+            Node::Mul(fs) if self.den_uses.get(&den_key(fs)).is_some_and(|&u| u >= 2) => {
+                self.shared_quotient(nodes, fs)
+            }
+            Node::Mul(fs) => {
+                let parts: Vec<((Expr, u32), i32)> =
+                    fs.iter().map(|(f, e)| (sub(*f), *e)).collect();
+                product(parts)
+            }
+            Node::Sin(a) => unary(sub(*a), Expr::Sin),
+            Node::Cos(a) => unary(sub(*a), Expr::Cos),
+            Node::Sqrt(a) => unary(sub(*a), Expr::Sqrt),
+            Node::Sign(a) => unary(sub(*a), Expr::Sign),
+        }
+    }
+
+    /// A product whose denominator other products share: its numerator times the
+    /// denominator's reciprocal, a temporary written at its first use.
+    fn shared_quotient(&mut self, nodes: &Nodes, fs: &[(Id, i32)]) -> (Expr, u32) {
+        let key = den_key(fs);
+        let r = match self.recips.get(&key) {
+            Some(&r) => r,
+            None => {
+                let den = key
+                    .iter()
+                    .map(|(f, e)| (self.sub(nodes, *f).0, *e))
+                    .collect();
+                self.temps.push(Expr::Mul(den));
+                self.recips.insert(key, self.temps.len() - 1);
+                self.temps.len() - 1
+            }
+        };
+        let mut parts: Vec<((Expr, u32), i32)> = fs
+            .iter()
+            .filter(|f| f.1 > 0)
+            .map(|(f, e)| (self.sub(nodes, *f), *e))
+            .collect();
+        parts.push(((Expr::Temp(r), 0), 1));
+        product(parts)
+    }
+}
+
+/// The product of `parts` (expressions with their depths, and exponents) and its depth.
+fn product(parts: Vec<((Expr, u32), i32)>) -> (Expr, u32) {
+    let d = parts.iter().map(|p| p.0 .1).max().unwrap_or(0) + 1;
+    (
+        Expr::Mul(parts.into_iter().map(|((e, _), x)| (e, x)).collect()),
+        d,
+    )
 }
 
 fn unary((e, d): (Expr, u32), f: fn(Box<Expr>) -> Expr) -> (Expr, u32) {
