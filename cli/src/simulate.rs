@@ -291,7 +291,7 @@ pub fn run(model: &Model, terms: &Terms, o: &Options) -> Result<Outcome, String>
         ));
     }
     let steps = steps as u64;
-    let names = model.coordinate_names();
+    let names = model.velocity_names();
     let mut csv = String::from("t");
     for prefix in ["q", "qd", "tau"] {
         for name in &names {
