@@ -65,13 +65,25 @@ impl Shape {
     }
 }
 
-/// Where a generated function lives.
+/// Where a generated function lives: a runtime trait's impl, or the generated type's inherent
+/// impl. A trait is implemented only when a selection keeps all of its methods
+/// ([`select`]); otherwise they are inherent.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Home {
-    /// A method of the runtime's `Dynamics` trait (and an inherent method of the same name).
+    /// A method of the runtime's `Dynamics` trait (fixed base).
     Dynamics,
+    /// A method of the runtime's `FloatingDynamics` trait (floating base).
+    FloatingDynamics,
+    /// A method of the runtime's `Contacts` trait (floating base with contact points); of
+    /// `contact_forward_dynamics`, the trait holds its `try_` variant.
+    Contacts,
     /// An inherent method of the generated type only.
     Inherent,
+}
+
+impl Home {
+    /// The runtime traits a quantity can live in.
+    pub const TRAITS: [Home; 3] = [Home::Dynamics, Home::FloatingDynamics, Home::Contacts];
 }
 
 /// Craig's two velocity-product matrices.
@@ -332,8 +344,8 @@ pub fn names(quantities: &[Quantity]) -> Vec<&'static str> {
 /// Keeps the quantities named in `wanted` and everything they need, transitively (a need of a
 /// need, such as the `mass_matrix` that a run-time `forward_dynamics` calls for
 /// `forward_dynamics_derivatives`), in catalogue order; `Err` with the first unknown name.
-/// The runtime's `Dynamics` trait is implemented only with all its methods: when the
-/// selection leaves some out, the ones kept become inherent ([`Home::Inherent`]).
+/// A runtime trait is implemented only with all its methods: when the selection leaves some
+/// of a trait's out, the ones kept become inherent ([`Home::Inherent`]).
 pub fn select(quantities: Vec<Quantity>, wanted: &[String]) -> Result<Vec<Quantity>, String> {
     if let Some(bad) = wanted
         .iter()
@@ -353,15 +365,17 @@ pub fn select(quantities: Vec<Quantity>, wanted: &[String]) -> Result<Vec<Quanti
             todo.extend(q.needs());
         }
     }
-    let in_trait = |qs: &[Quantity]| qs.iter().filter(|q| q.home == Home::Dynamics).count();
-    let all = in_trait(&quantities);
+    let count = |qs: &[Quantity], home| qs.iter().filter(|q| q.home == home).count();
+    let all = Home::TRAITS.map(|h| count(&quantities, h));
     let mut kept: Vec<Quantity> = quantities
         .into_iter()
         .filter(|q| keep.contains(&q.name))
         .collect();
-    if in_trait(&kept) < all {
-        for q in kept.iter_mut().filter(|q| q.home == Home::Dynamics) {
-            q.home = Home::Inherent;
+    for (home, all) in Home::TRAITS.into_iter().zip(all) {
+        if count(&kept, home) < all {
+            for q in kept.iter_mut().filter(|q| q.home == home) {
+                q.home = Home::Inherent;
+            }
         }
     }
     Ok(kept)

@@ -23,7 +23,7 @@ fn matrix(m: &[Vec<Id>]) -> Option<Vec<Id>> {
 }
 
 /// How people write the quantities that have symbols, in the order `eomgen show` prints them.
-pub static NOTATIONS: [Notation; 11] = [
+pub static NOTATIONS: &[Notation] = &[
     Notation {
         name: "mass_matrix",
         text: "M",
@@ -101,9 +101,7 @@ pub static NOTATIONS: [Notation; 11] = [
         latex: "F",
         aliases: &["F"],
         title: "Joint friction F(qd)",
-        definition:
-            "F_i = damping_i qd_i + friction_i sign(qd_i): the effort the actuators supply \
-                     against friction (with --friction).",
+        definition: "F_i = damping_i qd_i + friction_i sign(qd_i), supplied by the actuators.",
         layout: Layout::Vector,
         printed: |d| Some(d.friction.clone()),
     },
@@ -169,13 +167,30 @@ pub fn catalogue(model: &Model, d: &Derivation) -> Vec<Quantity> {
     out.extend(super::contact_derivatives::impulse_dynamics(d));
     out.extend(super::active_contacts::quantities(d));
     if !model.velocities_are_rates() {
-        // Without the `Dynamics` trait (whose arrays are all N long): the emitter puts those of
-        // `FloatingDynamics` and `Contacts` in their impls, the others are inherent methods.
+        // Not the `Dynamics` trait (whose arrays are all N long): a floating base's methods go
+        // to `FloatingDynamics` and `Contacts`; with floating joints below the root (whose
+        // coordinates are not first), every method is inherent.
         for q in &mut out {
-            q.home = Home::Inherent;
+            q.home = if model.is_floating() {
+                floating_home(q.name)
+            } else {
+                Home::Inherent
+            };
         }
     }
     out
+}
+
+/// Where a floating base's quantity lives: not in the `Dynamics` trait (whose arrays are all
+/// N long), but the runtime's `FloatingDynamics` and `Contacts` traits hold these; the others
+/// are inherent methods.
+fn floating_home(name: &str) -> Home {
+    match name {
+        "mass_matrix" | "gravity" | "bias" | "integrate" | "inverse_dynamics"
+        | "forward_dynamics" => Home::FloatingDynamics,
+        "contact_jacobian" | "contact_drift" | "contact_forward_dynamics" => Home::Contacts,
+        _ => Home::Inherent,
+    }
 }
 
 /// Remarks about joint effects that change what some functions mean.

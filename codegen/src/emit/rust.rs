@@ -24,7 +24,7 @@ use crate::cas::{Graph, OpCount};
 use crate::dynamics::{Derivation, Evaluation, Home, Quantity};
 use crate::model::Model;
 use items::{fields, Fields};
-use traits::{Trait, FLOATING_METHODS};
+use traits::Trait;
 
 /// What the emitted file is called and says about itself.
 #[derive(Clone, Debug)]
@@ -143,16 +143,15 @@ pub fn emit_tokens(
         // The catalogue leaves a trait's methods in it only when all are generated.
         in_trait: d.quantities.iter().any(|q| q.home == Home::Dynamics),
         try_forward_dynamics: TokenStream::new(),
-        floating_trait: model.is_floating()
-            && FLOATING_METHODS
-                .iter()
-                .all(|f| d.quantities.iter().any(|q| q.name == *f)),
-        contacts_trait: (model.is_floating()
-            && !d.centroidal.contact_drift.is_empty()
-            && d.quantities
-                .iter()
-                .any(|q| q.name == "contact_forward_dynamics"))
-        .then(|| usize_lit(d.centroidal.contact_drift.len())),
+        floating_trait: d
+            .quantities
+            .iter()
+            .any(|q| q.home == Home::FloatingDynamics),
+        contacts_trait: d
+            .quantities
+            .iter()
+            .any(|q| q.home == Home::Contacts)
+            .then(|| usize_lit(d.centroidal.contact_drift.len())),
         try_contact_forward_dynamics: TokenStream::new(),
         counts: Vec::new(),
         budget: opts.max_function_ops,

@@ -6,24 +6,7 @@ use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
 
 use super::{allow_lints, Emitter};
-use crate::dynamics::Home;
-
-/// The methods of the runtime's `FloatingDynamics` trait.
-pub(super) const FLOATING_METHODS: [&str; 6] = [
-    "mass_matrix",
-    "gravity",
-    "bias",
-    "integrate",
-    "inverse_dynamics",
-    "forward_dynamics",
-];
-
-/// The methods of the runtime's `Contacts` trait.
-pub(super) const CONTACT_METHODS: [&str; 3] = [
-    "contact_jacobian",
-    "contact_drift",
-    "try_contact_forward_dynamics",
-];
+use crate::dynamics::{Evaluation, Home};
 
 /// The runtime trait whose impl holds a generated method.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -39,21 +22,23 @@ pub(super) enum Trait {
 impl Emitter<'_> {
     /// The runtime trait whose impl holds the generated method `name`, if any (else it is
     /// inherent).
+    /// The catalogue says it ([`Home`]); of contact forward dynamics, `Contacts` holds the
+    /// `try_` method (`try_contact_forward_dynamics`), and the method itself is inherent.
     pub(super) fn trait_of(&self, name: &str) -> Option<Trait> {
-        if self.floating {
-            if self.floating_trait && FLOATING_METHODS.contains(&name) {
-                Some(Trait::Floating)
-            } else if self.contacts_trait.is_some() && CONTACT_METHODS.contains(&name) {
-                Some(Trait::Contacts)
-            } else {
-                None
-            }
-        } else {
-            let dynamics = self
-                .quantities
-                .iter()
-                .any(|q| q.name == name && q.home == Home::Dynamics);
-            (self.in_trait && dynamics).then_some(Trait::Dynamics)
+        let (quantity, try_) = match name.strip_prefix("try_") {
+            Some(n) => (n, true),
+            None => (name, false),
+        };
+        let q = self.quantities.iter().find(|q| q.name == quantity)?;
+        let solved = matches!(q.eval, Evaluation::ContactForwardDynamics { .. });
+        if solved != try_ {
+            return None;
+        }
+        match q.home {
+            Home::Dynamics => Some(Trait::Dynamics),
+            Home::FloatingDynamics => Some(Trait::Floating),
+            Home::Contacts => Some(Trait::Contacts),
+            Home::Inherent => None,
         }
     }
 
