@@ -70,7 +70,7 @@ pub fn warning(model: &Model, m: &[Vec<f64>], at: &str) -> Option<String> {
     let (estimate, weak) = near_singular(m)?;
     let names: Vec<String> = weak
         .iter()
-        .map(|&i| format!("`{}`", model.coordinate_names()[i]))
+        .map(|&i| format!("`{}`", model.velocity_names()[i]))
         .collect();
     let estimate = if estimate.is_finite() {
         format!("condition estimate {}", format_number(estimate, Some(2)))

@@ -296,7 +296,7 @@ fn step_count(o: &Options) -> Result<u64, String> {
 impl Outcome {
     /// An empty outcome whose CSV holds the header row for the model's coordinates.
     fn new(model: &Model) -> Outcome {
-        let names = model.coordinate_names();
+        let names = model.velocity_names();
         let mut csv = String::from("t");
         for prefix in ["q", "qd", "tau"] {
             for name in &names {

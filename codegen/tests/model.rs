@@ -1109,7 +1109,7 @@ fn planar_and_floating_joints_load_with_their_coordinates() {
         parts.push(link("l2"));
         parts.push(joint("free", kind, "l1", "l2"));
         let model = load(&robot(&parts)).unwrap();
-        assert_eq!(model.coordinate_names(), names, "{kind}");
+        assert_eq!(model.velocity_names(), names, "{kind}");
         assert_eq!((model.nq(), model.nv()), (nq, names.len()), "{kind}");
         assert_eq!(model.velocities_are_rates(), kind == "planar");
         // The link frame moves with the joint's last step.

@@ -219,12 +219,7 @@ impl Derived {
             .collect::<Result<_, EvalError>>()?;
         Ok(Evaluator {
             robot: self.model.name.clone(),
-            coordinates: self
-                .model
-                .coordinate_names()
-                .iter()
-                .map(|s| s.to_string())
-                .collect(),
+            coordinates: self.model.velocity_names(),
             layout,
             plans,
         })

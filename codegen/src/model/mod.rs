@@ -312,10 +312,20 @@ impl Model {
             .collect()
     }
 
+    /// The URDF names of the coordinates' joints, in coordinate order: one entry per
+    /// independent joint (a floating joint's six coordinates have one name here; see
+    /// [`Model::velocity_names`] for one per coordinate).
+    pub fn coordinate_names(&self) -> Vec<&str> {
+        self.coordinate_joints()
+            .into_iter()
+            .map(|j| self.joints[j].name.as_str())
+            .collect()
+    }
+
     /// The names of the joints' velocity coordinates, in coordinate order (what `JOINT_NAMES`
     /// lists): a joint's URDF name, or for a joint of several coordinates one entry per
     /// coordinate, `name.suffix` ([`JointKind::coordinate_suffixes`]).
-    pub fn coordinate_names(&self) -> Vec<String> {
+    pub fn velocity_names(&self) -> Vec<String> {
         let mut out = Vec::new();
         for j in self.coordinate_joints() {
             let joint = &self.joints[j];

@@ -55,7 +55,7 @@ impl Emitter<'_> {
         } else {
             let names = self
                 .model
-                .coordinate_names()
+                .velocity_names()
                 .into_iter()
                 .map(|name| Literal::string(&name));
             let what = if self.floating {

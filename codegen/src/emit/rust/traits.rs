@@ -87,7 +87,7 @@ impl Emitter<'_> {
         }
         let names = self
             .model
-            .coordinate_names()
+            .velocity_names()
             .into_iter()
             .map(|name| Literal::string(&name));
         let (ty, n, allow) = (&self.ty, &self.n, allow_lints());
