@@ -164,15 +164,23 @@ fn symplectic_integrators_keep_the_energy_where_rk4_drifts() {
     let robot = double_pendulum::DoublePendulum::<f64>::default();
     let start = State::new([core::f64::consts::PI + 0.3, -0.3], [0.0, 0.0]);
     let (dt, steps) = (3e-3, 100_000);
-    let (rk4, rk4_final) = energy_error(&robot, Integrator::Rk4, start, dt, steps);
+    // Four independent runs of 10^5 steps: one thread each.
+    let run =
+        |integrator| std::thread::spawn(move || energy_error(&robot, integrator, start, dt, steps));
+    let (rk4, y4, euler) = (
+        run(Integrator::Rk4),
+        run(Integrator::Yoshida4),
+        run(Integrator::SymplecticEuler),
+    );
     let counting = Counting {
         robot: &robot,
         calls: Cell::new(0),
     };
     let (mid, mid_final) = energy_error(&counting, Integrator::ImplicitMidpoint, start, dt, steps);
     let iterations = (counting.calls.get() - 2 * steps as u64) as f64 / steps as f64;
-    let (y4, y4_final) = energy_error(&robot, Integrator::Yoshida4, start, dt, steps);
-    let (euler, euler_final) = energy_error(&robot, Integrator::SymplecticEuler, start, dt, steps);
+    let joined = |h: std::thread::JoinHandle<(f64, f64)>| h.join().expect("no panic");
+    let ((rk4, rk4_final), (y4, y4_final), (euler, euler_final)) =
+        (joined(rk4), joined(y4), joined(euler));
     println!("relative energy error over {steps} steps of {dt} s (worst, final):");
     println!("  rk4               {rk4:.3e} {rk4_final:.3e}");
     println!("  implicit-midpoint {mid:.3e} {mid_final:.3e} ({iterations:.2} iterations per step)");
