@@ -8,24 +8,16 @@ use super::latex::aligned;
 
 /// `doc` as Markdown.
 pub(super) fn write(doc: &Document) -> String {
-    let (intro, joints, sections, bodies, legend, legend_text) = (
-        &doc.intro,
-        &doc.joints,
-        &doc.sections,
-        &doc.bodies,
-        &doc.legend,
-        &doc.legend_text,
-    );
     let mut out = String::new();
     let _ = writeln!(out, "# {}: equations of motion\n", md_escape(&doc.name));
-    for l in intro {
+    for l in &doc.intro {
         let _ = writeln!(out, "{}", md_escape(l));
     }
     let _ = writeln!(out, "\n| coordinate | joint |\n| --- | --- |");
-    for (q, what) in joints {
+    for (q, what) in &doc.joints {
         let _ = writeln!(out, "| ${q}$ | {} |", md_escape(what));
     }
-    for (s, body) in sections.iter().zip(bodies) {
+    for (s, body) in doc.sections.iter().zip(&doc.bodies) {
         let _ = writeln!(out, "\n## {}\n", s.title);
         for n in &s.notes {
             let _ = writeln!(out, "{}\n", md_escape(n));
@@ -38,10 +30,10 @@ pub(super) fn write(doc: &Document) -> String {
     }
     if doc.has_legend() {
         let _ = writeln!(out, "\n## Legend\n\n| symbol | meaning |\n| --- | --- |");
-        for (a, b) in legend {
+        for (a, b) in &doc.legend {
             let _ = writeln!(out, "| ${a}$ | ${b}$ |");
         }
-        for (a, b) in legend_text {
+        for (a, b) in &doc.legend_text {
             let a = if a.starts_with("qd_i") {
                 "$\\dot{q}_i$, $\\ddot{q}_i$".to_string()
             } else {

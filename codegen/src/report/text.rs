@@ -7,23 +7,15 @@ use super::document::Document;
 
 /// `doc` as plain text.
 pub(super) fn write(doc: &Document) -> String {
-    let (intro, joints, sections, bodies, legend, legend_text) = (
-        &doc.intro,
-        &doc.joints,
-        &doc.sections,
-        &doc.bodies,
-        &doc.legend,
-        &doc.legend_text,
-    );
     let mut out = String::new();
-    for l in intro {
+    for l in &doc.intro {
         let _ = writeln!(out, "{l}");
     }
     let _ = writeln!(out, "Joints:");
-    for (q, what) in joints {
+    for (q, what) in &doc.joints {
         let _ = writeln!(out, "  {q}: {what}");
     }
-    for (s, body) in sections.iter().zip(bodies) {
+    for (s, body) in doc.sections.iter().zip(&doc.bodies) {
         let _ = writeln!(out, "\n{}:", s.title);
         for n in &s.notes {
             let _ = writeln!(out, "  ({n})");
@@ -34,10 +26,10 @@ pub(super) fn write(doc: &Document) -> String {
     }
     if doc.has_legend() {
         let _ = writeln!(out, "\nLegend:");
-        for (a, b) in legend {
+        for (a, b) in &doc.legend {
             let _ = writeln!(out, "  {a} = {b}");
         }
-        for (a, b) in legend_text {
+        for (a, b) in &doc.legend_text {
             let _ = writeln!(out, "  {a}: {b}");
         }
     }
