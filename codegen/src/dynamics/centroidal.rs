@@ -278,6 +278,18 @@ pub(super) fn quantity(
 /// The catalogue's centre of mass quantities (every robot), the centroidal map and `integrate`
 /// (floating bases) and the contact quantities (robots with contact points).
 pub(super) fn quantities(model: &Model, d: &Derivation) -> Vec<Quantity> {
+    let mut out = center_of_mass_quantities(model, d);
+    if !d.centroidal.contact_drift.is_empty() {
+        out.extend(contact_quantities(model, d));
+    }
+    if !model.velocities_are_rates() {
+        out.push(integrate(model, d));
+    }
+    out
+}
+
+/// `center_of_mass`, its Jacobian and, on a floating base, the centroidal map.
+fn center_of_mass_quantities(model: &Model, d: &Derivation) -> Vec<Quantity> {
     let (nv, c) = (d.dof, &d.centroidal);
     let from_momenta = "each coordinate's composite-body momentum (the composite-rigid-body algorithm's), moved to the world";
     let mut out = vec![
@@ -311,61 +323,74 @@ pub(super) fn quantities(model: &Model, d: &Derivation) -> Vec<Quantity> {
             Evaluation::Exprs(flat(&c.map)),
         ));
     }
+    out
+}
+
+/// The contact rows' order, for the contact quantities' documentation: the contact points, the
+/// points at an offset in their link frames, then the 6D contact frames.
+fn contact_order(model: &Model) -> String {
+    let names = |frames: &[usize]| -> String {
+        let names: Vec<String> = frames
+            .iter()
+            .map(|&f| format!("`{}`", model.frames[f].name.replace('`', "'")))
+            .collect();
+        names.join(", ")
+    };
+    let mut order = String::new();
+    if !model.contacts.is_empty() {
+        order = format!(
+            "Contact points, 3 rows each, in this order: {}.",
+            names(&model.contacts)
+        );
+    }
+    if !model.contact_points_at.is_empty() {
+        let at: Vec<String> = model
+            .contact_points_at
+            .iter()
+            .map(|&(f, p)| {
+                let name = model.frames[f].name.replace('`', "'");
+                format!("`{name}` at ({}, {}, {})", p[0], p[1], p[2])
+            })
+            .collect();
+        order += &format!(
+            "{}ontact points in link frames, 3 rows each: {}.",
+            if order.is_empty() { "C" } else { " Then c" },
+            at.join(", ")
+        );
+    }
+    if !model.contact_frames.is_empty() {
+        order += &format!(
+            "{}6D contact frames, 6 rows each (linear, then angular; the drift is the frame's spatial acceleration), in this order: {}.",
+            if order.is_empty() { "" } else { " Then " },
+            names(&model.contact_frames)
+        );
+    }
+    order
+}
+
+/// `contact_jacobian`, `contact_drift` and `contact_forward_dynamics` (robots with contacts).
+fn contact_quantities(model: &Model, d: &Derivation) -> [Quantity; 3] {
+    let (nv, c) = (d.dof, &d.centroidal);
     let k3 = c.contact_drift.len();
-    if k3 > 0 {
-        let names = |frames: &[usize]| -> String {
-            let names: Vec<String> = frames
-                .iter()
-                .map(|&f| format!("`{}`", model.frames[f].name.replace('`', "'")))
-                .collect();
-            names.join(", ")
-        };
-        let mut order = String::new();
-        if !model.contacts.is_empty() {
-            order = format!(
-                "Contact points, 3 rows each, in this order: {}.",
-                names(&model.contacts)
-            );
-        }
-        if !model.contact_points_at.is_empty() {
-            let at: Vec<String> = model
-                .contact_points_at
-                .iter()
-                .map(|&(f, p)| {
-                    let name = model.frames[f].name.replace('`', "'");
-                    format!("`{name}` at ({}, {}, {})", p[0], p[1], p[2])
-                })
-                .collect();
-            order += &format!(
-                "{}ontact points in link frames, 3 rows each: {}.",
-                if order.is_empty() { "C" } else { " Then c" },
-                at.join(", ")
-            );
-        }
-        if !model.contact_frames.is_empty() {
-            order += &format!(
-                "{}6D contact frames, 6 rows each (linear, then angular; the drift is the frame's spatial acceleration), in this order: {}.",
-                if order.is_empty() { "" } else { " Then " },
-                names(&model.contact_frames)
-            );
-        }
-        out.push(quantity(
+    let order = contact_order(model);
+    [
+        quantity(
             "contact_jacobian",
             Q,
             Shape::Matrix(k3, nv),
             &["The contact points' Jacobian J_c, 3K x N: linear velocity of each contact link's origin,", "world axes.", "", &order],
             "joint axes and origins by forward kinematics",
             Evaluation::Exprs(flat(&c.contact_jacobian)),
-        ));
-        out.push(quantity(
+        ),
+        quantity(
             "contact_drift",
             &[Input::Q, Input::Qd],
             Shape::Vector(k3),
             &["`Jdot_c qd`: the contact points' acceleration at zero generalized acceleration, world axes.", "", &order],
             "Newton-Euler's forward pass without acceleration and gravity",
             Evaluation::Exprs(c.contact_drift.clone()),
-        ));
-        out.push(quantity(
+        ),
+        quantity(
             "contact_forward_dynamics",
             &[Input::Q, Input::Qd, Input::Tau],
             Shape::Vector(nv + k3),
@@ -380,12 +405,8 @@ pub(super) fn quantities(model: &Model, d: &Derivation) -> Vec<Quantity> {
             Evaluation::ContactForwardDynamics {
                 h: d.fast.bias_gravity_friction.clone(),
             },
-        ));
-    }
-    if !model.velocities_are_rates() {
-        out.push(integrate(model, d));
-    }
-    out
+        ),
+    ]
 }
 
 /// `integrate`: the floating base's SE(3) exponential, or each floating joint's.

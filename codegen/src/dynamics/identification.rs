@@ -147,48 +147,14 @@ fn cheapest(
 fn quantities(g: &mut Graph, id: &Identification) -> Vec<Quantity> {
     let n = id.regressor.len();
     let (p, pb) = (id.parameters.len(), id.base.len());
-    let extras = if p > 10 * n {
-        format!(
-            " Then {} joint coefficient(s) (rotor inertia `IA`, viscous `FV` and Coulomb `FS` friction).",
-            p - 10 * n
-        )
-    } else {
-        String::new()
-    };
-    let style = Style {
-        digits: Some(6),
-        ..Style::default()
-    };
-    let mut formulas: Vec<String> = vec![
-        "Each as its combination of standard parameters (`PARAMETER_NAMES`; coefficients to 6"
-            .into(),
-        "significant digits here, exact in the code):".into(),
-        String::new(),
-    ];
-    for b in &id.base {
-        let f = id.formula(g, b, style, 1e-12);
-        formulas.push(format!("- `{} = {}`", b.name, f));
-    }
-    let mut base_doc = vec![
-        format!("The {pb} base parameters: a minimal set of combinations of the standard parameters that"),
-        "determines the dynamics (`tau = base_regressor(q, qd, qdd) base_parameters()`), named in".into(),
-        "`BASE_PARAMETER_NAMES` after the standard parameter whose column they keep (`R` when others".into(),
-        "are grouped into it).".into(),
-        String::new(),
-    ];
-    base_doc.extend(formulas);
+    let base_doc = base_parameters_doc(g, id);
     vec![
         Quantity {
             name: "regressor",
             inputs: STATE,
             shape: Shape::Matrix(n, p),
             home: Home::Inherent,
-            doc: vec![
-                "The joint torque regressor Y(q, qd, qdd): `inverse_dynamics = Y parameters()`, row `i`".into(),
-                "joint `i`, column `k` standard parameter `k` (`PARAMETER_NAMES`). Ten per body (`BODY_NAMES`),".into(),
-                "m, m cx, m cy, m cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz, with the centre of mass c and the".into(),
-                format!("inertia about the origin of the body's frame (its joint's child link frame), in its axes.{extras}"),
-            ],
+            doc: regressor_doc(n, p),
             route: id.route.into(),
             eval: Evaluation::Exprs(flat(&id.regressor)),
         },
@@ -227,6 +193,48 @@ fn quantities(g: &mut Graph, id: &Identification) -> Vec<Quantity> {
             eval: Evaluation::Exprs(id.base.iter().map(|b| b.value).collect()),
         },
     ]
+}
+
+/// The regressor's documentation, for `n` joints and `p` standard parameters.
+fn regressor_doc(n: usize, p: usize) -> Vec<String> {
+    let extras = if p > 10 * n {
+        format!(
+            " Then {} joint coefficient(s) (rotor inertia `IA`, viscous `FV` and Coulomb `FS` friction).",
+            p - 10 * n
+        )
+    } else {
+        String::new()
+    };
+    vec![
+        "The joint torque regressor Y(q, qd, qdd): `inverse_dynamics = Y parameters()`, row `i`".into(),
+        "joint `i`, column `k` standard parameter `k` (`PARAMETER_NAMES`). Ten per body (`BODY_NAMES`),".into(),
+        "m, m cx, m cy, m cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz, with the centre of mass c and the".into(),
+        format!("inertia about the origin of the body's frame (its joint's child link frame), in its axes.{extras}"),
+    ]
+}
+
+/// `base_parameters`' documentation: what they are, then each as its formula.
+fn base_parameters_doc(g: &mut Graph, id: &Identification) -> Vec<String> {
+    let style = Style {
+        digits: Some(6),
+        ..Style::default()
+    };
+    let mut doc = vec![
+        format!("The {} base parameters: a minimal set of combinations of the standard parameters that", id.base.len()),
+        "determines the dynamics (`tau = base_regressor(q, qd, qdd) base_parameters()`), named in".into(),
+        "`BASE_PARAMETER_NAMES` after the standard parameter whose column they keep (`R` when others".into(),
+        "are grouped into it).".into(),
+        String::new(),
+        "Each as its combination of standard parameters (`PARAMETER_NAMES`; coefficients to 6"
+            .into(),
+        "significant digits here, exact in the code):".into(),
+        String::new(),
+    ];
+    for b in &id.base {
+        let f = id.formula(g, b, style, 1e-12);
+        doc.push(format!("- `{} = {}`", b.name, f));
+    }
+    doc
 }
 
 /// The `PARAMETER_NAMES` and `BASE_PARAMETER_NAMES` of an identification.

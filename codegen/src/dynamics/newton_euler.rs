@@ -230,57 +230,17 @@ pub fn forward_pass(
             None => (zero, zero, base_acc),
         };
         let r = &lm.rotation[i];
-        let t = &lm.translation[i];
-        let a = &lm.axis[i];
-        let col = lm.column[i];
-        let qd = terms.qd.map(|v| v[col]);
-        let qdd = terms.qdd.map(|v| v[col]);
         // Parent quantities in body axes.
         let wp_b = mat_t_vec(g, r, &wp);
         let dwp_b = mat_t_vec(g, r, &dwp);
-        // Acceleration of the body origin, carried from the parent: a_p + dw_p x t + w_p x (w_p x t).
-        let a_origin = {
-            let c1 = cross(g, &dwp, t);
-            let wt = cross(g, &wp, t);
-            let c2 = cross(g, &wp, &wt);
-            let s = [0, 1, 2].map(|k| g.add_all([ap[k], c1[k], c2[k]]));
-            mat_t_vec(g, r, &s)
-        };
-        let (wi, dwi, ai) = if lm.step[i] == Step::Free {
-            free_step(g, lm, i, terms, (wp_b, dwp_b, a_origin))
-        } else if lm.step[i] == Step::Revolute {
-            let wi = match qd {
-                Some(v) => {
-                    let aq = vec_scale(g, a, v);
-                    vec_add(g, &wp_b, &aq)
-                }
-                None => wp_b,
-            };
-            let mut dwi = dwp_b;
-            if let Some(v) = qdd {
-                let aq = vec_scale(g, a, v);
-                dwi = vec_add(g, &dwi, &aq);
-            }
-            if let Some(v) = qd {
-                let aq = vec_scale(g, a, v);
-                let c = cross(g, &wp_b, &aq);
-                dwi = vec_add(g, &dwi, &c);
-            }
-            (wi, dwi, a_origin)
-        } else {
-            let mut ai = a_origin;
-            if let Some(v) = qdd {
-                let aq = vec_scale(g, a, v);
-                ai = vec_add(g, &ai, &aq);
-            }
-            if let Some(v) = qd {
-                let aq = vec_scale(g, a, v);
-                let c = cross(g, &wp_b, &aq);
-                let two = g.constant(2.0);
-                let c2 = vec_scale(g, &c, two);
-                ai = vec_add(g, &ai, &c2);
-            }
-            (wp_b, dwp_b, ai)
+        let a_origin = origin_acceleration(g, r, &lm.translation[i], (wp, dwp, ap));
+        let parent = (wp_b, dwp_b, a_origin);
+        let (col, a) = (lm.column[i], &lm.axis[i]);
+        let (qd, qdd) = (terms.qd.map(|v| v[col]), terms.qdd.map(|v| v[col]));
+        let (wi, dwi, ai) = match lm.step[i] {
+            Step::Free => free_step(g, lm, i, terms, parent),
+            Step::Revolute => revolute_step(g, a, qd, qdd, parent),
+            Step::Prismatic => prismatic_step(g, a, qd, qdd, parent),
         };
         let motion = BodyMotion {
             w: wi,
@@ -347,6 +307,70 @@ pub fn rnea(g: &mut Graph, lm: &LocalModel, terms: Terms<'_>) -> Vec<Id> {
         }
     }
     tau
+}
+
+/// The classical acceleration of a body's origin carried from its parent's, in body axes:
+/// `R^T (a_p + dw_p x t + w_p x (w_p x t))`, the parent's motion `(w_p, dw_p, a_p)` in its axes.
+fn origin_acceleration(g: &mut Graph, r: &M3, t: &V3, (wp, dwp, ap): (V3, V3, V3)) -> V3 {
+    let c1 = cross(g, &dwp, t);
+    let wt = cross(g, &wp, t);
+    let c2 = cross(g, &wp, &wt);
+    let s = [0, 1, 2].map(|k| g.add_all([ap[k], c1[k], c2[k]]));
+    mat_t_vec(g, r, &s)
+}
+
+/// A revolute joint's step about `axis`: `w = w_p + a qd`, `dw = dw_p + a qdd + w_p x a qd`;
+/// the origin's acceleration is the parent's carried over.
+fn revolute_step(
+    g: &mut Graph,
+    axis: &V3,
+    qd: Option<Id>,
+    qdd: Option<Id>,
+    (wp, dwp, a_origin): (V3, V3, V3),
+) -> (V3, V3, V3) {
+    let wi = plus_axis(g, wp, axis, qd);
+    let mut dwi = plus_axis(g, dwp, axis, qdd);
+    if let Some(v) = qd {
+        let c = cross_axis(g, &wp, axis, v);
+        dwi = vec_add(g, &dwi, &c);
+    }
+    (wi, dwi, a_origin)
+}
+
+/// A prismatic joint's step along `axis`: the parent's rotation, and the origin's acceleration
+/// plus `a qdd + 2 w_p x a qd`.
+fn prismatic_step(
+    g: &mut Graph,
+    axis: &V3,
+    qd: Option<Id>,
+    qdd: Option<Id>,
+    (wp, dwp, a_origin): (V3, V3, V3),
+) -> (V3, V3, V3) {
+    let mut ai = plus_axis(g, a_origin, axis, qdd);
+    if let Some(v) = qd {
+        let c = cross_axis(g, &wp, axis, v);
+        let two = g.constant(2.0);
+        let c2 = vec_scale(g, &c, two);
+        ai = vec_add(g, &ai, &c2);
+    }
+    (wp, dwp, ai)
+}
+
+/// `x + axis s`, or `x` when `s` is zero (`None`).
+fn plus_axis(g: &mut Graph, x: V3, axis: &V3, s: Option<Id>) -> V3 {
+    match s {
+        Some(v) => {
+            let aq = vec_scale(g, axis, v);
+            vec_add(g, &x, &aq)
+        }
+        None => x,
+    }
+}
+
+/// `w x (axis qd)`.
+fn cross_axis(g: &mut Graph, w: &V3, axis: &V3, qd: Id) -> V3 {
+    let aq = vec_scale(g, axis, qd);
+    cross(g, w, &aq)
 }
 
 /// Newton-Euler's forward step for a free flyer (a floating base, or a floating joint below

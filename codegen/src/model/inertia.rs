@@ -3,7 +3,7 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use super::description::{InertialDescription, JointType, Pose, RobotDescription};
+use super::description::{InertialDescription, JointType, LinkDescription, Pose, RobotDescription};
 use super::errors::{ModelError, ModelWarning};
 use super::shapes::{mass_properties, Shape};
 use super::tree::Tree;
@@ -19,91 +19,122 @@ pub(super) fn fill_inertias(
     file: &str,
     warnings: &mut Vec<ModelWarning>,
 ) -> Result<RobotDescription, ModelError> {
-    // Links welded to the root (through fixed joints only) never move: skip them.
+    let welded = welded_to_root(robot, tree);
+    let mut filled = robot.clone();
+    for (link, welded) in filled.links.iter_mut().zip(welded) {
+        if welded || !is_missing(&link.inertial) || link.collisions.is_empty() {
+            continue;
+        }
+        let (parts, ignored) = collision_primitives(link, file)?;
+        fill_from_primitives(link, parts, ignored, density, file, warnings);
+    }
+    Ok(filled)
+}
+
+/// Which links are welded to the root (through fixed joints only): they never move.
+fn welded_to_root(robot: &RobotDescription, tree: &Tree) -> Vec<bool> {
     let mut welded = vec![false; robot.links.len()];
     welded[tree.root] = true;
     for &j in &tree.order {
         let (parent, child) = tree.ends[j];
         welded[child] = welded[parent] && robot.joints[j].joint_type == JointType::Fixed;
     }
-    let mut filled = robot.clone();
-    for (link, welded) in filled.links.iter_mut().zip(welded) {
-        if welded || !is_missing(&link.inertial) || link.collisions.is_empty() {
-            continue;
+    welded
+}
+
+/// Collision primitives, each placed in its link's frame.
+type Primitives = Vec<(Shape, Transform)>;
+
+/// A link's collision primitives placed in its frame, and what it has that is no primitive
+/// (meshes); a primitive of negative or non-finite size, or a non-finite origin, is an error.
+fn collision_primitives(
+    link: &LinkDescription,
+    file: &str,
+) -> Result<(Primitives, Vec<String>), ModelError> {
+    let invalid = |reason: String| ModelError::InvalidCollision {
+        file: file.into(),
+        link: link.name.clone(),
+        reason,
+    };
+    let mut parts = Vec::new();
+    let mut ignored = Vec::new();
+    for c in &link.collisions {
+        match c.geometry {
+            Ok(shape) => {
+                let sizes: Vec<f64> = match shape {
+                    Shape::Box { size } => size.to_vec(),
+                    Shape::Cylinder { radius, length } => vec![radius, length],
+                    Shape::Sphere { radius } => vec![radius],
+                    Shape::Rod { length } => vec![length],
+                };
+                if !sizes.iter().all(|x| x.is_finite() && *x >= 0.0) {
+                    return Err(invalid(format!(
+                        "geometry: sizes must be finite and non-negative, not {sizes:?}"
+                    )));
+                }
+                if !c.origin.is_finite() {
+                    return Err(invalid("origin: not finite".into()));
+                }
+                parts.push((shape, c.origin.to_transform()));
+            }
+            Err(kind) => ignored.push(kind.to_string()),
         }
-        let invalid = |reason: String| ModelError::InvalidCollision {
+    }
+    Ok((parts, ignored))
+}
+
+/// `link`'s inertial from `parts` at `density`, with the warning that says so; a link with
+/// nothing to weigh (no primitive, or only primitives of zero volume) stays massless, warned.
+fn fill_from_primitives(
+    link: &mut LinkDescription,
+    parts: Primitives,
+    mut ignored: Vec<String>,
+    density: f64,
+    file: &str,
+    warnings: &mut Vec<ModelWarning>,
+) {
+    match mass_properties(&parts, density) {
+        Some(p) => {
+            let i = (p.inertia + p.inertia.transpose()) * 0.5;
+            link.inertial = InertialDescription {
+                origin: Pose {
+                    xyz: p.com.into(),
+                    rpy: [0.0; 3],
+                },
+                mass: p.mass,
+                inertia: [
+                    i[(0, 0)],
+                    i[(0, 1)],
+                    i[(0, 2)],
+                    i[(1, 1)],
+                    i[(1, 2)],
+                    i[(2, 2)],
+                ],
+            };
+            warnings.push(ModelWarning::InertiaFromCollision {
+                file: file.into(),
+                link: link.name.clone(),
+                mass: p.mass,
+                primitives: parts.len(),
+                density,
+                ignored,
+            });
+        }
+        None if parts.is_empty() => warnings.push(ModelWarning::NoCollisionPrimitive {
             file: file.into(),
             link: link.name.clone(),
-            reason,
-        };
-        let mut parts = Vec::new();
-        let mut ignored = Vec::new();
-        for c in &link.collisions {
-            match c.geometry {
-                Ok(shape) => {
-                    let sizes: Vec<f64> = match shape {
-                        Shape::Box { size } => size.to_vec(),
-                        Shape::Cylinder { radius, length } => vec![radius, length],
-                        Shape::Sphere { radius } => vec![radius],
-                        Shape::Rod { length } => vec![length],
-                    };
-                    if !sizes.iter().all(|x| x.is_finite() && *x >= 0.0) {
-                        return Err(invalid(format!(
-                            "geometry: sizes must be finite and non-negative, not {sizes:?}"
-                        )));
-                    }
-                    if !c.origin.is_finite() {
-                        return Err(invalid("origin: not finite".into()));
-                    }
-                    parts.push((shape, c.origin.to_transform()));
-                }
-                Err(kind) => ignored.push(kind.to_string()),
-            }
-        }
-        match mass_properties(&parts, density) {
-            Some(p) => {
-                let i = (p.inertia + p.inertia.transpose()) * 0.5;
-                link.inertial = InertialDescription {
-                    origin: Pose {
-                        xyz: p.com.into(),
-                        rpy: [0.0; 3],
-                    },
-                    mass: p.mass,
-                    inertia: [
-                        i[(0, 0)],
-                        i[(0, 1)],
-                        i[(0, 2)],
-                        i[(1, 1)],
-                        i[(1, 2)],
-                        i[(2, 2)],
-                    ],
-                };
-                warnings.push(ModelWarning::InertiaFromCollision {
-                    file: file.into(),
-                    link: link.name.clone(),
-                    mass: p.mass,
-                    primitives: parts.len(),
-                    density,
-                    ignored,
-                });
-            }
-            None if parts.is_empty() => warnings.push(ModelWarning::NoCollisionPrimitive {
+            ignored,
+        }),
+        // Primitives of zero volume: nothing to weigh either.
+        None => {
+            ignored.extend(parts.iter().map(|_| "primitive of zero volume".to_string()));
+            warnings.push(ModelWarning::NoCollisionPrimitive {
                 file: file.into(),
                 link: link.name.clone(),
                 ignored,
-            }),
-            // Primitives of zero volume: nothing to weigh either.
-            None => {
-                ignored.extend(parts.iter().map(|_| "primitive of zero volume".to_string()));
-                warnings.push(ModelWarning::NoCollisionPrimitive {
-                    file: file.into(),
-                    link: link.name.clone(),
-                    ignored,
-                })
-            }
+            })
         }
     }
-    Ok(filled)
 }
 
 pub(super) fn inertia_matrix(&[ixx, ixy, ixz, iyy, iyz, izz]: &[f64; 6]) -> Matrix3<f64> {
