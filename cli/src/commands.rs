@@ -6,7 +6,7 @@ use std::time::Instant;
 use clap::{CommandFactory, ValueEnum};
 
 use eomgen::catalogue::{self, Layout};
-use eomgen::evaluate::State;
+use eomgen::evaluate::{State, Value};
 use eomgen::model::Model;
 use eomgen::report::{self, Form, Format, ShowOptions};
 use eomgen::Builder;
@@ -340,11 +340,9 @@ pub(crate) fn eval_cmd(a: EvalArgs) -> Result<(), Failure> {
     let (values, qdd) = eval::evaluate(&derived, &state).map_err(Failure)?;
     let model = derived.model();
     if !model.is_floating() {
-        warn_lines(conditioning::warning(
-            model,
-            &values.mass_matrix,
-            "at this state",
-        ));
+        let mass_matrix = values.iter().find(|v| v.name == "mass_matrix");
+        let rows = mass_matrix.map(Value::rows).unwrap_or_default();
+        warn_lines(conditioning::warning(model, &rows, "at this state"));
     }
     let digits = (a.digits > 0).then_some(a.digits);
     emit(&eval::print(model, &state, &values, &qdd, digits))

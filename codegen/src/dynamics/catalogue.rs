@@ -222,6 +222,18 @@ impl Notation {
     pub fn is_named(&self, s: &str) -> bool {
         self.name == s || self.aliases.contains(&s)
     }
+
+    /// The title's name and symbol, before its defining formula if it has one: what
+    /// `eomgen eval` prints before the quantity's value.
+    ///
+    /// ```
+    /// use eomgen::catalogue::notation;
+    /// assert_eq!(notation("b").unwrap().label(), "Bias b(q, qd)");
+    /// assert_eq!(notation("M").unwrap().label(), "Mass matrix M(q)");
+    /// ```
+    pub fn label(&self) -> &'static str {
+        self.title.split(" = ").next().unwrap_or(self.title)
+    }
 }
 
 pub use super::quantities::NOTATIONS;

@@ -100,7 +100,7 @@ pub static NOTATIONS: &[Notation] = &[
         text: "F",
         latex: "F",
         aliases: &["F"],
-        title: "Joint friction F(qd)",
+        title: "Friction F(qd)",
         definition: "F_i = damping_i qd_i + friction_i sign(qd_i), supplied by the actuators.",
         layout: Layout::Vector,
         printed: |d| Some(d.friction.clone()),
