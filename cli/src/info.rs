@@ -202,19 +202,23 @@ fn tree(out: &mut String, model: &Model) {
     }
 }
 
-/// Joint `j`'s line of the tree: its coordinate, name, kind, axis, body and mass, merged
-/// links and mimic tag.
+/// Joint `j`'s line of the tree: its coordinate, name, kind, axis (a floating joint has none),
+/// body and mass, merged links and mimic tag.
 fn tree_line(out: &mut String, model: &Model, j: usize, prefix: &str, last: bool) {
     let joint = &model.joints[j];
     let body = &model.bodies[j];
+    // A floating joint moves along no axis.
+    let axis = match joint.kind {
+        JointKind::Floating => String::new(),
+        _ => format!(" about {}", vec3(&joint.axis)),
+    };
     let _ = write!(
         out,
-        "{prefix}{} {} {}: {} about {} -> {}, {} kg",
+        "{prefix}{} {} {}: {}{axis} -> {}, {} kg",
         if last { "└──" } else { "├──" },
         label(model, j),
         joint.name,
         kind(joint.kind),
-        vec3(&joint.axis),
         body.name,
         format_number(body.mass, Some(6))
     );

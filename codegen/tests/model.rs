@@ -1115,6 +1115,18 @@ fn planar_and_floating_joints_load_with_their_coordinates() {
         // The link frame moves with the joint's last step.
         let l2 = model.frames.iter().find(|f| f.name == "l2").unwrap();
         assert_eq!(l2.body, Some(model.dof() - 1));
+        // The massless bodies between a planar joint's steps are named after their steps, not
+        // after the child link they do not hold (every body's name, and so every identified
+        // parameter's, is unique).
+        let bodies: Vec<&str> = model.bodies.iter().map(|b| b.name.as_str()).collect();
+        let expected = match kind {
+            "planar" => vec!["l1", "free.x", "free.y", "l2"],
+            _ => vec!["l1", "l2"],
+        };
+        assert_eq!(bodies, expected, "{kind}");
+        assert!(model.bodies[1..model.dof() - 1]
+            .iter()
+            .all(|b| b.merged_links.is_empty() && b.mass == 0.0));
     }
 }
 

@@ -5,7 +5,8 @@
 //!   then its rotation about the joint frame's z axis, with `qd = dq/dt`. That is exactly the
 //!   chain of a prismatic joint along x, a prismatic joint along y and a revolute joint about
 //!   z ([`planar_steps`]), so the model holds it as those three one-coordinate joints
-//!   (`name.x`, `name.y`, `name.theta`, the first two moving massless bodies): every algorithm
+//!   (`name.x`, `name.y`, `name.theta`, the first two moving massless bodies named after
+//!   them, `name.x` and `name.y`, the last the child link's): every algorithm
 //!   and the closed Lagrangian forms then apply unchanged. The plane is the joint frame's xy
 //!   plane (Pinocchio's reading); another plane comes from the joint origin's rpy.
 //! - `floating` below the root: one joint of kind [`JointKind::Floating`] (seven position and

@@ -106,11 +106,23 @@ impl Merged {
         let empty = InertialDescription::default();
         for (k, step) in steps.into_iter().enumerate() {
             let b = self.joints.len();
+            let name = match step.suffix {
+                Some(suffix) => format!("{}.{suffix}", joint.name),
+                None => joint.name.clone(),
+            };
+            // The last body is the child link's; the massless ones before it are named after
+            // their step (`base.x`), not after a link they do not hold.
+            let (body, links, inertial) = if k == last {
+                (
+                    child.name.clone(),
+                    vec![child.name.clone()],
+                    &child.inertial,
+                )
+            } else {
+                (name.clone(), Vec::new(), &empty)
+            };
             self.joints.push(Joint {
-                name: match step.suffix {
-                    Some(suffix) => format!("{}.{suffix}", joint.name),
-                    None => joint.name.clone(),
-                },
+                name,
                 kind: step.kind,
                 parent,
                 origin: if k == 0 {
@@ -126,13 +138,8 @@ impl Merged {
                 mimic: joint.mimic.clone(),
                 symbolic_origin: false,
             });
-            let (links, inertial) = if k == last {
-                (vec![child.name.clone()], &child.inertial)
-            } else {
-                (Vec::new(), &empty)
-            };
             self.bodies.push(Body {
-                name: child.name.clone(),
+                name: body,
                 mass: 0.0,
                 com: Vector3::zeros(),
                 inertia: Matrix3::zeros(),

@@ -209,7 +209,8 @@ pub struct Joint {
 /// The rigid body moved by one joint: its child link and every link welded to it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Body {
-    /// The URDF name of the joint's child link.
+    /// The URDF name of the joint's child link; for the massless bodies between the steps of
+    /// a joint of several (a planar joint's `base.x` and `base.y`), the step's joint name.
     pub name: String,
     /// Total mass (kg).
     pub mass: f64,
