@@ -5,7 +5,9 @@
 //! frame's origin, in world axes.
 //!
 //! The rates are those of the joint tree's velocity columns: a floating base's six (linear,
-//! then angular velocity in base axes) and one per joint.
+//! then angular velocity in base axes), and per joint one, or six for a free flyer below the
+//! root ([`Motion::Free`]: its body's linear, then angular velocity relative to its parent,
+//! in its own axes), in joint order.
 
 use crate::tree::{cross, Motion, TreeJoint};
 use crate::{Pose, Real};
@@ -13,8 +15,9 @@ use crate::{Pose, Real};
 /// A frame on a kinematic chain, as generated code describes it.
 ///
 /// With a floating base, body 0 is the base (moved by the free flyer, velocity columns 0 to 5)
-/// and body `b >= 1` is moved by `joints[b - 1]` (column `5 + b`); without one, body `j` is
-/// moved by `joints[j]` (column `j`).
+/// and body `b >= 1` is moved by `joints[b - 1]`; without one, body `j` is moved by
+/// `joints[j]`. A joint's columns follow those of the joints before it (one each, six for a
+/// [`Motion::Free`] joint) and the base's six.
 #[derive(Clone, Copy, Debug)]
 pub struct Chain<'a, T, F> {
     /// The bodies from the root to the frame's body.
@@ -71,11 +74,49 @@ fn at<T: Real>(x: &[T], i: usize) -> T {
     x.get(i).copied().unwrap_or_else(T::zero)
 }
 
+/// A free flyer's body state `s` (its pose, and its parent's motion carried to its origin)
+/// with the joint's own motion added: velocity `(lin, ang)` and acceleration `(dlin, dang)`
+/// in its axes from columns `col..col + 6`. Relative to the parent, the origin moves at
+/// `R lin` and accelerates at `R (dlin + ang x lin)`, the body turns at `R ang` and
+/// accelerates at `R dang`; the parent's rotation `w_p` adds `2 w_p x R lin` (Coriolis) and
+/// `w_p x R ang`.
+fn free_step<T: Real>(
+    mut s: State<T>,
+    parent: &State<T>,
+    col: usize,
+    qd: &[T],
+    qdd: Option<&[T]>,
+) -> State<T> {
+    let part = |x: &[T], k: usize| [at(x, col + k), at(x, col + k + 1), at(x, col + k + 2)];
+    let (lin, ang) = (part(qd, 0), part(qd, 3));
+    let (v_rel, w_rel) = (s.pose.transform_vector(&lin), s.pose.transform_vector(&ang));
+    s.v = add(&s.v, &v_rel);
+    s.w = add(&s.w, &w_rel);
+    if let Some(qdd) = qdd {
+        let (dlin, dang) = (part(qdd, 0), part(qdd, 3));
+        let dw = add(&s.pose.transform_vector(&dang), &cross(&parent.w, &w_rel));
+        s.dw = add(&s.dw, &dw);
+        let a_rel = s.pose.transform_vector(&add(&dlin, &cross(&ang, &lin)));
+        let coriolis = scale(&cross(&parent.w, &v_rel), T::from_f64(2.0));
+        s.a = add(&s.a, &add(&a_rel, &coriolis));
+    }
+    s
+}
+
 impl<T: Real, F: Fn(usize) -> Pose<T>> Chain<'_, T, F> {
-    /// The velocity column and joint of body `b`, unless it is a floating base.
+    /// The first velocity column and joint of body `b`, unless it is a floating base.
     fn joint(&self, b: usize) -> Option<(usize, TreeJoint)> {
         let j = if self.floating { b.checked_sub(1)? } else { b };
-        Some((j + 6 * usize::from(self.floating), *self.joints.get(j)?))
+        let before: usize = self
+            .joints
+            .get(..j)?
+            .iter()
+            .map(|t| t.motion.columns())
+            .sum();
+        Some((
+            before + 6 * usize::from(self.floating),
+            *self.joints.get(j)?,
+        ))
     }
 
     /// The floating base's state from its rates (base axes) `qd`, `qdd`.
@@ -118,6 +159,9 @@ impl<T: Real, F: Fn(usize) -> Pose<T>> Chain<'_, T, F> {
         let Some((col, joint)) = self.joint(b) else {
             return s;
         };
+        if joint.motion == Motion::Free {
+            return free_step(s, parent, col, qd, qdd);
+        }
         let z = pose.transform_vector(&joint.axis.map(T::from_f64));
         let x = at(qd, col);
         let (rotates, zx) = (joint.motion == Motion::Rotation, scale(&z, x));
@@ -252,18 +296,19 @@ pub fn jacobian_time_variation<T: Real, F: Fn(usize) -> Pose<T>, const N: usize>
         (lin, dz)
     };
     let zero = [T::zero(); 3];
+    // A free flyer's six columns from `col`: translations, then rotations, along and about
+    // its body's axes `e`, which turn with the body.
+    let free = |col: usize, s: &State<T>, put: &mut dyn FnMut(usize, [T; 3], [T; 3])| {
+        for k in 0..3 {
+            let e = [0, 1, 2].map(|r| s.pose.rotation[r][k]);
+            put(col + k, cross(&s.w, &e), zero);
+            let (lin, ang) = rotation(s, &e);
+            put(col + 3 + k, lin, ang);
+        }
+    };
     for (b, s) in bodies.iter().take(count) {
         if chain.floating && *b == 0 {
-            for k in 0..3 {
-                let e = [
-                    s.pose.rotation[0][k],
-                    s.pose.rotation[1][k],
-                    s.pose.rotation[2][k],
-                ];
-                put(k, cross(&s.w, &e), zero);
-                let (lin, ang) = rotation(s, &e);
-                put(3 + k, lin, ang);
-            }
+            free(0, s, &mut put);
         } else if let Some((col, joint)) = chain.joint(*b) {
             let z = s.pose.transform_vector(&joint.axis.map(T::from_f64));
             match joint.motion {
@@ -272,8 +317,7 @@ pub fn jacobian_time_variation<T: Real, F: Fn(usize) -> Pose<T>, const N: usize>
                     put(col, lin, ang);
                 }
                 Motion::Translation => put(col, cross(&s.w, &z), zero),
-                // Link motions are not generated for floating joints below the root.
-                Motion::Free => {}
+                Motion::Free => free(col, s, &mut put),
             }
         }
     }

@@ -64,16 +64,20 @@ pub fn integrate_jacobians<T: Real, const NQ: usize, const NV: usize>(
     if NV < 6 {
         return (identity(T::one()), identity(T::one()));
     }
+    let (dq, dv) = flyer_integrate_jacobians(&v[..6]);
+    (embed(&dq, T::one()), embed(&dv, T::one()))
+}
+
+/// A free flyer's blocks of [`integrate_jacobians`] at its velocity `v` (6 entries):
+/// `Ad(exp6(v))^-1` and the right Jacobian of `exp6` at `v`.
+fn flyer_integrate_jacobians<T: Real>(v: &[T]) -> (M6<T>, M6<T>) {
     let rho = [v[0], v[1], v[2]];
     let phi = [v[3], v[4], v[5]];
     let (quat, vmat) = exp_so3(&phi);
     let r = rotation(&quat);
     let t = mat_vec(&vmat, &rho);
-    let dq = embed(&inverse_action(&r, &t), T::one());
-    let dv = embed(
-        &right_jacobian(&r, &rho, &phi, &coefficients(&phi)),
-        T::one(),
-    );
+    let dq = inverse_action(&r, &t);
+    let dv = right_jacobian(&r, &rho, &phi, &coefficients(&phi));
     (dq, dv)
 }
 
@@ -94,6 +98,13 @@ pub fn difference_jacobians<T: Real, const NQ: usize, const NV: usize>(
     if NQ < 7 || NV < 6 {
         return (identity(-T::one()), identity(T::one()));
     }
+    let (d0, d1) = flyer_difference_jacobians(q0, q1);
+    (embed(&d0, -T::one()), embed(&d1, T::one()))
+}
+
+/// A free flyer's blocks of [`difference_jacobians`] from its coordinates in `q0` and `q1`
+/// (the first 7 entries of each): `-Jlog6(M) Ad(M)^-1` and `Jlog6(M)`, `M = M0^-1 M1`.
+fn flyer_difference_jacobians<T: Real>(q0: &[T], q1: &[T]) -> (M6<T>, M6<T>) {
     let (rho, phi, r, t) = relative_log(q0, q1);
     let jlog = inverse_right_jacobian(&r, &rho, &phi, &coefficients(&phi));
     let adinv = inverse_action(&r, &t);
@@ -103,7 +114,131 @@ pub fn difference_jacobians<T: Real, const NQ: usize, const NV: usize>(
             *x = -(0..6).fold(T::zero(), |s, k| s + j[k] * adinv[k][c]);
         }
     }
-    (embed(&d0, -T::one()), embed(&jlog, T::one()))
+    (d0, jlog)
+}
+
+/// [`difference`] for free flyers anywhere in `q` (floating joints below the root): each
+/// `(q0, v0)` of `free` (ascending) is a free flyer whose 7 position coordinates start at `q0`
+/// and 6 velocity coordinates at `v0`, its part `log6(M0^-1 M1)`; every other coordinate's
+/// is `q1 - q0`. As [`crate::free_flyer::integrate_blocks`] reads `free`.
+///
+/// ```
+/// use eomgen_runtime::free_flyer::integrate_blocks;
+/// use eomgen_runtime::manifold::difference_blocks;
+/// // a revolute joint, then a free flyer
+/// let q = [0.5_f64, 0.1, -0.2, 0.3, 0.0, 0.6, 0.0, 0.8];
+/// let v = [0.7, 0.3, -0.1, 0.2, 0.4, -0.5, 0.6];
+/// let d: [f64; 7] = difference_blocks(&q, &integrate_blocks(&q, &v, 1.0, &[(1, 1)]), &[(1, 1)]);
+/// assert!(d.iter().zip(&v).all(|(a, b)| (a - b).abs() < 1e-12));
+/// ```
+pub fn difference_blocks<T: Real, const NQ: usize, const NV: usize>(
+    q0: &[T; NQ],
+    q1: &[T; NQ],
+    free: &[(usize, usize)],
+) -> [T; NV] {
+    let mut out = [T::zero(); NV];
+    walk_blocks::<NQ, NV>(free, |block| match block {
+        Block::Vector(qi, vi) => out[vi] = q1[qi] - q0[qi],
+        Block::Flyer(a, b) => {
+            let (rho, phi, _, _) = relative_log(&q0[a..a + 7], &q1[a..a + 7]);
+            out[b..b + 3].copy_from_slice(&rho);
+            out[b + 3..b + 6].copy_from_slice(&phi);
+        }
+    });
+    out
+}
+
+/// [`integrate_jacobians`] for free flyers anywhere in `q`, `free` as in
+/// [`difference_blocks`]: each free flyer's 6 x 6 blocks on the diagonal, the identity for
+/// every other coordinate.
+///
+/// ```
+/// use eomgen_runtime::manifold::integrate_jacobians_blocks;
+/// let q = [0.5_f64, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0];
+/// let (dq, dv) = integrate_jacobians_blocks::<f64, 8, 7>(&q, &[0.0; 7], &[(1, 1)]);
+/// assert!((0..7).all(|i| dq[i][i] == 1.0 && dv[i][i] == 1.0));
+/// ```
+pub fn integrate_jacobians_blocks<T: Real, const NQ: usize, const NV: usize>(
+    q: &[T; NQ],
+    v: &[T; NV],
+    free: &[(usize, usize)],
+) -> ([[T; NV]; NV], [[T; NV]; NV]) {
+    let _ = q;
+    let (mut dq, mut dv) = (identity(T::one()), identity(T::one()));
+    walk_blocks::<NQ, NV>(free, |block| {
+        if let Block::Flyer(_, b) = block {
+            let (bq, bv) = flyer_integrate_jacobians(&v[b..b + 6]);
+            put_block(&mut dq, b, &bq);
+            put_block(&mut dv, b, &bv);
+        }
+    });
+    (dq, dv)
+}
+
+/// [`difference_jacobians`] for free flyers anywhere in `q`, `free` as in
+/// [`difference_blocks`]: each free flyer's 6 x 6 blocks on the diagonal, `-I` and `I` for
+/// every other coordinate.
+///
+/// ```
+/// use eomgen_runtime::manifold::difference_jacobians_blocks;
+/// let q = [0.5_f64, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0];
+/// let (d0, d1) = difference_jacobians_blocks::<f64, 8, 7>(&q, &q, &[(1, 1)]);
+/// assert!((0..7).all(|i| d0[i][i] == -1.0 && d1[i][i] == 1.0));
+/// ```
+pub fn difference_jacobians_blocks<T: Real, const NQ: usize, const NV: usize>(
+    q0: &[T; NQ],
+    q1: &[T; NQ],
+    free: &[(usize, usize)],
+) -> ([[T; NV]; NV], [[T; NV]; NV]) {
+    let (mut d0, mut d1) = (identity(-T::one()), identity(T::one()));
+    walk_blocks::<NQ, NV>(free, |block| {
+        if let Block::Flyer(a, b) = block {
+            let (b0, b1) = flyer_difference_jacobians(&q0[a..a + 7], &q1[a..a + 7]);
+            put_block(&mut d0, b, &b0);
+            put_block(&mut d1, b, &b1);
+        }
+    });
+    (d0, d1)
+}
+
+/// A part of a configuration: one coordinate of a vector space (its position and velocity
+/// index), or a free flyer (its first position and velocity index).
+#[derive(Clone, Copy)]
+enum Block {
+    Vector(usize, usize),
+    Flyer(usize, usize),
+}
+
+/// Walks a configuration of `NQ` positions and `NV` velocities in order, a [`Block`] at a
+/// time, the free flyers from `free` (ascending, as [`difference_blocks`] reads it). A block
+/// that does not fit ends the walk.
+fn walk_blocks<const NQ: usize, const NV: usize>(
+    free: &[(usize, usize)],
+    mut visit: impl FnMut(Block),
+) {
+    let (mut qi, mut vi) = (0, 0);
+    for &(q0, v0) in free {
+        if q0 + 7 > NQ || v0 + 6 > NV || v0 < vi || q0 < qi || q0 - qi != v0 - vi {
+            return;
+        }
+        while vi < v0 {
+            visit(Block::Vector(qi, vi));
+            (qi, vi) = (qi + 1, vi + 1);
+        }
+        visit(Block::Flyer(q0, v0));
+        (qi, vi) = (q0 + 7, v0 + 6);
+    }
+    while qi < NQ && vi < NV {
+        visit(Block::Vector(qi, vi));
+        (qi, vi) = (qi + 1, vi + 1);
+    }
+}
+
+/// `block` on the diagonal of `m`, from row and column `at`.
+fn put_block<T: Real, const N: usize>(m: &mut [[T; N]; N], at: usize, block: &M6<T>) {
+    for (row, b) in m[at..at + 6].iter_mut().zip(block) {
+        row[at..at + 6].copy_from_slice(b);
+    }
 }
 
 /// A fixed base's `difference`: `q1 - q0`.
@@ -143,10 +278,7 @@ fn embed<T: Real, const N: usize>(block: &M6<T>, d: T) -> [[T; N]; N] {
 
 /// `log6(M0^-1 M1)` of the bases of `q0` and `q1` as (translation part, rotation vector), and
 /// the relative rotation and translation `(R, t)` of `M0^-1 M1`.
-fn relative_log<T: Real, const NQ: usize>(
-    q0: &[T; NQ],
-    q1: &[T; NQ],
-) -> ([T; 3], [T; 3], M3<T>, [T; 3]) {
+fn relative_log<T: Real>(q0: &[T], q1: &[T]) -> ([T; 3], [T; 3], M3<T>, [T; 3]) {
     let a = [q0[3], q0[4], q0[5], q0[6]];
     let b = [q1[3], q1[4], q1[5], q1[6]];
     let mut rel = quat_mul(&[-a[0], -a[1], -a[2], a[3]], &b);

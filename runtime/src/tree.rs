@@ -22,6 +22,22 @@ pub enum Motion {
     Free,
 }
 
+impl Motion {
+    /// How many velocity columns a joint of this motion has: six for a free flyer, one
+    /// otherwise.
+    ///
+    /// ```
+    /// use eomgen_runtime::tree::Motion;
+    /// assert_eq!((Motion::Rotation.columns(), Motion::Free.columns()), (1, 6));
+    /// ```
+    pub const fn columns(self) -> usize {
+        match self {
+            Motion::Rotation | Motion::Translation => 1,
+            Motion::Free => 6,
+        }
+    }
+}
+
 /// A moving joint as the tree kernels see it: its unit axis in its body's frame and how it
 /// moves.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -8,7 +8,9 @@
 //!   Jacobians, the inverse-dynamics derivatives and `integrate`;
 //! - `rover_pods` (a planar joint in a tilted plane, two floating joints on two branches, one
 //!   three joints deep with a rotor below it): the identities the dynamics must obey, and
-//!   central finite differences through `integrate`;
+//!   central finite differences through `integrate`, of the dynamics and of the MPC kit (link
+//!   velocities, accelerations and Jacobian time variations, `difference` and the Jacobians of
+//!   `integrate` and `difference`);
 //! - the options a floating joint cannot be combined with yet are errors naming the joint.
 
 #![allow(clippy::needless_range_loop)]
@@ -128,7 +130,11 @@ macro_rules! check_reference {
                 worst.note("link_pose", elementwise(&pose.translation, &numbers(&f["position"])));
                 worst.note("link_pose", elementwise(&flat(&pose.rotation), &numbers(&f["rotation"])));
                 let j = flat(&r.link_jacobian(link, &q));
-                worst.note("link_jacobian", elementwise(&j, &pick(&f["jacobian"], &all6, &b.v)));
+                let j_ref = pick(&f["jacobian"], &all6, &b.v);
+                worst.note("link_jacobian", elementwise(&j, &j_ref));
+                // The frame's velocity is its reference Jacobian times the velocities.
+                let v_ref: Vec<f64> = j_ref.chunks($nv).map(|row| row.iter().zip(&qd).map(|(a, b)| a * b).sum()).collect();
+                worst.note("link_velocity", normwise(&r.link_velocity(link, &q, &qd), &v_ref));
             }
             let (dq, dqd) = r.inverse_dynamics_derivatives(&q, &qd, &qdd);
             worst.note("dtau_dq", normwise(&flat(&dq), &rm("dtau_dq")));
@@ -313,6 +319,125 @@ fn floating_joints_differentiate_through_integrate() {
         }
     }
     worst.check("rover_pods", |_| 1e-7, 3);
+}
+
+/// `(f(x + h) - f(x - h)) / 2h` of a vector function of a step `t`.
+fn rate<const M: usize>(h: f64, f: impl Fn(f64) -> [f64; M]) -> [f64; M] {
+    let (plus, minus) = (f(h), f(-h));
+    core::array::from_fn(|i| (plus[i] - minus[i]) / (2.0 * h))
+}
+
+/// The angular velocity `w` of a rotation moving at `dR/dt`: `w^ = dR/dt R^T`.
+fn angular_velocity(r: &[[f64; 3]; 3], dr: &[[f64; 3]; 3]) -> [f64; 3] {
+    let w = |i: usize, j: usize| (0..3).map(|k| dr[i][k] * r[j][k]).sum::<f64>();
+    [w(2, 1), w(0, 2), w(1, 0)]
+}
+
+/// The MPC kit with floating joints below the root, against central differences along
+/// `t -> integrate(q, qd, t)` (the motion at velocity `qd`, each floating joint along the
+/// SE(3) exponential) and through `integrate` in the tangent space.
+#[test]
+fn floating_joints_link_motion_matches_finite_differences() {
+    use rover_pods::{RoverPods, RoverPodsLink};
+    let r = RoverPods::<f64>::default();
+    let h = 1e-6;
+    let mut worst = Worst::default();
+    for seed in 11..14 {
+        let (q, qd, qdd) = rover_state(seed);
+        let along = |t: f64| r.integrate(&q, &qd, t);
+        for link in RoverPodsLink::ALL {
+            let v = r.link_velocity(link, &q, &qd);
+            let j = r.link_jacobian(link, &q);
+            let jv: Vec<f64> = (0..6)
+                .map(|i| (0..19).map(|k| j[i][k] * qd[k]).sum())
+                .collect();
+            worst.note("link_velocity = J qd", normwise(&v, &jv));
+            let dp = rate(h, |t| r.link_pose(link, &along(t)).translation);
+            let dr = rate(h, |t| -> [f64; 9] {
+                flat(&r.link_pose(link, &along(t)).rotation)
+                    .try_into()
+                    .unwrap()
+            });
+            let rot = r.link_pose(link, &q).rotation;
+            let dr: [[f64; 3]; 3] =
+                core::array::from_fn(|i| [dr[3 * i], dr[3 * i + 1], dr[3 * i + 2]]);
+            let w = angular_velocity(&rot, &dr);
+            let fd: Vec<f64> = dp.iter().chain(&w).copied().collect();
+            worst.note("link_velocity", normwise(&v, &fd));
+            // Velocities qd + t qdd along the same curve (its second order cancels).
+            let fd = rate(h, |t| {
+                let qd_t: [f64; 19] = core::array::from_fn(|k| qd[k] + t * qdd[k]);
+                r.link_velocity(link, &along(t), &qd_t)
+            });
+            worst.note(
+                "link_acceleration",
+                normwise(&r.link_acceleration(link, &q, &qd, &qdd), &fd),
+            );
+            let dj = r.link_jacobian_time_variation(link, &q, &qd);
+            let fd = rate(h, |t| -> [f64; 114] {
+                flat(&r.link_jacobian(link, &along(t))).try_into().unwrap()
+            });
+            worst.note("link_jacobian_time_variation", normwise(&flat(&dj), &fd));
+            // J qdd + dJ/dt qd is the classical acceleration.
+            let a: Vec<f64> = (0..6)
+                .map(|i| (0..19).map(|k| j[i][k] * qdd[k] + dj[i][k] * qd[k]).sum())
+                .collect();
+            worst.note(
+                "J qdd + dJ qd",
+                normwise(&r.link_acceleration(link, &q, &qd, &qdd), &a),
+            );
+        }
+    }
+    worst.check("rover_pods", |_| 1e-7, 5);
+}
+
+/// `difference` undoes `integrate`, and the Jacobians of `integrate` and `difference` match
+/// central differences with every argument perturbed in its tangent space (`integrate` by
+/// `h e_k`, the change read back by `difference`).
+#[test]
+fn floating_joints_manifold_matches_finite_differences() {
+    let r = rover_pods::RoverPods::<f64>::default();
+    let h = 1e-6;
+    let starts = quaternion_starts();
+    let mut worst = Worst::default();
+    for seed in 21..24 {
+        let (q0, v, _) = rover_state(seed);
+        let (q1, _, _) = rover_state(seed + 100);
+        let q = r.integrate(&q0, &v, 1.0);
+        worst.note(
+            "difference(q, integrate(q, v))",
+            normwise(&r.difference(&q0, &q), &v),
+        );
+        let mut back = r.integrate(&q0, &r.difference(&q0, &q1), 1.0);
+        for &w in &starts {
+            if back[w + 3] * q1[w + 3] < 0.0 {
+                back[w..w + 4].iter_mut().for_each(|x| *x = -*x);
+            }
+        }
+        worst.note("integrate(q0, difference(q0, q1))", normwise(&back, &q1));
+        let e = |k: usize, t: f64| -> [f64; 19] {
+            core::array::from_fn(|i| if i == k { t } else { 0.0 })
+        };
+        let (dq, dv) = r.integrate_jacobians(&q0, &v);
+        let (d0, d1) = r.difference_jacobians(&q0, &q1);
+        for k in 0..19 {
+            let column = |m: &[[f64; 19]; 19]| -> Vec<f64> { (0..19).map(|i| m[i][k]).collect() };
+            let fd = rate(h, |t| {
+                r.difference(&q, &r.integrate(&r.integrate(&q0, &e(k, t), 1.0), &v, 1.0))
+            });
+            worst.note("integrate_jacobians (q)", normwise(&column(&dq), &fd));
+            let fd = rate(h, |t| {
+                let vt: [f64; 19] = core::array::from_fn(|i| v[i] + e(k, t)[i]);
+                r.difference(&q, &r.integrate(&q0, &vt, 1.0))
+            });
+            worst.note("integrate_jacobians (v)", normwise(&column(&dv), &fd));
+            let fd = rate(h, |t| r.difference(&r.integrate(&q0, &e(k, t), 1.0), &q1));
+            worst.note("difference_jacobians (q0)", normwise(&column(&d0), &fd));
+            let fd = rate(h, |t| r.difference(&q0, &r.integrate(&q1, &e(k, t), 1.0)));
+            worst.note("difference_jacobians (q1)", normwise(&column(&d1), &fd));
+        }
+    }
+    worst.check("rover_pods", |_| 1e-7, 6);
 }
 
 #[test]

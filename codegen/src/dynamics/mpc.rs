@@ -44,11 +44,6 @@ pub(super) fn add(d: &mut Derivation, model: &Model) {
         .is_floating()
         .then(|| centroidal_momentum_rate(d, model));
     let n = d.dof;
-    if !model.floating_joints().is_empty() {
-        // The run-time kernels of the link motions and the manifold know a free flyer at the
-        // root only: not generated for floating joints below it yet.
-        return;
-    }
     let mut out = frame_motions(n);
     out.extend(manifold(model, n));
     if let Some(rate) = rate {
@@ -133,6 +128,11 @@ fn manifold(model: &Model, n: usize) -> Vec<Quantity> {
         (
             "The base moves along the SE(3) exponential (`integrate(q, v, 1) = q exp6(v)`), the joints as a vector space.",
             "the base's block in closed form (SE(3) logarithm, adjoint, right Jacobian of exp6 and its inverse), identity for the joints (eomgen_runtime::manifold)",
+        )
+    } else if !model.velocities_are_rates() {
+        (
+            "Each floating joint moves along the SE(3) exponential (its block of `integrate(q, v, 1)` is `q_j exp6(v_j)`), the other joints as a vector space.",
+            "each floating joint's block in closed form (SE(3) logarithm, adjoint, right Jacobian of exp6 and its inverse), identity for the other joints (eomgen_runtime::manifold, the `_blocks` kernels)",
         )
     } else {
         (

@@ -192,12 +192,8 @@ impl Emitter<'_> {
         let body = if self.floating {
             quote!(::eomgen_runtime::free_flyer::integrate(q, qd, dt))
         } else {
-            let (q_at, v_at) = (self.model.q_offsets(), self.model.v_offsets());
-            let blocks = self.model.floating_joints().into_iter().map(|j| {
-                let (a, b) = (usize_lit(q_at[j]), usize_lit(v_at[j]));
-                quote!((#a, #b))
-            });
-            quote!(::eomgen_runtime::free_flyer::integrate_blocks(q, qd, dt, &[#(#blocks),*]))
+            let blocks = self.free_blocks();
+            quote!(::eomgen_runtime::free_flyer::integrate_blocks(q, qd, dt, #blocks))
         };
         quote! {
             #docs
@@ -205,5 +201,16 @@ impl Emitter<'_> {
                 #body
             }
         }
+    }
+
+    /// The floating joints below the root as the runtime's `_blocks` kernels read them:
+    /// `&[(first position, first velocity coordinate), ...]`.
+    pub(super) fn free_blocks(&self) -> TokenStream {
+        let (q_at, v_at) = (self.model.q_offsets(), self.model.v_offsets());
+        let blocks = self.model.floating_joints().into_iter().map(|j| {
+            let (a, b) = (usize_lit(q_at[j]), usize_lit(v_at[j]));
+            quote!((#a, #b))
+        });
+        quote!(&[#(#blocks),*])
     }
 }

@@ -70,27 +70,38 @@ impl Emitter<'_> {
     }
 
     /// `difference`, `integrate_jacobians` or `difference_jacobians` from the runtime's
-    /// kernels: a floating base's, or a vector space's.
+    /// kernels: a floating base's, floating joints' below the root (`_blocks`), or a vector
+    /// space's.
     pub(super) fn manifold_fn(&mut self, q: &Quantity, which: Manifold) -> TokenStream {
         let docs = Self::quantity_doc(q, None);
         let (n, nq) = (&self.n, &self.nq);
         let m = quote!(::eomgen_runtime::manifold);
         let jacobians = quote!(([[T; #n]; #n], [[T; #n]; #n]));
-        let (floating, fixed) = match which {
+        let free = self.free_blocks();
+        let (floating, blocks, fixed) = match which {
             Manifold::Difference => (
                 quote!(#m::difference(q0, q1)),
+                quote!(#m::difference_blocks(q0, q1, #free)),
                 quote!(#m::vector_difference(q0, q1)),
             ),
             Manifold::IntegrateJacobians => (
                 quote!(#m::integrate_jacobians(q, v)),
+                quote!(#m::integrate_jacobians_blocks(q, v, #free)),
                 quote!(#m::vector_integrate_jacobians()),
             ),
             Manifold::DifferenceJacobians => (
                 quote!(#m::difference_jacobians(q0, q1)),
+                quote!(#m::difference_jacobians_blocks(q0, q1, #free)),
                 quote!(#m::vector_difference_jacobians()),
             ),
         };
-        let body = if self.floating { floating } else { fixed };
+        let body = if self.floating {
+            floating
+        } else if !self.model.floating_joints().is_empty() {
+            blocks
+        } else {
+            fixed
+        };
         match which {
             Manifold::Difference => quote! {
                 #docs
