@@ -309,19 +309,28 @@ pub(crate) fn eval_cmd(a: EvalArgs) -> Result<(), Failure> {
     let b = a.model.builder(&a.urdf, &None);
     let model = load(&b)?;
     let joints = model.coordinate_names().join(", ");
-    let floating = usize::from(model.is_floating());
-    let nv = model.coordinates() + 6 * floating;
-    let nq = nv + floating;
+    // Velocity coordinates: the base's six, then the independent joints' (mimic joints
+    // follow); one position more per quaternion.
+    let nv = model.coordinates() + 6 * usize::from(model.is_floating());
+    let nq = nv + (model.nq() - model.nv());
+    let which = |n: usize| if n == nq { "position" } else { "velocity" };
     let check = |flag: &str, v: Option<Numbers>, n: usize| -> Result<Vec<f64>, Failure> {
         match v {
             None => Ok(vec![0.0; n]),
             Some(Numbers(v)) if v.len() == n => Ok(v),
-            Some(Numbers(v)) if floating == 1 => Err(Failure(format!(
+            Some(Numbers(v)) if model.is_floating() => Err(Failure(format!(
                 "{flag} has {} value(s), but {} has {n} {} coordinates (the floating base's \
                  first; joints: {joints})",
                 v.len(),
                 model.name,
-                if n == nq { "position" } else { "velocity" }
+                which(n)
+            ))),
+            Some(Numbers(v)) if nq != nv => Err(Failure(format!(
+                "{flag} has {} value(s), but {} has {n} {} coordinates (7 positions and 6 \
+                 velocities for a floating joint; joints: {joints})",
+                v.len(),
+                model.name,
+                which(n)
             ))),
             Some(Numbers(v)) => Err(Failure(format!(
                 "{flag} has {} value(s), but {} has {n} joint(s): {joints}",
@@ -339,7 +348,7 @@ pub(crate) fn eval_cmd(a: EvalArgs) -> Result<(), Failure> {
     let derived = derived(&b, model)?;
     let (values, qdd) = eval::evaluate(&derived, &state).map_err(Failure)?;
     let model = derived.model();
-    if !model.is_floating() {
+    if model.velocities_are_rates() {
         let mass_matrix = values.iter().find(|v| v.name == "mass_matrix");
         let rows = mass_matrix.map(Value::rows).unwrap_or_default();
         warn_lines(conditioning::warning(model, &rows, "at this state"));

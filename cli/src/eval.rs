@@ -149,6 +149,15 @@ fn header(model: &Model) -> String {
             model.coordinates(),
             model.coordinates() + 6
         )
+    } else if !model.velocities_are_rates() {
+        format!(
+            "{}: {} degrees of freedom, {} position coordinates; a floating joint's q = position \
+             (3), quaternion x y z w (4) of its child, its qd = linear and angular velocity in \
+             the child's axes (6); joint order: {names}",
+            model.name,
+            model.nv(),
+            model.nq()
+        )
     } else {
         format!(
             "{}: {} degrees of freedom; joint order: {names}",

@@ -124,9 +124,7 @@ fn bad_floating_requests_get_one_line_errors() {
 #[test]
 fn eval_takes_a_floating_base() {
     let urdf = robot("floating/anymal");
-    let doc: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(urdf.with_extension("json")).unwrap())
-            .unwrap();
+    let doc = reference(&urdf);
     let refs: Vec<&str> = doc["joints"]
         .as_array()
         .unwrap()
@@ -200,6 +198,12 @@ fn eval_takes_a_floating_base() {
         }
         assert_eq!(got.len(), 18, "{text}");
     }
+}
+
+/// The reference values beside a URDF (`NAME.json`).
+fn reference(urdf: &std::path::Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(urdf.with_extension("json")).unwrap();
+    serde_json::from_str(&text).unwrap()
 }
 
 /// The numbers after `label` in `text`, up to the end of the line.
@@ -391,4 +395,47 @@ fn info_shows_floating_and_planar_joints_as_they_are() {
         "{text}"
     );
     assert!(text.contains("cart_planar.theta: continuous about (0, 0, 1) -> cart,"));
+}
+
+/// `eval` on a floating joint below the root (the crane's payload, `NQ` 10, `NV` 9; the
+/// reference's joint order is ours): Pinocchio's inverse and forward dynamics, and a wrong
+/// count says how many position coordinates the robot has.
+#[test]
+fn eval_takes_a_floating_joint_below_the_root() {
+    let urdf = robot("joints/crane_payload");
+    let doc = reference(&urdf);
+    let sample = &doc["samples"][1];
+    let numbers = |k: &str| -> Vec<f64> {
+        let v = sample[k].as_array().unwrap();
+        v.iter().map(|x| x.as_f64().unwrap()).collect()
+    };
+    let joined = |k: &str| -> String {
+        let v: Vec<String> = numbers(k).iter().map(|x| x.to_string()).collect();
+        v.join(",")
+    };
+    let path = urdf.to_str().unwrap();
+    let (q, qd, qdd, tau) = (joined("q"), joined("qd"), joined("qdd"), joined("tau_in"));
+    let text = stdout(&eomgen(&[
+        "eval", path, "--q", &q, "--qd", &qd, "--qdd", &qdd, "--tau", &tau,
+    ]));
+    assert!(text.starts_with("crane_payload: 9 degrees of freedom, 10 position coordinates"));
+    for (label, key) in [
+        ("inverse dynamics tau = M qdd + b + G = ", "tau"),
+        (
+            "forward dynamics qdd = M^-1 (tau_in - b - G) = ",
+            "forward_dynamics",
+        ),
+    ] {
+        let (got, want) = (numbers_after(&text, label), numbers(key));
+        let scale = want.iter().fold(1.0f64, |m, x| m.max(x.abs()));
+        assert_eq!(got.len(), want.len(), "{key}");
+        for (g, w) in got.iter().zip(&want) {
+            assert!((g - w).abs() <= 1e-9 * scale, "{key}: {got:?} vs {want:?}");
+        }
+    }
+    let e = one_line_error(&eomgen(&["eval", path, "--q", "0.1"]));
+    assert!(
+        e.contains("--q has 1 value(s), but crane_payload has 10 position coordinates"),
+        "{e}"
+    );
 }
