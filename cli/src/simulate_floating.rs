@@ -14,7 +14,7 @@ use std::fmt::Write as _;
 
 use eomgen::evaluate::{Evaluator, State};
 use eomgen::model::Model;
-use eomgen::Derived;
+use eomgen::{Derived, Input};
 use nalgebra::{DMatrix, DVector};
 
 /// The controller closing the loop.
@@ -82,14 +82,14 @@ struct Terms {
 /// The quantities [`terms`] reads, compiled once.
 fn compile(derived: &Derived) -> Result<Evaluator, String> {
     let model = derived.model();
-    let mut names = vec![
-        "mass_matrix",
-        "bias",
-        "gravity",
-        "kinetic_energy",
-        "potential_energy",
-    ];
-    names.extend(model.include_friction.then_some("friction"));
+    // What `eval` prints that needs no accelerations: M, b, G, F and the energies.
+    let at_state = |name: &&str| {
+        derived
+            .inputs(name)
+            .is_some_and(|i| !i.contains(&Input::Qdd))
+    };
+    let printed = super::eval::printed(derived);
+    let mut names: Vec<&str> = printed.iter().map(|n| n.name).filter(at_state).collect();
     if !model.contacts.is_empty() {
         names.extend(["contact_jacobian", "contact_drift"]);
     }

@@ -195,6 +195,22 @@ impl Derived {
         self.derivation.quantities.iter().map(|q| q.name).collect()
     }
 
+    /// The arguments of the quantity `name` (a catalogue name or a symbol), `None` if this
+    /// robot has no such quantity.
+    ///
+    /// ```
+    /// use eomgen::{Builder, Input};
+    /// let urdf = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/robots/double_pendulum.urdf");
+    /// let derived = Builder::new(urdf).derived().unwrap();
+    /// assert_eq!(derived.inputs("tau"), Some(&[Input::Q, Input::Qd, Input::Qdd][..]));
+    /// assert_eq!(derived.inputs("no_such_quantity"), None);
+    /// ```
+    pub fn inputs(&self, name: &str) -> Option<&'static [Input]> {
+        let name = crate::catalogue::canonical(name);
+        let q = self.derivation.quantities.iter().find(|q| q.name == name)?;
+        Some(q.inputs)
+    }
+
     /// Compiles the quantities `names` (catalogue names, as the generated methods, or their
     /// symbols: `M`, `tau`; see [`crate::catalogue`]).
     pub fn evaluator(&self, names: &[&str]) -> Result<Evaluator, EvalError> {
