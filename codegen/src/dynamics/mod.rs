@@ -448,7 +448,7 @@ impl Derivation {
 
 /// `d` with its catalogue and the stage timings.
 fn finish(mut d: Derivation, model: &Model, mut clock: Clock) -> Derivation {
-    d.quantities = quantities::catalogue(model, &d);
+    d.quantities = quantities::catalogue(model, &mut d);
     mpc::add(&mut d, model);
     clock.lap("catalogue");
     d.timings = clock.laps;

@@ -141,8 +141,9 @@ pub static NOTATIONS: &[Notation] = &[
     },
 ];
 
-/// Every quantity generated code can evaluate for `model`, in file order.
-pub fn catalogue(model: &Model, d: &Derivation) -> Vec<Quantity> {
+/// Every quantity generated code can evaluate for `model`, in file order. An entry may add the
+/// expressions it needs to `d`'s graph.
+pub fn catalogue(model: &Model, d: &mut Derivation) -> Vec<Quantity> {
     let notes = Notes::new(model);
     let mut out = vec![
         mass_matrix(d, &notes),
