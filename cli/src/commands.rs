@@ -44,8 +44,7 @@ pub(crate) fn generate(a: GenerateArgs) -> Result<(), Failure> {
         model.name,
         model.dof()
     );
-    let (generated, _, _) =
-        progress::run(&label, || b.generate_with_report()).map_err(cli_error)?;
+    let (generated, _) = progress::run(&label, || b.generate_derived()).map_err(cli_error)?;
     match &a.output {
         Some(path) => {
             eomgen::write_if_changed(path, generated.source.as_bytes())?;

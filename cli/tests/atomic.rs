@@ -1,7 +1,7 @@
 //! `eomgen generate -o FILE` writes atomically: an error at any stage leaves an existing output
 //! file byte-identical, with its modification time and no temporary file beside it.
 
-mod support;
+use crate::support;
 
 use support::{eomgen, listing, mtime, one_line_error, robot, scratch, workspace};
 

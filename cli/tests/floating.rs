@@ -1,7 +1,7 @@
 //! Floating bases on the command line: `--floating-base`, `--contact`, a URDF `floating` joint
 //! from a world link, `eval` on a floating base, and one-line errors for bad requests.
 
-mod support;
+use crate::support;
 
 use support::{eomgen, one_line_error, robot, scratch};
 

@@ -2,7 +2,7 @@
 //! and no control or bidirectional-text characters from names reaching the terminal.
 //! (`codegen/tests/catalogue.rs` checks the library's answer to the whole catalogue.)
 
-mod support;
+use crate::support;
 
 use support::{eomgen, one_line_error, scratch, workspace};
 

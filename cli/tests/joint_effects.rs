@@ -1,7 +1,7 @@
 //! Joint effects on the command line: `--friction`, `--armature` and `--density` in `generate`,
 //! `eval` and `info`, their warnings, and their bad values.
 
-mod support;
+use crate::support;
 
 use support::eomgen;
 

@@ -2,7 +2,7 @@
 //! with text escaped and long formulas broken into lines; compiled by pdflatex where it is
 //! installed.
 
-mod support;
+use crate::support;
 
 use support::{eomgen, robot, stdout_of};
 

@@ -1,6 +1,6 @@
 //! The command line names its own flags for the generator's limits.
 
-mod support;
+use crate::support;
 
 use support::{eomgen, one_line_error, robot};
 

@@ -2,7 +2,7 @@
 //! legend entry per joint, the velocity, effort and energy plots beside, byte-identical output
 //! for the same run, and a one-line error (writing nothing) for any other extension.
 
-mod support;
+use crate::support;
 
 use std::path::Path;
 

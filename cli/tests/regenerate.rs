@@ -1,8 +1,6 @@
 //! The "Regenerate:" line of a generated file is a command that, pasted into a shell in the
 //! crate root, writes the same file.
 
-mod support;
-
 use std::process::Command;
 
 /// The banner's command, without its trailing comment, split into arguments (the options here

@@ -1,7 +1,7 @@
 //! `eomgen show --derivatives`: d tau / d q printed for small robots in every format, checked
 //! against central differences of `eomgen eval`, and refused in one line for large ones.
 
-mod support;
+use crate::support;
 
 use support::{eomgen, robot, stdout_of};
 

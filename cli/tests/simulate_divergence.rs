@@ -1,7 +1,7 @@
 //! A simulation whose integration blows up says so and suggests a smaller `--dt`, instead of
 //! blaming the mass matrix.
 
-mod support;
+use crate::support;
 
 use support::{eomgen, one_line_error, scratch};
 

@@ -276,7 +276,8 @@ impl Builder {
     ///
     /// - the dynamics: `mass_matrix`, `gravity`, `bias`, `coriolis_matrix`,
     ///   `inverse_dynamics`, `forward_dynamics` (with `try_forward_dynamics`),
-    ///   `kinetic_energy`, `potential_energy`; Craig's `centrifugal` and `coriolis_pairs`
+    ///   `kinetic_energy`, `generalized_momentum`, `potential_energy`; Craig's `centrifugal`
+    ///   and `coriolis_pairs`
     ///   (fixed base); `friction` (with [`Builder::friction`]);
     /// - kinematics: `link_pose`, `link_jacobian`, `link_velocity`, `link_acceleration`,
     ///   `link_jacobian_time_variation`, `center_of_mass`, `center_of_mass_jacobian`,

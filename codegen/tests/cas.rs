@@ -1,8 +1,7 @@
 //! The symbolic core: one test per simplification rule, property tests against a direct
 //! evaluation of random expression trees, and a two-process determinism check.
 
-#[path = "support/child.rs"]
-mod child;
+use crate::child;
 
 use eomgen::cas::{Graph, Id, Node, Order, Program, Style, Syntax};
 use proptest::prelude::*;
@@ -599,7 +598,7 @@ fn determinism_child() {
 
 #[test]
 fn printing_is_byte_identical_across_processes() {
-    let run = || child::run_child("determinism_child");
+    let run = || child::run_child(concat!(module_path!(), "::determinism_child"));
     let (a, b) = (run(), run());
     assert!(!a.is_empty());
     assert_eq!(a, b);

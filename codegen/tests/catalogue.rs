@@ -690,10 +690,26 @@ fn every_catalogue_case_gives_a_clear_error_or_safe_code() {
     let cases = catalogue();
     assert!(cases.len() >= 30, "{} cases", cases.len());
     let start = Clock::start();
-    let failures: Vec<String> = cases
-        .iter()
-        .filter_map(|(name, text, expect)| run(name, text, expect).err())
-        .collect();
+    // Each case derives and checks a robot of its own: on every core (the test's unoptimized
+    // build would otherwise leave the others idle for seconds).
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let chunk = cases.len().div_ceil(threads);
+    let failures: Vec<String> = std::thread::scope(|s| {
+        let workers: Vec<_> = cases
+            .chunks(chunk)
+            .map(|part| {
+                s.spawn(move || {
+                    part.iter()
+                        .filter_map(|(name, text, expect)| run(name, text, expect).err())
+                        .collect::<Vec<String>>()
+                })
+            })
+            .collect();
+        workers
+            .into_iter()
+            .flat_map(|w| w.join().expect("a catalogue worker"))
+            .collect()
+    });
     // Long messages are failures in themselves; show their start only.
     let shown: Vec<String> = failures
         .iter()

@@ -1,7 +1,6 @@
 //! The same URDF and options give byte-identical output in separate processes.
 
-#[path = "support/child.rs"]
-mod child;
+use crate::child;
 
 use std::path::PathBuf;
 
@@ -63,7 +62,7 @@ fn child_process_generates() {
 
 #[test]
 fn every_reference_robot_generates_identical_bytes_in_two_processes() {
-    let run = || child::run_child("child_process_generates");
+    let run = || child::run_child(concat!(module_path!(), "::child_process_generates"));
     let (a, b) = (run(), run());
     assert_eq!(a.lines().count(), ROBOTS.len() + 2);
     assert_eq!(a, b);

@@ -210,6 +210,59 @@ impl<T: ::eomgen_runtime::Real> DoublePendulum<T> {
         }
         Ok(qdd)
     }
+    /// The generalized momentum p = M(q) qd = dT/dqd (a momentum observer's measurement).
+    ///
+    /// Route: Newton-Euler at rest without gravity, with qd as the accelerations, O(N).
+    /// Operations: 16 mul, 12 add, 0 div, 1 sin, 1 cos.
+    pub fn generalized_momentum(&self, q: &[T; 2], qd: &[T; 2]) -> [T; 2] {
+        let (s1, c1) = q[1].sin_cos();
+        let t0 = s1;
+        let t1 = c1;
+        let t2 = qd[0] * t1;
+        let t3 = qd[0] * t0;
+        let t4 = T::mul_add(
+            T::from_f64(0.1),
+            T::mul_add(
+                t0,
+                T::mul_add(
+                    T::from_f64(0.033238000000000004),
+                    t3,
+                    T::from_f64(0.0000000000643853298) * (qd[0] + qd[1]),
+                ),
+                t1
+                    * (T::mul_add(
+                        T::from_f64(0.033238000000000004),
+                        t2,
+                        T::from_f64(0.0335304944) * (qd[0] + qd[1]),
+                    )),
+            ),
+            T::mul_add(
+                T::from_f64(0.0000000000064385329799999996),
+                t3,
+                T::mul_add(
+                    T::from_f64(0.0033530494400000003),
+                    t2,
+                    T::mul_add(
+                        T::from_f64(0.004557856275072),
+                        qd[1],
+                        T::from_f64(0.005312427908704868) * qd[0],
+                    ),
+                ),
+            ),
+        );
+        [
+            t4,
+            T::mul_add(
+                T::from_f64(0.0000000000064385329799999996),
+                t3,
+                T::mul_add(
+                    T::from_f64(0.0033530494400000003),
+                    t2,
+                    T::from_f64(0.004557856275072) * (qd[0] + qd[1]),
+                ),
+            ),
+        ]
+    }
     /// Craig's centrifugal matrix C(q): `b = B(q) [qd qd] + C(q) [qd^2]`.
     ///
     /// Route: closed-form Lagrangian expressions.

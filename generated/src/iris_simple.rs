@@ -526,6 +526,52 @@ impl<T: ::eomgen_runtime::Real> IrisSimple<T> {
         );
         t0
     }
+    /// The generalized momentum p = M(q) qd = dT/dqd (a momentum observer's measurement).
+    ///
+    /// Route: Newton-Euler at rest without gravity, with qd as the accelerations, O(N).
+    /// Operations: 14 mul, 8 add, 0 div, 0 sin, 0 cos.
+    pub fn generalized_momentum(&self, q: &[T; 7], qd: &[T; 6]) -> [T; 6] {
+        [
+            T::mul_add(
+                T::from_f64(0.00045999999999999996),
+                qd[4],
+                T::from_f64(1.5349999999999995) * qd[0],
+            ),
+            T::mul_add(
+                -T::from_f64(0.00045999999999999996),
+                qd[3],
+                T::from_f64(1.5349999999999995) * qd[1],
+            ),
+            T::from_f64(1.5349999999999995) * qd[2],
+            T::mul_add(
+                -T::from_f64(0.000000000000000000005082197683525802),
+                qd[5],
+                T::mul_add(
+                    T::from_f64(0.030033480000000005),
+                    qd[3],
+                    -T::from_f64(0.00045999999999999996) * qd[1],
+                ),
+            ),
+            T::mul_add(
+                -T::from_f64(0.000000000000000000006776263578034403),
+                qd[5],
+                T::mul_add(
+                    T::from_f64(0.030575996),
+                    qd[4],
+                    T::from_f64(0.00045999999999999996) * qd[0],
+                ),
+            ),
+            T::mul_add(
+                T::from_f64(0.057553016000000005),
+                qd[5],
+                T::mul_add(
+                    -T::from_f64(0.000000000000000000006776263578034403),
+                    qd[4],
+                    -T::from_f64(0.000000000000000000005082197683525802) * qd[3],
+                ),
+            ),
+        ]
+    }
     /// The gravitational potential energy V = -sum m g.c, zero with every centre of mass at the origin.
     ///
     /// Route: centres of mass by forward kinematics.

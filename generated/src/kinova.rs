@@ -2404,6 +2404,742 @@ impl<T: ::eomgen_runtime::Real> Kinova<T> {
         }
         Ok(qdd)
     }
+    /// The generalized momentum p = M(q) qd = dT/dqd (a momentum observer's measurement).
+    ///
+    /// Route: Newton-Euler at rest without gravity, with qd as the accelerations, O(N).
+    /// Operations: 198 mul, 216 add, 0 div, 5 sin, 5 cos.
+    pub fn generalized_momentum(&self, q: &[T; 6], qd: &[T; 6]) -> [T; 6] {
+        let (s1, c1) = q[1].sin_cos();
+        let (s2, c2) = q[2].sin_cos();
+        let (s3, c3) = q[3].sin_cos();
+        let (s4, c4) = q[4].sin_cos();
+        let (s5, c5) = q[5].sin_cos();
+        let (
+            t0,
+            t1,
+            t2,
+            t3,
+            t4,
+            t5,
+            t6,
+            t7,
+            t8,
+            t9,
+            t10,
+            t11,
+            t12,
+            t13,
+            t14,
+            t15,
+            t16,
+            t17,
+            t18,
+            t19,
+            t20,
+            t21,
+            t22,
+            t23,
+            t24,
+            t25,
+            t26,
+            t27,
+            t28,
+            t29,
+            t30,
+            t31,
+            t32,
+            t33,
+            t34,
+            t35,
+            t36,
+            t37,
+            t38,
+            t39,
+            t40,
+            t41,
+            t42,
+            t43,
+            t44,
+            t45,
+            t46,
+            t47,
+            t48,
+            t49,
+            t50,
+            t51,
+            t52,
+            t53,
+            t54,
+            t55,
+            t56,
+            t57,
+            t58,
+            t59,
+            t60,
+            t61,
+            t62,
+            t63,
+        ) = {
+            let t0 = s1;
+            let t1 = c1;
+            let t2 = s2;
+            let t3 = c2;
+            let t4 = s3;
+            let t5 = c3;
+            let t6 = s4;
+            let t7 = c4;
+            let t8 = s5;
+            let t9 = c5;
+            let t10 = qd[1] - qd[2];
+            let t11 = qd[0] * t0;
+            let t12 = qd[0] * t1;
+            let t13 = qd[0] * t0 * t3;
+            let t14 = qd[0] * t1 * t2;
+            let t15 = qd[0] * t0 * t2;
+            let t16 = qd[0] * t1 * t3;
+            let t17 = t5 * t10;
+            let t18 = t13 - t14;
+            let t19 = qd[3] + t15 + t16;
+            let t20 = T::mul_add(T::from_f64(0.0016), t12, T::from_f64(0.41) * qd[1]);
+            let t21 = t4 * t18;
+            let t22 = t7 * t19;
+            let t23 = t3 * t20;
+            let t24 = t2 * t20;
+            let t25 = T::mul_add(-T::from_f64(0.2073), t18, T::from_f64(0.41) * t11);
+            let t26 = T::mul_add(-t4, t10, t5 * t18);
+            let t27 = qd[4] + t21 + t17;
+            let t28 = T::mul_add(
+                T::from_f64(0.0114),
+                t16,
+                T::mul_add(
+                    T::from_f64(0.0098),
+                    t15,
+                    T::mul_add(T::from_f64(0.2073), t10, -t23),
+                ),
+            );
+            let t29 = T::mul_add(
+                -T::from_f64(0.0114),
+                t14,
+                T::mul_add(T::from_f64(0.0098), t13, t24),
+            );
+            let t30 = t4 * t25;
+            let t31 = t5 * t25;
+            let t32 = t6 * t26;
+            let t33 = t8 * t27;
+            let t34 = t9 * t27;
+            let t35 = t5 * t28;
+            let t36 = t4 * t28;
+            let t37 = t6 * t29;
+            let t38 = t7 * t29;
+            let t39 = T::mul_add(t6, t19, t7 * t26);
+            let t40 = T::mul_add(T::from_f64(0.10375), t21 + t17, t35 - t30);
+            let t41 = t9 * t39;
+            let t42 = t8 * t39;
+            let t43 = t7 * t40;
+            let t44 = t6 * t40;
+            let t45 = T::mul_add(T::from_f64(0.10375), t26 - t39, -t36 - t31);
+            let t46 = T::mul_add(T::from_f64(0.10375), t27, t37 - t43);
+            let t47 = t8 * t45;
+            let t48 = t9 * t45;
+            let t49 = T::mul_add(
+                -T::from_f64(1.493),
+                t44 + t38,
+                T::mul_add(
+                    T::from_f64(0.00010000000000000503),
+                    t34 - t42,
+                    T::mul_add(
+                        -T::from_f64(0.00000000000000000010842021724855044),
+                        t41 + t33,
+                        T::from_f64(0.0013224560195000002) * t39,
+                    ),
+                ),
+            );
+            let t50 = t9 * t46;
+            let t51 = t8 * t46;
+            let t52 = t6 * t49;
+            let t53 = t7 * t49;
+            let t54 = T::mul_add(
+                T::from_f64(1.03),
+                t50 + t47,
+                T::mul_add(
+                    T::from_f64(0.0650091026469637),
+                    t34 - t42,
+                    T::from_f64(0.00000000000000000010842021724855044)
+                        * (qd[5] + t32 - t22),
+                ),
+            );
+            let t55 = T::mul_add(
+                -T::from_f64(0.0650091026469637),
+                t50 + t47,
+                T::mul_add(
+                    T::from_f64(0.00010000000000000503),
+                    t44 + t38,
+                    T::mul_add(
+                        T::from_f64(0.004705147001603182),
+                        t42 - t34,
+                        T::mul_add(
+                            -T::from_f64(0.0000000000000006979729257032011),
+                            t41 + t33,
+                            T::from_f64(0.000000000000000000006709516445275485)
+                                * (qd[5] + t32 - t22),
+                        ),
+                    ),
+                ),
+            );
+            let t56 = T::mul_add(
+                T::from_f64(0.0650091026469637),
+                t51 - t48,
+                T::mul_add(
+                    T::from_f64(0.00000000000000000010842021724855044),
+                    t44 + t38,
+                    T::mul_add(
+                        T::from_f64(0.0000000000000006979729257032011),
+                        t34 - t42,
+                        T::mul_add(
+                            T::from_f64(0.004894691391055498),
+                            t41 + t33,
+                            T::from_f64(0.000014022756617410007) * (qd[5] + t32 - t22),
+                        ),
+                    ),
+                ),
+            );
+            let t57 = T::mul_add(
+                T::from_f64(1.03),
+                t51 - t48,
+                T::mul_add(
+                    T::from_f64(0.0650091026469637),
+                    t41 + t33,
+                    T::from_f64(0.00010000000000000503) * (qd[5] + t32 - t22),
+                ),
+            );
+            let t58 = T::mul_add(
+                T::from_f64(0.00010000000000000503),
+                t48 - t51,
+                T::mul_add(
+                    -T::from_f64(0.00000000000000000010842021724855044),
+                    t50 + t47,
+                    T::mul_add(
+                        T::from_f64(0.0013224560195000002),
+                        t37 - t43,
+                        T::mul_add(
+                            T::from_f64(0.000000000000000000006709516445275485),
+                            t34 - t42,
+                            T::mul_add(
+                                -T::from_f64(0.000014022756617410007),
+                                t41 + t33,
+                                T::mul_add(
+                                    T::from_f64(0.0008740216642230976),
+                                    t22 - t32,
+                                    T::mul_add(
+                                        -T::from_f64(0.0007776443641723163),
+                                        qd[5],
+                                        T::from_f64(0.00006575368432434527) * t27,
+                                    ),
+                                ),
+                            ),
+                        ),
+                    ),
+                ),
+            );
+            let t59 = t9 * t54;
+            let t60 = t8 * t57;
+            let t61 = t8 * t54;
+            let t62 = t9 * t57;
+            let t63 = t8 * t56;
+            (
+                t0,
+                t1,
+                t2,
+                t3,
+                t4,
+                t5,
+                t6,
+                t7,
+                t8,
+                t9,
+                t10,
+                t11,
+                t12,
+                t13,
+                t14,
+                t15,
+                t16,
+                t17,
+                t18,
+                t19,
+                t20,
+                t21,
+                t22,
+                t23,
+                t24,
+                t25,
+                t26,
+                t27,
+                t28,
+                t29,
+                t30,
+                t31,
+                t32,
+                t33,
+                t34,
+                t35,
+                t36,
+                t37,
+                t38,
+                t39,
+                t40,
+                t41,
+                t42,
+                t43,
+                t44,
+                t45,
+                t46,
+                t47,
+                t48,
+                t49,
+                t50,
+                t51,
+                t52,
+                t53,
+                t54,
+                t55,
+                t56,
+                t57,
+                t58,
+                t59,
+                t60,
+                t61,
+                t62,
+                t63,
+            )
+        };
+        let (
+            t64,
+            t65,
+            t66,
+            t67,
+            t68,
+            t69,
+            t70,
+            t71,
+            t72,
+            t73,
+            t74,
+            t75,
+            t76,
+            t77,
+            t78,
+            t79,
+            t80,
+            t81,
+            t82,
+            t83,
+            t84,
+            t85,
+            t86,
+            t87,
+        ) = {
+            let t64 = t9 * t55;
+            let t65 = t7 * t58;
+            let t66 = T::mul_add(
+                -t8,
+                t55,
+                T::mul_add(
+                    -t9,
+                    t56,
+                    T::mul_add(
+                        T::from_f64(0.10375),
+                        t61 - t62,
+                        T::mul_add(
+                            T::from_f64(0.0013224560195000002),
+                            t44 + t38,
+                            T::mul_add(
+                                -T::from_f64(0.0230207699865),
+                                t36 + t31,
+                                T::mul_add(
+                                    -T::from_f64(0.0015805219734713843),
+                                    t39,
+                                    T::from_f64(0.0023884048860993747) * t26,
+                                ),
+                            ),
+                        ),
+                    ),
+                ),
+            );
+            let t67 = T::mul_add(
+                T::from_f64(0.463),
+                t37 - t43,
+                T::mul_add(
+                    T::from_f64(0.0013224560195000002),
+                    t22 - t32,
+                    T::mul_add(T::from_f64(0.0230207699865), t27, t59 + t60),
+                ),
+            );
+            let t68 = T::mul_add(
+                -T::from_f64(0.926),
+                t36 + t31,
+                T::mul_add(
+                    -T::from_f64(0.0230207699865),
+                    t39,
+                    T::mul_add(T::from_f64(0.07312772998190001), t26, t61 - t62),
+                ),
+            );
+            let t69 = t7 * t67;
+            let t70 = t6 * t67;
+            let t71 = t6 * t66;
+            let t72 = t4 * t68;
+            let t73 = t5 * t68;
+            let t74 = T::mul_add(
+                T::from_f64(0.10375),
+                t59 + t60 - t69 - t52,
+                T::mul_add(
+                    T::from_f64(0.0230207699865),
+                    t37 - t43,
+                    T::mul_add(
+                        T::from_f64(0.0250914799819),
+                        t35 - t30,
+                        T::mul_add(
+                            T::from_f64(0.00006575368432434527),
+                            t22 - t32,
+                            T::mul_add(
+                                T::from_f64(0.0033686654092834286),
+                                t21 + t17,
+                                T::mul_add(
+                                    T::from_f64(0.0015767446734206029),
+                                    qd[4],
+                                    T::mul_add(
+                                        T::from_f64(0.00007238626506919941),
+                                        t19,
+                                        t63 - t64,
+                                    ),
+                                ),
+                            ),
+                        ),
+                    ),
+                ),
+            );
+            let t75 = T::mul_add(
+                -t6,
+                t58,
+                T::mul_add(
+                    -t7,
+                    t66,
+                    T::mul_add(
+                        T::from_f64(0.10375),
+                        t61 - t62,
+                        T::mul_add(
+                            -T::from_f64(0.07312772998190001),
+                            t36 + t31,
+                            T::mul_add(
+                                T::from_f64(0.0013357060146000001),
+                                t24,
+                                T::mul_add(
+                                    -T::from_f64(0.0023884048860993747),
+                                    t39,
+                                    T::mul_add(
+                                        T::from_f64(0.00677953504389725),
+                                        t26,
+                                        T::mul_add(
+                                            -T::from_f64(0.000015227048566440002),
+                                            t14,
+                                            T::from_f64(0.000013089918943080001) * t13,
+                                        ),
+                                    ),
+                                ),
+                            ),
+                        ),
+                    ),
+                ),
+            );
+            let t76 = T::mul_add(
+                T::from_f64(0.463),
+                t35 - t30,
+                T::mul_add(
+                    T::from_f64(0.0250914799819),
+                    t21 + t17,
+                    T::mul_add(T::from_f64(0.0013357060146000001), t19, -t69 - t52),
+                ),
+            );
+            let t77 = T::mul_add(
+                T::from_f64(1.1393),
+                t24,
+                T::mul_add(
+                    T::from_f64(0.0013357060146000001),
+                    t26,
+                    T::mul_add(
+                        -T::from_f64(0.011094380000000001),
+                        t14,
+                        T::mul_add(T::from_f64(0.0092715), t13, t70 - t53),
+                    ),
+                ),
+            );
+            let t78 = t5 * t76;
+            let t79 = t4 * t76;
+            let t80 = t4 * t75;
+            let t81 = t5 * t74;
+            let t82 = t2 * t77;
+            let t83 = T::mul_add(
+                -T::from_f64(0.6763),
+                t23,
+                T::mul_add(
+                    T::from_f64(0.00581618),
+                    t16,
+                    T::mul_add(
+                        T::from_f64(0.0047341),
+                        t15,
+                        T::mul_add(T::from_f64(0.054780300000000004), t10, t78 - t72),
+                    ),
+                ),
+            );
+            let t84 = T::mul_add(
+                -t4,
+                t74,
+                T::mul_add(
+                    -t5,
+                    t75,
+                    T::mul_add(
+                        -T::from_f64(0.2073),
+                        t79 + t73,
+                        T::mul_add(
+                            T::from_f64(0.0114),
+                            t53 - t70,
+                            T::mul_add(
+                                -T::from_f64(0.011094380000000001),
+                                t24,
+                                T::mul_add(
+                                    -T::from_f64(0.000015227048566440002),
+                                    t26,
+                                    T::mul_add(
+                                        T::from_f64(0.00596761924708),
+                                        t14,
+                                        T::mul_add(
+                                            -T::from_f64(0.005949868239079999),
+                                            t13,
+                                            T::from_f64(0.022459923) * t11,
+                                        ),
+                                    ),
+                                ),
+                            ),
+                        ),
+                    ),
+                ),
+            );
+            let t85 = T::mul_add(
+                T::from_f64(0.0114),
+                t78 - t72,
+                T::mul_add(
+                    T::from_f64(0.0013357060146000001),
+                    t35 - t30,
+                    T::mul_add(
+                        -T::from_f64(0.00581618),
+                        t23,
+                        T::mul_add(
+                            T::from_f64(0.00007238626506919941),
+                            t21 + t17,
+                            T::mul_add(
+                                T::from_f64(0.00045080751853442445),
+                                t16,
+                                T::mul_add(
+                                    T::from_f64(0.00044150163053442444),
+                                    t15,
+                                    T::mul_add(
+                                        T::from_f64(0.00009645337053442467),
+                                        qd[3],
+                                        T::mul_add(T::from_f64(0.00047111058), t10, t65 - t71),
+                                    ),
+                                ),
+                            ),
+                        ),
+                    ),
+                ),
+            );
+            let t86 = t3 * t83;
+            let t87 = T::mul_add(
+                t1,
+                T::mul_add(
+                    t3,
+                    t85,
+                    T::mul_add(
+                        t2,
+                        t84,
+                        T::mul_add(
+                            T::from_f64(0.0009068400000000028),
+                            t12,
+                            T::from_f64(0.00204435) * qd[1],
+                        ),
+                    ),
+                ),
+                T::mul_add(
+                    t0,
+                    T::mul_add(
+                        t2,
+                        t85,
+                        T::mul_add(
+                            -t3,
+                            t84,
+                            T::mul_add(
+                                -T::from_f64(0.41),
+                                t79 + t73,
+                                T::mul_add(
+                                    -T::from_f64(0.022459923),
+                                    t18,
+                                    T::from_f64(0.16651890549099999) * t11,
+                                ),
+                            ),
+                        ),
+                    ),
+                    T::mul_add(
+                        T::from_f64(0.0016),
+                        T::mul_add(
+                            t0,
+                            T::mul_add(
+                                -t3,
+                                t77,
+                                T::mul_add(
+                                    -t2,
+                                    t83,
+                                    T::from_f64(0.011484000000000001) * t11,
+                                ),
+                            ),
+                            t1
+                                * (T::mul_add(
+                                    T::from_f64(0.011484000000000001),
+                                    t12,
+                                    T::mul_add(
+                                        T::from_f64(0.20443499999999998),
+                                        qd[1],
+                                        t82 - t86,
+                                    ),
+                                )),
+                        ),
+                        T::from_f64(0.0006011508000000001) * qd[0],
+                    ),
+                ),
+            );
+            (
+                t64,
+                t65,
+                t66,
+                t67,
+                t68,
+                t69,
+                t70,
+                t71,
+                t72,
+                t73,
+                t74,
+                t75,
+                t76,
+                t77,
+                t78,
+                t79,
+                t80,
+                t81,
+                t82,
+                t83,
+                t84,
+                t85,
+                t86,
+                t87,
+            )
+        };
+        [
+            t87,
+            T::mul_add(
+                T::from_f64(0.41),
+                t82 - t86,
+                T::mul_add(
+                    T::from_f64(0.2073),
+                    t78 - t72,
+                    T::mul_add(
+                        -T::from_f64(0.054780300000000004),
+                        t23,
+                        T::mul_add(
+                            T::from_f64(0.00047111058),
+                            t16,
+                            T::mul_add(
+                                T::from_f64(0.00038346210000000003),
+                                t15,
+                                T::mul_add(
+                                    T::from_f64(0.0023714459999999997),
+                                    t12,
+                                    T::mul_add(
+                                        -T::from_f64(0.0058574286190799995),
+                                        qd[2],
+                                        T::mul_add(
+                                            T::from_f64(0.05857546411007999),
+                                            qd[1],
+                                            t81 - t80,
+                                        ),
+                                    ),
+                                ),
+                            ),
+                        ),
+                    ),
+                ),
+            ),
+            T::mul_add(
+                T::from_f64(0.2073),
+                t72 - t78,
+                T::mul_add(
+                    T::from_f64(0.054780300000000004),
+                    t23,
+                    T::mul_add(
+                        -T::from_f64(0.00047111058),
+                        t16,
+                        T::mul_add(
+                            -T::from_f64(0.00038346210000000003),
+                            t15,
+                            T::mul_add(
+                                -T::from_f64(0.0058574286190799995),
+                                t10,
+                                t80 - t81,
+                            ),
+                        ),
+                    ),
+                ),
+            ),
+            T::mul_add(
+                T::from_f64(0.0013357060146000001),
+                t35 - t30,
+                T::mul_add(
+                    T::from_f64(0.00007238626506919941),
+                    t21 + t17,
+                    T::mul_add(T::from_f64(0.00009645337053442467), t19, t65 - t71),
+                ),
+            ),
+            T::mul_add(
+                T::from_f64(0.10375),
+                t59 + t60,
+                T::mul_add(
+                    T::from_f64(0.0230207699865),
+                    t37 - t43,
+                    T::mul_add(
+                        T::from_f64(0.00006575368432434527),
+                        t22 - t32,
+                        T::mul_add(T::from_f64(0.0015767446734206029), t27, t63 - t64),
+                    ),
+                ),
+            ),
+            T::mul_add(
+                T::from_f64(0.00010000000000000503),
+                t51 - t48,
+                T::mul_add(
+                    T::from_f64(0.00000000000000000010842021724855044),
+                    t50 + t47,
+                    T::mul_add(
+                        T::from_f64(0.000000000000000000006709516445275485),
+                        t42 - t34,
+                        T::mul_add(
+                            T::from_f64(0.000014022756617410007),
+                            t41 + t33,
+                            T::from_f64(0.0007776443641723163) * (qd[5] + t32 - t22),
+                        ),
+                    ),
+                ),
+            ),
+        ]
+    }
     /// Craig's centrifugal matrix C(q): `b = B(q) [qd qd] + C(q) [qd^2]`.
     ///
     /// Route: second velocity derivatives of the Newton-Euler bias.

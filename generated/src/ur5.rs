@@ -1531,6 +1531,446 @@ impl<T: ::eomgen_runtime::Real> Ur5<T> {
         }
         Ok(qdd)
     }
+    /// The generalized momentum p = M(q) qd = dT/dqd (a momentum observer's measurement).
+    ///
+    /// Route: Newton-Euler at rest without gravity, with qd as the accelerations, O(N).
+    /// Operations: 139 mul, 118 add, 0 div, 5 sin, 5 cos.
+    pub fn generalized_momentum(&self, q: &[T; 6], qd: &[T; 6]) -> [T; 6] {
+        let (s1, c1) = q[1].sin_cos();
+        let (s2, c2) = q[2].sin_cos();
+        let (s3, c3) = q[3].sin_cos();
+        let (s4, c4) = q[4].sin_cos();
+        let (s5, c5) = q[5].sin_cos();
+        let (
+            t0,
+            t1,
+            t2,
+            t3,
+            t4,
+            t5,
+            t6,
+            t7,
+            t8,
+            t9,
+            t10,
+            t11,
+            t12,
+            t13,
+            t14,
+            t15,
+            t16,
+            t17,
+            t18,
+            t19,
+            t20,
+            t21,
+            t22,
+            t23,
+            t24,
+            t25,
+            t26,
+            t27,
+            t28,
+            t29,
+            t30,
+            t31,
+            t32,
+            t33,
+            t34,
+            t35,
+            t36,
+            t37,
+            t38,
+            t39,
+            t40,
+            t41,
+            t42,
+            t43,
+            t44,
+            t45,
+            t46,
+            t47,
+            t48,
+            t49,
+            t50,
+            t51,
+            t52,
+            t53,
+            t54,
+            t55,
+            t56,
+            t57,
+            t58,
+            t59,
+            t60,
+            t61,
+            t62,
+            t63,
+        ) = {
+            let t0 = s1;
+            let t1 = c1;
+            let t2 = s2;
+            let t3 = c2;
+            let t4 = s3;
+            let t5 = c3;
+            let t6 = s4;
+            let t7 = c4;
+            let t8 = s5;
+            let t9 = c5;
+            let t10 = qd[1] + qd[2] + qd[3];
+            let t11 = qd[0] * t1;
+            let t12 = qd[0] * t0;
+            let t13 = qd[0] * t1 * t3;
+            let t14 = qd[0] * t1 * t2;
+            let t15 = t7 * t10;
+            let t16 = T::mul_add(qd[0], t0 * t3, t14);
+            let t17 = T::mul_add(-qd[0], t0 * t2, t13);
+            let t18 = T::mul_add(
+                T::from_f64(0.016149999999999998),
+                t12,
+                T::from_f64(0.425) * qd[1],
+            );
+            let t19 = t5 * t17;
+            let t20 = t4 * t16;
+            let t21 = t3 * t18;
+            let t22 = t2 * t18;
+            let t23 = T::mul_add(T::from_f64(0.39225), t17, T::from_f64(0.425) * t11);
+            let t24 = T::mul_add(t5, t16, t4 * t17);
+            let t25 = qd[4] + t20 - t19;
+            let t26 = T::mul_add(
+                T::from_f64(0.016149999999999998),
+                t14,
+                T::mul_add(T::from_f64(0.39225), qd[1] + qd[2], t21),
+            );
+            let t27 = T::mul_add(T::from_f64(0.016149999999999998), t13, -t22);
+            let t28 = t6 * t23;
+            let t29 = t7 * t23;
+            let t30 = t6 * t24;
+            let t31 = t4 * t26;
+            let t32 = t5 * t27;
+            let t33 = t5 * t26;
+            let t34 = t4 * t27;
+            let t35 = T::mul_add(t6, t10, t7 * t24);
+            let t36 = T::mul_add(T::from_f64(0.093), t19 - t20, t32 - t31);
+            let t37 = T::mul_add(T::from_f64(0.093), t24, t33 + t34);
+            let t38 = t7 * t36;
+            let t39 = t6 * t36;
+            let t40 = T::from_f64(0.0171364731454) * (T::mul_add(-t8, t25, t9 * t35));
+            let t41 = T::from_f64(0.033822) * (T::mul_add(t9, t25, t8 * t35));
+            let t42 = T::mul_add(T::from_f64(0.09465), t30 - t15, -t38 - t28);
+            let t43 = T::mul_add(
+                T::from_f64(1.4069),
+                t39 - t29,
+                T::from_f64(0.017784735) * t35,
+            );
+            let t44 = t8 * t40;
+            let t45 = t9 * t41;
+            let t46 = t6 * t43;
+            let t47 = t7 * t43;
+            let t48 = T::from_f64(0.1879) * (T::mul_add(-t9, t37, t8 * t42));
+            let t49 = T::from_f64(0.1879) * (T::mul_add(t8, t37, t9 * t42));
+            let t50 = T::mul_add(
+                t8,
+                t41,
+                T::mul_add(
+                    t9,
+                    t40,
+                    T::mul_add(
+                        T::from_f64(0.017784735),
+                        t39 - t29,
+                        T::from_f64(0.11285608069875) * t35,
+                    ),
+                ),
+            );
+            let t51 = t9 * t49;
+            let t52 = t8 * t48;
+            let t53 = t8 * t49;
+            let t54 = t9 * t48;
+            let t55 = t6 * t50;
+            let t56 = T::mul_add(T::from_f64(1.219), t38 + t28, -t51 - t52);
+            let t57 = T::mul_add(
+                -T::from_f64(0.09465),
+                t51 + t52,
+                T::mul_add(
+                    T::from_f64(0.12830922867640002),
+                    t15 - t30,
+                    T::from_f64(0.0171364731454) * qd[5],
+                ),
+            );
+            let t58 = T::mul_add(
+                T::from_f64(2.438),
+                t33 + t34,
+                T::mul_add(T::from_f64(0.11336700000000001), t24, t53 - t54),
+            );
+            let t59 = t7 * t56;
+            let t60 = t6 * t56;
+            let t61 = t7 * t57;
+            let t62 = t5 * t58;
+            let t63 = T::mul_add(
+                -t6,
+                t57,
+                T::mul_add(
+                    t7,
+                    t50,
+                    T::mul_add(
+                        T::from_f64(0.093),
+                        t53 - t54,
+                        T::mul_add(
+                            T::from_f64(0.11336700000000001),
+                            t33 + t34,
+                            T::from_f64(0.121715886531) * t24,
+                        ),
+                    ),
+                ),
+            );
+            (
+                t0,
+                t1,
+                t2,
+                t3,
+                t4,
+                t5,
+                t6,
+                t7,
+                t8,
+                t9,
+                t10,
+                t11,
+                t12,
+                t13,
+                t14,
+                t15,
+                t16,
+                t17,
+                t18,
+                t19,
+                t20,
+                t21,
+                t22,
+                t23,
+                t24,
+                t25,
+                t26,
+                t27,
+                t28,
+                t29,
+                t30,
+                t31,
+                t32,
+                t33,
+                t34,
+                t35,
+                t36,
+                t37,
+                t38,
+                t39,
+                t40,
+                t41,
+                t42,
+                t43,
+                t44,
+                t45,
+                t46,
+                t47,
+                t48,
+                t49,
+                t50,
+                t51,
+                t52,
+                t53,
+                t54,
+                t55,
+                t56,
+                t57,
+                t58,
+                t59,
+                t60,
+                t61,
+                t62,
+                t63,
+            )
+        };
+        let (t64, t65, t66, t67, t68, t69, t70, t71, t72, t73, t74, t75) = {
+            let t64 = T::mul_add(
+                -T::from_f64(0.093),
+                t59 + t46,
+                T::mul_add(
+                    T::from_f64(0.43884),
+                    t20 - t19,
+                    T::mul_add(T::from_f64(0.21942), qd[4], t45 - t44),
+                ),
+            );
+            let t65 = T::mul_add(T::from_f64(1.219), t31 - t32, -t59 - t46);
+            let t66 = t4 * t65;
+            let t67 = T::mul_add(
+                T::from_f64(2.275),
+                t21,
+                T::mul_add(
+                    T::from_f64(0.036741249999999996),
+                    t14,
+                    T::mul_add(T::from_f64(0.56875), qd[1] + qd[2], t66 + t62),
+                ),
+            );
+            let t68 = T::mul_add(
+                -t5,
+                t64,
+                T::mul_add(
+                    t4,
+                    t63,
+                    T::mul_add(
+                        T::from_f64(0.39225),
+                        t60 - t47,
+                        T::mul_add(
+                            T::from_f64(0.37918622974349997),
+                            t17,
+                            T::from_f64(0.44493366875) * t11,
+                        ),
+                    ),
+                ),
+            );
+            let t69 = T::mul_add(
+                t4,
+                t64,
+                T::mul_add(t5, t63, T::from_f64(0.004095) * t16),
+            );
+            let t70 = T::mul_add(
+                t4,
+                t58,
+                T::mul_add(
+                    -t5,
+                    t65,
+                    T::mul_add(
+                        -T::from_f64(2.275),
+                        t22,
+                        T::from_f64(0.036741249999999996) * t13,
+                    ),
+                ),
+            );
+            let t71 = t3 * t67;
+            let t72 = t2 * t70;
+            let t73 = t2 * t67;
+            let t74 = t3 * t70;
+            let t75 = T::mul_add(
+                t0,
+                T::mul_add(
+                    t3,
+                    t69,
+                    T::mul_add(
+                        -t2,
+                        t68,
+                        T::mul_add(
+                            T::from_f64(0.1197),
+                            t72 - t71,
+                            T::from_f64(0.0151074) * t12,
+                        ),
+                    ),
+                ),
+                T::mul_add(
+                    t1,
+                    T::mul_add(
+                        t2,
+                        t69,
+                        T::mul_add(
+                            t3,
+                            t68,
+                            T::mul_add(
+                                -T::from_f64(0.1197),
+                                t73 + t74,
+                                T::mul_add(
+                                    T::from_f64(0.425),
+                                    t60 - t47,
+                                    T::mul_add(
+                                        T::from_f64(0.44493366875),
+                                        t17,
+                                        T::from_f64(1.51600562591) * t11,
+                                    ),
+                                ),
+                            ),
+                        ),
+                    ),
+                    T::mul_add(
+                        T::from_f64(0.13585),
+                        T::mul_add(
+                            t1,
+                            T::mul_add(T::from_f64(1.14018905), t11, t73 + t74),
+                            t0
+                                * (T::mul_add(
+                                    T::from_f64(1.14018905),
+                                    t12,
+                                    T::mul_add(
+                                        T::from_f64(2.3500400000000004),
+                                        qd[1],
+                                        t71 - t72,
+                                    ),
+                                )),
+                        ),
+                        T::from_f64(0.00666) * qd[0],
+                    ),
+                ),
+            );
+            (t64, t65, t66, t67, t68, t69, t70, t71, t72, t73, t74, t75)
+        };
+        [
+            t75,
+            T::mul_add(
+                T::from_f64(0.425),
+                t71 - t72,
+                T::mul_add(
+                    T::from_f64(0.39225),
+                    t66 + t62,
+                    T::mul_add(
+                        T::from_f64(0.56875),
+                        t21,
+                        T::mul_add(
+                            T::from_f64(0.009185312499999999),
+                            t14,
+                            T::mul_add(
+                                T::from_f64(0.31925293400000004),
+                                t12,
+                                T::mul_add(
+                                    T::from_f64(0.111172755531),
+                                    qd[3],
+                                    T::mul_add(
+                                        T::from_f64(0.302803569087),
+                                        qd[2],
+                                        T::mul_add(
+                                            T::from_f64(1.1877054449970001),
+                                            qd[1],
+                                            t55 + t61,
+                                        ),
+                                    ),
+                                ),
+                            ),
+                        ),
+                    ),
+                ),
+            ),
+            T::mul_add(
+                T::from_f64(0.39225),
+                t66 + t62,
+                T::mul_add(
+                    T::from_f64(0.56875),
+                    t21,
+                    T::mul_add(
+                        T::from_f64(0.009185312499999999),
+                        t14,
+                        T::mul_add(
+                            T::from_f64(0.111172755531),
+                            qd[3],
+                            T::mul_add(
+                                T::from_f64(0.302803569087),
+                                qd[1] + qd[2],
+                                t55 + t61,
+                            ),
+                        ),
+                    ),
+                ),
+            ),
+            T::mul_add(T::from_f64(0.111172755531), t10, t55 + t61),
+            T::mul_add(T::from_f64(0.21942), t25, t45 - t44),
+            T::from_f64(0.0171364731454) * (qd[5] + t15 - t30),
+        ]
+    }
     /// Craig's centrifugal matrix C(q): `b = B(q) [qd qd] + C(q) [qd^2]`.
     ///
     /// Route: second velocity derivatives of the Newton-Euler bias.

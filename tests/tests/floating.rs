@@ -18,6 +18,10 @@ fn elementwise(ours: &[f64], reference: &[f64]) -> f64 {
         .fold(0.0, f64::max)
 }
 
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
 macro_rules! check_floating {
     ($name:literal, $module:ident, $ty:ident, $link:ident, $nq:literal, $nv:literal $(, $extra:ident)?) => {{
         let doc = reference(&format!("{}.json", $name));
@@ -44,6 +48,8 @@ macro_rules! check_floating {
             note("coriolis_matrix", elementwise(&flat(&r.coriolis_matrix(&q, &v)), &pick(&s["coriolis_matrix"], &o.v, &o.v)));
             note("forward_dynamics", normwise(&r.forward_dynamics(&q, &v, &tau_in), &rv("forward_dynamics")));
             note("kinetic_energy", elementwise(&[r.kinetic_energy(&q, &v)], &re("kinetic_energy")));
+            let momentum: Vec<f64> = o.v.iter().map(|&i| dot(&numbers(&s["mass_matrix"][i]), &re("v"))).collect();
+            note("generalized_momentum", elementwise(&r.generalized_momentum(&q, &v), &momentum));
             note("potential_energy", elementwise(&[r.potential_energy(&q)], &re("potential_energy")));
             note("com", elementwise(&r.center_of_mass(&q), &re("com")));
             note("com_jacobian", elementwise(&flat(&r.center_of_mass_jacobian(&q)), &pick(&s["com_jacobian"], &all3, &o.v)));
@@ -64,7 +70,7 @@ macro_rules! check_floating {
             };
             assert!(*e <= limit, "{}: {what} off by {e:e}", $name);
         }
-        assert!(worst.len() >= 11, "{}: only {} quantities checked", $name, worst.len());
+        assert!(worst.len() >= 12, "{}: only {} quantities checked", $name, worst.len());
     }};
 }
 

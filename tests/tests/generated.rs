@@ -63,6 +63,14 @@ macro_rules! check_robot {
                 f(robot.kinetic_energy(&q, &qd)),
                 sm.kinetic_energy,
             );
+            // p = M qd (Pinocchio's M), and qd . p = 2 T.
+            let p = robot.generalized_momentum(&q, &qd);
+            for i in 0..$n {
+                let want: f64 = (0..$n).map(|j| sm.mass_matrix[i][j] * sm.qd[j]).sum();
+                c.check(|| format!("#{s} p[{i}]"), f(p[o[i]]), want);
+            }
+            let qd_p: f64 = (0..$n).map(|i| f(qd[i]) * f(p[i])).sum();
+            c.check(|| format!("#{s} qd.p"), qd_p, 2.0 * sm.kinetic_energy);
             c.check(
                 || format!("#{s} V"),
                 f(robot.potential_energy(&q)),

@@ -12,10 +12,93 @@
 //!   `C(q, qd)_ij = sum_k G_ijk qd_k` (so that `dM/dt - 2 C(q, qd)` is skew-symmetric) and the
 //!   bias `b = C(q, qd) qd`.
 
+use super::{Clock, CoordinateMap, Coordinates};
 use crate::cas::{Graph, GraphFull, Id};
-use crate::kinematics::{joint, BodyKinematics, Params, WorldKinematics};
+use crate::kinematics::{const_v3, joint, BodyKinematics, Params, WorldKinematics};
 use crate::model::Model;
 use crate::spatial::{cross, mat_vec, vec_add, V3};
+
+/// Every quantity in closed form, a candidate route wherever the velocities are the rates of the
+/// positions (no floating base or floating joint): the reference for the reports.
+pub(super) struct Closed {
+    /// `M(q)`, in the coordinates (projected when joints are coupled).
+    pub mass_matrix: Vec<Vec<Id>>,
+    pub energies: Energies,
+    pub christoffel: Christoffel,
+    /// `tau = M qdd + b + G + F(qd)`.
+    pub tau: Vec<Id>,
+}
+
+impl Closed {
+    /// `M` from body Jacobians, the energies and `G = dV/dq`, the Christoffel symbols and
+    /// `tau` (with the `friction` effort), each stage timed on `clock`.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn derive(
+        g: &mut Graph,
+        model: &Model,
+        params: &Params,
+        map: &CoordinateMap,
+        c: &Coordinates,
+        world: &WorldKinematics,
+        friction: &Friction,
+        clock: &mut Clock,
+    ) -> Result<Closed, GraphFull> {
+        let body = BodyKinematics::new(g, model, params, &c.joint_q);
+        g.check()?;
+        clock.lap("kinematics");
+        let joint_mass_matrix = mass_matrix(g, model, params, &body)?;
+        let mass_matrix = map.project_matrix(g, &joint_mass_matrix, true);
+        clock.lap("mass matrix");
+        let grav = const_v3(g, &model.gravity);
+        let energies = energies(g, params, world, &grav, &mass_matrix, &c.q, &c.qd);
+        g.check()?;
+        clock.lap("energies and gravity");
+        let christoffel = christoffel(g, &mass_matrix, &c.q, &c.qd)?;
+        clock.lap("Christoffel symbols");
+        let tau = (0..c.q.len())
+            .map(|i| {
+                let mq = g.dot(&mass_matrix[i], &c.qdd);
+                let (b, gr, f) = (
+                    christoffel.bias[i],
+                    energies.gravity[i],
+                    friction.projected[i],
+                );
+                g.add_all([mq, b, gr, f])
+            })
+            .collect();
+        Ok(Closed {
+            mass_matrix,
+            energies,
+            christoffel,
+            tau,
+        })
+    }
+}
+
+/// The joint friction effort `F(qd)` (zero for a floating base's and floating joints'
+/// coordinates), per joint and in the coordinates.
+pub(super) struct Friction {
+    /// Per velocity coordinate of the joint tree.
+    pub joint: Vec<Id>,
+    /// Projected on the coordinates (the same without coupled joints).
+    pub projected: Vec<Id>,
+}
+
+impl Friction {
+    pub(super) fn new(
+        g: &mut Graph,
+        model: &Model,
+        params: &Params,
+        map: &CoordinateMap,
+        joint_qd: &[Id],
+    ) -> Friction {
+        let base = model.base_nv();
+        let mut joint = vec![g.zero(); base];
+        joint.extend(joint_friction(g, model, params, &joint_qd[base..]));
+        let projected = map.project(g, &joint);
+        Friction { joint, projected }
+    }
+}
 
 /// The pairs `(j, k)`, `j < k`, in Craig's order.
 pub fn pairs(n: usize) -> Vec<(usize, usize)> {

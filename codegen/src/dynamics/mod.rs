@@ -2,7 +2,9 @@
 //! and the [`catalogue`] of what generated code evaluates.
 //!
 //! - `lagrangian`: the closed forms (`M` from body Jacobians, `G = dV/dq`, Christoffel
-//!   symbols), readable and the reference for the reports;
+//!   symbols), readable and the reference for the reports, where the velocities are the rates
+//!   of the positions (no floating base or floating joint: there every quantity takes the
+//!   recursive route, in the same derivation);
 //! - [`newton_euler`]: the customized recursive algorithms (Newton-Euler, composite rigid
 //!   bodies, Echeandia and Wensing's Coriolis matrix), far fewer operations;
 //! - the fast forms ([`Fast`]): per quantity, whichever route needs fewer operations;
@@ -18,7 +20,7 @@ mod centroidal;
 mod contact_derivatives;
 pub mod coupling;
 mod derivatives;
-mod floating;
+mod fast;
 pub mod identification;
 mod lagrangian;
 mod mpc;
@@ -30,13 +32,15 @@ pub mod rnea_derivatives;
 
 use std::time::{Duration, Instant};
 
-use crate::cas::{Graph, GraphFull, Id, Limits, Program};
-use crate::kinematics::{const_v3, BodyKinematics, Params, WorldKinematics, M3, V3};
+use crate::cas::{Graph, GraphFull, Id, Limits};
+use crate::kinematics::{const_v3, Params, WorldKinematics, M3, V3};
 use crate::model::Model;
+use lagrangian::{Closed, Friction};
 
 pub use catalogue::{ActiveContacts, Craig, Evaluation, Home, Input, Quantity, Shape};
 pub use centroidal::Centroidal;
 pub use coupling::CoordinateMap;
+pub use fast::{Fast, Route, CLOSED_FORM_MAX_DEPTH, CRAIG_FLAT_MAX_ENTRIES};
 pub use identification::Identification;
 pub use lagrangian::pairs;
 pub use mpc::{FrameMotion, Manifold};
@@ -157,70 +161,6 @@ impl Recursive {
     }
 }
 
-/// Which derivation a fast form comes from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Route {
-    /// The closed-form Lagrangian expressions.
-    Lagrangian,
-    /// Newton-Euler or the composite-rigid-body algorithm.
-    Recursive,
-}
-
-impl Route {
-    /// A short description for documentation.
-    pub fn describe(self, recursive: &str) -> String {
-        match self {
-            Route::Lagrangian => "closed-form Lagrangian expressions".to_string(),
-            Route::Recursive => recursive.to_string(),
-        }
-    }
-}
-
-/// The forms generated code evaluates: per quantity, whichever route needs fewer operations.
-#[derive(Clone, Debug)]
-pub struct Fast {
-    pub mass_matrix: (Route, Vec<Vec<Id>>),
-    pub gravity: (Route, Vec<Id>),
-    pub bias: (Route, Vec<Id>),
-    pub tau: (Route, Vec<Id>),
-    /// `C(q, qd)`: Christoffel symbols, or Echeandia and Wensing's `O(N^2)` recursion.
-    pub coriolis_matrix: (Route, Vec<Vec<Id>>),
-    /// Craig's `C(q)` as flattened expressions (Christoffel symbols, or
-    /// `1/2 d^2 b_i / dqd_j^2`), for robots whose `B(q)` has at most [`CRAIG_FLAT_MAX_ENTRIES`] entries; larger
-    /// robots evaluate it from the columns of `C(q, qd)` ([`Evaluation::CraigColumns`]).
-    pub centrifugal: Option<(Route, Vec<Vec<Id>>)>,
-    /// Craig's `B(q)` likewise (Christoffel symbols, or `d^2 b_i / dqd_j dqd_k`).
-    pub coriolis_pairs: Option<(Route, Vec<Vec<Id>>)>,
-    pub kinetic_energy: Id,
-    /// Whether `kinetic_energy` is `qd^T M qd / 2` or the sum over body velocities.
-    pub kinetic_energy_route: Route,
-    /// Joint efforts as symbols `tau_i` (inputs of forward dynamics).
-    pub tau_in: Vec<Id>,
-    /// `h = b + G + F(qd)`, the right-hand side's part that forward dynamics subtracts.
-    pub bias_gravity_friction: Vec<Id>,
-    /// `qdd = M^-1 (tau_in - b - G - F)`, with an unrolled sparse `L^T D L` solve.
-    pub forward_dynamics: Vec<Id>,
-    /// The pivots `D` of that factorization, all positive when `M` is positive definite.
-    pub pivots: Vec<Id>,
-}
-
-/// Robots whose Craig's `B(q)` has more entries than this (`N^2 (N-1) / 2`; 16 joints have
-/// 1,920) never get flattened Craig forms: even when most entries are zero, each is code.
-pub const CRAIG_FLAT_MAX_ENTRIES: usize = 2000;
-
-/// Robots with a chain of more joints than this take the recursive route for `b`, `tau` and
-/// `C(q, qd)` without comparing it with the Christoffel forms.
-pub const CLOSED_FORM_MAX_DEPTH: usize = 12;
-
-fn cheaper<T: Clone>(g: &Graph, a: &T, b: &T, ids: impl Fn(&T) -> Vec<Id>) -> (Route, T) {
-    let cost = |x: &T| Program::new(g, &ids(x)).ops().total();
-    if cost(b) < cost(a) {
-        (Route::Recursive, b.clone())
-    } else {
-        (Route::Lagrangian, a.clone())
-    }
-}
-
 fn flat(m: &[Vec<Id>]) -> Vec<Id> {
     m.iter().flatten().copied().collect()
 }
@@ -246,15 +186,85 @@ impl Clock {
     }
 }
 
-/// The closed-form results the fast forms choose from.
-struct Closed<'a> {
-    mass_matrix: &'a [Vec<Id>],
-    gravity: &'a [Id],
-    bias: &'a [Id],
-    tau: &'a [Id],
-    coriolis_matrix: &'a [Vec<Id>],
-    centrifugal: &'a [Vec<Id>],
-    coriolis_pairs: &'a [Vec<Id>],
+/// The coordinates' symbols, and the joints' coordinates as expressions of them (the same
+/// symbols unless mimic joints follow others: see `coupling`).
+struct Coordinates {
+    q: Vec<Id>,
+    qd: Vec<Id>,
+    qdd: Vec<Id>,
+    joint_q: Vec<Id>,
+    joint_qd: Vec<Id>,
+    joint_qdd: Vec<Id>,
+}
+
+impl Coordinates {
+    fn new(g: &mut Graph, map: &CoordinateMap) -> Coordinates {
+        let (nq, nv) = (map.positions_len(), map.coordinates());
+        let q: Vec<Id> = (0..nq).map(|i| g.q(i)).collect();
+        let qd: Vec<Id> = (0..nv).map(|i| g.qd(i)).collect();
+        let qdd: Vec<Id> = (0..nv).map(|i| g.qdd(i)).collect();
+        let (joint_q, joint_qd, joint_qdd) =
+            (map.positions(g, &q), map.rates(g, &qd), map.rates(g, &qdd));
+        Coordinates {
+            q,
+            qd,
+            qdd,
+            joint_q,
+            joint_qd,
+            joint_qdd,
+        }
+    }
+}
+
+/// The forms [`Derivation`] shows people: the closed Lagrangian forms where there are any,
+/// else the recursive ones (a floating base or floating joints: no Craig's matrices).
+struct Forms {
+    mass_matrix: Vec<Vec<Id>>,
+    gravity: Vec<Id>,
+    centrifugal: Vec<Vec<Id>>,
+    coriolis_pairs: Vec<Vec<Id>>,
+    coriolis_matrix: Vec<Vec<Id>>,
+    bias: Vec<Id>,
+    tau: Vec<Id>,
+    kinetic_energy: Id,
+    potential_energy: Id,
+}
+
+impl Forms {
+    fn new(
+        g: &mut Graph,
+        closed: Option<Closed>,
+        rec: &Recursive,
+        centroidal: &Centroidal,
+        grav: V3,
+    ) -> Forms {
+        if let Some(c) = closed {
+            return Forms {
+                mass_matrix: c.mass_matrix,
+                gravity: c.energies.gravity,
+                centrifugal: c.christoffel.centrifugal,
+                coriolis_pairs: c.christoffel.coriolis_pairs,
+                coriolis_matrix: c.christoffel.coriolis_matrix,
+                bias: c.christoffel.bias,
+                tau: c.tau,
+                kinetic_energy: c.energies.kinetic_energy,
+                potential_energy: c.energies.potential_energy,
+            };
+        }
+        // V = -sum m g.c
+        let gc = g.dot(&grav, &centroidal.first_moment);
+        Forms {
+            mass_matrix: rec.mass_matrix.clone(),
+            gravity: rec.gravity.clone(),
+            centrifugal: Vec::new(),
+            coriolis_pairs: Vec::new(),
+            coriolis_matrix: rec.coriolis_matrix.clone(),
+            bias: rec.bias.clone(),
+            tau: rec.tau.clone(),
+            kinetic_energy: rec.kinetic_energy,
+            potential_energy: g.neg(gc),
+        }
+    }
 }
 
 impl Derivation {
@@ -272,104 +282,78 @@ impl Derivation {
     /// the graph is full (checked after every stage and every joint's step within a stage, so
     /// that a robot too large for the limit costs little time and at most the limit's memory).
     pub fn try_new(model: &Model, limits: Limits) -> Result<Derivation, GraphFull> {
-        if !model.velocities_are_rates() {
-            return floating::derive(model, limits);
-        }
         let mut clock = Clock::new();
         let mut g = Graph::with_limits(limits);
-        // The coordinates' symbols, and the joints' coordinates as expressions of them (the
-        // same symbols unless mimic joints follow others: see `coupling`).
         let map = CoordinateMap::new(model);
-        let n = map.coordinates();
-        let q: Vec<Id> = (0..n).map(|i| g.q(i)).collect();
-        let qd: Vec<Id> = (0..n).map(|i| g.qd(i)).collect();
-        let qdd: Vec<Id> = (0..n).map(|i| g.qdd(i)).collect();
-        let (joint_q, joint_qd, joint_qdd) = (
-            map.positions(&mut g, &q),
-            map.rates(&mut g, &qd),
-            map.rates(&mut g, &qdd),
-        );
+        let c = Coordinates::new(&mut g, &map);
         let params = Params::new(&mut g, model);
-        let world = WorldKinematics::new(&mut g, model, &params, &joint_q);
+        let world = WorldKinematics::new(&mut g, model, &params, &c.joint_q);
+        let friction = Friction::new(&mut g, model, &params, &map, &c.joint_qd);
         g.check()?;
-        let body = BodyKinematics::new(&mut g, model, &params, &joint_q);
-        g.check()?;
-        clock.lap("kinematics");
-
-        let joint_mass_matrix = lagrangian::mass_matrix(&mut g, model, &params, &body)?;
-        let mass_matrix = map.project_matrix(&mut g, &joint_mass_matrix, true);
-        clock.lap("mass matrix");
-        let grav = const_v3(&mut g, &model.gravity);
-        let en = lagrangian::energies(&mut g, &params, &world, &grav, &mass_matrix, &q, &qd);
-        g.check()?;
-        clock.lap("energies and gravity");
-        let ch = lagrangian::christoffel(&mut g, &mass_matrix, &q, &qd)?;
-        clock.lap("Christoffel symbols");
-        let joint_friction = lagrangian::joint_friction(&mut g, model, &params, &joint_qd);
-        let friction = map.project(&mut g, &joint_friction);
-        let tau: Vec<Id> = (0..n)
-            .map(|i| {
-                let mq = g.dot(&mass_matrix[i], &qdd);
-                g.add_all([mq, ch.bias[i], en.gravity[i], friction[i]])
-            })
-            .collect();
-
-        let lm = newton_euler::LocalModel::new(&mut g, model, &params, &joint_q);
-        g.check()?;
-        let joint_recursive = recursive(&mut g, &lm, grav, &joint_qd, &joint_qdd, &joint_friction)?;
-        let recursive = joint_recursive.projected(&mut g, &map);
-        clock.lap("recursive algorithms");
-        let closed = Closed {
-            mass_matrix: &mass_matrix,
-            gravity: &en.gravity,
-            bias: &ch.bias,
-            tau: &tau,
-            coriolis_matrix: &ch.coriolis_matrix,
-            centrifugal: &ch.centrifugal,
-            coriolis_pairs: &ch.coriolis_pairs,
+        // The closed Lagrangian forms are a candidate route only where the velocities are the
+        // rates of the positions (not with a floating base's or floating joint's quaternion).
+        let closed = match model.velocities_are_rates() {
+            true => Some(Closed::derive(
+                &mut g, model, &params, &map, &c, &world, &friction, &mut clock,
+            )?),
+            false => None,
         };
-        let coordinate_parents = map.parents(model, lm.coordinate_parents());
-        let fast = fast_forms(
+        let lm = newton_euler::LocalModel::new(&mut g, model, &params, &c.joint_q);
+        g.check()?;
+        if closed.is_none() {
+            clock.lap("kinematics");
+        }
+        let grav = const_v3(&mut g, &model.gravity);
+        let joint_rec = recursive(
             &mut g,
-            model,
-            &closed,
-            &recursive,
-            &friction,
-            &qd,
-            &coordinate_parents,
+            &lm,
+            grav,
+            &c.joint_qd,
+            &c.joint_qdd,
+            &friction.joint,
         )?;
+        // A floating base's centroidal quantities come from the base's rows of the joint tree's M.
+        let joint_mass_matrix = joint_rec.mass_matrix.clone();
+        let rec = joint_rec.projected(&mut g, &map);
+        clock.lap("recursive algorithms");
+        let coordinate_parents = map.parents(model, lm.coordinate_parents());
+        let (qd, parents) = (&c.qd, &coordinate_parents);
+        let f = &friction.projected;
+        let fast = fast::fast_forms(&mut g, model, closed.as_ref(), &rec, f, qd, parents)?;
         clock.lap("fast forms");
-        let joint_transforms = (0..model.dof())
+        let m = &joint_mass_matrix;
+        let centroidal = Centroidal::new(&mut g, model, &lm, &world, &c.joint_qd, m);
+        let centroidal = centroidal.projected(&mut g, &map);
+        g.check()?;
+        let forms = Forms::new(&mut g, closed, &rec, &centroidal, grav);
+        let joint_transforms = (0..lm.bodies())
             .map(|i| JointTransform {
                 rotation: lm.rotation[i],
                 translation: lm.translation[i],
             })
             .collect();
-        let centroidal = Centroidal::new(&mut g, model, &lm, &world, &joint_qd, &[]);
-        let centroidal = centroidal.projected(&mut g, &map);
-        g.check()?;
         let d = Derivation {
             graph: g,
-            dof: n,
-            nq: n,
-            q,
-            qd,
-            qdd,
+            dof: c.qd.len(),
+            nq: c.q.len(),
+            q: c.q,
+            qd: c.qd,
+            qdd: c.qdd,
             params: params.symbols,
-            mass_matrix,
-            gravity: en.gravity,
-            centrifugal: ch.centrifugal,
-            coriolis_pairs: ch.coriolis_pairs,
-            coriolis_matrix: ch.coriolis_matrix,
-            bias: ch.bias,
-            tau,
-            friction,
-            kinetic_energy: en.kinetic_energy,
-            potential_energy: en.potential_energy,
+            mass_matrix: forms.mass_matrix,
+            gravity: forms.gravity,
+            centrifugal: forms.centrifugal,
+            coriolis_pairs: forms.coriolis_pairs,
+            coriolis_matrix: forms.coriolis_matrix,
+            bias: forms.bias,
+            tau: forms.tau,
+            friction: friction.projected,
+            kinetic_energy: forms.kinetic_energy,
+            potential_energy: forms.potential_energy,
             joint_transforms,
             coordinate_parents,
             centroidal,
-            recursive,
+            recursive: rec,
             fast,
             quantities: Vec::new(),
             identification: None,
@@ -464,7 +448,7 @@ impl Derivation {
 
 /// `d` with its catalogue and the stage timings.
 fn finish(mut d: Derivation, model: &Model, mut clock: Clock) -> Derivation {
-    d.quantities = quantities::catalogue(model, &d);
+    d.quantities = quantities::catalogue(model, &mut d);
     mpc::add(&mut d, model);
     clock.lap("catalogue");
     d.timings = clock.laps;
@@ -511,120 +495,4 @@ fn recursive(
         coriolis_matrix,
         kinetic_energy,
     })
-}
-
-/// Per quantity the cheaper route, forward dynamics by an unrolled `L^T D L` solve on the
-/// cheaper `M`, and (for small robots) flattened Craig forms.
-fn fast_forms(
-    g: &mut Graph,
-    model: &Model,
-    closed: &Closed<'_>,
-    rec: &Recursive,
-    friction: &[Id],
-    qd: &[Id],
-    parents: &[Option<usize>],
-) -> Result<Fast, GraphFull> {
-    let n = qd.len();
-    let vec = |v: &Vec<Id>| v.clone();
-    let fl = |m: &Vec<Vec<Id>>| flat(m);
-    let mm = cheaper(g, &closed.mass_matrix.to_vec(), &rec.mass_matrix, fl);
-    let gr = cheaper(g, &closed.gravity.to_vec(), &rec.gravity, vec);
-    // On chains longer than a dozen joints the Christoffel forms of b, tau and C(q, qd) are
-    // never the cheaper ones, and merely costing them (scheduling millions of nodes) took most
-    // of a 64-joint chain's generation time. (A branched hand of short fingers keeps them.)
-    let depth = (0..model.dof())
-        .map(|i| model.path_to_root(i).len())
-        .max()
-        .unwrap_or(0);
-    let small = depth <= CLOSED_FORM_MAX_DEPTH;
-    let choose = |g: &Graph, closed: &[Id], recursive: &Vec<Id>| {
-        if small {
-            cheaper(g, &closed.to_vec(), recursive, vec)
-        } else {
-            (Route::Recursive, recursive.clone())
-        }
-    };
-    let bi = choose(g, closed.bias, &rec.bias);
-    let tq = choose(g, closed.tau, &rec.tau);
-    // h = b + G: one recursion, or the sum of the cheaper closed forms.
-    let lag_h: Vec<Id> = (0..n).map(|i| g.add(bi.1[i], gr.1[i])).collect();
-    let (_, h) = cheaper(g, &lag_h, &rec.bias_and_gravity, vec);
-    let h: Vec<Id> = (0..n).map(|i| g.add(h[i], friction[i])).collect();
-    let tau_in: Vec<Id> = (0..n).map(|i| g.tau(i)).collect();
-    let rhs: Vec<Id> = (0..n).map(|i| g.sub(tau_in[i], h[i])).collect();
-    let (forward_dynamics, pivots) = newton_euler::ltdl_solve(g, parents, &mm.1, &rhs);
-    let cm = if small {
-        cheaper(
-            g,
-            &closed.coriolis_matrix.to_vec(),
-            &rec.coriolis_matrix,
-            fl,
-        )
-    } else {
-        (Route::Recursive, rec.coriolis_matrix.clone())
-    };
-    let (centrifugal, coriolis_pairs) = if n * n * n.saturating_sub(1) / 2 <= CRAIG_FLAT_MAX_ENTRIES
-    {
-        let (cf, cp) = craig_from_bias(g, &rec.bias, qd)?;
-        (
-            Some(cheaper(g, &closed.centrifugal.to_vec(), &cf, fl)),
-            Some(cheaper(g, &closed.coriolis_pairs.to_vec(), &cp, fl)),
-        )
-    } else {
-        (None, None)
-    };
-    let quadratic = lagrangian::quadratic_form(g, &mm.1, qd);
-    let (kinetic_energy_route, ke) = cheaper(g, &vec![quadratic], &vec![rec.kinetic_energy], vec);
-    let kinetic_energy = ke[0];
-    g.check()?;
-    Ok(Fast {
-        mass_matrix: mm,
-        gravity: gr,
-        bias: bi,
-        tau: tq,
-        coriolis_matrix: cm,
-        centrifugal,
-        coriolis_pairs,
-        kinetic_energy,
-        kinetic_energy_route,
-        tau_in,
-        bias_gravity_friction: h,
-        forward_dynamics,
-        pivots,
-    })
-}
-
-/// Craig's `C(q)` and `B(q)` from second velocity derivatives of the Newton-Euler bias (`b` is
-/// quadratic in `qd`): `C_ij = 1/2 d^2 b_i / dqd_j^2`, `B_i,(jk) = d^2 b_i / dqd_j dqd_k`.
-#[allow(clippy::type_complexity)]
-fn craig_from_bias(
-    g: &mut Graph,
-    bias: &[Id],
-    qd: &[Id],
-) -> Result<(Vec<Vec<Id>>, Vec<Vec<Id>>), GraphFull> {
-    let n = qd.len();
-    let mut db: Vec<Vec<Id>> = Vec::with_capacity(n);
-    for j in 0..n {
-        db.push(g.diff_many(bias, qd[j]));
-        g.check()?;
-    }
-    // d2[k][j][i] = d^2 b_i / dqd_j dqd_k, one memoized pass per k over every first derivative.
-    let db_flat: Vec<Id> = db.iter().flatten().copied().collect();
-    let mut d2: Vec<Vec<Id>> = Vec::with_capacity(n);
-    for k in 0..n {
-        d2.push(g.diff_many(&db_flat, qd[k]));
-        g.check()?;
-    }
-    let second = |k: usize, j: usize, i: usize| d2[k][j * n + i];
-    let mut cf = vec![vec![g.zero(); n]; n];
-    let mut cp = vec![Vec::new(); n];
-    for i in 0..n {
-        for j in 0..n {
-            cf[i][j] = g.scale(second(j, j, i), 0.5);
-        }
-        for &(j, k) in &pairs(n) {
-            cp[i].push(second(k, j, i));
-        }
-    }
-    Ok((cf, cp))
 }

@@ -9,6 +9,7 @@
 //! `h = m c` and rotational inertia `J` about the body-frame origin (which saves the transfers
 //! to the centre of mass).
 
+use super::CoordinateMap;
 use crate::cas::{Graph, Id};
 use crate::kinematics::{joint, Params};
 use crate::model::{JointKind, Model};
@@ -615,6 +616,26 @@ pub fn kinetic_energy(g: &mut Graph, lm: &LocalModel, qd: &[Id]) -> Id {
         }
     }
     g.sum(0.0, terms)
+}
+
+/// The generalized momentum `p = M(q) qd = dT/dqd` in `O(N)`: Newton-Euler with the velocities
+/// in place of the accelerations, at rest and without gravity (`M x` is inverse dynamics at
+/// zero velocity with accelerations `x`), projected on the coordinates (see `coupling`). A
+/// momentum observer's measurement; with a floating base its first six entries are the
+/// robot's linear and angular momentum in base axes about the base origin.
+pub fn generalized_momentum(g: &mut Graph, model: &Model, q: &[Id], qd: &[Id]) -> Vec<Id> {
+    let params = Params::new(g, model);
+    let map = CoordinateMap::new(model);
+    let joint_q = map.positions(g, q);
+    let joint_qd = map.rates(g, qd);
+    let lm = LocalModel::new(g, model, &params, &joint_q);
+    let at_rest = Terms {
+        qd: None,
+        qdd: Some(&joint_qd),
+        gravity: None,
+    };
+    let p = rnea(g, &lm, at_rest);
+    map.project(g, &p)
 }
 
 /// The time derivative of a body's rotational inertia about its origin (in its axes, first

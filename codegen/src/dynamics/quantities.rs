@@ -141,8 +141,9 @@ pub static NOTATIONS: &[Notation] = &[
     },
 ];
 
-/// Every quantity generated code can evaluate for `model`, in file order.
-pub fn catalogue(model: &Model, d: &Derivation) -> Vec<Quantity> {
+/// Every quantity generated code can evaluate for `model`, in file order. An entry may add the
+/// expressions it needs to `d`'s graph.
+pub fn catalogue(model: &Model, d: &mut Derivation) -> Vec<Quantity> {
     let notes = Notes::new(model);
     let mut out = vec![
         mass_matrix(d, &notes),
@@ -152,6 +153,7 @@ pub fn catalogue(model: &Model, d: &Derivation) -> Vec<Quantity> {
         inverse_dynamics(d, &notes),
         forward_dynamics(d, &notes),
         kinetic_energy(d, &notes),
+        generalized_momentum(model, d, &notes),
         potential_energy(d),
     ];
     if model.velocities_are_rates() {
@@ -388,6 +390,24 @@ fn kinetic_energy(d: &Derivation, notes: &Notes) -> Quantity {
             Route::Recursive => "Route: a sum over body velocities, O(N).".into(),
         },
         eval: Evaluation::Exprs(vec![d.fast.kinetic_energy]),
+    }
+}
+
+fn generalized_momentum(model: &Model, d: &mut Derivation, notes: &Notes) -> Quantity {
+    let p = super::newton_euler::generalized_momentum(&mut d.graph, model, &d.q, &d.qd);
+    Quantity {
+        name: "generalized_momentum",
+        inputs: Q_QD,
+        shape: Shape::Vector(d.dof),
+        home: Home::Inherent,
+        doc: lines(&[
+            &[
+                "The generalized momentum p = M(q) qd = dT/dqd (a momentum observer's measurement).".into(),
+            ],
+            &notes.armature("M includes"),
+        ]),
+        route: "Route: Newton-Euler at rest without gravity, with qd as the accelerations, O(N).".into(),
+        eval: Evaluation::Exprs(p),
     }
 }
 

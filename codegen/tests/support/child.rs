@@ -28,10 +28,12 @@ pub fn child_main(payload: impl FnOnce() -> String, parent: impl FnOnce()) {
     }
 }
 
-/// Runs the ignored test named `test` of this binary in a new process and returns its
-/// payload.
+/// Runs the ignored test `test` (its module path, `concat!(module_path!(), "::NAME")`) in a new
+/// process of this binary and returns its payload.
 #[track_caller]
 pub fn run_child(test: &str) -> String {
+    // The test harness names a test by its path without the crate's name.
+    let test = test.split_once("::").map_or(test, |(_crate, path)| path);
     let out = std::process::Command::new(std::env::current_exe().expect("test binary"))
         .args([
             "--ignored",
