@@ -141,6 +141,130 @@ impl<T: Real, const NV: usize, const K: usize> ImpulseDynamicsDerivatives<T, NV,
     }
 }
 
+/// Factorizes the system whose mass matrix and contact Jacobian are in `factors` and `j`, in
+/// place (`M`'s `L^T D L` factors; the inactive rows of `J` zeroed), writes `Y = M^-1 J^T`
+/// into `y` (row `k` a column) and returns the Cholesky factor of `J M^-1 J^T` (the identity's
+/// rows and columns for inactive rows).
+fn factorize<T: Real, const N: usize, const K: usize>(
+    factors: &mut [[T; N]; N],
+    j: &mut [[T; N]; K],
+    y: &mut [[T; N]; K],
+    parent: &[Option<usize>; N],
+    active: &[bool; K],
+) -> Result<Cholesky<T, K>, FactorError> {
+    ltdl_factor(factors, parent)?;
+    for (jk, on) in j.iter_mut().zip(active) {
+        if !*on {
+            *jk = [T::zero(); N];
+        }
+    }
+    // Y^T = M^-1 J^T, all K columns in one substitution.
+    let mut yt = [[T::zero(); K]; N];
+    for (i, row) in yt.iter_mut().enumerate() {
+        for (x, jk) in row.iter_mut().zip(j.iter()) {
+            *x = jk[i];
+        }
+    }
+    ltdl_substitute_rows(factors, parent, &mut yt);
+    for (k, yk) in y.iter_mut().enumerate() {
+        for (y, row) in yk.iter_mut().zip(&yt) {
+            *y = row[k];
+        }
+    }
+    let mut lambda = [[T::zero(); K]; K];
+    for r in 0..K {
+        if !active[r] {
+            lambda[r][r] = T::one();
+            continue;
+        }
+        for c in 0..=r {
+            if active[c] {
+                lambda[r][c] = dot(&j[r], &y[c]);
+                lambda[c][r] = lambda[r][c];
+            }
+        }
+    }
+    Cholesky::new(lambda).map_err(shift::<N>)
+}
+
+/// The arrays of a factorized system, wherever they lie ([`ContactKkt`], or a result and a
+/// [`KktStash`]).
+struct Parts<'a, T, const N: usize, const K: usize> {
+    factors: &'a [[T; N]; N],
+    parent: &'a [Option<usize>; N],
+    j: &'a [[T; N]; K],
+    y: &'a [[T; N]; K],
+    lambda: &'a Cholesky<T, K>,
+    active: &'a [bool; K],
+}
+
+impl<T: Real, const N: usize, const K: usize> Parts<'_, T, N, K> {
+    /// [`ContactKkt::solve`].
+    fn solve(&self, top: &[T; N], bottom: &[T; K]) -> Result<([T; N], [T; K]), FactorError> {
+        let mut x = ltdl_substitute(self.factors, self.parent, top);
+        let mut b = *bottom;
+        for ((bk, jk), on) in b.iter_mut().zip(self.j).zip(self.active) {
+            *bk = if *on { *bk - dot(jk, &x) } else { T::zero() };
+        }
+        let f = self.lambda.solve(&b);
+        for (yk, fk) in self.y.iter().zip(&f) {
+            for (xi, yi) in x.iter_mut().zip(yk) {
+                *xi += *yi * *fk;
+            }
+        }
+        if let Some(pivot) = x.iter().position(|v| !v.is_finite()) {
+            return Err(FactorError::NonFinite { pivot });
+        }
+        if let Some(k) = f.iter().position(|v| !v.is_finite()) {
+            return Err(FactorError::NonFinite { pivot: N + k });
+        }
+        Ok((x, f))
+    }
+}
+
+/// What a [`ContactKkt`] keeps of itself while its two largest arrays lie in a result
+/// ([`ContactKkt::set_up_in`]): the coordinate tree, `M^-1 J^T`, the factor of `J M^-1 J^T` and
+/// the active rows (`8 K N + 16 N + 8 K^2` bytes where the system is `8 (N^2 + 2 K N)`).
+#[derive(Clone, Copy, Debug)]
+pub struct KktStash<T, const N: usize, const K: usize> {
+    parent: [Option<usize>; N],
+    y: [[T; N]; K],
+    lambda: Cholesky<T, K>,
+    active: [bool; K],
+}
+
+impl<T: Real, const N: usize, const K: usize> KktStash<T, N, K> {
+    /// [`ContactKkt::solve`] of the system set up in `d` by [`ContactKkt::set_up_in`].
+    pub fn solve(
+        &self,
+        d: &ContactDynamicsDerivatives<T, N, K>,
+        top: &[T; N],
+        bottom: &[T; K],
+    ) -> Result<([T; N], [T; K]), FactorError> {
+        let parts = Parts {
+            factors: &d.da_dtau,
+            parent: &self.parent,
+            j: &d.df_dtau,
+            y: &self.y,
+            lambda: &self.lambda,
+            active: &self.active,
+        };
+        parts.solve(top, bottom)
+    }
+
+    /// [`ContactKkt::contact_dynamics_derivatives_in_place`] of the system stashed in `d`,
+    /// whose `da_dq`, `da_dv`, `df_dq` and `df_dv` hold the right-hand sides by then. The
+    /// system is set up again in this function's own frame, so that it is never on the stack
+    /// while the caller computes them.
+    #[inline(never)]
+    pub fn contact_dynamics_derivatives_in_place(
+        &self,
+        d: &mut ContactDynamicsDerivatives<T, N, K>,
+    ) -> Result<(), FactorError> {
+        ContactKkt::from_stash(self, d).contact_dynamics_derivatives_in_place(d)
+    }
+}
+
 /// The factorized KKT system of `N` velocity coordinates and `K` contact rows (module
 /// documentation).
 #[derive(Clone, Copy, Debug)]
@@ -232,40 +356,53 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
         fill(&mut self.factors, &mut self.j);
         self.parent = *parent;
         self.active = *active;
-        ltdl_factor(&mut self.factors, parent)?;
-        for (jk, on) in self.j.iter_mut().zip(active) {
-            if !*on {
-                *jk = [T::zero(); N];
-            }
-        }
-        // Y^T = M^-1 J^T, all K columns in one substitution.
-        let mut yt = [[T::zero(); K]; N];
-        for (i, row) in yt.iter_mut().enumerate() {
-            for (x, jk) in row.iter_mut().zip(&self.j) {
-                *x = jk[i];
-            }
-        }
-        ltdl_substitute_rows(&self.factors, parent, &mut yt);
-        for (k, yk) in self.y.iter_mut().enumerate() {
-            for (y, row) in yk.iter_mut().zip(&yt) {
-                *y = row[k];
-            }
-        }
-        let mut lambda = [[T::zero(); K]; K];
-        for r in 0..K {
-            if !active[r] {
-                lambda[r][r] = T::one();
-                continue;
-            }
-            for c in 0..=r {
-                if active[c] {
-                    lambda[r][c] = dot(&self.j[r], &self.y[c]);
-                    lambda[c][r] = lambda[r][c];
-                }
-            }
-        }
-        self.lambda = Cholesky::new(lambda).map_err(shift::<N>)?;
+        let (factors, j, y) = (&mut self.factors, &mut self.j, &mut self.y);
+        self.lambda = factorize(factors, j, y, parent, active)?;
         Ok(())
+    }
+
+    /// [`ContactKkt::set_up`] with the system's two largest arrays in the parts of `d` that
+    /// [`ContactKkt::contact_dynamics_derivatives_in_place`] only writes: `M`'s factors in
+    /// `da_dtau`, `J` in `df_dtau`; the rest is returned. A caller then never holds the system
+    /// (on a 50-coordinate humanoid with two soles, 25 kB) on its stack while it computes the
+    /// inverse-dynamics derivatives and the partials into `d`'s other fields.
+    ///
+    /// ```
+    /// use eomgen_runtime::{ContactDynamicsDerivatives, ContactKkt};
+    /// let (m, j) = ([[2.0_f64, 0.5], [0.5, 1.0]], [[1.0, 1.0]]);
+    /// let kkt = ContactKkt::new(m, &[None, Some(0)], j).unwrap();
+    /// let mut d = ContactDynamicsDerivatives::<f64, 2, 1>::nan();
+    /// let fill = |mm: &mut [[f64; 2]; 2], jj: &mut [[f64; 2]; 1]| (*mm, *jj) = (m, j);
+    /// let stash = ContactKkt::set_up_in(&mut d, fill, &[None, Some(0)], &[true]).unwrap();
+    /// assert_eq!(stash.solve(&d, &[1.0, 2.0], &[0.5]), kkt.solve(&[1.0, 2.0], &[0.5]));
+    /// ```
+    pub fn set_up_in(
+        d: &mut ContactDynamicsDerivatives<T, N, K>,
+        fill: impl FnOnce(&mut [[T; N]; N], &mut [[T; N]; K]),
+        parent: &[Option<usize>; N],
+        active: &[bool; K],
+    ) -> Result<KktStash<T, N, K>, FactorError> {
+        fill(&mut d.da_dtau, &mut d.df_dtau);
+        let mut stash = KktStash {
+            parent: *parent,
+            y: [[T::zero(); N]; K],
+            lambda: Cholesky::identity(),
+            active: *active,
+        };
+        stash.lambda = factorize(&mut d.da_dtau, &mut d.df_dtau, &mut stash.y, parent, active)?;
+        Ok(stash)
+    }
+
+    /// The system that [`ContactKkt::set_up_in`] left in `d` and `stash`.
+    pub fn from_stash(stash: &KktStash<T, N, K>, d: &ContactDynamicsDerivatives<T, N, K>) -> Self {
+        ContactKkt {
+            factors: d.da_dtau,
+            parent: stash.parent,
+            j: d.df_dtau,
+            y: stash.y,
+            lambda: stash.lambda,
+            active: stash.active,
+        }
     }
 
     /// Which contact rows take part (all of them for [`ContactKkt::new`]).
@@ -282,24 +419,15 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
     /// dynamics is `solve(tau - h, -drift)`; a non-finite component of `x` (`pivot < N`) or
     /// `f` (`N + k`) is an error.
     pub fn solve(&self, top: &[T; N], bottom: &[T; K]) -> Result<([T; N], [T; K]), FactorError> {
-        let mut x = ltdl_substitute(&self.factors, &self.parent, top);
-        let mut b = *bottom;
-        for ((bk, jk), on) in b.iter_mut().zip(&self.j).zip(&self.active) {
-            *bk = if *on { *bk - dot(jk, &x) } else { T::zero() };
-        }
-        let f = self.lambda.solve(&b);
-        for (yk, fk) in self.y.iter().zip(&f) {
-            for (xi, yi) in x.iter_mut().zip(yk) {
-                *xi += *yi * *fk;
-            }
-        }
-        if let Some(pivot) = x.iter().position(|v| !v.is_finite()) {
-            return Err(FactorError::NonFinite { pivot });
-        }
-        if let Some(k) = f.iter().position(|v| !v.is_finite()) {
-            return Err(FactorError::NonFinite { pivot: N + k });
-        }
-        Ok((x, f))
+        let parts = Parts {
+            factors: &self.factors,
+            parent: &self.parent,
+            j: &self.j,
+            y: &self.y,
+            lambda: &self.lambda,
+            active: &self.active,
+        };
+        parts.solve(top, bottom)
     }
 
     /// Solves the system for `C` right-hand sides at once, the columns of `top` (N x C) and

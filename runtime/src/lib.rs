@@ -109,7 +109,7 @@ pub use dynamics::Dynamics;
 pub use floating::{rk4_step_floating, Contacts, FloatingDynamics, StandOnContacts};
 pub use hamiltonian::Hamiltonian;
 pub use joint_effects::WithJointEffects;
-pub use kkt::{ContactDynamicsDerivatives, ContactKkt, ImpulseDynamicsDerivatives};
+pub use kkt::{ContactDynamicsDerivatives, ContactKkt, ImpulseDynamicsDerivatives, KktStash};
 pub use linalg::{solve_spd, solve_spd_or_nan, Cholesky, FactorError, Ldlt};
 pub use pose::Pose;
 pub use real::Real;

@@ -186,37 +186,58 @@ impl Emitter<'_> {
         };
         let docs = Self::quantity_doc(q, Some(ops));
         let (n, nq, k) = (self.n.clone(), self.nq.clone(), self.k.clone());
-        let kkt = self.kkt(active);
         let s = self.signature(q, active, ("The derivatives of", ", or why they do not"));
         let (name, try_name, param, arg, why) = (&s.name, &s.try_name, &s.param, &s.arg, &s.why);
+        let (m, j) = (self.call("mass_matrix"), self.call("contact_jacobian"));
+        let rows = if active {
+            quote!(::eomgen_runtime::contact::row_mask(
+                &Self::CONTACT_ROWS,
+                active
+            ))
+        } else {
+            quote!([true; #k])
+        };
         let drift = self.call("contact_drift");
         let id_derivatives = self.id_derivatives_into(quote!(d.da_dq), quote!(d.da_dv), quote!(a));
         let partials = self.call("contact_dynamics_partials");
         let ty = quote!(::eomgen_runtime::ContactDynamicsDerivatives<T, #n, #k>);
-        let (into, stage) = (
-            format_ident!("{}_into", name),
-            format_ident!("{}_partials", name),
-        );
+        let [into, solve, stage] =
+            ["into", "solve", "partials"].map(|s| format_ident!("{}_{}", name, s));
+        let stash = quote!(::eomgen_runtime::KktStash<T, #n, #k>);
+        let err = quote!(::eomgen_runtime::FactorError);
+        // The KKT system's arrays lie in `d` (`ContactKkt::set_up_in`) until their last use,
+        // never in a frame that the inverse-dynamics derivatives or the partials run below.
         self.blocks.push(quote! {
             /// The derivatives written into `d` (which holds garbage on failure).
-            fn #into(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n] #param, d: &mut #ty) -> ::core::result::Result<(), ::eomgen_runtime::FactorError> {
+            fn #into(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n] #param, d: &mut #ty) -> ::core::result::Result<(), #err> {
                 let h: [T; #n] = { #hb };
                 let mut rhs = *tau;
                 for (r, h) in rhs.iter_mut().zip(h) {
                     *r -= h;
                 }
                 let drift = #drift(self, q, qd);
-                #kkt
-                let (a, f) = kkt.solve(&rhs, &drift.map(|x| -x))?;
+                let (a, f, stash) = self.#solve(q, &rhs, &drift #arg, d)?;
                 #id_derivatives
                 self.#stage(q, qd, &a, &f, d)?;
-                kkt.contact_dynamics_derivatives_in_place(d)
+                stash.contact_dynamics_derivatives_in_place(d)
             }
 
-            /// The partials added to `d` in a frame of their own, not alongside the
-            /// inverse-dynamics derivatives' blocks.
+            /// The accelerations and forces, with the KKT system set up in `d`.
             #[inline(never)]
-            fn #stage(&self, q: &[T; #nq], qd: &[T; #n], a: &[T; #n], f: &[T; #k], d: &mut #ty) -> ::core::result::Result<(), ::eomgen_runtime::FactorError> {
+            fn #solve(&self, q: &[T; #nq], rhs: &[T; #n], drift: &[T; #k] #param, d: &mut #ty) -> ::core::result::Result<([T; #n], [T; #k], #stash), #err> {
+                let rows = #rows;
+                let fill = |m: &mut [[T; #n]; #n], j: &mut [[T; #n]; #k]| {
+                    *m = #m(self, q);
+                    *j = #j(self, q);
+                };
+                let stash = ::eomgen_runtime::ContactKkt::set_up_in(d, fill, &Self::PARENTS, &rows)?;
+                let (a, f) = stash.solve(d, rhs, &drift.map(|x| -x))?;
+                Ok((a, f, stash))
+            }
+
+            /// The partials added to `d` in a frame of their own.
+            #[inline(never)]
+            fn #stage(&self, q: &[T; #nq], qd: &[T; #n], a: &[T; #n], f: &[T; #k], d: &mut #ty) -> ::core::result::Result<(), #err> {
                 d.add_partials(&#partials(self, q, qd, a, f))
             }
         });
