@@ -20,8 +20,17 @@ fn ms(d: Duration) -> String {
     format!("{:.1} ms", d.as_secs_f64() * 1e3)
 }
 
-/// Joint `j`'s coordinate as `q3`, or `mimic` for a mimic joint that follows another.
+/// Joint `j`'s coordinate as `q3`, its position coordinates as `q3..q9` (a floating joint's
+/// seven), or `mimic` for a mimic joint that follows another. Counted after a floating base's.
 fn label(model: &Model, j: usize) -> String {
+    let nq = model.joints[j].kind.nq();
+    if nq > 1 || !model.velocities_are_rates() {
+        let first = model.q_offsets()[j] - model.base_nq() + 1;
+        return match nq {
+            1 => format!("q{first}"),
+            _ => format!("q{first}..q{}", first + nq - 1),
+        };
+    }
     match model.coupling.get(j) {
         Some(c) if c.leader.is_some() => "mimic".to_string(),
         Some(c) => format!("q{}", c.coordinate + 1),

@@ -376,15 +376,22 @@ fn floating_controllers_are_checked() {
     assert!(e.contains("are for a floating base"), "{e}");
 }
 
-/// `info` on floating joints below the root and a planar joint: a floating joint has no axis,
-/// and the massless bodies between a planar joint's steps carry the steps' names, not the
-/// child link's.
+/// `info` on floating joints below the root and a planar joint: a floating joint has no axis
+/// and is labelled by its seven position coordinates (the joints after it by theirs), and the
+/// massless bodies between a planar joint's steps carry the steps' names, not the child link's.
 #[test]
 fn info_shows_floating_and_planar_joints_as_they_are() {
     let rover = robot("joints/rover_pods");
     let text = stdout(&eomgen(&["info", rover.to_str().unwrap()]));
-    assert!(text.contains("pod_free: floating -> pod, 2.2 kg"), "{text}");
-    assert!(text.contains("bob_free: floating -> bob, 0.7 kg"), "{text}");
+    assert!(
+        text.contains("q6..q12 pod_free: floating -> pod, 2.2 kg"),
+        "{text}"
+    );
+    assert!(text.contains("q13 pod_spin: revolute"), "{text}");
+    assert!(
+        text.contains("q15..q21 bob_free: floating -> bob, 0.7 kg"),
+        "{text}"
+    );
     assert!(!text.contains("floating about"), "{text}");
     assert!(
         text.contains("cart_planar.x: prismatic about (1, 0, 0) -> cart_planar.x, 0 kg"),
