@@ -107,6 +107,12 @@ impl fmt::Display for BatchError {
 impl std::error::Error for BatchError {}
 
 /// `Ok` when every `(name, len)` of `slices` has `expected` states.
+///
+/// ```
+/// use eomgen_runtime::batch::check;
+/// assert!(check(2, &[("q", 2), ("qd", 2)]).is_ok());
+/// assert_eq!(check(2, &[("q", 2), ("qd", 1)]).unwrap_err().argument, "qd");
+/// ```
 pub fn check(expected: usize, slices: &[(&'static str, usize)]) -> Result<(), BatchError> {
     match slices.iter().find(|(_, len)| *len != expected) {
         Some(&(argument, len)) => Err(BatchError {
@@ -119,7 +125,16 @@ pub fn check(expected: usize, slices: &[(&'static str, usize)]) -> Result<(), Ba
 }
 
 /// States `start..start + LANES` of `x` in the lanes of one array (lanes past the end of `x`
-/// repeat its last state; `x` must not be empty).
+/// repeat its last state; zeros if `x` is empty).
+///
+/// ```
+/// use eomgen_runtime::batch::{gather, scatter};
+/// let x = [[1.0_f64, 2.0], [3.0, 4.0]];
+/// let v: [f64; 2] = gather(&x, 1); // one lane: state 1
+/// let mut out = [[0.0; 2]; 1];
+/// scatter(&v, &mut out);
+/// assert_eq!(out, [[3.0, 4.0]]);
+/// ```
 #[inline(always)]
 pub fn gather<L: Pack, const N: usize>(x: &[[L::Scalar; N]], start: usize) -> [L; N] {
     let last = x.len().saturating_sub(1);
@@ -133,7 +148,7 @@ fn lane_of<L: Pack, const N: usize>(v: &[L; N], l: usize) -> [L::Scalar; N] {
     core::array::from_fn(|i| v[i].lane(l))
 }
 
-/// Lanes `0..out.len()` of an array of lanes, one array per state.
+/// Lanes `0..out.len()` of an array of lanes, one array per state (see [`gather`]).
 #[inline(always)]
 pub fn scatter<L: Pack, const N: usize>(v: &[L; N], out: &mut [[L::Scalar; N]]) {
     for (l, o) in out.iter_mut().enumerate() {
@@ -142,6 +157,13 @@ pub fn scatter<L: Pack, const N: usize>(v: &[L; N], out: &mut [[L::Scalar; N]]) 
 }
 
 /// Lanes `0..out.len()` of a matrix of lanes, one matrix per state.
+///
+/// ```
+/// use eomgen_runtime::batch::scatter_matrix;
+/// let mut out = [[[0.0_f64; 2]; 1]; 1];
+/// scatter_matrix(&[[1.0, 2.0]], &mut out);
+/// assert_eq!(out, [[[1.0, 2.0]]]);
+/// ```
 #[inline(always)]
 pub fn scatter_matrix<L: Pack, const R: usize, const C: usize>(
     v: &[[L; C]; R],
@@ -155,6 +177,13 @@ pub fn scatter_matrix<L: Pack, const R: usize, const C: usize>(
 }
 
 /// Lanes `0..out.len()` of one number of lanes.
+///
+/// ```
+/// use eomgen_runtime::batch::scatter_scalar;
+/// let mut out = [0.0_f64; 1];
+/// scatter_scalar(2.5, &mut out);
+/// assert_eq!(out, [2.5]);
+/// ```
 #[inline(always)]
 pub fn scatter_scalar<L: Pack>(v: L, out: &mut [L::Scalar]) {
     for (l, o) in out.iter_mut().enumerate() {
@@ -162,7 +191,15 @@ pub fn scatter_scalar<L: Pack>(v: L, out: &mut [L::Scalar]) {
     }
 }
 
-/// The output slices of a batch call, cut together into chunks of states.
+/// The output slices of a batch call, cut together into chunks of states: one slice or a
+/// tuple of two or three.
+///
+/// ```
+/// use eomgen_runtime::batch::Outputs;
+/// let (mut a, mut b) = ([1, 2, 3], [4, 5, 6]);
+/// let ((a0, b0), (a1, _)) = (&mut a[..], &mut b[..]).split_at(1);
+/// assert_eq!((a0.states(), b0[0], a1.states()), (1, 4, 2));
+/// ```
 pub trait Outputs: Send + Sized {
     /// The number of states (of the first slice).
     fn states(&self) -> usize;
@@ -206,6 +243,17 @@ mod tuples {
 /// Calls `f(start, chunk)` on consecutive chunks of `lanes` states of `out` (the last may be
 /// shorter), `start` the index of the chunk's first state; on rayon's threads with the `rayon`
 /// feature, in order on the calling thread without.
+///
+/// ```
+/// use eomgen_runtime::batch::run;
+/// let mut out = [0usize; 5];
+/// run(2, &mut out[..], &|start, chunk: &mut [usize]| {
+///     for (k, x) in chunk.iter_mut().enumerate() {
+///         *x = start + k;
+///     }
+/// });
+/// assert_eq!(out, [0, 1, 2, 3, 4]);
+/// ```
 #[inline]
 pub fn run<O: Outputs>(lanes: usize, out: O, f: &(impl Fn(usize, O) + Sync)) {
     #[cfg(feature = "rayon")]

@@ -12,7 +12,8 @@ use crate::{FactorError, Lane, Real};
 /// ```
 ///
 /// `tau`'s first six entries are the force and torque on the base in base axes (zero for a
-/// robot's own efforts), as Pinocchio's free flyer. A generated type's methods of this trait
+/// robot's own efforts), as Pinocchio's free flyer. `T` is any [`Lane`]: generated robots
+/// implement the trait for SIMD vectors of states too (`eomgen_runtime`'s `simd` feature). A generated type's methods of this trait
 /// (and of [`Contacts`]) live only in its impl: bring the trait into scope
 /// (`use eomgen_runtime::prelude::*;`) to call them.
 ///

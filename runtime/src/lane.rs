@@ -108,6 +108,13 @@ pub trait Lane: Copy + Debug + Default + Arithmetic + 'static {
 
 /// The operators of [`Real`] and [`Lane`]: `+ - * /`, their assignments and negation, all
 /// on `Self`. Implemented for every type that has them.
+///
+/// ```
+/// fn twice<T: eomgen_runtime::Arithmetic + Copy>(x: T) -> T {
+///     x + x
+/// }
+/// assert_eq!(twice(1.5_f32), 3.0);
+/// ```
 pub trait Arithmetic:
     Sized
     + Add<Output = Self>
@@ -175,6 +182,11 @@ pub fn check_pivots<T: Lane, const P: usize>(
 }
 
 /// [`Lane::check_finite`] on every component of `x`, in order.
+///
+/// ```
+/// use eomgen_runtime::{lane::check_finite, FactorError};
+/// assert_eq!(check_finite(&[1.0_f64, f64::NAN], &mut ()), Err(FactorError::NonFinite { pivot: 1 }));
+/// ```
 #[inline(always)]
 pub fn check_finite<T: Lane, const N: usize>(
     x: &[T; N],
@@ -198,6 +210,12 @@ pub fn nan_failed<T: Lane, const L: usize>(o: [T; L], failures: &T::Failures) ->
 }
 
 /// [`nan_failed`] in place, on the entries of `x` (a flattened matrix, say).
+///
+/// ```
+/// let mut m = [[1.0_f64, 2.0], [3.0, 4.0]];
+/// eomgen_runtime::lane::nan_failed_in::<f64>(m.as_flattened_mut(), &()); // a scalar: no failures
+/// assert_eq!(m, [[1.0, 2.0], [3.0, 4.0]]);
+/// ```
 #[inline]
 pub fn nan_failed_in<T: Lane>(x: &mut [T], failures: &T::Failures) {
     let failed = T::failed(failures);
@@ -209,6 +227,10 @@ pub fn nan_failed_in<T: Lane>(x: &mut [T], failures: &T::Failures) {
 }
 
 /// `Ok(x)` when no lane failed, else the lowest failed lane ([`Lane::first_failure`]).
+///
+/// ```
+/// assert_eq!(eomgen_runtime::lane::lanes_ok::<_, f64>(7, &()), Ok(7));
+/// ```
 #[inline(always)]
 pub fn lanes_ok<X, T: Lane>(x: X, failures: &T::Failures) -> Result<X, LaneError> {
     match T::first_failure(failures) {
