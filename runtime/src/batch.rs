@@ -137,22 +137,32 @@ pub fn check(expected: usize, slices: &[(&'static str, usize)]) -> Result<(), Ba
 /// ```
 #[inline(always)]
 pub fn gather<L: Pack, const N: usize>(x: &[[L::Scalar; N]], start: usize) -> [L; N] {
-    let last = x.len().saturating_sub(1);
     let zero = <L::Scalar as Real>::zero();
+    if let Some(full) = x.get(start..start + L::LANES) {
+        return core::array::from_fn(|i| L::gather(|l| full.get(l).map_or(zero, |s| s[i])));
+    }
+    let last = x.len().saturating_sub(1);
     core::array::from_fn(|i| L::gather(|l| x.get((start + l).min(last)).map_or(zero, |s| s[i])))
-}
-
-/// `L`'s value for state `l` of an array of lanes.
-#[inline(always)]
-fn lane_of<L: Pack, const N: usize>(v: &[L; N], l: usize) -> [L::Scalar; N] {
-    core::array::from_fn(|i| v[i].lane(l))
 }
 
 /// Lanes `0..out.len()` of an array of lanes, one array per state (see [`gather`]).
 #[inline(always)]
 pub fn scatter<L: Pack, const N: usize>(v: &[L; N], out: &mut [[L::Scalar; N]]) {
-    for (l, o) in out.iter_mut().enumerate() {
-        *o = lane_of(v, l);
+    if out.len() == L::LANES {
+        // A whole vector: a loop to the constant `LANES`, which the compiler unrolls so that
+        // each lane is read at a constant index; each state written in order.
+        #[allow(clippy::needless_range_loop)]
+        for l in 0..L::LANES {
+            for (o, x) in out[l].iter_mut().zip(v) {
+                *o = x.lane(l);
+            }
+        }
+        return;
+    }
+    for (i, x) in v.iter().enumerate() {
+        for (o, y) in out.iter_mut().zip(x.lanes().as_ref()) {
+            o[i] = *y;
+        }
     }
 }
 
@@ -169,9 +179,24 @@ pub fn scatter_matrix<L: Pack, const R: usize, const C: usize>(
     v: &[[L; C]; R],
     out: &mut [[[L::Scalar; C]; R]],
 ) {
-    for (l, o) in out.iter_mut().enumerate() {
-        for (row, vr) in o.iter_mut().zip(v) {
-            *row = lane_of(vr, l);
+    if out.len() == L::LANES {
+        // A whole vector: a loop to the constant `LANES`, which the compiler unrolls so that
+        // each lane is read at a constant index; each state written in order.
+        #[allow(clippy::needless_range_loop)]
+        for l in 0..L::LANES {
+            for (o, row) in out[l].iter_mut().zip(v) {
+                for (o, x) in o.iter_mut().zip(row) {
+                    *o = x.lane(l);
+                }
+            }
+        }
+        return;
+    }
+    for (r, row) in v.iter().enumerate() {
+        for (c, x) in row.iter().enumerate() {
+            for (o, y) in out.iter_mut().zip(x.lanes().as_ref()) {
+                o[r][c] = *y;
+            }
         }
     }
 }
@@ -186,8 +211,8 @@ pub fn scatter_matrix<L: Pack, const R: usize, const C: usize>(
 /// ```
 #[inline(always)]
 pub fn scatter_scalar<L: Pack>(v: L, out: &mut [L::Scalar]) {
-    for (l, o) in out.iter_mut().enumerate() {
-        *o = v.lane(l);
+    for (o, y) in out.iter_mut().zip(v.lanes().as_ref()) {
+        *o = *y;
     }
 }
 

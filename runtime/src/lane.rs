@@ -354,7 +354,7 @@ impl<T: Real> Lane for T {
 /// use eomgen_runtime::lane::Pack;
 ///
 /// let x = f64::gather(|l| 0.5 + l as f64);
-/// assert_eq!((x, x.lane(0)), (0.5, 0.5));
+/// assert_eq!((x, x.lane(0), x.lanes()), (0.5, 0.5, [0.5]));
 /// ```
 pub trait Pack: Lane {
     /// The scalar of one lane.
@@ -363,6 +363,10 @@ pub trait Pack: Lane {
     fn gather(f: impl FnMut(usize) -> Self::Scalar) -> Self;
     /// Lane `l` (`l < LANES`; a larger `l` gives lane `l % LANES`).
     fn lane(self, l: usize) -> Self::Scalar;
+    /// Every lane, in order (`[Scalar; LANES]`).
+    type Array: AsRef<[Self::Scalar]>;
+    /// Every lane, in order: cheaper than [`Pack::lane`] for each.
+    fn lanes(self) -> Self::Array;
 }
 
 impl<T: Real> Pack for T {
@@ -374,6 +378,11 @@ impl<T: Real> Pack for T {
     #[inline(always)]
     fn lane(self, _: usize) -> T {
         self
+    }
+    type Array = [T; 1];
+    #[inline(always)]
+    fn lanes(self) -> [T; 1] {
+        [self]
     }
 }
 

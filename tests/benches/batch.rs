@@ -71,14 +71,14 @@ fn group<'c>(c: &'c mut Criterion, name: &str) -> BenchmarkGroup<'c, WallTime> {
 }
 
 /// Function `$name` three ways in group `$g`, into fresh outputs `$o` (each `STATES` copies of
-/// `$zero`): `$scalar` once per state `$i` on this thread, `$batch` in the one-thread pool and
-/// in the pool of every core.
+/// `$zero`): `$scalar` once per state `$i` on this thread, `$batch` run from inside the
+/// one-thread pool and inside the pool of every core.
 macro_rules! three_ways {
     ($g:ident, $pools:ident, $name:literal, ($($o:ident: $zero:expr),+), |$i:ident| $scalar:block, $batch:block) => {{
         $(let mut $o = vec![$zero; STATES];)+
         $g.bench_function(concat!($name, "/scalar"), |b| b.iter(|| for $i in 0..STATES $scalar));
-        $g.bench_function(concat!($name, "/batch"), |b| b.iter(|| $pools.one.install(|| $batch)));
-        $g.bench_function(concat!($name, "/threads"), |b| b.iter(|| $pools.all.install(|| $batch)));
+        $g.bench_function(concat!($name, "/batch"), |b| $pools.one.install(|| b.iter(|| $batch)));
+        $g.bench_function(concat!($name, "/threads"), |b| $pools.all.install(|| b.iter(|| $batch)));
     }};
 }
 

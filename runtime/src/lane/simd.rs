@@ -137,6 +137,11 @@ macro_rules! impl_lane {
             fn lane(self, l: usize) -> $s {
                 self.to_array()[l % $n]
             }
+            type Array = [$s; $n];
+            #[inline(always)]
+            fn lanes(self) -> [$s; $n] {
+                self.to_array()
+            }
         }
     };
 }
