@@ -111,6 +111,17 @@ struct Emitter<'a> {
     helpers: BTreeSet<&'static str>,
 }
 
+/// The generated methods by where they go: the inherent impls for every `T: Lane` and for
+/// `T: Real` (with the blocks of their split bodies), and the trait impls.
+#[derive(Default)]
+struct Methods {
+    lane_items: Vec<TokenStream>,
+    real_items: Vec<TokenStream>,
+    trait_methods: Vec<TokenStream>,
+    floating_methods: Vec<TokenStream>,
+    contact_methods: Vec<TokenStream>,
+}
+
 /// Each contact's number of rows: 3 for the points (at link origins, then at positions), 6 for
 /// the frames.
 fn contact_rows(model: &Model) -> Vec<usize> {
@@ -183,6 +194,33 @@ impl Emitter<'_> {
         })
     }
 
+    /// Every quantity's method, and the blocks of split bodies, by where they go.
+    fn methods(&mut self) -> Methods {
+        let mut m = Methods::default();
+        for q in self.quantities {
+            let before = self.blocks.len();
+            let tokens = self.quantity_fn(q);
+            let items = if self.lanes.contains(q.name) {
+                &mut m.lane_items
+            } else {
+                &mut m.real_items
+            };
+            items.extend(self.blocks.drain(before..));
+            match self.trait_of(q.name) {
+                Some(Trait::Dynamics) => m.trait_methods.push(tokens),
+                Some(Trait::Floating) => m.floating_methods.push(tokens),
+                Some(Trait::Contacts) => m.contact_methods.push(tokens),
+                None => items.push(tokens),
+            }
+            if q.name == "forward_dynamics" {
+                items.push(std::mem::take(&mut self.forward_dynamics_lanes));
+            }
+        }
+        m.contact_methods
+            .push(self.try_contact_forward_dynamics.clone());
+        m
+    }
+
     /// The whole file: the type, its inherent impl with one method per quantity, the trait
     /// impls.
     fn file(&mut self, fields: &Fields, d: &Derivation) -> TokenStream {
@@ -192,32 +230,13 @@ impl Emitter<'_> {
         } else {
             TokenStream::new()
         };
-        let quantities = self.quantities;
-        // Inherent methods and blocks, by whether they are generated for every `T: Lane`.
-        let (mut lane_items, mut real_items) = (Vec::new(), Vec::new());
-        let mut trait_methods = Vec::new();
-        let mut floating_methods = Vec::new();
-        let mut contact_methods = Vec::new();
-        for q in quantities {
-            let before = self.blocks.len();
-            let tokens = self.quantity_fn(q);
-            let items = if self.lanes.contains(q.name) {
-                &mut lane_items
-            } else {
-                &mut real_items
-            };
-            items.extend(self.blocks.drain(before..));
-            match self.trait_of(q.name) {
-                Some(Trait::Dynamics) => trait_methods.push(tokens),
-                Some(Trait::Floating) => floating_methods.push(tokens),
-                Some(Trait::Contacts) => contact_methods.push(tokens),
-                None => items.push(tokens),
-            }
-            if q.name == "forward_dynamics" {
-                items.push(std::mem::take(&mut self.forward_dynamics_lanes));
-            }
-        }
-        contact_methods.push(self.try_contact_forward_dynamics.clone());
+        let Methods {
+            lane_items,
+            real_items,
+            trait_methods,
+            floating_methods,
+            contact_methods,
+        } = self.methods();
         let frames = if self.has_frames() {
             self.frame_support(d)
         } else {

@@ -20,6 +20,49 @@ fn element(shape: Shape) -> TokenStream {
     shape_type(shape)
 }
 
+/// A batch method's output slices: their names (`out`, or `out_0`, ... for a tuple), the type
+/// of one state's value in each, and the statements scattering the lanes' result `r` into them.
+struct Outs {
+    names: Vec<Ident>,
+    types: Vec<TokenStream>,
+    scatters: Vec<TokenStream>,
+}
+
+/// The output slices of a quantity of `shape`.
+fn outputs(shape: Shape) -> Outs {
+    let shapes: Vec<Shape> = match shape {
+        Shape::Matrices(k, r, c) => vec![Shape::Matrix(r, c); k],
+        s => vec![s],
+    };
+    let names: Vec<Ident> = match shapes.len() {
+        1 => vec![format_ident!("out")],
+        k => (0..k).map(|i| format_ident!("out_{}", i)).collect(),
+    };
+    let scatters = shapes
+        .iter()
+        .zip(&names)
+        .enumerate()
+        .map(|(k, (s, o))| {
+            let r = if shapes.len() == 1 {
+                quote!(r)
+            } else {
+                let k = usize_lit(k);
+                quote!(r.#k)
+            };
+            match s {
+                Shape::Scalar => quote!(::eomgen_runtime::batch::scatter_scalar(#r, #o);),
+                Shape::Vector(_) => quote!(::eomgen_runtime::batch::scatter(&#r, #o);),
+                _ => quote!(::eomgen_runtime::batch::scatter_matrix(&#r, #o);),
+            }
+        })
+        .collect();
+    Outs {
+        types: shapes.iter().map(|s| element(*s)).collect(),
+        names,
+        scatters,
+    }
+}
+
 impl Emitter<'_> {
     /// `impl<T: Batch>` with `in_lanes` and one `_batch` method per quantity on lanes.
     pub(super) fn batch_impl(&self, fields: &Fields) -> TokenStream {
@@ -74,15 +117,11 @@ impl Emitter<'_> {
             Input::Forces => &self.k,
             _ => &self.n,
         });
-        let shapes: Vec<Shape> = match q.shape {
-            Shape::Matrices(k, r, c) => vec![Shape::Matrix(r, c); k],
-            s => vec![s],
-        };
-        let outs: Vec<Ident> = match shapes.len() {
-            1 => vec![format_ident!("out")],
-            k => (0..k).map(|i| format_ident!("out_{}", i)).collect(),
-        };
-        let out_types: Vec<TokenStream> = shapes.iter().map(|s| element(*s)).collect();
+        let Outs {
+            names: outs,
+            types: out_types,
+            scatters,
+        } = outputs(q.shape);
         let integrate = matches!(q.eval, Evaluation::Integrate);
         let (dt, dt_arg, dt_lanes) = if integrate {
             let l = lanes();
@@ -99,22 +138,6 @@ impl Emitter<'_> {
             .map(|i| quote!(&::eomgen_runtime::batch::gather(#i, start)))
             .chain(integrate.then(|| dt_arg.clone()));
         let path = self.lane_path(q.name);
-        let scatters = shapes.iter().enumerate().map(|(k, s)| {
-            let (o, r) = (
-                &outs[k],
-                if shapes.len() == 1 {
-                    quote!(r)
-                } else {
-                    let k = usize_lit(k);
-                    quote!(r.#k)
-                },
-            );
-            match s {
-                Shape::Scalar => quote!(::eomgen_runtime::batch::scatter_scalar(#r, #o);),
-                Shape::Vector(_) => quote!(::eomgen_runtime::batch::scatter(&#r, #o);),
-                _ => quote!(::eomgen_runtime::batch::scatter_matrix(&#r, #o);),
-            }
-        });
         let first = &outs[0];
         let checked = inputs.iter().chain(&outs[1..]).map(|a| {
             let name = a.to_string();
