@@ -31,7 +31,7 @@ fn passive_elbow() {
         "pub fn selection() -> [[T; 2]; 1]",
         "pub fn full_effort(tau_a: &[T; 1]) -> [T; 2]",
         "pub fn forward_dynamics_actuated(",
-        "impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 2> for Acrobot<T>",
+        "impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 2> for Acrobot<T>",
         "--passive elbow",
     ] {
         assert!(source.contains(item), "missing {item}");

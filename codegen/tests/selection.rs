@@ -18,8 +18,23 @@ fn generate(names: &[&str]) -> Result<String, eomgen::Error> {
         .generate()
 }
 
-/// The names of the functions the source defines (besides `Default::default`).
+/// The names of the functions the source defines (besides `Default::default` and the batch
+/// versions, [`batch_functions`]).
 fn functions(source: &str) -> Vec<String> {
+    let all = all_functions(source);
+    all.into_iter()
+        .filter(|f| !f.ends_with("_batch") && f != "in_lanes")
+        .collect()
+}
+
+/// The `_batch` methods of the source.
+fn batch_functions(source: &str) -> Vec<String> {
+    let all = all_functions(source);
+    all.into_iter().filter(|f| f.ends_with("_batch")).collect()
+}
+
+/// The names of every function the source defines (besides `Default::default`).
+fn all_functions(source: &str) -> Vec<String> {
     let file = syn::parse_file(source).expect("generated code parses");
     let mut out = Vec::new();
     for item in file.items {
@@ -42,6 +57,10 @@ fn functions(source: &str) -> Vec<String> {
 fn only_the_selected_functions_and_their_helpers_are_generated() {
     let source = generate(&["inverse_dynamics", "gravity"]).unwrap();
     assert_eq!(functions(&source), ["gravity", "inverse_dynamics"]);
+    assert_eq!(
+        batch_functions(&source),
+        ["gravity_batch", "inverse_dynamics_batch"]
+    );
     assert!(
         !source.contains("Dynamics<T"),
         "no trait without all its methods"
@@ -62,6 +81,8 @@ fn only_the_selected_functions_and_their_helpers_are_generated() {
         functions(&source),
         ["joint_transform", "link_frame", "link_jacobian", "name"]
     );
+    // Link kinematics takes `Real` (the runtime's chain kernels), so it has no batch version.
+    assert!(batch_functions(&source).is_empty());
 }
 
 #[test]

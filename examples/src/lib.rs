@@ -10,6 +10,7 @@
 //! cargo run --example quadruped_stand       # a floating-base quadruped standing on its feet
 //! cargo run --example quadruped_mpc         # an MPC step (iLQR) lifting a foot of the quadruped
 //! cargo run --example identify              # base inertial parameters of a UR5 from noisy torques
+//! cargo run --release --example mppi_rollout  # MPPI rollouts: scalar vs batch (SIMD lanes, threads)
 //! ```
 //!
 //! `Ur5` (6 joints, `robots/ur5.urdf`) is generated with identification: `regressor`,

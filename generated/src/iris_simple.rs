@@ -14,7 +14,7 @@
 pub struct IrisSimple<T = f64> {
     _marker: ::core::marker::PhantomData<T>,
 }
-impl<T: ::eomgen_runtime::Real> ::core::default::Default for IrisSimple<T> {
+impl<T: ::eomgen_runtime::Lane> ::core::default::Default for IrisSimple<T> {
     fn default() -> Self {
         IrisSimple {
             _marker: ::core::marker::PhantomData,
@@ -61,7 +61,7 @@ impl IrisSimple<f64> {
     /// Number of velocity coordinates: the base's 6 (linear, then angular velocity, base axes), then the joints'.
     pub const NV: usize = 6;
 }
-impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dimensions for IrisSimple<T> {
+impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dimensions for IrisSimple<T> {
     const DOF: usize = 6;
     const NQ: usize = 7;
     const NV: usize = 6;
@@ -79,7 +79,7 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dimensions for IrisSimple<T> {
     clippy::type_complexity,
     clippy::too_many_arguments
 )]
-impl<T: ::eomgen_runtime::Real> IrisSimple<T> {
+impl<T: ::eomgen_runtime::Lane> IrisSimple<T> {
     /// Each coordinate's parent coordinate (`None`: the root), parents first: the
     /// joints' parents (a floating base's six coordinates form a chain). The sparsity
     /// of `mass_matrix` that the runtime's tree solves take (`eomgen_runtime::tree`,
@@ -100,18 +100,128 @@ impl<T: ::eomgen_runtime::Real> IrisSimple<T> {
     pub const VELOCITY_LIMITS: [f64; 0] = [];
     /// Each joint coordinate's effort limit (N m or N) from the URDF's `<limit effort>`, in `JOINT_NAMES` order (the joints only: entry `i` is velocity coordinate `6 + i`); infinite without `<limit>`.
     pub const EFFORT_LIMITS: [f64; 0] = [];
-    /// Forward dynamics `qdd = M(q)^-1 (tau - b(q, qd) - G(q))`, or which pivot of the
-    /// `L^T D L` factorization of M(q) was not positive (a non-physical model or
-    /// non-finite input); see `forward_dynamics` for the route and operation count.
-    /// `Ok` holds only finite numbers: a non-finite component `i` of the solution (from
-    /// a non-finite `qd` or `tau`, or a `q` that leaves M(q) finite) is reported as
-    /// `FactorError::NonFinite { pivot: i }`.
-    pub fn try_forward_dynamics(
+    /// The Christoffel-form Coriolis matrix C(q, qd): C qd = b, dM/dt - 2C skew-symmetric.
+    ///
+    /// Route: Echeandia and Wensing's O(N^2) recursion on composite inertias and momenta.
+    /// Operations: 26 mul, 8 add, 0 div, 0 sin, 0 cos.
+    pub fn coriolis_matrix(&self, q: &[T; 7], qd: &[T; 6]) -> [[T; 6]; 6] {
+        let t0 = T::from_f64(0.00045999999999999996) * qd[5];
+        let t1 = -T::from_f64(0.00045999999999999996) * qd[5];
+        [
+            [
+                T::zero(),
+                -T::from_f64(1.5349999999999995) * qd[5],
+                T::from_f64(1.5349999999999995) * qd[4],
+                t0,
+                T::zero(),
+                T::zero(),
+            ],
+            [
+                T::from_f64(1.5349999999999995) * qd[5],
+                T::zero(),
+                -T::from_f64(1.5349999999999995) * qd[3],
+                T::zero(),
+                t0,
+                T::zero(),
+            ],
+            [
+                -T::from_f64(1.5349999999999995) * qd[4],
+                T::from_f64(1.5349999999999995) * qd[3],
+                T::zero(),
+                -T::from_f64(0.00045999999999999996) * qd[3],
+                -T::from_f64(0.00045999999999999996) * qd[4],
+                T::zero(),
+            ],
+            [
+                t1,
+                T::zero(),
+                T::from_f64(0.00045999999999999996) * qd[3],
+                T::zero(),
+                T::mul_add(
+                    -T::from_f64(0.001528230000000002),
+                    qd[5],
+                    T::mul_add(
+                        -T::from_f64(0.000000000000000000006776263578034403),
+                        qd[4],
+                        -T::from_f64(0.000000000000000000005082197683525802) * qd[3],
+                    ),
+                ),
+                T::mul_add(
+                    T::from_f64(0.000000000000000000006776263578034403),
+                    qd[5],
+                    T::from_f64(0.028505250000000006) * qd[4],
+                ),
+            ],
+            [
+                T::zero(),
+                t1,
+                T::from_f64(0.00045999999999999996) * qd[4],
+                T::mul_add(
+                    T::from_f64(0.001528230000000002),
+                    qd[5],
+                    T::mul_add(
+                        T::from_f64(0.000000000000000000006776263578034403),
+                        qd[4],
+                        T::from_f64(0.000000000000000000005082197683525802) * qd[3],
+                    ),
+                ),
+                T::zero(),
+                T::mul_add(
+                    -T::from_f64(0.000000000000000000005082197683525802),
+                    qd[5],
+                    -T::from_f64(0.029047766000000003) * qd[3],
+                ),
+            ],
+            [
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::mul_add(
+                    -T::from_f64(0.000000000000000000006776263578034403),
+                    qd[5],
+                    -T::from_f64(0.028505250000000006) * qd[4],
+                ),
+                T::mul_add(
+                    T::from_f64(0.000000000000000000005082197683525802),
+                    qd[5],
+                    T::from_f64(0.029047766000000003) * qd[3],
+                ),
+                T::zero(),
+            ],
+        ]
+    }
+    /// `try_forward_dynamics` on a vector of states (`eomgen_runtime::Lane`, one state
+    /// per lane; a scalar is lane 0): the accelerations of every lane, or the lowest
+    /// lane whose factorization or solution failed, with that lane's own error.
+    pub fn try_forward_dynamics_lanes(
         &self,
         q: &[T; 7],
         qd: &[T; 6],
         tau: &[T; 6],
-    ) -> ::core::result::Result<[T; 6], ::eomgen_runtime::FactorError> {
+    ) -> ::core::result::Result<[T; 6], ::eomgen_runtime::LaneError> {
+        match self.forward_dynamics_checked(q, qd, tau) {
+            Ok((qdd, failures)) => {
+                ::eomgen_runtime::lane::lanes_ok::<_, T>(qdd, &failures)
+            }
+            Err(error) => {
+                Err(::eomgen_runtime::LaneError {
+                    lane: 0,
+                    error,
+                })
+            }
+        }
+    }
+    /// The accelerations and each lane's failure (a scalar returns its first at once).
+    fn forward_dynamics_checked(
+        &self,
+        q: &[T; 7],
+        qd: &[T; 6],
+        tau: &[T; 6],
+    ) -> ::core::result::Result<
+        ([T; 6], <T as ::eomgen_runtime::Lane>::Failures),
+        ::eomgen_runtime::FactorError,
+    > {
+        let mut failures: <T as ::eomgen_runtime::Lane>::Failures = ::core::default::Default::default();
         let o: [T; 12] = {
             let t0 = q[3] * q[5];
             let t1 = q[4] * q[5];
@@ -371,118 +481,13 @@ impl<T: ::eomgen_runtime::Real> IrisSimple<T> {
                 T::from_f64(0.057553016000000005),
             ]
         };
-        let pivots = [o[6], o[7], o[8], o[9], o[10], o[11]];
-        for (pivot, d) in pivots.iter().enumerate() {
-            if !d.is_finite() {
-                return Err(::eomgen_runtime::FactorError::NonFinite {
-                    pivot,
-                });
-            }
-            if *d <= T::zero() {
-                return Err(::eomgen_runtime::FactorError::NotPositiveDefinite {
-                    pivot,
-                });
-            }
-        }
+        ::eomgen_runtime::lane::check_pivots(
+            &[o[6], o[7], o[8], o[9], o[10], o[11]],
+            &mut failures,
+        )?;
         let qdd = [o[0], o[1], o[2], o[3], o[4], o[5]];
-        for (pivot, x) in qdd.iter().enumerate() {
-            if !x.is_finite() {
-                return Err(::eomgen_runtime::FactorError::NonFinite {
-                    pivot,
-                });
-            }
-        }
-        Ok(qdd)
-    }
-    /// The Christoffel-form Coriolis matrix C(q, qd): C qd = b, dM/dt - 2C skew-symmetric.
-    ///
-    /// Route: Echeandia and Wensing's O(N^2) recursion on composite inertias and momenta.
-    /// Operations: 26 mul, 8 add, 0 div, 0 sin, 0 cos.
-    pub fn coriolis_matrix(&self, q: &[T; 7], qd: &[T; 6]) -> [[T; 6]; 6] {
-        let t0 = T::from_f64(0.00045999999999999996) * qd[5];
-        let t1 = -T::from_f64(0.00045999999999999996) * qd[5];
-        [
-            [
-                T::zero(),
-                -T::from_f64(1.5349999999999995) * qd[5],
-                T::from_f64(1.5349999999999995) * qd[4],
-                t0,
-                T::zero(),
-                T::zero(),
-            ],
-            [
-                T::from_f64(1.5349999999999995) * qd[5],
-                T::zero(),
-                -T::from_f64(1.5349999999999995) * qd[3],
-                T::zero(),
-                t0,
-                T::zero(),
-            ],
-            [
-                -T::from_f64(1.5349999999999995) * qd[4],
-                T::from_f64(1.5349999999999995) * qd[3],
-                T::zero(),
-                -T::from_f64(0.00045999999999999996) * qd[3],
-                -T::from_f64(0.00045999999999999996) * qd[4],
-                T::zero(),
-            ],
-            [
-                t1,
-                T::zero(),
-                T::from_f64(0.00045999999999999996) * qd[3],
-                T::zero(),
-                T::mul_add(
-                    -T::from_f64(0.001528230000000002),
-                    qd[5],
-                    T::mul_add(
-                        -T::from_f64(0.000000000000000000006776263578034403),
-                        qd[4],
-                        -T::from_f64(0.000000000000000000005082197683525802) * qd[3],
-                    ),
-                ),
-                T::mul_add(
-                    T::from_f64(0.000000000000000000006776263578034403),
-                    qd[5],
-                    T::from_f64(0.028505250000000006) * qd[4],
-                ),
-            ],
-            [
-                T::zero(),
-                t1,
-                T::from_f64(0.00045999999999999996) * qd[4],
-                T::mul_add(
-                    T::from_f64(0.001528230000000002),
-                    qd[5],
-                    T::mul_add(
-                        T::from_f64(0.000000000000000000006776263578034403),
-                        qd[4],
-                        T::from_f64(0.000000000000000000005082197683525802) * qd[3],
-                    ),
-                ),
-                T::zero(),
-                T::mul_add(
-                    -T::from_f64(0.000000000000000000005082197683525802),
-                    qd[5],
-                    -T::from_f64(0.029047766000000003) * qd[3],
-                ),
-            ],
-            [
-                T::zero(),
-                T::zero(),
-                T::zero(),
-                T::mul_add(
-                    -T::from_f64(0.000000000000000000006776263578034403),
-                    qd[5],
-                    -T::from_f64(0.028505250000000006) * qd[4],
-                ),
-                T::mul_add(
-                    T::from_f64(0.000000000000000000005082197683525802),
-                    qd[5],
-                    T::from_f64(0.029047766000000003) * qd[3],
-                ),
-                T::zero(),
-            ],
-        ]
+        ::eomgen_runtime::lane::check_finite(&qdd, &mut failures)?;
+        Ok((qdd, failures))
     }
     /// The kinetic energy T = qd^T M(q) qd / 2.
     ///
@@ -585,30 +590,6 @@ impl<T: ::eomgen_runtime::Real> IrisSimple<T> {
                 q[2],
                 T::from_f64(0.004512599999999999),
             ),
-        )
-    }
-    /// Pose of a link frame in the world (root) frame.
-    ///
-    /// Route: each joint's transform composed along the link's chain from the root.
-    pub fn link_pose(
-        &self,
-        link: IrisSimpleLink,
-        q: &[T; 7],
-    ) -> ::eomgen_runtime::Pose<T> {
-        let (path, placement) = Self::link_frame(link);
-        ::eomgen_runtime::tree::chain_pose(path, |j| self.joint_transform(j, q))
-            .compose(&placement)
-    }
-    /// The 6 x N Jacobian of a link frame: rows vx, vy, vz, wx, wy, wz in world axes, at the link origin.
-    ///
-    /// Route: joint axes and origins along the link's chain, from the same transforms as `link_pose`.
-    pub fn link_jacobian(&self, link: IrisSimpleLink, q: &[T; 7]) -> [[T; 6]; 6] {
-        let (path, placement) = Self::link_frame(link);
-        ::eomgen_runtime::free_flyer::chain_jacobian(
-            path,
-            &Self::TREE_JOINTS,
-            |j| self.joint_transform(j, q),
-            &placement,
         )
     }
     /// The centre of mass of the moving bodies in world coordinates (a fixed root link, welded to the world, is not counted).
@@ -869,104 +850,6 @@ impl<T: ::eomgen_runtime::Real> IrisSimple<T> {
             ],
         ]
     }
-    /// The spatial velocity of a link frame: the velocity of its origin, then its angular velocity,
-    /// world axes (Pinocchio's `getFrameVelocity`, LOCAL_WORLD_ALIGNED); `link_jacobian` times `qd`.
-    ///
-    /// Route: each body's pose, velocity and acceleration walked along the link's chain from the same transforms as `link_pose` (eomgen_runtime::frame).
-    pub fn link_velocity(
-        &self,
-        link: IrisSimpleLink,
-        q: &[T; 7],
-        qd: &[T; 6],
-    ) -> [T; 6] {
-        let (path, placement) = Self::link_frame(link);
-        let chain = ::eomgen_runtime::frame::Chain {
-            path,
-            joints: &Self::TREE_JOINTS,
-            floating: true,
-            transform: |j| self.joint_transform(j, q),
-            placement,
-        };
-        ::eomgen_runtime::frame::velocity(&chain, qd)
-    }
-    /// The classical acceleration of a link frame: the acceleration of its origin, then its angular
-    /// acceleration, world axes (Pinocchio's `getFrameClassicalAcceleration`, LOCAL_WORLD_ALIGNED);
-    /// `J qdd + dJ/dt qd`.
-    ///
-    /// Route: each body's pose, velocity and acceleration walked along the link's chain from the same transforms as `link_pose` (eomgen_runtime::frame).
-    pub fn link_acceleration(
-        &self,
-        link: IrisSimpleLink,
-        q: &[T; 7],
-        qd: &[T; 6],
-        qdd: &[T; 6],
-    ) -> [T; 6] {
-        let (path, placement) = Self::link_frame(link);
-        let chain = ::eomgen_runtime::frame::Chain {
-            path,
-            joints: &Self::TREE_JOINTS,
-            floating: true,
-            transform: |j| self.joint_transform(j, q),
-            placement,
-        };
-        ::eomgen_runtime::frame::acceleration(&chain, qd, qdd)
-    }
-    /// The time derivative of `link_jacobian` at velocity `qd`, 6 x N, rows as `link_jacobian`
-    /// (Pinocchio's `getFrameJacobianTimeVariation`, LOCAL_WORLD_ALIGNED).
-    ///
-    /// Route: each body's pose, velocity and acceleration walked along the link's chain from the same transforms as `link_pose` (eomgen_runtime::frame).
-    pub fn link_jacobian_time_variation(
-        &self,
-        link: IrisSimpleLink,
-        q: &[T; 7],
-        qd: &[T; 6],
-    ) -> [[T; 6]; 6] {
-        let (path, placement) = Self::link_frame(link);
-        let chain = ::eomgen_runtime::frame::Chain {
-            path,
-            joints: &Self::TREE_JOINTS,
-            floating: true,
-            transform: |j| self.joint_transform(j, q),
-            placement,
-        };
-        ::eomgen_runtime::frame::jacobian_time_variation(&chain, qd)
-    }
-    /// `difference(q0, q1)`: the velocity that moves `q0` to `q1` in unit time, so that
-    /// `integrate(q0, difference(q0, q1), 1) = q1` (Pinocchio's `difference`). A floating base's
-    /// quaternions may have either sign.
-    ///
-    /// The base moves along the SE(3) exponential (`integrate(q, v, 1) = q exp6(v)`), the joints as a vector space.
-    ///
-    /// Route: the base's block in closed form (SE(3) logarithm, adjoint, right Jacobian of exp6 and its inverse), identity for the joints (eomgen_runtime::manifold).
-    pub fn difference(&self, q0: &[T; 7], q1: &[T; 7]) -> [T; 6] {
-        ::eomgen_runtime::manifold::difference(q0, q1)
-    }
-    /// The Jacobians of `integrate(q, v, 1)` in `q` and in `v`, q perturbed in its tangent space
-    /// (Pinocchio's `dIntegrate`, ARG0 and ARG1); element `[i][j]` = d out_i / d in_j.
-    ///
-    /// The base moves along the SE(3) exponential (`integrate(q, v, 1) = q exp6(v)`), the joints as a vector space.
-    ///
-    /// Route: the base's block in closed form (SE(3) logarithm, adjoint, right Jacobian of exp6 and its inverse), identity for the joints (eomgen_runtime::manifold).
-    pub fn integrate_jacobians(
-        &self,
-        q: &[T; 7],
-        v: &[T; 6],
-    ) -> ([[T; 6]; 6], [[T; 6]; 6]) {
-        ::eomgen_runtime::manifold::integrate_jacobians(q, v)
-    }
-    /// The Jacobians of `difference(q0, q1)` in `q0` and in `q1`, both perturbed in their tangent
-    /// spaces (Pinocchio's `dDifference`, ARG0 and ARG1); element `[i][j]` = d out_i / d in_j.
-    ///
-    /// The base moves along the SE(3) exponential (`integrate(q, v, 1) = q exp6(v)`), the joints as a vector space.
-    ///
-    /// Route: the base's block in closed form (SE(3) logarithm, adjoint, right Jacobian of exp6 and its inverse), identity for the joints (eomgen_runtime::manifold).
-    pub fn difference_jacobians(
-        &self,
-        q0: &[T; 7],
-        q1: &[T; 7],
-    ) -> ([[T; 6]; 6], [[T; 6]; 6]) {
-        ::eomgen_runtime::manifold::difference_jacobians(q0, q1)
-    }
     /// The rate of the centroidal momentum, `dh/dt = A_g qdd + dA_g/dt qd`: the rate of the linear
     /// momentum, then of the angular momentum about the centre of mass, world axes (Pinocchio's
     /// `computeCentroidalMomentumTimeVariation`, its `dhg`).
@@ -1143,6 +1026,157 @@ impl<T: ::eomgen_runtime::Real> IrisSimple<T> {
             ),
         ]
     }
+}
+#[allow(
+    unused_variables,
+    clippy::approx_constant,
+    clippy::excessive_precision,
+    clippy::unreadable_literal,
+    clippy::neg_multiply,
+    clippy::double_parens,
+    clippy::identity_op,
+    clippy::needless_range_loop,
+    clippy::let_and_return,
+    clippy::type_complexity,
+    clippy::too_many_arguments
+)]
+impl<T: ::eomgen_runtime::Real> IrisSimple<T> {
+    /// Forward dynamics `qdd = M(q)^-1 (tau - b(q, qd) - G(q))`, or which pivot of the
+    /// `L^T D L` factorization of M(q) was not positive (a non-physical model or
+    /// non-finite input); see `forward_dynamics` for the route and operation count.
+    /// `Ok` holds only finite numbers: a non-finite component `i` of the solution (from
+    /// a non-finite `qd` or `tau`, or a `q` that leaves M(q) finite) is reported as
+    /// `FactorError::NonFinite { pivot: i }`.
+    pub fn try_forward_dynamics(
+        &self,
+        q: &[T; 7],
+        qd: &[T; 6],
+        tau: &[T; 6],
+    ) -> ::core::result::Result<[T; 6], ::eomgen_runtime::FactorError> {
+        self.forward_dynamics_checked(q, qd, tau).map(|(qdd, _)| qdd)
+    }
+    /// Pose of a link frame in the world (root) frame.
+    ///
+    /// Route: each joint's transform composed along the link's chain from the root.
+    pub fn link_pose(
+        &self,
+        link: IrisSimpleLink,
+        q: &[T; 7],
+    ) -> ::eomgen_runtime::Pose<T> {
+        let (path, placement) = Self::link_frame(link);
+        ::eomgen_runtime::tree::chain_pose(path, |j| self.joint_transform(j, q))
+            .compose(&placement)
+    }
+    /// The 6 x N Jacobian of a link frame: rows vx, vy, vz, wx, wy, wz in world axes, at the link origin.
+    ///
+    /// Route: joint axes and origins along the link's chain, from the same transforms as `link_pose`.
+    pub fn link_jacobian(&self, link: IrisSimpleLink, q: &[T; 7]) -> [[T; 6]; 6] {
+        let (path, placement) = Self::link_frame(link);
+        ::eomgen_runtime::free_flyer::chain_jacobian(
+            path,
+            &Self::TREE_JOINTS,
+            |j| self.joint_transform(j, q),
+            &placement,
+        )
+    }
+    /// The spatial velocity of a link frame: the velocity of its origin, then its angular velocity,
+    /// world axes (Pinocchio's `getFrameVelocity`, LOCAL_WORLD_ALIGNED); `link_jacobian` times `qd`.
+    ///
+    /// Route: each body's pose, velocity and acceleration walked along the link's chain from the same transforms as `link_pose` (eomgen_runtime::frame).
+    pub fn link_velocity(
+        &self,
+        link: IrisSimpleLink,
+        q: &[T; 7],
+        qd: &[T; 6],
+    ) -> [T; 6] {
+        let (path, placement) = Self::link_frame(link);
+        let chain = ::eomgen_runtime::frame::Chain {
+            path,
+            joints: &Self::TREE_JOINTS,
+            floating: true,
+            transform: |j| self.joint_transform(j, q),
+            placement,
+        };
+        ::eomgen_runtime::frame::velocity(&chain, qd)
+    }
+    /// The classical acceleration of a link frame: the acceleration of its origin, then its angular
+    /// acceleration, world axes (Pinocchio's `getFrameClassicalAcceleration`, LOCAL_WORLD_ALIGNED);
+    /// `J qdd + dJ/dt qd`.
+    ///
+    /// Route: each body's pose, velocity and acceleration walked along the link's chain from the same transforms as `link_pose` (eomgen_runtime::frame).
+    pub fn link_acceleration(
+        &self,
+        link: IrisSimpleLink,
+        q: &[T; 7],
+        qd: &[T; 6],
+        qdd: &[T; 6],
+    ) -> [T; 6] {
+        let (path, placement) = Self::link_frame(link);
+        let chain = ::eomgen_runtime::frame::Chain {
+            path,
+            joints: &Self::TREE_JOINTS,
+            floating: true,
+            transform: |j| self.joint_transform(j, q),
+            placement,
+        };
+        ::eomgen_runtime::frame::acceleration(&chain, qd, qdd)
+    }
+    /// The time derivative of `link_jacobian` at velocity `qd`, 6 x N, rows as `link_jacobian`
+    /// (Pinocchio's `getFrameJacobianTimeVariation`, LOCAL_WORLD_ALIGNED).
+    ///
+    /// Route: each body's pose, velocity and acceleration walked along the link's chain from the same transforms as `link_pose` (eomgen_runtime::frame).
+    pub fn link_jacobian_time_variation(
+        &self,
+        link: IrisSimpleLink,
+        q: &[T; 7],
+        qd: &[T; 6],
+    ) -> [[T; 6]; 6] {
+        let (path, placement) = Self::link_frame(link);
+        let chain = ::eomgen_runtime::frame::Chain {
+            path,
+            joints: &Self::TREE_JOINTS,
+            floating: true,
+            transform: |j| self.joint_transform(j, q),
+            placement,
+        };
+        ::eomgen_runtime::frame::jacobian_time_variation(&chain, qd)
+    }
+    /// `difference(q0, q1)`: the velocity that moves `q0` to `q1` in unit time, so that
+    /// `integrate(q0, difference(q0, q1), 1) = q1` (Pinocchio's `difference`). A floating base's
+    /// quaternions may have either sign.
+    ///
+    /// The base moves along the SE(3) exponential (`integrate(q, v, 1) = q exp6(v)`), the joints as a vector space.
+    ///
+    /// Route: the base's block in closed form (SE(3) logarithm, adjoint, right Jacobian of exp6 and its inverse), identity for the joints (eomgen_runtime::manifold).
+    pub fn difference(&self, q0: &[T; 7], q1: &[T; 7]) -> [T; 6] {
+        ::eomgen_runtime::manifold::difference(q0, q1)
+    }
+    /// The Jacobians of `integrate(q, v, 1)` in `q` and in `v`, q perturbed in its tangent space
+    /// (Pinocchio's `dIntegrate`, ARG0 and ARG1); element `[i][j]` = d out_i / d in_j.
+    ///
+    /// The base moves along the SE(3) exponential (`integrate(q, v, 1) = q exp6(v)`), the joints as a vector space.
+    ///
+    /// Route: the base's block in closed form (SE(3) logarithm, adjoint, right Jacobian of exp6 and its inverse), identity for the joints (eomgen_runtime::manifold).
+    pub fn integrate_jacobians(
+        &self,
+        q: &[T; 7],
+        v: &[T; 6],
+    ) -> ([[T; 6]; 6], [[T; 6]; 6]) {
+        ::eomgen_runtime::manifold::integrate_jacobians(q, v)
+    }
+    /// The Jacobians of `difference(q0, q1)` in `q0` and in `q1`, both perturbed in their tangent
+    /// spaces (Pinocchio's `dDifference`, ARG0 and ARG1); element `[i][j]` = d out_i / d in_j.
+    ///
+    /// The base moves along the SE(3) exponential (`integrate(q, v, 1) = q exp6(v)`), the joints as a vector space.
+    ///
+    /// Route: the base's block in closed form (SE(3) logarithm, adjoint, right Jacobian of exp6 and its inverse), identity for the joints (eomgen_runtime::manifold).
+    pub fn difference_jacobians(
+        &self,
+        q0: &[T; 7],
+        q1: &[T; 7],
+    ) -> ([[T; 6]; 6], [[T; 6]; 6]) {
+        ::eomgen_runtime::manifold::difference_jacobians(q0, q1)
+    }
     /// Each joint's axis (in the frame of the body it moves) and motion.
     const TREE_JOINTS: [::eomgen_runtime::tree::TreeJoint; 0] = [];
     /// The pose of body `j` in its parent body's frame (a floating base is body 0).
@@ -1301,7 +1335,7 @@ impl<T: ::eomgen_runtime::Real> IrisSimple<T> {
     clippy::type_complexity,
     clippy::too_many_arguments
 )]
-impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::FloatingDynamics<T, 7, 6>
+impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::FloatingDynamics<T, 7, 6>
 for IrisSimple<T> {
     /// The joint-space mass matrix M(q), symmetric positive definite.
     ///
@@ -1572,8 +1606,8 @@ for IrisSimple<T> {
     /// Route: M and b + G as in `mass_matrix` and `bias`, then an unrolled L^T D L solve without fill-in.
     /// Operations: 75 mul, 89 add, 0 div, 0 sin, 0 cos.
     fn forward_dynamics(&self, q: &[T; 7], qd: &[T; 6], tau: &[T; 6]) -> [T; 6] {
-        match self.try_forward_dynamics(q, qd, tau) {
-            Ok(qdd) => qdd,
+        match self.forward_dynamics_checked(q, qd, tau) {
+            Ok((qdd, failures)) => ::eomgen_runtime::lane::nan_failed(qdd, &failures),
             Err(_) => [T::nan(); 6],
         }
     }
@@ -1583,5 +1617,397 @@ for IrisSimple<T> {
     /// Route: eomgen_runtime::free_flyer::integrate.
     fn integrate(&self, q: &[T; 7], qd: &[T; 6], dt: T) -> [T; 7] {
         ::eomgen_runtime::free_flyer::integrate(q, qd, dt)
+    }
+}
+#[allow(
+    unused_variables,
+    clippy::approx_constant,
+    clippy::excessive_precision,
+    clippy::unreadable_literal,
+    clippy::neg_multiply,
+    clippy::double_parens,
+    clippy::identity_op,
+    clippy::needless_range_loop,
+    clippy::let_and_return,
+    clippy::type_complexity,
+    clippy::too_many_arguments
+)]
+impl<T: ::eomgen_runtime::batch::Batch> IrisSimple<T> {
+    /// This robot's parameters in every lane of `L` (a vector of states such as
+    /// `wide::f64x4`, with `eomgen_runtime`'s `simd` feature): the robot whose
+    /// methods evaluate one state per lane.
+    pub fn in_lanes<L: ::eomgen_runtime::lane::Pack<Scalar = T>>(
+        &self,
+    ) -> IrisSimple<L> {
+        IrisSimple {
+            _marker: ::core::marker::PhantomData,
+        }
+    }
+    /// `mass_matrix` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out`.
+    pub fn mass_matrix_batch(
+        &self,
+        q: &[[T; 7]],
+        out: &mut [[[T; 6]; 6]],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
+        let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
+        ::eomgen_runtime::batch::run(
+            <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            out,
+            &|start: usize, out: &mut [[[T; 6]; 6]]| {
+                let r = <IrisSimple<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                > as ::eomgen_runtime::FloatingDynamics<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                    7,
+                    6,
+                >>::mass_matrix(&robot, &::eomgen_runtime::batch::gather(q, start));
+                ::eomgen_runtime::batch::scatter_matrix(&r, out);
+            },
+        );
+        Ok(())
+    }
+    /// `gravity` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out`.
+    pub fn gravity_batch(
+        &self,
+        q: &[[T; 7]],
+        out: &mut [[T; 6]],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
+        let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
+        ::eomgen_runtime::batch::run(
+            <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            out,
+            &|start: usize, out: &mut [[T; 6]]| {
+                let r = <IrisSimple<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                > as ::eomgen_runtime::FloatingDynamics<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                    7,
+                    6,
+                >>::gravity(&robot, &::eomgen_runtime::batch::gather(q, start));
+                ::eomgen_runtime::batch::scatter(&r, out);
+            },
+        );
+        Ok(())
+    }
+    /// `bias` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out`.
+    pub fn bias_batch(
+        &self,
+        q: &[[T; 7]],
+        qd: &[[T; 6]],
+        out: &mut [[T; 6]],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
+        let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
+        ::eomgen_runtime::batch::run(
+            <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            out,
+            &|start: usize, out: &mut [[T; 6]]| {
+                let r = <IrisSimple<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                > as ::eomgen_runtime::FloatingDynamics<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                    7,
+                    6,
+                >>::bias(
+                    &robot,
+                    &::eomgen_runtime::batch::gather(q, start),
+                    &::eomgen_runtime::batch::gather(qd, start),
+                );
+                ::eomgen_runtime::batch::scatter(&r, out);
+            },
+        );
+        Ok(())
+    }
+    /// `coriolis_matrix` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out`.
+    pub fn coriolis_matrix_batch(
+        &self,
+        q: &[[T; 7]],
+        qd: &[[T; 6]],
+        out: &mut [[[T; 6]; 6]],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
+        let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
+        ::eomgen_runtime::batch::run(
+            <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            out,
+            &|start: usize, out: &mut [[[T; 6]; 6]]| {
+                let r = IrisSimple::<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                >::coriolis_matrix(
+                    &robot,
+                    &::eomgen_runtime::batch::gather(q, start),
+                    &::eomgen_runtime::batch::gather(qd, start),
+                );
+                ::eomgen_runtime::batch::scatter_matrix(&r, out);
+            },
+        );
+        Ok(())
+    }
+    /// `inverse_dynamics` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out`.
+    pub fn inverse_dynamics_batch(
+        &self,
+        q: &[[T; 7]],
+        qd: &[[T; 6]],
+        qdd: &[[T; 6]],
+        out: &mut [[T; 6]],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(
+            out.len(),
+            &[("q", q.len()), ("qd", qd.len()), ("qdd", qdd.len())],
+        )?;
+        let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
+        ::eomgen_runtime::batch::run(
+            <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            out,
+            &|start: usize, out: &mut [[T; 6]]| {
+                let r = <IrisSimple<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                > as ::eomgen_runtime::FloatingDynamics<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                    7,
+                    6,
+                >>::inverse_dynamics(
+                    &robot,
+                    &::eomgen_runtime::batch::gather(q, start),
+                    &::eomgen_runtime::batch::gather(qd, start),
+                    &::eomgen_runtime::batch::gather(qdd, start),
+                );
+                ::eomgen_runtime::batch::scatter(&r, out);
+            },
+        );
+        Ok(())
+    }
+    /// `forward_dynamics` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out`.
+    pub fn forward_dynamics_batch(
+        &self,
+        q: &[[T; 7]],
+        qd: &[[T; 6]],
+        tau: &[[T; 6]],
+        out: &mut [[T; 6]],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(
+            out.len(),
+            &[("q", q.len()), ("qd", qd.len()), ("tau", tau.len())],
+        )?;
+        let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
+        ::eomgen_runtime::batch::run(
+            <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            out,
+            &|start: usize, out: &mut [[T; 6]]| {
+                let r = <IrisSimple<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                > as ::eomgen_runtime::FloatingDynamics<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                    7,
+                    6,
+                >>::forward_dynamics(
+                    &robot,
+                    &::eomgen_runtime::batch::gather(q, start),
+                    &::eomgen_runtime::batch::gather(qd, start),
+                    &::eomgen_runtime::batch::gather(tau, start),
+                );
+                ::eomgen_runtime::batch::scatter(&r, out);
+            },
+        );
+        Ok(())
+    }
+    /// `kinetic_energy` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out`.
+    pub fn kinetic_energy_batch(
+        &self,
+        q: &[[T; 7]],
+        qd: &[[T; 6]],
+        out: &mut [T],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
+        let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
+        ::eomgen_runtime::batch::run(
+            <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            out,
+            &|start: usize, out: &mut [T]| {
+                let r = IrisSimple::<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                >::kinetic_energy(
+                    &robot,
+                    &::eomgen_runtime::batch::gather(q, start),
+                    &::eomgen_runtime::batch::gather(qd, start),
+                );
+                ::eomgen_runtime::batch::scatter_scalar(r, out);
+            },
+        );
+        Ok(())
+    }
+    /// `generalized_momentum` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out`.
+    pub fn generalized_momentum_batch(
+        &self,
+        q: &[[T; 7]],
+        qd: &[[T; 6]],
+        out: &mut [[T; 6]],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
+        let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
+        ::eomgen_runtime::batch::run(
+            <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            out,
+            &|start: usize, out: &mut [[T; 6]]| {
+                let r = IrisSimple::<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                >::generalized_momentum(
+                    &robot,
+                    &::eomgen_runtime::batch::gather(q, start),
+                    &::eomgen_runtime::batch::gather(qd, start),
+                );
+                ::eomgen_runtime::batch::scatter(&r, out);
+            },
+        );
+        Ok(())
+    }
+    /// `potential_energy` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out`.
+    pub fn potential_energy_batch(
+        &self,
+        q: &[[T; 7]],
+        out: &mut [T],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
+        let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
+        ::eomgen_runtime::batch::run(
+            <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            out,
+            &|start: usize, out: &mut [T]| {
+                let r = IrisSimple::<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                >::potential_energy(&robot, &::eomgen_runtime::batch::gather(q, start));
+                ::eomgen_runtime::batch::scatter_scalar(r, out);
+            },
+        );
+        Ok(())
+    }
+    /// `center_of_mass` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out`.
+    pub fn center_of_mass_batch(
+        &self,
+        q: &[[T; 7]],
+        out: &mut [[T; 3]],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
+        let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
+        ::eomgen_runtime::batch::run(
+            <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            out,
+            &|start: usize, out: &mut [[T; 3]]| {
+                let r = IrisSimple::<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                >::center_of_mass(&robot, &::eomgen_runtime::batch::gather(q, start));
+                ::eomgen_runtime::batch::scatter(&r, out);
+            },
+        );
+        Ok(())
+    }
+    /// `center_of_mass_jacobian` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out`.
+    pub fn center_of_mass_jacobian_batch(
+        &self,
+        q: &[[T; 7]],
+        out: &mut [[[T; 6]; 3]],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
+        let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
+        ::eomgen_runtime::batch::run(
+            <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            out,
+            &|start: usize, out: &mut [[[T; 6]; 3]]| {
+                let r = IrisSimple::<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                >::center_of_mass_jacobian(
+                    &robot,
+                    &::eomgen_runtime::batch::gather(q, start),
+                );
+                ::eomgen_runtime::batch::scatter_matrix(&r, out);
+            },
+        );
+        Ok(())
+    }
+    /// `centroidal_map` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out`.
+    pub fn centroidal_map_batch(
+        &self,
+        q: &[[T; 7]],
+        out: &mut [[[T; 6]; 6]],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
+        let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
+        ::eomgen_runtime::batch::run(
+            <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            out,
+            &|start: usize, out: &mut [[[T; 6]; 6]]| {
+                let r = IrisSimple::<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                >::centroidal_map(&robot, &::eomgen_runtime::batch::gather(q, start));
+                ::eomgen_runtime::batch::scatter_matrix(&r, out);
+            },
+        );
+        Ok(())
+    }
+    /// `integrate` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out`.
+    pub fn integrate_batch(
+        &self,
+        q: &[[T; 7]],
+        qd: &[[T; 6]],
+        dt: T,
+        out: &mut [[T; 7]],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
+        let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
+        let dt = <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::from_f64(
+            ::eomgen_runtime::Real::to_f64(dt),
+        );
+        ::eomgen_runtime::batch::run(
+            <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            out,
+            &|start: usize, out: &mut [[T; 7]]| {
+                let r = <IrisSimple<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                > as ::eomgen_runtime::FloatingDynamics<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                    7,
+                    6,
+                >>::integrate(
+                    &robot,
+                    &::eomgen_runtime::batch::gather(q, start),
+                    &::eomgen_runtime::batch::gather(qd, start),
+                    dt,
+                );
+                ::eomgen_runtime::batch::scatter(&r, out);
+            },
+        );
+        Ok(())
+    }
+    /// `centroidal_momentum_rate` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out`.
+    pub fn centroidal_momentum_rate_batch(
+        &self,
+        q: &[[T; 7]],
+        qd: &[[T; 6]],
+        qdd: &[[T; 6]],
+        out: &mut [[T; 6]],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(
+            out.len(),
+            &[("q", q.len()), ("qd", qd.len()), ("qdd", qdd.len())],
+        )?;
+        let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
+        ::eomgen_runtime::batch::run(
+            <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            out,
+            &|start: usize, out: &mut [[T; 6]]| {
+                let r = IrisSimple::<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                >::centroidal_momentum_rate(
+                    &robot,
+                    &::eomgen_runtime::batch::gather(q, start),
+                    &::eomgen_runtime::batch::gather(qd, start),
+                    &::eomgen_runtime::batch::gather(qdd, start),
+                );
+                ::eomgen_runtime::batch::scatter(&r, out);
+            },
+        );
+        Ok(())
     }
 }

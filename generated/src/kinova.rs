@@ -9,7 +9,7 @@
 pub struct Kinova<T = f64> {
     _marker: ::core::marker::PhantomData<T>,
 }
-impl<T: ::eomgen_runtime::Real> ::core::default::Default for Kinova<T> {
+impl<T: ::eomgen_runtime::Lane> ::core::default::Default for Kinova<T> {
     fn default() -> Self {
         Kinova {
             _marker: ::core::marker::PhantomData,
@@ -73,7 +73,7 @@ impl Kinova<f64> {
     /// Number of joint coordinates (velocity coordinates with a floating base).
     pub const DOF: usize = 6;
 }
-impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dimensions for Kinova<T> {
+impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dimensions for Kinova<T> {
     const DOF: usize = 6;
     const NQ: usize = 6;
     const NV: usize = 6;
@@ -91,7 +91,7 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dimensions for Kinova<T> {
     clippy::type_complexity,
     clippy::too_many_arguments
 )]
-impl<T: ::eomgen_runtime::Real> Kinova<T> {
+impl<T: ::eomgen_runtime::Lane> Kinova<T> {
     /// Each coordinate's parent coordinate (`None`: the root), parents first: the
     /// joints' parents (a floating base's six coordinates form a chain). The sparsity
     /// of `mass_matrix` that the runtime's tree solves take (`eomgen_runtime::tree`,
@@ -124,18 +124,38 @@ impl<T: ::eomgen_runtime::Real> Kinova<T> {
     ];
     /// Each joint coordinate's effort limit (N m or N) from the URDF's `<limit effort>`, in `JOINT_NAMES` order; infinite without `<limit>`.
     pub const EFFORT_LIMITS: [f64; 6] = [40.0, 80.0, 40.0, 20.0, 20.0, 20.0];
-    /// Forward dynamics `qdd = M(q)^-1 (tau - b(q, qd) - G(q))`, or which pivot of the
-    /// `L^T D L` factorization of M(q) was not positive (a non-physical model or
-    /// non-finite input); see `forward_dynamics` for the route and operation count.
-    /// `Ok` holds only finite numbers: a non-finite component `i` of the solution (from
-    /// a non-finite `qd` or `tau`, or a `q` that leaves M(q) finite) is reported as
-    /// `FactorError::NonFinite { pivot: i }`.
-    pub fn try_forward_dynamics(
+    /// `try_forward_dynamics` on a vector of states (`eomgen_runtime::Lane`, one state
+    /// per lane; a scalar is lane 0): the accelerations of every lane, or the lowest
+    /// lane whose factorization or solution failed, with that lane's own error.
+    pub fn try_forward_dynamics_lanes(
         &self,
         q: &[T; 6],
         qd: &[T; 6],
         tau: &[T; 6],
-    ) -> ::core::result::Result<[T; 6], ::eomgen_runtime::FactorError> {
+    ) -> ::core::result::Result<[T; 6], ::eomgen_runtime::LaneError> {
+        match self.forward_dynamics_checked(q, qd, tau) {
+            Ok((qdd, failures)) => {
+                ::eomgen_runtime::lane::lanes_ok::<_, T>(qdd, &failures)
+            }
+            Err(error) => {
+                Err(::eomgen_runtime::LaneError {
+                    lane: 0,
+                    error,
+                })
+            }
+        }
+    }
+    /// The accelerations and each lane's failure (a scalar returns its first at once).
+    fn forward_dynamics_checked(
+        &self,
+        q: &[T; 6],
+        qd: &[T; 6],
+        tau: &[T; 6],
+    ) -> ::core::result::Result<
+        ([T; 6], <T as ::eomgen_runtime::Lane>::Failures),
+        ::eomgen_runtime::FactorError,
+    > {
+        let mut failures: <T as ::eomgen_runtime::Lane>::Failures = ::core::default::Default::default();
         let o: [T; 12] = {
             let (s1, c1) = q[1].sin_cos();
             let (s2, c2) = q[2].sin_cos();
@@ -2381,28 +2401,13 @@ impl<T: ::eomgen_runtime::Real> Kinova<T> {
                 T::from_f64(0.0007776443641723163),
             ]
         };
-        let pivots = [o[6], o[7], o[8], o[9], o[10], o[11]];
-        for (pivot, d) in pivots.iter().enumerate() {
-            if !d.is_finite() {
-                return Err(::eomgen_runtime::FactorError::NonFinite {
-                    pivot,
-                });
-            }
-            if *d <= T::zero() {
-                return Err(::eomgen_runtime::FactorError::NotPositiveDefinite {
-                    pivot,
-                });
-            }
-        }
+        ::eomgen_runtime::lane::check_pivots(
+            &[o[6], o[7], o[8], o[9], o[10], o[11]],
+            &mut failures,
+        )?;
         let qdd = [o[0], o[1], o[2], o[3], o[4], o[5]];
-        for (pivot, x) in qdd.iter().enumerate() {
-            if !x.is_finite() {
-                return Err(::eomgen_runtime::FactorError::NonFinite {
-                    pivot,
-                });
-            }
-        }
-        Ok(qdd)
+        ::eomgen_runtime::lane::check_finite(&qdd, &mut failures)?;
+        Ok((qdd, failures))
     }
     /// The generalized momentum p = M(q) qd = dT/dqd (a momentum observer's measurement).
     ///
@@ -10260,26 +10265,6 @@ impl<T: ::eomgen_runtime::Real> Kinova<T> {
             ],
         ]
     }
-    /// Pose of a link frame in the world (root) frame.
-    ///
-    /// Route: each joint's transform composed along the link's chain from the root.
-    pub fn link_pose(&self, link: KinovaLink, q: &[T; 6]) -> ::eomgen_runtime::Pose<T> {
-        let (path, placement) = Self::link_frame(link);
-        ::eomgen_runtime::tree::chain_pose(path, |j| self.joint_transform(j, q))
-            .compose(&placement)
-    }
-    /// The 6 x N Jacobian of a link frame: rows vx, vy, vz, wx, wy, wz in world axes, at the link origin.
-    ///
-    /// Route: joint axes and origins along the link's chain, from the same transforms as `link_pose`.
-    pub fn link_jacobian(&self, link: KinovaLink, q: &[T; 6]) -> [[T; 6]; 6] {
-        let (path, placement) = Self::link_frame(link);
-        ::eomgen_runtime::tree::chain_jacobian(
-            path,
-            &Self::TREE_JOINTS,
-            |j| self.joint_transform(j, q),
-            &placement,
-        )
-    }
     /// The centre of mass of the moving bodies in world coordinates (a fixed root link, welded to the world, is not counted).
     ///
     /// Route: the bodies' centres of mass by forward kinematics.
@@ -10526,6 +10511,55 @@ impl<T: ::eomgen_runtime::Real> Kinova<T> {
                 ),
             ],
         ]
+    }
+}
+#[allow(
+    unused_variables,
+    clippy::approx_constant,
+    clippy::excessive_precision,
+    clippy::unreadable_literal,
+    clippy::neg_multiply,
+    clippy::double_parens,
+    clippy::identity_op,
+    clippy::needless_range_loop,
+    clippy::let_and_return,
+    clippy::type_complexity,
+    clippy::too_many_arguments
+)]
+impl<T: ::eomgen_runtime::Real> Kinova<T> {
+    /// Forward dynamics `qdd = M(q)^-1 (tau - b(q, qd) - G(q))`, or which pivot of the
+    /// `L^T D L` factorization of M(q) was not positive (a non-physical model or
+    /// non-finite input); see `forward_dynamics` for the route and operation count.
+    /// `Ok` holds only finite numbers: a non-finite component `i` of the solution (from
+    /// a non-finite `qd` or `tau`, or a `q` that leaves M(q) finite) is reported as
+    /// `FactorError::NonFinite { pivot: i }`.
+    pub fn try_forward_dynamics(
+        &self,
+        q: &[T; 6],
+        qd: &[T; 6],
+        tau: &[T; 6],
+    ) -> ::core::result::Result<[T; 6], ::eomgen_runtime::FactorError> {
+        self.forward_dynamics_checked(q, qd, tau).map(|(qdd, _)| qdd)
+    }
+    /// Pose of a link frame in the world (root) frame.
+    ///
+    /// Route: each joint's transform composed along the link's chain from the root.
+    pub fn link_pose(&self, link: KinovaLink, q: &[T; 6]) -> ::eomgen_runtime::Pose<T> {
+        let (path, placement) = Self::link_frame(link);
+        ::eomgen_runtime::tree::chain_pose(path, |j| self.joint_transform(j, q))
+            .compose(&placement)
+    }
+    /// The 6 x N Jacobian of a link frame: rows vx, vy, vz, wx, wy, wz in world axes, at the link origin.
+    ///
+    /// Route: joint axes and origins along the link's chain, from the same transforms as `link_pose`.
+    pub fn link_jacobian(&self, link: KinovaLink, q: &[T; 6]) -> [[T; 6]; 6] {
+        let (path, placement) = Self::link_frame(link);
+        ::eomgen_runtime::tree::chain_jacobian(
+            path,
+            &Self::TREE_JOINTS,
+            |j| self.joint_transform(j, q),
+            &placement,
+        )
     }
     /// The spatial velocity of a link frame: the velocity of its origin, then its angular velocity,
     /// world axes (Pinocchio's `getFrameVelocity`, LOCAL_WORLD_ALIGNED); `link_jacobian` times `qd`.
@@ -11063,7 +11097,7 @@ impl<T: ::eomgen_runtime::Real> Kinova<T> {
     clippy::type_complexity,
     clippy::too_many_arguments
 )]
-impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 6> for Kinova<T> {
+impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Kinova<T> {
     const JOINT_NAMES: [&'static str; 6] = [
         "j2s6s200_joint_1",
         "j2s6s200_joint_2",
@@ -17448,8 +17482,8 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 6> for Kinova<T> {
     /// Route: M and b + G as in `mass_matrix` and `bias`, then an unrolled L^T D L solve without fill-in.
     /// Operations: 711 mul, 647 add, 9 div, 5 sin, 5 cos.
     fn forward_dynamics(&self, q: &[T; 6], qd: &[T; 6], tau: &[T; 6]) -> [T; 6] {
-        match self.try_forward_dynamics(q, qd, tau) {
-            Ok(qdd) => qdd,
+        match self.forward_dynamics_checked(q, qd, tau) {
+            Ok((qdd, failures)) => ::eomgen_runtime::lane::nan_failed(qdd, &failures),
             Err(_) => [T::nan(); 6],
         }
     }
@@ -17797,5 +17831,355 @@ impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, 6> for Kinova<T> {
                 ),
             ),
         )
+    }
+}
+#[allow(
+    unused_variables,
+    clippy::approx_constant,
+    clippy::excessive_precision,
+    clippy::unreadable_literal,
+    clippy::neg_multiply,
+    clippy::double_parens,
+    clippy::identity_op,
+    clippy::needless_range_loop,
+    clippy::let_and_return,
+    clippy::type_complexity,
+    clippy::too_many_arguments
+)]
+impl<T: ::eomgen_runtime::batch::Batch> Kinova<T> {
+    /// This robot's parameters in every lane of `L` (a vector of states such as
+    /// `wide::f64x4`, with `eomgen_runtime`'s `simd` feature): the robot whose
+    /// methods evaluate one state per lane.
+    pub fn in_lanes<L: ::eomgen_runtime::lane::Pack<Scalar = T>>(&self) -> Kinova<L> {
+        Kinova {
+            _marker: ::core::marker::PhantomData,
+        }
+    }
+    /// `mass_matrix` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out`.
+    pub fn mass_matrix_batch(
+        &self,
+        q: &[[T; 6]],
+        out: &mut [[[T; 6]; 6]],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
+        let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
+        ::eomgen_runtime::batch::run(
+            <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            out,
+            &|start: usize, out: &mut [[[T; 6]; 6]]| {
+                let r = <Kinova<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                > as ::eomgen_runtime::Dynamics<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                    6,
+                >>::mass_matrix(&robot, &::eomgen_runtime::batch::gather(q, start));
+                ::eomgen_runtime::batch::scatter_matrix(&r, out);
+            },
+        );
+        Ok(())
+    }
+    /// `gravity` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out`.
+    pub fn gravity_batch(
+        &self,
+        q: &[[T; 6]],
+        out: &mut [[T; 6]],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
+        let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
+        ::eomgen_runtime::batch::run(
+            <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            out,
+            &|start: usize, out: &mut [[T; 6]]| {
+                let r = <Kinova<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                > as ::eomgen_runtime::Dynamics<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                    6,
+                >>::gravity(&robot, &::eomgen_runtime::batch::gather(q, start));
+                ::eomgen_runtime::batch::scatter(&r, out);
+            },
+        );
+        Ok(())
+    }
+    /// `bias` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out`.
+    pub fn bias_batch(
+        &self,
+        q: &[[T; 6]],
+        qd: &[[T; 6]],
+        out: &mut [[T; 6]],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
+        let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
+        ::eomgen_runtime::batch::run(
+            <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            out,
+            &|start: usize, out: &mut [[T; 6]]| {
+                let r = <Kinova<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                > as ::eomgen_runtime::Dynamics<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                    6,
+                >>::bias(
+                    &robot,
+                    &::eomgen_runtime::batch::gather(q, start),
+                    &::eomgen_runtime::batch::gather(qd, start),
+                );
+                ::eomgen_runtime::batch::scatter(&r, out);
+            },
+        );
+        Ok(())
+    }
+    /// `coriolis_matrix` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out`.
+    pub fn coriolis_matrix_batch(
+        &self,
+        q: &[[T; 6]],
+        qd: &[[T; 6]],
+        out: &mut [[[T; 6]; 6]],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
+        let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
+        ::eomgen_runtime::batch::run(
+            <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            out,
+            &|start: usize, out: &mut [[[T; 6]; 6]]| {
+                let r = <Kinova<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                > as ::eomgen_runtime::Dynamics<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                    6,
+                >>::coriolis_matrix(
+                    &robot,
+                    &::eomgen_runtime::batch::gather(q, start),
+                    &::eomgen_runtime::batch::gather(qd, start),
+                );
+                ::eomgen_runtime::batch::scatter_matrix(&r, out);
+            },
+        );
+        Ok(())
+    }
+    /// `inverse_dynamics` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out`.
+    pub fn inverse_dynamics_batch(
+        &self,
+        q: &[[T; 6]],
+        qd: &[[T; 6]],
+        qdd: &[[T; 6]],
+        out: &mut [[T; 6]],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(
+            out.len(),
+            &[("q", q.len()), ("qd", qd.len()), ("qdd", qdd.len())],
+        )?;
+        let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
+        ::eomgen_runtime::batch::run(
+            <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            out,
+            &|start: usize, out: &mut [[T; 6]]| {
+                let r = <Kinova<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                > as ::eomgen_runtime::Dynamics<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                    6,
+                >>::inverse_dynamics(
+                    &robot,
+                    &::eomgen_runtime::batch::gather(q, start),
+                    &::eomgen_runtime::batch::gather(qd, start),
+                    &::eomgen_runtime::batch::gather(qdd, start),
+                );
+                ::eomgen_runtime::batch::scatter(&r, out);
+            },
+        );
+        Ok(())
+    }
+    /// `forward_dynamics` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out`.
+    pub fn forward_dynamics_batch(
+        &self,
+        q: &[[T; 6]],
+        qd: &[[T; 6]],
+        tau: &[[T; 6]],
+        out: &mut [[T; 6]],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(
+            out.len(),
+            &[("q", q.len()), ("qd", qd.len()), ("tau", tau.len())],
+        )?;
+        let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
+        ::eomgen_runtime::batch::run(
+            <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            out,
+            &|start: usize, out: &mut [[T; 6]]| {
+                let r = <Kinova<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                > as ::eomgen_runtime::Dynamics<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                    6,
+                >>::forward_dynamics(
+                    &robot,
+                    &::eomgen_runtime::batch::gather(q, start),
+                    &::eomgen_runtime::batch::gather(qd, start),
+                    &::eomgen_runtime::batch::gather(tau, start),
+                );
+                ::eomgen_runtime::batch::scatter(&r, out);
+            },
+        );
+        Ok(())
+    }
+    /// `kinetic_energy` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out`.
+    pub fn kinetic_energy_batch(
+        &self,
+        q: &[[T; 6]],
+        qd: &[[T; 6]],
+        out: &mut [T],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
+        let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
+        ::eomgen_runtime::batch::run(
+            <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            out,
+            &|start: usize, out: &mut [T]| {
+                let r = <Kinova<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                > as ::eomgen_runtime::Dynamics<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                    6,
+                >>::kinetic_energy(
+                    &robot,
+                    &::eomgen_runtime::batch::gather(q, start),
+                    &::eomgen_runtime::batch::gather(qd, start),
+                );
+                ::eomgen_runtime::batch::scatter_scalar(r, out);
+            },
+        );
+        Ok(())
+    }
+    /// `generalized_momentum` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out`.
+    pub fn generalized_momentum_batch(
+        &self,
+        q: &[[T; 6]],
+        qd: &[[T; 6]],
+        out: &mut [[T; 6]],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
+        let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
+        ::eomgen_runtime::batch::run(
+            <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            out,
+            &|start: usize, out: &mut [[T; 6]]| {
+                let r = Kinova::<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                >::generalized_momentum(
+                    &robot,
+                    &::eomgen_runtime::batch::gather(q, start),
+                    &::eomgen_runtime::batch::gather(qd, start),
+                );
+                ::eomgen_runtime::batch::scatter(&r, out);
+            },
+        );
+        Ok(())
+    }
+    /// `potential_energy` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out`.
+    pub fn potential_energy_batch(
+        &self,
+        q: &[[T; 6]],
+        out: &mut [T],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
+        let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
+        ::eomgen_runtime::batch::run(
+            <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            out,
+            &|start: usize, out: &mut [T]| {
+                let r = <Kinova<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                > as ::eomgen_runtime::Dynamics<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                    6,
+                >>::potential_energy(&robot, &::eomgen_runtime::batch::gather(q, start));
+                ::eomgen_runtime::batch::scatter_scalar(r, out);
+            },
+        );
+        Ok(())
+    }
+    /// `centrifugal` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out`.
+    pub fn centrifugal_batch(
+        &self,
+        q: &[[T; 6]],
+        out: &mut [[[T; 6]; 6]],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
+        let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
+        ::eomgen_runtime::batch::run(
+            <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            out,
+            &|start: usize, out: &mut [[[T; 6]; 6]]| {
+                let r = Kinova::<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                >::centrifugal(&robot, &::eomgen_runtime::batch::gather(q, start));
+                ::eomgen_runtime::batch::scatter_matrix(&r, out);
+            },
+        );
+        Ok(())
+    }
+    /// `coriolis_pairs` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out`.
+    pub fn coriolis_pairs_batch(
+        &self,
+        q: &[[T; 6]],
+        out: &mut [[[T; 15]; 6]],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
+        let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
+        ::eomgen_runtime::batch::run(
+            <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            out,
+            &|start: usize, out: &mut [[[T; 15]; 6]]| {
+                let r = Kinova::<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                >::coriolis_pairs(&robot, &::eomgen_runtime::batch::gather(q, start));
+                ::eomgen_runtime::batch::scatter_matrix(&r, out);
+            },
+        );
+        Ok(())
+    }
+    /// `center_of_mass` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out`.
+    pub fn center_of_mass_batch(
+        &self,
+        q: &[[T; 6]],
+        out: &mut [[T; 3]],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
+        let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
+        ::eomgen_runtime::batch::run(
+            <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            out,
+            &|start: usize, out: &mut [[T; 3]]| {
+                let r = Kinova::<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                >::center_of_mass(&robot, &::eomgen_runtime::batch::gather(q, start));
+                ::eomgen_runtime::batch::scatter(&r, out);
+            },
+        );
+        Ok(())
+    }
+    /// `center_of_mass_jacobian` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out`.
+    pub fn center_of_mass_jacobian_batch(
+        &self,
+        q: &[[T; 6]],
+        out: &mut [[[T; 6]; 3]],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
+        let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
+        ::eomgen_runtime::batch::run(
+            <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            out,
+            &|start: usize, out: &mut [[[T; 6]; 3]]| {
+                let r = Kinova::<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                >::center_of_mass_jacobian(
+                    &robot,
+                    &::eomgen_runtime::batch::gather(q, start),
+                );
+                ::eomgen_runtime::batch::scatter_matrix(&r, out);
+            },
+        );
+        Ok(())
     }
 }

@@ -3,7 +3,7 @@
 //! joints], as Pinocchio's free flyer.
 
 use crate::tree::{cross, Motion, TreeJoint};
-use crate::{Pose, Real};
+use crate::{Lane, Pose, Real};
 
 /// `q (+) v dt`: the base moved along the SE(3) exponential of its body-frame velocity for
 /// `dt` (exact for a constant twist; the quaternion stays unit up to rounding and is
@@ -18,7 +18,7 @@ use crate::{Pose, Real};
 /// assert!((q1[0] - 1.0).abs() < 1e-12 && (q1[1] - 1.0).abs() < 1e-12);
 /// assert!((q1[5] - q1[6]).abs() < 1e-12); // 90 degrees about z
 /// ```
-pub fn integrate<T: Real, const NQ: usize, const NV: usize>(
+pub fn integrate<T: Lane, const NQ: usize, const NV: usize>(
     q: &[T; NQ],
     v: &[T; NV],
     dt: T,
@@ -30,7 +30,7 @@ pub fn integrate<T: Real, const NQ: usize, const NV: usize>(
 
 /// [`integrate`] on slices (`q.len() == out.len() == v.len() + 1`), for sizes known only at
 /// run time. Entries beyond the shortest of the three are left alone.
-pub fn integrate_into<T: Real>(q: &[T], v: &[T], dt: T, out: &mut [T]) {
+pub fn integrate_into<T: Lane>(q: &[T], v: &[T], dt: T, out: &mut [T]) {
     if q.len() < 7 || v.len() < 6 || out.len() < 7 {
         return;
     }
@@ -69,7 +69,7 @@ pub fn integrate_into<T: Real>(q: &[T], v: &[T], dt: T, out: &mut [T]) {
 /// let q1: [f64; 8] = integrate_blocks(&q, &v, 2.0, &[(1, 1)]);
 /// assert_eq!(q1, [0.7, 1.0, 2.0, 3.0, 0.0, 0.0, 0.0, 1.0]);
 /// ```
-pub fn integrate_blocks<T: Real, const NQ: usize, const NV: usize>(
+pub fn integrate_blocks<T: Lane, const NQ: usize, const NV: usize>(
     q: &[T; NQ],
     v: &[T; NV],
     dt: T,
@@ -97,7 +97,7 @@ pub fn integrate_blocks<T: Real, const NQ: usize, const NV: usize>(
 }
 
 /// The rotation of a unit quaternion (x, y, z, w).
-pub fn rotation<T: Real>(q: &[T; 4]) -> [[T; 3]; 3] {
+pub fn rotation<T: Lane>(q: &[T; 4]) -> [[T; 3]; 3] {
     let (x, y, z, w) = (q[0], q[1], q[2], q[3]);
     let two = T::from_f64(2.0);
     let one = T::one();
@@ -122,21 +122,36 @@ pub fn rotation<T: Real>(q: &[T; 4]) -> [[T; 3]; 3] {
 
 /// The unit quaternion of the rotation vector `w` and the left Jacobian `V(w)` of SO(3)
 /// (series near zero).
-pub(crate) fn exp_so3<T: Real>(w: &[T; 3]) -> ([T; 4], [[T; 3]; 3]) {
+pub(crate) fn exp_so3<T: Lane>(w: &[T; 3]) -> ([T; 4], [[T; 3]; 3]) {
     let t2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
     let t = t2.sqrt();
     let half = T::from_f64(0.5);
     let (s, c) = (t * half).sin_cos();
-    // sin(t/2)/t, (1 - cos t)/t^2, (t - sin t)/t^3
-    let (k, a, b) = if t2 < T::from_f64(1e-8) {
+    // sin(t/2)/t, (1 - cos t)/t^2, (t - sin t)/t^3: the series where t^2 < 1e-8 (lane-wise
+    // for a vector of states, each lane from its own branch).
+    let series = || {
         (
             half - t2 / T::from_f64(48.0),
             half - t2 / T::from_f64(24.0),
             T::from_f64(1.0 / 6.0) - t2 / T::from_f64(120.0),
         )
-    } else {
+    };
+    let exact = || {
         let (st, ct) = t.sin_cos();
         (s / t, (T::one() - ct) / t2, (t - st) / (t2 * t))
+    };
+    let small = T::from_f64(1e-8).gt(t2);
+    let (k, a, b) = if T::all(small) {
+        series()
+    } else if !T::any(small) {
+        exact()
+    } else {
+        let (x, y) = (series(), exact());
+        (
+            T::select(small, x.0, y.0),
+            T::select(small, x.1, y.1),
+            T::select(small, x.2, y.2),
+        )
     };
     let quat = [w[0] * k, w[1] * k, w[2] * k, c];
     let kx = [
@@ -155,7 +170,7 @@ pub(crate) fn exp_so3<T: Real>(w: &[T; 3]) -> ([T; 4], [[T; 3]; 3]) {
     (quat, v)
 }
 
-pub(crate) fn quat_mul<T: Real>(a: &[T; 4], b: &[T; 4]) -> [T; 4] {
+pub(crate) fn quat_mul<T: Lane>(a: &[T; 4], b: &[T; 4]) -> [T; 4] {
     let (ax, ay, az, aw) = (a[0], a[1], a[2], a[3]);
     let (bx, by, bz, bw) = (b[0], b[1], b[2], b[3]);
     [
@@ -166,7 +181,7 @@ pub(crate) fn quat_mul<T: Real>(a: &[T; 4], b: &[T; 4]) -> [T; 4] {
     ]
 }
 
-fn mul<T: Real>(m: &[[T; 3]; 3], v: &[T; 3]) -> [T; 3] {
+fn mul<T: Lane>(m: &[[T; 3]; 3], v: &[T; 3]) -> [T; 3] {
     [0, 1, 2].map(|r| m[r][0] * v[0] + m[r][1] * v[1] + m[r][2] * v[2])
 }
 

@@ -30,6 +30,10 @@
 //! inverse and forward dynamics, energies, link poses and Jacobians). That code depends only on
 //! `core` and on this crate, which provides:
 //!
+//! - [`Lane`]: what generated code is generic over, a [`Real`] or a SIMD vector of them, one
+//!   state per lane (module [`lane`]);
+//! - batch evaluation (module [`batch`]): what the generated `NAME_batch` methods, many states
+//!   per call on SIMD lanes and threads, are built on;
 //! - [`Real`]: the scalar trait the generated code is generic over, implemented for [`f32`]
 //!   (firmware) and [`f64`] (host), with the transcendental functions taken from [`libm`] since
 //!   `core` has none;
@@ -66,7 +70,11 @@
 //!
 //! # Cargo features
 //! - `nalgebra`: conversions to and from `nalgebra` (no_std compatible; uses nalgebra's `libm`).
-//! - `std`: implements `std::error::Error` for [`FactorError`]. Off by default; the crate is
+//! - `simd`: `wide`'s `f64x2`, `f64x4`, `f32x4` and `f32x8` implement [`Lane`], so generated
+//!   code runs on one state per lane (module [`lane`]); `no_std`.
+//! - `rayon` (implies `std`; host only): the generated `_batch` methods spread their states over
+//!   rayon's threads (module [`batch`]).
+//! - `std`: implements `std::error::Error` for [`FactorError`] and [`LaneError`]. Off by default; the crate is
 //!   `#![no_std]` otherwise.
 
 #![no_std]
@@ -76,6 +84,7 @@
 #[cfg(feature = "std")]
 extern crate std;
 
+pub mod batch;
 mod baumgarte;
 pub mod contact;
 pub mod control;
@@ -88,6 +97,7 @@ mod hamiltonian;
 mod impulse;
 mod joint_effects;
 pub mod kkt;
+pub mod lane;
 mod linalg;
 pub mod manifold;
 pub mod place;
@@ -110,6 +120,7 @@ pub use floating::{rk4_step_floating, Contacts, FloatingDynamics, StandOnContact
 pub use hamiltonian::Hamiltonian;
 pub use joint_effects::WithJointEffects;
 pub use kkt::{ContactDynamicsDerivatives, ContactKkt, ImpulseDynamicsDerivatives, KktStash};
+pub use lane::{Arithmetic, Lane, LaneError};
 pub use linalg::{solve_spd, solve_spd_or_nan, Cholesky, FactorError, Ldlt};
 pub use pose::Pose;
 pub use real::Real;

@@ -7,13 +7,13 @@
 //! pivot, a NaN or infinity anywhere in the lower triangle is always reported, and a successful
 //! factorization has only finite entries.
 
-use crate::Real;
+use crate::{Lane, Real};
 use core::fmt;
 
 /// `y += a x`, entry by entry, fused: the row operation of the tree and contact solves, which
 /// keep `y` in a local accumulator (registers) while they gather into it.
 #[inline(always)]
-pub(crate) fn axpy<T: Real, const C: usize>(y: &mut [T; C], a: T, x: &[T; C]) {
+pub(crate) fn axpy<T: Lane, const C: usize>(y: &mut [T; C], a: T, x: &[T; C]) {
     for (yi, xi) in y.iter_mut().zip(x) {
         *yi = a.mul_add(*xi, *yi);
     }
@@ -65,21 +65,10 @@ impl fmt::Display for FactorError {
 #[cfg(feature = "std")]
 impl std::error::Error for FactorError {}
 
-#[inline(always)]
-fn check_pivot<T: Real>(d: T, pivot: usize) -> Result<(), FactorError> {
-    if !d.is_finite() {
-        Err(FactorError::NonFinite { pivot })
-    } else if d > T::zero() {
-        Ok(())
-    } else {
-        Err(FactorError::NotPositiveDefinite { pivot })
-    }
-}
-
 /// The dot product of the first `len` entries of `a` and `b` (no bounds checks: `zip` and
 /// `take` stop at the shorter length).
 #[inline(always)]
-fn dot_prefix<T: Real, const N: usize>(a: &[T; N], b: &[T; N], len: usize) -> T {
+fn dot_prefix<T: Lane, const N: usize>(a: &[T; N], b: &[T; N], len: usize) -> T {
     let mut s = T::zero();
     for (x, y) in a.iter().zip(b.iter()).take(len) {
         s += *x * *y;
@@ -126,26 +115,7 @@ impl<T: Real, const N: usize> Ldlt<T, N> {
     /// Factorizes `m` (lower triangle read). Errors on the first pivot that is not finite or
     /// not strictly positive.
     pub fn new(m: [[T; N]; N]) -> Result<Self, FactorError> {
-        let mut l = [[T::zero(); N]; N];
-        let mut d = [T::zero(); N];
-        let mut d_inv = [T::zero(); N];
-        // Work row: w[k] = L[j][k] * D[k] for k < j.
-        let mut w = [T::zero(); N];
-        for j in 0..N {
-            // w = L[j][..j] * D[..j]
-            for ((wk, lk), dk) in w.iter_mut().zip(l[j].iter()).zip(d.iter()).take(j) {
-                *wk = *lk * *dk;
-            }
-            let dj = m[j][j] - dot_prefix(&w, &l[j], j);
-            check_pivot(dj, j)?;
-            let inv = T::one() / dj;
-            d[j] = dj;
-            d_inv[j] = inv;
-            for i in (j + 1)..N {
-                let s = dot_prefix(&l[i], &w, j);
-                l[i][j] = (m[i][j] - s) * inv;
-            }
-        }
+        let (l, d, d_inv) = ldlt_factor(&m, &mut ())?;
         Ok(Ldlt { l, d, d_inv })
     }
 
@@ -178,23 +148,7 @@ impl<T: Real, const N: usize> Ldlt<T, N> {
 
     /// Overwrites `b` with the solution `x` of `M x = b`.
     pub fn solve_in_place(&self, b: &mut [T; N]) {
-        // L y = b (forward; unit diagonal)
-        for i in 0..N {
-            let s = dot_prefix(&self.l[i], b, i);
-            b[i] -= s;
-        }
-        // D z = y
-        for (x, inv) in b.iter_mut().zip(self.d_inv.iter()) {
-            *x *= *inv;
-        }
-        // Lᵀ x = z (backward; unit diagonal)
-        for i in (0..N).rev() {
-            let mut s = T::zero();
-            for (row, bk) in self.l.iter().zip(b.iter()).skip(i + 1) {
-                s += row[i] * *bk;
-            }
-            b[i] -= s;
-        }
+        ldlt_substitute(&self.l, &self.d_inv, b);
     }
 
     /// The solution `x` of `M x = b`.
@@ -202,6 +156,58 @@ impl<T: Real, const N: usize> Ldlt<T, N> {
         let mut x = *b;
         self.solve_in_place(&mut x);
         x
+    }
+}
+
+/// The `L D Lᵀ` factors `(L, D, D⁻¹)` of `m` (lower triangle read), each pivot checked by
+/// [`Lane::check_pivot`]: a scalar stops at its first bad pivot, a vector of states records
+/// each lane's in `failures` and carries on.
+#[allow(clippy::type_complexity)]
+fn ldlt_factor<T: Lane, const N: usize>(
+    m: &[[T; N]; N],
+    failures: &mut T::Failures,
+) -> Result<([[T; N]; N], [T; N], [T; N]), FactorError> {
+    let mut l = [[T::zero(); N]; N];
+    let mut d = [T::zero(); N];
+    let mut d_inv = [T::zero(); N];
+    // Work row: w[k] = L[j][k] * D[k] for k < j.
+    let mut w = [T::zero(); N];
+    for j in 0..N {
+        // w = L[j][..j] * D[..j]
+        for ((wk, lk), dk) in w.iter_mut().zip(l[j].iter()).zip(d.iter()).take(j) {
+            *wk = *lk * *dk;
+        }
+        let dj = m[j][j] - dot_prefix(&w, &l[j], j);
+        T::check_pivot(dj, j, failures)?;
+        let inv = T::one() / dj;
+        d[j] = dj;
+        d_inv[j] = inv;
+        for i in (j + 1)..N {
+            let s = dot_prefix(&l[i], &w, j);
+            l[i][j] = (m[i][j] - s) * inv;
+        }
+    }
+    Ok((l, d, d_inv))
+}
+
+/// Overwrites `b` with the solution of `L D Lᵀ x = b` (`L` strictly lower, unit diagonal).
+fn ldlt_substitute<T: Lane, const N: usize>(l: &[[T; N]; N], d_inv: &[T; N], b: &mut [T; N]) {
+    // L y = b (forward; unit diagonal)
+    for i in 0..N {
+        let s = dot_prefix(&l[i], b, i);
+        b[i] -= s;
+    }
+    // D z = y
+    for (x, inv) in b.iter_mut().zip(d_inv.iter()) {
+        *x *= *inv;
+    }
+    // Lᵀ x = z (backward; unit diagonal)
+    for i in (0..N).rev() {
+        let mut s = T::zero();
+        for (row, bk) in l.iter().zip(b.iter()).skip(i + 1) {
+            s += row[i] * *bk;
+        }
+        b[i] -= s;
     }
 }
 
@@ -256,7 +262,7 @@ impl<T: Real, const N: usize> Cholesky<T, N> {
         let mut diag_inv = [T::zero(); N];
         for j in 0..N {
             let d = m[j][j] - dot_prefix(&l[j], &l[j], j);
-            check_pivot(d, j)?;
+            <T as Lane>::check_pivot(d, j, &mut ())?;
             let ljj = d.sqrt();
             let inv = T::one() / ljj;
             l[j][j] = ljj;
@@ -331,7 +337,8 @@ pub fn solve_spd<T: Real, const N: usize>(
 }
 
 /// Like [`solve_spd`], but reports failure as an all-NaN result instead of an error: the form
-/// generated `forward_dynamics` uses, since its signature returns a plain array.
+/// generated `forward_dynamics` uses, since its signature returns a plain array. On a vector
+/// of states ([`Lane`]), NaN in the lanes that failed only.
 ///
 /// ```
 /// use eomgen_runtime::solve_spd_or_nan;
@@ -340,9 +347,14 @@ pub fn solve_spd<T: Real, const N: usize>(
 /// assert!(solve_spd_or_nan(&[[0.0_f64]], &[1.0])[0].is_nan());
 /// ```
 #[inline]
-pub fn solve_spd_or_nan<T: Real, const N: usize>(m: &[[T; N]; N], b: &[T; N]) -> [T; N] {
-    match solve_spd(m, b) {
-        Ok(x) => x,
+pub fn solve_spd_or_nan<T: Lane, const N: usize>(m: &[[T; N]; N], b: &[T; N]) -> [T; N] {
+    let mut failures = T::Failures::default();
+    match ldlt_factor(m, &mut failures) {
+        Ok((l, _, d_inv)) => {
+            let mut x = *b;
+            ldlt_substitute(&l, &d_inv, &mut x);
+            crate::lane::nan_failed(x, &failures)
+        }
         Err(_) => [T::nan(); N],
     }
 }

@@ -43,7 +43,7 @@ use core::mem::MaybeUninit;
 use core::ptr::addr_of_mut;
 
 use crate::kkt::{ContactDynamicsDerivatives, ImpulseDynamicsDerivatives};
-use crate::Real;
+use crate::{Lane, Real};
 
 /// An invariant lifetime: `'b` names one call of [`build`] and no other.
 type Brand<'b> = PhantomData<fn(&'b ()) -> &'b ()>;
@@ -92,7 +92,7 @@ mod sealed {
     pub trait Sealed {}
 }
 
-/// Results [`build`] can fill: arrays and matrices of a [`Real`], pairs and triples of them,
+/// Results [`build`] can fill: arrays and matrices of a [`Lane`], pairs and triples of them,
 /// and the derivatives of contact and impulse dynamics. Sealed: [`build`] relies on `zero_in`
 /// initializing everything.
 pub trait Zeroed: sealed::Sealed + Sized {
@@ -100,8 +100,8 @@ pub trait Zeroed: sealed::Sealed + Sized {
     fn zero_in(slot: &mut MaybeUninit<Self>) -> &mut Self;
 }
 
-impl<T: Real, const N: usize> sealed::Sealed for [T; N] {}
-impl<T: Real, const N: usize> Zeroed for [T; N] {
+impl<T: Lane, const N: usize> sealed::Sealed for [T; N] {}
+impl<T: Lane, const N: usize> Zeroed for [T; N] {
     #[inline]
     fn zero_in(slot: &mut MaybeUninit<Self>) -> &mut Self {
         let p = slot.as_mut_ptr().cast::<T>();
@@ -114,8 +114,8 @@ impl<T: Real, const N: usize> Zeroed for [T; N] {
     }
 }
 
-impl<T: Real, const R: usize, const C: usize> sealed::Sealed for [[T; C]; R] {}
-impl<T: Real, const R: usize, const C: usize> Zeroed for [[T; C]; R] {
+impl<T: Lane, const R: usize, const C: usize> sealed::Sealed for [[T; C]; R] {}
+impl<T: Lane, const R: usize, const C: usize> Zeroed for [[T; C]; R] {
     #[inline]
     fn zero_in(slot: &mut MaybeUninit<Self>) -> &mut Self {
         let p = slot.as_mut_ptr().cast::<T>();

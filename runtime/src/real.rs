@@ -1,7 +1,7 @@
 //! The scalar trait used by generated code.
 
+use crate::lane::Arithmetic;
 use core::fmt::Debug;
-use core::ops::{Add, AddAssign, Div, DivAssign, Mul, MulAssign, Neg, Sub, SubAssign};
 
 /// A real scalar type that generated dynamics code can be instantiated with.
 ///
@@ -28,22 +28,7 @@ use core::ops::{Add, AddAssign, Div, DivAssign, Mul, MulAssign, Neg, Sub, SubAss
 /// assert_eq!(Real::signum(0.0_f64), 0.0); // ... Real: 0 has sign 0
 /// ```
 pub trait Real:
-    Copy
-    + Clone
-    + PartialEq
-    + PartialOrd
-    + Debug
-    + Default
-    + Add<Output = Self>
-    + Sub<Output = Self>
-    + Mul<Output = Self>
-    + Div<Output = Self>
-    + Neg<Output = Self>
-    + AddAssign
-    + SubAssign
-    + MulAssign
-    + DivAssign
-    + 'static
+    Copy + Clone + PartialEq + PartialOrd + Debug + Default + Arithmetic + 'static
 {
     /// Converts an `f64` (rounding to nearest for `f32`). Generated code writes every numeric
     /// constant as `T::from_f64(..)`; for `f32` and `f64` this folds to a constant.

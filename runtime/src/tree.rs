@@ -7,7 +7,7 @@
 //! for every robot, so a 48-joint robot costs no more code than its joints.
 
 use crate::linalg::axpy;
-use crate::{FactorError, Pose, Real};
+use crate::{FactorError, Lane, Pose, Real};
 
 /// How a joint moves its body, for Jacobian columns.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -244,7 +244,7 @@ pub const fn pair_index(n: usize, j: usize, k: usize) -> usize {
 /// let c = centrifugal_from_coriolis(|v: &[f64; 1]| [[2.0 * v[0]]]);
 /// assert_eq!(c, [[2.0]]);
 /// ```
-pub fn centrifugal_from_coriolis<T: Real, const N: usize>(
+pub fn centrifugal_from_coriolis<T: Lane, const N: usize>(
     coriolis: impl Fn(&[T; N]) -> [[T; N]; N],
 ) -> [[T; N]; N] {
     let mut out = [[T::zero(); N]; N];
@@ -271,7 +271,7 @@ pub fn centrifugal_from_coriolis<T: Real, const N: usize>(
 /// let b = coriolis_pairs_from_coriolis::<f64, 2, 1>(|v| [[v[1], v[0]], [0.0, 0.0]]);
 /// assert_eq!(b, [[2.0], [0.0]]);
 /// ```
-pub fn coriolis_pairs_from_coriolis<T: Real, const N: usize, const P: usize>(
+pub fn coriolis_pairs_from_coriolis<T: Lane, const N: usize, const P: usize>(
     coriolis: impl Fn(&[T; N]) -> [[T; N]; N],
 ) -> [[T; P]; N] {
     let mut out = [[T::zero(); P]; N];
@@ -450,7 +450,7 @@ fn subtree_ends<const N: usize>(parent: &[Option<usize>; N]) -> [usize; N] {
 ///     assert!(row.iter().zip(e).all(|(x, y)| (x - y).abs() < 1e-15));
 /// }
 /// ```
-pub fn ltdl_inverse_factored<T: Real, const N: usize>(
+pub fn ltdl_inverse_factored<T: Lane, const N: usize>(
     m: &[[T; N]; N],
     parent: &[Option<usize>; N],
 ) -> [[T; N]; N] {
@@ -471,7 +471,7 @@ pub fn ltdl_inverse_factored<T: Real, const N: usize>(
 /// ltdl_inverse_factored_into(&m, &parent, &mut x);
 /// assert_eq!(x, ltdl_inverse_factored(&m, &parent));
 /// ```
-pub fn ltdl_inverse_factored_into<T: Real, const N: usize>(
+pub fn ltdl_inverse_factored_into<T: Lane, const N: usize>(
     m: &[[T; N]; N],
     parent: &[Option<usize>; N],
     x: &mut [[T; N]; N],
@@ -507,7 +507,7 @@ pub fn ltdl_inverse_factored_into<T: Real, const N: usize>(
 ///     assert!(row.iter().zip(e).all(|(x, y)| (x - y).abs() < 1e-15));
 /// }
 /// ```
-pub fn ltdl_substitute_rows<T: Real, const N: usize, const C: usize>(
+pub fn ltdl_substitute_rows<T: Lane, const N: usize, const C: usize>(
     m: &[[T; N]; N],
     parent: &[Option<usize>; N],
     x: &mut [[T; C]; N],
@@ -524,7 +524,7 @@ pub fn ltdl_substitute_rows<T: Real, const N: usize, const C: usize>(
 ///
 /// `SPARSE`: row `k` of `x` is zero outside columns `k..ends[k]` (the identity, whose rows keep
 /// that support through this pass), so only the chunks of columns there are gathered.
-fn pull_from_subtrees<T: Real, const N: usize, const C: usize, const SPARSE: bool>(
+fn pull_from_subtrees<T: Lane, const N: usize, const C: usize, const SPARSE: bool>(
     m: &[[T; N]; N],
     parent: &[Option<usize>; N],
     x: &mut [[T; C]; N],
@@ -556,7 +556,7 @@ fn pull_from_subtrees<T: Real, const N: usize, const C: usize, const SPARSE: boo
 /// `UPPER`: only the columns from `i` on are needed in row `i` (a symmetric result, mirrored
 /// afterwards), so only the chunks of columns there are gathered; the columns before `i` in
 /// the first chunk hold partial sums.
-fn pull_from_ancestors<T: Real, const N: usize, const C: usize, const UPPER: bool>(
+fn pull_from_ancestors<T: Lane, const N: usize, const C: usize, const UPPER: bool>(
     m: &[[T; N]; N],
     parent: &[Option<usize>; N],
     x: &mut [[T; C]; N],
@@ -585,7 +585,7 @@ const CHUNK: usize = 8;
 /// `acc -= k row` ([`axpy`]) on the chunks of [`CHUNK`] columns that overlap `columns` only (a loop of
 /// constant length, so that the compiler still unrolls it and keeps `acc` in registers).
 #[inline(always)]
-fn sub_scaled_chunks<T: Real, const C: usize>(
+fn sub_scaled_chunks<T: Lane, const C: usize>(
     acc: &mut [T; C],
     row: &[T; C],
     k: T,
@@ -604,7 +604,7 @@ fn sub_scaled_chunks<T: Real, const C: usize>(
 
 /// `-a b` for square matrices, the product forward-dynamics derivatives need
 /// (`d qdd / d x = -M^-1 d tau / d x`).
-pub fn neg_mat_mul<T: Real, const N: usize>(a: &[[T; N]; N], b: &[[T; N]; N]) -> [[T; N]; N] {
+pub fn neg_mat_mul<T: Lane, const N: usize>(a: &[[T; N]; N], b: &[[T; N]; N]) -> [[T; N]; N] {
     let mut out = [[T::zero(); N]; N];
     for (i, row) in out.iter_mut().enumerate() {
         for (j, x) in row.iter_mut().enumerate() {

@@ -3,6 +3,7 @@
 //! that install a global allocator stay binaries of their own.
 
 mod active_contacts;
+mod batch;
 mod contact_dynamics;
 mod derivatives;
 mod dimensions;

@@ -111,7 +111,7 @@ pub(super) fn trig_lets(trig: &BTreeSet<(usize, bool)>) -> Vec<TokenStream> {
 
 /// A straight-line body whose outputs hold when every pivot is positive: the outputs and the
 /// pivots in one program, then the value of `shape`, or NaN in every entry when a pivot is not
-/// positive and finite.
+/// positive and finite (in every lane where one is not, for a vector of states).
 pub(super) fn factored_body(
     g: &Graph,
     cx: &Ctx<'_>,
@@ -134,13 +134,14 @@ pub(super) fn factored_body(
     let pivots = (outputs.len()..all.len()).map(index);
     let result = shaped(&(0..outputs.len()).map(index).collect::<Vec<_>>(), shape);
     let nan = filled(quote!(T::nan()), shape);
+    // A scalar stops at its first bad pivot; a vector of states NaNs the lanes that had one.
     let checked = quote! {
         let o: [T; #len] = { #b };
-        for d in [#(#pivots),*] {
-            if !(d.is_finite() && d > T::zero()) {
-                return #nan;
-            }
+        let mut failures: <T as ::eomgen_runtime::Lane>::Failures = ::core::default::Default::default();
+        if ::eomgen_runtime::lane::check_pivots(&[#(#pivots),*], &mut failures).is_err() {
+            return #nan;
         }
+        let o = ::eomgen_runtime::lane::nan_failed(o, &failures);
         #result
     };
     Body {

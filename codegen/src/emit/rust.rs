@@ -5,8 +5,10 @@
 //! One emitter method per generated item, as prost-build's code generator does it: the
 //! parameter fields, the link enum, each kind of [`Evaluation`], the trait implementation.
 
+mod batch;
 mod contact;
 mod items;
+mod lanes;
 mod links;
 mod methods;
 mod mpc;
@@ -86,6 +88,10 @@ struct Emitter<'a> {
     in_trait: bool,
     /// `try_forward_dynamics`, which stays inherent when `forward_dynamics` is the trait's.
     try_forward_dynamics: TokenStream,
+    /// `try_forward_dynamics_lanes` and the checked solve behind both, with `forward_dynamics`.
+    forward_dynamics_lanes: TokenStream,
+    /// The quantities generated for every `T: Lane` (`rust/lanes.rs`).
+    lanes: BTreeSet<&'static str>,
     /// Whether a floating base's six `FloatingDynamics` methods are all generated, so that the
     /// trait is implemented (and its methods live there rather than in the inherent impl).
     floating_trait: bool,
@@ -103,6 +109,17 @@ struct Emitter<'a> {
     split: BTreeSet<String>,
     /// Private helper methods already in `blocks` (emitted once for several callers).
     helpers: BTreeSet<&'static str>,
+}
+
+/// The generated methods by where they go: the inherent impls for every `T: Lane` and for
+/// `T: Real` (with the blocks of their split bodies), and the trait impls.
+#[derive(Default)]
+struct Methods {
+    lane_items: Vec<TokenStream>,
+    real_items: Vec<TokenStream>,
+    trait_methods: Vec<TokenStream>,
+    floating_methods: Vec<TokenStream>,
+    contact_methods: Vec<TokenStream>,
 }
 
 /// Each contact's number of rows: 3 for the points (at link origins, then at positions), 6 for
@@ -143,6 +160,8 @@ pub fn emit_tokens(
         // The catalogue leaves a trait's methods in it only when all are generated.
         in_trait: d.quantities.iter().any(|q| q.home == Home::Dynamics),
         try_forward_dynamics: TokenStream::new(),
+        forward_dynamics_lanes: TokenStream::new(),
+        lanes: BTreeSet::new(),
         floating_trait: d
             .quantities
             .iter()
@@ -159,6 +178,7 @@ pub fn emit_tokens(
         split: BTreeSet::new(),
         helpers: BTreeSet::new(),
     };
+    e.lanes = e.lane_quantities();
     let tokens = e.file(&fields, d);
     (tokens, e.counts)
 }
@@ -174,6 +194,33 @@ impl Emitter<'_> {
         })
     }
 
+    /// Every quantity's method, and the blocks of split bodies, by where they go.
+    fn methods(&mut self) -> Methods {
+        let mut m = Methods::default();
+        for q in self.quantities {
+            let before = self.blocks.len();
+            let tokens = self.quantity_fn(q);
+            let items = if self.lanes.contains(q.name) {
+                &mut m.lane_items
+            } else {
+                &mut m.real_items
+            };
+            items.extend(self.blocks.drain(before..));
+            match self.trait_of(q.name) {
+                Some(Trait::Dynamics) => m.trait_methods.push(tokens),
+                Some(Trait::Floating) => m.floating_methods.push(tokens),
+                Some(Trait::Contacts) => m.contact_methods.push(tokens),
+                None => items.push(tokens),
+            }
+            if q.name == "forward_dynamics" {
+                items.push(std::mem::take(&mut self.forward_dynamics_lanes));
+            }
+        }
+        m.contact_methods
+            .push(self.try_contact_forward_dynamics.clone());
+        m
+    }
+
     /// The whole file: the type, its inherent impl with one method per quantity, the trait
     /// impls.
     fn file(&mut self, fields: &Fields, d: &Derivation) -> TokenStream {
@@ -183,21 +230,13 @@ impl Emitter<'_> {
         } else {
             TokenStream::new()
         };
-        let quantities = self.quantities;
-        let mut methods = Vec::new();
-        let mut trait_methods = Vec::new();
-        let mut floating_methods = Vec::new();
-        let mut contact_methods = Vec::new();
-        for q in quantities {
-            let tokens = self.quantity_fn(q);
-            match self.trait_of(q.name) {
-                Some(Trait::Dynamics) => trait_methods.push(tokens),
-                Some(Trait::Floating) => floating_methods.push(tokens),
-                Some(Trait::Contacts) => contact_methods.push(tokens),
-                None => methods.push(tokens),
-            }
-        }
-        contact_methods.push(self.try_contact_forward_dynamics.clone());
+        let Methods {
+            lane_items,
+            real_items,
+            trait_methods,
+            floating_methods,
+            contact_methods,
+        } = self.methods();
         let frames = if self.has_frames() {
             self.frame_support(d)
         } else {
@@ -217,25 +256,39 @@ impl Emitter<'_> {
         let joint_names = self.joint_names_const();
         let sizes = self.sizes();
         let limits = mpc::limit_constants(self.model);
-        let blocks = &self.blocks;
+        let (blocks, lane) = (&self.blocks, Self::bound(true));
+        let batch = self.batch_impl(fields);
+        let actuation_lanes =
+            !self.has("forward_dynamics") || self.lanes.contains("forward_dynamics");
+        let (lane_actuation, real_actuation) = if actuation_lanes {
+            (actuation, TokenStream::new())
+        } else {
+            (TokenStream::new(), actuation)
+        };
         quote! {
             #strukt
             #links
             #sizes
             #allow
-            impl<T: ::eomgen_runtime::Real> #ty<T> {
+            impl<T: #lane> #ty<T> {
                 #parents
                 #joint_names
                 #limits
                 #identification
-                #actuation
-                #try_fd
-                #(#methods)*
-                #frames
+                #lane_actuation
+                #(#lane_items)*
                 #(#blocks)*
+            }
+            #allow
+            impl<T: ::eomgen_runtime::Real> #ty<T> {
+                #real_actuation
+                #try_fd
+                #(#real_items)*
+                #frames
             }
             #trait_impl
             #floating_impls
+            #batch
         }
     }
 }

@@ -24,8 +24,8 @@ fn ancestors(parents: &[Option<usize>], k: usize) -> Vec<usize> {
     out
 }
 
-/// `fn ltdl_factor_unrolled(m)`: factorizes `m` in place as `tree::ltdl_factor` does (the
-/// factors in the same places, the same errors), pivots checked in elimination order.
+/// `fn ltdl_factor_unrolled(m, failures)`: factorizes `m` in place as `tree::ltdl_factor` does
+/// (the factors in the same places, the same errors), pivots checked in elimination order.
 pub(super) fn factor_fn(parents: &[Option<usize>], n: &Literal) -> TokenStream {
     let steps = (0..parents.len()).rev().map(|k| {
         let kl = usize_lit(k);
@@ -44,12 +44,7 @@ pub(super) fn factor_fn(parents: &[Option<usize>], n: &Literal) -> TokenStream {
         });
         quote! {
             let d = m[#kl][#kl];
-            if !d.is_finite() {
-                return Err(::eomgen_runtime::FactorError::NonFinite { pivot: #kl });
-            }
-            if d <= T::zero() {
-                return Err(::eomgen_runtime::FactorError::NotPositiveDefinite { pivot: #kl });
-            }
+            <T as ::eomgen_runtime::Lane>::check_pivot(d, #kl, failures)?;
             let inv = T::one() / d;
             #(#updates)*
         }
@@ -57,9 +52,10 @@ pub(super) fn factor_fn(parents: &[Option<usize>], n: &Literal) -> TokenStream {
     quote! {
         /// `M = L^T D L` in place over this robot's tree (`eomgen_runtime::tree::ltdl_factor`
         /// unrolled): `D` on the diagonal, `L` below it; fails with the first pivot, last
-        /// coordinate first, that is not finite or not positive.
+        /// coordinate first, that is not finite or not positive (a vector of states records
+        /// each lane's in `failures` instead, `eomgen_runtime::Lane::check_pivot`).
         #[inline(never)]
-        fn ltdl_factor_unrolled(m: &mut [[T; #n]; #n]) -> ::core::result::Result<(), ::eomgen_runtime::FactorError> {
+        fn ltdl_factor_unrolled(m: &mut [[T; #n]; #n], failures: &mut <T as ::eomgen_runtime::Lane>::Failures) -> ::core::result::Result<(), ::eomgen_runtime::FactorError> {
             #(#steps)*
             Ok(())
         }

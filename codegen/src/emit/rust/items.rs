@@ -98,7 +98,7 @@ impl Emitter<'_> {
                 pub const DOF: usize = #n;
                 #floating
             }
-            impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dimensions for #ty<T> {
+            impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dimensions for #ty<T> {
                 const DOF: usize = #n;
                 const NQ: usize = #nq;
                 const NV: usize = #n;
@@ -150,7 +150,7 @@ impl Emitter<'_> {
                 _marker: ::core::marker::PhantomData<T>,
             }
 
-            impl<T: ::eomgen_runtime::Real> ::core::default::Default for #ty<T> {
+            impl<T: ::eomgen_runtime::Lane> ::core::default::Default for #ty<T> {
                 fn default() -> Self {
                     #ty { #(#defaults)* _marker: ::core::marker::PhantomData }
                 }

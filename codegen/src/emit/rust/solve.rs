@@ -24,6 +24,7 @@ impl Emitter<'_> {
         };
         let docs = Self::quantity_doc(q, Some(ops));
         let (n, nq, vis) = (&self.n, &self.nq, self.vis(q.name));
+        let failures = quote!(<T as ::eomgen_runtime::Lane>::Failures);
         self.try_forward_dynamics = quote! {
             /// Forward dynamics `qdd = M(q)^-1 (tau - b(q, qd) - G(q))`, or which pivot of the
             /// `L^T D L` factorization of M(q) was not positive (a non-physical model or
@@ -32,14 +33,30 @@ impl Emitter<'_> {
             /// a non-finite `qd` or `tau`, or a `q` that leaves M(q) finite) is reported as
             /// `FactorError::NonFinite { pivot: i }`.
             pub fn try_forward_dynamics(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n]) -> ::core::result::Result<[T; #n], ::eomgen_runtime::FactorError> {
+                self.forward_dynamics_checked(q, qd, tau).map(|(qdd, _)| qdd)
+            }
+        };
+        self.forward_dynamics_lanes = quote! {
+            /// `try_forward_dynamics` on a vector of states (`eomgen_runtime::Lane`, one state
+            /// per lane; a scalar is lane 0): the accelerations of every lane, or the lowest
+            /// lane whose factorization or solution failed, with that lane's own error.
+            pub fn try_forward_dynamics_lanes(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n]) -> ::core::result::Result<[T; #n], ::eomgen_runtime::LaneError> {
+                match self.forward_dynamics_checked(q, qd, tau) {
+                    Ok((qdd, failures)) => ::eomgen_runtime::lane::lanes_ok::<_, T>(qdd, &failures),
+                    Err(error) => Err(::eomgen_runtime::LaneError { lane: 0, error }),
+                }
+            }
+            /// The accelerations and each lane's failure (a scalar returns its first at once).
+            fn forward_dynamics_checked(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n]) -> ::core::result::Result<([T; #n], #failures), ::eomgen_runtime::FactorError> {
+                let mut failures: #failures = ::core::default::Default::default();
                 #body
             }
         };
         quote! {
             #docs
             #vis fn forward_dynamics(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n]) -> [T; #n] {
-                match self.try_forward_dynamics(q, qd, tau) {
-                    Ok(qdd) => qdd,
+                match self.forward_dynamics_checked(q, qd, tau) {
+                    Ok((qdd, failures)) => ::eomgen_runtime::lane::nan_failed(qdd, &failures),
                     Err(_) => [T::nan(); #n],
                 }
             }
@@ -68,22 +85,10 @@ impl Emitter<'_> {
         });
         let body = quote! {
             let o: [T; #len] = { #b };
-            let pivots = [#(#pivots),*];
-            for (pivot, d) in pivots.iter().enumerate() {
-                if !d.is_finite() {
-                    return Err(::eomgen_runtime::FactorError::NonFinite { pivot });
-                }
-                if *d <= T::zero() {
-                    return Err(::eomgen_runtime::FactorError::NotPositiveDefinite { pivot });
-                }
-            }
+            ::eomgen_runtime::lane::check_pivots(&[#(#pivots),*], &mut failures)?;
             let qdd = [#(#x),*];
-            for (pivot, x) in qdd.iter().enumerate() {
-                if !x.is_finite() {
-                    return Err(::eomgen_runtime::FactorError::NonFinite { pivot });
-                }
-            }
-            Ok(qdd)
+            ::eomgen_runtime::lane::check_finite(&qdd, &mut failures)?;
+            Ok((qdd, failures))
         };
         (body, ops)
     }
@@ -101,12 +106,10 @@ impl Emitter<'_> {
             for (r, h) in rhs.iter_mut().zip(h) {
                 *r -= h;
             }
-            Self::ltdl_factor_unrolled(&mut m)?;
+            Self::ltdl_factor_unrolled(&mut m, &mut failures)?;
             let x = Self::ltdl_substitute_unrolled(&m, &rhs);
-            match x.iter().position(|v| !v.is_finite()) {
-                Some(pivot) => Err(::eomgen_runtime::FactorError::NonFinite { pivot }),
-                None => Ok(x),
-            }
+            ::eomgen_runtime::lane::check_finite(&x, &mut failures)?;
+            Ok((x, failures))
         };
         (body, ops)
     }
@@ -204,8 +207,12 @@ impl Emitter<'_> {
             fn mass_matrix_inverse_in_place<'b>(&self, q: &[T; #nq], slot: ::eomgen_runtime::place::Slot<'b, [[T; #n]; #n]>) -> ::eomgen_runtime::place::Filled<'b> {
                 let (o, filled) = slot.fill();
                 let mut m = #mass_matrix(self, q);
-                match Self::ltdl_factor_unrolled(&mut m) {
-                    Ok(()) => ::eomgen_runtime::tree::ltdl_inverse_factored_into(&m, &Self::PARENTS, o),
+                let mut failures = ::core::default::Default::default();
+                match Self::ltdl_factor_unrolled(&mut m, &mut failures) {
+                    Ok(()) => {
+                        ::eomgen_runtime::tree::ltdl_inverse_factored_into(&m, &Self::PARENTS, o);
+                        ::eomgen_runtime::lane::nan_failed_in::<T>(o.as_flattened_mut(), &failures);
+                    }
                     Err(_) => o.iter_mut().flatten().for_each(|v| *v = T::nan()),
                 }
                 filled
@@ -237,7 +244,8 @@ impl Emitter<'_> {
             fn forward_dynamics_derivatives_in_place<'b>(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n], slot: ::eomgen_runtime::place::Slot<'b, (#matrix, #matrix, #matrix)>) -> ::eomgen_runtime::place::Filled<'b> {
                 let ((dq, dqd, inverse), filled) = slot.fill();
                 let mut m = #mass_matrix(self, q);
-                if Self::ltdl_factor_unrolled(&mut m).is_err() {
+                let mut failures = ::core::default::Default::default();
+                if Self::ltdl_factor_unrolled(&mut m, &mut failures).is_err() {
                     for v in dq.iter_mut().chain(dqd.iter_mut()).chain(inverse.iter_mut()).flatten() {
                         *v = T::nan();
                     }
@@ -256,6 +264,9 @@ impl Emitter<'_> {
                     }
                 }
                 ::eomgen_runtime::tree::ltdl_inverse_factored_into(&m, &Self::PARENTS, inverse);
+                for x in [dq, dqd, inverse] {
+                    ::eomgen_runtime::lane::nan_failed_in::<T>(x.as_flattened_mut(), &failures);
+                }
                 filled
             }
         });
@@ -279,7 +290,7 @@ impl Emitter<'_> {
             for (r, h) in rhs.iter_mut().zip(h) {
                 *r -= h;
             }
-            Self::ltdl_factor_unrolled(&mut m)?;
+            Self::ltdl_factor_unrolled(&mut m, &mut ::core::default::Default::default())?;
             let free = Self::ltdl_substitute_unrolled(&m, &rhs);
         }
     }

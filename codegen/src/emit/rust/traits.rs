@@ -80,7 +80,8 @@ impl Emitter<'_> {
         }
     }
 
-    /// `impl Dynamics` with its methods, when every one of them is generated.
+    /// `impl Dynamics` with its methods, when every one of them is generated: for every
+    /// `T: Lane` when they all run on lanes.
     pub(super) fn trait_impl(&self, methods: &[TokenStream]) -> TokenStream {
         if !self.in_trait {
             return TokenStream::new();
@@ -91,9 +92,10 @@ impl Emitter<'_> {
             .into_iter()
             .map(|name| Literal::string(&name));
         let (ty, n, allow) = (&self.ty, &self.n, allow_lints());
+        let bound = Self::bound(self.trait_lanes(Trait::Dynamics));
         quote! {
             #allow
-            impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Dynamics<T, #n> for #ty<T> {
+            impl<T: #bound> ::eomgen_runtime::Dynamics<T, #n> for #ty<T> {
                 const JOINT_NAMES: [&'static str; #n] = [#(#names),*];
                 #(#methods)*
             }
@@ -114,9 +116,10 @@ impl Emitter<'_> {
         let (ty, n, nq, allow) = (&self.ty, &self.n, &self.nq, allow_lints());
         let mut out = TokenStream::new();
         if self.floating_trait {
+            let bound = Self::bound(self.trait_lanes(Trait::Floating));
             out.extend(quote! {
                 #allow
-                impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::FloatingDynamics<T, #nq, #n> for #ty<T> {
+                impl<T: #bound> ::eomgen_runtime::FloatingDynamics<T, #nq, #n> for #ty<T> {
                     #(#floating)*
                 }
             });

@@ -1,0 +1,177 @@
+//! The `NAME_batch` methods: each method generated for every `T: Lane` evaluated at many
+//! states per call, packed into the target's widest lanes (`eomgen_runtime::batch`).
+
+use proc_macro2::{Ident, TokenStream};
+use quote::{format_ident, quote};
+
+use super::items::Fields;
+use super::traits::Trait;
+use super::{allow_lints, usize_lit, Emitter};
+use crate::dynamics::{Evaluation, Input, Quantity, Shape};
+use crate::emit::body::shape_type;
+
+/// The lane type of a batch method: the widest vector of `T`.
+fn lanes() -> TokenStream {
+    quote!(<T as ::eomgen_runtime::batch::Batch>::Lanes)
+}
+
+/// The type of one state's value of `shape`, with `T` for its scalar.
+fn element(shape: Shape) -> TokenStream {
+    shape_type(shape)
+}
+
+/// A batch method's output slices: their names (`out`, or `out_0`, ... for a tuple), the type
+/// of one state's value in each, and the statements scattering the lanes' result `r` into them.
+struct Outs {
+    names: Vec<Ident>,
+    types: Vec<TokenStream>,
+    scatters: Vec<TokenStream>,
+}
+
+/// The output slices of a quantity of `shape`.
+fn outputs(shape: Shape) -> Outs {
+    let shapes: Vec<Shape> = match shape {
+        Shape::Matrices(k, r, c) => vec![Shape::Matrix(r, c); k],
+        s => vec![s],
+    };
+    let names: Vec<Ident> = match shapes.len() {
+        1 => vec![format_ident!("out")],
+        k => (0..k).map(|i| format_ident!("out_{}", i)).collect(),
+    };
+    let scatters = shapes
+        .iter()
+        .zip(&names)
+        .enumerate()
+        .map(|(k, (s, o))| {
+            let r = if shapes.len() == 1 {
+                quote!(r)
+            } else {
+                let k = usize_lit(k);
+                quote!(r.#k)
+            };
+            match s {
+                Shape::Scalar => quote!(::eomgen_runtime::batch::scatter_scalar(#r, #o);),
+                Shape::Vector(_) => quote!(::eomgen_runtime::batch::scatter(&#r, #o);),
+                _ => quote!(::eomgen_runtime::batch::scatter_matrix(&#r, #o);),
+            }
+        })
+        .collect();
+    Outs {
+        types: shapes.iter().map(|s| element(*s)).collect(),
+        names,
+        scatters,
+    }
+}
+
+impl Emitter<'_> {
+    /// `impl<T: Batch>` with `in_lanes` and one `_batch` method per quantity on lanes.
+    pub(super) fn batch_impl(&self, fields: &Fields) -> TokenStream {
+        let (ty, allow) = (&self.ty, allow_lints());
+        let names: Vec<&Ident> = fields.by_symbol.values().collect();
+        let methods = self
+            .quantities
+            .iter()
+            .filter(|q| self.lanes.contains(q.name))
+            .map(|q| self.batch_fn(q));
+        quote! {
+            #allow
+            impl<T: ::eomgen_runtime::batch::Batch> #ty<T> {
+                /// This robot's parameters in every lane of `L` (a vector of states such as
+                /// `wide::f64x4`, with `eomgen_runtime`'s `simd` feature): the robot whose
+                /// methods evaluate one state per lane.
+                pub fn in_lanes<L: ::eomgen_runtime::lane::Pack<Scalar = T>>(&self) -> #ty<L> {
+                    #ty {
+                        #(#names: <L as ::eomgen_runtime::Lane>::from_f64(::eomgen_runtime::Real::to_f64(self.#names)),)*
+                        _marker: ::core::marker::PhantomData,
+                    }
+                }
+                #(#methods)*
+            }
+        }
+    }
+
+    /// The path of method `name` on the robot of lanes.
+    fn lane_path(&self, name: &str) -> TokenStream {
+        let (ty, f, n, nq, l) = (
+            &self.ty,
+            format_ident!("{}", name),
+            &self.n,
+            &self.nq,
+            lanes(),
+        );
+        match self.trait_of(name) {
+            Some(Trait::Dynamics) => quote!(<#ty<#l> as ::eomgen_runtime::Dynamics<#l, #n>>::#f),
+            Some(Trait::Floating) => {
+                quote!(<#ty<#l> as ::eomgen_runtime::FloatingDynamics<#l, #nq, #n>>::#f)
+            }
+            _ => quote!(#ty::<#l>::#f),
+        }
+    }
+
+    /// `NAME_batch(&self, inputs: &[[T; _]]..., outputs: &mut [_]...)`.
+    fn batch_fn(&self, q: &Quantity) -> TokenStream {
+        let f = format_ident!("{}_batch", q.name);
+        let inputs = Self::arg_names(q.inputs);
+        let input_types = q.inputs.iter().map(|i| match i {
+            Input::Q => &self.nq,
+            Input::Forces => &self.k,
+            _ => &self.n,
+        });
+        let Outs {
+            names: outs,
+            types: out_types,
+            scatters,
+        } = outputs(q.shape);
+        let integrate = matches!(q.eval, Evaluation::Integrate);
+        let (dt, dt_arg, dt_lanes) = if integrate {
+            let l = lanes();
+            (
+                quote!(dt: T,),
+                quote!(dt),
+                quote!(let dt = <#l as ::eomgen_runtime::Lane>::from_f64(::eomgen_runtime::Real::to_f64(dt));),
+            )
+        } else {
+            (TokenStream::new(), TokenStream::new(), TokenStream::new())
+        };
+        let call_args = inputs
+            .iter()
+            .map(|i| quote!(&::eomgen_runtime::batch::gather(#i, start)))
+            .chain(integrate.then(|| dt_arg.clone()));
+        let path = self.lane_path(q.name);
+        let first = &outs[0];
+        let checked = inputs.iter().chain(&outs[1..]).map(|a| {
+            let name = a.to_string();
+            quote!((#name, #a.len()))
+        });
+        let (pattern, passed) = if outs.len() == 1 {
+            let t = &out_types[0];
+            (quote!(#first: &mut [#t]), quote!(#first))
+        } else {
+            (
+                quote!((#(#outs),*): (#(&mut [#out_types]),*)),
+                quote!((#(#outs),*)),
+            )
+        };
+        let doc = format!(
+            " `{}` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' \
+             element `i`, several states per vector of the target's widest SIMD lanes \
+             (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with \
+             nothing written, when a slice holds another number of states than `{}`.",
+            q.name, first
+        );
+        let l = lanes();
+        quote! {
+            #[doc = #doc]
+            pub fn #f(&self, #(#inputs: &[[T; #input_types]],)* #dt #(#outs: &mut [#out_types]),*) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+                ::eomgen_runtime::batch::check(#first.len(), &[#(#checked),*])?;
+                let robot = self.in_lanes::<#l>();
+                #dt_lanes
+                ::eomgen_runtime::batch::run(<#l as ::eomgen_runtime::Lane>::LANES, #passed, &|start: usize, #pattern| {
+                    let r = #path(&robot, #(#call_args),*);
+                    #(#scatters)*
+                });
+                Ok(())
+            }
+        }
+    }
+}

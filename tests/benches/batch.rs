@@ -1,0 +1,157 @@
+//! States per second of the generated dynamics three ways: the scalar code state by state on
+//! one core (`scalar`), the `_batch` methods on the target's widest SIMD lanes on one core
+//! (`batch`: `f64x4` and `f32x8` with AVX), and the same over every core (`threads`), for the
+//! panda (9 coordinates) and anymal (floating base, 18), in `f64` and `f32`. Named
+//! `batch-<robot>-<scalar>/<function>/<way>`; criterion prints states per second
+//! (`thrpt`). Needs the `rayon` feature:
+//!
+//!     RUSTFLAGS="-C target-cpu=native" cargo bench -p eomgen-tests --features rayon --bench batch
+//!
+//! Every way evaluates the same 1024 random states (angles in [-pi, pi], a random unit
+//! quaternion, velocities, accelerations and efforts in [-1, 1]).
+
+use std::hint::black_box;
+
+use criterion::measurement::WallTime;
+use criterion::{criterion_group, criterion_main, BenchmarkGroup, Criterion, Throughput};
+use eomgen_generated::panda::Panda;
+use eomgen_runtime::batch::Batch;
+use eomgen_runtime::prelude::*;
+use eomgen_tests::robots::anymal_derivatives::AnymalDerivatives;
+use eomgen_tests::robots::panda_derivatives::PandaDerivatives;
+use rayon::{ThreadPool, ThreadPoolBuilder};
+
+const STATES: usize = 1024;
+
+/// `STATES` arrays of `N` numbers in [-scale, scale] (splitmix64 from `seed`).
+fn states<S: Batch, const N: usize>(seed: u64, scale: f64) -> Vec<[S; N]> {
+    let mut x = seed;
+    let mut unit = move || {
+        x = x.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = x;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^= z >> 31;
+        (z >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+    };
+    (0..STATES)
+        .map(|_| core::array::from_fn(|_| S::from_f64(scale * unit())))
+        .collect()
+}
+
+/// Floating-base configurations: a unit quaternion in entries 3..7.
+fn configurations<S: Batch, const N: usize>(seed: u64) -> Vec<[S; N]> {
+    let mut q = states::<S, N>(seed, std::f64::consts::PI);
+    for s in &mut q {
+        let n = s[3..7]
+            .iter()
+            .map(|x| x.to_f64().powi(2))
+            .sum::<f64>()
+            .sqrt();
+        s[3..7]
+            .iter_mut()
+            .for_each(|x| *x = S::from_f64(x.to_f64() / n));
+    }
+    q
+}
+
+/// One pool of one thread (`batch`: rayon's joins run in turn) and one of every core.
+struct Pools {
+    one: ThreadPool,
+    all: ThreadPool,
+}
+
+fn group<'c>(c: &'c mut Criterion, name: &str) -> BenchmarkGroup<'c, WallTime> {
+    let mut g = c.benchmark_group(name);
+    g.throughput(Throughput::Elements(STATES as u64));
+    g.sample_size(20);
+    g.warm_up_time(std::time::Duration::from_millis(500));
+    g.measurement_time(std::time::Duration::from_secs(2));
+    g
+}
+
+/// Function `$name` three ways in group `$g`, into fresh outputs `$o` (each `STATES` copies of
+/// `$zero`): `$scalar` once per state `$i` on this thread, `$batch` run from inside the
+/// one-thread pool and inside the pool of every core.
+macro_rules! three_ways {
+    ($g:ident, $pools:ident, $name:literal, ($($o:ident: $zero:expr),+), |$i:ident| $scalar:block, $batch:block) => {{
+        $(let mut $o = vec![$zero; STATES];)+
+        $g.bench_function(concat!($name, "/scalar"), |b| b.iter(|| for $i in 0..STATES $scalar));
+        $g.bench_function(concat!($name, "/batch"), |b| $pools.one.install(|| b.iter(|| $batch)));
+        $g.bench_function(concat!($name, "/threads"), |b| $pools.all.install(|| b.iter(|| $batch)));
+    }};
+}
+
+/// The panda's inverse dynamics, mass matrix, forward dynamics and inverse-dynamics
+/// derivatives.
+fn panda<S: Batch>(c: &mut Criterion, pools: &Pools, label: &str) {
+    let (robot, d) = (Panda::<S>::default(), PandaDerivatives::<S>::default());
+    let q = states::<S, 9>(1, std::f64::consts::PI);
+    let (qd, qdd) = (states::<S, 9>(2, 1.0), states::<S, 9>(3, 1.0));
+    let (v, m) = ([S::zero(); 9], [[S::zero(); 9]; 9]);
+    let mut g = group(c, &format!("batch-panda-{label}"));
+    three_ways!(g, pools, "inverse_dynamics", (o: v), |i| {
+        o[i] = robot.inverse_dynamics(black_box(&q[i]), &qd[i], &qdd[i]);
+    }, {
+        robot.inverse_dynamics_batch(black_box(&q), &qd, &qdd, &mut o).unwrap()
+    });
+    three_ways!(g, pools, "mass_matrix", (o: m), |i| {
+        o[i] = robot.mass_matrix(black_box(&q[i]));
+    }, {
+        robot.mass_matrix_batch(black_box(&q), &mut o).unwrap()
+    });
+    three_ways!(g, pools, "forward_dynamics", (o: v), |i| {
+        o[i] = robot.forward_dynamics(black_box(&q[i]), &qd[i], &qdd[i]);
+    }, {
+        robot.forward_dynamics_batch(black_box(&q), &qd, &qdd, &mut o).unwrap()
+    });
+    three_ways!(g, pools, "inverse_dynamics_derivatives", (a: m, b: m), |i| {
+        (a[i], b[i]) = d.inverse_dynamics_derivatives(black_box(&q[i]), &qd[i], &qdd[i]);
+    }, {
+        d.inverse_dynamics_derivatives_batch(black_box(&q), &qd, &qdd, &mut a, &mut b).unwrap()
+    });
+}
+
+/// anymal's inverse dynamics, mass matrix, forward dynamics and inverse-dynamics derivatives.
+fn anymal<S: Batch>(c: &mut Criterion, pools: &Pools, label: &str) {
+    let robot = AnymalDerivatives::<S>::default();
+    let q = configurations::<S, 19>(4);
+    let (v, a) = (states::<S, 18>(5, 1.0), states::<S, 18>(6, 1.0));
+    let (z, m) = ([S::zero(); 18], [[S::zero(); 18]; 18]);
+    let mut g = group(c, &format!("batch-anymal-{label}"));
+    three_ways!(g, pools, "inverse_dynamics", (o: z), |i| {
+        o[i] = robot.inverse_dynamics(black_box(&q[i]), &v[i], &a[i]);
+    }, {
+        robot.inverse_dynamics_batch(black_box(&q), &v, &a, &mut o).unwrap()
+    });
+    three_ways!(g, pools, "mass_matrix", (o: m), |i| {
+        o[i] = robot.mass_matrix(black_box(&q[i]));
+    }, {
+        robot.mass_matrix_batch(black_box(&q), &mut o).unwrap()
+    });
+    three_ways!(g, pools, "forward_dynamics", (o: z), |i| {
+        o[i] = robot.forward_dynamics(black_box(&q[i]), &v[i], &a[i]);
+    }, {
+        robot.forward_dynamics_batch(black_box(&q), &v, &a, &mut o).unwrap()
+    });
+    three_ways!(g, pools, "inverse_dynamics_derivatives", (x: m, y: m), |i| {
+        (x[i], y[i]) = robot.inverse_dynamics_derivatives(black_box(&q[i]), &v[i], &a[i]);
+    }, {
+        robot.inverse_dynamics_derivatives_batch(black_box(&q), &v, &a, &mut x, &mut y).unwrap()
+    });
+}
+
+fn batch(c: &mut Criterion) {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let pools = Pools {
+        one: ThreadPoolBuilder::new().num_threads(1).build().unwrap(),
+        all: ThreadPoolBuilder::new().num_threads(cores).build().unwrap(),
+    };
+    panda::<f64>(c, &pools, "f64");
+    anymal::<f64>(c, &pools, "f64");
+    panda::<f32>(c, &pools, "f32");
+    anymal::<f32>(c, &pools, "f32");
+}
+
+criterion_group!(benches, batch);
+criterion_main!(benches);

@@ -1,0 +1,280 @@
+//! The `_batch` methods and the generated code on SIMD lanes (`eomgen_runtime::Lane`, the
+//! `simd` feature) against the scalar code, state by state: bit for bit where the operations
+//! are the same (no sine or cosine but of 0, which `wide` and `libm` both give exactly), within
+//! 1e-12 relative to the result's size otherwise (`wide`'s sine and cosine differ from `libm`'s
+//! in the last bits), with non-finite states next to finite ones, on fixed and floating bases.
+
+use eomgen_generated::panda::Panda;
+use eomgen_runtime::lane::Pack;
+use eomgen_runtime::prelude::*;
+use eomgen_runtime::{FactorError, LaneError};
+use eomgen_tests::robots::{anymal_derivatives, joint_effects_full, panda_derivatives};
+use wide::{f32x8, f64x4};
+
+/// Deterministic numbers in [-1, 1).
+struct Numbers(u64);
+
+impl Numbers {
+    fn next(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (self.0 >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+    }
+    fn states<const N: usize>(&mut self, count: usize, scale: f64) -> Vec<[f64; N]> {
+        (0..count)
+            .map(|_| core::array::from_fn(|_| scale * self.next()))
+            .collect()
+    }
+}
+
+/// Anything with `f64` entries, flattened.
+trait Flat {
+    fn flat(&self) -> Vec<f64>;
+}
+impl Flat for f64 {
+    fn flat(&self) -> Vec<f64> {
+        vec![*self]
+    }
+}
+impl<const N: usize> Flat for [f64; N] {
+    fn flat(&self) -> Vec<f64> {
+        self.to_vec()
+    }
+}
+impl<const R: usize, const C: usize> Flat for [[f64; C]; R] {
+    fn flat(&self) -> Vec<f64> {
+        self.iter().flatten().copied().collect()
+    }
+}
+
+/// `got` equals `want` entry by entry: the same NaNs and infinities, and finite entries bit for
+/// bit (`tol` 0) or within `tol` times the largest finite entry of `want` (at least 1).
+fn assert_close<X: Flat>(what: &str, state: usize, got: &X, want: &X, tol: f64) {
+    let (g, w) = (got.flat(), want.flat());
+    let scale = w
+        .iter()
+        .filter(|x| x.is_finite())
+        .fold(1.0_f64, |m, x| m.max(x.abs()));
+    for (k, (a, b)) in g.iter().zip(&w).enumerate() {
+        let same = if tol == 0.0 || !b.is_finite() {
+            a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan())
+        } else {
+            (a - b).abs() <= tol * scale
+        };
+        assert!(
+            same,
+            "{what}, state {state}, entry {k}: batch {a}, scalar {b}"
+        );
+    }
+}
+
+/// Replaces a few states by non-finite ones next to finite ones: NaN in `q` of state 2, an
+/// infinite velocity in state 5.
+fn spoil<const N: usize, const V: usize>(q: &mut [[f64; N]], qd: &mut [[f64; V]]) {
+    q[2][N - 1] = f64::NAN;
+    qd[5][0] = f64::INFINITY;
+}
+
+const STATES: usize = 11; // not a multiple of any lane count: the last vector is partial
+
+#[test]
+fn panda_batch_equals_scalar_state_by_state() {
+    let robot = Panda::<f64>::default();
+    let mut n = Numbers(1);
+    let (mut q, mut qd) = (n.states::<9>(STATES, 2.0), n.states::<9>(STATES, 1.0));
+    let (qdd, tau) = (n.states::<9>(STATES, 1.0), n.states::<9>(STATES, 10.0));
+    spoil(&mut q, &mut qd);
+    let mut v = vec![[0.0; 9]; STATES];
+    let mut m = vec![[[0.0; 9]; 9]; STATES];
+    let mut e = vec![0.0; STATES];
+    robot.inverse_dynamics_batch(&q, &qd, &qdd, &mut v).unwrap();
+    for i in 0..STATES {
+        let want = robot.inverse_dynamics(&q[i], &qd[i], &qdd[i]);
+        assert_close("inverse_dynamics", i, &v[i], &want, 1e-12);
+    }
+    robot.forward_dynamics_batch(&q, &qd, &tau, &mut v).unwrap();
+    for i in 0..STATES {
+        let want = robot.forward_dynamics(&q[i], &qd[i], &tau[i]);
+        assert_close("forward_dynamics", i, &v[i], &want, 1e-12);
+    }
+    robot.mass_matrix_batch(&q, &mut m).unwrap();
+    for i in 0..STATES {
+        assert_close("mass_matrix", i, &m[i], &robot.mass_matrix(&q[i]), 1e-12);
+    }
+    robot.kinetic_energy_batch(&q, &qd, &mut e).unwrap();
+    for i in 0..STATES {
+        let want = robot.kinetic_energy(&q[i], &qd[i]);
+        assert_close("kinetic_energy", i, &e[i], &want, 1e-12);
+    }
+}
+
+#[test]
+fn batch_at_zero_angles_is_bit_for_bit() {
+    let robot = Panda::<f64>::default();
+    let mut n = Numbers(2);
+    let q = vec![[0.0; 9]; STATES];
+    let (qd, tau) = (n.states::<9>(STATES, 1.0), n.states::<9>(STATES, 10.0));
+    let mut v = vec![[0.0; 9]; STATES];
+    robot.forward_dynamics_batch(&q, &qd, &tau, &mut v).unwrap();
+    for i in 0..STATES {
+        let want = robot.forward_dynamics(&q[i], &qd[i], &tau[i]);
+        assert_close("forward_dynamics", i, &v[i], &want, 0.0);
+    }
+}
+
+#[test]
+fn derivatives_in_batches_fixed_and_floating() {
+    let robot = panda_derivatives::PandaDerivatives::<f64>::default();
+    let mut n = Numbers(3);
+    let (mut q, mut qd) = (n.states::<9>(STATES, 2.0), n.states::<9>(STATES, 1.0));
+    let tau = n.states::<9>(STATES, 10.0);
+    spoil(&mut q, &mut qd);
+    let z = [[0.0; 9]; 9];
+    let (mut a, mut b, mut c) = (vec![z; STATES], vec![z; STATES], vec![z; STATES]);
+    robot
+        .forward_dynamics_derivatives_batch(&q, &qd, &tau, &mut a, &mut b, &mut c)
+        .unwrap();
+    for i in 0..STATES {
+        let want = robot.forward_dynamics_derivatives(&q[i], &qd[i], &tau[i]);
+        assert_close("d qdd / dq", i, &a[i], &want.0, 1e-12);
+        assert_close("d qdd / dqd", i, &b[i], &want.1, 1e-12);
+        assert_close("M^-1", i, &c[i], &want.2, 1e-12);
+    }
+
+    let robot = anymal_derivatives::AnymalDerivatives::<f64>::default();
+    let (mut q, mut v) = (n.states::<19>(STATES, 1.0), n.states::<18>(STATES, 1.0));
+    for s in &mut q {
+        let norm = s[3..7].iter().map(|x| x * x).sum::<f64>().sqrt();
+        s[3..7].iter_mut().for_each(|x| *x /= norm);
+    }
+    let a = n.states::<18>(STATES, 1.0);
+    spoil(&mut q, &mut v);
+    let z = [[0.0; 18]; 18];
+    let (mut dq, mut dv) = (vec![z; STATES], vec![z; STATES]);
+    robot
+        .inverse_dynamics_derivatives_batch(&q, &v, &a, &mut dq, &mut dv)
+        .unwrap();
+    let mut acc = vec![[0.0; 18]; STATES];
+    robot.forward_dynamics_batch(&q, &v, &a, &mut acc).unwrap();
+    let mut next = vec![[0.0; 19]; STATES];
+    robot.integrate_batch(&q, &v, 0.01, &mut next).unwrap();
+    for i in 0..STATES {
+        let want = robot.inverse_dynamics_derivatives(&q[i], &v[i], &a[i]);
+        assert_close("d tau / dq", i, &dq[i], &want.0, 1e-12);
+        assert_close("d tau / dv", i, &dv[i], &want.1, 1e-12);
+        let want = robot.forward_dynamics(&q[i], &v[i], &a[i]);
+        assert_close("floating forward_dynamics", i, &acc[i], &want, 1e-12);
+        let want = robot.integrate(&q[i], &v[i], 0.01);
+        assert_close("integrate", i, &next[i], &want, 1e-12);
+    }
+}
+
+#[test]
+fn coulomb_friction_sign_per_lane() {
+    let robot = joint_effects_full::JointEffectsFull::<f64>::default();
+    let mut n = Numbers(4);
+    let q = n.states::<2>(STATES, 1.0);
+    let mut qd = n.states::<2>(STATES, 1.0);
+    // At rest, moving either way, and -0: the sign is taken lane by lane.
+    (qd[0], qd[1], qd[3]) = ([0.0, 0.0], [-0.0, 1e-300], [-1.0, 0.0]);
+    let qdd = n.states::<2>(STATES, 1.0);
+    let mut tau = vec![[0.0; 2]; STATES];
+    robot
+        .inverse_dynamics_batch(&q, &qd, &qdd, &mut tau)
+        .unwrap();
+    for i in 0..STATES {
+        let want = robot.inverse_dynamics(&q[i], &qd[i], &qdd[i]);
+        assert_close("inverse_dynamics with friction", i, &tau[i], &want, 1e-12);
+    }
+}
+
+#[test]
+fn lanes_of_four_doubles_and_eight_floats() {
+    let mut n = Numbers(5);
+    let (q, qd, tau) = (
+        n.states::<9>(8, 2.0),
+        n.states::<9>(8, 1.0),
+        n.states::<9>(8, 10.0),
+    );
+    let lanes =
+        |x: &[[f64; 9]]| -> [f64x4; 9] { core::array::from_fn(|j| f64x4::gather(|l| x[l][j])) };
+    let robot = Panda::<f64>::default();
+    let wide = robot.in_lanes::<f64x4>();
+    let got = wide.forward_dynamics(&lanes(&q), &lanes(&qd), &lanes(&tau));
+    for l in 0..4 {
+        let one: [f64; 9] = core::array::from_fn(|j| got[j].lane(l));
+        let want = robot.forward_dynamics(&q[l], &qd[l], &tau[l]);
+        assert_close("f64x4 forward_dynamics", l, &one, &want, 1e-12);
+    }
+    // Eight states in single precision, against the scalar f32 code.
+    let robot32 = Panda::<f32>::default();
+    let wide32 = robot32.in_lanes::<f32x8>();
+    let lanes32 = |x: &[[f64; 9]]| -> [f32x8; 9] {
+        core::array::from_fn(|j| f32x8::gather(|l| x[l][j] as f32))
+    };
+    let f32s = |x: &[f64; 9]| -> [f32; 9] { x.map(|v| v as f32) };
+    let got = wide32.inverse_dynamics(&lanes32(&q), &lanes32(&qd), &lanes32(&tau));
+    for l in 0..8 {
+        let one: [f64; 9] = core::array::from_fn(|j| got[j].lane(l) as f64);
+        let want = robot32.inverse_dynamics(&f32s(&q[l]), &f32s(&qd[l]), &f32s(&tau[l]));
+        assert_close(
+            "f32x8 inverse_dynamics",
+            l,
+            &one,
+            &want.map(f64::from),
+            1e-5,
+        );
+    }
+}
+
+#[test]
+fn a_failed_lane_is_named_and_the_others_are_unaffected() {
+    let robot = Panda::<f64>::default();
+    let wide = robot.in_lanes::<f64x4>();
+    let mut n = Numbers(6);
+    let (mut q, qd, tau) = (
+        n.states::<9>(4, 2.0),
+        n.states::<9>(4, 1.0),
+        n.states::<9>(4, 10.0),
+    );
+    q[2][4] = f64::NAN;
+    let lanes =
+        |x: &[[f64; 9]]| -> [f64x4; 9] { core::array::from_fn(|j| f64x4::gather(|l| x[l][j])) };
+    let err = wide
+        .try_forward_dynamics_lanes(&lanes(&q), &lanes(&qd), &lanes(&tau))
+        .unwrap_err();
+    let scalar = robot
+        .try_forward_dynamics(&q[2], &qd[2], &tau[2])
+        .unwrap_err();
+    assert_eq!(
+        err,
+        LaneError {
+            lane: 2,
+            error: scalar
+        }
+    );
+    assert!(matches!(scalar, FactorError::NonFinite { .. }));
+    let got = wide.forward_dynamics(&lanes(&q), &lanes(&qd), &lanes(&tau));
+    for l in 0..4 {
+        let one: [f64; 9] = core::array::from_fn(|j| got[j].lane(l));
+        assert_eq!(one.iter().all(|x| x.is_nan()), l == 2, "lane {l}");
+    }
+}
+
+#[test]
+fn mismatched_lengths_are_an_error_and_nothing_is_written() {
+    let robot = Panda::<f64>::default();
+    let (q, qd) = (vec![[0.1; 9]; 4], vec![[0.0; 9]; 3]);
+    let mut tau = vec![[7.0; 9]; 4];
+    let e = robot
+        .inverse_dynamics_batch(&q, &qd, &q, &mut tau)
+        .unwrap_err();
+    assert_eq!((e.argument, e.len, e.expected), ("qd", 3, 4));
+    assert!(tau.iter().flatten().all(|x| *x == 7.0));
+    let mut empty: Vec<[f64; 9]> = Vec::new();
+    robot
+        .inverse_dynamics_batch(&[], &[], &[], &mut empty)
+        .unwrap();
+}
