@@ -37,7 +37,7 @@ pub struct Fast {
     pub coriolis_matrix: (Route, Vec<Vec<Id>>),
     /// Craig's `C(q)` as flattened expressions (Christoffel symbols, or
     /// `1/2 d^2 b_i / dqd_j^2`), for robots whose `B(q)` has at most [`CRAIG_FLAT_MAX_ENTRIES`] entries; larger
-    /// robots evaluate it from the columns of `C(q, qd)` ([`Evaluation::CraigColumns`]).
+    /// robots evaluate it from the columns of `C(q, qd)` ([`Evaluation::CraigColumns`](super::Evaluation::CraigColumns)).
     pub centrifugal: Option<(Route, Vec<Vec<Id>>)>,
     /// Craig's `B(q)` likewise (Christoffel symbols, or `d^2 b_i / dqd_j dqd_k`).
     pub coriolis_pairs: Option<(Route, Vec<Vec<Id>>)>,
