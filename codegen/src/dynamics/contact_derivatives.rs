@@ -17,11 +17,11 @@
 
 use super::catalogue::{Evaluation, Input, Quantity, Shape};
 use super::centroidal::quantity;
-use super::newton_euler::LocalModel;
+use super::newton_euler::JointTree;
 use super::rnea_derivatives::inverse_dynamics_derivatives;
-use super::{flat, CoordinateMap, Derivation};
+use super::{flat, Derivation};
 use crate::cas::{Graph, Id};
-use crate::kinematics::{joint, Params};
+use crate::kinematics::joint;
 use crate::model::Model;
 
 /// The partial derivatives of the contact and impulse problems, as stacked matrices (rows
@@ -77,11 +77,8 @@ fn tangent_directions(g: &mut Graph, model: &Model, q: &[Id], nv: usize) -> Vec<
 /// `d(M(q) x)/dq` for the symbols `x` (here `qdd`): Newton-Euler's derivatives at zero
 /// velocity and gravity, projected onto the coordinates when joints are coupled.
 fn mass_times_derivative(g: &mut Graph, model: &Model, q: &[Id], x: &[Id]) -> Vec<Vec<Id>> {
-    let params = Params::new(g, model);
-    let map = CoordinateMap::new(model);
-    let joint_q = map.positions(g, q);
+    let JointTree { map, lm, .. } = JointTree::new(g, model, q);
     let joint_x = map.rates(g, x);
-    let lm = LocalModel::new(g, model, &params, &joint_q);
     let zero3 = [g.zero(); 3];
     let zeros = vec![g.zero(); joint_x.len()];
     let r = inverse_dynamics_derivatives(g, &lm, zero3, &zeros, &joint_x, &zeros);

@@ -7,11 +7,13 @@
 //! `d qdd / d x = -M^-1 d ID / d x` at `qdd = FD(q, qd, tau)` for `x` = `q` or `qd`, and
 //! `d qdd / d tau = M^-1`: each column is one more substitution through the factorization.
 
-use super::newton_euler::{ltdl_solve, LocalModel};
+use super::lagrangian::Friction;
+use super::newton_euler::ltdl_solve;
+use super::newton_euler::JointTree;
 use super::rnea_derivatives::{inverse_dynamics_derivatives, InverseDynamicsDerivatives};
-use super::{lagrangian, CoordinateMap, Derivation};
+use super::Derivation;
 use crate::cas::{Graph, Id};
-use crate::kinematics::{const_v3, Params};
+use crate::kinematics::const_v3;
 use crate::model::Model;
 
 /// The expressions of the three generated derivative functions.
@@ -38,23 +40,19 @@ pub struct Derivatives {
 /// the coordinates.
 pub fn derive(d: &mut Derivation, model: &Model) -> Derivatives {
     let g = &mut d.graph;
-    let params = Params::new(g, model);
-    let map = CoordinateMap::new(model);
-    let joint_q = map.positions(g, &d.q);
+    let JointTree { params, map, lm } = JointTree::new(g, model, &d.q);
     let joint_qd = map.rates(g, &d.qd);
-    let lm = LocalModel::new(g, model, &params, &joint_q);
     let grav = const_v3(g, &model.gravity);
     let m = &d.fast.mass_matrix.1;
     let n = d.dof;
     let parents = d.coordinate_parents.clone();
     // Per velocity column of the joint tree (none on a floating base's six). With mimic joints
     // the friction is differentiated in the coordinates instead, after the projection.
-    let base = model.base_nv();
-    let mut joint_friction = vec![g.zero(); joint_qd.len()];
-    if !map.is_coupled() {
-        let f = lagrangian::joint_friction(g, model, &params, &joint_qd[base..]);
-        joint_friction[base..].copy_from_slice(&f);
-    }
+    let joint_friction = if map.is_coupled() {
+        vec![g.zero(); joint_qd.len()]
+    } else {
+        Friction::new(g, model, &params, &map, &joint_qd).joint
+    };
     let id = |g: &mut Graph, qdd: &[Id]| {
         let joint_qdd = map.rates(g, qdd);
         let r = inverse_dynamics_derivatives(g, &lm, grav, &joint_qd, &joint_qdd, &joint_friction);

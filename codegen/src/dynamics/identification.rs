@@ -3,14 +3,14 @@
 //! catalogue entries.
 
 use crate::cas::{Graph, GraphFull, Id, Program, Style};
-use crate::kinematics::{const_v3, Params};
+use crate::kinematics::const_v3;
 use crate::model::Model;
 
 use super::base_parameters::{base_parameters, BaseParameter};
 use super::catalogue::{Evaluation, Home, Input, Quantity, Shape};
-use super::newton_euler::LocalModel;
+use super::newton_euler::JointTree;
 use super::regressor::{self, standard_parameters, Parameter};
-use super::{flat, CoordinateMap, Derivation};
+use super::{flat, Derivation};
 
 /// The regressor and the parameters of a derivation (with [`Derivation::add_regressor`]).
 #[derive(Clone, Debug)]
@@ -71,13 +71,10 @@ impl Derivation {
     /// [`super::base_parameters`]). Fails when the graph fills.
     pub fn add_regressor(&mut self, model: &Model) -> Result<(), GraphFull> {
         let g = &mut self.graph;
-        let params = Params::new(g, model);
         // The joint tree's regressor at the joints' coordinates, projected onto the robot's
         // (`G^T Y`: unchanged without mimic joints, see `coupling`).
-        let map = CoordinateMap::new(model);
-        let joint_q = map.positions(g, &self.q);
+        let JointTree { params, map, lm } = JointTree::new(g, model, &self.q);
         let (joint_qd, joint_qdd) = (map.rates(g, &self.qd), map.rates(g, &self.qdd));
-        let lm = LocalModel::new(g, model, &params, &joint_q);
         let grav = const_v3(g, &model.gravity);
         let parameters = standard_parameters(g, model, &lm, &params);
         let inputs = regressor::Inputs {

@@ -9,10 +9,11 @@
 
 use super::catalogue::{Evaluation, Input, Quantity, Shape};
 use super::centroidal::quantity;
-use super::newton_euler::{self, LocalModel, Terms};
-use super::{CoordinateMap, Derivation};
+use super::newton_euler::JointTree;
+use super::newton_euler::{self, Terms};
+use super::Derivation;
 use crate::cas::Id;
-use crate::kinematics::{cross, joint, mat_vec, vec_add, vec_sub, Params};
+use crate::kinematics::{cross, joint, mat_vec, vec_add, vec_sub};
 use crate::model::Model;
 
 /// A link frame's motion, from a walk along its chain at run time (`eomgen_runtime::frame`).
@@ -70,12 +71,9 @@ pub(super) fn add(d: &mut Derivation, model: &Model) {
 fn centroidal_momentum_rate(d: &mut Derivation, model: &Model) -> Vec<Id> {
     let g = &mut d.graph;
     // The same nodes as the derivation's (the graph is hash-consed).
-    let params = Params::new(g, model);
-    let map = CoordinateMap::new(model);
-    let q = map.positions(g, &d.q);
+    let JointTree { map, lm, .. } = JointTree::new(g, model, &d.q);
     let qd = map.rates(g, &d.qd);
     let qdd = map.rates(g, &d.qdd);
-    let lm = LocalModel::new(g, model, &params, &q);
     let terms = Terms {
         qd: Some(&qd),
         qdd: Some(&qdd),

@@ -618,24 +618,40 @@ pub fn kinetic_energy(g: &mut Graph, lm: &LocalModel, qd: &[Id]) -> Id {
     g.sum(0.0, terms)
 }
 
+/// The joint tree at the coordinates `q`, as every recursion after the derivation's own needs
+/// it: the parameters, the map from the coordinates to the joints' (see `coupling`) and the
+/// local model. Built anywhere, it is the same nodes (the graph is hash-consed).
+pub(super) struct JointTree {
+    pub params: Params,
+    pub map: CoordinateMap,
+    pub lm: LocalModel,
+}
+
+impl JointTree {
+    pub(super) fn new(g: &mut Graph, model: &Model, q: &[Id]) -> JointTree {
+        let params = Params::new(g, model);
+        let map = CoordinateMap::new(model);
+        let joint_q = map.positions(g, q);
+        let lm = LocalModel::new(g, model, &params, &joint_q);
+        JointTree { params, map, lm }
+    }
+}
+
 /// The generalized momentum `p = M(q) qd = dT/dqd` in `O(N)`: Newton-Euler with the velocities
 /// in place of the accelerations, at rest and without gravity (`M x` is inverse dynamics at
 /// zero velocity with accelerations `x`), projected on the coordinates (see `coupling`). A
 /// momentum observer's measurement; with a floating base its first six entries are the
 /// robot's linear and angular momentum in base axes about the base origin.
 pub fn generalized_momentum(g: &mut Graph, model: &Model, q: &[Id], qd: &[Id]) -> Vec<Id> {
-    let params = Params::new(g, model);
-    let map = CoordinateMap::new(model);
-    let joint_q = map.positions(g, q);
-    let joint_qd = map.rates(g, qd);
-    let lm = LocalModel::new(g, model, &params, &joint_q);
+    let tree = JointTree::new(g, model, q);
+    let joint_qd = tree.map.rates(g, qd);
     let at_rest = Terms {
         qd: None,
         qdd: Some(&joint_qd),
         gravity: None,
     };
-    let p = rnea(g, &lm, at_rest);
-    map.project(g, &p)
+    let p = rnea(g, &tree.lm, at_rest);
+    tree.map.project(g, &p)
 }
 
 /// The time derivative of a body's rotational inertia about its origin (in its axes, first
