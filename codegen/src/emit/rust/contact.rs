@@ -48,12 +48,8 @@ impl Emitter<'_> {
     /// it is made of.
     fn kkt(&mut self, active: bool) -> TokenStream {
         let (n, nq, k) = (self.n.clone(), self.nq.clone(), self.k.clone());
-        let (m, j) = (self.call("mass_matrix"), self.call("contact_jacobian"));
         let kkt_ty = quote!(::eomgen_runtime::ContactKkt<T, #n, #k>);
-        let fill = quote!(|m, j| {
-            *m = #m(self, q);
-            *j = #j(self, q);
-        });
+        let (fill, rows) = self.kkt_inputs(active);
         let result = quote!(::core::result::Result<(), ::eomgen_runtime::FactorError>);
         let (helper, call, item) = if active {
             let c = usize_lit(self.contact_rows.len());
@@ -64,8 +60,7 @@ impl Emitter<'_> {
                     /// Sets `kkt` up for the contacts of `active` at `q`.
                     #[inline(never)]
                     fn contact_kkt_active(&self, q: &[T; #nq], active: &[bool; #c], kkt: &mut #kkt_ty) -> #result {
-                        let rows = ::eomgen_runtime::contact::row_mask(&Self::CONTACT_ROWS, active);
-                        kkt.set_up(#fill, &Self::PARENTS, &rows)
+                        kkt.set_up(#fill, &Self::PARENTS, &#rows)
                     }
                 },
             )
@@ -77,7 +72,7 @@ impl Emitter<'_> {
                     /// Sets `kkt` up for every contact at `q`.
                     #[inline(never)]
                     fn contact_kkt(&self, q: &[T; #nq], kkt: &mut #kkt_ty) -> #result {
-                        kkt.set_up(#fill, &Self::PARENTS, &[true; #k])
+                        kkt.set_up(#fill, &Self::PARENTS, &#rows)
                     }
                 },
             )
@@ -90,6 +85,26 @@ impl Emitter<'_> {
             #call?;
             let kkt = &kkt;
         }
+    }
+
+    /// The closure that writes `M` and `J_c` at `q` into a KKT system's storage, and the
+    /// contact rows that take part: every one, or those of the contacts of `active`.
+    fn kkt_inputs(&self, active: bool) -> (TokenStream, TokenStream) {
+        let (m, j) = (self.call("mass_matrix"), self.call("contact_jacobian"));
+        let fill = quote!(|m, j| {
+            *m = #m(self, q);
+            *j = #j(self, q);
+        });
+        let k = &self.k;
+        let rows = if active {
+            quote!(::eomgen_runtime::contact::row_mask(
+                &Self::CONTACT_ROWS,
+                active
+            ))
+        } else {
+            quote!([true; #k])
+        };
+        (fill, rows)
     }
 
     /// `h` (`b + G`, and friction) of the `_active` contact methods: its straight-line code is
@@ -188,15 +203,7 @@ impl Emitter<'_> {
         let (n, nq, k) = (self.n.clone(), self.nq.clone(), self.k.clone());
         let s = self.signature(q, active, ("The derivatives of", ", or why they do not"));
         let (name, try_name, param, arg, why) = (&s.name, &s.try_name, &s.param, &s.arg, &s.why);
-        let (m, j) = (self.call("mass_matrix"), self.call("contact_jacobian"));
-        let rows = if active {
-            quote!(::eomgen_runtime::contact::row_mask(
-                &Self::CONTACT_ROWS,
-                active
-            ))
-        } else {
-            quote!([true; #k])
-        };
+        let (fill, rows) = self.kkt_inputs(active);
         let drift = self.call("contact_drift");
         let id_derivatives = self.id_derivatives_into(quote!(d.da_dq), quote!(d.da_dv), quote!(a));
         let partials = self.call("contact_dynamics_partials");
@@ -225,12 +232,7 @@ impl Emitter<'_> {
             /// The accelerations and forces, with the KKT system set up in `d`.
             #[inline(never)]
             fn #solve(&self, q: &[T; #nq], rhs: &[T; #n], drift: &[T; #k] #param, d: &mut #ty) -> ::core::result::Result<([T; #n], [T; #k], #stash), #err> {
-                let rows = #rows;
-                let fill = |m: &mut [[T; #n]; #n], j: &mut [[T; #n]; #k]| {
-                    *m = #m(self, q);
-                    *j = #j(self, q);
-                };
-                let stash = ::eomgen_runtime::ContactKkt::set_up_in(d, fill, &Self::PARENTS, &rows)?;
+                let stash = ::eomgen_runtime::ContactKkt::set_up_in(d, #fill, &Self::PARENTS, &#rows)?;
                 let (a, f) = stash.solve(d, rhs, &drift.map(|x| -x))?;
                 Ok((a, f, stash))
             }
