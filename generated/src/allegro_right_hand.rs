@@ -228,21 +228,56 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
     > {
         let mut failures: <T as ::eomgen_runtime::Lane>::Failures = ::core::default::Default::default();
         let o: [T; 32] = {
-            let (s0, c0) = q[0].sin_cos();
-            let (s1, c1) = q[1].sin_cos();
-            let (s2, c2) = q[2].sin_cos();
-            let (s3, c3) = q[3].sin_cos();
-            let (s4, c4) = q[4].sin_cos();
-            let (s5, c5) = q[5].sin_cos();
-            let (s6, c6) = q[6].sin_cos();
-            let (s7, c7) = q[7].sin_cos();
-            let (s9, c9) = q[9].sin_cos();
-            let (s10, c10) = q[10].sin_cos();
-            let (s11, c11) = q[11].sin_cos();
-            let (s12, c12) = q[12].sin_cos();
-            let (s13, c13) = q[13].sin_cos();
-            let (s14, c14) = q[14].sin_cos();
-            let (s15, c15) = q[15].sin_cos();
+            let (
+                [s0,
+                s1,
+                s2,
+                s3,
+                s4,
+                s5,
+                s6,
+                s7,
+                s9,
+                s10,
+                s11,
+                s12,
+                s13,
+                s14,
+                s15,
+                ],
+                [c0,
+                c1,
+                c2,
+                c3,
+                c4,
+                c5,
+                c6,
+                c7,
+                c9,
+                c10,
+                c11,
+                c12,
+                c13,
+                c14,
+                c15,
+                ],
+            ) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+                q[0],
+                q[1],
+                q[2],
+                q[3],
+                q[4],
+                q[5],
+                q[6],
+                q[7],
+                q[9],
+                q[10],
+                q[11],
+                q[12],
+                q[13],
+                q[14],
+                q[15],
+            ]);
             let (
                 t0,
                 t1,
@@ -1563,63 +1598,62 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                 let t211 = t11 * t157;
                 let t212 = t12 * t157;
                 let t213 = t158 + T::from_f64(0.000000795929506936549);
-                let t214 = t9 * t156;
-                let t215 = t4 * t161;
-                let t216 = t5 * t161;
-                let t217 = t10 * (T::mul_add(-t11, t60, t12 * t58));
-                let t218 = T::mul_add(
+                let t214 = t4 * t161;
+                let t215 = t5 * t161;
+                let t216 = t10 * (T::mul_add(-t11, t60, t12 * t58));
+                let t217 = T::mul_add(
                     qd[2],
                     t112,
                     T::mul_add(qd[0], qd[1] * t2 * t5, qd[0] * qd[1] * t3 * t4),
                 );
-                let t219 = T::mul_add(
+                let t218 = T::mul_add(
                     -qd[2],
                     t111,
                     T::mul_add(-qd[0], qd[1] * t2 * t4, qd[0] * qd[1] * t3 * t5),
                 );
-                let t220 = t111 * t167;
-                let t221 = t112 * t169;
-                let t222 = T::mul_add(t7, t111, t6 * t112);
-                let t223 = T::mul_add(-t6, t111, t7 * t112);
-                let t224 = T::mul_add(qd[6], t118, qd[4] * qd[5] * t9 * t12);
-                let t225 = T::mul_add(-qd[6], t119, qd[4] * qd[5] * t9 * t11);
-                let t226 = t118 * t172;
-                let t227 = t119 * t174;
-                let t228 = t118 * t175;
-                let t229 = T::mul_add(t14, t118, t13 * t119);
-                let t230 = T::mul_add(-t13, t118, t14 * t119);
-                let t231 = T::from_f64(0.0007106399999999999) * t177;
-                let t232 = T::mul_add(
+                let t219 = t111 * t167;
+                let t220 = t112 * t169;
+                let t221 = T::mul_add(t7, t111, t6 * t112);
+                let t222 = T::mul_add(-t6, t111, t7 * t112);
+                let t223 = T::mul_add(qd[6], t118, qd[4] * qd[5] * t9 * t12);
+                let t224 = T::mul_add(-qd[6], t119, qd[4] * qd[5] * t9 * t11);
+                let t225 = t118 * t172;
+                let t226 = t119 * t174;
+                let t227 = t118 * t175;
+                let t228 = T::mul_add(t14, t118, t13 * t119);
+                let t229 = T::mul_add(-t13, t118, t14 * t119);
+                let t230 = T::from_f64(0.0007106399999999999) * t177;
+                let t231 = T::mul_add(
                     qd[10],
                     t124,
                     T::mul_add(qd[8], qd[9] * t15 * t18, qd[8] * qd[9] * t16 * t17),
                 );
-                let t233 = T::mul_add(
+                let t232 = T::mul_add(
                     -qd[10],
                     t123,
                     T::mul_add(-qd[8], qd[9] * t15 * t17, qd[8] * qd[9] * t16 * t18),
                 );
-                let t234 = t123 * t178;
-                let t235 = t124 * t180;
-                let t236 = T::mul_add(t20, t123, t19 * t124);
-                let t237 = T::mul_add(-t19, t123, t20 * t124);
-                let t238 = T::mul_add(
+                let t233 = t123 * t178;
+                let t234 = t124 * t180;
+                let t235 = T::mul_add(t20, t123, t19 * t124);
+                let t236 = T::mul_add(-t19, t123, t20 * t124);
+                let t237 = T::mul_add(
                     qd[14],
                     t130,
                     T::mul_add(qd[12], qd[13] * t23 * t26, qd[12] * qd[13] * t24 * t25),
                 );
-                let t239 = T::mul_add(
+                let t238 = T::mul_add(
                     -qd[14],
                     t129,
                     T::mul_add(-qd[12], qd[13] * t23 * t25, qd[12] * qd[13] * t24 * t26),
                 );
-                let t240 = t129 * t183;
-                let t241 = t130 * t185;
-                let t242 = T::mul_add(t28, t129, t27 * t130);
-                let t243 = T::mul_add(-t27, t129, t28 * t130);
-                let t244 = t12 * t192;
-                let t245 = t11 * t192;
-                let t246 = T::mul_add(
+                let t239 = t129 * t183;
+                let t240 = t130 * t185;
+                let t241 = T::mul_add(t28, t129, t27 * t130);
+                let t242 = T::mul_add(-t27, t129, t28 * t130);
+                let t243 = t12 * t192;
+                let t244 = t11 * t192;
+                let t245 = T::mul_add(
                     -t107,
                     t94,
                     T::mul_add(
@@ -1636,6 +1670,7 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                         ),
                     ),
                 );
+                let t246 = T::one() / t203;
                 let t247 = T::mul_add(
                     -t106,
                     t95,
@@ -1653,8 +1688,10 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                         ),
                     ),
                 );
-                let t248 = T::from_f64(21844.852556112917) * t164;
-                let t249 = T::mul_add(
+                let t248 = T::one() / t204;
+                let t249 = T::from_f64(21844.852556112917) * t164;
+                let t250 = T::one() / t205;
+                let t251 = T::mul_add(
                     -t105,
                     t97,
                     T::mul_add(
@@ -1671,12 +1708,10 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                         ),
                     ),
                 );
-                let t250 = T::mul_add(t26, t144, -t207);
-                let t251 = T::mul_add(-t25, t145, t208);
-                let t252 = T::mul_add(t18, t149, -t209);
-                let t253 = T::mul_add(-t17, t150, t210);
-                let t254 = T::mul_add(t12, t154, -t211);
-                let t255 = T::mul_add(-t11, t155, t212);
+                let t252 = T::one() / t206;
+                let t253 = T::mul_add(t26, t144, -t207);
+                let t254 = T::mul_add(-t25, t145, t208);
+                let t255 = T::mul_add(t18, t149, -t209);
                 (
                     t192,
                     t193,
@@ -1810,197 +1845,197 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                 t318,
                 t319,
             ) = {
-                let t256 = T::mul_add(t5, t159, -t215);
-                let t257 = T::mul_add(-t4, t160, t216);
-                let t258 = T::mul_add(
+                let t256 = T::mul_add(-t17, t150, t210);
+                let t257 = T::mul_add(t12, t154, -t211);
+                let t258 = T::mul_add(-t11, t155, t212);
+                let t259 = T::mul_add(t5, t159, -t214);
+                let t260 = T::mul_add(-t4, t160, t215);
+                let t261 = T::mul_add(
                     t3,
                     T::mul_add(t5, t67, t4 * t65),
                     t2 * (T::mul_add(-t4, t67, t5 * t65)),
                 );
-                let t259 = T::mul_add(
+                let t262 = T::mul_add(
                     -T::from_f64(0.0399),
                     t165,
                     T::mul_add(
                         T::from_f64(0.0000035531999999999997),
                         t34 + t35,
-                        t166 - t217,
+                        t166 - t216,
                     ),
                 );
-                let t260 = T::mul_add(
+                let t263 = T::mul_add(
                     t16,
                     T::mul_add(t18, t53, t17 * t51),
                     t15 * (T::mul_add(-t17, t53, t18 * t51)),
                 );
-                let t261 = T::mul_add(
+                let t264 = T::mul_add(
                     t24,
                     T::mul_add(t26, t46, t25 * t44),
                     t23 * (T::mul_add(-t25, t46, t26 * t44)),
                 );
-                let t262 = t7 * t219;
-                let t263 = t6 * t218;
-                let t264 = t6 * t219;
                 let t265 = t7 * t218;
-                let t266 = qd[3] * t222;
-                let t267 = qd[3] * t223;
-                let t268 = T::from_f64(0.00044856000000000003) * t223;
-                let t269 = t222 * t113;
-                let t270 = T::mul_add(
+                let t266 = t6 * t217;
+                let t267 = t6 * t218;
+                let t268 = t7 * t217;
+                let t269 = qd[3] * t221;
+                let t270 = qd[3] * t222;
+                let t271 = T::from_f64(0.00044856000000000003) * t222;
+                let t272 = t221 * t113;
+                let t273 = T::mul_add(
                     -T::from_f64(0.0000012936),
-                    t222,
+                    t221,
                     T::mul_add(
                         -T::from_f64(0.0000176458),
-                        t223,
+                        t222,
                         T::from_f64(0.000001255968) * t76,
                     ),
                 );
-                let t271 = T::mul_add(
+                let t274 = T::mul_add(
                     -T::from_f64(0.0000017622),
-                    t222,
+                    t221,
                     T::mul_add(
                         -T::from_f64(0.000001255968),
-                        t223,
+                        t222,
                         T::from_f64(0.000016593864000000002) * t76,
                     ),
                 );
-                let t272 = T::mul_add(
+                let t275 = T::mul_add(
                     -T::from_f64(0.0000056692479999999995),
-                    t222,
+                    t221,
                     T::mul_add(
                         -T::from_f64(0.0000012936),
-                        t223,
+                        t222,
                         T::from_f64(0.0000017622) * t76,
                     ),
                 );
-                let t273 = t14 * t224;
-                let t274 = t13 * t225;
-                let t275 = t13 * t224;
-                let t276 = t14 * t225;
-                let t277 = qd[7] * t229;
-                let t278 = qd[7] * t230;
-                let t279 = T::from_f64(0.0007106399999999999) * t230;
-                let t280 = t229 * t231;
-                let t281 = T::mul_add(
+                let t276 = t14 * t223;
+                let t277 = t13 * t224;
+                let t278 = t13 * t223;
+                let t279 = t14 * t224;
+                let t280 = qd[7] * t228;
+                let t281 = qd[7] * t229;
+                let t282 = T::from_f64(0.0007106399999999999) * t229;
+                let t283 = t228 * t230;
+                let t284 = T::mul_add(
                     -T::from_f64(0.0000052283),
-                    t229,
+                    t228,
                     T::mul_add(
                         -T::from_f64(0.00006395038933329998),
-                        t230,
+                        t229,
                         T::from_f64(0.000008042076) * t177,
                     ),
                 );
-                let t282 = T::mul_add(
+                let t285 = T::mul_add(
                     -T::from_f64(0.000011283525),
-                    t229,
+                    t228,
                     T::mul_add(
                         -T::from_f64(0.000008042076),
-                        t230,
+                        t229,
                         T::from_f64(0.000045777374666699994) * t177,
                     ),
                 );
-                let t283 = T::mul_add(
+                let t286 = T::mul_add(
                     -T::from_f64(0.0000338903173333),
-                    t229,
+                    t228,
                     T::mul_add(
                         -T::from_f64(0.0000052283),
-                        t230,
+                        t229,
                         T::from_f64(0.000011283525) * t177,
                     ),
                 );
-                let t284 = t20 * t233;
-                let t285 = t19 * t232;
-                let t286 = t19 * t233;
                 let t287 = t20 * t232;
-                let t288 = qd[11] * t236;
-                let t289 = qd[11] * t237;
-                let t290 = T::from_f64(0.00044856000000000003) * t237;
-                let t291 = t236 * t125;
-                let t292 = T::mul_add(
+                let t288 = t19 * t231;
+                let t289 = t19 * t232;
+                let t290 = t20 * t231;
+                let t291 = qd[11] * t235;
+                let t292 = qd[11] * t236;
+                let t293 = T::from_f64(0.00044856000000000003) * t236;
+                let t294 = t235 * t125;
+                let t295 = T::mul_add(
                     -T::from_f64(0.0000012936),
-                    t236,
+                    t235,
                     T::mul_add(
                         -T::from_f64(0.0000176458),
-                        t237,
+                        t236,
                         T::from_f64(0.000001255968) * t86,
                     ),
                 );
-                let t293 = T::mul_add(
+                let t296 = T::mul_add(
                     -T::from_f64(0.0000017622),
-                    t236,
+                    t235,
                     T::mul_add(
                         -T::from_f64(0.000001255968),
-                        t237,
+                        t236,
                         T::from_f64(0.000016593864000000002) * t86,
                     ),
                 );
-                let t294 = T::mul_add(
+                let t297 = T::mul_add(
                     -T::from_f64(0.0000056692479999999995),
-                    t236,
+                    t235,
                     T::mul_add(
                         -T::from_f64(0.0000012936),
-                        t237,
+                        t236,
                         T::from_f64(0.0000017622) * t86,
                     ),
                 );
-                let t295 = t28 * t239;
-                let t296 = t27 * t238;
-                let t297 = t27 * t239;
                 let t298 = t28 * t238;
-                let t299 = qd[15] * t242;
-                let t300 = qd[15] * t243;
-                let t301 = T::from_f64(0.00044856000000000003) * t243;
-                let t302 = t242 * t131;
-                let t303 = T::mul_add(
+                let t299 = t27 * t237;
+                let t300 = t27 * t238;
+                let t301 = t28 * t237;
+                let t302 = qd[15] * t241;
+                let t303 = qd[15] * t242;
+                let t304 = T::from_f64(0.00044856000000000003) * t242;
+                let t305 = t241 * t131;
+                let t306 = T::mul_add(
                     -T::from_f64(0.0000012936),
-                    t242,
+                    t241,
                     T::mul_add(
                         -T::from_f64(0.0000176458),
-                        t243,
+                        t242,
                         T::from_f64(0.000001255968) * t92,
                     ),
                 );
-                let t304 = T::mul_add(
+                let t307 = T::mul_add(
                     -T::from_f64(0.0000017622),
-                    t242,
+                    t241,
                     T::mul_add(
                         -T::from_f64(0.000001255968),
-                        t243,
+                        t242,
                         T::from_f64(0.000016593864000000002) * t92,
                     ),
                 );
-                let t305 = T::mul_add(
+                let t308 = T::mul_add(
                     -T::from_f64(0.0000056692479999999995),
-                    t242,
+                    t241,
                     T::mul_add(
                         -T::from_f64(0.0000012936),
-                        t243,
+                        t242,
                         T::from_f64(0.0000017622) * t92,
                     ),
                 );
-                let t306 = T::mul_add(t111, t170, -t188 - t189);
-                let t307 = T::mul_add(t30, t75, T::mul_add(t112, t170, t190 - t191));
-                let t308 = T::mul_add(
+                let t309 = T::mul_add(t111, t170, -t188 - t189);
+                let t310 = T::mul_add(t30, t75, T::mul_add(t112, t170, t190 - t191));
+                let t311 = T::mul_add(
                     t118,
                     t176,
-                    T::mul_add(T::from_f64(0.0514), t80, t244 + t193),
+                    T::mul_add(T::from_f64(0.0514), t80, t243 + t193),
                 );
-                let t309 = T::mul_add(t117, t175, T::mul_add(t119, t176, t194 - t245));
-                let t310 = T::mul_add(t123, t181, -t195 - t196);
-                let t311 = T::mul_add(t31, t85, T::mul_add(t124, t181, t197 - t198));
-                let t312 = T::mul_add(t129, t186, -t199 - t200);
-                let t313 = T::mul_add(t32, t91, T::mul_add(t130, t186, t201 - t202));
-                let t314 = T::one() / t203;
-                let t315 = T::one() / t204;
-                let t316 = T::mul_add(
+                let t312 = T::mul_add(t117, t175, T::mul_add(t119, t176, t194 - t244));
+                let t313 = T::mul_add(t123, t181, -t195 - t196);
+                let t314 = T::mul_add(t31, t85, T::mul_add(t124, t181, t197 - t198));
+                let t315 = T::mul_add(t129, t186, -t199 - t200);
+                let t316 = T::mul_add(t32, t91, T::mul_add(t130, t186, t201 - t202));
+                let t317 = T::mul_add(
                     T::from_f64(21844.852556112917),
-                    t166 - t217,
+                    t166 - t216,
                     T::mul_add(
                         -T::from_f64(871.6096169889054),
                         t165,
                         T::from_f64(0.0776191301023804) * (t34 + t35),
                     ),
                 );
-                let t317 = T::mul_add(-t164, t96, t102 + t103);
-                let t318 = T::one() / t206;
+                let t318 = T::mul_add(-t164, t96, t102 + t103);
                 let t319 = T::mul_add(
                     -t9,
                     T::mul_add(
@@ -2151,26 +2186,26 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                 t382,
                 t383,
             ) = {
-                let t320 = t222 * t270;
-                let t321 = t223 * t272;
-                let t322 = t229 * t281;
-                let t323 = t230 * t283;
-                let t324 = t236 * t292;
-                let t325 = t237 * t294;
-                let t326 = t242 * t303;
-                let t327 = t243 * t305;
-                let t328 = t7 * t306;
-                let t329 = t6 * t307;
-                let t330 = t14 * t308;
-                let t331 = t13 * t309;
-                let t332 = t20 * t310;
-                let t333 = t19 * t311;
-                let t334 = t28 * t312;
-                let t335 = t27 * t313;
-                let t336 = T::from_f64(60263.23947213258) * t261;
+                let t320 = t221 * t273;
+                let t321 = t222 * t275;
+                let t322 = t228 * t284;
+                let t323 = t229 * t286;
+                let t324 = t235 * t295;
+                let t325 = t236 * t297;
+                let t326 = t241 * t306;
+                let t327 = t242 * t308;
+                let t328 = t7 * t309;
+                let t329 = t6 * t310;
+                let t330 = t14 * t311;
+                let t331 = t13 * t312;
+                let t332 = t20 * t313;
+                let t333 = t19 * t314;
+                let t334 = t28 * t315;
+                let t335 = t27 * t316;
+                let t336 = T::from_f64(60263.23947213258) * t264;
                 let t337 = T::mul_add(
-                    -t246,
-                    t246 * t314,
+                    -t245,
+                    t245 * t246,
                     T::mul_add(
                         -t107,
                         t141,
@@ -2189,10 +2224,10 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                         ),
                     ),
                 );
-                let t338 = T::from_f64(60263.23947213258) * t260;
+                let t338 = T::from_f64(60263.23947213258) * t263;
                 let t339 = T::mul_add(
                     -t247,
-                    t247 * t315,
+                    t247 * t248,
                     T::mul_add(
                         -t106,
                         t142,
@@ -2211,12 +2246,10 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                         ),
                     ),
                 );
-                let t340 = t259 * t316;
-                let t341 = T::one() / t205;
-                let t342 = T::from_f64(60263.23947213258) * t258;
-                let t343 = T::mul_add(
-                    -t249,
-                    t249 * t318,
+                let t340 = T::from_f64(60263.23947213258) * t261;
+                let t341 = T::mul_add(
+                    -t251,
+                    t251 * t252,
                     T::mul_add(
                         -t105,
                         t143,
@@ -2235,7 +2268,7 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                         ),
                     ),
                 );
-                let t344 = T::mul_add(
+                let t342 = T::mul_add(
                     t26,
                     T::mul_add(t26, t145, t207),
                     T::mul_add(
@@ -2244,12 +2277,12 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                         T::from_f64(0.0000796647061621031),
                     ),
                 );
-                let t345 = T::mul_add(
+                let t343 = T::mul_add(
                     t26,
-                    t251,
+                    t254,
                     T::mul_add(
                         t25,
-                        t250,
+                        t253,
                         T::mul_add(
                             T::from_f64(0.054),
                             t25 * t47,
@@ -2261,7 +2294,7 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                         ),
                     ),
                 );
-                let t346 = T::mul_add(
+                let t344 = T::mul_add(
                     t18,
                     T::mul_add(t18, t150, t209),
                     T::mul_add(
@@ -2270,12 +2303,12 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                         T::from_f64(0.0000796647061621031),
                     ),
                 );
-                let t347 = T::mul_add(
+                let t345 = T::mul_add(
                     t18,
-                    t253,
+                    t256,
                     T::mul_add(
                         t17,
-                        t252,
+                        t255,
                         T::mul_add(
                             T::from_f64(0.054),
                             t17 * t54,
@@ -2287,22 +2320,21 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                         ),
                     ),
                 );
-                let t348 = t9 * t319;
-                let t349 = T::mul_add(
+                let t346 = T::mul_add(
                     t5,
-                    T::mul_add(t5, t160, t215),
+                    T::mul_add(t5, t160, t214),
                     T::mul_add(
                         t4,
-                        T::mul_add(t4, t159, t216),
+                        T::mul_add(t4, t159, t215),
                         T::from_f64(0.0000796647061621031),
                     ),
                 );
-                let t350 = T::mul_add(
+                let t347 = T::mul_add(
                     t5,
-                    t257,
+                    t260,
                     T::mul_add(
                         t4,
-                        t256,
+                        t259,
                         T::mul_add(
                             T::from_f64(0.054),
                             t4 * t68,
@@ -2314,54 +2346,54 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                         ),
                     ),
                 );
-                let t351 = T::mul_add(
+                let t348 = T::mul_add(
                     -t177,
-                    t281,
+                    t284,
                     T::mul_add(
-                        -t230,
-                        t282,
+                        -t229,
+                        t285,
                         T::mul_add(
                             T::from_f64(0.0000338903173333),
-                            t275 + t276 - t278,
+                            t278 + t279 - t281,
                             T::mul_add(
                                 T::from_f64(0.0000052283),
-                                t273 + t277 - t274,
+                                t276 + t280 - t277,
                                 T::from_f64(0.000011283525) * t80,
                             ),
                         ),
                     ),
                 );
-                let t352 = T::mul_add(
+                let t349 = T::mul_add(
                     t92,
-                    t303,
+                    t306,
                     T::mul_add(
-                        t243,
-                        t304,
+                        t242,
+                        t307,
                         T::mul_add(
                             T::from_f64(0.0000056692479999999995),
-                            t297 + t298 + t300,
-                            T::from_f64(0.0000012936) * (t295 - t296 - t299),
+                            t300 + t301 + t303,
+                            T::from_f64(0.0000012936) * (t298 - t299 - t302),
                         ),
                     ),
                 );
-                let t353 = T::mul_add(
-                    -t236,
-                    t293,
+                let t350 = T::mul_add(
+                    -t235,
+                    t296,
                     T::mul_add(
                         -t86,
-                        t294,
+                        t297,
                         T::mul_add(
                             -T::from_f64(0.00044856000000000003),
                             t182,
                             T::mul_add(
                                 T::from_f64(0.0000012936),
-                                t286 + t287 + t289,
+                                t289 + t290 + t292,
                                 T::mul_add(
                                     T::from_f64(0.0000176458),
-                                    t284 - t285 - t288,
+                                    t287 - t288 - t291,
                                     T::mul_add(
                                         T::from_f64(0.000017224704),
-                                        t233,
+                                        t232,
                                         T::from_f64(0.000048444480000000005) * t83,
                                     ),
                                 ),
@@ -2369,51 +2401,51 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                         ),
                     ),
                 );
-                let t354 = T::mul_add(
+                let t351 = T::mul_add(
                     t86,
-                    t292,
+                    t295,
                     T::mul_add(
-                        t237,
-                        t293,
+                        t236,
+                        t296,
                         T::mul_add(
                             T::from_f64(0.0000056692479999999995),
-                            t286 + t287 + t289,
-                            T::from_f64(0.0000012936) * (t284 - t285 - t288),
+                            t289 + t290 + t292,
+                            T::from_f64(0.0000012936) * (t287 - t288 - t291),
                         ),
                     ),
                 );
-                let t355 = T::mul_add(
+                let t352 = T::mul_add(
                     t76,
-                    t270,
+                    t273,
                     T::mul_add(
-                        t223,
-                        t271,
+                        t222,
+                        t274,
                         T::mul_add(
                             T::from_f64(0.0000056692479999999995),
-                            t264 + t265 + t267,
-                            T::from_f64(0.0000012936) * (t262 - t263 - t266),
+                            t267 + t268 + t270,
+                            T::from_f64(0.0000012936) * (t265 - t266 - t269),
                         ),
                     ),
                 );
-                let t356 = T::mul_add(T::from_f64(0.0264), t328 + t329, t222 * t268);
-                let t357 = T::mul_add(
-                    t222,
-                    t271,
+                let t353 = T::mul_add(T::from_f64(0.0264), t328 + t329, t221 * t271);
+                let t354 = T::mul_add(
+                    t221,
+                    t274,
                     T::mul_add(
                         t76,
-                        t272,
+                        t275,
                         T::mul_add(
                             T::from_f64(0.00044856000000000003),
                             t171,
                             T::mul_add(
                                 -T::from_f64(0.0000012936),
-                                t264 + t265 + t267,
+                                t267 + t268 + t270,
                                 T::mul_add(
                                     T::from_f64(0.0000176458),
-                                    t263 + t266 - t262,
+                                    t266 + t269 - t265,
                                     T::mul_add(
                                         -T::from_f64(0.000017224704),
-                                        t219,
+                                        t218,
                                         T::mul_add(
                                             -T::from_f64(0.000048444480000000005),
                                             t73,
@@ -2425,29 +2457,29 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                         ),
                     ),
                 );
-                let t358 = T::mul_add(
+                let t355 = T::mul_add(
                     T::from_f64(0.0556),
                     t330 + t331,
-                    T::mul_add(t229, t279, T::from_f64(0.0007106399999999999) * t80),
+                    T::mul_add(t228, t282, T::from_f64(0.0007106399999999999) * t80),
                 );
-                let t359 = T::mul_add(
-                    t229,
-                    t282,
+                let t356 = T::mul_add(
+                    t228,
+                    t285,
                     T::mul_add(
                         t177,
-                        t283,
+                        t286,
                         T::mul_add(
                             T::from_f64(0.0007106399999999999),
-                            t228 - t135,
+                            t227 - t135,
                             T::mul_add(
                                 T::from_f64(0.0000052283),
-                                t275 + t276 - t278,
+                                t278 + t279 - t281,
                                 T::mul_add(
                                     T::from_f64(0.00006395038933329998),
-                                    t273 + t277 - t274,
+                                    t276 + t280 - t277,
                                     T::mul_add(
                                         T::from_f64(0.00003652689599999999),
-                                        t224,
+                                        t223,
                                         T::mul_add(
                                             T::from_f64(0.000008042076),
                                             t80,
@@ -2459,26 +2491,26 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                         ),
                     ),
                 );
-                let t360 = T::mul_add(T::from_f64(0.0264), t332 + t333, t236 * t290);
-                let t361 = T::mul_add(T::from_f64(0.0264), t334 + t335, t242 * t301);
-                let t362 = T::mul_add(
-                    -t242,
-                    t304,
+                let t357 = T::mul_add(T::from_f64(0.0264), t332 + t333, t235 * t293);
+                let t358 = T::mul_add(T::from_f64(0.0264), t334 + t335, t241 * t304);
+                let t359 = T::mul_add(
+                    -t241,
+                    t307,
                     T::mul_add(
                         -t92,
-                        t305,
+                        t308,
                         T::mul_add(
                             -T::from_f64(0.00044856000000000003),
                             t187,
                             T::mul_add(
                                 T::from_f64(0.0000012936),
-                                t297 + t298 + t300,
+                                t300 + t301 + t303,
                                 T::mul_add(
                                     T::from_f64(0.0000176458),
-                                    t295 - t296 - t299,
+                                    t298 - t299 - t302,
                                     T::mul_add(
                                         T::from_f64(0.000017224704),
-                                        t239,
+                                        t238,
                                         T::mul_add(
                                             T::from_f64(0.000048444480000000005),
                                             t89,
@@ -2490,69 +2522,71 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                         ),
                     ),
                 );
+                let t360 = T::mul_add(
+                    T::from_f64(0.0264),
+                    T::mul_add(t28, t316, -t27 * t315),
+                    T::mul_add(t92, t131, t242 * t304),
+                );
+                let t361 = T::mul_add(
+                    T::from_f64(0.0264),
+                    T::mul_add(t20, t314, -t19 * t313),
+                    T::mul_add(t86, t125, t236 * t293),
+                );
+                let t362 = T::mul_add(
+                    T::from_f64(0.0556),
+                    T::mul_add(t14, t312, -t13 * t311),
+                    T::mul_add(t177, t230, t229 * t282),
+                );
                 let t363 = T::mul_add(
                     T::from_f64(0.0264),
-                    T::mul_add(t28, t313, -t27 * t312),
-                    T::mul_add(t92, t131, t243 * t301),
+                    T::mul_add(t7, t310, -t6 * t309),
+                    T::mul_add(t76, t113, t222 * t271),
                 );
                 let t364 = T::mul_add(
-                    T::from_f64(0.0264),
-                    T::mul_add(t20, t311, -t19 * t310),
-                    T::mul_add(t86, t125, t237 * t290),
-                );
-                let t365 = T::mul_add(
-                    T::from_f64(0.0556),
-                    T::mul_add(t14, t309, -t13 * t308),
-                    T::mul_add(t177, t231, t230 * t279),
-                );
-                let t366 = T::mul_add(
-                    T::from_f64(0.0264),
-                    T::mul_add(t7, t307, -t6 * t306),
-                    T::mul_add(t76, t113, t223 * t268),
-                );
-                let t367 = T::mul_add(
                     -T::from_f64(0.00044856000000000003),
                     t328 + t329,
                     T::mul_add(
                         T::from_f64(0.0000017622),
-                        t264 + t265 + t267,
+                        t267 + t268 + t270,
                         T::mul_add(
                             T::from_f64(0.000001255968),
-                            t262 - t263 - t266,
+                            t265 - t266 - t269,
                             t320 + tau[3] - t321,
                         ),
                     ),
                 );
-                let t368 = T::mul_add(
+                let t365 = T::mul_add(
                     -T::from_f64(0.00044856000000000003),
                     t332 + t333,
                     T::mul_add(
                         T::from_f64(0.0000017622),
-                        t286 + t287 + t289,
+                        t289 + t290 + t292,
                         T::mul_add(
                             T::from_f64(0.000001255968),
-                            t284 - t285 - t288,
+                            t287 - t288 - t291,
                             t324 + tau[11] - t325,
                         ),
                     ),
                 );
-                let t369 = T::mul_add(
+                let t366 = T::mul_add(
                     -T::from_f64(0.00044856000000000003),
                     t334 + t335,
                     T::mul_add(
                         T::from_f64(0.0000017622),
-                        t297 + t298 + t300,
+                        t300 + t301 + t303,
                         T::mul_add(
                             T::from_f64(0.000001255968),
-                            t295 - t296 - t299,
+                            t298 - t299 - t302,
                             t326 + tau[15] - t327,
                         ),
                     ),
                 );
-                let t370 = T::mul_add(-t261, t94, T::mul_add(t24, t148, t23 * t147));
-                let t371 = T::mul_add(-t260, t95, T::mul_add(t16, t153, t15 * t152));
-                let t372 = T::mul_add(
-                    -t259,
+                let t367 = T::mul_add(-t264, t94, T::mul_add(t24, t148, t23 * t147));
+                let t368 = T::one() / t337;
+                let t369 = T::mul_add(-t263, t95, T::mul_add(t16, t153, t15 * t152));
+                let t370 = T::one() / t339;
+                let t371 = T::mul_add(
+                    -t262,
                     t96,
                     T::mul_add(
                         t9,
@@ -2589,12 +2623,12 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                         ),
                     ),
                 );
-                let t373 = T::mul_add(
-                    -t317,
-                    t317 * t341,
+                let t372 = T::mul_add(
+                    -t250,
+                    t318 * t318,
                     T::mul_add(
                         -t164,
-                        t248,
+                        t249,
                         T::mul_add(
                             t12,
                             T::mul_add(t12, t155, t211),
@@ -2606,16 +2640,17 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                         ),
                     ),
                 );
-                let t374 = T::mul_add(-t258, t97, T::mul_add(t3, t163, t2 * t162));
+                let t373 = T::mul_add(-t261, t97, T::mul_add(t3, t163, t2 * t162));
+                let t374 = T::one() / t341;
                 let t375 = T::mul_add(
                     T::from_f64(0.0007106399999999999),
                     t330 + t331,
                     T::mul_add(
                         T::from_f64(0.000011283525),
-                        t275 + t276 - t278,
+                        t278 + t279 - t281,
                         T::mul_add(
                             T::from_f64(0.000008042076),
-                            t273 + t277 - t274,
+                            t276 + t280 - t277,
                             T::mul_add(
                                 T::from_f64(0.000045777374666699994),
                                 t80,
@@ -2624,14 +2659,14 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                         ),
                     ),
                 );
-                let t376 = t28 * t361;
-                let t377 = t27 * t363;
-                let t378 = t20 * t360;
-                let t379 = t19 * t364;
-                let t380 = t14 * t358;
-                let t381 = t13 * t365;
-                let t382 = t7 * t356;
-                let t383 = t6 * t366;
+                let t376 = t28 * t358;
+                let t377 = t27 * t360;
+                let t378 = t20 * t357;
+                let t379 = t19 * t361;
+                let t380 = t14 * t355;
+                let t381 = t13 * t362;
+                let t382 = t7 * t353;
+                let t383 = t6 * t363;
                 (
                     t320,
                     t321,
@@ -2751,22 +2786,16 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                 t432,
                 t433,
                 t434,
-                t435,
-                t436,
-                t437,
-                t438,
-                t439,
-                t440,
             ) = {
-                let t384 = t372 * t372 * t341;
+                let t384 = T::one() / t372;
                 let t385 = T::mul_add(
                     -t23,
                     T::mul_add(
                         t25,
-                        t251,
+                        t254,
                         T::mul_add(
                             -t26,
-                            t250,
+                            t253,
                             T::mul_add(
                                 -T::from_f64(0.108),
                                 t98,
@@ -2778,16 +2807,16 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                             ),
                         ),
                     ),
-                    t24 * t345,
+                    t24 * t343,
                 );
                 let t386 = T::mul_add(
                     -t15,
                     T::mul_add(
                         t17,
-                        t253,
+                        t256,
                         T::mul_add(
                             -t18,
-                            t252,
+                            t255,
                             T::mul_add(
                                 -T::from_f64(0.108),
                                 t99,
@@ -2799,7 +2828,7 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                             ),
                         ),
                     ),
-                    t16 * t347,
+                    t16 * t345,
                 );
                 let t387 = T::mul_add(
                     t9,
@@ -2807,10 +2836,10 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                     t10
                         * (T::mul_add(
                             t11,
-                            t255,
+                            t258,
                             T::mul_add(
                                 -t12,
-                                t254,
+                                t257,
                                 T::mul_add(
                                     -T::from_f64(0.0354),
                                     t101,
@@ -2827,10 +2856,10 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                     -t2,
                     T::mul_add(
                         t4,
-                        t257,
+                        t260,
                         T::mul_add(
                             -t5,
-                            t256,
+                            t259,
                             T::mul_add(
                                 -T::from_f64(0.108),
                                 t104,
@@ -2842,23 +2871,23 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                             ),
                         ),
                     ),
-                    t3 * t350,
+                    t3 * t347,
                 );
                 let t389 = T::mul_add(
                     -T::from_f64(0.0384),
-                    t291,
+                    t294,
                     T::mul_add(
                         -T::from_f64(0.0010137599999999998),
                         t182,
                         T::mul_add(
                             T::from_f64(0.000017224704),
-                            t284 - t285 - t288,
+                            t287 - t288 - t291,
                             T::mul_add(
                                 t19,
-                                t354,
+                                t351,
                                 T::mul_add(
                                     t20,
-                                    t353,
+                                    t350,
                                     T::mul_add(
                                         -t123,
                                         t179,
@@ -2867,10 +2896,10 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                                             t180,
                                             T::mul_add(
                                                 T::from_f64(0.00000285079817622615),
-                                                t232,
+                                                t231,
                                                 T::mul_add(
                                                     T::from_f64(0.00006603729237680699),
-                                                    t233,
+                                                    t232,
                                                     T::from_f64(0.00010948608) * t83,
                                                 ),
                                             ),
@@ -2883,10 +2912,10 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                 );
                 let t390 = T::mul_add(
                     t20,
-                    t354,
+                    t351,
                     T::mul_add(
                         -t19,
-                        t353,
+                        t350,
                         T::mul_add(
                             t31,
                             t178,
@@ -2895,8 +2924,8 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                                 t179,
                                 T::mul_add(
                                     T::from_f64(0.0000266287347075153),
-                                    t232,
-                                    T::from_f64(0.00000285079817622615) * t233,
+                                    t231,
+                                    T::from_f64(0.00000285079817622615) * t232,
                                 ),
                             ),
                         ),
@@ -2904,19 +2933,19 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                 );
                 let t391 = T::mul_add(
                     -T::from_f64(0.0384),
-                    t302,
+                    t305,
                     T::mul_add(
                         -T::from_f64(0.0010137599999999998),
                         t187,
                         T::mul_add(
                             T::from_f64(0.000017224704),
-                            t295 - t296 - t299,
+                            t298 - t299 - t302,
                             T::mul_add(
                                 t28,
-                                t362,
+                                t359,
                                 T::mul_add(
                                     t27,
-                                    t352,
+                                    t349,
                                     T::mul_add(
                                         -t129,
                                         t184,
@@ -2925,10 +2954,10 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                                             t185,
                                             T::mul_add(
                                                 T::from_f64(0.00000285079817622615),
-                                                t238,
+                                                t237,
                                                 T::mul_add(
                                                     T::from_f64(0.00006603729237680699),
-                                                    t239,
+                                                    t238,
                                                     T::mul_add(
                                                         T::from_f64(0.00010948608),
                                                         t89,
@@ -2945,10 +2974,10 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                 );
                 let t392 = T::mul_add(
                     -t27,
-                    t362,
+                    t359,
                     T::mul_add(
                         t28,
-                        t352,
+                        t349,
                         T::mul_add(
                             t32,
                             t183,
@@ -2957,34 +2986,34 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                                 t184,
                                 T::mul_add(
                                     T::from_f64(0.0000266287347075153),
-                                    t238,
-                                    T::from_f64(0.00000285079817622615) * t239,
+                                    t237,
+                                    T::from_f64(0.00000285079817622615) * t238,
                                 ),
                             ),
                         ),
                     ),
                 );
-                let t393 = T::mul_add(T::from_f64(0.038), t244 + t193, t380 - t381);
+                let t393 = T::mul_add(T::from_f64(0.038), t243 + t193, t380 - t381);
                 let t394 = T::mul_add(
                     -t14,
-                    t365,
-                    T::mul_add(-t13, t358, T::from_f64(0.038) * (t245 - t194)),
+                    t362,
+                    T::mul_add(-t13, t355, T::from_f64(0.038) * (t244 - t194)),
                 );
                 let t395 = T::mul_add(
                     T::from_f64(0.0514),
-                    t280,
+                    t283,
                     T::mul_add(
                         T::from_f64(0.00285784),
-                        t228 - t135,
+                        t227 - t135,
                         T::mul_add(
                             T::from_f64(0.00003652689599999999),
-                            t273 + t277 - t274,
+                            t276 + t280 - t277,
                             T::mul_add(
                                 t14,
-                                t359,
+                                t356,
                                 T::mul_add(
                                     t13,
-                                    t351,
+                                    t348,
                                     T::mul_add(
                                         t118,
                                         t173,
@@ -2993,10 +3022,10 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                                             t174,
                                             T::mul_add(
                                                 T::from_f64(0.00000255404234759754),
-                                                t225,
+                                                t224,
                                                 T::mul_add(
                                                     T::from_f64(0.000190704793294825),
-                                                    t224,
+                                                    t223,
                                                     T::mul_add(
                                                         T::from_f64(0.00000818299639785789),
                                                         t80,
@@ -3013,10 +3042,10 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                 );
                 let t396 = T::mul_add(
                     -t13,
-                    t359,
+                    t356,
                     T::mul_add(
                         t14,
-                        t351,
+                        t348,
                         T::mul_add(
                             -t117,
                             t172,
@@ -3025,10 +3054,10 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                                 t173,
                                 T::mul_add(
                                     T::from_f64(0.0000431323573125218),
-                                    t225,
+                                    t224,
                                     T::mul_add(
                                         T::from_f64(0.00000255404234759754),
-                                        t224,
+                                        t223,
                                         T::from_f64(0.000011844769255572) * t80,
                                     ),
                                 ),
@@ -3038,19 +3067,19 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                 );
                 let t397 = T::mul_add(
                     T::from_f64(0.0384),
-                    t269,
+                    t272,
                     T::mul_add(
                         T::from_f64(0.0010137599999999998),
                         t171,
                         T::mul_add(
                             T::from_f64(0.000017224704),
-                            t263 + t266 - t262,
+                            t266 + t269 - t265,
                             T::mul_add(
                                 t7,
-                                t357,
+                                t354,
                                 T::mul_add(
                                     -t6,
-                                    t355,
+                                    t352,
                                     T::mul_add(
                                         t111,
                                         t168,
@@ -3059,10 +3088,10 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                                             t169,
                                             T::mul_add(
                                                 -T::from_f64(0.00000285079817622615),
-                                                t218,
+                                                t217,
                                                 T::mul_add(
                                                     -T::from_f64(0.00006603729237680699),
-                                                    t219,
+                                                    t218,
                                                     T::mul_add(
                                                         -T::from_f64(0.00010948608),
                                                         t73,
@@ -3079,10 +3108,10 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                 );
                 let t398 = T::mul_add(
                     t6,
-                    t357,
+                    t354,
                     T::mul_add(
                         t7,
-                        t355,
+                        t352,
                         T::mul_add(
                             t30,
                             t167,
@@ -3091,18 +3120,18 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                                 t168,
                                 T::mul_add(
                                     T::from_f64(0.0000266287347075153),
-                                    t218,
-                                    T::from_f64(0.00000285079817622615) * t219,
+                                    t217,
+                                    T::from_f64(0.00000285079817622615) * t218,
                                 ),
                             ),
                         ),
                     ),
                 );
                 let t399 = T::mul_add(
-                    -t246,
-                    t370 * t314,
+                    -t245,
+                    t246 * t367,
                     T::mul_add(
-                        -t261,
+                        -t264,
                         t141,
                         T::mul_add(
                             t24,
@@ -3113,9 +3142,9 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                 );
                 let t400 = T::mul_add(
                     -t247,
-                    t371 * t315,
+                    t248 * t369,
                     T::mul_add(
-                        -t260,
+                        -t263,
                         t142,
                         T::mul_add(
                             t16,
@@ -3125,11 +3154,11 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                     ),
                 );
                 let t401 = T::mul_add(
-                    t372,
-                    t317 * t341,
+                    t371,
+                    t250 * t318,
                     T::mul_add(
-                        t259,
-                        t248,
+                        t262,
+                        t249,
                         T::mul_add(
                             -t9,
                             t102 + t103 - T::from_f64(0.00000118904291699917),
@@ -3137,10 +3166,10 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                                 t10,
                                 T::mul_add(
                                     t12,
-                                    t255,
+                                    t258,
                                     T::mul_add(
                                         t11,
-                                        t254,
+                                        t257,
                                         T::mul_add(
                                             T::from_f64(0.0177),
                                             t100,
@@ -3158,10 +3187,10 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                     ),
                 );
                 let t402 = T::mul_add(
-                    -t249,
-                    t374 * t318,
+                    -t251,
+                    t252 * t373,
                     T::mul_add(
-                        -t258,
+                        -t261,
                         t143,
                         T::mul_add(
                             t3,
@@ -3178,20 +3207,20 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                         t334 + t335,
                         T::mul_add(
                             T::from_f64(0.0000017622),
-                            t297 + t298 + t300,
+                            t300 + t301 + t303,
                             T::mul_add(
                                 T::from_f64(0.000001255968),
-                                t295 - t296 - t299,
+                                t298 - t299 - t302,
                                 T::mul_add(
-                                    -t369,
+                                    -t366,
                                     t94,
                                     T::mul_add(
                                         T::from_f64(0.00000793657186922407),
-                                        t238,
+                                        t237,
                                         T::mul_add(
                                             T::from_f64(0.0000054115225794551),
-                                            t239,
-                                            t240 + t326 + tau[14] - t241 - t327,
+                                            t238,
+                                            t239 + t326 + tau[14] - t240 - t327,
                                         ),
                                     ),
                                 ),
@@ -3207,20 +3236,20 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                         t332 + t333,
                         T::mul_add(
                             T::from_f64(0.0000017622),
-                            t286 + t287 + t289,
+                            t289 + t290 + t292,
                             T::mul_add(
                                 T::from_f64(0.000001255968),
-                                t284 - t285 - t288,
+                                t287 - t288 - t291,
                                 T::mul_add(
-                                    -t368,
+                                    -t365,
                                     t95,
                                     T::mul_add(
                                         T::from_f64(0.00000793657186922407),
-                                        t232,
+                                        t231,
                                         T::mul_add(
                                             T::from_f64(0.0000054115225794551),
-                                            t233,
-                                            t234 + t324 + tau[10] - t235 - t325,
+                                            t232,
+                                            t233 + t324 + tau[10] - t234 - t325,
                                         ),
                                     ),
                                 ),
@@ -3236,23 +3265,23 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                         t330 + t331,
                         T::mul_add(
                             T::from_f64(0.000011283525),
-                            t275 + t276 - t278,
+                            t278 + t279 - t281,
                             T::mul_add(
                                 T::from_f64(0.000008042076),
-                                t273 + t277 - t274,
+                                t276 + t280 - t277,
                                 T::mul_add(
                                     -t96,
                                     t375,
                                     T::mul_add(
                                         T::from_f64(0.000011844769255572),
-                                        t225,
+                                        t224,
                                         T::mul_add(
                                             T::from_f64(0.00000818299639785789),
-                                            t224,
+                                            t223,
                                             T::mul_add(
                                                 T::from_f64(0.00006238331952591029),
                                                 t80,
-                                                t227 + t323 - t226 - t322 - tau[6],
+                                                t226 + t323 - t225 - t322 - tau[6],
                                             ),
                                         ),
                                     ),
@@ -3269,20 +3298,20 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                         t328 + t329,
                         T::mul_add(
                             T::from_f64(0.0000017622),
-                            t264 + t265 + t267,
+                            t267 + t268 + t270,
                             T::mul_add(
                                 T::from_f64(0.000001255968),
-                                t262 - t263 - t266,
+                                t265 - t266 - t269,
                                 T::mul_add(
-                                    -t367,
+                                    -t364,
                                     t97,
                                     T::mul_add(
                                         T::from_f64(0.00000793657186922407),
-                                        t218,
+                                        t217,
                                         T::mul_add(
                                             T::from_f64(0.0000054115225794551),
-                                            t219,
-                                            t220 + t320 + tau[2] - t221 - t321,
+                                            t218,
+                                            t219 + t320 + tau[2] - t220 - t321,
                                         ),
                                     ),
                                 ),
@@ -3290,73 +3319,100 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                         ),
                     ),
                 );
-                let t407 = t10 * t387;
-                let t408 = t12 * t393;
-                let t409 = t11 * t394;
-                let t410 = T::one() / t337;
-                let t411 = T::one() / t339;
-                let t412 = T::one() / t373;
-                let t413 = t401 * t401 * t412;
-                let t414 = T::one() / t343;
-                let t415 = T::mul_add(
-                    -t399,
-                    t399 * t410,
+                let t407 = t12 * t393;
+                let t408 = t11 * t394;
+                let t409 = T::mul_add(
+                    -t368,
+                    t399 * t399,
                     T::mul_add(
-                        -t370,
-                        t370 * t314,
+                        -t246,
+                        t367 * t367,
                         T::mul_add(
-                            -t261,
+                            -t264,
                             t336,
                             T::mul_add(
                                 t24,
-                                T::mul_add(t24, t344, t23 * t345),
+                                T::mul_add(t24, t342, t23 * t343),
                                 T::mul_add(t23, t385, T::from_f64(0.00000101666658333)),
                             ),
                         ),
                     ),
                 );
-                let t416 = T::mul_add(
-                    -t400,
-                    t400 * t411,
+                let t410 = T::mul_add(
+                    -t370,
+                    t400 * t400,
                     T::mul_add(
-                        -t371,
-                        t371 * t315,
+                        -t248,
+                        t369 * t369,
                         T::mul_add(
-                            -t260,
+                            -t263,
                             t338,
                             T::mul_add(
                                 t16,
-                                T::mul_add(t16, t346, t15 * t347),
+                                T::mul_add(t16, t344, t15 * t345),
                                 T::mul_add(t15, t386, T::from_f64(0.00000101666658333)),
                             ),
                         ),
                     ),
                 );
-                let t417 = T::mul_add(
-                    -t402,
-                    t402 * t414,
+                let t411 = T::mul_add(
+                    -t401,
+                    t401 * t384,
                     T::mul_add(
-                        -t374,
-                        t374 * t318,
+                        -t371,
+                        t371 * t250,
                         T::mul_add(
-                            -t258,
-                            t342,
+                            -t262,
+                            t317,
+                            T::mul_add(
+                                -t9,
+                                t319,
+                                T::mul_add(
+                                    -t10,
+                                    t387,
+                                    T::mul_add(
+                                        T::from_f64(0.01),
+                                        t9 * t156,
+                                        T::mul_add(
+                                            T::from_f64(0.0798),
+                                            t101,
+                                            T::mul_add(
+                                                -T::from_f64(0.00005670907199999999),
+                                                t36,
+                                                T::from_f64(0.0003224740048544997),
+                                            ),
+                                        ),
+                                    ),
+                                ),
+                            ),
+                        ),
+                    ),
+                );
+                let t412 = T::mul_add(
+                    -t374,
+                    t402 * t402,
+                    T::mul_add(
+                        -t252,
+                        t373 * t373,
+                        T::mul_add(
+                            -t261,
+                            t340,
                             T::mul_add(
                                 t3,
-                                T::mul_add(t3, t349, t2 * t350),
+                                T::mul_add(t3, t346, t2 * t347),
                                 T::mul_add(t2, t388, T::from_f64(0.00000101666658333)),
                             ),
                         ),
                     ),
                 );
-                let t418 = T::mul_add(
+                let t413 = T::mul_add(
                     T::from_f64(0.054),
                     T::mul_add(
                         t25,
                         T::mul_add(
                             t28,
-                            t363,
-                            T::mul_add(t27, t361, T::from_f64(0.0355) * (t201 - t202)),
+                            t360,
+                            T::mul_add(t27, t358, T::from_f64(0.0355) * (t201 - t202)),
                         ),
                         t26 * (T::mul_add(T::from_f64(0.0355), t199 + t200, t377 - t376)),
                     ),
@@ -3368,21 +3424,21 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                             t334 + t335,
                             T::mul_add(
                                 T::from_f64(0.0000017622),
-                                t297 + t298 + t300,
+                                t300 + t301 + t303,
                                 T::mul_add(
                                     T::from_f64(0.000001255968),
-                                    t295 - t296 - t299,
+                                    t298 - t299 - t302,
                                     T::mul_add(
                                         T::from_f64(0.00000793657186922407),
-                                        t238,
+                                        t237,
                                         T::mul_add(
                                             T::from_f64(0.0000054115225794551),
-                                            t239,
+                                            t238,
                                             T::mul_add(
-                                                -t246,
-                                                t403 * t314,
+                                                -t245,
+                                                t246 * t403,
                                                 T::mul_add(
-                                                    -t369,
+                                                    -t366,
                                                     t141,
                                                     T::mul_add(
                                                         -qd[12],
@@ -3396,7 +3452,7 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                                                                 T::mul_add(
                                                                     T::from_f64(0.0000148386162019941),
                                                                     t89,
-                                                                    t240 + t326 + tau[13] - t241 - t327,
+                                                                    t239 + t326 + tau[13] - t240 - t327,
                                                                 ),
                                                             ),
                                                         ),
@@ -3410,14 +3466,14 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                         ),
                     ),
                 );
-                let t419 = T::mul_add(
+                let t414 = T::mul_add(
                     T::from_f64(0.054),
                     T::mul_add(
                         t17,
                         T::mul_add(
                             t20,
-                            t364,
-                            T::mul_add(t19, t360, T::from_f64(0.0355) * (t197 - t198)),
+                            t361,
+                            T::mul_add(t19, t357, T::from_f64(0.0355) * (t197 - t198)),
                         ),
                         t18 * (T::mul_add(T::from_f64(0.0355), t195 + t196, t379 - t378)),
                     ),
@@ -3429,21 +3485,21 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                             t332 + t333,
                             T::mul_add(
                                 T::from_f64(0.0000017622),
-                                t286 + t287 + t289,
+                                t289 + t290 + t292,
                                 T::mul_add(
                                     T::from_f64(0.000001255968),
-                                    t284 - t285 - t288,
+                                    t287 - t288 - t291,
                                     T::mul_add(
                                         T::from_f64(0.00000793657186922407),
-                                        t232,
+                                        t231,
                                         T::mul_add(
                                             T::from_f64(0.0000054115225794551),
-                                            t233,
+                                            t232,
                                             T::mul_add(
                                                 -t247,
-                                                t404 * t315,
+                                                t248 * t404,
                                                 T::mul_add(
-                                                    -t368,
+                                                    -t365,
                                                     t142,
                                                     T::mul_add(
                                                         -qd[8],
@@ -3457,7 +3513,7 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                                                                 T::mul_add(
                                                                     T::from_f64(0.0000148386162019941),
                                                                     t83,
-                                                                    t234 + t324 + tau[9] - t235 - t325,
+                                                                    t233 + t324 + tau[9] - t234 - t325,
                                                                 ),
                                                             ),
                                                         ),
@@ -3471,11 +3527,11 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                         ),
                     ),
                 );
-                let t420 = T::mul_add(
-                    t317,
-                    t405 * t341,
+                let t415 = T::mul_add(
+                    t250,
+                    t318 * t405,
                     T::mul_add(
-                        t248,
+                        t249,
                         t375,
                         T::mul_add(
                             t12,
@@ -3504,14 +3560,14 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                         ),
                     ),
                 );
-                let t421 = T::mul_add(
+                let t416 = T::mul_add(
                     T::from_f64(0.054),
                     T::mul_add(
                         t4,
                         T::mul_add(
                             t7,
-                            t366,
-                            T::mul_add(t6, t356, T::from_f64(0.0355) * (t190 - t191)),
+                            t363,
+                            T::mul_add(t6, t353, T::from_f64(0.0355) * (t190 - t191)),
                         ),
                         t5 * (T::mul_add(T::from_f64(0.0355), t188 + t189, t383 - t382)),
                     ),
@@ -3523,21 +3579,21 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                             t328 + t329,
                             T::mul_add(
                                 T::from_f64(0.0000017622),
-                                t264 + t265 + t267,
+                                t267 + t268 + t270,
                                 T::mul_add(
                                     T::from_f64(0.000001255968),
-                                    t262 - t263 - t266,
+                                    t265 - t266 - t269,
                                     T::mul_add(
                                         T::from_f64(0.00000793657186922407),
-                                        t218,
+                                        t217,
                                         T::mul_add(
                                             T::from_f64(0.0000054115225794551),
-                                            t219,
+                                            t218,
                                             T::mul_add(
-                                                -t249,
-                                                t406 * t318,
+                                                -t251,
+                                                t252 * t406,
                                                 T::mul_add(
-                                                    -t367,
+                                                    -t364,
                                                     t143,
                                                     T::mul_add(
                                                         -qd[0],
@@ -3551,7 +3607,7 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                                                                 T::mul_add(
                                                                     T::from_f64(0.0000148386162019941),
                                                                     t73,
-                                                                    t220 + t320 + tau[1] - t221 - t321,
+                                                                    t219 + t320 + tau[1] - t220 - t321,
                                                                 ),
                                                             ),
                                                         ),
@@ -3565,29 +3621,19 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                         ),
                     ),
                 );
-                let t422 = T::mul_add(
-                    -T::from_f64(0.01),
-                    t214,
+                let t417 = T::one() / t409;
+                let t418 = T::one() / t410;
+                let t419 = T::one() / t411;
+                let t420 = T::one() / t412;
+                let t421 = T::mul_add(
+                    t374,
+                    t402 * t416,
                     T::mul_add(
-                        -T::from_f64(0.0798),
-                        t101,
+                        t252,
+                        t373 * t406,
                         T::mul_add(
-                            T::from_f64(0.00005670907199999999),
-                            t36,
-                            t407 + t348 + t340 + t384 + t413
-                                - T::from_f64(0.0003224740048544997),
-                        ),
-                    ),
-                );
-                let t423 = T::mul_add(
-                    t402,
-                    t421 * t414,
-                    T::mul_add(
-                        t374,
-                        t406 * t318,
-                        T::mul_add(
-                            t367,
-                            t342,
+                            t364,
+                            t340,
                             T::mul_add(
                                 t3,
                                 T::mul_add(
@@ -3615,16 +3661,16 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                                     t2,
                                     T::mul_add(
                                         T::from_f64(0.054),
-                                        t269,
+                                        t272,
                                         T::mul_add(
                                             T::from_f64(0.0014256),
                                             t171,
                                             T::mul_add(
                                                 T::from_f64(0.000024222240000000003),
-                                                t263 + t266 - t262,
+                                                t266 + t269 - t265,
                                                 T::mul_add(
                                                     -T::from_f64(0.00005474303999999999),
-                                                    t219,
+                                                    t218,
                                                     T::mul_add(
                                                         -t4,
                                                         t398,
@@ -3660,20 +3706,20 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                         ),
                     ),
                 );
-                let t424 = T::mul_add(
+                let t422 = T::mul_add(
                     -t401,
-                    t420 * t412,
+                    t384 * t415,
                     T::mul_add(
-                        -t372,
-                        t405 * t341,
+                        -t371,
+                        t250 * t405,
                         T::mul_add(
-                            -t316,
+                            -t317,
                             t375,
                             T::mul_add(
                                 t9,
                                 T::mul_add(
                                     T::from_f64(0.0177),
-                                    t408 + t409,
+                                    t407 + t408,
                                     T::mul_add(
                                         T::from_f64(0.0514),
                                         t380 - t381,
@@ -3682,16 +3728,16 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                                             t330 + t331,
                                             T::mul_add(
                                                 T::from_f64(0.000011283525),
-                                                t275 + t276 - t278,
+                                                t278 + t279 - t281,
                                                 T::mul_add(
                                                     T::from_f64(0.000008042076),
-                                                    t273 + t277 - t274,
+                                                    t276 + t280 - t277,
                                                     T::mul_add(
                                                         T::from_f64(0.000011844769255572),
-                                                        t225,
+                                                        t224,
                                                         T::mul_add(
                                                             T::from_f64(0.00000818299639785789),
-                                                            t224,
+                                                            t223,
                                                             T::mul_add(
                                                                 qd[4],
                                                                 t10 * t116,
@@ -3704,7 +3750,7 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                                                                         T::mul_add(
                                                                             T::from_f64(0.000000795929506936549),
                                                                             t79,
-                                                                            t227 + t323 - t226 - t322,
+                                                                            t226 + t323 - t225 - t322,
                                                                         ),
                                                                     ),
                                                                 ),
@@ -3723,16 +3769,16 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                                         t135,
                                         T::mul_add(
                                             T::from_f64(0.0177),
-                                            t280,
+                                            t283,
                                             T::mul_add(
                                                 T::from_f64(0.00098412),
-                                                t228,
+                                                t227,
                                                 T::mul_add(
                                                     T::from_f64(0.000012578328),
-                                                    t273 + t277 - t274,
+                                                    t276 + t280 - t277,
                                                     T::mul_add(
                                                         T::from_f64(0.000050583768),
-                                                        t224,
+                                                        t223,
                                                         T::mul_add(
                                                             t11,
                                                             t396,
@@ -3772,14 +3818,14 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                                                 t135,
                                                 T::mul_add(
                                                     T::from_f64(0.0556),
-                                                    t228,
+                                                    t227,
                                                     T::mul_add(
                                                         T::from_f64(0.0007106399999999999),
-                                                        t273 + t277 - t274,
+                                                        t276 + t280 - t277,
                                                         T::mul_add(
                                                             T::from_f64(0.00285784),
-                                                            t224,
-                                                            T::mul_add(T::from_f64(1.031016683848749), t9, t280),
+                                                            t223,
+                                                            T::mul_add(T::from_f64(1.031016683848749), t9, t283),
                                                         ),
                                                     ),
                                                 ),
@@ -3791,7 +3837,7 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                                                     T::mul_add(
                                                         T::from_f64(0.11629477287014325),
                                                         t10,
-                                                        t408 + t409,
+                                                        t407 + t408,
                                                     ),
                                                 )),
                                         ),
@@ -3810,14 +3856,14 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                         ),
                     ),
                 );
-                let t425 = T::mul_add(
-                    -t400,
-                    t419 * t411,
+                let t423 = T::mul_add(
+                    -t370,
+                    t400 * t414,
                     T::mul_add(
-                        -t371,
-                        t404 * t315,
+                        -t248,
+                        t369 * t404,
                         T::mul_add(
-                            -t368,
+                            -t365,
                             t338,
                             T::mul_add(
                                 -t16,
@@ -3846,16 +3892,16 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                                     t15,
                                     T::mul_add(
                                         -T::from_f64(0.054),
-                                        t291,
+                                        t294,
                                         T::mul_add(
                                             -T::from_f64(0.0014256),
                                             t182,
                                             T::mul_add(
                                                 T::from_f64(0.000024222240000000003),
-                                                t284 - t285 - t288,
+                                                t287 - t288 - t291,
                                                 T::mul_add(
                                                     T::from_f64(0.00005474303999999999),
-                                                    t233,
+                                                    t232,
                                                     T::mul_add(
                                                         t17,
                                                         t390,
@@ -3887,14 +3933,14 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                         ),
                     ),
                 );
-                let t426 = T::mul_add(
-                    -t399,
-                    t418 * t410,
+                let t424 = T::mul_add(
+                    -t368,
+                    t399 * t413,
                     T::mul_add(
-                        -t370,
-                        t403 * t314,
+                        -t246,
+                        t367 * t403,
                         T::mul_add(
-                            -t369,
+                            -t366,
                             t336,
                             T::mul_add(
                                 -t24,
@@ -3923,16 +3969,16 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                                     t23,
                                     T::mul_add(
                                         -T::from_f64(0.054),
-                                        t302,
+                                        t305,
                                         T::mul_add(
                                             -T::from_f64(0.0014256),
                                             t187,
                                             T::mul_add(
                                                 T::from_f64(0.000024222240000000003),
-                                                t295 - t296 - t299,
+                                                t298 - t299 - t302,
                                                 T::mul_add(
                                                     T::from_f64(0.00005474303999999999),
-                                                    t239,
+                                                    t238,
                                                     T::mul_add(
                                                         t25,
                                                         t392,
@@ -3968,36 +4014,32 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                         ),
                     ),
                 );
-                let t427 = T::one() / t417;
-                let t428 = T::one() / t422;
-                let t429 = T::one() / t416;
-                let t430 = T::one() / t415;
-                let t431 = T::mul_add(t421, t414, t402 * t423 / (t343 * t417));
-                let t432 = T::mul_add(-t420, t412, -t401 * t424 / (t373 * t422));
-                let t433 = T::mul_add(t419, t411, -t400 * t425 / (t339 * t416));
-                let t434 = T::mul_add(t418, t410, -t399 * t426 / (t337 * t415));
-                let t435 = -t432;
-                let t436 = T::mul_add(
-                    -t249,
-                    t431 * t318,
-                    T::mul_add(t406, t318, t374 * t423 / (t206 * t417)),
+                let t425 = T::mul_add(t374, t402 * t420 * t421, t374 * t416);
+                let t426 = T::mul_add(t401, t384 * t419 * t422, -t384 * t415);
+                let t427 = T::mul_add(-t370, t400 * t418 * t423, t370 * t414);
+                let t428 = T::mul_add(-t368, t399 * t417 * t424, t368 * t413);
+                let t429 = -t426;
+                let t430 = T::mul_add(
+                    t252,
+                    t373 * t420 * t421,
+                    T::mul_add(-t251, t252 * t425, t252 * t406),
                 );
-                let t437 = T::mul_add(
-                    -t247,
-                    t433 * t315,
-                    T::mul_add(t404, t315, -t371 * t425 / (t204 * t416)),
+                let t431 = T::mul_add(
+                    -t248,
+                    t369 * t418 * t423,
+                    T::mul_add(-t247, t248 * t427, t248 * t404),
                 );
-                let t438 = T::mul_add(
+                let t432 = T::mul_add(
                     -t246,
-                    t434 * t314,
-                    T::mul_add(t403, t314, -t370 * t426 / (t203 * t415)),
+                    t367 * t417 * t424,
+                    T::mul_add(-t245, t246 * t428, t246 * t403),
                 );
-                let t439 = T::mul_add(
-                    -t317,
-                    t435 * t341,
-                    T::mul_add(-t405, t341, -t372 * t424 / (t205 * t422)),
+                let t433 = T::mul_add(
+                    t371,
+                    t250 * t419 * t422,
+                    T::mul_add(-t250, t318 * t429, -t250 * t405),
                 );
-                let t440 = T::mul_add(
+                let t434 = T::mul_add(
                     -T::from_f64(15.523826020476081),
                     t330 + t331,
                     T::mul_add(
@@ -4005,14 +4047,14 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                         t322 + tau[7] - t323,
                         T::mul_add(
                             T::from_f64(0.246486939938214),
-                            t278 - t275 - t276,
+                            t281 - t278 - t279,
                             T::mul_add(
                                 T::from_f64(0.17567796446505435),
-                                t274 - t273 - t277,
+                                t277 - t276 - t280,
                                 T::mul_add(
-                                    -t316,
-                                    t424 * t428,
-                                    T::mul_add(-t248, t435, T::mul_add(t96, -t439, -t80)),
+                                    t317,
+                                    t419 * t422,
+                                    T::mul_add(-t249, t429, T::mul_add(t96, -t433, -t80)),
                                 ),
                             ),
                         ),
@@ -4070,27 +4112,21 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                     t432,
                     t433,
                     t434,
-                    t435,
-                    t436,
-                    t437,
-                    t438,
-                    t439,
-                    t440,
                 )
             };
             [
-                t423 * t427,
-                t431,
-                t436,
+                t420 * t421,
+                t425,
+                t430,
                 T::mul_add(
-                    t342,
-                    t423 * t427,
+                    t340,
+                    t420 * t421,
                     T::mul_add(
                         -t143,
-                        t431,
+                        t425,
                         T::mul_add(
                             -t97,
-                            t436,
+                            t430,
                             T::mul_add(
                                 -T::from_f64(27.031678697619792),
                                 t328 + t329,
@@ -4099,30 +4135,30 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                                     t320 + tau[3] - t321,
                                     T::mul_add(
                                         T::from_f64(0.10619588059779204),
-                                        t264 + t265 + t267,
-                                        T::from_f64(0.07568870035333543) * (t262 - t263 - t266),
+                                        t267 + t268 + t270,
+                                        T::from_f64(0.07568870035333543) * (t265 - t266 - t269),
                                     ),
                                 ),
                             ),
                         ),
                     ),
                 ),
-                t424 * t428,
-                t432,
-                t439,
-                t440,
-                -t425 * t429,
+                -t419 * t422,
+                t426,
                 t433,
-                t437,
+                t434,
+                -t418 * t423,
+                t427,
+                t431,
                 T::mul_add(
                     -t338,
-                    t425 * t429,
+                    t418 * t423,
                     T::mul_add(
                         -t142,
-                        t433,
+                        t427,
                         T::mul_add(
                             -t95,
-                            t437,
+                            t431,
                             T::mul_add(
                                 -T::from_f64(27.031678697619792),
                                 t332 + t333,
@@ -4131,26 +4167,26 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                                     t324 + tau[11] - t325,
                                     T::mul_add(
                                         T::from_f64(0.10619588059779204),
-                                        t286 + t287 + t289,
-                                        T::from_f64(0.07568870035333543) * (t284 - t285 - t288),
+                                        t289 + t290 + t292,
+                                        T::from_f64(0.07568870035333543) * (t287 - t288 - t291),
                                     ),
                                 ),
                             ),
                         ),
                     ),
                 ),
-                -t426 * t430,
-                t434,
-                t438,
+                -t417 * t424,
+                t428,
+                t432,
                 T::mul_add(
                     -t336,
-                    t426 * t430,
+                    t417 * t424,
                     T::mul_add(
                         -t141,
-                        t434,
+                        t428,
                         T::mul_add(
                             -t94,
-                            t438,
+                            t432,
                             T::mul_add(
                                 -T::from_f64(27.031678697619792),
                                 t334 + t335,
@@ -4159,40 +4195,27 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                                     t326 + tau[15] - t327,
                                     T::mul_add(
                                         T::from_f64(0.10619588059779204),
-                                        t297 + t298 + t300,
-                                        T::from_f64(0.07568870035333543) * (t295 - t296 - t299),
+                                        t300 + t301 + t303,
+                                        T::from_f64(0.07568870035333543) * (t298 - t299 - t302),
                                     ),
                                 ),
                             ),
                         ),
                     ),
                 ),
-                t417,
-                t343,
+                t412,
+                t341,
                 t206,
                 T::from_f64(0.000016593864000000002),
-                T::mul_add(
-                    T::from_f64(0.01),
-                    t214,
-                    T::mul_add(
-                        T::from_f64(0.0798),
-                        t101,
-                        T::mul_add(
-                            -T::from_f64(0.00005670907199999999),
-                            t36,
-                            T::from_f64(0.0003224740048544997) - t407 - t348 - t340
-                                - t384 - t413,
-                        ),
-                    ),
-                ),
-                t373,
+                t411,
+                t372,
                 t205,
                 T::from_f64(0.000045777374666699994),
-                t416,
+                t410,
                 t339,
                 t204,
                 T::from_f64(0.000016593864000000002),
-                t415,
+                t409,
                 t337,
                 t203,
                 T::from_f64(0.000016593864000000002),
@@ -4245,18 +4268,47 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
     /// Route: Newton-Euler at rest without gravity, with qd as the accelerations, O(N).
     /// Operations: 406 mul, 369 add, 0 div, 12 sin, 12 cos.
     pub fn generalized_momentum(&self, q: &[T; 16], qd: &[T; 16]) -> [T; 16] {
-        let (s1, c1) = q[1].sin_cos();
-        let (s2, c2) = q[2].sin_cos();
-        let (s3, c3) = q[3].sin_cos();
-        let (s5, c5) = q[5].sin_cos();
-        let (s6, c6) = q[6].sin_cos();
-        let (s7, c7) = q[7].sin_cos();
-        let (s9, c9) = q[9].sin_cos();
-        let (s10, c10) = q[10].sin_cos();
-        let (s11, c11) = q[11].sin_cos();
-        let (s13, c13) = q[13].sin_cos();
-        let (s14, c14) = q[14].sin_cos();
-        let (s15, c15) = q[15].sin_cos();
+        let (
+            [s1,
+            s2,
+            s3,
+            s5,
+            s6,
+            s7,
+            s9,
+            s10,
+            s11,
+            s13,
+            s14,
+            s15,
+            ],
+            [c1,
+            c2,
+            c3,
+            c5,
+            c6,
+            c7,
+            c9,
+            c10,
+            c11,
+            c13,
+            c14,
+            c15,
+            ],
+        ) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[1],
+            q[2],
+            q[3],
+            q[5],
+            q[6],
+            q[7],
+            q[9],
+            q[10],
+            q[11],
+            q[13],
+            q[14],
+            q[15],
+        ]);
         let (
             t0,
             t1,
@@ -5605,18 +5657,47 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
     /// Route: closed-form Lagrangian expressions.
     /// Operations: 676 mul, 432 add, 0 div, 12 sin, 12 cos.
     pub fn centrifugal(&self, q: &[T; 16]) -> [[T; 16]; 16] {
-        let (s1, c1) = q[1].sin_cos();
-        let (s2, c2) = q[2].sin_cos();
-        let (s3, c3) = q[3].sin_cos();
-        let (s5, c5) = q[5].sin_cos();
-        let (s6, c6) = q[6].sin_cos();
-        let (s7, c7) = q[7].sin_cos();
-        let (s9, c9) = q[9].sin_cos();
-        let (s10, c10) = q[10].sin_cos();
-        let (s11, c11) = q[11].sin_cos();
-        let (s13, c13) = q[13].sin_cos();
-        let (s14, c14) = q[14].sin_cos();
-        let (s15, c15) = q[15].sin_cos();
+        let (
+            [s1,
+            s2,
+            s3,
+            s5,
+            s6,
+            s7,
+            s9,
+            s10,
+            s11,
+            s13,
+            s14,
+            s15,
+            ],
+            [c1,
+            c2,
+            c3,
+            c5,
+            c6,
+            c7,
+            c9,
+            c10,
+            c11,
+            c13,
+            c14,
+            c15,
+            ],
+        ) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[1],
+            q[2],
+            q[3],
+            q[5],
+            q[6],
+            q[7],
+            q[9],
+            q[10],
+            q[11],
+            q[13],
+            q[14],
+            q[15],
+        ]);
         let (
             t0,
             t1,
@@ -7537,18 +7618,47 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
     /// Route: second velocity derivatives of the Newton-Euler bias.
     /// Operations: 623 mul, 452 add, 0 div, 12 sin, 12 cos.
     pub fn coriolis_pairs(&self, q: &[T; 16]) -> [[T; 120]; 16] {
-        let (s1, c1) = q[1].sin_cos();
-        let (s2, c2) = q[2].sin_cos();
-        let (s3, c3) = q[3].sin_cos();
-        let (s5, c5) = q[5].sin_cos();
-        let (s6, c6) = q[6].sin_cos();
-        let (s7, c7) = q[7].sin_cos();
-        let (s9, c9) = q[9].sin_cos();
-        let (s10, c10) = q[10].sin_cos();
-        let (s11, c11) = q[11].sin_cos();
-        let (s13, c13) = q[13].sin_cos();
-        let (s14, c14) = q[14].sin_cos();
-        let (s15, c15) = q[15].sin_cos();
+        let (
+            [s1,
+            s2,
+            s3,
+            s5,
+            s6,
+            s7,
+            s9,
+            s10,
+            s11,
+            s13,
+            s14,
+            s15,
+            ],
+            [c1,
+            c2,
+            c3,
+            c5,
+            c6,
+            c7,
+            c9,
+            c10,
+            c11,
+            c13,
+            c14,
+            c15,
+            ],
+        ) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[1],
+            q[2],
+            q[3],
+            q[5],
+            q[6],
+            q[7],
+            q[9],
+            q[10],
+            q[11],
+            q[13],
+            q[14],
+            q[15],
+        ]);
         let (
             t0,
             t1,
@@ -11292,22 +11402,59 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
     /// Route: the bodies' centres of mass by forward kinematics.
     /// Operations: 148 mul, 91 add, 0 div, 16 sin, 16 cos.
     pub fn center_of_mass(&self, q: &[T; 16]) -> [T; 3] {
-        let (s0, c0) = q[0].sin_cos();
-        let (s1, c1) = q[1].sin_cos();
-        let (s2, c2) = q[2].sin_cos();
-        let (s3, c3) = q[3].sin_cos();
-        let (s4, c4) = q[4].sin_cos();
-        let (s5, c5) = q[5].sin_cos();
-        let (s6, c6) = q[6].sin_cos();
-        let (s7, c7) = q[7].sin_cos();
-        let (s8, c8) = q[8].sin_cos();
-        let (s9, c9) = q[9].sin_cos();
-        let (s10, c10) = q[10].sin_cos();
-        let (s11, c11) = q[11].sin_cos();
-        let (s12, c12) = q[12].sin_cos();
-        let (s13, c13) = q[13].sin_cos();
-        let (s14, c14) = q[14].sin_cos();
-        let (s15, c15) = q[15].sin_cos();
+        let (
+            [s0,
+            s1,
+            s2,
+            s3,
+            s4,
+            s5,
+            s6,
+            s7,
+            s8,
+            s9,
+            s10,
+            s11,
+            s12,
+            s13,
+            s14,
+            s15,
+            ],
+            [c0,
+            c1,
+            c2,
+            c3,
+            c4,
+            c5,
+            c6,
+            c7,
+            c8,
+            c9,
+            c10,
+            c11,
+            c12,
+            c13,
+            c14,
+            c15,
+            ],
+        ) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[0],
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+            q[6],
+            q[7],
+            q[8],
+            q[9],
+            q[10],
+            q[11],
+            q[12],
+            q[13],
+            q[14],
+            q[15],
+        ]);
         let t0 = s0;
         let t1 = c0;
         let t2 = s1;
@@ -11587,22 +11734,59 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
     /// Route: each coordinate's composite-body momentum (the composite-rigid-body algorithm's), moved to the world.
     /// Operations: 266 mul, 91 add, 0 div, 16 sin, 16 cos.
     pub fn center_of_mass_jacobian(&self, q: &[T; 16]) -> [[T; 16]; 3] {
-        let (s0, c0) = q[0].sin_cos();
-        let (s1, c1) = q[1].sin_cos();
-        let (s2, c2) = q[2].sin_cos();
-        let (s3, c3) = q[3].sin_cos();
-        let (s4, c4) = q[4].sin_cos();
-        let (s5, c5) = q[5].sin_cos();
-        let (s6, c6) = q[6].sin_cos();
-        let (s7, c7) = q[7].sin_cos();
-        let (s8, c8) = q[8].sin_cos();
-        let (s9, c9) = q[9].sin_cos();
-        let (s10, c10) = q[10].sin_cos();
-        let (s11, c11) = q[11].sin_cos();
-        let (s12, c12) = q[12].sin_cos();
-        let (s13, c13) = q[13].sin_cos();
-        let (s14, c14) = q[14].sin_cos();
-        let (s15, c15) = q[15].sin_cos();
+        let (
+            [s0,
+            s1,
+            s2,
+            s3,
+            s4,
+            s5,
+            s6,
+            s7,
+            s8,
+            s9,
+            s10,
+            s11,
+            s12,
+            s13,
+            s14,
+            s15,
+            ],
+            [c0,
+            c1,
+            c2,
+            c3,
+            c4,
+            c5,
+            c6,
+            c7,
+            c8,
+            c9,
+            c10,
+            c11,
+            c12,
+            c13,
+            c14,
+            c15,
+            ],
+        ) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[0],
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+            q[6],
+            q[7],
+            q[8],
+            q[9],
+            q[10],
+            q[11],
+            q[12],
+            q[13],
+            q[14],
+            q[15],
+        ]);
         let (
             t0,
             t1,
@@ -12348,7 +12532,9 @@ impl<T: ::eomgen_runtime::Real> AllegroRightHand<T> {
         match j {
             0 => {
                 let o = {
-                    let (s0, c0) = q[0].sin_cos();
+                    let ([s0], [c0]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+                        q[0],
+                    ]);
                     let t0 = s0;
                     let t1 = c0;
                     [
@@ -12377,7 +12563,9 @@ impl<T: ::eomgen_runtime::Real> AllegroRightHand<T> {
             }
             1 => {
                 let o = {
-                    let (s1, c1) = q[1].sin_cos();
+                    let ([s1], [c1]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+                        q[1],
+                    ]);
                     let t0 = s1;
                     let t1 = c1;
                     [
@@ -12406,7 +12594,9 @@ impl<T: ::eomgen_runtime::Real> AllegroRightHand<T> {
             }
             2 => {
                 let o = {
-                    let (s2, c2) = q[2].sin_cos();
+                    let ([s2], [c2]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+                        q[2],
+                    ]);
                     let t0 = s2;
                     let t1 = c2;
                     [
@@ -12435,7 +12625,9 @@ impl<T: ::eomgen_runtime::Real> AllegroRightHand<T> {
             }
             3 => {
                 let o = {
-                    let (s3, c3) = q[3].sin_cos();
+                    let ([s3], [c3]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+                        q[3],
+                    ]);
                     let t0 = s3;
                     let t1 = c3;
                     [
@@ -12464,7 +12656,9 @@ impl<T: ::eomgen_runtime::Real> AllegroRightHand<T> {
             }
             4 => {
                 let o = {
-                    let (s4, c4) = q[4].sin_cos();
+                    let ([s4], [c4]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+                        q[4],
+                    ]);
                     let t0 = s4;
                     let t1 = c4;
                     [
@@ -12493,7 +12687,9 @@ impl<T: ::eomgen_runtime::Real> AllegroRightHand<T> {
             }
             5 => {
                 let o = {
-                    let (s5, c5) = q[5].sin_cos();
+                    let ([s5], [c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+                        q[5],
+                    ]);
                     let t0 = s5;
                     let t1 = c5;
                     [
@@ -12522,7 +12718,9 @@ impl<T: ::eomgen_runtime::Real> AllegroRightHand<T> {
             }
             6 => {
                 let o = {
-                    let (s6, c6) = q[6].sin_cos();
+                    let ([s6], [c6]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+                        q[6],
+                    ]);
                     let t0 = s6;
                     let t1 = c6;
                     [
@@ -12551,7 +12749,9 @@ impl<T: ::eomgen_runtime::Real> AllegroRightHand<T> {
             }
             7 => {
                 let o = {
-                    let (s7, c7) = q[7].sin_cos();
+                    let ([s7], [c7]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+                        q[7],
+                    ]);
                     let t0 = s7;
                     let t1 = c7;
                     [
@@ -12580,7 +12780,9 @@ impl<T: ::eomgen_runtime::Real> AllegroRightHand<T> {
             }
             8 => {
                 let o = {
-                    let (s8, c8) = q[8].sin_cos();
+                    let ([s8], [c8]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+                        q[8],
+                    ]);
                     let t0 = s8;
                     let t1 = c8;
                     [
@@ -12609,7 +12811,9 @@ impl<T: ::eomgen_runtime::Real> AllegroRightHand<T> {
             }
             9 => {
                 let o = {
-                    let (s9, c9) = q[9].sin_cos();
+                    let ([s9], [c9]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+                        q[9],
+                    ]);
                     let t0 = s9;
                     let t1 = c9;
                     [
@@ -12638,7 +12842,9 @@ impl<T: ::eomgen_runtime::Real> AllegroRightHand<T> {
             }
             10 => {
                 let o = {
-                    let (s10, c10) = q[10].sin_cos();
+                    let ([s10], [c10]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+                        q[10],
+                    ]);
                     let t0 = s10;
                     let t1 = c10;
                     [
@@ -12667,7 +12873,9 @@ impl<T: ::eomgen_runtime::Real> AllegroRightHand<T> {
             }
             11 => {
                 let o = {
-                    let (s11, c11) = q[11].sin_cos();
+                    let ([s11], [c11]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+                        q[11],
+                    ]);
                     let t0 = s11;
                     let t1 = c11;
                     [
@@ -12696,7 +12904,9 @@ impl<T: ::eomgen_runtime::Real> AllegroRightHand<T> {
             }
             12 => {
                 let o = {
-                    let (s12, c12) = q[12].sin_cos();
+                    let ([s12], [c12]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+                        q[12],
+                    ]);
                     let t0 = s12;
                     let t1 = c12;
                     [
@@ -12725,7 +12935,9 @@ impl<T: ::eomgen_runtime::Real> AllegroRightHand<T> {
             }
             13 => {
                 let o = {
-                    let (s13, c13) = q[13].sin_cos();
+                    let ([s13], [c13]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+                        q[13],
+                    ]);
                     let t0 = s13;
                     let t1 = c13;
                     [
@@ -12754,7 +12966,9 @@ impl<T: ::eomgen_runtime::Real> AllegroRightHand<T> {
             }
             14 => {
                 let o = {
-                    let (s14, c14) = q[14].sin_cos();
+                    let ([s14], [c14]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+                        q[14],
+                    ]);
                     let t0 = s14;
                     let t1 = c14;
                     [
@@ -12783,7 +12997,9 @@ impl<T: ::eomgen_runtime::Real> AllegroRightHand<T> {
             }
             15 => {
                 let o = {
-                    let (s15, c15) = q[15].sin_cos();
+                    let ([s15], [c15]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+                        q[15],
+                    ]);
                     let t0 = s15;
                     let t1 = c15;
                     [
@@ -13132,18 +13348,47 @@ for AllegroRightHand<T> {
     /// Route: composite-rigid-body algorithm.
     /// Operations: 321 mul, 241 add, 0 div, 12 sin, 12 cos.
     fn mass_matrix(&self, q: &[T; 16]) -> [[T; 16]; 16] {
-        let (s1, c1) = q[1].sin_cos();
-        let (s2, c2) = q[2].sin_cos();
-        let (s3, c3) = q[3].sin_cos();
-        let (s5, c5) = q[5].sin_cos();
-        let (s6, c6) = q[6].sin_cos();
-        let (s7, c7) = q[7].sin_cos();
-        let (s9, c9) = q[9].sin_cos();
-        let (s10, c10) = q[10].sin_cos();
-        let (s11, c11) = q[11].sin_cos();
-        let (s13, c13) = q[13].sin_cos();
-        let (s14, c14) = q[14].sin_cos();
-        let (s15, c15) = q[15].sin_cos();
+        let (
+            [s1,
+            s2,
+            s3,
+            s5,
+            s6,
+            s7,
+            s9,
+            s10,
+            s11,
+            s13,
+            s14,
+            s15,
+            ],
+            [c1,
+            c2,
+            c3,
+            c5,
+            c6,
+            c7,
+            c9,
+            c10,
+            c11,
+            c13,
+            c14,
+            c15,
+            ],
+        ) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[1],
+            q[2],
+            q[3],
+            q[5],
+            q[6],
+            q[7],
+            q[9],
+            q[10],
+            q[11],
+            q[13],
+            q[14],
+            q[15],
+        ]);
         let (
             t0,
             t1,
@@ -14586,21 +14831,56 @@ for AllegroRightHand<T> {
     /// Route: closed-form Lagrangian expressions.
     /// Operations: 122 mul, 59 add, 0 div, 15 sin, 15 cos.
     fn gravity(&self, q: &[T; 16]) -> [T; 16] {
-        let (s0, c0) = q[0].sin_cos();
-        let (s1, c1) = q[1].sin_cos();
-        let (s2, c2) = q[2].sin_cos();
-        let (s3, c3) = q[3].sin_cos();
-        let (s4, c4) = q[4].sin_cos();
-        let (s5, c5) = q[5].sin_cos();
-        let (s6, c6) = q[6].sin_cos();
-        let (s7, c7) = q[7].sin_cos();
-        let (s9, c9) = q[9].sin_cos();
-        let (s10, c10) = q[10].sin_cos();
-        let (s11, c11) = q[11].sin_cos();
-        let (s12, c12) = q[12].sin_cos();
-        let (s13, c13) = q[13].sin_cos();
-        let (s14, c14) = q[14].sin_cos();
-        let (s15, c15) = q[15].sin_cos();
+        let (
+            [s0,
+            s1,
+            s2,
+            s3,
+            s4,
+            s5,
+            s6,
+            s7,
+            s9,
+            s10,
+            s11,
+            s12,
+            s13,
+            s14,
+            s15,
+            ],
+            [c0,
+            c1,
+            c2,
+            c3,
+            c4,
+            c5,
+            c6,
+            c7,
+            c9,
+            c10,
+            c11,
+            c12,
+            c13,
+            c14,
+            c15,
+            ],
+        ) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[0],
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+            q[6],
+            q[7],
+            q[9],
+            q[10],
+            q[11],
+            q[12],
+            q[13],
+            q[14],
+            q[15],
+        ]);
         let t0 = s0;
         let t1 = c0;
         let t2 = s1;
@@ -14814,18 +15094,47 @@ for AllegroRightHand<T> {
     /// Route: Newton-Euler.
     /// Operations: 751 mul, 581 add, 0 div, 12 sin, 12 cos.
     fn bias(&self, q: &[T; 16], qd: &[T; 16]) -> [T; 16] {
-        let (s1, c1) = q[1].sin_cos();
-        let (s2, c2) = q[2].sin_cos();
-        let (s3, c3) = q[3].sin_cos();
-        let (s5, c5) = q[5].sin_cos();
-        let (s6, c6) = q[6].sin_cos();
-        let (s7, c7) = q[7].sin_cos();
-        let (s9, c9) = q[9].sin_cos();
-        let (s10, c10) = q[10].sin_cos();
-        let (s11, c11) = q[11].sin_cos();
-        let (s13, c13) = q[13].sin_cos();
-        let (s14, c14) = q[14].sin_cos();
-        let (s15, c15) = q[15].sin_cos();
+        let (
+            [s1,
+            s2,
+            s3,
+            s5,
+            s6,
+            s7,
+            s9,
+            s10,
+            s11,
+            s13,
+            s14,
+            s15,
+            ],
+            [c1,
+            c2,
+            c3,
+            c5,
+            c6,
+            c7,
+            c9,
+            c10,
+            c11,
+            c13,
+            c14,
+            c15,
+            ],
+        ) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[1],
+            q[2],
+            q[3],
+            q[5],
+            q[6],
+            q[7],
+            q[9],
+            q[10],
+            q[11],
+            q[13],
+            q[14],
+            q[15],
+        ]);
         let (
             t0,
             t1,
@@ -17099,18 +17408,47 @@ for AllegroRightHand<T> {
     /// Route: closed-form Lagrangian expressions.
     /// Operations: 925 mul, 622 add, 0 div, 12 sin, 12 cos.
     fn coriolis_matrix(&self, q: &[T; 16], qd: &[T; 16]) -> [[T; 16]; 16] {
-        let (s1, c1) = q[1].sin_cos();
-        let (s2, c2) = q[2].sin_cos();
-        let (s3, c3) = q[3].sin_cos();
-        let (s5, c5) = q[5].sin_cos();
-        let (s6, c6) = q[6].sin_cos();
-        let (s7, c7) = q[7].sin_cos();
-        let (s9, c9) = q[9].sin_cos();
-        let (s10, c10) = q[10].sin_cos();
-        let (s11, c11) = q[11].sin_cos();
-        let (s13, c13) = q[13].sin_cos();
-        let (s14, c14) = q[14].sin_cos();
-        let (s15, c15) = q[15].sin_cos();
+        let (
+            [s1,
+            s2,
+            s3,
+            s5,
+            s6,
+            s7,
+            s9,
+            s10,
+            s11,
+            s13,
+            s14,
+            s15,
+            ],
+            [c1,
+            c2,
+            c3,
+            c5,
+            c6,
+            c7,
+            c9,
+            c10,
+            c11,
+            c13,
+            c14,
+            c15,
+            ],
+        ) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[1],
+            q[2],
+            q[3],
+            q[5],
+            q[6],
+            q[7],
+            q[9],
+            q[10],
+            q[11],
+            q[13],
+            q[14],
+            q[15],
+        ]);
         let (
             t0,
             t1,
@@ -19667,21 +20005,56 @@ for AllegroRightHand<T> {
     /// Route: Newton-Euler.
     /// Operations: 801 mul, 745 add, 0 div, 15 sin, 15 cos.
     fn inverse_dynamics(&self, q: &[T; 16], qd: &[T; 16], qdd: &[T; 16]) -> [T; 16] {
-        let (s0, c0) = q[0].sin_cos();
-        let (s1, c1) = q[1].sin_cos();
-        let (s2, c2) = q[2].sin_cos();
-        let (s3, c3) = q[3].sin_cos();
-        let (s4, c4) = q[4].sin_cos();
-        let (s5, c5) = q[5].sin_cos();
-        let (s6, c6) = q[6].sin_cos();
-        let (s7, c7) = q[7].sin_cos();
-        let (s9, c9) = q[9].sin_cos();
-        let (s10, c10) = q[10].sin_cos();
-        let (s11, c11) = q[11].sin_cos();
-        let (s12, c12) = q[12].sin_cos();
-        let (s13, c13) = q[13].sin_cos();
-        let (s14, c14) = q[14].sin_cos();
-        let (s15, c15) = q[15].sin_cos();
+        let (
+            [s0,
+            s1,
+            s2,
+            s3,
+            s4,
+            s5,
+            s6,
+            s7,
+            s9,
+            s10,
+            s11,
+            s12,
+            s13,
+            s14,
+            s15,
+            ],
+            [c0,
+            c1,
+            c2,
+            c3,
+            c4,
+            c5,
+            c6,
+            c7,
+            c9,
+            c10,
+            c11,
+            c12,
+            c13,
+            c14,
+            c15,
+            ],
+        ) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[0],
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+            q[6],
+            q[7],
+            q[9],
+            q[10],
+            q[11],
+            q[12],
+            q[13],
+            q[14],
+            q[15],
+        ]);
         let (
             t0,
             t1,
@@ -22261,7 +22634,7 @@ for AllegroRightHand<T> {
     /// model and finite inputs); `try_forward_dynamics` says which pivot failed.
     ///
     /// Route: M and b + G as in `mass_matrix` and `bias`, then an unrolled L^T D L solve without fill-in.
-    /// Operations: 1252 mul, 1018 add, 20 div, 15 sin, 15 cos.
+    /// Operations: 1257 mul, 1010 add, 12 div, 15 sin, 15 cos.
     fn forward_dynamics(&self, q: &[T; 16], qd: &[T; 16], tau: &[T; 16]) -> [T; 16] {
         match self.forward_dynamics_checked(q, qd, tau) {
             Ok((qdd, failures)) => ::eomgen_runtime::lane::nan_failed(qdd, &failures),
@@ -22273,18 +22646,47 @@ for AllegroRightHand<T> {
     /// Route: a sum over body velocities, O(N).
     /// Operations: 340 mul, 187 add, 0 div, 12 sin, 12 cos.
     fn kinetic_energy(&self, q: &[T; 16], qd: &[T; 16]) -> T {
-        let (s1, c1) = q[1].sin_cos();
-        let (s2, c2) = q[2].sin_cos();
-        let (s3, c3) = q[3].sin_cos();
-        let (s5, c5) = q[5].sin_cos();
-        let (s6, c6) = q[6].sin_cos();
-        let (s7, c7) = q[7].sin_cos();
-        let (s9, c9) = q[9].sin_cos();
-        let (s10, c10) = q[10].sin_cos();
-        let (s11, c11) = q[11].sin_cos();
-        let (s13, c13) = q[13].sin_cos();
-        let (s14, c14) = q[14].sin_cos();
-        let (s15, c15) = q[15].sin_cos();
+        let (
+            [s1,
+            s2,
+            s3,
+            s5,
+            s6,
+            s7,
+            s9,
+            s10,
+            s11,
+            s13,
+            s14,
+            s15,
+            ],
+            [c1,
+            c2,
+            c3,
+            c5,
+            c6,
+            c7,
+            c9,
+            c10,
+            c11,
+            c13,
+            c14,
+            c15,
+            ],
+        ) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[1],
+            q[2],
+            q[3],
+            q[5],
+            q[6],
+            q[7],
+            q[9],
+            q[10],
+            q[11],
+            q[13],
+            q[14],
+            q[15],
+        ]);
         let (
             t0,
             t1,
@@ -23114,21 +23516,56 @@ for AllegroRightHand<T> {
     /// Route: centres of mass by forward kinematics.
     /// Operations: 51 mul, 33 add, 0 div, 15 sin, 13 cos.
     fn potential_energy(&self, q: &[T; 16]) -> T {
-        let s0 = q[0].sin();
-        let (s1, c1) = q[1].sin_cos();
-        let (s2, c2) = q[2].sin_cos();
-        let (s3, c3) = q[3].sin_cos();
-        let (s4, c4) = q[4].sin_cos();
-        let (s5, c5) = q[5].sin_cos();
-        let (s6, c6) = q[6].sin_cos();
-        let (s7, c7) = q[7].sin_cos();
-        let (s9, c9) = q[9].sin_cos();
-        let (s10, c10) = q[10].sin_cos();
-        let (s11, c11) = q[11].sin_cos();
-        let s12 = q[12].sin();
-        let (s13, c13) = q[13].sin_cos();
-        let (s14, c14) = q[14].sin_cos();
-        let (s15, c15) = q[15].sin_cos();
+        let (
+            [s0,
+            s1,
+            s2,
+            s3,
+            s4,
+            s5,
+            s6,
+            s7,
+            s9,
+            s10,
+            s11,
+            s12,
+            s13,
+            s14,
+            s15,
+            ],
+            [_,
+            c1,
+            c2,
+            c3,
+            c4,
+            c5,
+            c6,
+            c7,
+            c9,
+            c10,
+            c11,
+            _,
+            c13,
+            c14,
+            c15,
+            ],
+        ) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[0],
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+            q[6],
+            q[7],
+            q[9],
+            q[10],
+            q[11],
+            q[12],
+            q[13],
+            q[14],
+            q[15],
+        ]);
         let t0 = s0;
         let t1 = s1;
         let t2 = c1;

@@ -109,8 +109,10 @@ impl<T: ::eomgen_runtime::Lane> DoublePendulum<T> {
     > {
         let mut failures: <T as ::eomgen_runtime::Lane>::Failures = ::core::default::Default::default();
         let o: [T; 4] = {
-            let (s0, c0) = q[0].sin_cos();
-            let (s1, c1) = q[1].sin_cos();
+            let ([s0, s1], [c0, c1]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+                q[0],
+                q[1],
+            ]);
             let t0 = s0;
             let t1 = c0;
             let t2 = s1;
@@ -149,7 +151,8 @@ impl<T: ::eomgen_runtime::Lane> DoublePendulum<T> {
                 ),
             );
             let t12 = qd[0] * qd[0] * (T::from_f64(0.033238000000000004) * (t9 - t10));
-            let t13 = T::mul_add(
+            let t13 = T::one() / t11;
+            let t14 = T::mul_add(
                 t8,
                 T::mul_add(
                     -T::from_f64(0.328934150064),
@@ -187,7 +190,6 @@ impl<T: ::eomgen_runtime::Lane> DoublePendulum<T> {
                     ),
                 ),
             );
-            let t14 = T::one() / t11;
             [
                 t13 * t14,
                 T::mul_add(
@@ -217,7 +219,7 @@ impl<T: ::eomgen_runtime::Lane> DoublePendulum<T> {
     /// Route: Newton-Euler at rest without gravity, with qd as the accelerations, O(N).
     /// Operations: 16 mul, 12 add, 0 div, 1 sin, 1 cos.
     pub fn generalized_momentum(&self, q: &[T; 2], qd: &[T; 2]) -> [T; 2] {
-        let (s1, c1) = q[1].sin_cos();
+        let ([s1], [c1]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([q[1]]);
         let t0 = s1;
         let t1 = c1;
         let t2 = qd[0] * t1;
@@ -270,7 +272,7 @@ impl<T: ::eomgen_runtime::Lane> DoublePendulum<T> {
     /// Route: closed-form Lagrangian expressions.
     /// Operations: 7 mul, 4 add, 0 div, 1 sin, 1 cos.
     pub fn centrifugal(&self, q: &[T; 2]) -> [[T; 2]; 2] {
-        let (s1, c1) = q[1].sin_cos();
+        let ([s1], [c1]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([q[1]]);
         let t0 = s1;
         let t1 = c1;
         let t2 = T::from_f64(0.033238000000000004)
@@ -296,7 +298,7 @@ impl<T: ::eomgen_runtime::Lane> DoublePendulum<T> {
     /// Route: second velocity derivatives of the Newton-Euler bias.
     /// Operations: 2 mul, 1 add, 0 div, 1 sin, 1 cos.
     pub fn coriolis_pairs(&self, q: &[T; 2]) -> [[T; 1]; 2] {
-        let (s1, c1) = q[1].sin_cos();
+        let ([s1], [c1]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([q[1]]);
         [
             [
                 T::mul_add(
@@ -313,8 +315,10 @@ impl<T: ::eomgen_runtime::Lane> DoublePendulum<T> {
     /// Route: the bodies' centres of mass by forward kinematics.
     /// Operations: 12 mul, 11 add, 0 div, 2 sin, 2 cos.
     pub fn center_of_mass(&self, q: &[T; 2]) -> [T; 3] {
-        let (s0, c0) = q[0].sin_cos();
-        let (s1, c1) = q[1].sin_cos();
+        let ([s0, s1], [c0, c1]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[0],
+            q[1],
+        ]);
         let t0 = s0;
         let t1 = c0;
         let t2 = s1;
@@ -362,8 +366,10 @@ impl<T: ::eomgen_runtime::Lane> DoublePendulum<T> {
     /// Route: each coordinate's composite-body momentum (the composite-rigid-body algorithm's), moved to the world.
     /// Operations: 18 mul, 12 add, 0 div, 2 sin, 2 cos.
     pub fn center_of_mass_jacobian(&self, q: &[T; 2]) -> [[T; 2]; 3] {
-        let (s0, c0) = q[0].sin_cos();
-        let (s1, c1) = q[1].sin_cos();
+        let ([s0, s1], [c0, c1]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[0],
+            q[1],
+        ]);
         let t0 = s0;
         let t1 = c0;
         let t2 = s1;
@@ -577,7 +583,9 @@ impl<T: ::eomgen_runtime::Real> DoublePendulum<T> {
         match j {
             0 => {
                 let o = {
-                    let (s0, c0) = q[0].sin_cos();
+                    let ([s0], [c0]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+                        q[0],
+                    ]);
                     let t0 = s0;
                     let t1 = c0;
                     [
@@ -606,7 +614,9 @@ impl<T: ::eomgen_runtime::Real> DoublePendulum<T> {
             }
             1 => {
                 let o = {
-                    let (s1, c1) = q[1].sin_cos();
+                    let ([s1], [c1]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+                        q[1],
+                    ]);
                     let t0 = s1;
                     let t1 = c1;
                     [
@@ -703,7 +713,7 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 2> for DoublePendu
     /// Route: composite-rigid-body algorithm.
     /// Operations: 4 mul, 4 add, 0 div, 1 sin, 1 cos.
     fn mass_matrix(&self, q: &[T; 2]) -> [[T; 2]; 2] {
-        let (s1, c1) = q[1].sin_cos();
+        let ([s1], [c1]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([q[1]]);
         let t0 = s1;
         let t1 = c1;
         let t2 = T::mul_add(
@@ -736,8 +746,10 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 2> for DoublePendu
     /// Route: closed-form Lagrangian expressions.
     /// Operations: 10 mul, 8 add, 0 div, 2 sin, 2 cos.
     fn gravity(&self, q: &[T; 2]) -> [T; 2] {
-        let (s0, c0) = q[0].sin_cos();
-        let (s1, c1) = q[1].sin_cos();
+        let ([s0, s1], [c0, c1]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[0],
+            q[1],
+        ]);
         let t0 = s0;
         let t1 = c0;
         let t2 = s1;
@@ -772,7 +784,7 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 2> for DoublePendu
     /// Route: closed-form Lagrangian expressions.
     /// Operations: 14 mul, 6 add, 0 div, 1 sin, 1 cos.
     fn bias(&self, q: &[T; 2], qd: &[T; 2]) -> [T; 2] {
-        let (s1, c1) = q[1].sin_cos();
+        let ([s1], [c1]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([q[1]]);
         let t0 = s1;
         let t1 = c1;
         let t2 = t0 * (T::mul_add(T::from_f64(0.1), t1, T::from_f64(0.10088)));
@@ -794,7 +806,7 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 2> for DoublePendu
     /// Route: closed-form Lagrangian expressions.
     /// Operations: 13 mul, 5 add, 0 div, 1 sin, 1 cos.
     fn coriolis_matrix(&self, q: &[T; 2], qd: &[T; 2]) -> [[T; 2]; 2] {
-        let (s1, c1) = q[1].sin_cos();
+        let ([s1], [c1]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([q[1]]);
         let t0 = s1;
         let t1 = c1;
         let t2 = T::from_f64(0.06647600000000001)
@@ -821,8 +833,10 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 2> for DoublePendu
     /// Route: Newton-Euler.
     /// Operations: 29 mul, 25 add, 0 div, 2 sin, 2 cos.
     fn inverse_dynamics(&self, q: &[T; 2], qd: &[T; 2], qdd: &[T; 2]) -> [T; 2] {
-        let (s0, c0) = q[0].sin_cos();
-        let (s1, c1) = q[1].sin_cos();
+        let ([s0, s1], [c0, c1]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[0],
+            q[1],
+        ]);
         let t0 = s0;
         let t1 = c0;
         let t2 = s1;
@@ -907,7 +921,7 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 2> for DoublePendu
     /// Route: the quadratic form of `mass_matrix`.
     /// Operations: 11 mul, 7 add, 0 div, 1 sin, 1 cos.
     fn kinetic_energy(&self, q: &[T; 2], qd: &[T; 2]) -> T {
-        let (s1, c1) = q[1].sin_cos();
+        let ([s1], [c1]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([q[1]]);
         let t0 = s1;
         let t1 = c1;
         let t2 = T::mul_add(
@@ -946,8 +960,10 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 2> for DoublePendu
     /// Route: centres of mass by forward kinematics.
     /// Operations: 8 mul, 6 add, 0 div, 2 sin, 2 cos.
     fn potential_energy(&self, q: &[T; 2]) -> T {
-        let (s0, c0) = q[0].sin_cos();
-        let (s1, c1) = q[1].sin_cos();
+        let ([s0, s1], [c0, c1]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[0],
+            q[1],
+        ]);
         let t0 = s0;
         let t1 = c0;
         let t2 = s1;

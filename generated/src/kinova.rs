@@ -157,11 +157,13 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
     > {
         let mut failures: <T as ::eomgen_runtime::Lane>::Failures = ::core::default::Default::default();
         let o: [T; 12] = {
-            let (s1, c1) = q[1].sin_cos();
-            let (s2, c2) = q[2].sin_cos();
-            let (s3, c3) = q[3].sin_cos();
-            let (s4, c4) = q[4].sin_cos();
-            let (s5, c5) = q[5].sin_cos();
+            let ([s1, s2, s3, s4, s5], [c1, c2, c3, c4, c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+                q[1],
+                q[2],
+                q[3],
+                q[4],
+                q[5],
+            ]);
             let (
                 t0,
                 t1,
@@ -583,9 +585,10 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                 let t81 = t11 * t58;
                 let t82 = t36 * t60;
                 let t83 = T::mul_add(-t4, t11, t5 * t36);
-                let t84 = T::mul_add(t7, t42, t29);
-                let t85 = T::mul_add(-t6, t17, t7 * t43);
-                let t86 = T::mul_add(
+                let t84 = T::one() / t66;
+                let t85 = T::mul_add(t7, t42, t29);
+                let t86 = T::mul_add(-t6, t17, t7 * t43);
+                let t87 = T::mul_add(
                     T::from_f64(0.000000000000000000011248597539537108),
                     t9,
                     T::mul_add(
@@ -594,11 +597,11 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                         -t68 - t31 - T::from_f64(0.00006481854695392561),
                     ),
                 );
-                let t87 = T::mul_add(-t4, t18, t5 * t40);
-                let t88 = T::mul_add(t5, t18, t4 * t40);
-                let t89 = T::mul_add(T::from_f64(0.0114), t70, t68 + t31);
-                let t90 = T::mul_add(t2, t40, t3 * t5 * t41);
-                let t91 = T::mul_add(
+                let t88 = T::mul_add(-t4, t18, t5 * t40);
+                let t89 = T::mul_add(t5, t18, t4 * t40);
+                let t90 = T::mul_add(T::from_f64(0.0114), t70, t68 + t31);
+                let t91 = T::mul_add(t2, t40, t3 * t5 * t41);
+                let t92 = T::mul_add(
                     t4,
                     t48,
                     T::mul_add(
@@ -611,9 +614,9 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                         ),
                     ),
                 );
-                let t92 = T::mul_add(T::from_f64(0.2073), t51, t73 - t74);
-                let t93 = T::mul_add(t2, t6 * t12, t3 * t51);
-                let t94 = T::mul_add(
+                let t93 = T::mul_add(T::from_f64(0.2073), t51, t73 - t74);
+                let t94 = T::mul_add(t2, t6 * t12, t3 * t51);
+                let t95 = T::mul_add(
                     -t37,
                     t58,
                     T::mul_add(
@@ -626,29 +629,29 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                         ),
                     ),
                 );
-                let t95 = T::from_f64(0.0250914799819) * t83;
-                let t96 = T::from_f64(0.0013357060146000001) * t83;
-                let t97 = T::mul_add(
+                let t96 = T::from_f64(0.0250914799819) * t83;
+                let t97 = T::from_f64(0.0013357060146000001) * t83;
+                let t98 = T::mul_add(
                     T::from_f64(0.0250914799819),
                     t80,
                     T::from_f64(0.0013357060146000001) * t61,
                 );
-                let t98 = T::mul_add(
+                let t99 = T::mul_add(
                     T::from_f64(0.0017919207358628258),
                     t80,
                     T::from_f64(0.00007238626506919941) * t61,
                 );
-                let t99 = T::mul_add(
+                let t100 = T::mul_add(
                     T::from_f64(0.00007238626506919941),
                     t80,
                     T::from_f64(0.00009645337053442467) * t61,
                 );
-                let t100 = T::from_f64(0.0017957741063972504) * t83;
-                let t101 = t7 * t77;
-                let t102 = T::from_f64(0.10375) * t83;
-                let t103 = T::from_f64(0.10375) * t80;
-                let t104 = t80 + qd[4];
-                let t105 = T::mul_add(
+                let t101 = T::from_f64(0.0017957741063972504) * t83;
+                let t102 = t7 * t77;
+                let t103 = T::from_f64(0.10375) * t83;
+                let t104 = T::from_f64(0.10375) * t80;
+                let t105 = t80 + qd[4];
+                let t106 = T::mul_add(
                     t11,
                     t59,
                     T::mul_add(
@@ -657,36 +660,35 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                         T::mul_add(T::from_f64(0.0114), t77, t63 - t62),
                     ),
                 );
-                let t106 = T::mul_add(
+                let t107 = T::mul_add(
                     T::from_f64(1285.9348644085492),
                     t73 - t74,
                     T::from_f64(266.5742973918923) * t51,
                 );
-                let t107 = T::mul_add(-t50, t24, t68 + t31);
-                let t108 = t6 * (T::mul_add(-t6, t42, t30));
-                let t109 = t4 * t85;
-                let t110 = t5 * t85;
+                let t108 = T::mul_add(-t50, t24, t68 + t31);
+                let t109 = t6 * (T::mul_add(-t6, t42, t30));
+                let t110 = t4 * t86;
                 let t111 = t5 * t86;
-                let t112 = T::mul_add(
+                let t112 = t5 * t87;
+                let t113 = T::mul_add(
                     -T::from_f64(0.41),
-                    t93,
+                    t94,
                     T::mul_add(T::from_f64(0.2073), t51, t73 - t74),
                 );
-                let t113 = t1 * t93;
-                let t114 = t0 * (T::mul_add(-t3, t6 * t12, t2 * t51));
-                let t115 = t4 * t94;
-                let t116 = t5 * t94;
-                let t117 = T::mul_add(qd[3], t83, t4 * t76);
-                let t118 = T::mul_add(-qd[3], t80, t5 * t76);
-                let t119 = t83 * t95;
-                let t120 = t80 * t97;
-                let t121 = t83 * t98;
-                let t122 = t80 * t100;
-                let t123 = T::mul_add(t6, t61, t7 * t83);
-                let t124 = t61 * t103;
-                let t125 = T::mul_add(-t7, t61, t6 * t83);
-                let t126 = T::from_f64(0.10375) * t104;
-                let t127 = t5 * t105;
+                let t114 = t1 * t94;
+                let t115 = t0 * (T::mul_add(-t3, t6 * t12, t2 * t51));
+                let t116 = t4 * t95;
+                let t117 = t5 * t95;
+                let t118 = T::mul_add(qd[3], t83, t4 * t76);
+                let t119 = T::mul_add(-qd[3], t80, t5 * t76);
+                let t120 = t83 * t96;
+                let t121 = t80 * t98;
+                let t122 = t83 * t99;
+                let t123 = t80 * t101;
+                let t124 = T::mul_add(t6, t61, t7 * t83);
+                let t125 = t61 * t104;
+                let t126 = T::mul_add(-t7, t61, t6 * t83);
+                let t127 = T::from_f64(0.10375) * t105;
                 (
                     t64,
                     t65,
@@ -820,24 +822,23 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                 t190,
                 t191,
             ) = {
-                let t128 = t4 * t105;
-                let t129 = t92 * t106;
+                let t128 = t5 * t106;
+                let t129 = t4 * t106;
                 let t130 = T::mul_add(
                     -T::from_f64(527.2332944075051),
-                    t93,
+                    t94,
                     T::mul_add(
                         T::from_f64(1285.9348644085492),
                         t73 - t74,
                         T::from_f64(266.5742973918923) * t51,
                     ),
                 );
-                let t131 = T::one() / t66;
-                let t132 = T::mul_add(
+                let t131 = T::mul_add(
                     t7,
                     t44,
                     T::mul_add(
                         t6,
-                        t84,
+                        t85,
                         T::mul_add(
                             T::from_f64(0.10375),
                             t27,
@@ -845,12 +846,12 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                         ),
                     ),
                 );
-                let t133 = T::mul_add(
+                let t132 = T::mul_add(
                     -t6,
                     t44,
                     T::mul_add(
                         t7,
-                        t84,
+                        t85,
                         T::mul_add(
                             -T::from_f64(0.2075),
                             t28,
@@ -862,20 +863,20 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                         ),
                     ),
                 );
-                let t134 = T::mul_add(t4, t45, t110);
-                let t135 = T::mul_add(
+                let t133 = T::mul_add(t4, t45, t111);
+                let t134 = T::mul_add(
                     T::from_f64(0.0228),
-                    t88,
-                    t108 + t69 + T::from_f64(0.0007050092785344214),
+                    t89,
+                    t109 + t69 + T::from_f64(0.0007050092785344214),
                 );
-                let t136 = T::mul_add(-t2, t46, t3 * t87);
-                let t137 = T::mul_add(t3, t46, t2 * t87);
-                let t138 = T::mul_add(
+                let t135 = T::mul_add(-t2, t46, t3 * t88);
+                let t136 = T::mul_add(t3, t46, t2 * t88);
+                let t137 = T::mul_add(
                     T::from_f64(0.0114),
-                    t88,
-                    t108 + t69 + T::from_f64(0.00009645337053442467),
+                    t89,
+                    t109 + t69 + T::from_f64(0.00009645337053442467),
                 );
-                let t139 = T::mul_add(
+                let t138 = T::mul_add(
                     -T::from_f64(0.2073),
                     t71,
                     T::mul_add(
@@ -884,166 +885,175 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                         T::mul_add(
                             T::from_f64(0.0114),
                             t27,
-                            T::mul_add(T::from_f64(0.0022217730480214863), t6, -t110),
+                            T::mul_add(T::from_f64(0.0022217730480214863), t6, -t111),
                         ),
                     ),
                 );
-                let t140 = t6 * t118;
-                let t141 = qd[4] * t123;
-                let t142 = T::from_f64(0.0013224560195000002) * t123;
-                let t143 = T::from_f64(0.0230207699865) * t123;
-                let t144 = T::mul_add(
+                let t139 = t6 * t119;
+                let t140 = qd[4] * t124;
+                let t141 = T::from_f64(0.0013224560195000002) * t124;
+                let t142 = T::from_f64(0.0230207699865) * t124;
+                let t143 = T::mul_add(
                     -T::from_f64(0.0013224560195000002),
-                    t125,
-                    T::from_f64(0.0230207699865) * t104,
+                    t126,
+                    T::from_f64(0.0230207699865) * t105,
                 );
-                let t145 = T::from_f64(0.0015805219734713843) * t123;
-                let t146 = T::mul_add(
+                let t144 = T::from_f64(0.0015805219734713843) * t124;
+                let t145 = T::mul_add(
                     -T::from_f64(0.00009637730005078133),
-                    t125,
-                    T::from_f64(0.00006575368432434527) * t104,
+                    t126,
+                    T::from_f64(0.00006575368432434527) * t105,
                 );
-                let t147 = T::mul_add(
+                let t146 = T::mul_add(
                     -T::from_f64(0.00006575368432434527),
-                    t125,
-                    T::from_f64(0.0015767446734206029) * t104,
+                    t126,
+                    T::from_f64(0.0015767446734206029) * t105,
                 );
-                let t148 = t8 * t117;
-                let t149 = t9 * t117;
-                let t150 = T::from_f64(0.10375) * t123;
-                let t151 = t104 * t126;
-                let t152 = t125 + qd[5];
-                let t153 = T::mul_add(
+                let t147 = t8 * t118;
+                let t148 = t9 * t118;
+                let t149 = T::from_f64(0.10375) * t124;
+                let t150 = t105 * t127;
+                let t151 = t126 + qd[5];
+                let t152 = T::mul_add(
                     -t61,
-                    t102,
-                    T::mul_add(T::from_f64(0.10375), t117, t127 - t115),
-                );
-                let t154 = T::mul_add(
-                    -t80,
                     t103,
+                    T::mul_add(T::from_f64(0.10375), t118, t128 - t116),
+                );
+                let t153 = T::mul_add(
+                    -t80,
+                    t104,
                     T::mul_add(
                         -t83,
-                        t102,
+                        t103,
                         T::mul_add(T::from_f64(0.0114), t76, t64 + t65 - t81 - t82),
                     ),
                 );
-                let t155 = t112 * t130;
-                let t156 = T::mul_add(
-                    -t107,
-                    t107 * t131,
+                let t154 = T::mul_add(
+                    -t84,
+                    t108 * t108,
                     T::mul_add(
                         -t50,
                         t67,
-                        t108 + t69 + T::from_f64(0.00009645337053442467),
+                        t109 + t69 + T::from_f64(0.00009645337053442467),
                     ),
                 );
-                let t157 = T::mul_add(
+                let t155 = T::mul_add(
                     -T::from_f64(0.2073),
                     t70,
-                    T::mul_add(t92, t24, t109 - t72),
+                    T::mul_add(t93, t24, t110 - t72),
                 );
-                let t158 = t4 * t132;
-                let t159 = t5 * (T::mul_add(-t5, t45, t109));
-                let t160 = t0 * t136;
-                let t161 = t0
+                let t156 = t4 * t131;
+                let t157 = t5 * (T::mul_add(-t5, t45, t110));
+                let t158 = t0 * t135;
+                let t159 = t0
                     * (T::mul_add(
                         -t2,
                         t75,
-                        T::mul_add(t3, t91, T::from_f64(0.41) * (t32 - t33)),
+                        T::mul_add(t3, t92, T::from_f64(0.41) * (t32 - t33)),
                     ));
-                let t162 = t1 * (T::mul_add(t3, t75, t2 * t91));
-                let t163 = T::mul_add(-qd[4], t125, T::mul_add(t6, t77, t7 * t118));
-                let t164 = t123 * t142;
-                let t165 = t125 * t144;
-                let t166 = t123 * t146;
-                let t167 = t125 * t145;
-                let t168 = T::mul_add(-t9, t104, t8 * t123);
-                let t169 = t123 * t150;
-                let t170 = T::mul_add(t8, t104, t9 * t123);
-                let t171 = t7 * t153;
-                let t172 = t6 * t154;
-                let t173 = t6 * t153;
-                let t174 = t7 * t154;
-                let t175 = T::mul_add(
+                let t160 = t1 * (T::mul_add(t3, t75, t2 * t92));
+                let t161 = T::mul_add(-qd[4], t126, T::mul_add(t6, t77, t7 * t119));
+                let t162 = t124 * t141;
+                let t163 = t126 * t143;
+                let t164 = t124 * t145;
+                let t165 = t126 * t144;
+                let t166 = T::mul_add(-t9, t105, t8 * t124);
+                let t167 = t124 * t149;
+                let t168 = T::mul_add(t8, t105, t9 * t124);
+                let t169 = t7 * t152;
+                let t170 = t6 * t153;
+                let t171 = t6 * t152;
+                let t172 = t7 * t153;
+                let t173 = T::mul_add(
                     T::from_f64(0.41),
-                    t90,
+                    t91,
                     T::mul_add(
                         -T::from_f64(0.2073),
                         t70,
-                        T::mul_add(t112, t24, t109 - t72),
+                        T::mul_add(t113, t24, t110 - t72),
                     ),
                 );
-                let t176 = t157 * t157 * t131;
-                let t177 = T::mul_add(t5, t133, t109);
-                let t178 = T::mul_add(
+                let t174 = T::one() / t154;
+                let t175 = T::mul_add(t5, t132, t110);
+                let t176 = T::mul_add(
                     -t4,
-                    t86,
-                    T::mul_add(t5, t132, T::from_f64(0.2073) * t87),
+                    t87,
+                    T::mul_add(t5, t131, T::from_f64(0.2073) * t88),
                 );
-                let t179 = T::mul_add(
+                let t177 = T::mul_add(
                     -T::from_f64(0.2073),
-                    t88,
+                    t89,
                     T::mul_add(
                         -T::from_f64(0.0114),
                         t28,
                         T::mul_add(
                             T::from_f64(0.0022217730480214863),
                             t7,
-                            -t158 - t111 - T::from_f64(0.007145457521793661),
+                            -t156 - t112 - T::from_f64(0.007145457521793661),
                         ),
                     ),
                 );
-                let t180 = T::mul_add(T::from_f64(0.0016), t113 + t114, t161 - t162);
-                let t181 = t9 * t163;
-                let t182 = t8 * t163;
-                let t183 = qd[5] * t168;
-                let t184 = qd[5] * t170;
-                let t185 = T::mul_add(
+                let t178 = T::mul_add(T::from_f64(0.0016), t114 + t115, t159 - t160);
+                let t179 = t9 * t161;
+                let t180 = t8 * t161;
+                let t181 = qd[5] * t166;
+                let t182 = qd[5] * t168;
+                let t183 = T::mul_add(
                     -T::from_f64(0.0650091026469637),
+                    t166,
+                    T::from_f64(0.00000000000000000010842021724855044) * t151,
+                );
+                let t184 = T::mul_add(
+                    T::from_f64(0.00010000000000000503),
+                    t166,
+                    T::from_f64(0.00000000000000000010842021724855044) * t168,
+                );
+                let t185 = T::mul_add(
+                    T::from_f64(0.0650091026469637),
                     t168,
-                    T::from_f64(0.00000000000000000010842021724855044) * t152,
+                    T::from_f64(0.00010000000000000503) * t151,
                 );
                 let t186 = T::mul_add(
-                    T::from_f64(0.00010000000000000503),
-                    t168,
-                    T::from_f64(0.00000000000000000010842021724855044) * t170,
-                );
-                let t187 = T::mul_add(
-                    T::from_f64(0.0650091026469637),
-                    t170,
-                    T::from_f64(0.00010000000000000503) * t152,
-                );
-                let t188 = T::mul_add(
                     T::from_f64(0.004705147001603182),
-                    t168,
+                    t166,
                     T::mul_add(
                         -T::from_f64(0.0000000000000006979729257032011),
-                        t170,
-                        T::from_f64(0.000000000000000000006709516445275485) * t152,
+                        t168,
+                        T::from_f64(0.000000000000000000006709516445275485) * t151,
+                    ),
+                );
+                let t187 = T::mul_add(
+                    T::from_f64(0.000000000000000000006709516445275485),
+                    t166,
+                    T::mul_add(
+                        T::from_f64(0.000014022756617410007),
+                        t168,
+                        T::from_f64(0.0007776443641723163) * t151,
+                    ),
+                );
+                let t188 = T::mul_add(
+                    -T::from_f64(0.0000000000000006979729257032011),
+                    t166,
+                    T::mul_add(
+                        T::from_f64(0.004894691391055498),
+                        t168,
+                        T::from_f64(0.000014022756617410007) * t151,
                     ),
                 );
                 let t189 = T::mul_add(
-                    T::from_f64(0.000000000000000000006709516445275485),
-                    t168,
-                    T::mul_add(
-                        T::from_f64(0.000014022756617410007),
-                        t170,
-                        T::from_f64(0.0007776443641723163) * t152,
-                    ),
+                    t126,
+                    t149,
+                    T::mul_add(T::from_f64(0.10375), t118, t170 - t169),
                 );
                 let t190 = T::mul_add(
-                    -T::from_f64(0.0000000000000006979729257032011),
-                    t168,
-                    T::mul_add(
-                        T::from_f64(0.004894691391055498),
-                        t170,
-                        T::from_f64(0.000014022756617410007) * t152,
-                    ),
+                    t126,
+                    t127,
+                    T::mul_add(T::from_f64(0.10375), t119 - t161, t125 - t117 - t129),
                 );
                 let t191 = T::mul_add(
-                    t125,
-                    t150,
-                    T::mul_add(T::from_f64(0.10375), t117, t172 - t171),
+                    T::from_f64(1285.9348644085492),
+                    t159 - t160,
+                    T::from_f64(2.0574957830536786) * (t114 + t115),
                 );
                 (
                     t128,
@@ -1179,59 +1189,45 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                 t255,
             ) = {
                 let t192 = T::mul_add(
-                    t125,
-                    t126,
-                    T::mul_add(T::from_f64(0.10375), t118 - t163, t124 - t116 - t128),
-                );
-                let t193 = T::mul_add(
-                    T::from_f64(1285.9348644085492),
-                    t161 - t162,
-                    T::from_f64(2.0574957830536786) * (t113 + t114),
-                );
-                let t194 = t175 * t175 * t131;
-                let t195 = T::mul_add(
-                    t107,
-                    t157 * t131,
+                    t84,
+                    t108 * t155,
                     T::mul_add(
-                        -t92,
+                        -t93,
                         t67,
-                        T::mul_add(T::from_f64(0.2073), t88, t158 + t111),
+                        T::mul_add(T::from_f64(0.2073), t89, t156 + t112),
                     ),
                 );
-                let t196 = t4 * (T::mul_add(-t4, t133, t110));
-                let t197 = t2 * t178;
-                let t198 = t3 * t178;
-                let t199 = t170 * t188;
-                let t200 = t168 * t190;
-                let t201 = t9 * t191;
-                let t202 = t8 * t192;
-                let t203 = t8 * t191;
-                let t204 = t9 * t192;
-                let t205 = t180 * t193;
-                let t206 = T::mul_add(
+                let t193 = t4 * (T::mul_add(-t4, t132, t111));
+                let t194 = t2 * t176;
+                let t195 = t3 * t176;
+                let t196 = t168 * t186;
+                let t197 = t166 * t188;
+                let t198 = t9 * t189;
+                let t199 = t8 * t190;
+                let t200 = t8 * t189;
+                let t201 = t9 * t190;
+                let t202 = T::mul_add(
                     -T::from_f64(0.41),
-                    t3 * t88,
+                    t3 * t89,
                     T::mul_add(
-                        t175,
-                        t107 * t131,
+                        t173,
+                        t84 * t108,
                         T::mul_add(
-                            -t112,
+                            -t113,
                             t67,
-                            T::mul_add(T::from_f64(0.2073), t88, t158 + t111),
+                            T::mul_add(T::from_f64(0.2073), t89, t156 + t112),
                         ),
                     ),
                 );
-                let t207 = T::one() / t156;
-                let t208 = t195 * t195 * t207;
-                let t209 = T::mul_add(
+                let t203 = T::mul_add(
                     t4,
-                    t134,
+                    t133,
                     T::mul_add(
                         t5,
-                        t177,
+                        t175,
                         T::mul_add(
                             -T::from_f64(0.0228),
-                            t88,
+                            t89,
                             T::mul_add(
                                 -T::from_f64(0.4146),
                                 t28,
@@ -1244,123 +1240,123 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                         ),
                     ),
                 );
-                let t210 = T::mul_add(
+                let t204 = T::mul_add(
                     -t5,
-                    t134,
-                    T::mul_add(t4, t177, T::from_f64(0.0114) * t87),
+                    t133,
+                    T::mul_add(t4, t175, T::from_f64(0.0114) * t88),
                 );
-                let t211 = T::mul_add(-t2, t135, t198);
-                let t212 = T::mul_add(
+                let t205 = T::mul_add(-t2, t134, t195);
+                let t206 = T::mul_add(
                     T::from_f64(1.03),
-                    t201 + t202,
+                    t198 + t199,
                     T::mul_add(
-                        t152,
+                        t151,
+                        t185,
+                        T::mul_add(
+                            t166,
+                            t184,
+                            T::mul_add(
+                                T::from_f64(0.0650091026469637),
+                                t148 - t180 - t182,
+                                T::from_f64(0.00000000000000000010842021724855044)
+                                    * (t139 + t140 - t102),
+                            ),
+                        ),
+                    ),
+                );
+                let t207 = T::mul_add(
+                    -T::from_f64(0.0650091026469637),
+                    t198 + t199,
+                    T::mul_add(
+                        t168,
                         t187,
                         T::mul_add(
-                            t168,
-                            t186,
-                            T::mul_add(
-                                T::from_f64(0.0650091026469637),
-                                t149 - t182 - t184,
-                                T::from_f64(0.00000000000000000010842021724855044)
-                                    * (t140 + t141 - t101),
-                            ),
-                        ),
-                    ),
-                );
-                let t213 = T::mul_add(
-                    -T::from_f64(0.0650091026469637),
-                    t201 + t202,
-                    T::mul_add(
-                        t170,
-                        t189,
-                        T::mul_add(
-                            -t152,
-                            t190,
+                            -t151,
+                            t188,
                             T::mul_add(
                                 T::from_f64(0.00010000000000000503),
-                                t151 + t169 + t173 + t174,
+                                t150 + t167 + t171 + t172,
                                 T::mul_add(
                                     T::from_f64(0.004705147001603182),
-                                    t182 + t184 - t149,
+                                    t180 + t182 - t148,
                                     T::mul_add(
                                         T::from_f64(0.0000000000000006979729257032011),
-                                        t183 - t181 - t148,
+                                        t181 - t179 - t147,
                                         T::from_f64(0.000000000000000000006709516445275485)
-                                            * (t140 + t141 - t101),
+                                            * (t139 + t140 - t102),
                                     ),
                                 ),
                             ),
                         ),
                     ),
                 );
-                let t214 = T::mul_add(
+                let t208 = T::mul_add(
                     T::from_f64(0.0650091026469637),
-                    t203 - t204,
+                    t200 - t201,
                     T::mul_add(
-                        t152,
-                        t188,
-                        T::mul_add(
-                            -t168,
-                            t189,
-                            T::mul_add(
-                                T::from_f64(0.00000000000000000010842021724855044),
-                                t151 + t169 + t173 + t174,
-                                T::mul_add(
-                                    T::from_f64(0.0000000000000006979729257032011),
-                                    t149 - t182 - t184,
-                                    T::mul_add(
-                                        T::from_f64(0.004894691391055498),
-                                        t181 + t148 - t183,
-                                        T::from_f64(0.000014022756617410007) * (t140 + t141 - t101),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                );
-                let t215 = T::mul_add(
-                    T::from_f64(1.03),
-                    t203 - t204,
-                    T::mul_add(
-                        -t170,
+                        t151,
                         t186,
                         T::mul_add(
-                            -t152,
-                            t185,
+                            -t166,
+                            t187,
                             T::mul_add(
-                                T::from_f64(0.0650091026469637),
-                                t181 + t148 - t183,
-                                T::from_f64(0.00010000000000000503) * (t140 + t141 - t101),
+                                T::from_f64(0.00000000000000000010842021724855044),
+                                t150 + t167 + t171 + t172,
+                                T::mul_add(
+                                    T::from_f64(0.0000000000000006979729257032011),
+                                    t148 - t180 - t182,
+                                    T::mul_add(
+                                        T::from_f64(0.004894691391055498),
+                                        t179 + t147 - t181,
+                                        T::from_f64(0.000014022756617410007) * (t139 + t140 - t102),
+                                    ),
+                                ),
                             ),
                         ),
                     ),
                 );
-                let t216 = T::mul_add(
+                let t209 = T::mul_add(
+                    T::from_f64(1.03),
+                    t200 - t201,
+                    T::mul_add(
+                        -t168,
+                        t184,
+                        T::mul_add(
+                            -t151,
+                            t183,
+                            T::mul_add(
+                                T::from_f64(0.0650091026469637),
+                                t179 + t147 - t181,
+                                T::from_f64(0.00010000000000000503) * (t139 + t140 - t102),
+                            ),
+                        ),
+                    ),
+                );
+                let t210 = T::mul_add(
                     -T::from_f64(1.493),
-                    t173 + t174,
+                    t171 + t172,
                     T::mul_add(
                         -T::from_f64(1.03),
-                        t151 + t169,
+                        t150 + t167,
                         T::mul_add(
                             T::from_f64(0.00010000000000000503),
-                            t149 - t182 - t184,
+                            t148 - t180 - t182,
                             T::mul_add(
                                 T::from_f64(0.00000000000000000010842021724855044),
-                                t183 - t181 - t148,
+                                t181 - t179 - t147,
                                 T::mul_add(
-                                    t168,
-                                    t185,
+                                    t166,
+                                    t183,
                                     T::mul_add(
-                                        -t170,
-                                        t187,
+                                        -t168,
+                                        t185,
                                         T::mul_add(
-                                            -t123,
-                                            t143,
+                                            -t124,
+                                            t142,
                                             T::mul_add(
-                                                -t104,
-                                                t144,
-                                                T::from_f64(0.0013224560195000002) * t163,
+                                                -t105,
+                                                t143,
+                                                T::from_f64(0.0013224560195000002) * t161,
                                             ),
                                         ),
                                     ),
@@ -1369,34 +1365,34 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                         ),
                     ),
                 );
-                let t217 = T::mul_add(
+                let t211 = T::mul_add(
                     T::from_f64(0.00010000000000000503),
-                    t204 - t203,
+                    t201 - t200,
                     T::mul_add(
                         -T::from_f64(0.00000000000000000010842021724855044),
-                        t201 + t202,
+                        t198 + t199,
                         T::mul_add(
                             T::from_f64(0.0013224560195000002),
-                            t172 - t171,
+                            t170 - t169,
                             T::mul_add(
                                 T::from_f64(0.000000000000000000006709516445275485),
-                                t149 - t182 - t184,
+                                t148 - t180 - t182,
                                 T::mul_add(
                                     T::from_f64(0.000014022756617410007),
-                                    t183 - t181 - t148,
+                                    t181 - t179 - t147,
                                     T::mul_add(
-                                        -t123,
-                                        t147,
+                                        -t124,
+                                        t146,
                                         T::mul_add(
-                                            t104,
-                                            t145,
+                                            t105,
+                                            t144,
                                             T::mul_add(
                                                 T::from_f64(0.0008740216642230976),
-                                                t101 - t140 - t141,
+                                                t102 - t139 - t140,
                                                 T::mul_add(
                                                     T::from_f64(0.00006575368432434527),
-                                                    t117,
-                                                    t199 - t200,
+                                                    t118,
+                                                    t196 - t197,
                                                 ),
                                             ),
                                         ),
@@ -1406,122 +1402,132 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                         ),
                     ),
                 );
-                let t218 = T::mul_add(
-                    -t180,
+                let t212 = T::mul_add(
+                    -t178,
                     t24,
                     T::mul_add(
                         -t1,
-                        T::mul_add(t3, t89, t2 * t139),
+                        T::mul_add(t3, t90, t2 * t138),
                         T::mul_add(
                             t0,
                             T::mul_add(
                                 -t2,
-                                t89,
-                                T::mul_add(t3, t139, T::from_f64(0.41) * t71),
+                                t90,
+                                T::mul_add(t3, t138, T::from_f64(0.41) * t71),
                             ),
                             T::from_f64(0.0016)
                                 * (T::mul_add(
                                     t0,
                                     T::mul_add(-t3, t40, t2 * t5 * t41),
-                                    t1 * t90,
+                                    t1 * t91,
                                 )),
                         ),
                     ),
                 );
-                let t219 = t206 * t206 * t207;
-                let t220 = T::mul_add(
-                    -T::from_f64(0.4146),
-                    t28,
+                let t213 = T::mul_add(
+                    -t174,
+                    t192 * t192,
                     T::mul_add(
-                        T::from_f64(0.08080237769383405),
-                        t7,
-                        t129 + t176 + t208 - t196 - t159
-                            - T::from_f64(0.16453713320957578),
-                    ),
-                );
-                let t221 = T::mul_add(
-                    T::from_f64(0.00010000000000000503),
-                    t203 - t204,
-                    T::mul_add(
-                        T::from_f64(0.00000000000000000010842021724855044),
-                        t201 + t202,
+                        -t84,
+                        t155 * t155,
                         T::mul_add(
-                            T::from_f64(0.000000000000000000006709516445275485),
-                            t182 + t184 - t149,
+                            -t93,
+                            t107,
                             T::mul_add(
-                                T::from_f64(0.000014022756617410007),
-                                t181 + t148 - t183,
+                                T::from_f64(0.4146),
+                                t28,
                                 T::mul_add(
-                                    T::from_f64(0.0007776443641723163),
-                                    t140 + t141 - t101,
-                                    t200 - t199 - tau[5],
+                                    -T::from_f64(0.08080237769383405),
+                                    t7,
+                                    t193 + t157 + T::from_f64(0.16453713320957578),
                                 ),
                             ),
                         ),
                     ),
                 );
-                let t222 = t9 * t212;
-                let t223 = t8 * t215;
-                let t224 = t8 * t212;
-                let t225 = t9 * t215;
-                let t226 = t8 * t214;
-                let t227 = t9 * t213;
-                let t228 = t6 * t216;
-                let t229 = t7 * t216;
-                let t230 = t7 * t217;
-                let t231 = t218 * t218 * t131;
-                let t232 = T::mul_add(
-                    -T::from_f64(0.41),
-                    t137,
+                let t214 = T::mul_add(
+                    T::from_f64(0.00010000000000000503),
+                    t200 - t201,
                     T::mul_add(
-                        t206,
-                        t195 * t207,
+                        T::from_f64(0.00000000000000000010842021724855044),
+                        t198 + t199,
                         T::mul_add(
-                            t175,
-                            t157 * t131,
+                            T::from_f64(0.000000000000000000006709516445275485),
+                            t180 + t182 - t148,
                             T::mul_add(
-                                t112,
-                                t106,
+                                T::from_f64(0.000014022756617410007),
+                                t179 + t147 - t181,
+                                T::mul_add(
+                                    T::from_f64(0.0007776443641723163),
+                                    t139 + t140 - t102,
+                                    t197 - t196 - tau[5],
+                                ),
+                            ),
+                        ),
+                    ),
+                );
+                let t215 = t9 * t206;
+                let t216 = t8 * t209;
+                let t217 = t8 * t206;
+                let t218 = t9 * t209;
+                let t219 = t8 * t208;
+                let t220 = t9 * t207;
+                let t221 = t6 * t210;
+                let t222 = t7 * t210;
+                let t223 = t7 * t211;
+                let t224 = T::mul_add(
+                    -T::from_f64(0.41),
+                    t136,
+                    T::mul_add(
+                        t202,
+                        t174 * t192,
+                        T::mul_add(
+                            t173,
+                            t84 * t155,
+                            T::mul_add(
+                                t113,
+                                t107,
                                 T::mul_add(
                                     -T::from_f64(0.4146),
                                     t28,
                                     T::mul_add(
                                         T::from_f64(0.08080237769383405),
                                         t7,
-                                        -t196 - t159 - T::from_f64(0.16453713320957578),
+                                        -t193 - t157 - T::from_f64(0.16453713320957578),
                                     ),
                                 ),
                             ),
                         ),
                     ),
                 );
-                let t233 = T::mul_add(t3, t209, t197);
-                let t234 = T::mul_add(t3, t179, t2 * t210);
-                let t235 = T::mul_add(
+                let t225 = T::one() / t213;
+                let t226 = T::mul_add(t3, t203, t194);
+                let t227 = T::mul_add(t3, t177, t2 * t204);
+                let t228 = T::mul_add(
                     T::from_f64(0.10375),
-                    t224 - t225,
+                    t217 - t218,
                     T::mul_add(
                         T::from_f64(0.0013224560195000002),
-                        t173 + t174,
+                        t171 + t172,
                         T::mul_add(
                             -t8,
-                            t213,
+                            t207,
                             T::mul_add(
                                 -t9,
-                                t214,
+                                t208,
                                 T::mul_add(
-                                    t104,
-                                    t146,
+                                    t105,
+                                    t145,
                                     T::mul_add(
-                                        t125,
-                                        t147,
+                                        t126,
+                                        t146,
                                         T::mul_add(
                                             -T::from_f64(0.0015805219734713843),
-                                            t163,
+                                            t161,
                                             T::mul_add(
                                                 T::from_f64(0.0230207699865),
-                                                t124 - t116 - t128,
-                                                T::from_f64(0.0023884048860993747) * t118,
+                                                t125 - t117 - t129,
+                                                T::from_f64(0.0023884048860993747) * t119,
                                             ),
                                         ),
                                     ),
@@ -1530,153 +1536,165 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                         ),
                     ),
                 );
-                let t236 = T::mul_add(
+                let t229 = T::mul_add(
                     T::from_f64(0.463),
-                    t172 - t171,
+                    t170 - t169,
                     T::mul_add(
-                        t104,
-                        t142,
+                        t105,
+                        t141,
                         T::mul_add(
-                            t125,
-                            t143,
+                            t126,
+                            t142,
                             T::mul_add(
                                 T::from_f64(0.0013224560195000002),
-                                t101 - t140 - t141,
-                                T::mul_add(T::from_f64(0.0230207699865), t117, t222 + t223),
+                                t102 - t139 - t140,
+                                T::mul_add(T::from_f64(0.0230207699865), t118, t215 + t216),
                             ),
                         ),
                     ),
                 );
-                let t237 = T::mul_add(
+                let t230 = T::mul_add(
                     T::from_f64(0.463),
-                    t124,
+                    t125,
                     T::mul_add(
                         -T::from_f64(0.0230207699865),
-                        t163,
+                        t161,
                         T::mul_add(
                             t83,
-                            t96,
+                            t97,
                             T::mul_add(
                                 t61,
-                                t97,
+                                t98,
                                 T::mul_add(
                                     -T::from_f64(0.926),
-                                    t116 + t128,
+                                    t117 + t129,
                                     T::mul_add(
                                         T::from_f64(0.07312772998190001),
-                                        t118,
-                                        t165 + t224 - t164 - t225,
+                                        t119,
+                                        t163 + t217 - t162 - t218,
                                     ),
                                 ),
                             ),
                         ),
                     ),
                 );
-                let t238 = T::mul_add(
-                    -t218,
-                    t107 * t131,
+                let t231 = T::mul_add(
+                    -t212,
+                    t84 * t108,
                     T::mul_add(
-                        -t180,
+                        -t178,
                         t67,
                         T::mul_add(
                             -t1,
-                            T::mul_add(t3, t138, t197),
+                            T::mul_add(t3, t137, t194),
                             T::mul_add(
                                 -t0,
                                 T::mul_add(
                                     t2,
-                                    t138,
-                                    T::mul_add(T::from_f64(0.41), t87, -t198),
+                                    t137,
+                                    T::mul_add(T::from_f64(0.41), t88, -t195),
                                 ),
                                 T::from_f64(0.0016)
-                                    * (T::mul_add(t0, t2 * t88, t1 * t3 * t88)),
+                                    * (T::mul_add(t0, t2 * t89, t1 * t3 * t89)),
                             ),
                         ),
                     ),
                 );
-                let t239 = T::one() / t220;
-                let t240 = t232 * t232 * t239;
-                let t241 = T::mul_add(
+                let t232 = T::mul_add(
                     T::from_f64(0.10375),
-                    t222 + t223,
+                    t215 + t216,
                     T::mul_add(
                         T::from_f64(0.0230207699865),
-                        t172 - t171,
+                        t170 - t169,
                         T::mul_add(
                             -t24,
-                            t221,
+                            t214,
                             T::mul_add(
                                 T::from_f64(0.00006575368432434527),
-                                t101 - t140 - t141,
+                                t102 - t139 - t140,
                                 T::mul_add(
                                     T::from_f64(0.0015767446734206029),
-                                    t117,
-                                    t166 + t167 + t226 - t227 - tau[4],
+                                    t118,
+                                    t164 + t165 + t219 - t220 - tau[4],
                                 ),
                             ),
                         ),
                     ),
                 );
-                let t242 = t0 * (T::mul_add(-t2, t179, t3 * t210));
-                let t243 = t7 * t236;
-                let t244 = t6 * t236;
-                let t245 = t6 * t235;
-                let t246 = t4 * t237;
-                let t247 = t5 * t237;
-                let t248 = t238 * t238 * t207;
-                let t249 = T::mul_add(
-                    -T::from_f64(0.82),
-                    t137,
+                let t233 = t0 * (T::mul_add(-t2, t177, t3 * t204));
+                let t234 = t7 * t229;
+                let t235 = t6 * t229;
+                let t236 = t6 * t228;
+                let t237 = t4 * t230;
+                let t238 = t5 * t230;
+                let t239 = T::mul_add(
+                    T::from_f64(0.82),
+                    t136,
                     T::mul_add(
-                        -T::from_f64(0.4146),
-                        t28,
+                        -t224,
+                        t224 * t225,
                         T::mul_add(
-                            T::from_f64(0.08080237769383405),
-                            t7,
-                            t155 + t194 + t219 - t196 - t159 - t240
-                                - T::from_f64(0.6597447987005757),
+                            -t202,
+                            t202 * t174,
+                            T::mul_add(
+                                -t173,
+                                t173 * t84,
+                                T::mul_add(
+                                    -t113,
+                                    t130,
+                                    T::mul_add(
+                                        T::from_f64(0.4146),
+                                        t28,
+                                        T::mul_add(
+                                            -T::from_f64(0.08080237769383405),
+                                            t7,
+                                            t193 + t157 + T::from_f64(0.6597447987005757),
+                                        ),
+                                    ),
+                                ),
+                            ),
                         ),
                     ),
                 );
-                let t250 = T::mul_add(
+                let t240 = T::mul_add(
                     -t3,
-                    t211,
-                    T::mul_add(t2, t233, T::from_f64(0.41) * t136),
+                    t205,
+                    T::mul_add(t2, t226, T::from_f64(0.41) * t135),
                 );
-                let t251 = T::mul_add(
+                let t241 = T::mul_add(
                     t3,
-                    T::mul_add(t3, t135, t197),
+                    T::mul_add(t3, t134, t194),
                     T::mul_add(
                         t2,
-                        T::mul_add(-t2, t209, t198),
+                        T::mul_add(-t2, t203, t195),
                         T::from_f64(0.0008910000000000028),
                     ),
                 );
-                let t252 = T::mul_add(
+                let t242 = T::mul_add(
                     T::from_f64(0.10375),
-                    t222 + t223 - t243 - t228,
+                    t215 + t216 - t234 - t221,
                     T::mul_add(
                         T::from_f64(0.0230207699865),
-                        t172 - t171,
+                        t170 - t169,
                         T::mul_add(
                             T::from_f64(0.00006575368432434527),
-                            t101 - t140 - t141,
+                            t102 - t139 - t140,
                             T::mul_add(
                                 t83,
-                                t99,
+                                t100,
                                 T::mul_add(
                                     -t61,
-                                    t100,
+                                    t101,
                                     T::mul_add(
                                         T::from_f64(0.0250914799819),
-                                        t127 - t115,
+                                        t128 - t116,
                                         T::mul_add(
                                             T::from_f64(0.0033686654092834286),
-                                            t117,
+                                            t118,
                                             T::mul_add(
                                                 T::from_f64(0.00007238626506919941),
                                                 t77,
-                                                t166 + t167 + t226 - t227,
+                                                t164 + t165 + t219 - t220,
                                             ),
                                         ),
                                     ),
@@ -1685,36 +1703,36 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                         ),
                     ),
                 );
-                let t253 = T::mul_add(
+                let t243 = T::mul_add(
                     T::from_f64(0.10375),
-                    t165 + t224 - t164 - t225,
+                    t163 + t217 - t162 - t218,
                     T::mul_add(
                         T::from_f64(0.04803625),
-                        t124,
+                        t125,
                         T::mul_add(
                             -T::from_f64(0.0023884048860993747),
-                            t163,
+                            t161,
                             T::mul_add(
                                 -t6,
-                                t217,
+                                t211,
                                 T::mul_add(
                                     -t7,
-                                    t235,
+                                    t228,
                                     T::mul_add(
                                         t61,
-                                        t98,
+                                        t99,
                                         T::mul_add(
                                             -t80,
-                                            t99,
+                                            t100,
                                             T::mul_add(
                                                 -T::from_f64(0.07312772998190001),
-                                                t116 + t128,
+                                                t117 + t129,
                                                 T::mul_add(
                                                     T::from_f64(0.0013357060146000001),
                                                     t64 + t65 - t81 - t82,
                                                     T::mul_add(
                                                         T::from_f64(0.00677953504389725),
-                                                        t118,
+                                                        t119,
                                                         T::from_f64(0.000015227048566440002) * t76,
                                                     ),
                                                 ),
@@ -1726,28 +1744,28 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                         ),
                     ),
                 );
-                let t254 = T::mul_add(
+                let t244 = T::mul_add(
                     -t61,
-                    t95,
+                    t96,
                     T::mul_add(
                         t80,
-                        t96,
+                        t97,
                         T::mul_add(
                             T::from_f64(0.463),
-                            t127 - t115,
+                            t128 - t116,
                             T::mul_add(
                                 T::from_f64(0.0250914799819),
-                                t117,
+                                t118,
                                 T::mul_add(
                                     T::from_f64(0.0013357060146000001),
                                     t77,
-                                    -t243 - t228,
+                                    -t234 - t221,
                                 ),
                             ),
                         ),
                     ),
                 );
-                let t255 = T::mul_add(
+                let t245 = T::mul_add(
                     T::from_f64(1.1393),
                     t64 + t65,
                     T::mul_add(
@@ -1755,7 +1773,7 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                         t81 + t82,
                         T::mul_add(
                             T::from_f64(0.0013357060146000001),
-                            t118,
+                            t119,
                             T::mul_add(
                                 -t36,
                                 t54,
@@ -1765,10 +1783,88 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                                     T::mul_add(
                                         T::from_f64(0.011094380000000001),
                                         t76,
-                                        t244 - t119 - t120 - t229,
+                                        t235 - t120 - t121 - t222,
                                     ),
                                 ),
                             ),
+                        ),
+                    ),
+                );
+                let t246 = T::mul_add(
+                    -t174,
+                    t192 * t231,
+                    T::mul_add(
+                        t212,
+                        t84 * t155,
+                        T::mul_add(
+                            -t178,
+                            t107,
+                            T::mul_add(
+                                t1,
+                                t227,
+                                T::mul_add(
+                                    T::from_f64(0.0016),
+                                    T::mul_add(-t1, t136, t158),
+                                    -t233,
+                                ),
+                            ),
+                        ),
+                    ),
+                );
+                let t247 = T::one() / t239;
+                let t248 = T::mul_add(
+                    t84,
+                    t108 * t232,
+                    T::mul_add(
+                        t67,
+                        t214,
+                        T::mul_add(
+                            T::from_f64(0.0013357060146000001),
+                            t128 - t116,
+                            T::mul_add(
+                                T::from_f64(0.00007238626506919941),
+                                t118,
+                                T::mul_add(
+                                    T::from_f64(0.00009645337053442467),
+                                    t77,
+                                    t123 + t223 - t122 - t236 - tau[3],
+                                ),
+                            ),
+                        ),
+                    ),
+                );
+                let t249 = t5 * t244;
+                let t250 = t4 * t244;
+                let t251 = t4 * t243;
+                let t252 = t5 * t242;
+                let t253 = t2 * t245;
+                let t254 = T::mul_add(
+                    t0,
+                    T::mul_add(
+                        -t2,
+                        t205,
+                        T::mul_add(
+                            -t3,
+                            t226,
+                            T::mul_add(
+                                T::from_f64(0.82),
+                                t136,
+                                T::from_f64(0.49530666549099994),
+                            ),
+                        ),
+                    ),
+                    t1 * t240,
+                );
+                let t255 = T::mul_add(
+                    T::from_f64(0.6763),
+                    t63 - t62,
+                    T::mul_add(
+                        t11,
+                        t53,
+                        T::mul_add(
+                            -t37,
+                            t54,
+                            T::mul_add(T::from_f64(0.00581618), t77, t249 - t237),
                         ),
                     ),
                 );
@@ -1857,120 +1953,28 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                 t270,
                 t271,
                 t272,
-                t273,
-                t274,
-                t275,
-                t276,
-                t277,
-                t278,
-                t279,
-                t280,
-                t281,
-                t282,
-                t283,
-                t284,
-                t285,
-                t286,
             ) = {
                 let t256 = T::mul_add(
-                    -t195,
-                    t238 * t207,
-                    T::mul_add(
-                        t218,
-                        t157 * t131,
-                        T::mul_add(
-                            -t180,
-                            t106,
-                            T::mul_add(
-                                t1,
-                                t234,
-                                T::mul_add(
-                                    T::from_f64(0.0016),
-                                    T::mul_add(-t1, t137, t160),
-                                    -t242,
-                                ),
-                            ),
-                        ),
-                    ),
-                );
-                let t257 = T::mul_add(
-                    t107,
-                    t241 * t131,
-                    T::mul_add(
-                        t67,
-                        t221,
-                        T::mul_add(
-                            T::from_f64(0.0013357060146000001),
-                            t127 - t115,
-                            T::mul_add(
-                                T::from_f64(0.00007238626506919941),
-                                t117,
-                                T::mul_add(
-                                    T::from_f64(0.00009645337053442467),
-                                    t77,
-                                    t122 + t230 - t121 - t245 - tau[3],
-                                ),
-                            ),
-                        ),
-                    ),
-                );
-                let t258 = t5 * t254;
-                let t259 = t4 * t254;
-                let t260 = t4 * t253;
-                let t261 = t5 * t252;
-                let t262 = t2 * t255;
-                let t263 = t256 * t256 * t239;
-                let t264 = T::mul_add(
-                    t0,
-                    T::mul_add(
-                        -t2,
-                        t211,
-                        T::mul_add(
-                            -t3,
-                            t233,
-                            T::mul_add(
-                                T::from_f64(0.82),
-                                t137,
-                                T::from_f64(0.49530666549099994),
-                            ),
-                        ),
-                    ),
-                    t1 * t250,
-                );
-                let t265 = T::mul_add(
-                    T::from_f64(0.6763),
-                    t63 - t62,
-                    T::mul_add(
-                        t11,
-                        t53,
-                        T::mul_add(
-                            -t37,
-                            t54,
-                            T::mul_add(T::from_f64(0.00581618), t77, t258 - t246),
-                        ),
-                    ),
-                );
-                let t266 = T::mul_add(
                     -T::from_f64(0.2073),
-                    t259 + t247,
+                    t250 + t238,
                     T::mul_add(
                         -T::from_f64(0.011094380000000001),
                         t64 + t65,
                         T::mul_add(
                             T::from_f64(0.0114),
-                            t119 + t120 + t229 - t244,
+                            t120 + t121 + t222 - t235,
                             T::mul_add(
                                 T::from_f64(0.0052782),
                                 t81 + t82,
                                 T::mul_add(
                                     -T::from_f64(0.000015227048566440002),
-                                    t118,
+                                    t119,
                                     T::mul_add(
                                         -t4,
-                                        t252,
+                                        t242,
                                         T::mul_add(
                                             -t5,
-                                            t253,
+                                            t243,
                                             T::mul_add(
                                                 t11,
                                                 t57,
@@ -1995,18 +1999,18 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                         ),
                     ),
                 );
-                let t267 = T::mul_add(
+                let t257 = T::mul_add(
                     T::from_f64(0.0114),
-                    t258 - t246,
+                    t249 - t237,
                     T::mul_add(
                         T::from_f64(0.00581618),
                         t63 - t62,
                         T::mul_add(
                             T::from_f64(0.0013357060146000001),
-                            t127 - t115,
+                            t128 - t116,
                             T::mul_add(
                                 T::from_f64(0.00007238626506919941),
-                                t117,
+                                t118,
                                 T::mul_add(
                                     -t36,
                                     t56,
@@ -2016,7 +2020,7 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                                         T::mul_add(
                                             T::from_f64(0.00045080751853442445),
                                             t77,
-                                            t122 + t230 - t121 - t245,
+                                            t123 + t223 - t122 - t236,
                                         ),
                                     ),
                                 ),
@@ -2024,78 +2028,74 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                         ),
                     ),
                 );
-                let t268 = T::mul_add(
-                    -t232,
-                    t256 * t239,
+                let t258 = T::mul_add(
+                    t224,
+                    t246 * t225,
                     T::mul_add(
-                        -t206,
-                        t238 * t207,
+                        -t202,
+                        t174 * t231,
                         T::mul_add(
-                            t175,
-                            t218 * t131,
+                            t173,
+                            t212 * t84,
                             T::mul_add(
-                                -t180,
+                                -t178,
                                 t130,
                                 T::mul_add(
                                     t1,
                                     T::mul_add(
                                         T::from_f64(0.41),
-                                        t88,
-                                        t234 + T::from_f64(0.0094826278),
+                                        t89,
+                                        t227 + T::from_f64(0.0094826278),
                                     ),
                                     T::mul_add(
                                         T::from_f64(0.0016),
                                         T::mul_add(
                                             -t1,
-                                            t137 + T::from_f64(1.2836779999999999),
-                                            t160,
+                                            t136 + T::from_f64(1.2836779999999999),
+                                            t158,
                                         ),
-                                        -t242,
+                                        -t233,
                                     ),
                                 ),
                             ),
                         ),
                     ),
                 );
-                let t269 = T::mul_add(
+                let t259 = T::mul_add(
                     T::from_f64(0.2073),
-                    t258 - t246,
+                    t249 - t237,
                     T::mul_add(
                         T::from_f64(0.054780300000000004),
                         t63 - t62,
                         T::mul_add(
-                            -t195,
-                            t257 * t207,
+                            -t174,
+                            t192 * t248,
                             T::mul_add(
-                                -t157,
-                                t241 * t131,
+                                -t84,
+                                t155 * t232,
                                 T::mul_add(
-                                    t106,
-                                    t221,
+                                    t107,
+                                    t214,
                                     T::mul_add(
                                         T::from_f64(0.00047111058),
                                         t77,
-                                        t78 + t261 + tau[2] - t79 - t260,
+                                        t78 + t252 + tau[2] - t79 - t251,
                                     ),
                                 ),
                             ),
                         ),
                     ),
                 );
-                let t270 = t0 * t264;
-                let t271 = t1 * (T::mul_add(t1, t251, t0 * t250));
-                let t272 = t3 * t265;
-                let t273 = T::one() / t249;
-                let t274 = t268 * t268 * t273;
-                let t275 = T::mul_add(
+                let t260 = t3 * t255;
+                let t261 = T::mul_add(
                     T::from_f64(0.20443499999999998),
                     t23,
                     T::mul_add(
                         t3,
-                        t255,
+                        t245,
                         T::mul_add(
                             t2,
-                            t265,
+                            t255,
                             T::mul_add(
                                 qd[1],
                                 T::mul_add(
@@ -2112,12 +2112,45 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                         ),
                     ),
                 );
-                let t276 = T::mul_add(
+                let t262 = T::mul_add(
+                    -t247,
+                    t258 * t258,
+                    T::mul_add(
+                        -t246,
+                        t246 * t225,
+                        T::mul_add(
+                            -t174,
+                            t231 * t231,
+                            T::mul_add(
+                                -t212,
+                                t212 * t84,
+                                T::mul_add(
+                                    -t178,
+                                    t191,
+                                    T::mul_add(
+                                        t1,
+                                        T::mul_add(t1, t241, t0 * t240),
+                                        T::mul_add(
+                                            t0,
+                                            t254,
+                                            T::mul_add(
+                                                -T::from_f64(0.0032),
+                                                t89,
+                                                T::from_f64(0.0005521372320000016),
+                                            ),
+                                        ),
+                                    ),
+                                ),
+                            ),
+                        ),
+                    ),
+                );
+                let t263 = T::mul_add(
                     T::from_f64(0.41),
-                    t262 - t272,
+                    t253 - t260,
                     T::mul_add(
                         T::from_f64(0.2073),
-                        t258 - t246,
+                        t249 - t237,
                         T::mul_add(
                             T::from_f64(0.054780300000000004),
                             t63 - t62,
@@ -2125,17 +2158,17 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                                 T::from_f64(0.00047111058),
                                 t77,
                                 T::mul_add(
-                                    -t232,
-                                    t269 * t239,
+                                    t224,
+                                    t225 * t259,
                                     T::mul_add(
-                                        -t206,
-                                        t257 * t207,
+                                        -t202,
+                                        t174 * t248,
                                         T::mul_add(
-                                            -t175,
-                                            t241 * t131,
+                                            -t173,
+                                            t84 * t232,
                                             T::mul_add(
                                                 t130,
-                                                t221,
+                                                t214,
                                                 T::mul_add(
                                                     qd[0],
                                                     t0 * t35,
@@ -2148,7 +2181,7 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                                                             T::mul_add(
                                                                 T::from_f64(2.00550735),
                                                                 t0,
-                                                                t78 + t261 - t79 - t260 - tau[1],
+                                                                t78 + t252 - t79 - t251 - tau[1],
                                                             ),
                                                         ),
                                                     ),
@@ -2161,35 +2194,30 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                         ),
                     ),
                 );
-                let t277 = T::mul_add(
-                    T::from_f64(0.0032),
-                    t88,
-                    t205 + t231 + t248 - t270 - t271 - t263 - t274
-                        - T::from_f64(0.0005521372320000016),
-                );
-                let t278 = T::mul_add(
-                    -t268,
-                    t276 * t273,
+                let t264 = T::one() / t262;
+                let t265 = T::mul_add(
+                    t247,
+                    t258 * t263,
                     T::mul_add(
-                        -t256,
-                        t269 * t239,
+                        t246,
+                        t225 * t259,
                         T::mul_add(
-                            t238,
-                            t257 * t207,
+                            t174,
+                            t231 * t248,
                             T::mul_add(
-                                -t218,
-                                t241 * t131,
+                                -t212,
+                                t84 * t232,
                                 T::mul_add(
-                                    -t193,
-                                    t221,
+                                    -t191,
+                                    t214,
                                     T::mul_add(
                                         t1,
                                         T::mul_add(
                                             t3,
-                                            t267,
+                                            t257,
                                             T::mul_add(
                                                 t2,
-                                                t266,
+                                                t256,
                                                 T::mul_add(
                                                     -qd[0],
                                                     t0 * t34,
@@ -2205,16 +2233,16 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                                             -t0,
                                             T::mul_add(
                                                 T::from_f64(0.41),
-                                                T::mul_add(t37, t52, T::mul_add(t36, t53, t259 + t247)),
+                                                T::mul_add(t37, t52, T::mul_add(t36, t53, t250 + t238)),
                                                 T::mul_add(
                                                     T::from_f64(0.022459923),
                                                     t76,
                                                     T::mul_add(
                                                         -t2,
-                                                        t267,
+                                                        t257,
                                                         T::mul_add(
                                                             t3,
-                                                            t266,
+                                                            t256,
                                                             T::mul_add(
                                                                 qd[1],
                                                                 t35,
@@ -2240,12 +2268,12 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                                                 T::from_f64(0.0016),
                                                 T::mul_add(
                                                     -t0,
-                                                    t275,
+                                                    t261,
                                                     t1
                                                         * (T::mul_add(
                                                             -T::from_f64(0.20443499999999998),
                                                             t22,
-                                                            T::mul_add(T::from_f64(9.7119), t0, t262 - t272),
+                                                            T::mul_add(T::from_f64(9.7119), t0, t253 - t260),
                                                         )),
                                                 ),
                                                 -tau[0],
@@ -2257,65 +2285,64 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                         ),
                     ),
                 );
-                let t279 = T::one() / t277;
-                let t280 = T::mul_add(t276, t273, -t268 * t278 / (t249 * t277));
-                let t281 = T::mul_add(
-                    t232,
-                    t280 * t239,
-                    T::mul_add(-t269, t239, t256 * t278 / (t220 * t277)),
+                let t266 = T::mul_add(-t247, t258 * t264 * t265, -t247 * t263);
+                let t267 = -t266;
+                let t268 = T::mul_add(
+                    t246,
+                    t225 * t264 * t265,
+                    T::mul_add(t224, t225 * t267, t225 * t259),
                 );
-                let t282 = -t281;
-                let t283 = T::mul_add(
-                    -t206,
-                    t280 * t207,
+                let t269 = T::mul_add(
+                    -t174,
+                    t231 * t264 * t265,
                     T::mul_add(
-                        -t195,
-                        t282 * t207,
-                        T::mul_add(-t257, t207, t238 * t278 / (t156 * t277)),
+                        t202,
+                        t174 * t267,
+                        T::mul_add(t174, t192 * t268, -t174 * t248),
                     ),
                 );
-                let t284 = -t283;
-                let t285 = T::mul_add(
-                    -t175,
-                    t280 * t131,
+                let t270 = -t269;
+                let t271 = T::mul_add(
+                    t212,
+                    t84 * t264 * t265,
                     T::mul_add(
-                        -t157,
-                        t282 * t131,
+                        t173,
+                        t84 * t267,
                         T::mul_add(
-                            -t107,
-                            t284 * t131,
-                            T::mul_add(-t241, t131, -t218 * t278 / (t66 * t277)),
+                            t84,
+                            t155 * t268,
+                            T::mul_add(-t84, t108 * t270, -t84 * t232),
                         ),
                     ),
                 );
-                let t286 = T::mul_add(
+                let t272 = T::mul_add(
                     T::from_f64(0.12859348644086138),
-                    t204 - t203,
+                    t201 - t200,
                     T::mul_add(
                         -T::from_f64(0.00000000000000013942133736666016),
-                        t201 + t202,
+                        t198 + t199,
                         T::mul_add(
                             T::from_f64(1285.9348644085492),
-                            t199 + tau[5] - t200,
+                            t196 + tau[5] - t197,
                             T::mul_add(
                                 T::from_f64(0.000000000000000008628001120302262),
-                                t149 - t182 - t184,
+                                t148 - t180 - t182,
                                 T::mul_add(
                                     T::from_f64(0.018032351629443222),
-                                    t183 - t181 - t148,
+                                    t181 - t179 - t147,
                                     T::mul_add(
-                                        -t193,
-                                        t278 * t279,
+                                        t191,
+                                        t264 * t265,
                                         T::mul_add(
-                                            t130,
-                                            t280,
+                                            -t130,
+                                            t267,
                                             T::mul_add(
-                                                t106,
-                                                t282,
+                                                -t107,
+                                                t268,
                                                 T::mul_add(
                                                     -t67,
-                                                    t284,
-                                                    T::mul_add(t24, -t285, t101 - t140 - t141),
+                                                    t270,
+                                                    T::mul_add(t24, -t271, t102 - t139 - t140),
                                                 ),
                                             ),
                                         ),
@@ -2343,60 +2370,19 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                     t270,
                     t271,
                     t272,
-                    t273,
-                    t274,
-                    t275,
-                    t276,
-                    t277,
-                    t278,
-                    t279,
-                    t280,
-                    t281,
-                    t282,
-                    t283,
-                    t284,
-                    t285,
-                    t286,
                 )
             };
             [
-                t278 * t279,
-                t280,
-                t281,
-                t283,
-                t285,
-                t286,
-                T::mul_add(
-                    -T::from_f64(0.0032),
-                    t88,
-                    t270 + t271 + t263 + t274 + T::from_f64(0.0005521372320000016) - t205
-                        - t231 - t248,
-                ),
-                T::mul_add(
-                    T::from_f64(0.82),
-                    t137,
-                    T::mul_add(
-                        T::from_f64(0.4146),
-                        t28,
-                        T::mul_add(
-                            -T::from_f64(0.08080237769383405),
-                            t7,
-                            t196 + t159 + t240 + T::from_f64(0.6597447987005757) - t155
-                                - t194 - t219,
-                        ),
-                    ),
-                ),
-                T::mul_add(
-                    T::from_f64(0.4146),
-                    t28,
-                    T::mul_add(
-                        -T::from_f64(0.08080237769383405),
-                        t7,
-                        t196 + t159 + T::from_f64(0.16453713320957578) - t129 - t176
-                            - t208,
-                    ),
-                ),
-                t156,
+                -t264 * t265,
+                t266,
+                t268,
+                t269,
+                t271,
+                t272,
+                t262,
+                t239,
+                t213,
+                t154,
                 t66,
                 T::from_f64(0.0007776443641723163),
             ]
@@ -2414,11 +2400,13 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
     /// Route: Newton-Euler at rest without gravity, with qd as the accelerations, O(N).
     /// Operations: 198 mul, 216 add, 0 div, 5 sin, 5 cos.
     pub fn generalized_momentum(&self, q: &[T; 6], qd: &[T; 6]) -> [T; 6] {
-        let (s1, c1) = q[1].sin_cos();
-        let (s2, c2) = q[2].sin_cos();
-        let (s3, c3) = q[3].sin_cos();
-        let (s4, c4) = q[4].sin_cos();
-        let (s5, c5) = q[5].sin_cos();
+        let ([s1, s2, s3, s4, s5], [c1, c2, c3, c4, c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+        ]);
         let (
             t0,
             t1,
@@ -3150,11 +3138,13 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
     /// Route: second velocity derivatives of the Newton-Euler bias.
     /// Operations: 852 mul, 617 add, 0 div, 5 sin, 5 cos.
     pub fn centrifugal(&self, q: &[T; 6]) -> [[T; 6]; 6] {
-        let (s1, c1) = q[1].sin_cos();
-        let (s2, c2) = q[2].sin_cos();
-        let (s3, c3) = q[3].sin_cos();
-        let (s4, c4) = q[4].sin_cos();
-        let (s5, c5) = q[5].sin_cos();
+        let ([s1, s2, s3, s4, s5], [c1, c2, c3, c4, c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+        ]);
         let (
             t0,
             t1,
@@ -5555,11 +5545,13 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
     /// Route: second velocity derivatives of the Newton-Euler bias.
     /// Operations: 1563 mul, 1348 add, 0 div, 5 sin, 5 cos.
     pub fn coriolis_pairs(&self, q: &[T; 6]) -> [[T; 15]; 6] {
-        let (s1, c1) = q[1].sin_cos();
-        let (s2, c2) = q[2].sin_cos();
-        let (s3, c3) = q[3].sin_cos();
-        let (s4, c4) = q[4].sin_cos();
-        let (s5, c5) = q[5].sin_cos();
+        let ([s1, s2, s3, s4, s5], [c1, c2, c3, c4, c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+        ]);
         let (
             t0,
             t1,
@@ -10270,12 +10262,14 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
     /// Route: the bodies' centres of mass by forward kinematics.
     /// Operations: 79 mul, 40 add, 0 div, 6 sin, 6 cos.
     pub fn center_of_mass(&self, q: &[T; 6]) -> [T; 3] {
-        let (s0, c0) = q[0].sin_cos();
-        let (s1, c1) = q[1].sin_cos();
-        let (s2, c2) = q[2].sin_cos();
-        let (s3, c3) = q[3].sin_cos();
-        let (s4, c4) = q[4].sin_cos();
-        let (s5, c5) = q[5].sin_cos();
+        let ([s0, s1, s2, s3, s4, s5], [c0, c1, c2, c3, c4, c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[0],
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+        ]);
         let t0 = s0;
         let t1 = c0;
         let t2 = s1;
@@ -10384,12 +10378,14 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
     /// Route: each coordinate's composite-body momentum (the composite-rigid-body algorithm's), moved to the world.
     /// Operations: 126 mul, 51 add, 0 div, 6 sin, 6 cos.
     pub fn center_of_mass_jacobian(&self, q: &[T; 6]) -> [[T; 6]; 3] {
-        let (s0, c0) = q[0].sin_cos();
-        let (s1, c1) = q[1].sin_cos();
-        let (s2, c2) = q[2].sin_cos();
-        let (s3, c3) = q[3].sin_cos();
-        let (s4, c4) = q[4].sin_cos();
-        let (s5, c5) = q[5].sin_cos();
+        let ([s0, s1, s2, s3, s4, s5], [c0, c1, c2, c3, c4, c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[0],
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+        ]);
         let t0 = s0;
         let t1 = c0;
         let t2 = s1;
@@ -10686,7 +10682,9 @@ impl<T: ::eomgen_runtime::Real> Kinova<T> {
         match j {
             0 => {
                 let o = {
-                    let (s0, c0) = q[0].sin_cos();
+                    let ([s0], [c0]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+                        q[0],
+                    ]);
                     let t0 = s0;
                     let t1 = -c0;
                     [
@@ -10715,7 +10713,9 @@ impl<T: ::eomgen_runtime::Real> Kinova<T> {
             }
             1 => {
                 let o = {
-                    let (s1, c1) = q[1].sin_cos();
+                    let ([s1], [c1]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+                        q[1],
+                    ]);
                     let t0 = s1;
                     let t1 = -c1;
                     [
@@ -10744,7 +10744,9 @@ impl<T: ::eomgen_runtime::Real> Kinova<T> {
             }
             2 => {
                 let o = {
-                    let (s2, c2) = q[2].sin_cos();
+                    let ([s2], [c2]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+                        q[2],
+                    ]);
                     let t0 = s2;
                     let t1 = c2;
                     [
@@ -10773,7 +10775,9 @@ impl<T: ::eomgen_runtime::Real> Kinova<T> {
             }
             3 => {
                 let o = {
-                    let (s3, c3) = q[3].sin_cos();
+                    let ([s3], [c3]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+                        q[3],
+                    ]);
                     let t0 = s3;
                     let t1 = -c3;
                     [
@@ -10802,7 +10806,9 @@ impl<T: ::eomgen_runtime::Real> Kinova<T> {
             }
             4 => {
                 let o = {
-                    let (s4, c4) = q[4].sin_cos();
+                    let ([s4], [c4]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+                        q[4],
+                    ]);
                     let t0 = s4;
                     let t1 = c4;
                     [
@@ -10831,7 +10837,9 @@ impl<T: ::eomgen_runtime::Real> Kinova<T> {
             }
             5 => {
                 let o = {
-                    let (s5, c5) = q[5].sin_cos();
+                    let ([s5], [c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+                        q[5],
+                    ]);
                     let t0 = s5;
                     let t1 = -c5;
                     [
@@ -11111,11 +11119,13 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Kinova<T> {
     /// Route: composite-rigid-body algorithm.
     /// Operations: 216 mul, 172 add, 0 div, 5 sin, 5 cos.
     fn mass_matrix(&self, q: &[T; 6]) -> [[T; 6]; 6] {
-        let (s1, c1) = q[1].sin_cos();
-        let (s2, c2) = q[2].sin_cos();
-        let (s3, c3) = q[3].sin_cos();
-        let (s4, c4) = q[4].sin_cos();
-        let (s5, c5) = q[5].sin_cos();
+        let ([s1, s2, s3, s4, s5], [c1, c2, c3, c4, c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+        ]);
         let (
             t0,
             t1,
@@ -11772,11 +11782,13 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Kinova<T> {
     /// Route: closed-form Lagrangian expressions.
     /// Operations: 64 mul, 30 add, 0 div, 5 sin, 5 cos.
     fn gravity(&self, q: &[T; 6]) -> [T; 6] {
-        let (s1, c1) = q[1].sin_cos();
-        let (s2, c2) = q[2].sin_cos();
-        let (s3, c3) = q[3].sin_cos();
-        let (s4, c4) = q[4].sin_cos();
-        let (s5, c5) = q[5].sin_cos();
+        let ([s1, s2, s3, s4, s5], [c1, c2, c3, c4, c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+        ]);
         let t0 = s1;
         let t1 = c1;
         let t2 = s2;
@@ -11874,11 +11886,13 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Kinova<T> {
     /// Route: Newton-Euler.
     /// Operations: 370 mul, 346 add, 0 div, 5 sin, 5 cos.
     fn bias(&self, q: &[T; 6], qd: &[T; 6]) -> [T; 6] {
-        let (s1, c1) = q[1].sin_cos();
-        let (s2, c2) = q[2].sin_cos();
-        let (s3, c3) = q[3].sin_cos();
-        let (s4, c4) = q[4].sin_cos();
-        let (s5, c5) = q[5].sin_cos();
+        let ([s1, s2, s3, s4, s5], [c1, c2, c3, c4, c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+        ]);
         let (
             t0,
             t1,
@@ -13119,11 +13133,13 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Kinova<T> {
     /// Route: Echeandia and Wensing's O(N^2) recursion on composite inertias and momenta.
     /// Operations: 960 mul, 912 add, 0 div, 5 sin, 5 cos.
     fn coriolis_matrix(&self, q: &[T; 6], qd: &[T; 6]) -> [[T; 6]; 6] {
-        let (s1, c1) = q[1].sin_cos();
-        let (s2, c2) = q[2].sin_cos();
-        let (s3, c3) = q[3].sin_cos();
-        let (s4, c4) = q[4].sin_cos();
-        let (s5, c5) = q[5].sin_cos();
+        let ([s1, s2, s3, s4, s5], [c1, c2, c3, c4, c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+        ]);
         let (
             t0,
             t1,
@@ -16133,11 +16149,13 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Kinova<T> {
     /// Route: Newton-Euler.
     /// Operations: 379 mul, 407 add, 0 div, 5 sin, 5 cos.
     fn inverse_dynamics(&self, q: &[T; 6], qd: &[T; 6], qdd: &[T; 6]) -> [T; 6] {
-        let (s1, c1) = q[1].sin_cos();
-        let (s2, c2) = q[2].sin_cos();
-        let (s3, c3) = q[3].sin_cos();
-        let (s4, c4) = q[4].sin_cos();
-        let (s5, c5) = q[5].sin_cos();
+        let ([s1, s2, s3, s4, s5], [c1, c2, c3, c4, c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+        ]);
         let (
             t0,
             t1,
@@ -17480,7 +17498,7 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Kinova<T> {
     /// model and finite inputs); `try_forward_dynamics` says which pivot failed.
     ///
     /// Route: M and b + G as in `mass_matrix` and `bias`, then an unrolled L^T D L solve without fill-in.
-    /// Operations: 711 mul, 647 add, 9 div, 5 sin, 5 cos.
+    /// Operations: 709 mul, 623 add, 5 div, 5 sin, 5 cos.
     fn forward_dynamics(&self, q: &[T; 6], qd: &[T; 6], tau: &[T; 6]) -> [T; 6] {
         match self.forward_dynamics_checked(q, qd, tau) {
             Ok((qdd, failures)) => ::eomgen_runtime::lane::nan_failed(qdd, &failures),
@@ -17492,11 +17510,13 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Kinova<T> {
     /// Route: a sum over body velocities, O(N).
     /// Operations: 156 mul, 92 add, 0 div, 5 sin, 5 cos.
     fn kinetic_energy(&self, q: &[T; 6], qd: &[T; 6]) -> T {
-        let (s1, c1) = q[1].sin_cos();
-        let (s2, c2) = q[2].sin_cos();
-        let (s3, c3) = q[3].sin_cos();
-        let (s4, c4) = q[4].sin_cos();
-        let (s5, c5) = q[5].sin_cos();
+        let ([s1, s2, s3, s4, s5], [c1, c2, c3, c4, c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+        ]);
         let t0 = s1;
         let t1 = c1;
         let t2 = s2;
@@ -17788,11 +17808,13 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Kinova<T> {
     /// Route: centres of mass by forward kinematics.
     /// Operations: 23 mul, 12 add, 0 div, 5 sin, 5 cos.
     fn potential_energy(&self, q: &[T; 6]) -> T {
-        let (s1, c1) = q[1].sin_cos();
-        let (s2, c2) = q[2].sin_cos();
-        let (s3, c3) = q[3].sin_cos();
-        let (s4, c4) = q[4].sin_cos();
-        let (s5, c5) = q[5].sin_cos();
+        let ([s1, s2, s3, s4, s5], [c1, c2, c3, c4, c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+        ]);
         let t0 = s1;
         let t1 = c1;
         let t2 = s2;

@@ -144,11 +144,13 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
     > {
         let mut failures: <T as ::eomgen_runtime::Lane>::Failures = ::core::default::Default::default();
         let o: [T; 12] = {
-            let (s1, c1) = q[1].sin_cos();
-            let (s2, c2) = q[2].sin_cos();
-            let (s3, c3) = q[3].sin_cos();
-            let (s4, c4) = q[4].sin_cos();
-            let (s5, c5) = q[5].sin_cos();
+            let ([s1, s2, s3, s4, s5], [c1, c2, c3, c4, c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+                q[1],
+                q[2],
+                q[3],
+                q[4],
+                q[5],
+            ]);
             let (
                 t0,
                 t1,
@@ -293,8 +295,7 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
                 let t47 = t3 * t39;
                 let t48 = t2 * t39;
                 let t49 = T::one() / t29;
-                let t50 = t6 * t6 * t8 * t8 * t9 * t9 * t49;
-                let t51 = T::mul_add(
+                let t50 = T::mul_add(
                     t7,
                     t7 * t30,
                     T::mul_add(
@@ -303,16 +304,16 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
                         T::from_f64(0.123341033631),
                     ),
                 );
-                let t52 = T::mul_add(
+                let t51 = T::mul_add(
                     -t6,
                     t7 * t30,
                     T::from_f64(0.12999255384415) * t6 * t7,
                 );
-                let t53 = T::mul_add(-t5, t32, T::from_f64(0.016685526854599998) * t20);
-                let t54 = t1 * (T::mul_add(T::from_f64(0.017784735), t18, -t33));
-                let t55 = T::mul_add(-t5, t29, T::from_f64(0.016685526854599998) * t20);
-                let t56 = T::mul_add(t4, t29, T::from_f64(0.016685526854599998) * t19);
-                let t57 = T::mul_add(
+                let t52 = T::mul_add(-t5, t32, T::from_f64(0.016685526854599998) * t20);
+                let t53 = t1 * (T::mul_add(T::from_f64(0.017784735), t18, -t33));
+                let t54 = T::mul_add(-t5, t29, T::from_f64(0.016685526854599998) * t20);
+                let t55 = T::mul_add(t4, t29, T::from_f64(0.016685526854599998) * t19);
+                let t56 = T::mul_add(
                     -t0,
                     T::from_f64(0.0171364731454)
                         * (T::mul_add(-t3, t5 * t6, t2 * t4 * t6)),
@@ -320,20 +321,29 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
                         * (T::from_f64(0.0171364731454)
                             * (T::mul_add(t2, t5 * t6, t3 * t4 * t6))),
                 );
-                let t58 = T::mul_add(
+                let t57 = T::mul_add(
                     qd[2],
                     t36,
                     T::mul_add(qd[0], qd[1] * t1 * t2, qd[0] * qd[1] * t0 * t3),
                 );
-                let t59 = T::mul_add(
+                let t58 = T::mul_add(
                     -qd[2],
                     t37,
                     T::mul_add(-qd[0], qd[1] * t1 * t3, qd[0] * qd[1] * t0 * t2),
                 );
-                let t60 = t36 * t44;
-                let t61 = t37 * t43;
-                let t62 = T::mul_add(t5, t36, t4 * t37);
-                let t63 = T::mul_add(-t4, t36, t5 * t37);
+                let t59 = t36 * t44;
+                let t60 = t37 * t43;
+                let t61 = T::mul_add(t5, t36, t4 * t37);
+                let t62 = T::mul_add(-t4, t36, t5 * t37);
+                let t63 = T::mul_add(
+                    qd[1],
+                    t35,
+                    T::mul_add(
+                        T::from_f64(0.425),
+                        t24,
+                        T::mul_add(T::from_f64(0.1197), t22, T::from_f64(9.81) * t0),
+                    ),
+                );
                 (
                     t0,
                     t1,
@@ -467,27 +477,28 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
                 t126,
                 t127,
             ) = {
-                let t64 = T::mul_add(
-                    qd[1],
-                    t35,
-                    T::mul_add(
-                        T::from_f64(0.425),
-                        t24,
-                        T::mul_add(T::from_f64(0.1197), t22, T::from_f64(9.81) * t0),
-                    ),
-                );
-                let t65 = T::mul_add(
+                let t64 = t6 * t6 * t8 * t8 * t9 * t9 * t49;
+                let t65 = T::from_f64(0.111172755531) * t61;
+                let t66 = T::from_f64(0.21942) * t62;
+                let t67 = T::from_f64(0.093) * t62;
+                let t68 = T::from_f64(0.093) * t61;
+                let t69 = qd[4] - t62;
+                let t70 = t2 * t63;
+                let t71 = t3 * t63;
+                let t72 = t7 * t56;
+                let t73 = T::from_f64(58.355064750790525) * t56;
+                let t74 = T::mul_add(
                     -T::from_f64(0.0002784068064155777),
-                    t50,
+                    t64,
                     T::mul_add(
                         T::from_f64(0.11285608069875001),
                         t14,
                         t40 + T::from_f64(0.111172755531),
                     ),
                 );
-                let t66 = T::mul_add(
+                let t75 = T::mul_add(
                     T::from_f64(0.0002784068064155777),
-                    t50,
+                    t64,
                     T::mul_add(
                         -T::from_f64(0.11285608069875001),
                         t14,
@@ -498,9 +509,9 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
                         ),
                     ),
                 );
-                let t67 = T::mul_add(
+                let t76 = T::mul_add(
                     T::from_f64(0.0002784068064155777),
-                    t50,
+                    t64,
                     T::mul_add(
                         -T::from_f64(0.11285608069875001),
                         t14,
@@ -515,54 +526,128 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
                         ),
                     ),
                 );
-                let t68 = T::from_f64(0.111172755531) * t62;
-                let t69 = T::from_f64(0.21942) * t63;
-                let t70 = T::from_f64(0.093) * t63;
-                let t71 = T::from_f64(0.093) * t62;
-                let t72 = qd[4] - t63;
-                let t73 = t2 * t64;
-                let t74 = t3 * t64;
-                let t75 = t7 * t57;
-                let t76 = T::from_f64(58.355064750790525) * t57;
-                let t77 = T::one() / t65;
-                let t78 = t66 * t66 * t77;
-                let t79 = t67 * t67 * t77;
-                let t80 = T::mul_add(t5, t31, t4 * t52);
-                let t81 = T::mul_add(-t4, t31, t5 * t52);
-                let t82 = T::mul_add(-T::from_f64(0.016685526854599998), t19, t4 * t51);
-                let t83 = T::mul_add(qd[3], t62, T::mul_add(-t4, t59, t5 * t58));
-                let t84 = T::mul_add(-qd[3], t63, T::mul_add(t5, t59, t4 * t58));
-                let t85 = t63 * t68;
-                let t86 = t62 * t69;
-                let t87 = T::mul_add(t6, t28, t7 * t62);
-                let t88 = t28 * t70;
-                let t89 = T::mul_add(-t7, t28, t6 * t62);
-                let t90 = T::from_f64(0.21942) * t72;
-                let t91 = T::mul_add(t36, t45, t73 - t47);
-                let t92 = T::mul_add(t11, t27, T::mul_add(t37, t45, t48 + t74));
-                let t93 = t57 * t76;
-                let t94 = T::mul_add(
-                    T::from_f64(0.0002784068064155777),
-                    t50,
+                let t77 = T::mul_add(t5, t31, t4 * t51);
+                let t78 = T::mul_add(-t4, t31, t5 * t51);
+                let t79 = T::mul_add(-T::from_f64(0.016685526854599998), t19, t4 * t50);
+                let t80 = T::mul_add(qd[3], t61, T::mul_add(-t4, t58, t5 * t57));
+                let t81 = T::mul_add(-qd[3], t62, T::mul_add(t5, t58, t4 * t57));
+                let t82 = t62 * t65;
+                let t83 = t61 * t66;
+                let t84 = T::mul_add(t6, t28, t7 * t61);
+                let t85 = t28 * t67;
+                let t86 = T::mul_add(-t7, t28, t6 * t61);
+                let t87 = T::from_f64(0.21942) * t69;
+                let t88 = T::mul_add(t36, t45, t70 - t47);
+                let t89 = T::mul_add(t11, t27, T::mul_add(t37, t45, t48 + t71));
+                let t90 = T::one() / t74;
+                let t91 = t78 - T::from_f64(0.051322656825);
+                let t92 = t3 * t77;
+                let t93 = t2 * t77;
+                let t94 = t6 * t81;
+                let t95 = T::mul_add(
+                    t61,
+                    t68,
                     T::mul_add(
-                        -T::from_f64(0.11285608069875001),
-                        t14,
+                        t62,
+                        t67,
                         T::mul_add(
-                            T::from_f64(0.0139521246075),
-                            t4,
-                            t78 - t40 - T::from_f64(0.70682470720575),
+                            T::from_f64(0.39225),
+                            t57,
+                            T::mul_add(
+                                -T::from_f64(0.1197),
+                                t24,
+                                T::mul_add(
+                                    T::from_f64(0.425),
+                                    t22,
+                                    T::mul_add(T::from_f64(0.13585), t10, t41 + t46),
+                                ),
+                            ),
                         ),
                     ),
                 );
-                let t95 = T::mul_add(
+                let t96 = qd[4] * t84;
+                let t97 = T::from_f64(0.111172755531) * t84;
+                let t98 = T::from_f64(0.111172755531) * t86;
+                let t99 = T::from_f64(0.09465) * t84;
+                let t100 = T::from_f64(0.09465) * t86;
+                let t101 = qd[5] - t86;
+                let t102 = t4 * t88;
+                let t103 = t5 * t89;
+                let t104 = t5 * t88;
+                let t105 = t4 * t89;
+                let t106 = T::mul_add(
+                    t4,
+                    T::mul_add(t4, t32, T::from_f64(0.016685526854599998) * t19),
+                    T::mul_add(
+                        t5,
+                        T::mul_add(t5, t50, T::from_f64(0.016685526854599998) * t20),
+                        T::from_f64(0.004095),
+                    ),
+                );
+                let t107 = T::mul_add(
+                    t5,
+                    t52,
+                    T::mul_add(
+                        -t4,
+                        t79,
+                        T::mul_add(
+                            T::from_f64(0.0139521246075),
+                            t4,
+                            -T::from_f64(0.5956519516747499),
+                        ),
+                    ),
+                );
+                let t108 = T::mul_add(
+                    -t4,
+                    t52,
+                    T::mul_add(-t5, t79, T::from_f64(0.00697606230375) * t5),
+                );
+                let t109 = t3 * t91;
+                let t110 = T::mul_add(
+                    -t0,
+                    T::mul_add(-t3, t55, t2 * t54),
+                    t1 * (T::mul_add(t2, t55, t3 * t54)),
+                );
+                let t111 = t6 * t95;
+                let t112 = t7 * t95;
+                let t113 = T::mul_add(qd[4], t86, t7 * t81);
+                let t114 = t84 * t98;
+                let t115 = t86 * t97;
+                let t116 = T::mul_add(-t8, t69, t9 * t84);
+                let t117 = T::mul_add(t9, t69, t8 * t84);
+                let t118 = t69 * t100;
+                let t119 = T::from_f64(0.0171364731454) * t101;
+                let t120 = T::mul_add(
+                    -t28,
+                    t68,
+                    T::mul_add(T::from_f64(0.093), t80, t102 - t103),
+                );
+                let t121 = T::mul_add(
+                    -T::from_f64(0.0002784068064155777),
+                    t64,
+                    T::mul_add(
+                        -t90,
+                        t75 * t75,
+                        T::mul_add(
+                            T::from_f64(0.11285608069875001),
+                            t14,
+                            T::mul_add(
+                                -T::from_f64(0.0139521246075),
+                                t4,
+                                t40 + T::from_f64(0.70682470720575),
+                            ),
+                        ),
+                    ),
+                );
+                let t122 = T::mul_add(
                     T::from_f64(0.0002784068064155777),
-                    t50,
+                    t64,
                     T::mul_add(
                         T::from_f64(0.425),
                         t34,
                         T::mul_add(
-                            t66,
-                            t67 * t77,
+                            t90,
+                            t75 * t76,
                             T::mul_add(
                                 -T::from_f64(0.11285608069875001),
                                 t14,
@@ -579,90 +664,11 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
                         ),
                     ),
                 );
-                let t96 = t81 - T::from_f64(0.051322656825);
-                let t97 = t3 * t80;
-                let t98 = t2 * t80;
-                let t99 = t6 * t84;
-                let t100 = T::mul_add(
-                    t62,
-                    t71,
-                    T::mul_add(
-                        t63,
-                        t70,
-                        T::mul_add(
-                            T::from_f64(0.39225),
-                            t58,
-                            T::mul_add(
-                                -T::from_f64(0.1197),
-                                t24,
-                                T::mul_add(
-                                    T::from_f64(0.425),
-                                    t22,
-                                    T::mul_add(T::from_f64(0.13585), t10, t41 + t46),
-                                ),
-                            ),
-                        ),
-                    ),
-                );
-                let t101 = qd[4] * t87;
-                let t102 = T::from_f64(0.111172755531) * t87;
-                let t103 = T::from_f64(0.111172755531) * t89;
-                let t104 = T::from_f64(0.09465) * t87;
-                let t105 = T::from_f64(0.09465) * t89;
-                let t106 = qd[5] - t89;
-                let t107 = t4 * t91;
-                let t108 = t5 * t92;
-                let t109 = t5 * t91;
-                let t110 = t4 * t92;
-                let t111 = T::one() / t94;
-                let t112 = t95 * t95 * t111;
-                let t113 = T::mul_add(
-                    t4,
-                    T::mul_add(t4, t32, T::from_f64(0.016685526854599998) * t19),
-                    T::mul_add(
-                        t5,
-                        T::mul_add(t5, t51, T::from_f64(0.016685526854599998) * t20),
-                        T::from_f64(0.004095),
-                    ),
-                );
-                let t114 = T::mul_add(
-                    t5,
-                    t53,
-                    T::mul_add(
-                        -t4,
-                        t82,
-                        T::mul_add(
-                            T::from_f64(0.0139521246075),
-                            t4,
-                            -T::from_f64(0.5956519516747499),
-                        ),
-                    ),
-                );
-                let t115 = T::mul_add(
-                    -t4,
-                    t53,
-                    T::mul_add(-t5, t82, T::from_f64(0.00697606230375) * t5),
-                );
-                let t116 = t3 * t96;
-                let t117 = T::mul_add(
-                    -t0,
-                    T::mul_add(-t3, t56, t2 * t55),
-                    t1 * (T::mul_add(t2, t56, t3 * t55)),
-                );
-                let t118 = t6 * t100;
-                let t119 = t7 * t100;
-                let t120 = T::mul_add(qd[4], t89, t7 * t84);
-                let t121 = t87 * t103;
-                let t122 = t89 * t102;
-                let t123 = T::mul_add(-t8, t72, t9 * t87);
-                let t124 = T::mul_add(t9, t72, t8 * t87);
-                let t125 = t72 * t105;
-                let t126 = T::from_f64(0.0171364731454) * t106;
-                let t127 = T::mul_add(
-                    -t28,
-                    t71,
-                    T::mul_add(T::from_f64(0.093), t83, t107 - t108),
-                );
+                let t123 = t2 * t108;
+                let t124 = t3 * t108;
+                let t125 = T::from_f64(0.0171364731454) * t116;
+                let t126 = T::from_f64(0.033822) * t117;
+                let t127 = t7 * t120;
                 (
                     t64,
                     t65,
@@ -796,88 +802,62 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
                 t190,
                 t191,
             ) = {
-                let t128 = T::mul_add(
-                    T::from_f64(0.0002784068064155777),
-                    t50,
+                let t128 = t6 * t120;
+                let t129 = T::mul_add(
+                    t86,
+                    t100,
                     T::mul_add(
-                        T::from_f64(0.85),
-                        t34,
-                        T::mul_add(
-                            -T::from_f64(0.11285608069875001),
-                            t14,
-                            T::mul_add(
-                                T::from_f64(0.01511702475),
-                                t13,
-                                T::mul_add(
-                                    T::from_f64(0.0139521246075),
-                                    t4,
-                                    t79 - t40 - t112 - T::from_f64(2.47695164561575),
-                                ),
-                            ),
-                        ),
+                        t84,
+                        t99,
+                        T::mul_add(T::from_f64(0.093), t81, t85 - t104 - t105),
                     ),
                 );
-                let t129 = t2 * t115;
-                let t130 = t3 * t115;
-                let t131 = T::from_f64(0.0171364731454) * t123;
-                let t132 = T::from_f64(0.033822) * t124;
-                let t133 = t7 * t127;
-                let t134 = t6 * t127;
-                let t135 = T::mul_add(
-                    t89,
-                    t105,
-                    T::mul_add(
-                        t87,
-                        t104,
-                        T::mul_add(T::from_f64(0.093), t84, t88 - t109 - t110),
-                    ),
-                );
-                let t136 = t6 * t8 * t9 * t117 * t49;
-                let t137 = t117 * t117 * t49;
-                let t138 = T::mul_add(t3, t114, t129);
-                let t139 = T::mul_add(-t2, t113, t130);
-                let t140 = t1
+                let t130 = t6 * t8 * t9 * t110 * t49;
+                let t131 = T::one() / t121;
+                let t132 = T::mul_add(t3, t107, t123);
+                let t133 = T::mul_add(-t2, t106, t124);
+                let t134 = t1
                     * (T::mul_add(
                         t2,
-                        t96,
+                        t91,
                         T::mul_add(
                             -T::from_f64(0.1197),
                             t33,
-                            T::mul_add(T::from_f64(0.0021288327795), t18, t97),
+                            T::mul_add(T::from_f64(0.0021288327795), t18, t92),
                         ),
                     ));
-                let t141 = t124 * t131;
-                let t142 = t123 * t132;
-                let t143 = T::mul_add(
-                    t72,
-                    t104,
-                    T::mul_add(T::from_f64(0.09465), t99 - t101, -t118 - t133),
+                let t135 = t117 * t125;
+                let t136 = t116 * t126;
+                let t137 = T::mul_add(
+                    t69,
+                    t99,
+                    T::mul_add(T::from_f64(0.09465), t94 - t96, -t111 - t127),
                 );
-                let t144 = T::mul_add(
+                let t138 = T::mul_add(
                     -T::from_f64(0.1879),
-                    t125,
+                    t118,
                     T::mul_add(
                         T::from_f64(1.4069),
-                        t134 - t119,
-                        T::from_f64(0.017784735) * t120,
+                        t128 - t112,
+                        T::from_f64(0.017784735) * t113,
                     ),
                 );
-                let t145 = T::mul_add(
+                let t139 = T::mul_add(
                     T::from_f64(0.016685526854599998),
-                    t136,
+                    t130,
                     T::mul_add(
                         -t0,
                         T::mul_add(
                             -t3,
-                            t81,
-                            T::mul_add(T::from_f64(0.0021288327795), t13 + t17, t98),
+                            t78,
+                            T::mul_add(T::from_f64(0.0021288327795), t13 + t17, t93),
                         ),
                         T::mul_add(
                             -t1,
                             T::mul_add(
                                 -t2,
-                                t81,
-                                T::mul_add(T::from_f64(0.0021288327795), t12 - t18, -t97),
+                                t78,
+                                T::mul_add(T::from_f64(0.0021288327795), t12 - t18, -t92),
                             ),
                             T::mul_add(
                                 T::from_f64(0.13585),
@@ -886,54 +866,82 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
                                     T::from_f64(0.017784735) * (t12 - t18),
                                     t0 * (T::from_f64(0.017784735) * (t13 + t17)),
                                 ),
-                                -t75,
+                                -t72,
                             ),
                         ),
                     ),
                 );
-                let t146 = T::mul_add(
-                    t124,
-                    t126,
+                let t140 = T::mul_add(
+                    t117,
+                    t119,
                     T::mul_add(
-                        -t106,
-                        t132,
-                        T::from_f64(0.0171364731454)
-                            * (T::mul_add(qd[5], t124, T::mul_add(t8, t83, t9 * t120))),
-                    ),
-                );
-                let t147 = T::mul_add(
-                    t106,
-                    t131,
-                    T::mul_add(
-                        -t123,
+                        -t101,
                         t126,
-                        T::from_f64(0.033822)
-                            * (T::mul_add(-qd[5], t123, T::mul_add(-t9, t83, t8 * t120))),
+                        T::from_f64(0.0171364731454)
+                            * (T::mul_add(qd[5], t117, T::mul_add(t8, t80, t9 * t113))),
                     ),
                 );
-                let t148 = t6 * t144;
-                let t149 = t7 * t144;
-                let t150 = t145 * t145 * t77;
-                let t151 = T::mul_add(
-                    T::from_f64(0.0171364731454),
-                    t99 - t101,
-                    t141 - t142 - tau[5],
+                let t141 = T::mul_add(
+                    t101,
+                    t125,
+                    T::mul_add(
+                        -t116,
+                        t119,
+                        T::from_f64(0.033822)
+                            * (T::mul_add(-qd[5], t116, T::mul_add(-t9, t80, t8 * t113))),
+                    ),
                 );
-                let t152 = T::mul_add(
+                let t142 = t6 * t138;
+                let t143 = t7 * t138;
+                let t144 = T::mul_add(
+                    -T::from_f64(0.0002784068064155777),
+                    t64,
+                    T::mul_add(
+                        -T::from_f64(0.85),
+                        t34,
+                        T::mul_add(
+                            -t131,
+                            t122 * t122,
+                            T::mul_add(
+                                -t90,
+                                t76 * t76,
+                                T::mul_add(
+                                    T::from_f64(0.11285608069875001),
+                                    t14,
+                                    T::mul_add(
+                                        -T::from_f64(0.01511702475),
+                                        t13,
+                                        T::mul_add(
+                                            -T::from_f64(0.0139521246075),
+                                            t4,
+                                            t40 + T::from_f64(2.47695164561575),
+                                        ),
+                                    ),
+                                ),
+                            ),
+                        ),
+                    ),
+                );
+                let t145 = T::mul_add(
+                    T::from_f64(0.0171364731454),
+                    t94 - t96,
+                    t135 - t136 - tau[5],
+                );
+                let t146 = T::mul_add(
                     t3,
-                    T::mul_add(t3, t113, t129),
+                    T::mul_add(t3, t106, t123),
                     T::mul_add(
                         t2,
-                        T::mul_add(-t2, t114, t130),
+                        T::mul_add(-t2, t107, t124),
                         T::from_f64(0.054004433300999945),
                     ),
                 );
-                let t153 = T::mul_add(
+                let t147 = T::mul_add(
                     t3,
-                    t139,
+                    t133,
                     T::mul_add(
                         -t2,
-                        t138,
+                        t132,
                         T::mul_add(
                             -T::from_f64(0.425),
                             t33,
@@ -941,75 +949,75 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
                         ),
                     ),
                 );
-                let t154 = t8 * t146;
-                let t155 = t9 * t147;
-                let t156 = T::from_f64(0.1879) * (T::mul_add(t8, t135, t9 * t143));
-                let t157 = T::from_f64(0.1879) * (T::mul_add(-t9, t135, t8 * t143));
-                let t158 = T::mul_add(
+                let t148 = t8 * t140;
+                let t149 = t9 * t141;
+                let t150 = T::from_f64(0.1879) * (T::mul_add(t8, t129, t9 * t137));
+                let t151 = T::from_f64(0.1879) * (T::mul_add(-t9, t129, t8 * t137));
+                let t152 = T::mul_add(
                     -T::from_f64(0.016685526854599998),
-                    t136,
+                    t130,
                     T::mul_add(
-                        -t66,
-                        t145 * t77,
+                        -t90,
+                        t75 * t139,
                         T::mul_add(
                             t0,
                             T::mul_add(
                                 T::from_f64(0.1197),
                                 t34,
-                                T::mul_add(T::from_f64(0.0021288327795), t13, t98 - t116),
+                                T::mul_add(T::from_f64(0.0021288327795), t13, t93 - t109),
                             ),
                             T::mul_add(
                                 T::from_f64(0.13585),
                                 T::mul_add(
                                     -t0,
                                     T::mul_add(T::from_f64(0.017784735), t13, t34),
-                                    t54,
+                                    t53,
                                 ),
-                                t75 - t140,
+                                t72 - t134,
                             ),
                         ),
                     ),
                 );
-                let t159 = t7 * t151;
-                let t160 = t9 * t156;
-                let t161 = t8 * t157;
-                let t162 = t8 * t156;
-                let t163 = t9 * t157;
-                let t164 = T::mul_add(
+                let t153 = T::one() / t144;
+                let t154 = t7 * t145;
+                let t155 = t9 * t150;
+                let t156 = t8 * t151;
+                let t157 = t8 * t150;
+                let t158 = t9 * t151;
+                let t159 = T::mul_add(
                     t8,
-                    t147,
+                    t141,
                     T::mul_add(
                         t9,
-                        t146,
+                        t140,
                         T::mul_add(
-                            -t72,
-                            t103,
+                            -t69,
+                            t98,
                             T::mul_add(
-                                t89,
-                                t90,
+                                t86,
+                                t87,
                                 T::mul_add(
                                     T::from_f64(0.017784735),
-                                    t134 - t119 - t125,
-                                    T::from_f64(0.11285608069875) * t120,
+                                    t128 - t112 - t118,
+                                    T::from_f64(0.11285608069875) * t113,
                                 ),
                             ),
                         ),
                     ),
                 );
-                let t165 = t158 * t158 * t111;
-                let t166 = T::mul_add(
+                let t160 = T::mul_add(
                     T::from_f64(0.21942),
-                    t83,
-                    t122 + t154 - t121 - t155 - tau[4],
+                    t80,
+                    t115 + t148 - t114 - t149 - tau[4],
                 );
-                let t167 = T::mul_add(
+                let t161 = T::mul_add(
                     t1,
                     T::mul_add(
                         t2,
-                        t139,
+                        t133,
                         T::mul_add(
                             t3,
-                            t138,
+                            t132,
                             T::mul_add(
                                 T::from_f64(0.85),
                                 t34,
@@ -1021,45 +1029,45 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
                             ),
                         ),
                     ),
-                    t0 * t153,
+                    t0 * t147,
                 );
-                let t168 = T::mul_add(
+                let t162 = T::mul_add(
                     T::from_f64(0.09465),
-                    t160 + t161,
+                    t155 + t156,
                     T::mul_add(
-                        -t87,
-                        t90,
+                        -t84,
+                        t87,
                         T::mul_add(
-                            t72,
-                            t102,
+                            t69,
+                            t97,
                             T::mul_add(
                                 T::from_f64(0.12830922867640002),
-                                t99 - t101,
-                                t141 - t142,
+                                t94 - t96,
+                                t135 - t136,
                             ),
                         ),
                     ),
                 );
-                let t169 = T::mul_add(T::from_f64(1.219), t118 + t133, -t160 - t161);
-                let t170 = t6 * t164;
-                let t171 = T::mul_add(
+                let t163 = T::mul_add(T::from_f64(1.219), t111 + t127, -t155 - t156);
+                let t164 = t6 * t159;
+                let t165 = T::mul_add(
                     -T::from_f64(2.438),
-                    t109 + t110,
+                    t104 + t105,
                     T::mul_add(
                         T::from_f64(1.219),
-                        t88,
-                        T::mul_add(T::from_f64(0.11336700000000001), t84, t162 - t163),
+                        t85,
+                        T::mul_add(T::from_f64(0.11336700000000001), t81, t157 - t158),
                     ),
                 );
-                let t172 = T::mul_add(
+                let t166 = T::mul_add(
                     -T::from_f64(0.016685526854599998),
-                    t136,
+                    t130,
                     T::mul_add(
-                        -t158,
-                        t95 * t111,
+                        t152,
+                        t131 * t122,
                         T::mul_add(
-                            -t67,
-                            t145 * t77,
+                            -t90,
+                            t76 * t139,
                             T::mul_add(
                                 t0,
                                 T::mul_add(
@@ -1068,7 +1076,7 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
                                     T::mul_add(
                                         T::from_f64(0.0021288327795),
                                         t13,
-                                        t98 - t116 - T::from_f64(0.19371331275000003),
+                                        t93 - t109 - T::from_f64(0.19371331275000003),
                                     ),
                                 ),
                                 T::mul_add(
@@ -1080,87 +1088,107 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
                                             t13,
                                             t34 - T::from_f64(4.4329225),
                                         ),
-                                        t54,
+                                        t53,
                                     ),
-                                    t75 - t140,
+                                    t72 - t134,
                                 ),
                             ),
                         ),
                     ),
                 );
-                let t173 = t6 * t8 * t9 * t166 * t49;
-                let t174 = t1 * t167;
-                let t175 = t0 * (T::mul_add(-t0, t152, t1 * t153));
-                let t176 = t7 * t169;
-                let t177 = t6 * t169;
-                let t178 = t7 * t168;
-                let t179 = t5 * t171;
-                let t180 = T::one() / t128;
-                let t181 = t172 * t172 * t180;
-                let t182 = T::mul_add(
+                let t167 = t6 * t8 * t9 * t49 * t160;
+                let t168 = t7 * t163;
+                let t169 = t6 * t163;
+                let t170 = t7 * t162;
+                let t171 = t5 * t165;
+                let t172 = T::mul_add(
                     T::from_f64(0.093),
-                    t176 + t148,
+                    t168 + t142,
                     T::mul_add(
                         -t28,
-                        t68,
+                        t65,
                         T::mul_add(
-                            t62,
+                            t61,
                             t38,
                             T::mul_add(
                                 T::from_f64(0.43884),
-                                t83,
-                                t122 + t154 - t121 - t155,
+                                t80,
+                                t115 + t148 - t114 - t149,
                             ),
                         ),
                     ),
                 );
-                let t183 = T::mul_add(
+                let t173 = T::mul_add(
                     T::from_f64(0.093),
-                    t162 - t163,
+                    t157 - t158,
                     T::mul_add(
                         T::from_f64(0.11336700000000001),
-                        t88 - t109 - t110,
+                        t85 - t104 - t105,
                         T::mul_add(
                             t6,
-                            t168,
+                            t162,
                             T::mul_add(
                                 t7,
-                                t164,
+                                t159,
                                 T::mul_add(
-                                    -t63,
+                                    -t62,
                                     t38,
-                                    T::mul_add(t28, t69, T::from_f64(0.121715886531) * t84),
+                                    T::mul_add(t28, t66, T::from_f64(0.121715886531) * t81),
                                 ),
                             ),
                         ),
                     ),
                 );
-                let t184 = T::mul_add(T::from_f64(1.219), t107 - t108, t176 + t148);
-                let t185 = T::mul_add(
+                let t174 = T::mul_add(T::from_f64(1.219), t102 - t103, t168 + t142);
+                let t175 = T::mul_add(
+                    -t166,
+                    t166 * t153,
+                    T::mul_add(
+                        -t152,
+                        t152 * t131,
+                        T::mul_add(
+                            -t90,
+                            t139 * t139,
+                            T::mul_add(
+                                -t110,
+                                t110 * t49,
+                                T::mul_add(
+                                    -t56,
+                                    t73,
+                                    T::mul_add(
+                                        -t0,
+                                        T::mul_add(-t0, t146, t1 * t147),
+                                        T::mul_add(-t1, t161, T::from_f64(0.12816210104175002)),
+                                    ),
+                                ),
+                            ),
+                        ),
+                    ),
+                );
+                let t176 = T::mul_add(
                     T::from_f64(0.016685526854599998),
-                    t173,
-                    t85 + t170 + tau[3] + t159 - t86 - t178,
+                    t167,
+                    t82 + t164 + tau[3] + t154 - t83 - t170,
                 );
-                let t186 = t174 + t175 + t93 + t137 + t150 - t165 - t181
-                    - T::from_f64(0.12816210104175002);
-                let t187 = t4 * t184;
-                let t188 = T::mul_add(
+                let t177 = t4 * t174;
+                let t178 = T::one() / t175;
+                let t179 = T::mul_add(
                     T::from_f64(2.275),
-                    t73 - t47,
-                    T::mul_add(t36, t42, t187 - t179),
+                    t70 - t47,
+                    T::mul_add(t36, t42, t177 - t171),
                 );
-                let t189 = T::mul_add(
+                let t180 = T::mul_add(
                     T::from_f64(0.39225),
-                    t177 - t149,
+                    t169 - t143,
                     T::mul_add(
                         T::from_f64(0.47815275),
                         t46,
                         T::mul_add(
                             t5,
-                            t182,
+                            t172,
                             T::mul_add(
                                 t4,
-                                t183,
+                                t173,
                                 T::mul_add(
                                     t36,
                                     t26,
@@ -1172,7 +1200,7 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
                                             t41,
                                             T::mul_add(
                                                 T::from_f64(0.37918622974349997),
-                                                t58,
+                                                t57,
                                                 T::mul_add(
                                                     -T::from_f64(0.125314259175),
                                                     t24,
@@ -1190,27 +1218,181 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
                         ),
                     ),
                 );
-                let t190 = T::mul_add(
+                let t181 = T::mul_add(
                     -t4,
-                    t182,
+                    t172,
                     T::mul_add(
                         t5,
-                        t183,
+                        t173,
                         T::mul_add(
                             t11,
                             t44,
-                            T::mul_add(-t37, t26, T::from_f64(0.004095) * t59),
+                            T::mul_add(-t37, t26, T::from_f64(0.004095) * t58),
                         ),
                     ),
                 );
-                let t191 = T::mul_add(
+                let t182 = T::mul_add(
                     T::from_f64(2.275),
-                    t48 + t74,
+                    t48 + t71,
                     T::mul_add(
                         -t4,
-                        t171,
-                        T::mul_add(-t5, t184, T::mul_add(t11, t25, t37 * t42)),
+                        t165,
+                        T::mul_add(-t5, t174, T::mul_add(t11, t25, t37 * t42)),
                     ),
+                );
+                let t183 = T::mul_add(
+                    -T::from_f64(0.016685526854599998),
+                    t167,
+                    T::mul_add(
+                        T::from_f64(0.39225),
+                        t177 - t171,
+                        T::mul_add(
+                            T::from_f64(0.56875),
+                            t70 - t47,
+                            T::mul_add(
+                                -t90,
+                                t75 * t176,
+                                t59 + t83 + t170 - t60 - t82 - t164 - tau[2] - t154,
+                            ),
+                        ),
+                    ),
+                );
+                let t184 = t3 * t179;
+                let t185 = t2 * t182;
+                let t186 = t2 * t179;
+                let t187 = t3 * t182;
+                let t188 = T::mul_add(
+                    T::from_f64(0.016685526854599998),
+                    t167,
+                    T::mul_add(
+                        T::from_f64(0.425),
+                        t185 - t184,
+                        T::mul_add(
+                            T::from_f64(0.39225),
+                            t171 - t177,
+                            T::mul_add(
+                                T::from_f64(0.56875),
+                                t47 - t70,
+                                T::mul_add(
+                                    -t131,
+                                    t122 * t183,
+                                    T::mul_add(
+                                        t90,
+                                        t76 * t176,
+                                        T::mul_add(
+                                            -T::from_f64(0.8697944759100001),
+                                            t23,
+                                            T::mul_add(
+                                                T::from_f64(23.053892400000006),
+                                                t1,
+                                                t60 + t82 + t164 + tau[1] + t154 - t59 - t83 - t170,
+                                            ),
+                                        ),
+                                    ),
+                                ),
+                            ),
+                        ),
+                    ),
+                );
+                let t189 = T::mul_add(
+                    -t166,
+                    t153 * t188,
+                    T::mul_add(
+                        t152,
+                        t131 * t183,
+                        T::mul_add(
+                            t90,
+                            t139 * t176,
+                            T::mul_add(
+                                t110,
+                                t49 * t160,
+                                T::mul_add(
+                                    -t73,
+                                    t145,
+                                    T::mul_add(
+                                        -t0,
+                                        T::mul_add(
+                                            -t3,
+                                            t181,
+                                            T::mul_add(
+                                                t2,
+                                                t180,
+                                                T::mul_add(
+                                                    T::from_f64(0.1197),
+                                                    t185 - t184,
+                                                    T::from_f64(0.0151074) * qd[0] * qd[1] * t1,
+                                                ),
+                                            ),
+                                        ),
+                                        T::mul_add(
+                                            t1,
+                                            T::mul_add(
+                                                t2,
+                                                t181,
+                                                T::mul_add(
+                                                    t3,
+                                                    t180,
+                                                    T::mul_add(
+                                                        T::from_f64(0.1197),
+                                                        t186 + t187,
+                                                        T::mul_add(
+                                                            T::from_f64(0.5180750000000001),
+                                                            t46,
+                                                            T::mul_add(
+                                                                T::from_f64(0.425),
+                                                                T::mul_add(t36, t25, t169 - t143),
+                                                                T::mul_add(
+                                                                    T::from_f64(1.4849499999999998),
+                                                                    t41,
+                                                                    T::mul_add(
+                                                                        T::from_f64(0.44493366875),
+                                                                        t57,
+                                                                        T::mul_add(
+                                                                            -T::from_f64(0.17774851500000002),
+                                                                            t24,
+                                                                            T::mul_add(
+                                                                                T::from_f64(2.38580010182),
+                                                                                t22,
+                                                                                T::from_f64(0.5209833915000001) * t10,
+                                                                            ),
+                                                                        ),
+                                                                    ),
+                                                                ),
+                                                            ),
+                                                        ),
+                                                    ),
+                                                ),
+                                            ),
+                                            T::mul_add(
+                                                T::from_f64(0.13585),
+                                                T::mul_add(
+                                                    -t1,
+                                                    T::mul_add(
+                                                        T::from_f64(2.3500400000000004),
+                                                        T::mul_add(qd[1], qd[1], t24),
+                                                        T::mul_add(T::from_f64(82.33533000000001), t0, t186 + t187),
+                                                    ),
+                                                    t0
+                                                        * (T::mul_add(
+                                                            -T::from_f64(2.3500400000000004),
+                                                            t23,
+                                                            T::mul_add(T::from_f64(82.33533000000001), t1, t185 - t184),
+                                                        )),
+                                                ),
+                                                tau[0],
+                                            ),
+                                        ),
+                                    ),
+                                ),
+                            ),
+                        ),
+                    ),
+                );
+                let t190 = T::mul_add(-t166, t153 * t178 * t189, t153 * t188);
+                let t191 = T::mul_add(
+                    -t152,
+                    t131 * t178 * t189,
+                    T::mul_add(t131, t122 * t190, -t131 * t183),
                 );
                 (
                     t128,
@@ -1279,251 +1461,46 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
                     t191,
                 )
             };
-            let (
-                t192,
-                t193,
-                t194,
-                t195,
-                t196,
-                t197,
-                t198,
-                t199,
-                t200,
-                t201,
-                t202,
-                t203,
-            ) = {
-                let t192 = T::mul_add(
-                    -T::from_f64(0.016685526854599998),
-                    t173,
-                    T::mul_add(
-                        T::from_f64(0.39225),
-                        t187 - t179,
-                        T::mul_add(
-                            T::from_f64(0.56875),
-                            t73 - t47,
-                            T::mul_add(
-                                -t66,
-                                t185 * t77,
-                                t60 + t86 + t178 - t61 - t85 - t170 - tau[2] - t159,
-                            ),
-                        ),
-                    ),
+            let (t192, t193) = {
+                let t192 = -t191;
+                let t193 = T::mul_add(
+                    t90,
+                    t139 * t178 * t189,
+                    T::mul_add(t90, t76 * t190, T::mul_add(-t90, t75 * t192, t90 * t176)),
                 );
-                let t193 = t3 * t188;
-                let t194 = t2 * t191;
-                let t195 = t2 * t188;
-                let t196 = t3 * t191;
-                let t197 = T::mul_add(
-                    T::from_f64(0.016685526854599998),
-                    t173,
-                    T::mul_add(
-                        T::from_f64(0.425),
-                        t194 - t193,
-                        T::mul_add(
-                            T::from_f64(0.39225),
-                            t179 - t187,
-                            T::mul_add(
-                                T::from_f64(0.56875),
-                                t47 - t73,
-                                T::mul_add(
-                                    t95,
-                                    t192 * t111,
-                                    T::mul_add(
-                                        t67,
-                                        t185 * t77,
-                                        T::mul_add(
-                                            -T::from_f64(0.8697944759100001),
-                                            t23,
-                                            T::mul_add(
-                                                T::from_f64(23.053892400000006),
-                                                t1,
-                                                t61 + t85 + t170 + tau[1] + t159 - t60 - t86 - t178,
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                );
-                let t198 = T::mul_add(
-                    t172,
-                    t197 * t180,
-                    T::mul_add(
-                        -t158,
-                        t192 * t111,
-                        T::mul_add(
-                            t145,
-                            t185 * t77,
-                            T::mul_add(
-                                t117,
-                                t166 * t49,
-                                T::mul_add(
-                                    -t76,
-                                    t151,
-                                    T::mul_add(
-                                        -t0,
-                                        T::mul_add(
-                                            -t3,
-                                            t190,
-                                            T::mul_add(
-                                                t2,
-                                                t189,
-                                                T::mul_add(
-                                                    T::from_f64(0.1197),
-                                                    t194 - t193,
-                                                    T::from_f64(0.0151074) * qd[0] * qd[1] * t1,
-                                                ),
-                                            ),
-                                        ),
-                                        T::mul_add(
-                                            t1,
-                                            T::mul_add(
-                                                t2,
-                                                t190,
-                                                T::mul_add(
-                                                    t3,
-                                                    t189,
-                                                    T::mul_add(
-                                                        T::from_f64(0.1197),
-                                                        t195 + t196,
-                                                        T::mul_add(
-                                                            T::from_f64(0.5180750000000001),
-                                                            t46,
-                                                            T::mul_add(
-                                                                T::from_f64(0.425),
-                                                                T::mul_add(t36, t25, t177 - t149),
-                                                                T::mul_add(
-                                                                    T::from_f64(1.4849499999999998),
-                                                                    t41,
-                                                                    T::mul_add(
-                                                                        T::from_f64(0.44493366875),
-                                                                        t58,
-                                                                        T::mul_add(
-                                                                            -T::from_f64(0.17774851500000002),
-                                                                            t24,
-                                                                            T::mul_add(
-                                                                                T::from_f64(2.38580010182),
-                                                                                t22,
-                                                                                T::from_f64(0.5209833915000001) * t10,
-                                                                            ),
-                                                                        ),
-                                                                    ),
-                                                                ),
-                                                            ),
-                                                        ),
-                                                    ),
-                                                ),
-                                            ),
-                                            T::mul_add(
-                                                T::from_f64(0.13585),
-                                                T::mul_add(
-                                                    -t1,
-                                                    T::mul_add(
-                                                        T::from_f64(2.3500400000000004),
-                                                        T::mul_add(qd[1], qd[1], t24),
-                                                        T::mul_add(T::from_f64(82.33533000000001), t0, t195 + t196),
-                                                    ),
-                                                    t0
-                                                        * (T::mul_add(
-                                                            -T::from_f64(2.3500400000000004),
-                                                            t23,
-                                                            T::mul_add(T::from_f64(82.33533000000001), t1, t194 - t193),
-                                                        )),
-                                                ),
-                                                tau[0],
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                );
-                let t199 = T::one() / t186;
-                let t200 = T::mul_add(-t197, t180, -t172 * t198 / (t128 * t186));
-                let t201 = -t200;
-                let t202 = T::mul_add(
-                    t95,
-                    t201 * t111,
-                    T::mul_add(t192, t111, -t158 * t198 / (t94 * t186)),
-                );
-                let t203 = T::mul_add(
-                    -t67,
-                    t201 * t77,
-                    T::mul_add(
-                        t66,
-                        t202 * t77,
-                        T::mul_add(t185, t77, -t145 * t198 / (t65 * t186)),
-                    ),
-                );
-                (t192, t193, t194, t195, t196, t197, t198, t199, t200, t201, t202, t203)
+                (t192, t193)
             };
             [
-                -t198 * t199,
-                t200,
-                t202,
-                t203,
+                t178 * t189,
+                t190,
+                t191,
+                t193,
                 T::mul_add(
                     T::from_f64(0.016685526854599998),
                     T::mul_add(
-                        t6,
-                        t8 * t9 * t201 * t49,
-                        T::mul_add(-t6, t8 * t9 * t202 * t49, -t6 * t8 * t9 * t203 * t49),
+                        -t6,
+                        t8 * t9 * t49 * t190,
+                        T::mul_add(t6, t8 * t9 * t49 * t192, -t6 * t8 * t9 * t49 * t193),
                     ),
-                    T::mul_add(-t166, t49, t117 * t198 / (t29 * t186)),
+                    T::mul_add(-t110, t49 * t178 * t189, -t49 * t160),
                 ),
                 T::mul_add(
                     T::from_f64(58.355064750790525),
-                    t142 + tau[5] - t141,
+                    t136 + tau[5] - t135,
                     T::mul_add(
-                        -t76,
-                        t198 * t199,
+                        t73,
+                        t178 * t189,
                         T::mul_add(
-                            t7,
-                            t201,
-                            T::mul_add(-t7, t202, T::mul_add(-t7, t203, t101 - t99)),
+                            -t7,
+                            t190,
+                            T::mul_add(t7, t192, T::mul_add(-t7, t193, t96 - t94)),
                         ),
                     ),
                 ),
-                t165 + t181 + T::from_f64(0.12816210104175002) - t174 - t175 - t93 - t137
-                    - t150,
-                T::mul_add(
-                    -T::from_f64(0.0002784068064155777),
-                    t50,
-                    T::mul_add(
-                        -T::from_f64(0.85),
-                        t34,
-                        T::mul_add(
-                            T::from_f64(0.11285608069875001),
-                            t14,
-                            T::mul_add(
-                                -T::from_f64(0.01511702475),
-                                t13,
-                                T::mul_add(
-                                    -T::from_f64(0.0139521246075),
-                                    t4,
-                                    t40 + t112 + T::from_f64(2.47695164561575) - t79,
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-                T::mul_add(
-                    -T::from_f64(0.0002784068064155777),
-                    t50,
-                    T::mul_add(
-                        T::from_f64(0.11285608069875001),
-                        t14,
-                        T::mul_add(
-                            -T::from_f64(0.0139521246075),
-                            t4,
-                            t40 + T::from_f64(0.70682470720575) - t78,
-                        ),
-                    ),
-                ),
-                t65,
+                t175,
+                t144,
+                t121,
+                t74,
                 t29,
                 T::from_f64(0.0171364731454),
             ]
@@ -1541,11 +1518,13 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
     /// Route: Newton-Euler at rest without gravity, with qd as the accelerations, O(N).
     /// Operations: 139 mul, 118 add, 0 div, 5 sin, 5 cos.
     pub fn generalized_momentum(&self, q: &[T; 6], qd: &[T; 6]) -> [T; 6] {
-        let (s1, c1) = q[1].sin_cos();
-        let (s2, c2) = q[2].sin_cos();
-        let (s3, c3) = q[3].sin_cos();
-        let (s4, c4) = q[4].sin_cos();
-        let (s5, c5) = q[5].sin_cos();
+        let ([s1, s2, s3, s4, s5], [c1, c2, c3, c4, c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+        ]);
         let (
             t0,
             t1,
@@ -1981,11 +1960,13 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
     /// Route: second velocity derivatives of the Newton-Euler bias.
     /// Operations: 431 mul, 232 add, 0 div, 5 sin, 5 cos.
     pub fn centrifugal(&self, q: &[T; 6]) -> [[T; 6]; 6] {
-        let (s1, c1) = q[1].sin_cos();
-        let (s2, c2) = q[2].sin_cos();
-        let (s3, c3) = q[3].sin_cos();
-        let (s4, c4) = q[4].sin_cos();
-        let (s5, c5) = q[5].sin_cos();
+        let ([s1, s2, s3, s4, s5], [c1, c2, c3, c4, c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+        ]);
         let (
             t0,
             t1,
@@ -2977,11 +2958,13 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
     /// Route: second velocity derivatives of the Newton-Euler bias.
     /// Operations: 527 mul, 255 add, 0 div, 5 sin, 5 cos.
     pub fn coriolis_pairs(&self, q: &[T; 6]) -> [[T; 15]; 6] {
-        let (s1, c1) = q[1].sin_cos();
-        let (s2, c2) = q[2].sin_cos();
-        let (s3, c3) = q[3].sin_cos();
-        let (s4, c4) = q[4].sin_cos();
-        let (s5, c5) = q[5].sin_cos();
+        let ([s1, s2, s3, s4, s5], [c1, c2, c3, c4, c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+        ]);
         let (
             t0,
             t1,
@@ -4150,10 +4133,12 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
     /// Route: the bodies' centres of mass by forward kinematics.
     /// Operations: 39 mul, 18 add, 0 div, 4 sin, 4 cos.
     pub fn center_of_mass(&self, q: &[T; 6]) -> [T; 3] {
-        let (s0, c0) = q[0].sin_cos();
-        let (s1, c1) = q[1].sin_cos();
-        let (s2, c2) = q[2].sin_cos();
-        let (s3, c3) = q[3].sin_cos();
+        let ([s0, s1, s2, s3], [c0, c1, c2, c3]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[0],
+            q[1],
+            q[2],
+            q[3],
+        ]);
         let t0 = s0;
         let t1 = c0;
         let t2 = s1;
@@ -4207,10 +4192,12 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
     /// Route: each coordinate's composite-body momentum (the composite-rigid-body algorithm's), moved to the world.
     /// Operations: 64 mul, 21 add, 0 div, 4 sin, 4 cos.
     pub fn center_of_mass_jacobian(&self, q: &[T; 6]) -> [[T; 6]; 3] {
-        let (s0, c0) = q[0].sin_cos();
-        let (s1, c1) = q[1].sin_cos();
-        let (s2, c2) = q[2].sin_cos();
-        let (s3, c3) = q[3].sin_cos();
+        let ([s0, s1, s2, s3], [c0, c1, c2, c3]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[0],
+            q[1],
+            q[2],
+            q[3],
+        ]);
         let t0 = s0;
         let t1 = c0;
         let t2 = s1;
@@ -4456,7 +4443,9 @@ impl<T: ::eomgen_runtime::Real> Ur5<T> {
         match j {
             0 => {
                 let o = {
-                    let (s0, c0) = q[0].sin_cos();
+                    let ([s0], [c0]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+                        q[0],
+                    ]);
                     let t0 = s0;
                     let t1 = c0;
                     [
@@ -4485,7 +4474,9 @@ impl<T: ::eomgen_runtime::Real> Ur5<T> {
             }
             1 => {
                 let o = {
-                    let (s1, c1) = q[1].sin_cos();
+                    let ([s1], [c1]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+                        q[1],
+                    ]);
                     let t0 = c1;
                     let t1 = -s1;
                     [
@@ -4514,7 +4505,9 @@ impl<T: ::eomgen_runtime::Real> Ur5<T> {
             }
             2 => {
                 let o = {
-                    let (s2, c2) = q[2].sin_cos();
+                    let ([s2], [c2]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+                        q[2],
+                    ]);
                     let t0 = s2;
                     let t1 = c2;
                     [
@@ -4543,7 +4536,9 @@ impl<T: ::eomgen_runtime::Real> Ur5<T> {
             }
             3 => {
                 let o = {
-                    let (s3, c3) = q[3].sin_cos();
+                    let ([s3], [c3]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+                        q[3],
+                    ]);
                     let t0 = c3;
                     let t1 = -s3;
                     [
@@ -4572,7 +4567,9 @@ impl<T: ::eomgen_runtime::Real> Ur5<T> {
             }
             4 => {
                 let o = {
-                    let (s4, c4) = q[4].sin_cos();
+                    let ([s4], [c4]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+                        q[4],
+                    ]);
                     let t0 = s4;
                     let t1 = c4;
                     [
@@ -4601,7 +4598,9 @@ impl<T: ::eomgen_runtime::Real> Ur5<T> {
             }
             5 => {
                 let o = {
-                    let (s5, c5) = q[5].sin_cos();
+                    let ([s5], [c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+                        q[5],
+                    ]);
                     let t0 = s5;
                     let t1 = c5;
                     [
@@ -4807,11 +4806,13 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
     /// Route: composite-rigid-body algorithm.
     /// Operations: 149 mul, 104 add, 0 div, 5 sin, 5 cos.
     fn mass_matrix(&self, q: &[T; 6]) -> [[T; 6]; 6] {
-        let (s1, c1) = q[1].sin_cos();
-        let (s2, c2) = q[2].sin_cos();
-        let (s3, c3) = q[3].sin_cos();
-        let (s4, c4) = q[4].sin_cos();
-        let (s5, c5) = q[5].sin_cos();
+        let ([s1, s2, s3, s4, s5], [c1, c2, c3, c4, c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+        ]);
         let t0 = s1;
         let t1 = c1;
         let t2 = s2;
@@ -5134,9 +5135,11 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
     /// Route: closed-form Lagrangian expressions.
     /// Operations: 12 mul, 8 add, 0 div, 3 sin, 3 cos.
     fn gravity(&self, q: &[T; 6]) -> [T; 6] {
-        let (s1, c1) = q[1].sin_cos();
-        let (s2, c2) = q[2].sin_cos();
-        let (s3, c3) = q[3].sin_cos();
+        let ([s1, s2, s3], [c1, c2, c3]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[1],
+            q[2],
+            q[3],
+        ]);
         let t0 = s1;
         let t1 = c1;
         let t2 = s2;
@@ -5170,11 +5173,13 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
     /// Route: Newton-Euler.
     /// Operations: 253 mul, 176 add, 0 div, 5 sin, 5 cos.
     fn bias(&self, q: &[T; 6], qd: &[T; 6]) -> [T; 6] {
-        let (s1, c1) = q[1].sin_cos();
-        let (s2, c2) = q[2].sin_cos();
-        let (s3, c3) = q[3].sin_cos();
-        let (s4, c4) = q[4].sin_cos();
-        let (s5, c5) = q[5].sin_cos();
+        let ([s1, s2, s3, s4, s5], [c1, c2, c3, c4, c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+        ]);
         let (
             t0,
             t1,
@@ -5894,11 +5899,13 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
     /// Route: Echeandia and Wensing's O(N^2) recursion on composite inertias and momenta.
     /// Operations: 639 mul, 511 add, 0 div, 5 sin, 5 cos.
     fn coriolis_matrix(&self, q: &[T; 6], qd: &[T; 6]) -> [[T; 6]; 6] {
-        let (s1, c1) = q[1].sin_cos();
-        let (s2, c2) = q[2].sin_cos();
-        let (s3, c3) = q[3].sin_cos();
-        let (s4, c4) = q[4].sin_cos();
-        let (s5, c5) = q[5].sin_cos();
+        let ([s1, s2, s3, s4, s5], [c1, c2, c3, c4, c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+        ]);
         let (
             t0,
             t1,
@@ -7602,11 +7609,13 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
     /// Route: Newton-Euler.
     /// Operations: 260 mul, 223 add, 0 div, 5 sin, 5 cos.
     fn inverse_dynamics(&self, q: &[T; 6], qd: &[T; 6], qdd: &[T; 6]) -> [T; 6] {
-        let (s1, c1) = q[1].sin_cos();
-        let (s2, c2) = q[2].sin_cos();
-        let (s3, c3) = q[3].sin_cos();
-        let (s4, c4) = q[4].sin_cos();
-        let (s5, c5) = q[5].sin_cos();
+        let ([s1, s2, s3, s4, s5], [c1, c2, c3, c4, c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+        ]);
         let (
             t0,
             t1,
@@ -8392,7 +8401,7 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
     /// model and finite inputs); `try_forward_dynamics` says which pivot failed.
     ///
     /// Route: M and b + G as in `mass_matrix` and `bias`, then an unrolled L^T D L solve without fill-in.
-    /// Operations: 507 mul, 373 add, 9 div, 5 sin, 5 cos.
+    /// Operations: 503 mul, 353 add, 5 div, 5 sin, 5 cos.
     fn forward_dynamics(&self, q: &[T; 6], qd: &[T; 6], tau: &[T; 6]) -> [T; 6] {
         match self.forward_dynamics_checked(q, qd, tau) {
             Ok((qdd, failures)) => ::eomgen_runtime::lane::nan_failed(qdd, &failures),
@@ -8404,11 +8413,13 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
     /// Route: a sum over body velocities, O(N).
     /// Operations: 108 mul, 57 add, 0 div, 5 sin, 5 cos.
     fn kinetic_energy(&self, q: &[T; 6], qd: &[T; 6]) -> T {
-        let (s1, c1) = q[1].sin_cos();
-        let (s2, c2) = q[2].sin_cos();
-        let (s3, c3) = q[3].sin_cos();
-        let (s4, c4) = q[4].sin_cos();
-        let (s5, c5) = q[5].sin_cos();
+        let ([s1, s2, s3, s4, s5], [c1, c2, c3, c4, c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+        ]);
         let t0 = s1;
         let t1 = c1;
         let t2 = s2;
@@ -8566,9 +8577,11 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
     /// Route: centres of mass by forward kinematics.
     /// Operations: 9 mul, 6 add, 0 div, 3 sin, 3 cos.
     fn potential_energy(&self, q: &[T; 6]) -> T {
-        let (s1, c1) = q[1].sin_cos();
-        let (s2, c2) = q[2].sin_cos();
-        let (s3, c3) = q[3].sin_cos();
+        let ([s1, s2, s3], [c1, c2, c3]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[1],
+            q[2],
+            q[3],
+        ]);
         let t0 = s1;
         let t1 = c1;
         let t2 = s2;

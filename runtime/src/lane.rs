@@ -66,6 +66,13 @@ pub trait Lane: Copy + Debug + Default + Arithmetic + 'static {
     fn cos(self) -> Self;
     /// `(sin(self), cos(self))`, lane-wise.
     fn sin_cos(self) -> (Self, Self);
+    /// The sines and the cosines of every element of `x` ([`Real::sin_cos_many`] for a
+    /// scalar; [`Lane::sin_cos`] element by element by default).
+    #[inline(always)]
+    fn sin_cos_many<const K: usize>(x: [Self; K]) -> ([Self; K], [Self; K]) {
+        let pairs = x.map(Self::sin_cos);
+        (pairs.map(|p| p.0), pairs.map(|p| p.1))
+    }
     /// Square root, lane-wise; NaN for negative lanes.
     fn sqrt(self) -> Self;
     /// Absolute value, lane-wise.
@@ -282,6 +289,10 @@ impl<T: Real> Lane for T {
     #[inline(always)]
     fn sin_cos(self) -> (Self, Self) {
         Real::sin_cos(self)
+    }
+    #[inline(always)]
+    fn sin_cos_many<const K: usize>(x: [Self; K]) -> ([Self; K], [Self; K]) {
+        <T as Real>::sin_cos_many(x)
     }
     #[inline(always)]
     fn sqrt(self) -> Self {

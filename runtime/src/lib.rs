@@ -106,6 +106,7 @@ pub mod prelude;
 mod real;
 pub mod sim;
 pub mod tree;
+pub mod trig;
 
 #[cfg(feature = "nalgebra")]
 pub mod nalgebra_support;

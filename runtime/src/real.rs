@@ -49,6 +49,20 @@ pub trait Real:
     fn cos(self) -> Self;
     /// Sine and cosine at once, `(sin(self), cos(self))`; cheaper than two calls.
     fn sin_cos(self) -> (Self, Self);
+    /// The sines and the cosines of every element of `x`: generated code calls this once, with
+    /// every joint angle it needs. By default [`Real::sin_cos`] element by element; `f64`
+    /// computes the whole array with vector instructions ([`crate::trig::sin_cos_f64`]).
+    ///
+    /// ```
+    /// use eomgen_runtime::Real;
+    /// let (s, c) = <f64 as Real>::sin_cos_many([0.5, -1.0]);
+    /// assert!((s[0] - 0.5_f64.sin()).abs() < 1e-15 && (c[1] - 1.0_f64.cos()).abs() < 1e-15);
+    /// ```
+    #[inline(always)]
+    fn sin_cos_many<const K: usize>(x: [Self; K]) -> ([Self; K], [Self; K]) {
+        let pairs = x.map(Self::sin_cos);
+        (pairs.map(|p| p.0), pairs.map(|p| p.1))
+    }
     /// Four-quadrant arctangent of `self / x` (`self` is y), in `[-pi, pi]`.
     fn atan2(self, x: Self) -> Self;
     /// Square root; NaN for negative arguments.
@@ -80,8 +94,8 @@ pub trait Real:
 }
 
 macro_rules! impl_real {
-    ($t:ty, $sin:path, $cos:path, $sincos:path, $atan2:path, $sqrt:path, $fabs:path,
-     $fmin:path, $fmax:path, $fma:path) => {
+    ($t:ty, $sin:path, $cos:path, $sincos:path, $many:path, $atan2:path, $sqrt:path,
+     $fabs:path, $fmin:path, $fmax:path, $fma:path) => {
         impl Real for $t {
             #[inline(always)]
             fn from_f64(v: f64) -> Self {
@@ -118,6 +132,10 @@ macro_rules! impl_real {
             #[inline(always)]
             fn sin_cos(self) -> (Self, Self) {
                 $sincos(self)
+            }
+            #[inline(always)]
+            fn sin_cos_many<const K: usize>(x: [Self; K]) -> ([Self; K], [Self; K]) {
+                $many(x)
             }
             #[inline(always)]
             fn atan2(self, x: Self) -> Self {
@@ -170,6 +188,7 @@ impl_real!(
     libm::sinf,
     libm::cosf,
     libm::sincosf,
+    sin_cos_each,
     libm::atan2f,
     libm::sqrtf,
     libm::fabsf,
@@ -182,6 +201,7 @@ impl_real!(
     libm::sin,
     libm::cos,
     libm::sincos,
+    crate::trig::sin_cos_f64,
     libm::atan2,
     libm::sqrt,
     libm::fabs,
@@ -189,6 +209,14 @@ impl_real!(
     libm::fmax,
     fused::f64
 );
+
+/// `f32`'s [`Real::sin_cos_many`]: `libm::sincosf` element by element (single precision
+/// mostly runs on microcontrollers, whose FPU has no vector unit and no double precision).
+#[inline(always)]
+fn sin_cos_each<const K: usize>(x: [f32; K]) -> ([f32; K], [f32; K]) {
+    let pairs = x.map(libm::sincosf);
+    (pairs.map(|p| p.0), pairs.map(|p| p.1))
+}
 
 /// `x * a + b`, fused where the target has an FMA instruction, known at compile time.
 ///

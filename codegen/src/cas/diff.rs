@@ -130,6 +130,16 @@ impl Graph {
                         self.scale(p, 0.5)
                     }
                 }
+                // d(1/a) = -a' (1/a)^2.
+                Node::Recip(a) => {
+                    let da = get(&d, a);
+                    if da == zero {
+                        zero
+                    } else {
+                        let p = self.product([(da, 1), (id, 2)]);
+                        self.neg(p)
+                    }
+                }
                 // Piecewise constant; its derivative is zero almost everywhere.
                 Node::Sign(_) => zero,
             };
@@ -161,6 +171,7 @@ impl Graph {
                 Node::Cos(a) => self.cos(s[&a]),
                 Node::Sqrt(a) => self.sqrt(s[&a]),
                 Node::Sign(a) => self.sign(s[&a]),
+                Node::Recip(a) => self.recip(s[&a]),
             };
             s.insert(id, r);
         }

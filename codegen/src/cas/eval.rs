@@ -56,6 +56,7 @@ impl Graph {
                 Node::Sin(a) => v[slot(*a)].sin(),
                 Node::Cos(a) => v[slot(*a)].cos(),
                 Node::Sqrt(a) => v[slot(*a)].sqrt(),
+                Node::Recip(a) => 1.0 / v[slot(*a)],
                 Node::Sign(a) => sign(v[slot(*a)]),
             };
         }

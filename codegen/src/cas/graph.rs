@@ -98,6 +98,10 @@ pub enum Node {
     Sqrt(Id),
     /// -1, 0 or 1 (used for Coulomb friction).
     Sign(Id),
+    /// `1 / a` as a value of its own: a product keeps it as a factor instead of merging it into
+    /// a division, so that a reciprocal many products share (a factorization's pivot) is
+    /// computed once and multiplied.
+    Recip(Id),
 }
 
 impl Node {
@@ -107,7 +111,9 @@ impl Node {
             Node::Const(_) | Node::Sym(_) => Children::One(None),
             Node::Add(_, t) => Children::Terms(t.iter()),
             Node::Mul(f) => Children::Factors(f.iter()),
-            Node::Sin(a) | Node::Cos(a) | Node::Sqrt(a) | Node::Sign(a) => Children::One(Some(*a)),
+            Node::Sin(a) | Node::Cos(a) | Node::Sqrt(a) | Node::Sign(a) | Node::Recip(a) => {
+                Children::One(Some(*a))
+            }
         }
     }
 }
@@ -581,6 +587,14 @@ impl Graph {
             return self.intern(Node::Cos(pos));
         }
         self.intern(Node::Cos(a))
+    }
+
+    /// `1 / a` kept apart from products ([`Node::Recip`]); folds constants.
+    pub fn recip(&mut self, a: Id) -> Id {
+        if let Some(v) = self.as_const(a) {
+            return self.constant(1.0 / v);
+        }
+        self.intern(Node::Recip(a))
     }
 
     /// `sqrt a`; folds constants.

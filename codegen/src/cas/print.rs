@@ -308,6 +308,7 @@ impl Graph {
                 Node::Sin(a) => p.func("sin", take(&out, *a)),
                 Node::Cos(a) => p.func("cos", take(&out, *a)),
                 Node::Sqrt(a) => p.func("sqrt", take(&out, *a)),
+                Node::Recip(a) => p.product(vec![(take(&out, *a), -1)]),
                 Node::Sign(a) => p.func(
                     if style.syntax == Syntax::Latex {
                         "operatorname{sign}"
@@ -394,6 +395,7 @@ fn print_expr(p: &Printer<'_>, e: &Expr, temp: &dyn Fn(usize) -> String) -> Frag
         Expr::Sin(a) => p.func("sin", print_expr(p, a, temp)),
         Expr::Cos(a) => p.func("cos", print_expr(p, a, temp)),
         Expr::Sqrt(a) => p.func("sqrt", print_expr(p, a, temp)),
+        Expr::Recip(a) => p.product(vec![(print_expr(p, a, temp), -1)]),
         Expr::Sign(a) => p.func("sign", print_expr(p, a, temp)),
     }
 }

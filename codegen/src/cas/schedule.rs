@@ -28,6 +28,8 @@ pub enum Expr {
     Cos(Box<Expr>),
     Sqrt(Box<Expr>),
     Sign(Box<Expr>),
+    /// `1 / a` ([`Node::Recip`](super::graph::Node::Recip)), one division.
+    Recip(Box<Expr>),
 }
 
 /// Operation counts of a program, the cost model for generated code.
@@ -128,6 +130,10 @@ impl Expr {
                 n.sign += 1;
                 a.count(n)
             }
+            Expr::Recip(a) => {
+                n.div += 1;
+                a.count(n)
+            }
         }
     }
 
@@ -145,6 +151,7 @@ impl Expr {
             Expr::Sin(a) => a.eval(inputs, temps).sin(),
             Expr::Cos(a) => a.eval(inputs, temps).cos(),
             Expr::Sqrt(a) => a.eval(inputs, temps).sqrt(),
+            Expr::Recip(a) => 1.0 / a.eval(inputs, temps),
             Expr::Sign(a) => sign(a.eval(inputs, temps)),
         }
     }
@@ -241,7 +248,9 @@ impl Program {
                 Expr::Const(_) | Expr::Temp(_) => {}
                 Expr::Add(_, ts) => ts.iter().for_each(|(t, _)| mark(t, used)),
                 Expr::Mul(fs) => fs.iter().for_each(|(f, _)| mark(f, used)),
-                Expr::Sin(a) | Expr::Cos(a) | Expr::Sqrt(a) | Expr::Sign(a) => mark(a, used),
+                Expr::Sin(a) | Expr::Cos(a) | Expr::Sqrt(a) | Expr::Sign(a) | Expr::Recip(a) => {
+                    mark(a, used)
+                }
             }
         }
         for e in self.temps.iter().chain(&self.outputs) {
@@ -599,6 +608,7 @@ impl Writer {
             Node::Sin(a) => unary(sub(*a), Expr::Sin),
             Node::Cos(a) => unary(sub(*a), Expr::Cos),
             Node::Sqrt(a) => unary(sub(*a), Expr::Sqrt),
+            Node::Recip(a) => unary(sub(*a), Expr::Recip),
             Node::Sign(a) => unary(sub(*a), Expr::Sign),
         }
     }

@@ -118,9 +118,12 @@ impl Graph {
                         Poly::from([(Vec::new(), c.get())])
                     }
                 }
-                Node::Sym(_) | Node::Sin(_) | Node::Cos(_) | Node::Sqrt(_) | Node::Sign(_) => {
-                    atom(id)
-                }
+                Node::Sym(_)
+                | Node::Sin(_)
+                | Node::Cos(_)
+                | Node::Sqrt(_)
+                | Node::Sign(_)
+                | Node::Recip(_) => atom(id),
                 Node::Add(c, ts) => {
                     let mut acc = Poly::new();
                     if c.get() != 0.0 {

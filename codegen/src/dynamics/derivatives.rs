@@ -8,7 +8,7 @@
 //! `d qdd / d tau = M^-1`: each column is one more substitution through the factorization.
 
 use super::lagrangian::Friction;
-use super::newton_euler::ltdl_solve;
+use super::ltdl::Factors;
 use super::newton_euler::JointTree;
 use super::rnea_derivatives::{inverse_dynamics_derivatives, InverseDynamicsDerivatives};
 use super::Derivation;
@@ -44,7 +44,6 @@ pub fn derive(d: &mut Derivation, model: &Model) -> Derivatives {
     let joint_qd = map.rates(g, &d.qd);
     let grav = const_v3(g, &model.gravity);
     let m = &d.fast.mass_matrix.1;
-    let n = d.dof;
     let parents = d.coordinate_parents.clone();
     // Per velocity column of the joint tree (none on a floating base's six). With mimic joints
     // the friction is differentiated in the coordinates instead, after the projection.
@@ -70,8 +69,9 @@ pub fn derive(d: &mut Derivation, model: &Model) -> Derivatives {
         InverseDynamicsDerivatives { dq, dqd }
     };
     let inverse = id(g, &d.qdd);
-    let unit = identity(g, n);
-    let (mass_matrix_inverse, pivots) = solve_columns(g, &parents, m, &unit);
+    let factors = Factors::new(g, &parents, m);
+    let mass_matrix_inverse = factors.inverse(g);
+    let pivots = factors.pivots();
     let at_fd = id(g, &d.fast.forward_dynamics);
     let neg = |g: &mut Graph, a: &[Vec<Id>]| -> Vec<Vec<Id>> {
         a.iter()
@@ -81,8 +81,8 @@ pub fn derive(d: &mut Derivation, model: &Model) -> Derivatives {
     let rhs_q = neg(g, &at_fd.dq);
     let rhs_qd = neg(g, &at_fd.dqd);
     let forward = InverseDynamicsDerivatives {
-        dq: solve_columns(g, &parents, m, &rhs_q).0,
-        dqd: solve_columns(g, &parents, m, &rhs_qd).0,
+        dq: solve_columns(g, &factors, &rhs_q),
+        dqd: solve_columns(g, &factors, &rhs_qd),
     };
     Derivatives {
         inverse,
@@ -92,31 +92,15 @@ pub fn derive(d: &mut Derivation, model: &Model) -> Derivatives {
     }
 }
 
-fn identity(g: &mut Graph, n: usize) -> Vec<Vec<Id>> {
-    let (zero, one) = (g.zero(), g.one());
-    (0..n)
-        .map(|i| (0..n).map(|j| if i == j { one } else { zero }).collect())
-        .collect()
-}
-
-/// `M^-1 B` column by column through the tree `L^T D L` factorization of `M` (built once: the
-/// graph shares it between columns), and the pivots.
-fn solve_columns(
-    g: &mut Graph,
-    parents: &[Option<usize>],
-    m: &[Vec<Id>],
-    b: &[Vec<Id>],
-) -> (Vec<Vec<Id>>, Vec<Id>) {
-    let n = m.len();
+/// `M^-1 B` column by column through the tree `L^T D L` factors of `M`.
+fn solve_columns(g: &mut Graph, factors: &Factors, b: &[Vec<Id>]) -> Vec<Vec<Id>> {
+    let n = b.len();
     let mut out = vec![vec![g.zero(); n]; n];
-    let mut pivots = Vec::new();
     for j in 0..n {
         let col: Vec<Id> = (0..n).map(|i| b[i][j]).collect();
-        let (x, p) = ltdl_solve(g, parents, m, &col);
-        for i in 0..n {
-            out[i][j] = x[i];
+        for (i, x) in factors.solve(g, &col).into_iter().enumerate() {
+            out[i][j] = x;
         }
-        pivots = p;
     }
-    (out, pivots)
+    out
 }

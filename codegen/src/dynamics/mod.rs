@@ -23,6 +23,7 @@ mod derivatives;
 mod fast;
 pub mod identification;
 mod lagrangian;
+pub(crate) mod ltdl;
 mod mpc;
 pub mod newton_euler;
 pub mod projected;

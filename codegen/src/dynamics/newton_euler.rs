@@ -783,7 +783,7 @@ pub(crate) fn transfer_spatial(g: &mut Graph, lm: &LocalModel, c: usize, f: &Spa
 /// Solves `M x = rhs` symbolically by Featherstone's `L^T D L` factorization in reverse joint
 /// order, which for a kinematic tree creates no fill-in: `M_ij` is only touched when one of `i`,
 /// `j` is an ancestor of the other, so a branched robot's independent chains stay independent
-/// (RBDA, tables 6.3 and 6.4). Returns `x`, straight-line expressions with `n` divisions, and
+/// (RBDA, tables 6.3 and 6.4). Returns `x`, straight-line expressions with `n` divisions (one per pivot, `super::ltdl`), and
 /// the pivots `D`: `M` is positive definite exactly when every pivot is positive.
 pub fn ltdl_solve(
     g: &mut Graph,
@@ -791,42 +791,6 @@ pub fn ltdl_solve(
     m: &[Vec<Id>],
     rhs: &[Id],
 ) -> (Vec<Id>, Vec<Id>) {
-    let n = m.len();
-    let mut h: Vec<Vec<Id>> = m.to_vec();
-    for k in (0..n).rev() {
-        let mut i = parent[k];
-        while let Some(ii) = i {
-            let a = g.div(h[k][ii], h[k][k]);
-            let mut j = Some(ii);
-            while let Some(jj) = j {
-                let p = g.mul(h[k][jj], a);
-                h[ii][jj] = g.sub(h[ii][jj], p);
-                j = parent[jj];
-            }
-            h[k][ii] = a;
-            i = parent[ii];
-        }
-    }
-    let mut x = rhs.to_vec();
-    for i in (0..n).rev() {
-        let mut j = parent[i];
-        while let Some(jj) = j {
-            let p = g.mul(h[i][jj], x[i]);
-            x[jj] = g.sub(x[jj], p);
-            j = parent[jj];
-        }
-    }
-    for i in 0..n {
-        x[i] = g.div(x[i], h[i][i]);
-    }
-    for i in 0..n {
-        let mut j = parent[i];
-        while let Some(jj) = j {
-            let p = g.mul(h[i][jj], x[jj]);
-            x[i] = g.sub(x[i], p);
-            j = parent[jj];
-        }
-    }
-    let pivots = (0..n).map(|i| h[i][i]).collect();
-    (x, pivots)
+    let factors = super::ltdl::Factors::new(g, parent, m);
+    (factors.solve(g, rhs), factors.pivots())
 }

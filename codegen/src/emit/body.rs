@@ -91,22 +91,42 @@ pub(super) fn chunked_lets(defs: &[(Ident, TokenStream)]) -> Vec<TokenStream> {
         .collect()
 }
 
-/// One `sin_cos` per joint angle the body uses, computed up front.
+/// The sine and cosine of every joint angle the body uses, computed up front: one
+/// `Lane::sin_cos_many` call for all of them (vector instructions for `f64`,
+/// `eomgen_runtime::trig`), also for a single angle, so that the blocks of a split body,
+/// which each take the angles they read first, compute the same bits as the whole body. The
+/// sine or cosine that nothing reads is bound to `_`.
 pub(super) fn trig_lets(trig: &BTreeSet<(usize, bool)>) -> Vec<TokenStream> {
-    let joints: BTreeSet<usize> = trig.iter().map(|t| t.0).collect();
-    joints
+    let joints: Vec<usize> = trig
+        .iter()
+        .map(|t| t.0)
+        .collect::<BTreeSet<usize>>()
+        .into_iter()
+        .collect();
+    let name = |i: usize, is_sin: bool| {
+        if trig.contains(&(i, is_sin)) {
+            let prefix = if is_sin { "s" } else { "c" };
+            let id = format_ident!("{}{}", prefix, i);
+            quote!(#id)
+        } else {
+            quote!(_)
+        }
+    };
+    let sines: Vec<TokenStream> = joints.iter().map(|&i| name(i, true)).collect();
+    let cosines: Vec<TokenStream> = joints.iter().map(|&i| name(i, false)).collect();
+    let angles: Vec<TokenStream> = joints
         .iter()
         .map(|&i| {
-            let (s, c) = (format_ident!("s{}", i), format_ident!("c{}", i));
-            let (has_sin, has_cos) = (trig.contains(&(i, true)), trig.contains(&(i, false)));
             let i = Literal::usize_unsuffixed(i);
-            match (has_sin, has_cos) {
-                (true, true) => quote!(let (#s, #c) = q[#i].sin_cos();),
-                (true, false) => quote!(let #s = q[#i].sin();),
-                _ => quote!(let #c = q[#i].cos();),
-            }
+            quote!(q[#i])
         })
-        .collect()
+        .collect();
+    if joints.is_empty() {
+        return Vec::new();
+    }
+    vec![quote! {
+        let ([#(#sines),*], [#(#cosines),*]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([#(#angles),*]);
+    }]
 }
 
 /// A straight-line body whose outputs hold when every pivot is positive: the outputs and the

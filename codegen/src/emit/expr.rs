@@ -145,6 +145,15 @@ impl Ctx<'_> {
                     atom: false,
                 }
             }
+            // Marked as a sum so that a product parenthesizes it: `x * (T::one() / d)`.
+            Expr::Recip(a) => {
+                let inner = self.paren(a, trig);
+                Tok {
+                    ts: quote!(T::one() / #inner),
+                    sum: true,
+                    atom: false,
+                }
+            }
             Expr::Sign(a) => {
                 let inner = self.paren(a, trig);
                 Tok {

@@ -73,7 +73,9 @@ fn temps_read(e: &Expr, out: &mut BTreeSet<usize>) {
         Expr::Const(_) | Expr::Input(_) => {}
         Expr::Add(_, ts) => ts.iter().for_each(|(t, _)| temps_read(t, out)),
         Expr::Mul(fs) => fs.iter().for_each(|(f, _)| temps_read(f, out)),
-        Expr::Sin(a) | Expr::Cos(a) | Expr::Sqrt(a) | Expr::Sign(a) => temps_read(a, out),
+        Expr::Sin(a) | Expr::Cos(a) | Expr::Sqrt(a) | Expr::Sign(a) | Expr::Recip(a) => {
+            temps_read(a, out)
+        }
     }
 }
 

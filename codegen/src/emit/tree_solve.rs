@@ -12,17 +12,7 @@ use proc_macro2::{Literal, TokenStream};
 use quote::quote;
 
 use super::rust::usize_lit;
-
-/// `k`'s ancestors, nearest first.
-fn ancestors(parents: &[Option<usize>], k: usize) -> Vec<usize> {
-    let mut out = Vec::new();
-    let mut i = parents[k];
-    while let Some(p) = i {
-        out.push(p);
-        i = parents[p];
-    }
-    out
-}
+use crate::dynamics::ltdl::ancestors;
 
 /// `fn ltdl_factor_unrolled(m, failures)`: factorizes `m` in place as `tree::ltdl_factor` does
 /// (the factors in the same places, the same errors), pivots checked in elimination order.

@@ -29,6 +29,7 @@ enum Op {
     Cos(usize),
     Sqrt(usize),
     Sign(usize),
+    Recip(usize),
 }
 
 /// Straight-line code for some outputs of a graph; see the module documentation.
@@ -83,6 +84,7 @@ impl Tape {
                 Node::Sin(a) => Op::Sin(slot(*a)),
                 Node::Cos(a) => Op::Cos(slot(*a)),
                 Node::Sqrt(a) => Op::Sqrt(slot(*a)),
+                Node::Recip(a) => Op::Recip(slot(*a)),
                 Node::Sign(a) => Op::Sign(slot(*a)),
             };
             tape.ops.push(op);
@@ -107,6 +109,7 @@ impl Tape {
                 Op::Sin(a) => v[a].sin(),
                 Op::Cos(a) => v[a].cos(),
                 Op::Sqrt(a) => v[a].sqrt(),
+                Op::Recip(a) => 1.0 / v[a],
                 Op::Sign(a) => sign(v[a]),
             };
         }
