@@ -22,6 +22,8 @@ enum Tree {
     Sin(Box<Tree>),
     Cos(Box<Tree>),
     Neg(Box<Tree>),
+    /// `1 / (2 + sin a)` through `Graph::recip`, a reciprocal that products keep as a factor.
+    Recip(Box<Tree>),
 }
 
 impl Tree {
@@ -37,6 +39,7 @@ impl Tree {
             Tree::Sin(a) => a.eval(x).sin(),
             Tree::Cos(a) => a.eval(x).cos(),
             Tree::Neg(a) => -a.eval(x),
+            Tree::Recip(a) => 1.0 / (2.0 + a.eval(x).sin()),
         }
     }
 
@@ -79,6 +82,13 @@ impl Tree {
                 let a = a.build(g);
                 g.neg(a)
             }
+            Tree::Recip(a) => {
+                let a = a.build(g);
+                let s = g.sin(a);
+                let two = g.constant(2.0);
+                let d = g.add(two, s);
+                g.recip(d)
+            }
         }
     }
 
@@ -94,6 +104,7 @@ impl Tree {
             Tree::Sin(a) => Tree::Sin(m(a)),
             Tree::Cos(a) => Tree::Cos(m(a)),
             Tree::Neg(a) => Tree::Neg(m(a)),
+            Tree::Recip(a) => Tree::Recip(m(a)),
             leaf => leaf.clone(),
         }
     }
@@ -114,7 +125,8 @@ fn tree() -> impl Strategy<Value = Tree> {
             (inner.clone(), 0..4i32).prop_map(|(a, n)| Tree::Pow(Box::new(a), n)),
             inner.clone().prop_map(|a| Tree::Sin(Box::new(a))),
             inner.clone().prop_map(|a| Tree::Cos(Box::new(a))),
-            inner.prop_map(|a| Tree::Neg(Box::new(a))),
+            inner.clone().prop_map(|a| Tree::Neg(Box::new(a))),
+            inner.prop_map(|a| Tree::Recip(Box::new(a))),
         ]
     })
 }

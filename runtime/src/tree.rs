@@ -563,8 +563,9 @@ fn pull_from_ancestors<T: Lane, const N: usize, const C: usize, const UPPER: boo
 ) {
     for i in 0..N {
         let mut acc = x[i];
-        let d = m[i][i];
-        acc.iter_mut().for_each(|v| *v /= d);
+        // One division per row rather than per column.
+        let inv = T::one() / m[i][i];
+        acc.iter_mut().for_each(|v| *v *= inv);
         let mut a = parent[i];
         while let Some(row) = a.and_then(|aa| x.get(aa)) {
             let aa = a.unwrap_or(0);
