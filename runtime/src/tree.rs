@@ -618,3 +618,63 @@ pub fn neg_mat_mul<T: Lane, const N: usize>(a: &[[T; N]; N], b: &[[T; N]; N]) ->
     }
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A floating base's six coordinates, then two limbs interleaved (not depth first) and a
+    /// branch: the orders `ltdl_inverse_factored` must handle.
+    const PARENT: [Option<usize>; 13] = [
+        None,
+        Some(0),
+        Some(1),
+        Some(2),
+        Some(3),
+        Some(4),
+        Some(5),
+        Some(5),
+        Some(6),
+        Some(7),
+        Some(8),
+        Some(9),
+        Some(8),
+    ];
+
+    /// Symmetric positive definite, nonzero exactly where one coordinate is above the other.
+    fn matrix() -> [[f64; 13]; 13] {
+        let above = |i: usize, j: usize| {
+            let mut k = PARENT[i];
+            while let Some(p) = k {
+                if p == j {
+                    return true;
+                }
+                k = PARENT[p];
+            }
+            false
+        };
+        core::array::from_fn(|i| {
+            core::array::from_fn(|j| match () {
+                _ if i == j => 3.0 + 0.25 * i as f64,
+                _ if above(i, j) || above(j, i) => 0.2 + 0.03 * (i * j % 7) as f64,
+                _ => 0.0,
+            })
+        })
+    }
+
+    #[test]
+    fn inverse_of_a_branched_tree_out_of_depth_first_order() {
+        let m = matrix();
+        let mut f = m;
+        ltdl_factor(&mut f, &PARENT).unwrap();
+        let inv = ltdl_inverse_factored(&f, &PARENT);
+        for i in 0..13 {
+            for j in 0..13 {
+                let p: f64 = (0..13).map(|k| m[i][k] * inv[k][j]).sum();
+                let want = if i == j { 1.0 } else { 0.0 };
+                assert!((p - want).abs() < 1e-14, "({i}, {j}): {p}");
+                assert_eq!(inv[i][j], inv[j][i]);
+            }
+        }
+    }
+}
