@@ -668,9 +668,10 @@ mod tests {
         let mut f = m;
         ltdl_factor(&mut f, &PARENT).unwrap();
         let inv = ltdl_inverse_factored(&f, &PARENT);
-        for i in 0..13 {
-            for j in 0..13 {
-                let p: f64 = (0..13).map(|k| m[i][k] * inv[k][j]).sum();
+        for (i, row) in m.iter().enumerate() {
+            for (j, column) in inv.iter().enumerate() {
+                // `inv` is symmetric: its row `j` is its column `j`.
+                let p: f64 = row.iter().zip(column).map(|(a, b)| a * b).sum();
                 let want = if i == j { 1.0 } else { 0.0 };
                 assert!((p - want).abs() < 1e-14, "({i}, {j}): {p}");
                 assert_eq!(inv[i][j], inv[j][i]);
