@@ -141,18 +141,27 @@ impl<T: Real, const NV: usize, const K: usize> ImpulseDynamicsDerivatives<T, NV,
     }
 }
 
+/// Whether `factors` holds `M` itself or already its `L^T D L` factors.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Held {
+    Matrix,
+    Factors,
+}
+
 /// Factorizes the system whose mass matrix and contact Jacobian are in `factors` and `j`, in
-/// place (`M`'s `L^T D L` factors; the inactive rows of `J` zeroed), writes `Y = M^-1 J^T`
-/// into `y` (row `k` a column) and returns the Cholesky factor of `J M^-1 J^T` (the identity's
-/// rows and columns for inactive rows).
+/// place (`M`'s `L^T D L` factors, unless `held` says they are there already; the inactive
+/// rows of `J` zeroed), writes `Y = M^-1 J^T` into `y` (row `k` a column) and returns the
+/// Cholesky factor of `J M^-1 J^T` (the identity's rows and columns for inactive rows).
 fn factorize<T: Real, const N: usize, const K: usize>(
     factors: &mut [[T; N]; N],
     j: &mut [[T; N]; K],
     y: &mut [[T; N]; K],
-    parent: &[Option<usize>; N],
+    (parent, held): (&[Option<usize>; N], Held),
     active: &[bool; K],
 ) -> Result<Cholesky<T, K>, FactorError> {
-    ltdl_factor(factors, parent)?;
+    if held == Held::Matrix {
+        ltdl_factor(factors, parent)?;
+    }
     for (jk, on) in j.iter_mut().zip(active) {
         if !*on {
             *jk = [T::zero(); N];
@@ -171,17 +180,28 @@ fn factorize<T: Real, const N: usize, const K: usize>(
             *y = row[k];
         }
     }
+    // J Y^T row by row, each row gathered over the rows of Y^T (K columns at a time, in vector
+    // operations), not entry by entry as dot products: a dot product is a chain of N dependent
+    // multiply-adds, and the K^2 / 2 of them were a fifth of impulse dynamics on a quadruped.
+    // Inactive rows of J are zero; their diagonal becomes one.
     let mut lambda = [[T::zero(); K]; K];
-    for r in 0..K {
-        if !active[r] {
-            lambda[r][r] = T::one();
-            continue;
-        }
-        for c in 0..=r {
-            if active[c] {
-                lambda[r][c] = dot(&j[r], &y[c]);
-                lambda[c][r] = lambda[r][c];
+    for ((r, lr), jr) in lambda.iter_mut().enumerate().zip(j.iter()) {
+        let mut acc = [T::zero(); K];
+        for (jri, yti) in jr.iter().zip(&yt) {
+            for (a, v) in acc.iter_mut().zip(yti) {
+                *a = jri.mul_add(*v, *a);
             }
+        }
+        *lr = acc;
+        if !active[r] {
+            lr[r] = T::one();
+        }
+    }
+    // Exactly symmetric: the lower triangle mirrored.
+    for c in 1..K {
+        let (upper, lower) = lambda.split_at_mut(c);
+        for (r, above) in upper.iter_mut().enumerate() {
+            above[c] = lower[0][r];
         }
     }
     Cholesky::new(lambda).map_err(shift::<N>)
@@ -353,11 +373,52 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
         parent: &[Option<usize>; N],
         active: &[bool; K],
     ) -> Result<(), FactorError> {
-        fill(&mut self.factors, &mut self.j);
+        let fill = |m: &mut _, j: &mut _| {
+            fill(m, j);
+            Ok(())
+        };
+        self.set_up_holding(fill, (parent, Held::Matrix), active)
+    }
+
+    /// [`ContactKkt::set_up`] for a `fill` that writes `M`'s `L^T D L` factors over the
+    /// coordinate tree `parent` (as [`ltdl_factor`] leaves them), not `M`: a caller with a
+    /// faster factorization of its own, as generated code has one unrolled for the robot's
+    /// tree. An error of `fill` is returned as it is.
+    ///
+    /// ```
+    /// use eomgen_runtime::{tree::ltdl_factor, ContactKkt};
+    /// let (m, j, parent) = ([[2.0_f64, 0.5], [0.5, 1.0]], [[1.0, 1.0]], [None, Some(0)]);
+    /// let kkt = ContactKkt::new(m, &parent, j).unwrap();
+    /// let mut own = ContactKkt::zeroed();
+    /// let fill = |mm: &mut [[f64; 2]; 2], jj: &mut [[f64; 2]; 1]| {
+    ///     (*mm, *jj) = (m, j);
+    ///     ltdl_factor(mm, &parent)
+    /// };
+    /// own.set_up_factored(fill, &parent, &[true]).unwrap();
+    /// assert_eq!(own.solve(&[1.0, 2.0], &[0.5]), kkt.solve(&[1.0, 2.0], &[0.5]));
+    /// ```
+    pub fn set_up_factored(
+        &mut self,
+        fill: impl FnOnce(&mut [[T; N]; N], &mut [[T; N]; K]) -> Result<(), FactorError>,
+        parent: &[Option<usize>; N],
+        active: &[bool; K],
+    ) -> Result<(), FactorError> {
+        self.set_up_holding(fill, (parent, Held::Factors), active)
+    }
+
+    /// [`ContactKkt::set_up`] and [`ContactKkt::set_up_factored`]: `held` says what `fill`
+    /// writes.
+    fn set_up_holding(
+        &mut self,
+        fill: impl FnOnce(&mut [[T; N]; N], &mut [[T; N]; K]) -> Result<(), FactorError>,
+        (parent, held): (&[Option<usize>; N], Held),
+        active: &[bool; K],
+    ) -> Result<(), FactorError> {
+        fill(&mut self.factors, &mut self.j)?;
         self.parent = *parent;
         self.active = *active;
         let (factors, j, y) = (&mut self.factors, &mut self.j, &mut self.y);
-        self.lambda = factorize(factors, j, y, parent, active)?;
+        self.lambda = factorize(factors, j, y, (parent, held), active)?;
         Ok(())
     }
 
@@ -382,14 +443,53 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
         parent: &[Option<usize>; N],
         active: &[bool; K],
     ) -> Result<KktStash<T, N, K>, FactorError> {
-        fill(&mut d.da_dtau, &mut d.df_dtau);
+        let fill = |m: &mut _, j: &mut _| {
+            fill(m, j);
+            Ok(())
+        };
+        Self::set_up_in_holding(d, fill, (parent, Held::Matrix), active)
+    }
+
+    /// [`ContactKkt::set_up_in`] for a `fill` that writes `M`'s factors, as
+    /// [`ContactKkt::set_up_factored`].
+    ///
+    /// ```
+    /// use eomgen_runtime::{tree::ltdl_factor, ContactDynamicsDerivatives, ContactKkt};
+    /// let (m, j, parent) = ([[2.0_f64, 0.5], [0.5, 1.0]], [[1.0, 1.0]], [None, Some(0)]);
+    /// let kkt = ContactKkt::new(m, &parent, j).unwrap();
+    /// let mut d = ContactDynamicsDerivatives::<f64, 2, 1>::nan();
+    /// let fill = |mm: &mut [[f64; 2]; 2], jj: &mut [[f64; 2]; 1]| {
+    ///     (*mm, *jj) = (m, j);
+    ///     ltdl_factor(mm, &parent)
+    /// };
+    /// let stash = ContactKkt::set_up_in_factored(&mut d, fill, &parent, &[true]).unwrap();
+    /// assert_eq!(stash.solve(&d, &[1.0, 2.0], &[0.5]), kkt.solve(&[1.0, 2.0], &[0.5]));
+    /// ```
+    pub fn set_up_in_factored(
+        d: &mut ContactDynamicsDerivatives<T, N, K>,
+        fill: impl FnOnce(&mut [[T; N]; N], &mut [[T; N]; K]) -> Result<(), FactorError>,
+        parent: &[Option<usize>; N],
+        active: &[bool; K],
+    ) -> Result<KktStash<T, N, K>, FactorError> {
+        Self::set_up_in_holding(d, fill, (parent, Held::Factors), active)
+    }
+
+    /// [`ContactKkt::set_up_in`] and [`ContactKkt::set_up_in_factored`].
+    fn set_up_in_holding(
+        d: &mut ContactDynamicsDerivatives<T, N, K>,
+        fill: impl FnOnce(&mut [[T; N]; N], &mut [[T; N]; K]) -> Result<(), FactorError>,
+        (parent, held): (&[Option<usize>; N], Held),
+        active: &[bool; K],
+    ) -> Result<KktStash<T, N, K>, FactorError> {
+        fill(&mut d.da_dtau, &mut d.df_dtau)?;
         let mut stash = KktStash {
             parent: *parent,
             y: [[T::zero(); N]; K],
             lambda: Cholesky::identity(),
             active: *active,
         };
-        stash.lambda = factorize(&mut d.da_dtau, &mut d.df_dtau, &mut stash.y, parent, active)?;
+        let (m, j, y) = (&mut d.da_dtau, &mut d.df_dtau, &mut stash.y);
+        stash.lambda = factorize(m, j, y, (parent, held), active)?;
         Ok(stash)
     }
 

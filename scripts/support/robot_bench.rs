@@ -34,6 +34,18 @@ struct State {
     v: [f64; NV],
     a: [f64; NV],
     tau: [f64; NV],
+    /// A second configuration, for `difference` and its Jacobians.
+    q1: [f64; NQ],
+}
+
+/// Joint angles in [-pi, pi], a unit quaternion for a floating base.
+fn config(unit: &mut impl FnMut() -> f64) -> [f64; NQ] {
+    let mut q: [f64; NQ] = core::array::from_fn(|_| core::f64::consts::PI * unit());
+    if NQ > NV {
+        let n = q[3..7].iter().map(|x| x * x).sum::<f64>().sqrt();
+        q[3..7].iter_mut().for_each(|x| *x /= n);
+    }
+    q
 }
 
 /// splitmix64 from a fixed seed, uniform in [-1, 1).
@@ -49,17 +61,19 @@ fn states() -> Vec<State> {
     };
     (0..STATES)
         .map(|_| {
-            let mut q: [f64; NQ] = core::array::from_fn(|_| core::f64::consts::PI * unit());
-            if NQ > NV {
-                let n = q[3..7].iter().map(|x| x * x).sum::<f64>().sqrt();
-                q[3..7].iter_mut().for_each(|x| *x /= n);
-            }
+            let q = config(&mut unit);
             let floating = NQ > NV;
+            let (v, a, tau) = (
+                core::array::from_fn(|_| unit()),
+                core::array::from_fn(|_| unit()),
+                core::array::from_fn(|i| if floating && i < 6 { 0.0 } else { unit() }),
+            );
             State {
                 q,
-                v: core::array::from_fn(|_| unit()),
-                a: core::array::from_fn(|_| unit()),
-                tau: core::array::from_fn(|i| if floating && i < 6 { 0.0 } else { unit() }),
+                v,
+                a,
+                tau,
+                q1: config(&mut unit),
             }
         })
         .collect()
@@ -121,6 +135,65 @@ fn benches() -> Vec<Bench> {
     }
     #[cfg(all(contacts, derivatives))]
     b.extend(contact_derivatives());
+    b.extend(mpc_kit());
+    b
+}
+
+/// The link whose frame the frame kinematics are timed at: `ROBOT_BENCH_LINK` from the build
+/// script, the first contact link as pinbench's; without contacts the last link (pinbench
+/// then takes Pinocchio's last frame, which may be another).
+fn bench_link() -> RobotLink {
+    let name = env!("ROBOT_BENCH_LINK");
+    let last = RobotLink::ALL[RobotLink::ALL.len() - 1];
+    RobotLink::ALL.into_iter().find(|l| l.name() == name).unwrap_or(last)
+}
+
+/// The MPC kit's frame kinematics, manifold and centroidal rate (with contacts, the impulse
+/// dynamics), against pinbench's lines of the same names.
+fn mpc_kit() -> Vec<Bench> {
+    let mut b: Vec<Bench> = vec![
+        (
+            "link_velocity",
+            |r, s| r.link_velocity(bench_link(), &s.q, &s.v)[0],
+            matrices::<1, 1, 6>(),
+        ),
+        (
+            "link_acceleration",
+            |r, s| r.link_acceleration(bench_link(), &s.q, &s.v, &s.a)[0],
+            matrices::<1, 1, 6>(),
+        ),
+        (
+            "link_jacobian_time_variation",
+            |r, s| r.link_jacobian_time_variation(bench_link(), &s.q, &s.v)[0][0],
+            matrices::<1, 6, NV>(),
+        ),
+        (
+            "centroidal_momentum_rate",
+            |r, s| r.centroidal_momentum_rate(&s.q, &s.v, &s.a)[0],
+            matrices::<1, 1, 6>(),
+        ),
+        (
+            "difference",
+            |r, s| r.difference(&s.q, &s.q1)[0],
+            matrices::<1, 1, NV>(),
+        ),
+        (
+            "integrate_jacobians",
+            |r, s| r.integrate_jacobians(&s.q, &s.v).0[0][0],
+            matrices::<2, NV, NV>(),
+        ),
+        (
+            "difference_jacobians",
+            |r, s| r.difference_jacobians(&s.q, &s.q1).0[0][0],
+            matrices::<2, NV, NV>(),
+        ),
+    ];
+    #[cfg(contacts)]
+    b.push((
+        "impulse_dynamics",
+        |r, s| r.impulse_dynamics(&s.q, &s.v, 0.0).0[0],
+        0, // a few hundred bytes: counted with the function
+    ));
     b
 }
 

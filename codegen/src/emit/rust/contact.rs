@@ -60,7 +60,7 @@ impl Emitter<'_> {
                     /// Sets `kkt` up for the contacts of `active` at `q`.
                     #[inline(never)]
                     fn contact_kkt_active(&self, q: &[T; #nq], active: &[bool; #c], kkt: &mut #kkt_ty) -> #result {
-                        kkt.set_up(#fill, &Self::PARENTS, &#rows)
+                        kkt.set_up_factored(#fill, &Self::PARENTS, &#rows)
                     }
                 },
             )
@@ -72,7 +72,7 @@ impl Emitter<'_> {
                     /// Sets `kkt` up for every contact at `q`.
                     #[inline(never)]
                     fn contact_kkt(&self, q: &[T; #nq], kkt: &mut #kkt_ty) -> #result {
-                        kkt.set_up(#fill, &Self::PARENTS, &#rows)
+                        kkt.set_up_factored(#fill, &Self::PARENTS, &#rows)
                     }
                 },
             )
@@ -87,13 +87,17 @@ impl Emitter<'_> {
         }
     }
 
-    /// The closure that writes `M` and `J_c` at `q` into a KKT system's storage, and the
-    /// contact rows that take part: every one, or those of the contacts of `active`.
+    /// The closure that writes `M`'s factors and `J_c` at `q` into a KKT system's storage
+    /// (`ContactKkt::set_up_factored`), and the contact rows that take part: every one, or
+    /// those of the contacts of `active`.
     fn kkt_inputs(&self, active: bool) -> (TokenStream, TokenStream) {
         let (m, j) = (self.call("mass_matrix"), self.call("contact_jacobian"));
+        // M factorized by the robot's unrolled L^T D L (`emit/tree_solve.rs`), not by the
+        // runtime's loops over the tree.
         let fill = quote!(|m, j| {
             *m = #m(self, q);
             *j = #j(self, q);
+            Self::ltdl_factor_unrolled(m, &mut ::core::default::Default::default())
         });
         let k = &self.k;
         let rows = if active {
@@ -232,7 +236,7 @@ impl Emitter<'_> {
             /// The accelerations and forces, with the KKT system set up in `d`.
             #[inline(never)]
             fn #solve(&self, q: &[T; #nq], rhs: &[T; #n], drift: &[T; #k] #param, d: &mut #ty) -> ::core::result::Result<([T; #n], [T; #k], #stash), #err> {
-                let stash = ::eomgen_runtime::ContactKkt::set_up_in(d, #fill, &Self::PARENTS, &#rows)?;
+                let stash = ::eomgen_runtime::ContactKkt::set_up_in_factored(d, #fill, &Self::PARENTS, &#rows)?;
                 let (a, f) = stash.solve(d, rhs, &drift.map(|x| -x))?;
                 Ok((a, f, stash))
             }

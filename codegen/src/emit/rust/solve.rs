@@ -181,7 +181,18 @@ impl Emitter<'_> {
                     )
             )
         };
-        let factor = if self.any_eval(|e| solves(e) || matches!(e, E::MassMatrixInverse)) {
+        // Every KKT system (`ContactKkt::set_up_factored`) takes M's factors from it too.
+        let kkt = |e: &Evaluation| {
+            matches!(
+                e,
+                E::MassMatrixInverse
+                    | E::ContactDynamicsDerivatives { .. }
+                    | E::ImpulseDynamics
+                    | E::ImpulseDynamicsDerivatives
+                    | E::ActiveContacts(_)
+            )
+        };
+        let factor = if self.any_eval(|e| solves(e) || kkt(e)) {
             crate::emit::tree_solve::factor_fn(&self.parents, n)
         } else {
             TokenStream::new()
