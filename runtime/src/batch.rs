@@ -125,7 +125,8 @@ pub fn check(expected: usize, slices: &[(&'static str, usize)]) -> Result<(), Ba
 }
 
 /// States `start..start + LANES` of `x` in the lanes of one array (lanes past the end of `x`
-/// repeat its last state; zeros if `x` is empty).
+/// repeat its last state; zeros if `x` is empty). A whole vector of states is packed by
+/// [`Pack::pack`] (an in-register transposition for `f64x4` and `f32x8` on AVX).
 ///
 /// ```
 /// use eomgen_runtime::batch::{gather, scatter};
@@ -137,36 +138,25 @@ pub fn check(expected: usize, slices: &[(&'static str, usize)]) -> Result<(), Ba
 /// ```
 #[inline(always)]
 pub fn gather<L: Pack, const N: usize>(x: &[[L::Scalar; N]], start: usize) -> [L; N] {
-    let zero = <L::Scalar as Real>::zero();
     if let Some(full) = x.get(start..start + L::LANES) {
-        return core::array::from_fn(|i| L::gather(|l| full.get(l).map_or(zero, |s| s[i])));
+        let mut v = [L::zero(); N];
+        L::pack(full.as_flattened(), &mut v);
+        return v;
     }
+    let zero = <L::Scalar as Real>::zero();
     let last = x.len().saturating_sub(1);
     core::array::from_fn(|i| L::gather(|l| x.get((start + l).min(last)).map_or(zero, |s| s[i])))
 }
 
-/// Lanes `0..out.len()` of an array of lanes, one array per state (see [`gather`]).
+/// Lanes `0..out.len()` of an array of lanes, one array per state (see [`gather`]), by
+/// [`Pack::unpack`]: each state's result written as one contiguous run.
 #[inline(always)]
 pub fn scatter<L: Pack, const N: usize>(v: &[L; N], out: &mut [[L::Scalar; N]]) {
-    if out.len() == L::LANES {
-        // A whole vector: a loop to the constant `LANES`, which the compiler unrolls so that
-        // each lane is read at a constant index; each state written in order.
-        #[allow(clippy::needless_range_loop)]
-        for l in 0..L::LANES {
-            for (o, x) in out[l].iter_mut().zip(v) {
-                *o = x.lane(l);
-            }
-        }
-        return;
-    }
-    for (i, x) in v.iter().enumerate() {
-        for (o, y) in out.iter_mut().zip(x.lanes().as_ref()) {
-            o[i] = *y;
-        }
-    }
+    L::unpack(v, out.as_flattened_mut());
 }
 
-/// Lanes `0..out.len()` of a matrix of lanes, one matrix per state.
+/// Lanes `0..out.len()` of a matrix of lanes, one matrix per state (by [`Pack::unpack`] of
+/// the row-major entries).
 ///
 /// ```
 /// use eomgen_runtime::batch::scatter_matrix;
@@ -179,26 +169,7 @@ pub fn scatter_matrix<L: Pack, const R: usize, const C: usize>(
     v: &[[L; C]; R],
     out: &mut [[[L::Scalar; C]; R]],
 ) {
-    if out.len() == L::LANES {
-        // A whole vector: a loop to the constant `LANES`, which the compiler unrolls so that
-        // each lane is read at a constant index; each state written in order.
-        #[allow(clippy::needless_range_loop)]
-        for l in 0..L::LANES {
-            for (o, row) in out[l].iter_mut().zip(v) {
-                for (o, x) in o.iter_mut().zip(row) {
-                    *o = x.lane(l);
-                }
-            }
-        }
-        return;
-    }
-    for (r, row) in v.iter().enumerate() {
-        for (c, x) in row.iter().enumerate() {
-            for (o, y) in out.iter_mut().zip(x.lanes().as_ref()) {
-                o[r][c] = *y;
-            }
-        }
-    }
+    L::unpack(v.as_flattened(), out.as_flattened_mut().as_flattened_mut());
 }
 
 /// Lanes `0..out.len()` of one number of lanes.

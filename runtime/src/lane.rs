@@ -378,6 +378,65 @@ pub trait Pack: Lane {
     type Array: AsRef<[Self::Scalar]>;
     /// Every lane, in order: cheaper than [`Pack::lane`] for each.
     fn lanes(self) -> Self::Array;
+    /// Packs the states stored one after another in `states`, `v.len()` scalars each, into
+    /// `v`: lane `l` of `v[j]` is `states[l * v.len() + j]`. Lanes whose state `states` does
+    /// not hold whole are zero. `f64x4` and `f32x8` on AVX transpose blocks of 4 x 4 (8 x 8)
+    /// in registers: one load per state and block instead of one per lane and entry.
+    ///
+    /// ```
+    /// use eomgen_runtime::lane::Pack;
+    ///
+    /// let mut v = [0.0_f64; 3];
+    /// f64::pack(&[1.0, 2.0, 3.0], &mut v); // one lane: one state of three entries
+    /// assert_eq!(v, [1.0, 2.0, 3.0]);
+    /// ```
+    #[inline(always)]
+    fn pack(states: &[Self::Scalar], v: &mut [Self]) {
+        pack_each(states, v);
+    }
+    /// The inverse of [`Pack::pack`]: lane `l` of `v[j]` into `states[l * v.len() + j]`, for
+    /// the first `LANES` states that `states` holds whole (fewer for a partial last vector).
+    ///
+    /// ```
+    /// use eomgen_runtime::lane::Pack;
+    ///
+    /// let mut states = [0.0_f64; 2];
+    /// f64::unpack(&[1.5, 2.5], &mut states);
+    /// assert_eq!(states, [1.5, 2.5]);
+    /// ```
+    #[inline(always)]
+    fn unpack(v: &[Self], states: &mut [Self::Scalar]) {
+        unpack_each(v, states);
+    }
+}
+
+/// [`Pack::pack`] lane by lane (what vectors without a transposition of their own use).
+#[inline(always)]
+pub(crate) fn pack_each<L: Pack>(states: &[L::Scalar], v: &mut [L]) {
+    let n = v.len();
+    let zero = <L::Scalar as Real>::zero();
+    for (j, x) in v.iter_mut().enumerate() {
+        *x = L::gather(|l| {
+            let whole = states.len() / n.max(1) > l;
+            states.get(l * n + j).filter(|_| whole).map_or(zero, |s| *s)
+        });
+    }
+}
+
+/// [`Pack::unpack`] lane by lane: each vector's lanes read once.
+#[inline(always)]
+pub(crate) fn unpack_each<L: Pack>(v: &[L], states: &mut [L::Scalar]) {
+    let n = v.len();
+    if n == 0 {
+        return;
+    }
+    for (j, x) in v.iter().enumerate() {
+        for (state, y) in states.chunks_exact_mut(n).zip(x.lanes().as_ref()) {
+            if let Some(o) = state.get_mut(j) {
+                *o = *y;
+            }
+        }
+    }
 }
 
 impl<T: Real> Pack for T {

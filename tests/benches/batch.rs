@@ -8,7 +8,8 @@
 //!     RUSTFLAGS="-C target-cpu=native" cargo bench -p eomgen-tests --features rayon --bench batch
 //!
 //! Every way evaluates the same 1024 random states (angles in [-pi, pi], a random unit
-//! quaternion, velocities, accelerations and efforts in [-1, 1]).
+//! quaternion, velocities, accelerations and efforts in [-1, 1]); `EOMGEN_BATCH_STATES=128`
+//! evaluates 128 instead (results that fit in a core's L2 cache).
 
 use std::hint::black_box;
 
@@ -21,7 +22,14 @@ use eomgen_tests::robots::anymal_derivatives::AnymalDerivatives;
 use eomgen_tests::robots::panda_derivatives::PandaDerivatives;
 use rayon::{ThreadPool, ThreadPoolBuilder};
 
-const STATES: usize = 1024;
+/// States per call: `EOMGEN_BATCH_STATES` (1024 unless set). 1024 anymal mass matrices are
+/// 2.6 MB in `f64`, more than a core's L2 cache: set it to 128 to time the batch in cache.
+fn states_per_call() -> usize {
+    std::env::var("EOMGEN_BATCH_STATES")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(1024)
+}
 
 /// `STATES` arrays of `N` numbers in [-scale, scale] (splitmix64 from `seed`).
 fn states<S: Batch, const N: usize>(seed: u64, scale: f64) -> Vec<[S; N]> {
@@ -34,7 +42,7 @@ fn states<S: Batch, const N: usize>(seed: u64, scale: f64) -> Vec<[S; N]> {
         z ^= z >> 31;
         (z >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
     };
-    (0..STATES)
+    (0..states_per_call())
         .map(|_| core::array::from_fn(|_| S::from_f64(scale * unit())))
         .collect()
 }
@@ -63,20 +71,21 @@ struct Pools {
 
 fn group<'c>(c: &'c mut Criterion, name: &str) -> BenchmarkGroup<'c, WallTime> {
     let mut g = c.benchmark_group(name);
-    g.throughput(Throughput::Elements(STATES as u64));
+    g.throughput(Throughput::Elements(states_per_call() as u64));
     g.sample_size(20);
     g.warm_up_time(std::time::Duration::from_millis(500));
     g.measurement_time(std::time::Duration::from_secs(2));
     g
 }
 
-/// Function `$name` three ways in group `$g`, into fresh outputs `$o` (each `STATES` copies of
+/// Function `$name` three ways in group `$g`, into fresh outputs `$o` (each `states_per_call()` copies of
 /// `$zero`): `$scalar` once per state `$i` on this thread, `$batch` run from inside the
 /// one-thread pool and inside the pool of every core.
 macro_rules! three_ways {
     ($g:ident, $pools:ident, $name:literal, ($($o:ident: $zero:expr),+), |$i:ident| $scalar:block, $batch:block) => {{
-        $(let mut $o = vec![$zero; STATES];)+
-        $g.bench_function(concat!($name, "/scalar"), |b| b.iter(|| for $i in 0..STATES $scalar));
+        let states = states_per_call();
+        $(let mut $o = vec![$zero; states];)+
+        $g.bench_function(concat!($name, "/scalar"), |b| b.iter(|| for $i in 0..states $scalar));
         $g.bench_function(concat!($name, "/batch"), |b| $pools.one.install(|| b.iter(|| $batch)));
         $g.bench_function(concat!($name, "/threads"), |b| $pools.all.install(|| b.iter(|| $batch)));
     }};

@@ -5,6 +5,7 @@
 //! in the last bits), with non-finite states next to finite ones, on fixed and floating bases.
 
 use eomgen_generated::panda::Panda;
+use eomgen_runtime::batch::{gather, scatter, scatter_matrix};
 use eomgen_runtime::lane::Pack;
 use eomgen_runtime::prelude::*;
 use eomgen_runtime::{FactorError, LaneError};
@@ -277,4 +278,108 @@ fn mismatched_lengths_are_an_error_and_nothing_is_written() {
     robot
         .inverse_dynamics_batch(&[], &[], &[], &mut empty)
         .unwrap();
+}
+
+/// `count` states of `n` entries, one after another, with NaN and infinities between finite
+/// entries.
+fn run_of_states(n: usize, count: usize, numbers: &mut Numbers) -> Vec<f64> {
+    (0..n * count)
+        .map(|k| match k % 11 {
+            3 => f64::NAN,
+            7 => f64::NEG_INFINITY,
+            _ => numbers.next(),
+        })
+        .collect()
+}
+
+/// `Pack::pack` and `Pack::unpack` of `L` against lane-by-lane packing: every run length
+/// (whole transposed blocks and the entries past them), whole and partial vectors, NaN lanes
+/// next to finite ones, bit for bit.
+fn pack_round_trip<L: Pack>(from: impl Fn(f64) -> L::Scalar) {
+    let mut numbers = Numbers(7);
+    for n in [1, 2, 3, 4, 5, 7, 8, 9, 17, 19, 81] {
+        for count in 0..=L::LANES {
+            let states: Vec<L::Scalar> = run_of_states(n, count, &mut numbers)
+                .into_iter()
+                .map(&from)
+                .collect();
+            let mut v = vec![L::from_f64(5.0); n];
+            L::pack(&states, &mut v);
+            for (j, x) in v.iter().enumerate() {
+                for l in 0..L::LANES {
+                    let want = states.get(l * n + j).copied().unwrap_or(from(0.0));
+                    let got = x.lane(l);
+                    assert_eq!(
+                        got.to_f64().to_bits(),
+                        want.to_f64().to_bits(),
+                        "pack n {n}, {count} states, entry {j}, lane {l}"
+                    );
+                }
+            }
+            // Unpacking writes exactly the states the slice holds, lane l into state l.
+            let full = run_of_states(n, L::LANES, &mut numbers);
+            let v: Vec<L> = (0..n)
+                .map(|j| L::gather(|l| from(full[l * n + j])))
+                .collect();
+            let mut out = vec![from(-2.0); n * count + 1];
+            L::unpack(&v, &mut out[..n * count]);
+            for (k, got) in out.iter().enumerate() {
+                let want = if k < n * count {
+                    from(full[k])
+                } else {
+                    from(-2.0)
+                };
+                assert_eq!(
+                    got.to_f64().to_bits(),
+                    want.to_f64().to_bits(),
+                    "unpack n {n}, {count} states, scalar {k}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn pack_and_unpack_transpose_whole_and_partial_vectors() {
+    pack_round_trip::<f64x4>(|x| x);
+    pack_round_trip::<f32x8>(|x| x as f32);
+    pack_round_trip::<wide::f64x2>(|x| x);
+    pack_round_trip::<f64>(|x| x);
+}
+
+#[test]
+fn gather_and_scatter_of_four_doubles_partial_last_vector() {
+    let mut n = Numbers(8);
+    let mut x = n.states::<9>(6, 1.0);
+    x[4][8] = f64::NAN;
+    // States 4 and 5, then two copies of state 5 past the end.
+    let v: [f64x4; 9] = gather(&x, 4);
+    for (j, e) in v.iter().enumerate() {
+        let want = [x[4][j], x[5][j], x[5][j], x[5][j]];
+        assert_eq!(e.to_array().map(f64::to_bits), want.map(f64::to_bits));
+    }
+    let mut out = vec![[7.0; 9]; 3];
+    scatter(&v, &mut out[..2]);
+    assert_eq!(out[0].map(f64::to_bits), x[4].map(f64::to_bits));
+    assert_eq!(out[1], x[5]);
+    assert_eq!(out[2], [7.0; 9]);
+    let m: [[f64x4; 18]; 18] = core::array::from_fn(|r| {
+        core::array::from_fn(|c| f64x4::gather(|l| (100 * l + 18 * r + c) as f64))
+    });
+    for count in 0..=4 {
+        let mut out = vec![[[-1.0; 18]; 18]; 4];
+        scatter_matrix(&m, &mut out[..count]);
+        for (l, s) in out.iter().enumerate() {
+            for (r, row) in s.iter().enumerate() {
+                for (c, e) in row.iter().enumerate() {
+                    let want = if l < count {
+                        (100 * l + 18 * r + c) as f64
+                    } else {
+                        -1.0
+                    };
+                    assert_eq!(*e, want, "{count} states: state {l} ({r}, {c})");
+                }
+            }
+        }
+    }
 }

@@ -8,12 +8,14 @@
 //! except for `sin` and `cos`: `wide`'s polynomial approximations differ from `libm`'s in the
 //! last bits.
 
-use super::{scalar_check, Lane, LaneError, Pack};
+use super::{pack_each, scalar_check, unpack_each, Lane, LaneError, Pack};
 use crate::FactorError;
 use wide::{f32x4, f32x8, f64x2, f64x4};
 
+mod transpose;
+
 macro_rules! impl_lane {
-    ($v:ident, $s:ident, $n:literal) => {
+    ($v:ident, $s:ident, $n:literal, $pack:path, $unpack:path) => {
         impl Lane for $v {
             const LANES: usize = $n;
             type Mask = $v;
@@ -142,14 +144,34 @@ macro_rules! impl_lane {
             fn lanes(self) -> [$s; $n] {
                 self.to_array()
             }
+            #[inline(always)]
+            fn pack(states: &[$s], v: &mut [Self]) {
+                $pack(states, v);
+            }
+            #[inline(always)]
+            fn unpack(v: &[Self], states: &mut [$s]) {
+                $unpack(v, states);
+            }
         }
     };
 }
 
-impl_lane!(f64x2, f64, 2);
-impl_lane!(f64x4, f64, 4);
-impl_lane!(f32x4, f32, 4);
-impl_lane!(f32x8, f32, 8);
+impl_lane!(f64x2, f64, 2, pack_each, unpack_each);
+impl_lane!(
+    f64x4,
+    f64,
+    4,
+    transpose::pack_f64x4,
+    transpose::unpack_f64x4
+);
+impl_lane!(f32x4, f32, 4, pack_each, unpack_each);
+impl_lane!(
+    f32x8,
+    f32,
+    8,
+    transpose::pack_f32x8,
+    transpose::unpack_f32x8
+);
 
 /// Records, in each lane without a failure yet, the failure `check` finds in its value.
 #[cold]

@@ -1,0 +1,152 @@
+//! [`Pack::pack`](super::Pack::pack) and [`Pack::unpack`](super::Pack::unpack) of `f64x4`
+//! and `f32x8` by in-register transpositions of square blocks.
+//!
+//! A batch holds states one after another (`[[f64; N]]`); a vector holds one entry of `LANES`
+//! states. Moving entry by entry between the two costs a load or a store per lane and entry
+//! and, done through a lane index, a round trip through memory for each (an 18 x 18 `f32x8`
+//! mass matrix spent three quarters of its batch time there). Here `W` consecutive entries of
+//! `W` states (`W` = `LANES`) are `W` vectors: `W` loads of a run of each state (or of `W`
+//! result vectors), a transposition by shuffles (8 for `f64x4`, 24 for `f32x8`), and `W`
+//! stores. Entries past the last whole block go lane by lane. Without AVX the same blocks are
+//! transposed lane by lane (the code path the tests exercise on every target).
+
+use wide::{f32x8, f64x4};
+
+/// Packs `states` (the whole runs of `v.len()` scalars it holds, up to `W`) into `v`: `W`
+/// entries at a time by `transpose` (of `W` rows of `W` scalars, one per state, into the `W`
+/// vectors of those entries), the rest by `new` (one vector from its `W` lanes). Lanes of
+/// missing states are zero.
+#[inline(always)]
+fn pack_blocks<V: Copy, S: Copy + Default, const W: usize>(
+    states: &[S],
+    v: &mut [V],
+    transpose: impl Fn(&[[S; W]; W]) -> [V; W],
+    new: impl Fn([S; W]) -> V,
+) {
+    let n = v.len();
+    let rows: [&[S]; W] =
+        core::array::from_fn(|l| states.get(l * n..(l + 1) * n).unwrap_or_default());
+    let mut blocks = v.chunks_exact_mut(W);
+    for (k, block) in (&mut blocks).enumerate() {
+        let m: [[S; W]; W] = core::array::from_fn(|l| {
+            match rows[l].get(k * W..(k + 1) * W).map(<&[S; W]>::try_from) {
+                Some(Ok(run)) => *run,
+                _ => [S::default(); W],
+            }
+        });
+        for (o, x) in block.iter_mut().zip(transpose(&m)) {
+            *o = x;
+        }
+    }
+    let rest = blocks.into_remainder();
+    let k = n - rest.len();
+    for (j, o) in rest.iter_mut().enumerate() {
+        *o = new(core::array::from_fn(|l| {
+            rows[l].get(k + j).copied().unwrap_or_default()
+        }));
+    }
+}
+
+/// Unpacks `v` into the whole runs of `v.len()` scalars of `states` (up to `W`): `W` entries
+/// at a time by `transpose` (of `W` vectors into `W` rows, one per state), the rest by `lanes`.
+#[inline(always)]
+fn unpack_blocks<V: Copy, S: Copy, const W: usize>(
+    v: &[V],
+    states: &mut [S],
+    transpose: impl Fn(&[V; W]) -> [[S; W]; W],
+    lanes: impl Fn(V) -> [S; W],
+) {
+    let n = v.len();
+    if n == 0 {
+        return;
+    }
+    let blocks = v.chunks_exact(W);
+    let rest = blocks.remainder();
+    for (k, block) in blocks.enumerate() {
+        let Ok(block) = <&[V; W]>::try_from(block) else {
+            continue;
+        };
+        let rows = transpose(block);
+        for (state, row) in states.chunks_exact_mut(n).zip(rows) {
+            let run = state.get_mut(k * W..(k + 1) * W);
+            if let Some(Ok(run)) = run.map(<&mut [S; W]>::try_from) {
+                *run = row;
+            }
+        }
+    }
+    let k = n - rest.len();
+    for (j, x) in rest.iter().enumerate() {
+        for (state, y) in states.chunks_exact_mut(n).zip(lanes(*x)) {
+            if let Some(o) = state.get_mut(k + j) {
+                *o = y;
+            }
+        }
+    }
+}
+
+/// The 4 x 4 transposition: lane `l` of vector `i` to lane `i` of vector `l` (4 unpacks, 4
+/// lane permutations).
+#[cfg(target_feature = "avx")]
+#[inline(always)]
+fn transpose4(v: &[f64x4; 4]) -> [f64x4; 4] {
+    use safe_arch::{m256d, permute2z_m256d, unpack_hi_m256d, unpack_lo_m256d};
+    let m = v.map(|x| m256d::from_array(x.to_array()));
+    // [a0 b0 a2 b2], [a1 b1 a3 b3], [c0 d0 c2 d2], [c1 d1 c3 d3]
+    let (ab0, ab1) = (unpack_lo_m256d(m[0], m[1]), unpack_hi_m256d(m[0], m[1]));
+    let (cd0, cd1) = (unpack_lo_m256d(m[2], m[3]), unpack_hi_m256d(m[2], m[3]));
+    [
+        permute2z_m256d::<0x20>(ab0, cd0),
+        permute2z_m256d::<0x20>(ab1, cd1),
+        permute2z_m256d::<0x31>(ab0, cd0),
+        permute2z_m256d::<0x31>(ab1, cd1),
+    ]
+    .map(|x| f64x4::new(x.to_array()))
+}
+
+/// The 4 x 4 transposition, lane by lane (no AVX: `f64x4` is two halves or an array).
+#[cfg(not(target_feature = "avx"))]
+#[inline(always)]
+fn transpose4(v: &[f64x4; 4]) -> [f64x4; 4] {
+    let a = v.map(f64x4::to_array);
+    core::array::from_fn(|l| f64x4::new([a[0][l], a[1][l], a[2][l], a[3][l]]))
+}
+
+/// [`Pack::pack`](super::Pack::pack) of `f64x4`.
+#[inline(always)]
+pub(super) fn pack_f64x4(states: &[f64], v: &mut [f64x4]) {
+    pack_blocks(states, v, |m| transpose4(&m.map(f64x4::new)), f64x4::new);
+}
+
+/// [`Pack::unpack`](super::Pack::unpack) of `f64x4`.
+#[inline(always)]
+pub(super) fn unpack_f64x4(v: &[f64x4], states: &mut [f64]) {
+    unpack_blocks(
+        v,
+        states,
+        |b| transpose4(b).map(f64x4::to_array),
+        f64x4::to_array,
+    );
+}
+
+/// [`Pack::pack`](super::Pack::pack) of `f32x8` (`wide`'s transposition: shuffles on AVX,
+/// lane by lane elsewhere).
+#[inline(always)]
+pub(super) fn pack_f32x8(states: &[f32], v: &mut [f32x8]) {
+    pack_blocks(
+        states,
+        v,
+        |m| f32x8::transpose(m.map(f32x8::new)),
+        f32x8::new,
+    );
+}
+
+/// [`Pack::unpack`](super::Pack::unpack) of `f32x8`.
+#[inline(always)]
+pub(super) fn unpack_f32x8(v: &[f32x8], states: &mut [f32]) {
+    unpack_blocks(
+        v,
+        states,
+        |b| f32x8::transpose(*b).map(f32x8::to_array),
+        f32x8::to_array,
+    );
+}
