@@ -62,6 +62,9 @@ pub struct Builder {
     regressor: bool,
     /// The most operations of one generated function body ([`Builder::max_function_ops`]).
     max_function_ops: usize,
+    /// Straight-line `M^-1` and forward-dynamics derivatives up to this many operations
+    /// ([`Builder::derivatives_flat_max_ops`]).
+    derivatives_flat_max_ops: usize,
 }
 
 /// Robots with more joints than this are refused unless [`Builder::max_dof`] raises the limit:
@@ -109,6 +112,7 @@ impl Builder {
             derivatives: false,
             regressor: false,
             max_function_ops: DEFAULT_MAX_FUNCTION_OPS,
+            derivatives_flat_max_ops: crate::dynamics::DERIVATIVES_FLAT_MAX_OPS,
         }
     }
 
@@ -267,6 +271,21 @@ impl Builder {
     /// ```
     pub fn max_function_ops(mut self, limit: usize) -> Builder {
         self.max_function_ops = limit.max(1);
+        self
+    }
+
+    /// With [`Builder::derivatives`]: `mass_matrix_inverse` and `forward_dynamics_derivatives`
+    /// are straight-line code up to this many operations each (default
+    /// [`crate::dynamics::DERIVATIVES_FLAT_MAX_OPS`], 40,000), and beyond it composed at run
+    /// time from `mass_matrix`, its factorization unrolled for the robot's tree and
+    /// `inverse_dynamics_derivatives`. Straight-line code is faster on small robots; the
+    /// composed route compiles faster and is faster on humanoids. `0` always composes.
+    ///
+    /// ```
+    /// let b = eomgen::Builder::new("robots/anymal.urdf").derivatives().derivatives_flat_max_ops(0);
+    /// ```
+    pub fn derivatives_flat_max_ops(mut self, limit: usize) -> Builder {
+        self.derivatives_flat_max_ops = limit;
         self
     }
 
@@ -619,7 +638,8 @@ impl Builder {
         }
         let mut d = Derivation::try_new(model, limits).map_err(full)?;
         if self.derivatives {
-            d.add_derivatives(model).map_err(full)?;
+            d.add_derivatives_flat_up_to(model, self.derivatives_flat_max_ops)
+                .map_err(full)?;
         }
         if self.regressor {
             d.add_regressor(model).map_err(full)?;

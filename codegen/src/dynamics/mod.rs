@@ -45,6 +45,7 @@ pub use fast::{Fast, Route, CLOSED_FORM_MAX_DEPTH, CRAIG_FLAT_MAX_ENTRIES};
 pub use identification::Identification;
 pub use lagrangian::pairs;
 pub use mpc::{FrameMotion, Manifold};
+pub use quantities::DERIVATIVES_FLAT_MAX_OPS;
 
 /// The pose of a body in its parent body's frame (the root's for a body whose parent is the
 /// root), as expressions in the body's joint coordinate: `p_parent = rotation p + translation`.
@@ -396,9 +397,20 @@ impl Derivation {
     /// (`contact_derivatives.rs`).
     /// Fails when the graph fills.
     pub fn add_derivatives(&mut self, model: &Model) -> Result<(), GraphFull> {
+        self.add_derivatives_flat_up_to(model, quantities::DERIVATIVES_FLAT_MAX_OPS)
+    }
+
+    /// [`Derivation::add_derivatives`] with `M^-1` and the forward-dynamics derivatives
+    /// straight-line up to `flat_max_ops` operations each
+    /// ([`crate::Builder::derivatives_flat_max_ops`]).
+    pub fn add_derivatives_flat_up_to(
+        &mut self,
+        model: &Model,
+        flat_max_ops: usize,
+    ) -> Result<(), GraphFull> {
         let derived = derivatives::derive(self, model);
         self.graph.check()?;
-        let extra = quantities::derivatives(self, &derived);
+        let extra = quantities::derivatives(self, &derived, flat_max_ops);
         self.quantities.extend(extra);
         if !self.centroidal.contact_drift.is_empty() {
             let partials = contact_derivatives::derive(self, model);

@@ -530,15 +530,15 @@ fn link_jacobian(n: usize) -> Quantity {
 }
 
 /// `mass_matrix_inverse` and `forward_dynamics_derivatives` are straight-line code (sharing `M`,
-/// its factorization and the accelerations) up to this many operations each; beyond, they are
-/// composed at run time from `mass_matrix`, `forward_dynamics` and
-/// `inverse_dynamics_derivatives`.
+/// its factorization and the accelerations) up to this many operations each by default
+/// ([`crate::Builder::derivatives_flat_max_ops`]); beyond, they are composed at run time from
+/// `mass_matrix`, `forward_dynamics` and `inverse_dynamics_derivatives`.
 pub const DERIVATIVES_FLAT_MAX_OPS: usize = 40_000;
 
 /// The derivatives of the dynamics ([`Derivation::add_derivatives`]): inverse dynamics
 /// (straight-line), `M^-1` and forward dynamics (straight-line, or composed at run time when
 /// that is large).
-pub fn derivatives(d: &Derivation, x: &Derivatives) -> Vec<Quantity> {
+pub fn derivatives(d: &Derivation, x: &Derivatives, flat_max_ops: usize) -> Vec<Quantity> {
     let n = d.dof;
     let mut both = flat(&x.inverse.dq);
     both.extend(flat(&x.inverse.dqd));
@@ -548,7 +548,7 @@ pub fn derivatives(d: &Derivation, x: &Derivatives) -> Vec<Quantity> {
     fd.extend(&minv);
     let factored = |outputs: Vec<Id>| {
         let all: Vec<Id> = outputs.iter().chain(&x.pivots).copied().collect();
-        (ops(&d.graph, &all) <= DERIVATIVES_FLAT_MAX_OPS).then(|| Evaluation::Factored {
+        (ops(&d.graph, &all) <= flat_max_ops).then(|| Evaluation::Factored {
             outputs,
             pivots: x.pivots.clone(),
         })
