@@ -141,27 +141,17 @@ impl<T: Real, const NV: usize, const K: usize> ImpulseDynamicsDerivatives<T, NV,
     }
 }
 
-/// Whether `factors` holds `M` itself or already its `L^T D L` factors.
-#[derive(Clone, Copy, PartialEq, Eq)]
-enum Held {
-    Matrix,
-    Factors,
-}
-
-/// Factorizes the system whose mass matrix and contact Jacobian are in `factors` and `j`, in
-/// place (`M`'s `L^T D L` factors, unless `held` says they are there already; the inactive
-/// rows of `J` zeroed), writes `Y = M^-1 J^T` into `y` (row `k` a column) and returns the
-/// Cholesky factor of `J M^-1 J^T` (the identity's rows and columns for inactive rows).
+/// Completes the system whose `M`'s `L^T D L` factors and contact Jacobian are in `factors`
+/// and `j`: zeroes the inactive rows of `J`, writes `Y = M^-1 J^T` into `y` (row `k` a column)
+/// and returns the Cholesky factor of `J M^-1 J^T` (the identity's rows and columns for
+/// inactive rows).
 fn factorize<T: Real, const N: usize, const K: usize>(
-    factors: &mut [[T; N]; N],
+    factors: &[[T; N]; N],
     j: &mut [[T; N]; K],
     y: &mut [[T; N]; K],
-    (parent, held): (&[Option<usize>; N], Held),
+    parent: &[Option<usize>; N],
     active: &[bool; K],
 ) -> Result<Cholesky<T, K>, FactorError> {
-    if held == Held::Matrix {
-        ltdl_factor(factors, parent)?;
-    }
     for (jk, on) in j.iter_mut().zip(active) {
         if !*on {
             *jk = [T::zero(); N];
@@ -373,11 +363,11 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
         parent: &[Option<usize>; N],
         active: &[bool; K],
     ) -> Result<(), FactorError> {
-        let fill = |m: &mut _, j: &mut _| {
+        let fill = |m: &mut [[T; N]; N], j: &mut _| {
             fill(m, j);
-            Ok(())
+            ltdl_factor(m, parent)
         };
-        self.set_up_holding(fill, (parent, Held::Matrix), active)
+        self.set_up_factored(fill, parent, active)
     }
 
     /// [`ContactKkt::set_up`] for a `fill` that writes `M`'s `L^T D L` factors over the
@@ -403,22 +393,11 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
         parent: &[Option<usize>; N],
         active: &[bool; K],
     ) -> Result<(), FactorError> {
-        self.set_up_holding(fill, (parent, Held::Factors), active)
-    }
-
-    /// [`ContactKkt::set_up`] and [`ContactKkt::set_up_factored`]: `held` says what `fill`
-    /// writes.
-    fn set_up_holding(
-        &mut self,
-        fill: impl FnOnce(&mut [[T; N]; N], &mut [[T; N]; K]) -> Result<(), FactorError>,
-        (parent, held): (&[Option<usize>; N], Held),
-        active: &[bool; K],
-    ) -> Result<(), FactorError> {
         fill(&mut self.factors, &mut self.j)?;
         self.parent = *parent;
         self.active = *active;
         let (factors, j, y) = (&mut self.factors, &mut self.j, &mut self.y);
-        self.lambda = factorize(factors, j, y, (parent, held), active)?;
+        self.lambda = factorize(factors, j, y, parent, active)?;
         Ok(())
     }
 
@@ -443,11 +422,11 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
         parent: &[Option<usize>; N],
         active: &[bool; K],
     ) -> Result<KktStash<T, N, K>, FactorError> {
-        let fill = |m: &mut _, j: &mut _| {
+        let fill = |m: &mut [[T; N]; N], j: &mut _| {
             fill(m, j);
-            Ok(())
+            ltdl_factor(m, parent)
         };
-        Self::set_up_in_holding(d, fill, (parent, Held::Matrix), active)
+        Self::set_up_in_factored(d, fill, parent, active)
     }
 
     /// [`ContactKkt::set_up_in`] for a `fill` that writes `M`'s factors, as
@@ -471,16 +450,6 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
         parent: &[Option<usize>; N],
         active: &[bool; K],
     ) -> Result<KktStash<T, N, K>, FactorError> {
-        Self::set_up_in_holding(d, fill, (parent, Held::Factors), active)
-    }
-
-    /// [`ContactKkt::set_up_in`] and [`ContactKkt::set_up_in_factored`].
-    fn set_up_in_holding(
-        d: &mut ContactDynamicsDerivatives<T, N, K>,
-        fill: impl FnOnce(&mut [[T; N]; N], &mut [[T; N]; K]) -> Result<(), FactorError>,
-        (parent, held): (&[Option<usize>; N], Held),
-        active: &[bool; K],
-    ) -> Result<KktStash<T, N, K>, FactorError> {
         fill(&mut d.da_dtau, &mut d.df_dtau)?;
         let mut stash = KktStash {
             parent: *parent,
@@ -489,7 +458,7 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
             active: *active,
         };
         let (m, j, y) = (&mut d.da_dtau, &mut d.df_dtau, &mut stash.y);
-        stash.lambda = factorize(m, j, y, (parent, held), active)?;
+        stash.lambda = factorize(m, j, y, parent, active)?;
         Ok(stash)
     }
 

@@ -70,8 +70,7 @@ pub trait Lane: Copy + Debug + Default + Arithmetic + 'static {
     /// scalar; [`Lane::sin_cos`] element by element by default).
     #[inline(always)]
     fn sin_cos_many<const K: usize>(x: [Self; K]) -> ([Self; K], [Self; K]) {
-        let pairs = x.map(Self::sin_cos);
-        (pairs.map(|p| p.0), pairs.map(|p| p.1))
+        crate::trig::each(x, Self::sin_cos)
     }
     /// Square root, lane-wise; NaN for negative lanes.
     fn sqrt(self) -> Self;

@@ -60,8 +60,7 @@ pub trait Real:
     /// ```
     #[inline(always)]
     fn sin_cos_many<const K: usize>(x: [Self; K]) -> ([Self; K], [Self; K]) {
-        let pairs = x.map(Self::sin_cos);
-        (pairs.map(|p| p.0), pairs.map(|p| p.1))
+        crate::trig::each(x, Self::sin_cos)
     }
     /// Four-quadrant arctangent of `self / x` (`self` is y), in `[-pi, pi]`.
     fn atan2(self, x: Self) -> Self;
@@ -214,8 +213,7 @@ impl_real!(
 /// mostly runs on microcontrollers, whose FPU has no vector unit and no double precision).
 #[inline(always)]
 fn sin_cos_each<const K: usize>(x: [f32; K]) -> ([f32; K], [f32; K]) {
-    let pairs = x.map(libm::sincosf);
-    (pairs.map(|p| p.0), pairs.map(|p| p.1))
+    crate::trig::each(x, libm::sincosf)
 }
 
 /// `x * a + b`, fused where the target has an FMA instruction, known at compile time.

@@ -51,6 +51,17 @@ const ROUNDER: f64 = 6_755_399_441_055_744.0;
 /// angle's absolute error below `1e-20`.
 pub const REDUCED_MAX: f64 = 1.0e5;
 
+/// `(sin x_i, cos x_i)` by `sin_cos` element by element: the default of
+/// [`crate::Real::sin_cos_many`] and [`crate::Lane::sin_cos_many`], and `f32`'s.
+#[inline(always)]
+pub(crate) fn each<T: Copy, const K: usize>(
+    x: [T; K],
+    sin_cos: impl Fn(T) -> (T, T),
+) -> ([T; K], [T; K]) {
+    let pairs = x.map(sin_cos);
+    (pairs.map(|p| p.0), pairs.map(|p| p.1))
+}
+
 /// `a * b + c`, one instruction where the target has FMA.
 #[inline(always)]
 fn fma(a: f64, b: f64, c: f64) -> f64 {

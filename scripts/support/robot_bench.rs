@@ -142,10 +142,14 @@ fn benches() -> Vec<Bench> {
 /// The link whose frame the frame kinematics are timed at: `ROBOT_BENCH_LINK` from the build
 /// script, the first contact link as pinbench's; without contacts the last link (pinbench
 /// then takes Pinocchio's last frame, which may be another).
+/// Looked up by name once, not inside the timed calls.
 fn bench_link() -> RobotLink {
-    let name = env!("ROBOT_BENCH_LINK");
-    let last = RobotLink::ALL[RobotLink::ALL.len() - 1];
-    RobotLink::ALL.into_iter().find(|l| l.name() == name).unwrap_or(last)
+    static LINK: std::sync::OnceLock<RobotLink> = std::sync::OnceLock::new();
+    *LINK.get_or_init(|| {
+        let name = env!("ROBOT_BENCH_LINK");
+        let last = RobotLink::ALL[RobotLink::ALL.len() - 1];
+        RobotLink::ALL.into_iter().find(|l| l.name() == name).unwrap_or(last)
+    })
 }
 
 /// The MPC kit's frame kinematics and manifold, with a floating base the centroidal rate, with

@@ -99,10 +99,11 @@ impl Factors {
         }
         let mut inv = vec![vec![g.zero(); n]; n];
         for i in 0..n {
-            let mine: Vec<(usize, Id)> = self.coordinates(i).zip(x[i].iter().copied()).collect();
-            let scaled: Vec<(usize, Id)> = mine
-                .iter()
-                .map(|&(k, v)| (k, g.mul(v, self.inv_d[k])))
+            // Y_ik = X_ik / D_k over i's coordinates.
+            let scaled: Vec<(usize, Id)> = self
+                .coordinates(i)
+                .zip(&x[i])
+                .map(|(k, &v)| (k, g.mul(v, self.inv_d[k])))
                 .collect();
             for j in i..n {
                 let pairs: Vec<(Id, Id)> = self
