@@ -98,8 +98,13 @@ pub fn integrate_blocks<T: Lane, const NQ: usize, const NV: usize>(
 
 /// The rotation of a unit quaternion (x, y, z, w).
 pub fn rotation<T: Lane>(q: &[T; 4]) -> [[T; 3]; 3] {
+    rotation_scaled(q, T::from_f64(2.0))
+}
+
+/// The rotation of the quaternion `q` (x, y, z, w) of squared norm `n2`, given `two = 2 / n2`:
+/// no square root, no normalization.
+pub(crate) fn rotation_scaled<T: Lane>(q: &[T; 4], two: T) -> [[T; 3]; 3] {
     let (x, y, z, w) = (q[0], q[1], q[2], q[3]);
-    let two = T::from_f64(2.0);
     let one = T::one();
     [
         [
@@ -126,7 +131,7 @@ pub(crate) fn exp_so3<T: Lane>(w: &[T; 3]) -> ([T; 4], [[T; 3]; 3]) {
     let t2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
     let t = t2.sqrt();
     let half = T::from_f64(0.5);
-    let (s, c) = (t * half).sin_cos();
+    let ([s], [c]) = T::sin_cos_many([t * half]);
     // sin(t/2)/t, (1 - cos t)/t^2, (t - sin t)/t^3: the series where t^2 < 1e-8 (lane-wise
     // for a vector of states, each lane from its own branch).
     let series = || {
@@ -136,9 +141,12 @@ pub(crate) fn exp_so3<T: Lane>(w: &[T; 3]) -> ([T; 4], [[T; 3]; 3]) {
             T::from_f64(1.0 / 6.0) - t2 / T::from_f64(120.0),
         )
     };
+    // sin t = 2 sin(t/2) cos(t/2) and 1 - cos t = 2 sin(t/2)^2: no second sine and cosine
+    // (and no cancellation in 1 - cos t).
     let exact = || {
-        let (st, ct) = t.sin_cos();
-        (s / t, (T::one() - ct) / t2, (t - st) / (t2 * t))
+        let two = T::from_f64(2.0);
+        let st = two * s * c;
+        (s / t, two * s * s / t2, (t - st) / (t2 * t))
     };
     let small = T::from_f64(1e-8).gt(t2);
     let (k, a, b) = if T::all(small) {

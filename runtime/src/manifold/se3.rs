@@ -1,0 +1,311 @@
+//! The free flyer's closed forms behind [`super`]: the SE(3) logarithm of the relative pose of
+//! two configurations, and the 6 x 6 blocks of `dIntegrate` and `dDifference` (the inverse
+//! adjoint, the right Jacobian of `exp6` and its inverse), built from 3 x 3 blocks.
+//!
+//! Every function of the rotation angle `theta` comes from the sine and cosine of its half:
+//! the relative quaternion holds them already (scaled by its norm, which cancels), and
+//! `dIntegrate` takes one `sin_cos` of `theta / 2`. Nothing normalizes a quaternion: the
+//! rotation of `M0^-1 M1` is scaled by `2 / |q|^2` instead.
+
+use super::atan::atan2_quadrant;
+use crate::free_flyer::{quat_mul, rotation, rotation_scaled};
+use crate::Real;
+
+pub(super) type M3<T> = [[T; 3]; 3];
+pub(super) type M6<T> = [[T; 6]; 6];
+
+/// `M0^-1 M1` of two free flyers' coordinates (7 entries each) and its logarithm
+/// `log6 = (rho, phi)`.
+pub(super) struct Relative<T> {
+    /// The translation part of the logarithm.
+    pub rho: [T; 3],
+    /// The rotation vector, of angle `theta` in `[0, pi]`.
+    pub phi: [T; 3],
+    /// The relative quaternion (x, y, z, w), `w >= 0`, not normalized.
+    quat: [T; 4],
+    /// `|quat|^2`.
+    n2: T,
+    /// `|(x, y, z)|`: `sin(theta / 2)` times the norm, as `w` is `cos(theta / 2)` times it.
+    s: T,
+    /// `theta^2`.
+    t2: T,
+    /// `theta`.
+    theta: T,
+    /// `c` of `V(phi)^-1 = I - phi^/2 + c phi^2`.
+    c: T,
+    /// The relative translation, in the axes of `q0`'s base.
+    t: [T; 3],
+}
+
+impl<T: Real> Relative<T> {
+    /// The relative pose of the bases whose coordinates (position, quaternion x, y, z, w)
+    /// start `q0` and `q1`; `q1`'s quaternion may have either sign.
+    #[inline]
+    pub(super) fn new(q0: &[T], q1: &[T]) -> Self {
+        let f = T::from_f64;
+        let a = [q0[3], q0[4], q0[5], q0[6]];
+        let b = [q1[3], q1[4], q1[5], q1[6]];
+        let mut quat = quat_mul(&[-a[0], -a[1], -a[2], a[3]], &b);
+        // The same rotation with w >= 0: its angle is in [0, pi].
+        if quat[3] < T::zero() {
+            quat = [-quat[0], -quat[1], -quat[2], -quat[3]];
+        }
+        let w = quat[3];
+        let s2 = quat[0] * quat[0] + quat[1] * quat[1] + quat[2] * quat[2];
+        let n2 = s2 + w * w;
+        let s = s2.sqrt();
+        let theta = f(2.0) * atan2_quadrant(s, w);
+        // phi = (x, y, z) theta / s, free of the norm; its series near the zero rotation.
+        let k = if s2 < f(1e-12) * n2 {
+            f(2.0) / w * (T::one() - s2 / (f(3.0) * w * w))
+        } else {
+            theta / s
+        };
+        let phi = [quat[0] * k, quat[1] * k, quat[2] * k];
+        let t2 = theta * theta;
+        // c = 1/theta^2 - (1 + cos)/(2 theta sin) = 1/theta^2 - w/(2 theta s).
+        let c = if t2 < f(1e-4) {
+            f(1.0 / 12.0) + t2 / f(720.0) + t2 * t2 / f(30240.0)
+        } else {
+            T::one() / t2 - w / (f(2.0) * theta * s)
+        };
+        let r0 = rotation(&a);
+        let dp = [q1[0] - q0[0], q1[1] - q0[1], q1[2] - q0[2]];
+        let t = mat_vec(&transpose(&r0), &dp);
+        let pt = cross(&phi, &t);
+        let ppt = cross(&phi, &pt);
+        let half = f(0.5);
+        let entry = |i: usize| t[i] - half * pt[i] + c * ppt[i];
+        let rho = [entry(0), entry(1), entry(2)];
+        Self {
+            rho,
+            phi,
+            quat,
+            n2,
+            s,
+            t2,
+            theta,
+            c,
+            t,
+        }
+    }
+}
+
+/// The functions of a rotation vector's angle `theta` that the Jacobians use.
+struct Coefficients<T> {
+    /// `sin / theta`.
+    sinc: T,
+    /// `(1 - cos) / theta^2`.
+    a: T,
+    /// `(theta - sin) / theta^3`.
+    b: T,
+    /// `a'(theta) / theta`.
+    da: T,
+    /// `b'(theta) / theta`.
+    db: T,
+}
+
+/// [`Coefficients`] from `theta^2`, `theta`, `sin theta` and `1 - cos theta`; their series
+/// where `theta^2 < 1e-4`.
+#[inline]
+fn coefficients<T: Real>(t2: T, theta: T, sin: T, vers: T) -> Coefficients<T> {
+    if t2 < T::from_f64(1e-4) {
+        series(t2)
+    } else {
+        exact(t2, theta, sin, vers)
+    }
+}
+
+/// [`Coefficients`] by their Taylor series in `theta^2`, to `theta^4`.
+fn series<T: Real>(t2: T) -> Coefficients<T> {
+    let f = T::from_f64;
+    let t4 = t2 * t2;
+    Coefficients {
+        sinc: T::one() - t2 / f(6.0) + t4 / f(120.0),
+        a: f(0.5) - t2 / f(24.0) + t4 / f(720.0),
+        b: f(1.0 / 6.0) - t2 / f(120.0) + t4 / f(5040.0),
+        da: f(-1.0 / 12.0) + t2 / f(180.0) - t4 / f(6720.0),
+        db: f(-1.0 / 60.0) + t2 / f(1260.0) - t4 / f(30240.0),
+    }
+}
+
+/// [`Coefficients`] by their closed forms.
+fn exact<T: Real>(t2: T, theta: T, sin: T, vers: T) -> Coefficients<T> {
+    let f = T::from_f64;
+    let (r1, r2) = (T::one() / theta, T::one() / t2);
+    let r4 = r2 * r2;
+    let gap = theta - sin;
+    Coefficients {
+        sinc: sin * r1,
+        a: vers * r2,
+        b: gap * r2 * r1,
+        da: (theta * sin - f(2.0) * vers) * r4,
+        db: (vers * theta - f(3.0) * gap) * r4 * r1,
+    }
+}
+
+/// A free flyer's blocks of `dIntegrate` at its velocity `v` (6 entries):
+/// `Ad(exp6(v))^-1` and the right Jacobian of `exp6` at `v`,
+/// `[[Jr3, R^T D], [0, Jr3]]` with `Jr3 = I - a phi^ + b phi^2` and `D` the derivative of
+/// `V(phi) rho` in `phi`.
+pub(super) fn integrate_jacobians<T: Real>(v: &[T]) -> (M6<T>, M6<T>) {
+    let f = T::from_f64;
+    let rho = [v[0], v[1], v[2]];
+    let phi = [v[3], v[4], v[5]];
+    let t2 = phi[0] * phi[0] + phi[1] * phi[1] + phi[2] * phi[2];
+    let theta = t2.sqrt();
+    let ([sh], [ch]) = T::sin_cos_many([theta * f(0.5)]);
+    let k = coefficients(t2, theta, f(2.0) * sh * ch, f(2.0) * sh * sh);
+    let h = hat(&phi);
+    let h2 = hat_squared(&phi, t2);
+    let r = combine(&h, &h2, k.sinc, k.a);
+    let t = mat_vec(&combine(&h, &h2, k.a, k.b), &rho);
+    let jr = combine(&h, &h2, -k.a, k.b);
+    let q = mat_mul(&transpose(&r), &dv_dphi(&rho, &phi, &k));
+    (inverse_action(&r, &t), blocks(&jr, &q, &jr))
+}
+
+/// A free flyer's blocks of `dDifference` from its coordinates in `q0` and `q1` (7 entries
+/// each): `-Jlog6(M) Ad(M)^-1` and `Jlog6(M)`, `M = M0^-1 M1`, `Jlog6` the inverse of the
+/// right Jacobian, `[[J, -J Q J], [0, J]]` with `J = Jr3^-1 = I + phi^/2 + c phi^2` and
+/// `Q = R^T D`. With `P = J R^T`, the first is `[[-P, P t^ + J Q J R^T], [0, -P]]`.
+pub(super) fn difference_jacobians<T: Real>(q0: &[T], q1: &[T]) -> (M6<T>, M6<T>) {
+    let rel = Relative::new(q0, q1);
+    let two_n2 = T::from_f64(2.0) / rel.n2;
+    let rt = transpose(&rotation_scaled(&rel.quat, two_n2));
+    let (s, w) = (rel.s, rel.quat[3]);
+    let k = coefficients(rel.t2, rel.theta, two_n2 * s * w, two_n2 * s * s);
+    let h = hat(&rel.phi);
+    let h2 = hat_squared(&rel.phi, rel.t2);
+    let j = combine(&h, &h2, T::from_f64(0.5), rel.c);
+    let q = mat_mul(&rt, &dv_dphi(&rel.rho, &rel.phi, &k));
+    let jqj = mat_mul(&mat_mul(&j, &q), &j);
+    let p = mat_mul(&j, &rt);
+    let pt = mat_mul(&p, &hat(&rel.t));
+    let jqjr = mat_mul(&jqj, &rt);
+    let d0_top = each(|i, c| pt[i][c] + jqjr[i][c]);
+    let minus_p = negated(&p);
+    (
+        blocks(&minus_p, &d0_top, &minus_p),
+        blocks(&j, &negated(&jqj), &j),
+    )
+}
+
+/// `d (V(phi) rho) / d phi` with `V = I + a phi^ + b phi^2`:
+/// `-a rho^ + (a'/theta) (phi x rho) phi^T + b ((phi.rho) I + phi rho^T - 2 rho phi^T)
+/// + (b'/theta) (phi x (phi x rho)) phi^T`.
+fn dv_dphi<T: Real>(rho: &[T; 3], phi: &[T; 3], k: &Coefficients<T>) -> M3<T> {
+    let pr = cross(phi, rho);
+    let ppr = cross(phi, &pr);
+    let dot = phi[0] * rho[0] + phi[1] * rho[1] + phi[2] * rho[2];
+    let rh = hat(rho);
+    let two = T::from_f64(2.0);
+    each(|i, j| {
+        let id = if i == j { dot } else { T::zero() };
+        let sym = id + phi[i] * rho[j] - two * rho[i] * phi[j];
+        -k.a * rh[i][j] + (k.da * pr[i] + k.db * ppr[i]) * phi[j] + k.b * sym
+    })
+}
+
+/// `Ad((R, t))^-1 = [[R^T, -R^T t^], [0, R^T]]` on [linear; angular] vectors.
+fn inverse_action<T: Real>(r: &M3<T>, t: &[T; 3]) -> M6<T> {
+    let rt = transpose(r);
+    let top = negated(&mat_mul(&rt, &hat(t)));
+    blocks(&rt, &top, &rt)
+}
+
+/// `[[a, b], [0, c]]`.
+fn blocks<T: Real>(a: &M3<T>, b: &M3<T>, c: &M3<T>) -> M6<T> {
+    let mut m = [[T::zero(); 6]; 6];
+    for i in 0..3 {
+        for j in 0..3 {
+            m[i][j] = a[i][j];
+            m[i][3 + j] = b[i][j];
+            m[3 + i][3 + j] = c[i][j];
+        }
+    }
+    m
+}
+
+/// `I + x h + y h2`.
+fn combine<T: Real>(h: &M3<T>, h2: &M3<T>, x: T, y: T) -> M3<T> {
+    each(|i, j| {
+        let id = if i == j { T::one() } else { T::zero() };
+        id + x * h[i][j] + y * h2[i][j]
+    })
+}
+
+/// The 3 x 3 matrix of `entry(i, j)`, written out (no closure calls left for the optimizer to
+/// inline, as `core::array::from_fn`'s were not).
+#[inline(always)]
+fn each<T: Real>(entry: impl Fn(usize, usize) -> T) -> M3<T> {
+    let mut m = [[T::zero(); 3]; 3];
+    for (i, row) in m.iter_mut().enumerate() {
+        for (j, x) in row.iter_mut().enumerate() {
+            *x = entry(i, j);
+        }
+    }
+    m
+}
+
+fn hat<T: Real>(w: &[T; 3]) -> M3<T> {
+    let z = T::zero();
+    [[z, -w[2], w[1]], [w[2], z, -w[0]], [-w[1], w[0], z]]
+}
+
+/// `hat(w)^2 = w w^T - |w|^2 I`, given `t2 = |w|^2`.
+fn hat_squared<T: Real>(w: &[T; 3], t2: T) -> M3<T> {
+    each(|i, j| {
+        let d = if i == j { t2 } else { T::zero() };
+        w[i] * w[j] - d
+    })
+}
+
+fn cross<T: Real>(a: &[T; 3], b: &[T; 3]) -> [T; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn negated<T: Real>(m: &M3<T>) -> M3<T> {
+    each(|i, j| -m[i][j])
+}
+
+fn transpose<T: Real>(m: &M3<T>) -> M3<T> {
+    each(|i, j| m[j][i])
+}
+
+fn mat_mul<T: Real>(a: &M3<T>, b: &M3<T>) -> M3<T> {
+    each(|i, j| a[i][0] * b[0][j] + a[i][1] * b[1][j] + a[i][2] * b[2][j])
+}
+
+fn mat_vec<T: Real>(m: &M3<T>, v: &[T; 3]) -> [T; 3] {
+    let row = |i: usize| m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2];
+    [row(0), row(1), row(2)]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The series and the closed forms agree where one hands over to the other.
+    #[test]
+    fn series_meets_closed_forms() {
+        for t2 in [0.6e-4_f64, 1e-4] {
+            let theta = t2.sqrt();
+            let (s, c) = theta.sin_cos();
+            let (x, y) = (series(t2), exact(t2, theta, s, 1.0 - c));
+            for (a, b, tol) in [
+                (x.sinc, y.sinc, 1e-14),
+                (x.a, y.a, 1e-11),
+                (x.b, y.b, 1e-9),
+                (x.da, y.da, 1e-7),
+                (x.db, y.db, 1e-5),
+            ] {
+                assert!((a - b).abs() <= tol * b.abs(), "{a} vs {b} at {t2}");
+            }
+        }
+    }
+}
