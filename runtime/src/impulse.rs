@@ -14,7 +14,7 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
     pub fn impulse(&self, v: &[T; N], e: T) -> Result<([T; N], [T; K]), FactorError> {
         let k = -(T::one() + e);
         let bottom: [T; K] = core::array::from_fn(|r| k * dot(&self.jacobian()[r], v));
-        let (mut dv, p) = self.solve(&[T::zero(); N], &bottom)?;
+        let (mut dv, p) = self.solve_bottom(&bottom)?;
         for (x, vi) in dv.iter_mut().zip(v) {
             *x += *vi;
         }

@@ -209,9 +209,17 @@ struct Parts<'a, T, const N: usize, const K: usize> {
 }
 
 impl<T: Real, const N: usize, const K: usize> Parts<'_, T, N, K> {
-    /// [`ContactKkt::solve`].
-    fn solve(&self, top: &[T; N], bottom: &[T; K]) -> Result<([T; N], [T; K]), FactorError> {
-        let mut x = ltdl_substitute(self.factors, self.parent, top);
+    /// [`ContactKkt::solve`]; `top = None` stands for zeros (impulse dynamics), whose
+    /// substitution through `M` is skipped.
+    fn solve(
+        &self,
+        top: Option<&[T; N]>,
+        bottom: &[T; K],
+    ) -> Result<([T; N], [T; K]), FactorError> {
+        let mut x = match top {
+            Some(top) => ltdl_substitute(self.factors, self.parent, top),
+            None => [T::zero(); N],
+        };
         let mut b = *bottom;
         for ((bk, jk), on) in b.iter_mut().zip(self.j).zip(self.active) {
             *bk = if *on { *bk - dot(jk, &x) } else { T::zero() };
@@ -259,7 +267,7 @@ impl<T: Real, const N: usize, const K: usize> KktStash<T, N, K> {
             lambda: &self.lambda,
             active: &self.active,
         };
-        parts.solve(top, bottom)
+        parts.solve(Some(top), bottom)
     }
 
     /// [`ContactKkt::contact_dynamics_derivatives_in_place`] of the system stashed in `d`,
@@ -488,15 +496,25 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
     /// dynamics is `solve(tau - h, -drift)`; a non-finite component of `x` (`pivot < N`) or
     /// `f` (`N + k`) is an error.
     pub fn solve(&self, top: &[T; N], bottom: &[T; K]) -> Result<([T; N], [T; K]), FactorError> {
-        let parts = Parts {
+        self.parts().solve(Some(top), bottom)
+    }
+
+    /// [`ContactKkt::solve`] with `top = 0`: `x = M^-1 J^T f`, with no substitution of the
+    /// zeros through `M` (impulse dynamics' system).
+    pub fn solve_bottom(&self, bottom: &[T; K]) -> Result<([T; N], [T; K]), FactorError> {
+        self.parts().solve(None, bottom)
+    }
+
+    /// The system's arrays, for [`Parts`]' methods.
+    fn parts(&self) -> Parts<'_, T, N, K> {
+        Parts {
             factors: &self.factors,
             parent: &self.parent,
             j: &self.j,
             y: &self.y,
             lambda: &self.lambda,
             active: &self.active,
-        };
-        parts.solve(top, bottom)
+        }
     }
 
     /// Solves the system for `C` right-hand sides at once, the columns of `top` (N x C) and
