@@ -2,14 +2,15 @@
 //! of `M a + h = tau + J^T F`, `J a + drift = 0`.
 //!
 //! `M` is factorized once with the tree's sparse `L^T D L` ([`crate::tree::ltdl_factor`]);
-//! then `Y = M^-1 J^T` (one substitution of all contact rows at once,
-//! [`crate::tree::ltdl_substitute_rows`]), the contact-space inverse inertia
-//! `J M^-1 J^T` by Cholesky ([`Cholesky`]), `F = -(J M^-1 J^T)^-1 (drift + J M^-1 (tau - h))`
-//! and `a = M^-1 (tau - h) + Y F`. Everything is in fixed-size arrays on the stack.
+//! then `W = L^-T J^T` (the first half of a substitution, all contact rows at once), the
+//! contact-space inverse inertia `J M^-1 J^T = W^T D^-1 W` by Cholesky ([`Cholesky`]),
+//! `F = -(J M^-1 J^T)^-1 (drift + J M^-1 (tau - h))` and `a = M^-1 (tau - h + J^T F)`: one
+//! more substitution of one vector (generated code passes its unrolled one), not the K columns
+//! of `M^-1 J^T`. Everything is in fixed-size arrays on the stack.
 
 pub use crate::baumgarte::{log3, placement, Baumgarte};
 use crate::linalg::{Cholesky, FactorError};
-use crate::tree::{ltdl_factor, ltdl_substitute, ltdl_substitute_rows};
+use crate::tree::{ltdl_factor, ltdl_lower_rows, ltdl_substitute};
 use crate::Real;
 
 /// Solves the contact forward dynamics for `rhs = tau - h` (`h = b + G`, friction included),
@@ -91,35 +92,36 @@ pub fn solve_factored_active<T: Real, const N: usize, const K: usize>(
     drift: &[T; K],
     active: &[bool; K],
 ) -> Result<([T; N], [T; K]), FactorError> {
-    // Y = M^-1 J^T (N x K), all K columns in one substitution; inactive columns zero.
-    let mut y = [[T::zero(); K]; N];
-    for (i, yi) in y.iter_mut().enumerate() {
-        for ((yik, jk), on) in yi.iter_mut().zip(j).zip(active) {
-            if *on {
-                *yik = jk[i];
-            }
-        }
-    }
-    ltdl_substitute_rows(m, parent, &mut y);
-    let mut lambda = [[T::zero(); K]; K];
-    for (r, (jr, lr)) in j.iter().zip(lambda.iter_mut()).enumerate() {
-        if !active[r] {
-            lr[r] = T::one();
-            continue;
-        }
-        for (jri, yi) in jr.iter().zip(&y) {
-            for (l, yic) in lr.iter_mut().zip(yi) {
-                *l = jri.mul_add(*yic, *l);
-            }
-        }
-    }
-    let shift = |e: FactorError| match e {
-        FactorError::NotPositiveDefinite { pivot } => {
-            FactorError::NotPositiveDefinite { pivot: N + pivot }
-        }
-        FactorError::NonFinite { pivot } => FactorError::NonFinite { pivot: N + pivot },
-    };
-    let chol = Cholesky::new(lambda).map_err(shift)?;
+    let substitute = |b: &[T; N]| ltdl_substitute(m, parent, b);
+    solve_factored_active_with(m, parent, free, j, drift, active, substitute)
+}
+
+/// [`solve_factored_active`] with the caller's own `M^-1 b` from the factors in `m`
+/// (`substitute`): generated code passes its unrolled substitution, for the one
+/// `M^-1 J^T F` the solve needs.
+///
+/// ```
+/// use eomgen_runtime::contact::solve_factored_active_with;
+/// use eomgen_runtime::tree::ltdl_substitute;
+/// // The point mass of `solve`, M = I already factorized.
+/// let (m, parent) = ([[1.0_f64, 0.0], [0.0, 1.0]], [None, None]);
+/// let j = [[1.0, 0.0], [0.0, 1.0]];
+/// let substitute = |b: &[f64; 2]| ltdl_substitute(&m, &parent, b);
+/// let (a, f) =
+///     solve_factored_active_with(&m, &parent, &[0.0, -9.81], &j, &[0.0; 2], &[true; 2], substitute)
+///         .unwrap();
+/// assert!(a[1].abs() < 1e-12 && (f[1] - 9.81).abs() < 1e-12);
+/// ```
+pub fn solve_factored_active_with<T: Real, const N: usize, const K: usize>(
+    m: &[[T; N]; N],
+    parent: &[Option<usize>; N],
+    free: &[T; N],
+    j: &[[T; N]; K],
+    drift: &[T; K],
+    active: &[bool; K],
+    substitute: impl Fn(&[T; N]) -> [T; N],
+) -> Result<([T; N], [T; K]), FactorError> {
+    let chol = contact_space(m, parent, j, active)?;
     let mut b = [T::zero(); K];
     for k in 0..K {
         if active[k] {
@@ -127,11 +129,18 @@ pub fn solve_factored_active<T: Real, const N: usize, const K: usize>(
         }
     }
     let f = chol.solve(&b);
-    let mut a = *free;
-    for (ai, yi) in a.iter_mut().zip(&y) {
-        for (yik, fk) in yi.iter().zip(&f) {
-            *ai = yik.mul_add(*fk, *ai);
+    // a = free + M^-1 (J^T f).
+    let mut jtf = [T::zero(); N];
+    for ((jk, fk), on) in j.iter().zip(&f).zip(active) {
+        if *on {
+            for (x, y) in jtf.iter_mut().zip(jk) {
+                *x = fk.mul_add(*y, *x);
+            }
         }
+    }
+    let mut a = substitute(&jtf);
+    for (ai, fi) in a.iter_mut().zip(free) {
+        *ai += *fi;
     }
     if let Some(pivot) = a.iter().position(|x| !x.is_finite()) {
         return Err(FactorError::NonFinite { pivot });
@@ -140,6 +149,53 @@ pub fn solve_factored_active<T: Real, const N: usize, const K: usize>(
         return Err(FactorError::NonFinite { pivot: N + k });
     }
     Ok((a, f))
+}
+
+/// The Cholesky factor of `J M^-1 J^T = W^T D^-1 W` with `W = L^-T J^T` (the inactive rows of
+/// `J` as zero; the identity's rows and columns for them), from `M`'s factors `m`: half the
+/// substitution that `M^-1 J^T` would take.
+///
+/// Errors: a pivot of `J M^-1 J^T` that is not positive or not finite (pivot `N + k`).
+pub(crate) fn contact_space<T: Real, const N: usize, const K: usize>(
+    m: &[[T; N]; N],
+    parent: &[Option<usize>; N],
+    j: &[[T; N]; K],
+    active: &[bool; K],
+) -> Result<Cholesky<T, K>, FactorError> {
+    let mut w = [[T::zero(); K]; N];
+    for (i, wi) in w.iter_mut().enumerate() {
+        for ((wik, jk), on) in wi.iter_mut().zip(j).zip(active) {
+            if *on {
+                *wik = jk[i];
+            }
+        }
+    }
+    ltdl_lower_rows(m, parent, &mut w);
+    // W^T D^-1 W as N rank-one updates, one per coordinate: the K x K sums are independent
+    // chains the processor overlaps (gathered row by row, each row was a chain of N dependent
+    // multiply-adds, and they were a sixth of a quadruped's contact dynamics).
+    let mut lambda = [[T::zero(); K]; K];
+    for (i, wi) in w.iter().enumerate() {
+        let d = T::one() / m[i][i];
+        for (lr, wir) in lambda.iter_mut().zip(wi) {
+            let s = *wir * d;
+            for (l, x) in lr.iter_mut().zip(wi) {
+                *l = s.mul_add(*x, *l);
+            }
+        }
+    }
+    for (r, lr) in lambda.iter_mut().enumerate() {
+        if !active[r] {
+            lr[r] = T::one();
+        }
+    }
+    let shift = |e: FactorError| match e {
+        FactorError::NotPositiveDefinite { pivot } => {
+            FactorError::NotPositiveDefinite { pivot: N + pivot }
+        }
+        FactorError::NonFinite { pivot } => FactorError::NonFinite { pivot: N + pivot },
+    };
+    Cholesky::new(lambda).map_err(shift)
 }
 
 /// The contact rows (`K` of them) of the contacts (`C`) that `active` switches on, each

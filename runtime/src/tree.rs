@@ -516,6 +516,16 @@ pub fn ltdl_substitute_rows<T: Lane, const N: usize, const C: usize>(
     pull_from_ancestors::<T, N, C, false>(m, parent, x);
 }
 
+/// The first half of [`ltdl_substitute_rows`]: `x <- L^-T x` (from the leaves up), for
+/// products that need only `L^-T J^T` (`J M^-1 J^T = W^T D^-1 W` with `W = L^-T J^T`).
+pub(crate) fn ltdl_lower_rows<T: Lane, const N: usize, const C: usize>(
+    m: &[[T; N]; N],
+    parent: &[Option<usize>; N],
+    x: &mut [[T; C]; N],
+) {
+    pull_from_subtrees::<T, N, C, false>(m, parent, x);
+}
+
 /// `L^-T`: row `a` of `x` less `L[k][a]` times row `k` for every `k` of its subtree, from the
 /// last row up (those rows final by then). Each row is gathered in one accumulator, read once
 /// and written once ("pull"), rather than updated once per descendant ("push"): repeated

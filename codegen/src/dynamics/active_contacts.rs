@@ -54,7 +54,7 @@ pub(super) fn quantities(d: &Derivation) -> Vec<Quantity> {
                 "NaN in every entry when M(q) is not positive definite or the active rows of J_c are",
                 "rank-deficient; `try_contact_forward_dynamics_active` says why.",
             ],
-            &format!("M from `mass_matrix`, b + G by Newton-Euler, J_c and its drift, {kkt} (eomgen_runtime::contact::solve_factored_active)"),
+            &format!("M from `mass_matrix`, b + G by Newton-Euler, J_c and its drift, {kkt} (eomgen_runtime::contact::solve_factored_active_with)"),
             Evaluation::ActiveContacts(ActiveContacts::Dynamics { h: h() }),
         ),
         quantity(

@@ -177,7 +177,8 @@ impl Emitter<'_> {
                 let j = #j(self, q);
                 #drift
                 let rows = ::eomgen_runtime::contact::row_mask(&Self::CONTACT_ROWS, active);
-                ::eomgen_runtime::contact::solve_factored_active(&m, &Self::PARENTS, &free, &j, &drift, &rows)
+                let substitute = |b: &[T; #n]| Self::ltdl_substitute_unrolled(&m, b);
+                ::eomgen_runtime::contact::solve_factored_active_with(&m, &Self::PARENTS, &free, &j, &drift, &rows, substitute)
             }
 
             #docs

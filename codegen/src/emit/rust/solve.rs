@@ -345,7 +345,8 @@ impl Emitter<'_> {
             /// a rank-deficient contact Jacobian) that is not positive, or non-finite input.
             #try_vis fn try_contact_forward_dynamics(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n]) -> ::core::result::Result<([T; #n], [T; #k3]), ::eomgen_runtime::FactorError> {
                 #free
-                ::eomgen_runtime::contact::solve_factored(&m, &Self::PARENTS, &free, &#j(self, q), &#drift(self, q, qd))
+                let substitute = |b: &[T; #n]| Self::ltdl_substitute_unrolled(&m, b);
+                ::eomgen_runtime::contact::solve_factored_active_with(&m, &Self::PARENTS, &free, &#j(self, q), &#drift(self, q, qd), &[true; #k3], substitute)
             }
         };
         let inherent_try = if self.trait_of("try_contact_forward_dynamics").is_some() {
