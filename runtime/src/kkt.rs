@@ -170,19 +170,20 @@ fn factorize<T: Real, const N: usize, const K: usize>(
             *y = row[k];
         }
     }
-    // J Y^T row by row, each row gathered over the rows of Y^T (K columns at a time, in vector
-    // operations), not entry by entry as dot products: a dot product is a chain of N dependent
-    // multiply-adds, and the K^2 / 2 of them were a fifth of impulse dynamics on a quadruped.
-    // Inactive rows of J are zero; their diagonal becomes one.
+    // J Y^T as N rank-one updates (column i of J times row i of Y^T): the K x K sums are
+    // independent chains the processor overlaps, where K^2 / 2 dot products (a fifth of
+    // impulse dynamics on a quadruped), and then K rows each gathered over N dependent
+    // multiply-adds, were chains. Inactive rows of J are zero; their diagonal becomes one.
     let mut lambda = [[T::zero(); K]; K];
-    for ((r, lr), jr) in lambda.iter_mut().enumerate().zip(j.iter()) {
-        let mut acc = [T::zero(); K];
-        for (jri, yti) in jr.iter().zip(&yt) {
-            for (a, v) in acc.iter_mut().zip(yti) {
-                *a = jri.mul_add(*v, *a);
+    for (i, yti) in yt.iter().enumerate() {
+        for (lr, jr) in lambda.iter_mut().zip(j.iter()) {
+            let s = jr[i];
+            for (l, v) in lr.iter_mut().zip(yti) {
+                *l = s.mul_add(*v, *l);
             }
         }
-        *lr = acc;
+    }
+    for (r, lr) in lambda.iter_mut().enumerate() {
         if !active[r] {
             lr[r] = T::one();
         }
