@@ -5,6 +5,7 @@
 //! the impact `v+` satisfy `M (v+ - v) = J^T p` and `J v+ = -e J v`: the KKT system with
 //! `top = 0`, `bottom = -(1 + e) J v` gives `(v+ - v, p)`.
 
+use crate::contact::contact_space;
 use crate::kkt::{axpy, dot, finite_rows, negate, ContactKkt, ImpulseDynamicsDerivatives};
 use crate::{FactorError, Real};
 
@@ -76,4 +77,62 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
         finite_rows(&d.dimpulse_dv, N)?;
         Ok(())
     }
+}
+
+/// [`ContactKkt::impulse`] from `M`'s factors `m` (as [`crate::tree::ltdl_factor`] leaves
+/// them over the coordinate tree `parent`) and the contact Jacobian `j`, with only the rows
+/// of `active` taking part, and the caller's own `M^-1 b` (`substitute`; generated code passes
+/// its unrolled substitution): `p = -(1 + e) (J M^-1 J^T)^-1 J v` and
+/// `v+ = v + M^-1 J^T p`. No KKT system is built: `J M^-1 J^T` comes from half a
+/// substitution of the contact rows ([`crate::contact::solve_factored_active_with`] likewise),
+/// and `M^-1` meets the one vector `J^T p`, not the K columns of `M^-1 J^T`.
+///
+/// Errors as [`ContactKkt::impulse`], without the pivots of `M`.
+///
+/// ```
+/// use eomgen_runtime::impulse::solve_factored_active_with;
+/// use eomgen_runtime::tree::ltdl_substitute;
+/// // A unit point mass in the plane moving at (1, -2), hitting the ground (y) inelastically.
+/// let (m, parent) = ([[1.0_f64, 0.0], [0.0, 1.0]], [None, None]);
+/// let substitute = |b: &[f64; 2]| ltdl_substitute(&m, &parent, b);
+/// let (after, p) =
+///     solve_factored_active_with(&m, &parent, &[[0.0, 1.0]], &[1.0, -2.0], 0.0, &[true], substitute)
+///         .unwrap();
+/// assert_eq!((after, p), ([1.0, 0.0], [2.0]));
+/// ```
+pub fn solve_factored_active_with<T: Real, const N: usize, const K: usize>(
+    m: &[[T; N]; N],
+    parent: &[Option<usize>; N],
+    j: &[[T; N]; K],
+    v: &[T; N],
+    e: T,
+    active: &[bool; K],
+    substitute: impl Fn(&[T; N]) -> [T; N],
+) -> Result<([T; N], [T; K]), FactorError> {
+    let chol = contact_space(m, parent, j, active)?;
+    let k = -(T::one() + e);
+    let mut bottom = [T::zero(); K];
+    for ((b, jr), on) in bottom.iter_mut().zip(j).zip(active) {
+        if *on {
+            *b = k * dot(jr, v);
+        }
+    }
+    let p = chol.solve(&bottom);
+    let mut jtp = [T::zero(); N];
+    for ((jr, pr), on) in j.iter().zip(&p).zip(active) {
+        if *on {
+            axpy(&mut jtp, *pr, jr);
+        }
+    }
+    let mut after = substitute(&jtp);
+    if let Some(pivot) = after.iter().position(|x| !x.is_finite()) {
+        return Err(FactorError::NonFinite { pivot });
+    }
+    if let Some(r) = p.iter().position(|x| !x.is_finite()) {
+        return Err(FactorError::NonFinite { pivot: N + r });
+    }
+    for (x, vi) in after.iter_mut().zip(v) {
+        *x += *vi;
+    }
+    Ok((after, p))
 }

@@ -52,6 +52,8 @@
 //! - kernels that generated code loops over (module [`tree`]): poses and Jacobians along a
 //!   kinematic chain, Craig's `B(q)` and `C(q)` from the Christoffel-form Coriolis matrix;
 //!   a link frame's velocity, acceleration and Jacobian time variation (module [`frame`]);
+//! - contact dynamics (module [`contact`]), impulse dynamics (module [`impulse`]) and the KKT
+//!   system with their derivatives ([`ContactKkt`]), from a factorized mass matrix;
 //! - the configuration manifold (module [`manifold`]): `difference` and the Jacobians of
 //!   `integrate` and `difference`, for fixed and floating bases;
 //! - [`WithJointEffects`]: rotor inertia (armature), viscous and Coulomb joint friction added
@@ -94,7 +96,7 @@ mod floating;
 pub mod frame;
 pub mod free_flyer;
 mod hamiltonian;
-mod impulse;
+pub mod impulse;
 mod joint_effects;
 pub mod kkt;
 pub mod lane;

@@ -89,7 +89,7 @@ pub(super) fn quantities(d: &Derivation) -> Vec<Quantity> {
                 "",
                 "NaN in every entry as `impulse_dynamics`; `try_impulse_dynamics_active` says why.",
             ],
-            &format!("M from `mass_matrix`, J_c from `contact_jacobian`, {kkt} (eomgen_runtime::ContactKkt::new_active)"),
+            &format!("M from `mass_matrix`, J_c from `contact_jacobian`, {kkt} (eomgen_runtime::impulse::solve_factored_active_with)"),
             Evaluation::ActiveContacts(ActiveContacts::Impulse),
         ),
     ]

@@ -315,7 +315,8 @@ impl Emitter<'_> {
     pub(super) fn impulse_dynamics_fns(&mut self, q: &Quantity, active: bool) -> TokenStream {
         let docs = Self::quantity_doc(q, None);
         let (n, nq, k) = (self.n.clone(), self.nq.clone(), self.k.clone());
-        let kkt = self.kkt(active);
+        let (m, j) = (self.call("mass_matrix"), self.call("contact_jacobian"));
+        let (_, rows) = self.kkt_inputs(active);
         let s = self.signature(
             q,
             active,
@@ -331,8 +332,12 @@ impl Emitter<'_> {
             /// (`pivot` - N, a rank-deficient contact Jacobian) that is not positive, or a
             /// non-finite result.
             pub fn #try_name(&self, q: &[T; #nq], qd: &[T; #n], restitution: T #param) -> ::core::result::Result<([T; #n], [T; #k]), ::eomgen_runtime::FactorError> {
-                #kkt
-                kkt.impulse(qd, restitution)
+                // M's factors and J_c, no KKT system: M^-1 meets the one vector J_c^T p.
+                let mut m = #m(self, q);
+                let j = #j(self, q);
+                Self::ltdl_factor_unrolled(&mut m, &mut ::core::default::Default::default())?;
+                let substitute = |b: &[T; #n]| Self::ltdl_substitute_unrolled(&m, b);
+                ::eomgen_runtime::impulse::solve_factored_active_with(&m, &Self::PARENTS, &j, qd, restitution, &#rows, substitute)
             }
 
             #docs
