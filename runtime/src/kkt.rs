@@ -549,7 +549,11 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
             *fk = acc;
         }
         self.lambda_solve_columns(f);
-        // X += Y F, row by row likewise.
+        self.add_y_times(x, f);
+    }
+
+    /// `X += Y F` (`Y = M^-1 J^T`), row by row, each gathered in a local accumulator.
+    fn add_y_times<const C: usize>(&self, x: &mut [[T; C]; N], f: &[[T; C]; K]) {
         for (i, xi) in x.iter_mut().enumerate() {
             let mut acc = *xi;
             for (yk, fk) in self.y.iter().zip(f.iter()) {
@@ -557,6 +561,19 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
             }
             *xi = acc;
         }
+    }
+
+    /// The system's solution for `top = I`, `bottom = 0` (its derivatives in `tau`), written
+    /// into `x` (N x N) and `f` (K x N): `x = M^-1 + Y F` and `F = -(J M^-1 J^T)^-1 Y^T`, since
+    /// `J M^-1 = Y^T`. `M^-1` comes from [`crate::tree::ltdl_inverse_factored_into`], which
+    /// uses the identity's sparsity and the symmetry, and `J M^-1` is not formed again.
+    pub fn solve_identity_in_place(&self, x: &mut [[T; N]; N], f: &mut [[T; N]; K]) {
+        crate::tree::ltdl_inverse_factored_into(&self.factors, &self.parent, x);
+        for (fk, (yk, on)) in f.iter_mut().zip(self.y.iter().zip(&self.active)) {
+            *fk = if *on { yk.map(|v| -v) } else { [T::zero(); N] };
+        }
+        self.lambda_solve_columns(f);
+        self.add_y_times(x, f);
     }
 
     /// `(J M^-1 J^T)^-1 B` for the K x C matrix `B`, in place.
@@ -682,12 +699,7 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
         }
         self.solve_columns_in_place(&mut d.da_dq, &mut d.df_dq);
         self.solve_columns_in_place(&mut d.da_dv, &mut d.df_dv);
-        for (i, row) in d.da_dtau.iter_mut().enumerate() {
-            row.iter_mut().for_each(|x| *x = T::zero());
-            row[i] = T::one();
-        }
-        d.df_dtau.iter_mut().flatten().for_each(|x| *x = T::zero());
-        self.solve_columns_in_place(&mut d.da_dtau, &mut d.df_dtau);
+        self.solve_identity_in_place(&mut d.da_dtau, &mut d.df_dtau);
         for m in [&d.da_dq, &d.da_dv, &d.da_dtau] {
             finite_rows(m, 0)?;
         }
