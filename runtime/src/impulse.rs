@@ -6,7 +6,7 @@
 //! `top = 0`, `bottom = -(1 + e) J v` gives `(v+ - v, p)`.
 
 use crate::contact::contact_space;
-use crate::kkt::{axpy, dot, finite_rows, negate, ContactKkt, ImpulseDynamicsDerivatives};
+use crate::kkt::{axpy, dot, finite_rows, ContactKkt, ImpulseDynamicsDerivatives};
 use crate::{FactorError, Real};
 
 impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
@@ -53,9 +53,7 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
         e: T,
         d: &mut ImpulseDynamicsDerivatives<T, N, K>,
     ) -> Result<(), FactorError> {
-        negate(&mut d.dv_dq);
-        negate(&mut d.dimpulse_dq);
-        self.solve_columns_in_place(&mut d.dv_dq, &mut d.dimpulse_dq);
+        self.solve_negated_columns_in_place(&mut d.dv_dq, &mut d.dimpulse_dq);
         d.dimpulse_dv = *self.jacobian();
         self.lambda_solve_columns(&mut d.dimpulse_dv);
         let k = -(T::one() + e);

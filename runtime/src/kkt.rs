@@ -533,8 +533,29 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
     /// [`ContactKkt::solve_columns`] in place: `x` holds `top` on entry and `X` on return,
     /// `f` holds `bottom` and then `F`.
     pub fn solve_columns_in_place<const C: usize>(&self, x: &mut [[T; C]; N], f: &mut [[T; C]; K]) {
+        self.solve_signed_columns_in_place(x, f, T::one());
+    }
+
+    /// [`ContactKkt::solve_columns_in_place`] for the negated right-hand sides `(-top,
+    /// -bottom)` (what derivatives solve for: minus the partials), the signs applied on the
+    /// way rather than in a pass over the inputs of their own.
+    pub fn solve_negated_columns_in_place<const C: usize>(
+        &self,
+        x: &mut [[T; C]; N],
+        f: &mut [[T; C]; K],
+    ) {
+        self.solve_signed_columns_in_place(x, f, -T::one());
+    }
+
+    /// The solution for `(sign top, sign bottom)`, `sign` one or minus one: with
+    /// `X0 = M^-1 top`, `F = Lambda^-1 sign (bottom - J X0)` and `X = sign X0 + Y F`.
+    fn solve_signed_columns_in_place<const C: usize>(
+        &self,
+        x: &mut [[T; C]; N],
+        f: &mut [[T; C]; K],
+        sign: T,
+    ) {
         self.substitute_columns(x);
-        // F = Lambda^-1 (bottom - J X)
         for ((fk, jk), on) in f.iter_mut().zip(&self.j).zip(&self.active) {
             if !*on {
                 *fk = [T::zero(); C];
@@ -542,20 +563,20 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
             }
             // Each row gathered in a local accumulator (kept in registers), not updated in
             // memory once per term: that form was vectorized across rows, with gathers.
-            let mut acc = *fk;
+            let mut acc = fk.map(|v| sign * v);
             for (jki, xi) in jk.iter().zip(x.iter()) {
-                axpy(&mut acc, -*jki, xi);
+                axpy(&mut acc, -sign * *jki, xi);
             }
             *fk = acc;
         }
         self.lambda_solve_columns(f);
-        self.add_y_times(x, f);
+        self.add_y_times(x, f, sign);
     }
 
-    /// `X += Y F` (`Y = M^-1 J^T`), row by row, each gathered in a local accumulator.
-    fn add_y_times<const C: usize>(&self, x: &mut [[T; C]; N], f: &[[T; C]; K]) {
+    /// `X = sign X + Y F` (`Y = M^-1 J^T`), row by row, each gathered in a local accumulator.
+    fn add_y_times<const C: usize>(&self, x: &mut [[T; C]; N], f: &[[T; C]; K], sign: T) {
         for (i, xi) in x.iter_mut().enumerate() {
-            let mut acc = *xi;
+            let mut acc = xi.map(|v| sign * v);
             for (yk, fk) in self.y.iter().zip(f.iter()) {
                 axpy(&mut acc, yk[i], fk);
             }
@@ -573,7 +594,7 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
             *fk = if *on { yk.map(|v| -v) } else { [T::zero(); N] };
         }
         self.lambda_solve_columns(f);
-        self.add_y_times(x, f);
+        self.add_y_times(x, f, T::one());
     }
 
     /// `(J M^-1 J^T)^-1 B` for the K x C matrix `B`, in place.
@@ -636,13 +657,6 @@ fn scale<T: Real, const C: usize>(y: &mut [T; C], a: T) {
     }
 }
 
-/// Every entry of `m` negated, in place.
-pub(crate) fn negate<T: Real, const C: usize, const R: usize>(m: &mut [[T; C]; R]) {
-    for row in m.iter_mut() {
-        scale(row, -T::one());
-    }
-}
-
 /// `NonFinite` at `offset` plus the first row of `m` with a non-finite entry.
 pub(crate) fn finite_rows<T: Real, const C: usize, const R: usize>(
     m: &[[T; C]; R],
@@ -691,14 +705,8 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
         &self,
         d: &mut ContactDynamicsDerivatives<T, N, K>,
     ) -> Result<(), FactorError> {
-        for m in [&mut d.da_dq, &mut d.da_dv] {
-            negate(m);
-        }
-        for m in [&mut d.df_dq, &mut d.df_dv] {
-            negate(m);
-        }
-        self.solve_columns_in_place(&mut d.da_dq, &mut d.df_dq);
-        self.solve_columns_in_place(&mut d.da_dv, &mut d.df_dv);
+        self.solve_negated_columns_in_place(&mut d.da_dq, &mut d.df_dq);
+        self.solve_negated_columns_in_place(&mut d.da_dv, &mut d.df_dv);
         self.solve_identity_in_place(&mut d.da_dtau, &mut d.df_dtau);
         for m in [&d.da_dq, &d.da_dv, &d.da_dtau] {
             finite_rows(m, 0)?;
