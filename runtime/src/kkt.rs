@@ -217,8 +217,20 @@ impl<T: Real, const N: usize, const K: usize> Parts<'_, T, N, K> {
         top: Option<&[T; N]>,
         bottom: &[T; K],
     ) -> Result<([T; N], [T; K]), FactorError> {
+        self.solve_with(top, bottom, |b| {
+            ltdl_substitute(self.factors, self.parent, b)
+        })
+    }
+
+    /// [`Parts::solve`] with the caller's `M^-1 b` from the factors (`substitute`).
+    fn solve_with(
+        &self,
+        top: Option<&[T; N]>,
+        bottom: &[T; K],
+        substitute: impl Fn(&[T; N]) -> [T; N],
+    ) -> Result<([T; N], [T; K]), FactorError> {
         let mut x = match top {
-            Some(top) => ltdl_substitute(self.factors, self.parent, top),
+            Some(top) => substitute(top),
             None => [T::zero(); N],
         };
         let mut b = *bottom;
@@ -260,15 +272,31 @@ impl<T: Real, const N: usize, const K: usize> KktStash<T, N, K> {
         top: &[T; N],
         bottom: &[T; K],
     ) -> Result<([T; N], [T; K]), FactorError> {
-        let parts = Parts {
+        self.parts(d).solve(Some(top), bottom)
+    }
+
+    /// [`KktStash::solve`] with the caller's own `M^-1 b` from the factors in `d.da_dtau`
+    /// (`substitute`): generated code passes its unrolled substitution.
+    pub fn solve_with(
+        &self,
+        d: &ContactDynamicsDerivatives<T, N, K>,
+        top: &[T; N],
+        bottom: &[T; K],
+        substitute: impl Fn(&[T; N]) -> [T; N],
+    ) -> Result<([T; N], [T; K]), FactorError> {
+        self.parts(d).solve_with(Some(top), bottom, substitute)
+    }
+
+    /// The arrays of the system stashed in `d`, for [`Parts`]' methods.
+    fn parts<'a>(&'a self, d: &'a ContactDynamicsDerivatives<T, N, K>) -> Parts<'a, T, N, K> {
+        Parts {
             factors: &d.da_dtau,
             parent: &self.parent,
             j: &d.df_dtau,
             y: &self.y,
             lambda: &self.lambda,
             active: &self.active,
-        };
-        parts.solve(Some(top), bottom)
+        }
     }
 
     /// [`ContactKkt::contact_dynamics_derivatives_in_place`] of the system stashed in `d`,

@@ -238,7 +238,8 @@ impl Emitter<'_> {
             #[inline(never)]
             fn #solve(&self, q: &[T; #nq], rhs: &[T; #n], drift: &[T; #k] #param, d: &mut #ty) -> ::core::result::Result<([T; #n], [T; #k], #stash), #err> {
                 let stash = ::eomgen_runtime::ContactKkt::set_up_in_factored(d, #fill, &Self::PARENTS, &#rows)?;
-                let (a, f) = stash.solve(d, rhs, &drift.map(|x| -x))?;
+                let substitute = |b: &[T; #n]| Self::ltdl_substitute_unrolled(&d.da_dtau, b);
+                let (a, f) = stash.solve_with(d, rhs, &drift.map(|x| -x), substitute)?;
                 Ok((a, f, stash))
             }
 
