@@ -9,6 +9,7 @@
 //! of `M^-1 J^T`. Everything is in fixed-size arrays on the stack.
 
 pub use crate::baumgarte::{log3, placement, Baumgarte};
+use crate::kkt::dot;
 use crate::linalg::{Cholesky, FactorError};
 use crate::tree::{ltdl_factor, ltdl_lower_rows, ltdl_substitute};
 use crate::Real;
@@ -224,12 +225,4 @@ pub fn row_mask<const C: usize, const K: usize>(
         at = end;
     }
     out
-}
-
-fn dot<T: Real, const N: usize>(a: &[T; N], b: &[T; N]) -> T {
-    let mut s = T::zero();
-    for (x, y) in a.iter().zip(b) {
-        s += *x * *y;
-    }
-    s
 }
