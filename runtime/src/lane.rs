@@ -67,7 +67,8 @@ pub trait Lane: Copy + Debug + Default + Arithmetic + 'static {
     /// `(sin(self), cos(self))`, lane-wise.
     fn sin_cos(self) -> (Self, Self);
     /// The sines and the cosines of every element of `x` ([`Real::sin_cos_many`] for a
-    /// scalar; [`Lane::sin_cos`] element by element by default).
+    /// scalar; `wide`'s `f64` vectors run [`crate::trig::sin_cos_f64_in`] on all their lanes at
+    /// once, as the scalar `f64` does; [`Lane::sin_cos`] element by element by default).
     #[inline(always)]
     fn sin_cos_many<const K: usize>(x: [Self; K]) -> ([Self; K], [Self; K]) {
         crate::trig::each(x, Self::sin_cos)

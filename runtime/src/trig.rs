@@ -51,6 +51,9 @@ const ROUNDER: f64 = 6_755_399_441_055_744.0;
 /// angle's absolute error below `1e-20`.
 pub const REDUCED_MAX: f64 = 1.0e5;
 
+/// The sign bit of an `f64`.
+const SIGN: u64 = 1 << 63;
+
 /// `(sin x_i, cos x_i)` by `sin_cos` element by element: the default of
 /// [`crate::Real::sin_cos_many`] and [`crate::Lane::sin_cos_many`], and `f32`'s.
 #[inline(always)]
@@ -113,17 +116,37 @@ fn reduced(x: f64) -> (f64, f64) {
 #[inline(always)]
 pub fn sin_cos_f64<const K: usize>(x: [f64; K]) -> ([f64; K], [f64; K]) {
     let (mut s, mut c) = ([0.0; K], [0.0; K]);
-    for ((x, s), c) in x.iter().zip(&mut s).zip(&mut c) {
+    sin_cos_f64_in(&x, &mut s, &mut c);
+    (s, c)
+}
+
+/// [`sin_cos_f64`] on slices: `s[i], c[i] = sin x[i], cos x[i]` for `i` below the shortest
+/// length. The vector lanes' [`crate::Lane::sin_cos_many`] run it on all their lanes at once
+/// (an array of `f64x4` is one slice of `f64`), so that a lane computes what the scalar code
+/// computes, bit for bit, with the widest vector instructions the target has.
+///
+/// ```
+/// use eomgen_runtime::trig::{sin_cos_f64, sin_cos_f64_in};
+/// let x = [0.25, -3.0, 7.5];
+/// let (mut s, mut c) = ([0.0; 3], [0.0; 3]);
+/// sin_cos_f64_in(&x, &mut s, &mut c);
+/// assert_eq!((s, c), sin_cos_f64(x));
+/// ```
+#[inline(always)]
+pub fn sin_cos_f64_in(x: &[f64], s: &mut [f64], c: &mut [f64]) {
+    for ((x, s), c) in x.iter().zip(&mut *s).zip(&mut *c) {
         (*s, *c) = reduced(*x);
     }
-    // Rarely taken, and independent of each other: no chain of comparisons before the
-    // vector loop. NaN stays with the branch-free result, NaN.
-    for ((x, s), c) in x.iter().zip(&mut s).zip(&mut c) {
-        if libm::fabs(*x) >= REDUCED_MAX {
-            (*s, *c) = libm::sincos(*x);
+    // The largest magnitude's bits (non-negative floats order as their bits; NaN above
+    // infinity): one vector reduction instead of a comparison and branch per angle.
+    let largest = x.iter().fold(0, |m: u64, x| m.max(x.to_bits() & !SIGN));
+    if largest >= REDUCED_MAX.to_bits() {
+        for ((x, s), c) in x.iter().zip(s).zip(c) {
+            if libm::fabs(*x) >= REDUCED_MAX {
+                (*s, *c) = libm::sincos(*x);
+            }
         }
     }
-    (s, c)
 }
 
 #[cfg(test)]

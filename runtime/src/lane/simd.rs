@@ -4,9 +4,11 @@
 //! the target features (`-C target-cpu=native`): AVX for `f64x4` and `f32x8`, SSE2 or NEON for
 //! `f64x2` and `f32x4`, and plain arrays elsewhere. Its `mul_add` fuses exactly when
 //! [`Real::mul_add`](crate::Real::mul_add) does on x86-64 (the `fma` feature), its arithmetic
-//! and square root are IEEE's, so a lane computes what the scalar code computes, bit for bit,
-//! except for `sin` and `cos`: `wide`'s polynomial approximations differ from `libm`'s in the
-//! last bits.
+//! and square root are IEEE's, so a lane computes what the scalar code computes, bit for bit.
+//! Sines and cosines: the `f64` vectors' [`Lane::sin_cos_many`] (every joint angle of
+//! generated code) runs the scalar `f64` kernel, [`crate::trig::sin_cos_f64_in`], on all lanes
+//! at once, bit for bit again; single sines and cosines, and the `f32` vectors', are `wide`'s
+//! polynomial approximations, which differ from `libm`'s in the last bits.
 
 use super::{pack_each, scalar_check, unpack_each, Lane, LaneError, Pack};
 use crate::FactorError;
@@ -15,7 +17,7 @@ use wide::{f32x4, f32x8, f64x2, f64x4};
 mod transpose;
 
 macro_rules! impl_lane {
-    ($v:ident, $s:ident, $n:literal, $pack:path, $unpack:path) => {
+    ($v:ident, $s:ident, $n:literal, $pack:path, $unpack:path, $many:path) => {
         impl Lane for $v {
             const LANES: usize = $n;
             type Mask = $v;
@@ -47,6 +49,10 @@ macro_rules! impl_lane {
             #[inline(always)]
             fn sin_cos(self) -> (Self, Self) {
                 $v::sin_cos(self)
+            }
+            #[inline(always)]
+            fn sin_cos_many<const K: usize>(x: [Self; K]) -> ([Self; K], [Self; K]) {
+                $many(x)
             }
             #[inline(always)]
             fn sqrt(self) -> Self {
@@ -156,22 +162,46 @@ macro_rules! impl_lane {
     };
 }
 
-impl_lane!(f64x2, f64, 2, pack_each, unpack_each);
+impl_lane!(f64x2, f64, 2, pack_each, unpack_each, sin_cos_flat);
 impl_lane!(
     f64x4,
     f64,
     4,
     transpose::pack_f64x4,
-    transpose::unpack_f64x4
+    transpose::unpack_f64x4,
+    sin_cos_flat
 );
-impl_lane!(f32x4, f32, 4, pack_each, unpack_each);
+impl_lane!(f32x4, f32, 4, pack_each, unpack_each, sin_cos_wide);
 impl_lane!(
     f32x8,
     f32,
     8,
     transpose::pack_f32x8,
-    transpose::unpack_f32x8
+    transpose::unpack_f32x8,
+    sin_cos_wide
 );
+
+/// The `f64` vectors' [`Lane::sin_cos_many`]: every lane of every element by
+/// [`crate::trig::sin_cos_f64_in`], as one slice of `f64` (its loop runs on the widest vectors
+/// the target has, eight angles per instruction with AVX-512), so that each lane gets the
+/// scalar `f64` code's sines and cosines, bit for bit.
+#[inline(always)]
+fn sin_cos_flat<V, const W: usize, const K: usize>(x: [V; K]) -> ([V; K], [V; K])
+where
+    V: Pack<Scalar = f64, Array = [f64; W]>,
+{
+    let x = x.map(V::lanes);
+    let (mut s, mut c) = ([[0.0; W]; K], [[0.0; W]; K]);
+    crate::trig::sin_cos_f64_in(x.as_flattened(), s.as_flattened_mut(), c.as_flattened_mut());
+    let vector = |a: [f64; W]| V::gather(|l| a[l]);
+    (s.map(vector), c.map(vector))
+}
+
+/// The `f32` vectors' [`Lane::sin_cos_many`]: `wide`'s `sin_cos`, element by element.
+#[inline(always)]
+fn sin_cos_wide<V: Lane, const K: usize>(x: [V; K]) -> ([V; K], [V; K]) {
+    crate::trig::each(x, V::sin_cos)
+}
 
 /// Records, in each lane without a failure yet, the failure `check` finds in its value.
 #[cold]
