@@ -476,10 +476,7 @@ pub fn ltdl_inverse_factored_into<T: Lane, const N: usize>(
     parent: &[Option<usize>; N],
     x: &mut [[T; N]; N],
 ) {
-    for (i, row) in x.iter_mut().enumerate() {
-        row.iter_mut().for_each(|v| *v = T::zero());
-        row[i] = T::one();
-    }
+    // The identity is not written first: the pass starts each row from its unit row itself.
     pull_from_subtrees::<T, N, N, true>(m, parent, x);
     pull_from_ancestors::<T, N, N, true>(m, parent, x);
     // The upper triangle mirrored, so that the result is exactly symmetric.
@@ -532,8 +529,9 @@ pub(crate) fn ltdl_lower_rows<T: Lane, const N: usize, const C: usize>(
 /// read-modify-writes of the same row stall on store forwarding, and on a 50-DoF humanoid the
 /// push form took twice as long.
 ///
-/// `SPARSE`: row `k` of `x` is zero outside columns `k..ends[k]` (the identity, whose rows keep
-/// that support through this pass), so only the chunks of columns there are gathered.
+/// `SPARSE`: `x` is the identity, whatever it holds on entry (each row starts from its unit row,
+/// and is written whole), and row `k` keeps its support `k..ends[k]` through this pass, so only
+/// the chunks of columns there are gathered.
 fn pull_from_subtrees<T: Lane, const N: usize, const C: usize, const SPARSE: bool>(
     m: &[[T; N]; N],
     parent: &[Option<usize>; N],
@@ -544,7 +542,7 @@ fn pull_from_subtrees<T: Lane, const N: usize, const C: usize, const SPARSE: boo
     // `ends[a]` may belong to other subtrees when the order is not depth first).
     let mut inside = [false; N];
     for a in (0..N).rev() {
-        let mut acc = x[a];
+        let mut acc = if SPARSE { unit_row(a) } else { x[a] };
         for k in a + 1..ends[a] {
             let below =
                 parent[k].is_some_and(|p| p == a || (p > a && inside.get(p) == Some(&true)));
@@ -557,6 +555,15 @@ fn pull_from_subtrees<T: Lane, const N: usize, const C: usize, const SPARSE: boo
         }
         x[a] = acc;
     }
+}
+
+/// Row `a` of the identity, `C` columns.
+fn unit_row<T: Lane, const C: usize>(a: usize) -> [T; C] {
+    let mut row = [T::zero(); C];
+    if let Some(x) = row.get_mut(a) {
+        *x = T::one();
+    }
+    row
 }
 
 /// `D^-1`, then `L^-1`: row `i` of `x` less `L[i][a]` times row `a` for every
