@@ -170,14 +170,21 @@ impl Emitter<'_> {
         } else {
             TokenStream::new()
         };
+        // What substitutes through M's unrolled factors: forward dynamics, and contact dynamics,
+        // impulse dynamics and the contact derivatives for their one `M^-1 b` each.
         let solves = |e: &Evaluation| {
             matches!(
                 e,
                 E::ForwardDynamicsSolve { .. }
                     | E::ContactForwardDynamics { .. }
                     | E::ForwardDynamicsDerivatives
+                    | E::ImpulseDynamics
+                    | E::ContactDynamicsDerivatives { .. }
                     | E::ActiveContacts(
-                        ActiveContacts::Dynamics { .. } | ActiveContacts::Stabilized { .. }
+                        ActiveContacts::Dynamics { .. }
+                            | ActiveContacts::Stabilized { .. }
+                            | ActiveContacts::Impulse
+                            | ActiveContacts::Derivatives { .. }
                     )
             )
         };
