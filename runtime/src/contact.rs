@@ -9,7 +9,7 @@
 //! of `M^-1 J^T`. Everything is in fixed-size arrays on the stack.
 
 pub use crate::baumgarte::{log3, placement, Baumgarte};
-use crate::kkt::dot;
+use crate::kkt::{axpy, dot, finite_solution, shift};
 use crate::linalg::{Cholesky, FactorError};
 use crate::tree::{ltdl_factor, ltdl_lower_rows, ltdl_substitute};
 use crate::Real;
@@ -131,25 +131,11 @@ pub fn solve_factored_active_with<T: Real, const N: usize, const K: usize>(
     }
     let f = chol.solve(&b);
     // a = free + M^-1 (J^T f).
-    let mut jtf = [T::zero(); N];
-    for ((jk, fk), on) in j.iter().zip(&f).zip(active) {
-        if *on {
-            for (x, y) in jtf.iter_mut().zip(jk) {
-                *x = fk.mul_add(*y, *x);
-            }
-        }
-    }
-    let mut a = substitute(&jtf);
+    let mut a = substitute(&transpose_times(j, &f, active));
     for (ai, fi) in a.iter_mut().zip(free) {
         *ai += *fi;
     }
-    if let Some(pivot) = a.iter().position(|x| !x.is_finite()) {
-        return Err(FactorError::NonFinite { pivot });
-    }
-    if let Some(k) = f.iter().position(|x| !x.is_finite()) {
-        return Err(FactorError::NonFinite { pivot: N + k });
-    }
-    Ok((a, f))
+    finite_solution(a, f)
 }
 
 /// The Cholesky factor of `J M^-1 J^T = W^T D^-1 W` with `W = L^-T J^T` (the inactive rows of
@@ -190,13 +176,22 @@ pub(crate) fn contact_space<T: Real, const N: usize, const K: usize>(
             lr[r] = T::one();
         }
     }
-    let shift = |e: FactorError| match e {
-        FactorError::NotPositiveDefinite { pivot } => {
-            FactorError::NotPositiveDefinite { pivot: N + pivot }
+    Cholesky::new(lambda).map_err(shift::<N>)
+}
+
+/// `J^T f` over the rows of `active` only.
+pub(crate) fn transpose_times<T: Real, const N: usize, const K: usize>(
+    j: &[[T; N]; K],
+    f: &[T; K],
+    active: &[bool; K],
+) -> [T; N] {
+    let mut out = [T::zero(); N];
+    for ((jk, fk), on) in j.iter().zip(f).zip(active) {
+        if *on {
+            axpy(&mut out, *fk, jk);
         }
-        FactorError::NonFinite { pivot } => FactorError::NonFinite { pivot: N + pivot },
-    };
-    Cholesky::new(lambda).map_err(shift)
+    }
+    out
 }
 
 /// The contact rows (`K` of them) of the contacts (`C`) that `active` switches on, each

@@ -5,8 +5,8 @@
 //! the impact `v+` satisfy `M (v+ - v) = J^T p` and `J v+ = -e J v`: the KKT system with
 //! `top = 0`, `bottom = -(1 + e) J v` gives `(v+ - v, p)`.
 
-use crate::contact::contact_space;
-use crate::kkt::{axpy, dot, finite_rows, ContactKkt, ImpulseDynamicsDerivatives};
+use crate::contact::{contact_space, transpose_times};
+use crate::kkt::{axpy, dot, finite_rows, finite_solution, ContactKkt, ImpulseDynamicsDerivatives};
 use crate::{FactorError, Real};
 
 impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
@@ -116,19 +116,7 @@ pub fn solve_factored_active_with<T: Real, const N: usize, const K: usize>(
         }
     }
     let p = chol.solve(&bottom);
-    let mut jtp = [T::zero(); N];
-    for ((jr, pr), on) in j.iter().zip(&p).zip(active) {
-        if *on {
-            axpy(&mut jtp, *pr, jr);
-        }
-    }
-    let mut after = substitute(&jtp);
-    if let Some(pivot) = after.iter().position(|x| !x.is_finite()) {
-        return Err(FactorError::NonFinite { pivot });
-    }
-    if let Some(r) = p.iter().position(|x| !x.is_finite()) {
-        return Err(FactorError::NonFinite { pivot: N + r });
-    }
+    let (mut after, p) = finite_solution(substitute(&transpose_times(j, &p, active)), p)?;
     for (x, vi) in after.iter_mut().zip(v) {
         *x += *vi;
     }

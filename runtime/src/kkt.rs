@@ -243,13 +243,7 @@ impl<T: Real, const N: usize, const K: usize> Parts<'_, T, N, K> {
                 *xi += *yi * *fk;
             }
         }
-        if let Some(pivot) = x.iter().position(|v| !v.is_finite()) {
-            return Err(FactorError::NonFinite { pivot });
-        }
-        if let Some(k) = f.iter().position(|v| !v.is_finite()) {
-            return Err(FactorError::NonFinite { pivot: N + k });
-        }
-        Ok((x, f))
+        finite_solution(x, f)
     }
 }
 
@@ -662,7 +656,7 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
 }
 
 /// Pivot `k` of `J M^-1 J^T` is pivot `N + k` of the system.
-fn shift<const N: usize>(e: FactorError) -> FactorError {
+pub(crate) fn shift<const N: usize>(e: FactorError) -> FactorError {
     match e {
         FactorError::NotPositiveDefinite { pivot } => {
             FactorError::NotPositiveDefinite { pivot: N + pivot }
@@ -694,6 +688,21 @@ fn scale<T: Real, const C: usize>(y: &mut [T; C], a: T) {
     for yi in y.iter_mut() {
         *yi *= a;
     }
+}
+
+/// `(x, f)` if every entry is finite; else `NonFinite` at the first bad one of `x` (`pivot <
+/// N`) or of `f` (`N + k`): how the system's solvers report a non-finite solution.
+pub(crate) fn finite_solution<T: Real, const N: usize, const K: usize>(
+    x: [T; N],
+    f: [T; K],
+) -> Result<([T; N], [T; K]), FactorError> {
+    if let Some(pivot) = x.iter().position(|v| !v.is_finite()) {
+        return Err(FactorError::NonFinite { pivot });
+    }
+    if let Some(k) = f.iter().position(|v| !v.is_finite()) {
+        return Err(FactorError::NonFinite { pivot: N + k });
+    }
+    Ok((x, f))
 }
 
 /// `NonFinite` at `offset` plus the first row of `m` with a non-finite entry.

@@ -9,6 +9,7 @@
 
 use super::atan::atan2_quadrant;
 use crate::free_flyer::{quat_mul, rotation, rotation_scaled};
+use crate::tree::cross;
 use crate::Real;
 
 pub(super) type M3<T> = [[T; 3]; 3];
@@ -259,14 +260,6 @@ fn hat_squared<T: Real>(w: &[T; 3], t2: T) -> M3<T> {
         let d = if i == j { t2 } else { T::zero() };
         w[i] * w[j] - d
     })
-}
-
-fn cross<T: Real>(a: &[T; 3], b: &[T; 3]) -> [T; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }
 
 fn negated<T: Real>(m: &M3<T>) -> M3<T> {

@@ -99,16 +99,20 @@ impl Emitter<'_> {
             *j = #j(self, q);
             Self::ltdl_factor_unrolled(m, &mut ::core::default::Default::default())
         });
+        (fill, self.active_rows(active))
+    }
+
+    /// The contact rows that take part: every one, or those of the contacts of `active`.
+    fn active_rows(&self, active: bool) -> TokenStream {
         let k = &self.k;
-        let rows = if active {
+        if active {
             quote!(::eomgen_runtime::contact::row_mask(
                 &Self::CONTACT_ROWS,
                 active
             ))
         } else {
             quote!([true; #k])
-        };
-        (fill, rows)
+        }
     }
 
     /// `h` (`b + G`, and friction) of the `_active` contact methods: its straight-line code is
@@ -317,7 +321,7 @@ impl Emitter<'_> {
         let docs = Self::quantity_doc(q, None);
         let (n, nq, k) = (self.n.clone(), self.nq.clone(), self.k.clone());
         let (m, j) = (self.call("mass_matrix"), self.call("contact_jacobian"));
-        let (_, rows) = self.kkt_inputs(active);
+        let rows = self.active_rows(active);
         let s = self.signature(
             q,
             active,
