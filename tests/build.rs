@@ -18,6 +18,7 @@ fn main() {
         regressors,
         joint_effects,
         deep_chain,
+        tree_route,
         underactuated,
         mpc_kinematics,
         bad_input,
@@ -165,6 +166,27 @@ fn floating() {
             "forward_dynamics",
             "mass_matrix",
             "integrate",
+            "inverse_dynamics_derivatives",
+            "forward_dynamics_derivatives",
+            "mass_matrix_inverse",
+        ])
+        .compile()
+        .unwrap();
+}
+
+/// anymal with `M^-1` and the forward-dynamics derivatives composed at run time through the
+/// tree (`derivatives_flat_max_ops(0)`: the route of robots too large for straight-line
+/// ones), for `tests/tree_route.rs`: a branched tree (a base and four legs).
+fn tree_route() {
+    eomgen::Builder::new("robots/floating/anymal.urdf")
+        .floating_base()
+        .derivatives()
+        .derivatives_flat_max_ops(0)
+        .module_name("anymal_tree_route")
+        .type_name("AnymalTreeRoute")
+        .quantities([
+            "inverse_dynamics",
+            "mass_matrix",
             "inverse_dynamics_derivatives",
             "forward_dynamics_derivatives",
             "mass_matrix_inverse",

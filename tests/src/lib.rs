@@ -359,6 +359,11 @@ pub mod robots {
     pub mod anymal_derivatives {
         include!(concat!(env!("OUT_DIR"), "/anymal_derivatives.rs"));
     }
+    /// anymal with `M^-1` and the forward-dynamics derivatives through the tree at run time
+    /// (the route of large robots), for `tests/tree_route.rs`.
+    pub mod anymal_tree_route {
+        include!(concat!(env!("OUT_DIR"), "/anymal_tree_route.rs"));
+    }
     /// `double_pendulum.urdf` with identification (`Builder::regressor`) and inverse dynamics.
     pub mod double_pendulum_regressor {
         include!(concat!(env!("OUT_DIR"), "/double_pendulum_regressor.rs"));

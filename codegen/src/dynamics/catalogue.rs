@@ -119,15 +119,17 @@ pub enum Evaluation {
     /// A link frame's 6 x N Jacobian, from the same per-joint transforms.
     LinkJacobian,
     /// `M^-1`: `M` from `mass_matrix`, factorized by the unrolled tree `L^T D L`, then
-    /// `L^-1 D^-1 L^-T` with the tree's structure at run time (`tree::ltdl_inverse_factored`).
+    /// `L^-1 D^-1 L^-T` unrolled over the tree too (`tree::ltdl_inverse_factored`'s operations;
+    /// `emit::tree_solve`).
     MassMatrixInverse,
     /// Straight-line expressions that hold when every pivot of the unrolled `L^T D L`
     /// factorization of `M` is positive (checked at run time: NaN in every entry otherwise).
     Factored { outputs: Vec<Id>, pivots: Vec<Id> },
     /// `(d qdd/dq, d qdd/dqd, M^-1)` at run time through one tree factorization of
     /// `mass_matrix`: `qdd` from it and `inverse_dynamics(q, qd, 0)`, then `-M^-1` times
-    /// `inverse_dynamics_derivatives` at `(q, qd, qdd)` (`tree::ltdl_substitute_rows`), and
-    /// `M^-1` from the same factors (`tree::ltdl_inverse_factored`).
+    /// `inverse_dynamics_derivatives` at `(q, qd, qdd)` and `M^-1` from the same factors, both
+    /// unrolled over the tree (`tree::ltdl_substitute_rows`'s and
+    /// `tree::ltdl_inverse_factored`'s operations; `emit::tree_solve`).
     ForwardDynamicsDerivatives,
     /// The accelerations and contact forces with the contact points held, solved at run time:
     /// `M` from `mass_matrix`, `h = b + G + F` straight-line, `J_c` and its drift from

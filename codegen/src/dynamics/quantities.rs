@@ -555,11 +555,11 @@ pub fn derivatives(d: &Derivation, x: &Derivatives, flat_max_ops: usize) -> Vec<
     };
     let (minv_route, minv_eval) = match factored(minv) {
         Some(e) => ("Route: M as in `mass_matrix`, an unrolled L^T D L factorization without fill-in, one substitution per column.", e),
-        None => ("Route: M from `mass_matrix`, the sparse L^T D L factorization over the joint tree, unrolled for this robot, then L^-1 D^-1 L^-T with the tree's structure at run time (eomgen_runtime::tree::ltdl_inverse_factored).", Evaluation::MassMatrixInverse),
+        None => ("Route: M from `mass_matrix`, the sparse L^T D L factorization over the joint tree, unrolled for this robot, then L^-1 D^-1 L^-T over the tree, unrolled too (eomgen_runtime::tree::ltdl_inverse_factored's operations, in parts of at most 128 row updates).", Evaluation::MassMatrixInverse),
     };
     let (fd_route, fd_eval) = match factored(fd) {
         Some(e) => ("Route: qdd as in `forward_dynamics`, `inverse_dynamics_derivatives` at (q, qd, qdd), then -M^-1 times them by substitutions through the one unrolled factorization of M, all in one straight-line body.", e),
-        None => ("Route: one factorization of M (from `mass_matrix`, the tree L^T D L unrolled): qdd from it and `inverse_dynamics` at zero acceleration, `inverse_dynamics_derivatives` at (q, qd, qdd), then -M^-1 times them by substitutions of all columns at once (eomgen_runtime::tree::ltdl_substitute_rows), and M^-1 from the same factors.", Evaluation::ForwardDynamicsDerivatives),
+        None => ("Route: one factorization of M (from `mass_matrix`, the tree L^T D L unrolled): qdd from it and `inverse_dynamics` at zero acceleration, `inverse_dynamics_derivatives` at (q, qd, qdd), then -M^-1 times them by substitutions of all columns at once and M^-1 from the same factors, both unrolled over the tree (eomgen_runtime::tree::ltdl_substitute_rows's and ltdl_inverse_factored's operations).", Evaluation::ForwardDynamicsDerivatives),
     };
     vec![
         Quantity {

@@ -9,7 +9,7 @@
 //! humanoid), small next to the mass matrix it factorizes.
 
 use proc_macro2::{Literal, TokenStream};
-use quote::quote;
+use quote::{format_ident, quote};
 
 use super::rust::usize_lit;
 use crate::dynamics::ltdl::ancestors;
@@ -83,4 +83,251 @@ pub(super) fn substitute_fn(parents: &[Option<usize>], n: &Literal) -> TokenStre
             x
         }
     }
+}
+
+/// Columns per chunk of the runtime's `tree` passes (a vector register of `f64` with
+/// AVX-512): the inverse below updates whole chunks as they do, so that its result is theirs
+/// to the bit.
+const CHUNK: usize = 8;
+
+/// Row updates per generated function of the passes below: one function of 50 rows and 760
+/// updates (a 50-DoF humanoid's inverse) took a frame of 28 kB, most of it the compiler's
+/// spills, and ran a quarter slower than in parts.
+const PART_UPDATES: usize = 128;
+
+/// The columns one update of a row covers.
+#[derive(Clone, Copy)]
+enum Span {
+    /// Columns `lo..hi`, whole chunks of [`CHUNK`] (the last cut at the matrix's size).
+    Chunks(usize, usize),
+    /// All `C` columns of a function generic over `C`.
+    All,
+}
+
+impl Span {
+    /// The chunks of `n` columns that overlap `start..end`.
+    fn chunks(start: usize, end: usize, n: usize) -> Span {
+        Span::Chunks(start / CHUNK * CHUNK, (end.div_ceil(CHUNK) * CHUNK).min(n))
+    }
+}
+
+/// One update of a row: `m[row][col]` times row `k` of `x`, over `span`.
+struct Update {
+    row: usize,
+    col: usize,
+    k: usize,
+    span: Span,
+}
+
+/// `x[target]` from `init` (`None`: the row as it is) and its updates, gathered in a local
+/// accumulator (kept in registers) and written once, as the runtime's `tree` passes do.
+fn gather(target: usize, init: Option<TokenStream>, updates: &[Update]) -> TokenStream {
+    let t = usize_lit(target);
+    let init = match (init, updates.is_empty()) {
+        (None, true) => return TokenStream::new(),
+        (Some(init), true) => return quote!(x[#t] = #init;),
+        (init, false) => init.unwrap_or_else(|| quote!(x[#t])),
+    };
+    let steps = updates.iter().map(|u| {
+        let (r, c, k) = (usize_lit(u.row), usize_lit(u.col), usize_lit(u.k));
+        let columns = match u.span {
+            Span::Chunks(lo, hi) => {
+                let (lo, hi) = (usize_lit(lo), usize_lit(hi));
+                quote!(#lo..#hi)
+            }
+            Span::All => quote!(0..C),
+        };
+        quote! {
+            let f = -m[#r][#c];
+            for j in #columns {
+                acc[j] = f.mul_add(x[#k][j], acc[j]);
+            }
+        }
+    });
+    quote! {
+        {
+            let mut acc = #init;
+            #(#steps)*
+            x[#t] = acc;
+        }
+    }
+}
+
+/// `L^-T` (from the leaves up): row `a` less `L[k][a]` times row `k` for each `k` of its
+/// subtree, in increasing order, over `span(k)`; `init(a)` its starting value (`None`: the row
+/// as it is). The runtime's
+/// `pull_from_subtrees`.
+fn from_subtrees(
+    parents: &[Option<usize>],
+    init: impl Fn(usize) -> Option<TokenStream>,
+    span: impl Fn(usize) -> Span,
+) -> Vec<(usize, TokenStream)> {
+    let ends = subtree_ends(parents);
+    (0..parents.len())
+        .rev()
+        .map(|a| {
+            let updates: Vec<Update> = (a + 1..ends[a])
+                .filter(|&k| ancestors(parents, k).contains(&a))
+                .map(|k| Update {
+                    row: k,
+                    col: a,
+                    k,
+                    span: span(k),
+                })
+                .collect();
+            (updates.len(), gather(a, init(a), &updates))
+        })
+        .collect()
+}
+
+/// `D^-1`, then `L^-1` (from the root down): row `i` scaled by `1 / D[i]`, less `L[i][a]`
+/// times row `a` for each ancestor `a`, nearest first, over `span(i)`. The runtime's
+/// `pull_from_ancestors`.
+fn from_ancestors(
+    parents: &[Option<usize>],
+    span: impl Fn(usize) -> Span,
+) -> Vec<(usize, TokenStream)> {
+    (0..parents.len())
+        .map(|i| {
+            let il = usize_lit(i);
+            let updates: Vec<Update> = ancestors(parents, i)
+                .into_iter()
+                .map(|a| Update {
+                    row: i,
+                    col: a,
+                    k: a,
+                    span: span(i),
+                })
+                .collect();
+            let init = quote! {{
+                let mut row = x[#il];
+                let inv = T::one() / m[#il][#il];
+                for v in row.iter_mut() {
+                    *v *= inv;
+                }
+                row
+            }};
+            (updates.len(), gather(i, Some(init), &updates))
+        })
+        .collect()
+}
+
+/// The rows `(updates, code)` as functions `name_0`, `name_1`, ... of at most
+/// [`PART_UPDATES`] updates each (a row with more is a function alone), with the signature
+/// `x` (the type of the matrix the rows update) and `generics`: the functions and the calls
+/// of them in order.
+fn in_parts(
+    name: &str,
+    generics: TokenStream,
+    turbofish: TokenStream,
+    x: TokenStream,
+    n: &Literal,
+    rows: Vec<(usize, TokenStream)>,
+) -> (TokenStream, TokenStream) {
+    let mut parts: Vec<Vec<TokenStream>> = Vec::new();
+    let mut size = 0;
+    for (updates, code) in rows {
+        match parts.last_mut() {
+            Some(last) if size + updates <= PART_UPDATES => {
+                last.push(code);
+                size += updates;
+            }
+            _ => {
+                parts.push(vec![code]);
+                size = updates;
+            }
+        }
+    }
+    let names: Vec<_> = (0..parts.len())
+        .map(|p| format_ident!("{}_{}", name, p))
+        .collect();
+    let bodies = names.iter().zip(&parts).map(|(f, rows)| {
+        quote! {
+            #[inline(never)]
+            fn #f #generics(m: &[[T; #n]; #n], x: &mut #x) {
+                #(#rows)*
+            }
+        }
+    });
+    (
+        quote!(#(#bodies)*),
+        quote!(#(Self::#names #turbofish(m, x);)*),
+    )
+}
+
+/// `fn ltdl_inverse_unrolled(m, x)`: `M^-1` into `x` from the factors of
+/// `ltdl_factor_unrolled`, as `tree::ltdl_inverse_factored_into` computes it (the same
+/// operations in the same order, so the same result to the bit), with its walks of the tree
+/// and its choice of chunks done here: at run time each update of a row tested up to seven
+/// chunks for overlap and branched on the tree, and on a 50-DoF humanoid those tests, not
+/// the arithmetic, were most of the inverse's time (talos `mass_matrix_inverse` 6.9 -> 4.6 us).
+pub(super) fn inverse_fn(parents: &[Option<usize>], n: &Literal) -> TokenStream {
+    let size = parents.len();
+    let ends = subtree_ends(parents);
+    let unit = |a: usize| {
+        let al = usize_lit(a);
+        Some(quote! {{
+            let mut unit = [T::zero(); #n];
+            unit[#al] = T::one();
+            unit
+        }})
+    };
+    let mut rows = from_subtrees(parents, unit, |k| Span::chunks(k, ends[k], size));
+    rows.extend(from_ancestors(parents, |i| Span::chunks(i, size, size)));
+    let x = quote!([[T; #n]; #n]);
+    let (parts, calls) = in_parts("ltdl_inverse_part", quote!(), quote!(), x, n, rows);
+    quote! {
+        #parts
+        /// `M^-1` from the factors of `ltdl_factor_unrolled`, whatever `x` held
+        /// (`eomgen_runtime::tree::ltdl_inverse_factored_into` unrolled): `L^-T` from the
+        /// identity, then `D^-1` and `L^-1` on the upper triangle, mirrored.
+        #[inline(never)]
+        fn ltdl_inverse_unrolled(m: &[[T; #n]; #n], x: &mut [[T; #n]; #n]) {
+            #calls
+            for i in 1..#n {
+                let (upper, lower) = x.split_at_mut(i);
+                for (j, above) in upper.iter().enumerate() {
+                    lower[0][j] = above[i];
+                }
+            }
+        }
+    }
+}
+
+/// `fn ltdl_substitute_rows_unrolled::<C>(m, x)`: `M^-1 X` in place for the `C` columns of
+/// `x`, as `tree::ltdl_substitute_rows` computes it (to the bit), the tree walks done here.
+pub(super) fn substitute_rows_fn(parents: &[Option<usize>], n: &Literal) -> TokenStream {
+    let mut rows = from_subtrees(parents, |_| None, |_| Span::All);
+    rows.extend(from_ancestors(parents, |_| Span::All));
+    let generics = quote!(<const C: usize>);
+    let x = quote!([[T; C]; #n]);
+    let (parts, calls) = in_parts(
+        "ltdl_substitute_rows_part",
+        generics,
+        quote!(::<C>),
+        x,
+        n,
+        rows,
+    );
+    quote! {
+        #parts
+        /// Solves `M X = B` for the `C` columns of `x` (`B` on entry, `X` on return) with the
+        /// factors of `ltdl_factor_unrolled` (`eomgen_runtime::tree::ltdl_substitute_rows`
+        /// unrolled).
+        #[inline(never)]
+        fn ltdl_substitute_rows_unrolled<const C: usize>(m: &[[T; #n]; #n], x: &mut [[T; C]; #n]) {
+            #calls
+        }
+    }
+}
+
+/// One past the last coordinate of each coordinate's subtree (parents before children).
+fn subtree_ends(parents: &[Option<usize>]) -> Vec<usize> {
+    let mut ends: Vec<usize> = (1..=parents.len()).collect();
+    for i in (0..parents.len()).rev() {
+        if let Some(p) = parents[i] {
+            ends[p] = ends[p].max(ends[i]);
+        }
+    }
+    ends
 }

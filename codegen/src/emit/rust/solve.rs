@@ -209,11 +209,25 @@ impl Emitter<'_> {
         } else {
             TokenStream::new()
         };
+        let inverts =
+            |e: &Evaluation| matches!(e, E::MassMatrixInverse | E::ForwardDynamicsDerivatives);
+        let inverse = if self.any_eval(inverts) {
+            crate::emit::tree_solve::inverse_fn(&self.parents, n)
+        } else {
+            TokenStream::new()
+        };
+        let substitute_rows = if self.any_eval(|e| matches!(e, E::ForwardDynamicsDerivatives)) {
+            crate::emit::tree_solve::substitute_rows_fn(&self.parents, n)
+        } else {
+            TokenStream::new()
+        };
         quote! {
             #table
             #rows
             #factor
             #substitute
+            #inverse
+            #substitute_rows
         }
     }
 
@@ -228,7 +242,7 @@ impl Emitter<'_> {
                 let mut failures = ::core::default::Default::default();
                 match Self::ltdl_factor_unrolled(&mut m, &mut failures) {
                     Ok(()) => {
-                        ::eomgen_runtime::tree::ltdl_inverse_factored_into(&m, &Self::PARENTS, o);
+                        Self::ltdl_inverse_unrolled(&m, o);
                         ::eomgen_runtime::lane::nan_failed_in::<T>(o.as_flattened_mut(), &failures);
                     }
                     Err(_) => o.iter_mut().flatten().for_each(|v| *v = T::nan()),
@@ -276,12 +290,12 @@ impl Emitter<'_> {
                 let qdd = Self::ltdl_substitute_unrolled(&m, &rhs);
                 #id_derivatives
                 for x in [&mut *dq, &mut *dqd] {
-                    ::eomgen_runtime::tree::ltdl_substitute_rows(&m, &Self::PARENTS, x);
+                    Self::ltdl_substitute_rows_unrolled(&m, x);
                     for v in x.iter_mut().flatten() {
                         *v = -*v;
                     }
                 }
-                ::eomgen_runtime::tree::ltdl_inverse_factored_into(&m, &Self::PARENTS, inverse);
+                Self::ltdl_inverse_unrolled(&m, inverse);
                 for x in [dq, dqd, inverse] {
                     ::eomgen_runtime::lane::nan_failed_in::<T>(x.as_flattened_mut(), &failures);
                 }

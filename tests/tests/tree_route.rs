@@ -1,0 +1,78 @@
+//! `M^-1` and the forward-dynamics derivatives of a robot too large for straight-line ones,
+//! through its tree at run time: the generated code unrolls the runtime's `tree` passes for the
+//! robot's tree (`emit::tree_solve`), and must compute what they compute on a branched tree
+//! (anymal: a floating base's chain of six coordinates, then four legs). The generated
+//! factorization rounds differently from `tree::ltdl_factor` (a reciprocal and fused
+//! multiply-adds), so the two agree to rounding, not to the bit; a wrong or missing update of
+//! a row would be off by far more.
+
+use eomgen_runtime::tree::{
+    ltdl_factor, ltdl_inverse_factored, ltdl_substitute, ltdl_substitute_rows,
+};
+use eomgen_tests::floating_reference::{flat, normwise, random_state};
+use eomgen_tests::robots::anymal_tree_route::AnymalTreeRoute;
+
+const NV: usize = 18;
+type Robot = AnymalTreeRoute<f64>;
+
+/// Normwise relative agreement the unrolled passes must keep with the runtime's.
+const TOLERANCE: f64 = 1e-12;
+
+#[test]
+fn the_generated_code_takes_the_tree_route() {
+    let source = include_str!(concat!(env!("OUT_DIR"), "/anymal_tree_route.rs"));
+    assert!(source.contains("fn ltdl_inverse_unrolled"));
+    assert!(source.contains("fn ltdl_substitute_rows_unrolled"));
+    assert!(!source.contains("::eomgen_runtime::tree::ltdl_inverse_factored_into"));
+    assert!(!source.contains("::eomgen_runtime::tree::ltdl_substitute_rows"));
+}
+
+/// `M`'s factors by the runtime's tree factorization.
+fn factors(robot: &Robot, q: &[f64; NV + 1]) -> [[f64; NV]; NV] {
+    let mut m = robot.mass_matrix(q);
+    ltdl_factor(&mut m, &Robot::PARENTS).unwrap();
+    m
+}
+
+#[test]
+fn mass_matrix_inverse_is_the_runtime_one_and_inverts_m() {
+    let robot = Robot::default();
+    for seed in 0..6 {
+        let (q, _, _) = random_state::<{ NV + 1 }, NV>(seed);
+        let inverse = robot.mass_matrix_inverse(&q);
+        let expected = ltdl_inverse_factored(&factors(&robot, &q), &Robot::PARENTS);
+        let e = normwise(&flat(&inverse), &flat(&expected));
+        assert!(e < TOLERANCE, "seed {seed}: {e:e}");
+        let m = robot.mass_matrix(&q);
+        let identity: [[f64; NV]; NV] = core::array::from_fn(|i| {
+            core::array::from_fn(|j| (0..NV).map(|k| m[i][k] * inverse[k][j]).sum())
+        });
+        let unit: [[f64; NV]; NV] =
+            core::array::from_fn(|i| core::array::from_fn(|j| f64::from(u8::from(i == j))));
+        let e = normwise(&flat(&identity), &flat(&unit));
+        assert!(e < 1e-10, "seed {seed}: |M M^-1 - I| {e:e}");
+    }
+}
+
+#[test]
+fn forward_dynamics_derivatives_are_the_runtime_ones() {
+    let robot = Robot::default();
+    for seed in 0..6 {
+        let (q, v, tau) = random_state::<{ NV + 1 }, NV>(seed);
+        let m = factors(&robot, &q);
+        let h = robot.inverse_dynamics(&q, &v, &[0.0; NV]);
+        let rhs: [f64; NV] = core::array::from_fn(|i| tau[i] - h[i]);
+        let qdd = ltdl_substitute(&m, &Robot::PARENTS, &rhs);
+        let (mut dq, mut dv) = robot.inverse_dynamics_derivatives(&q, &v, &qdd);
+        for x in [&mut dq, &mut dv] {
+            ltdl_substitute_rows(&m, &Robot::PARENTS, x);
+            x.iter_mut().flatten().for_each(|e| *e = -*e);
+        }
+        let (gq, gv, inverse) = robot.forward_dynamics_derivatives(&q, &v, &tau);
+        for (what, ours, runtime) in [("dq", gq, dq), ("dv", gv, dv)] {
+            let e = normwise(&flat(&ours), &flat(&runtime));
+            assert!(e < 1e-10, "seed {seed}: {what} {e:e}");
+        }
+        assert_eq!(inverse, robot.mass_matrix_inverse(&q), "seed {seed}");
+    }
+}
