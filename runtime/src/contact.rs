@@ -122,7 +122,38 @@ pub fn solve_factored_active_with<T: Real, const N: usize, const K: usize>(
     active: &[bool; K],
     substitute: impl Fn(&[T; N]) -> [T; N],
 ) -> Result<([T; N], [T; K]), FactorError> {
-    let chol = contact_space(m, parent, j, active)?;
+    let lower = |w: &mut [[T; K]; N]| ltdl_lower_rows(m, parent, w);
+    solve_factored_active_by(m, free, j, drift, active, substitute, lower)
+}
+
+/// [`solve_factored_active_with`] with the caller's own first half of the substitution too
+/// (`lower`: `x <- L^-T x` for the K columns of `x`, as [`ltdl_lower_rows`] computes it from
+/// the factors in `m`): generated code passes its passes unrolled for the robot's tree, and
+/// the tree's parents are not needed.
+///
+/// ```
+/// use eomgen_runtime::contact::solve_factored_active_by;
+/// use eomgen_runtime::tree::{ltdl_lower_rows, ltdl_substitute};
+/// // The point mass of `solve`, M = I already factorized.
+/// let (m, parent) = ([[1.0_f64, 0.0], [0.0, 1.0]], [None, None]);
+/// let j = [[1.0, 0.0], [0.0, 1.0]];
+/// let substitute = |b: &[f64; 2]| ltdl_substitute(&m, &parent, b);
+/// let lower = |w: &mut [[f64; 2]; 2]| ltdl_lower_rows(&m, &parent, w);
+/// let (a, f) =
+///     solve_factored_active_by(&m, &[0.0, -9.81], &j, &[0.0; 2], &[true; 2], substitute, lower)
+///         .unwrap();
+/// assert!(a[1].abs() < 1e-12 && (f[1] - 9.81).abs() < 1e-12);
+/// ```
+pub fn solve_factored_active_by<T: Real, const N: usize, const K: usize>(
+    m: &[[T; N]; N],
+    free: &[T; N],
+    j: &[[T; N]; K],
+    drift: &[T; K],
+    active: &[bool; K],
+    substitute: impl Fn(&[T; N]) -> [T; N],
+    lower: impl FnOnce(&mut [[T; K]; N]),
+) -> Result<([T; N], [T; K]), FactorError> {
+    let chol = contact_space(m, j, active, lower)?;
     let mut b = [T::zero(); K];
     for k in 0..K {
         if active[k] {
@@ -139,15 +170,15 @@ pub fn solve_factored_active_with<T: Real, const N: usize, const K: usize>(
 }
 
 /// The Cholesky factor of `J M^-1 J^T = W^T D^-1 W` with `W = L^-T J^T` (the inactive rows of
-/// `J` as zero; the identity's rows and columns for them), from `M`'s factors `m`: half the
-/// substitution that `M^-1 J^T` would take.
+/// `J` as zero; the identity's rows and columns for them), from `M`'s factors `m` and `lower`
+/// (`x <- L^-T x`, [`ltdl_lower_rows`]): half the substitution that `M^-1 J^T` would take.
 ///
 /// Errors: a pivot of `J M^-1 J^T` that is not positive or not finite (pivot `N + k`).
 pub(crate) fn contact_space<T: Real, const N: usize, const K: usize>(
     m: &[[T; N]; N],
-    parent: &[Option<usize>; N],
     j: &[[T; N]; K],
     active: &[bool; K],
+    lower: impl FnOnce(&mut [[T; K]; N]),
 ) -> Result<Cholesky<T, K>, FactorError> {
     let mut w = [[T::zero(); K]; N];
     for (i, wi) in w.iter_mut().enumerate() {
@@ -157,7 +188,7 @@ pub(crate) fn contact_space<T: Real, const N: usize, const K: usize>(
             }
         }
     }
-    ltdl_lower_rows(m, parent, &mut w);
+    lower(&mut w);
     // W^T D^-1 W as N rank-one updates, one per coordinate: the K x K sums are independent
     // chains the processor overlaps (gathered row by row, each row was a chain of N dependent
     // multiply-adds, and they were a sixth of a quadruped's contact dynamics).

@@ -7,6 +7,7 @@
 
 use crate::contact::{contact_space, transpose_times};
 use crate::kkt::{axpy, dot, finite_rows, finite_solution, ContactKkt, ImpulseDynamicsDerivatives};
+use crate::tree::ltdl_lower_rows;
 use crate::{FactorError, Real};
 
 impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
@@ -107,7 +108,36 @@ pub fn solve_factored_active_with<T: Real, const N: usize, const K: usize>(
     active: &[bool; K],
     substitute: impl Fn(&[T; N]) -> [T; N],
 ) -> Result<([T; N], [T; K]), FactorError> {
-    let chol = contact_space(m, parent, j, active)?;
+    let lower = |w: &mut [[T; K]; N]| ltdl_lower_rows(m, parent, w);
+    solve_factored_active_by(m, j, v, e, active, substitute, lower)
+}
+
+/// [`solve_factored_active_with`] with the caller's own first half of the substitution too
+/// (`lower`: `x <- L^-T x` for the K columns of `x`, as [`ltdl_lower_rows`] computes it from
+/// the factors in `m`): generated code passes its passes unrolled for the robot's tree.
+///
+/// ```
+/// use eomgen_runtime::impulse::solve_factored_active_by;
+/// use eomgen_runtime::tree::{ltdl_lower_rows, ltdl_substitute};
+/// // The point mass of `solve_factored_active_with`, hitting the ground inelastically.
+/// let (m, parent) = ([[1.0_f64, 0.0], [0.0, 1.0]], [None, None]);
+/// let substitute = |b: &[f64; 2]| ltdl_substitute(&m, &parent, b);
+/// let lower = |w: &mut [[f64; 1]; 2]| ltdl_lower_rows(&m, &parent, w);
+/// let (after, p) =
+///     solve_factored_active_by(&m, &[[0.0, 1.0]], &[1.0, -2.0], 0.0, &[true], substitute, lower)
+///         .unwrap();
+/// assert_eq!((after, p), ([1.0, 0.0], [2.0]));
+/// ```
+pub fn solve_factored_active_by<T: Real, const N: usize, const K: usize>(
+    m: &[[T; N]; N],
+    j: &[[T; N]; K],
+    v: &[T; N],
+    e: T,
+    active: &[bool; K],
+    substitute: impl Fn(&[T; N]) -> [T; N],
+    lower: impl FnOnce(&mut [[T; K]; N]),
+) -> Result<([T; N], [T; K]), FactorError> {
+    let chol = contact_space(m, j, active, lower)?;
     let k = -(T::one() + e);
     let mut bottom = [T::zero(); K];
     for ((b, jr), on) in bottom.iter_mut().zip(j).zip(active) {

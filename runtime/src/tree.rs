@@ -515,7 +515,17 @@ pub fn ltdl_substitute_rows<T: Lane, const N: usize, const C: usize>(
 
 /// The first half of [`ltdl_substitute_rows`]: `x <- L^-T x` (from the leaves up), for
 /// products that need only `L^-T J^T` (`J M^-1 J^T = W^T D^-1 W` with `W = L^-T J^T`).
-pub(crate) fn ltdl_lower_rows<T: Lane, const N: usize, const C: usize>(
+///
+/// ```
+/// use eomgen_runtime::tree::{ltdl_factor, ltdl_lower_rows};
+/// let parent = [None, Some(0)];
+/// let mut m = [[2.0_f64, 0.5], [0.5, 1.0]];
+/// ltdl_factor(&mut m, &parent).unwrap(); // L[1][0] = 0.5
+/// let mut x = [[1.0], [2.0]];
+/// ltdl_lower_rows(&m, &parent, &mut x);
+/// assert_eq!(x, [[0.0], [2.0]]);
+/// ```
+pub fn ltdl_lower_rows<T: Lane, const N: usize, const C: usize>(
     m: &[[T; N]; N],
     parent: &[Option<usize>; N],
     x: &mut [[T; C]; N],

@@ -54,7 +54,7 @@ pub(super) fn quantities(d: &Derivation) -> Vec<Quantity> {
                 "NaN in every entry when M(q) is not positive definite or the active rows of J_c are",
                 "rank-deficient; `try_contact_forward_dynamics_active` says why.",
             ],
-            &format!("M from `mass_matrix`, b + G by Newton-Euler, J_c and its drift, {kkt} (eomgen_runtime::contact::solve_factored_active_with)"),
+            &format!("M from `mass_matrix`, b + G by Newton-Euler, J_c and its drift, {kkt} (eomgen_runtime::contact::solve_factored_active_by, with the first half of the substitution unrolled too)"),
             Evaluation::ActiveContacts(ActiveContacts::Dynamics { h: h() }),
         ),
         quantity(
@@ -89,7 +89,7 @@ pub(super) fn quantities(d: &Derivation) -> Vec<Quantity> {
                 "",
                 "NaN in every entry as `impulse_dynamics`; `try_impulse_dynamics_active` says why.",
             ],
-            &format!("M from `mass_matrix`, J_c from `contact_jacobian`, {kkt} (eomgen_runtime::impulse::solve_factored_active_with)"),
+            &format!("M from `mass_matrix`, J_c from `contact_jacobian`, {kkt} (eomgen_runtime::impulse::solve_factored_active_by, with the first half of the substitution unrolled too)"),
             Evaluation::ActiveContacts(ActiveContacts::Impulse),
         ),
     ]

@@ -401,7 +401,7 @@ fn contact_quantities(model: &Model, d: &Derivation) -> [Quantity; 3] {
                 "NaN in every entry when M(q) is not positive definite or J_c is rank-deficient;",
                 "`try_contact_forward_dynamics` says why.",
             ],
-            "M from `mass_matrix`, b + G by Newton-Euler, J_c and its drift, then the unrolled L^T D L of M, a Cholesky factorization of J_c M^-1 J_c^T and one more substitution (eomgen_runtime::contact::solve_factored_active_with)",
+            "M from `mass_matrix`, b + G by Newton-Euler, J_c and its drift, then the unrolled L^T D L of M, a Cholesky factorization of J_c M^-1 J_c^T and one more substitution (eomgen_runtime::contact::solve_factored_active_by, with the first half of the substitution unrolled too)",
             Evaluation::ContactForwardDynamics {
                 h: d.fast.bias_gravity_friction.clone(),
             },

@@ -156,7 +156,7 @@ pub(super) fn impulse_dynamics(d: &Derivation) -> Option<Quantity> {
             "NaN in every entry when M(q) is not positive definite or J_c is rank-deficient;",
             "`try_impulse_dynamics` says why.",
         ],
-        "M from `mass_matrix`, J_c from `contact_jacobian`, then the unrolled L^T D L of M, a Cholesky factorization of J_c M^-1 J_c^T and one more substitution (eomgen_runtime::impulse::solve_factored_active_with)",
+        "M from `mass_matrix`, J_c from `contact_jacobian`, then the unrolled L^T D L of M, a Cholesky factorization of J_c M^-1 J_c^T and one more substitution (eomgen_runtime::impulse::solve_factored_active_by, with the first half of the substitution unrolled too)",
         Evaluation::ImpulseDynamics,
     ))
 }

@@ -321,6 +321,25 @@ pub(super) fn substitute_rows_fn(parents: &[Option<usize>], n: &Literal) -> Toke
     }
 }
 
+/// `fn ltdl_lower_rows_unrolled::<C>(m, x)`: `x <- L^-T x` for the `C` columns of `x`, the
+/// first half of the substitution (`J M^-1 J^T = W^T D^-1 W` with `W = L^-T J^T` needs no
+/// more), as `tree::ltdl_lower_rows` computes it (to the bit), the tree walks done here.
+pub(super) fn lower_rows_fn(parents: &[Option<usize>], n: &Literal) -> TokenStream {
+    let rows = from_subtrees(parents, |_| None, |_| Span::All);
+    let generics = quote!(<const C: usize>);
+    let x = quote!([[T; C]; #n]);
+    let (parts, calls) = in_parts("ltdl_lower_rows_part", generics, quote!(::<C>), x, n, rows);
+    quote! {
+        #parts
+        /// `x <- L^-T x` for the `C` columns of `x` with the factors of
+        /// `ltdl_factor_unrolled` (`eomgen_runtime::tree::ltdl_lower_rows` unrolled).
+        #[inline(never)]
+        fn ltdl_lower_rows_unrolled<const C: usize>(m: &[[T; #n]; #n], x: &mut [[T; C]; #n]) {
+            #calls
+        }
+    }
+}
+
 /// One past the last coordinate of each coordinate's subtree (parents before children).
 fn subtree_ends(parents: &[Option<usize>]) -> Vec<usize> {
     let mut ends: Vec<usize> = (1..=parents.len()).collect();

@@ -182,7 +182,8 @@ impl Emitter<'_> {
                 #drift
                 let rows = ::eomgen_runtime::contact::row_mask(&Self::CONTACT_ROWS, active);
                 let substitute = |b: &[T; #n]| Self::ltdl_substitute_unrolled(&m, b);
-                ::eomgen_runtime::contact::solve_factored_active_with(&m, &Self::PARENTS, &free, &j, &drift, &rows, substitute)
+                let lower = |w: &mut [[T; #k]; #n]| Self::ltdl_lower_rows_unrolled(&m, w);
+                ::eomgen_runtime::contact::solve_factored_active_by(&m, &free, &j, &drift, &rows, substitute, lower)
             }
 
             #docs
@@ -342,7 +343,8 @@ impl Emitter<'_> {
                 let j = #j(self, q);
                 Self::ltdl_factor_unrolled(&mut m, &mut ::core::default::Default::default())?;
                 let substitute = |b: &[T; #n]| Self::ltdl_substitute_unrolled(&m, b);
-                ::eomgen_runtime::impulse::solve_factored_active_with(&m, &Self::PARENTS, &j, qd, restitution, &#rows, substitute)
+                let lower = |w: &mut [[T; #k]; #n]| Self::ltdl_lower_rows_unrolled(&m, w);
+                ::eomgen_runtime::impulse::solve_factored_active_by(&m, &j, qd, restitution, &#rows, substitute, lower)
             }
 
             #docs

@@ -216,6 +216,24 @@ impl Emitter<'_> {
         } else {
             TokenStream::new()
         };
+        // What forms `W = L^-T J^T` for `J M^-1 J^T`: contact and impulse dynamics.
+        let lowers = |e: &Evaluation| {
+            matches!(
+                e,
+                E::ContactForwardDynamics { .. }
+                    | E::ImpulseDynamics
+                    | E::ActiveContacts(
+                        ActiveContacts::Dynamics { .. }
+                            | ActiveContacts::Stabilized { .. }
+                            | ActiveContacts::Impulse
+                    )
+            )
+        };
+        let lower_rows = if self.any_eval(lowers) {
+            crate::emit::tree_solve::lower_rows_fn(&self.parents, n)
+        } else {
+            TokenStream::new()
+        };
         let substitute_rows = if self.any_eval(|e| matches!(e, E::ForwardDynamicsDerivatives)) {
             crate::emit::tree_solve::substitute_rows_fn(&self.parents, n)
         } else {
@@ -228,6 +246,7 @@ impl Emitter<'_> {
             #substitute
             #inverse
             #substitute_rows
+            #lower_rows
         }
     }
 
@@ -367,7 +386,8 @@ impl Emitter<'_> {
             #try_vis fn try_contact_forward_dynamics(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n]) -> ::core::result::Result<([T; #n], [T; #k3]), ::eomgen_runtime::FactorError> {
                 #free
                 let substitute = |b: &[T; #n]| Self::ltdl_substitute_unrolled(&m, b);
-                ::eomgen_runtime::contact::solve_factored_active_with(&m, &Self::PARENTS, &free, &#j(self, q), &#drift(self, q, qd), &[true; #k3], substitute)
+                let lower = |w: &mut [[T; #k3]; #n]| Self::ltdl_lower_rows_unrolled(&m, w);
+                ::eomgen_runtime::contact::solve_factored_active_by(&m, &free, &#j(self, q), &#drift(self, q, qd), &[true; #k3], substitute, lower)
             }
         };
         let inherent_try = if self.trait_of("try_contact_forward_dynamics").is_some() {
