@@ -127,9 +127,9 @@ pub enum Evaluation {
     Factored { outputs: Vec<Id>, pivots: Vec<Id> },
     /// `(d qdd/dq, d qdd/dqd, M^-1)` at run time through one tree factorization of
     /// `mass_matrix`: `qdd` from it and `inverse_dynamics(q, qd, 0)`, then `-M^-1` times
-    /// `inverse_dynamics_derivatives` at `(q, qd, qdd)` and `M^-1` from the same factors, both
-    /// unrolled over the tree (`tree::ltdl_substitute_rows`'s and
-    /// `tree::ltdl_inverse_factored`'s operations; `emit::tree_solve`).
+    /// `inverse_dynamics_derivatives` at `(q, qd, qdd)` (`tree::ltdl_substitute_rows`), and
+    /// `M^-1` from the same factors, unrolled over the tree (`tree::ltdl_inverse_factored`'s
+    /// operations; `emit::tree_solve`).
     ForwardDynamicsDerivatives,
     /// The accelerations and contact forces with the contact points held, solved at run time:
     /// `M` from `mass_matrix`, `h = b + G + F` straight-line, `J_c` and its drift from

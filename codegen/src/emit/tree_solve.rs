@@ -294,33 +294,6 @@ pub(super) fn inverse_fn(parents: &[Option<usize>], n: &Literal) -> TokenStream 
     }
 }
 
-/// `fn ltdl_substitute_rows_unrolled::<C>(m, x)`: `M^-1 X` in place for the `C` columns of
-/// `x`, as `tree::ltdl_substitute_rows` computes it (to the bit), the tree walks done here.
-pub(super) fn substitute_rows_fn(parents: &[Option<usize>], n: &Literal) -> TokenStream {
-    let mut rows = from_subtrees(parents, |_| None, |_| Span::All);
-    rows.extend(from_ancestors(parents, |_| Span::All));
-    let generics = quote!(<const C: usize>);
-    let x = quote!([[T; C]; #n]);
-    let (parts, calls) = in_parts(
-        "ltdl_substitute_rows_part",
-        generics,
-        quote!(::<C>),
-        x,
-        n,
-        rows,
-    );
-    quote! {
-        #parts
-        /// Solves `M X = B` for the `C` columns of `x` (`B` on entry, `X` on return) with the
-        /// factors of `ltdl_factor_unrolled` (`eomgen_runtime::tree::ltdl_substitute_rows`
-        /// unrolled).
-        #[inline(never)]
-        fn ltdl_substitute_rows_unrolled<const C: usize>(m: &[[T; #n]; #n], x: &mut [[T; C]; #n]) {
-            #calls
-        }
-    }
-}
-
 /// `fn ltdl_lower_rows_unrolled::<C>(m, x)`: `x <- L^-T x` for the `C` columns of `x`, the
 /// first half of the substitution (`J M^-1 J^T = W^T D^-1 W` with `W = L^-T J^T` needs no
 /// more), as `tree::ltdl_lower_rows` computes it (to the bit), the tree walks done here.

@@ -234,18 +234,12 @@ impl Emitter<'_> {
         } else {
             TokenStream::new()
         };
-        let substitute_rows = if self.any_eval(|e| matches!(e, E::ForwardDynamicsDerivatives)) {
-            crate::emit::tree_solve::substitute_rows_fn(&self.parents, n)
-        } else {
-            TokenStream::new()
-        };
         quote! {
             #table
             #rows
             #factor
             #substitute
             #inverse
-            #substitute_rows
             #lower_rows
         }
     }
@@ -309,7 +303,7 @@ impl Emitter<'_> {
                 let qdd = Self::ltdl_substitute_unrolled(&m, &rhs);
                 #id_derivatives
                 for x in [&mut *dq, &mut *dqd] {
-                    Self::ltdl_substitute_rows_unrolled(&m, x);
+                    ::eomgen_runtime::tree::ltdl_substitute_rows(&m, &Self::PARENTS, x);
                     for v in x.iter_mut().flatten() {
                         *v = -*v;
                     }
