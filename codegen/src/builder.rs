@@ -276,10 +276,10 @@ impl Builder {
 
     /// With [`Builder::derivatives`]: `mass_matrix_inverse` and `forward_dynamics_derivatives`
     /// are straight-line code up to this many operations each (default
-    /// [`crate::dynamics::DERIVATIVES_FLAT_MAX_OPS`], 40,000), and beyond it composed at run
+    /// [`crate::dynamics::DERIVATIVES_FLAT_MAX_OPS`], 20,000), and beyond it composed at run
     /// time from `mass_matrix`, its factorization unrolled for the robot's tree and
-    /// `inverse_dynamics_derivatives`. Straight-line code is faster on small robots; the
-    /// composed route compiles faster and is faster on humanoids. `0` always composes.
+    /// `inverse_dynamics_derivatives`. Straight-line code is faster on small robots (an arm); the
+    /// composed route compiles faster and is faster from a quadruped on. `0` always composes.
     ///
     /// ```
     /// let b = eomgen::Builder::new("robots/anymal.urdf").derivatives().derivatives_flat_max_ops(0);
