@@ -607,8 +607,11 @@ fn pull_from_ancestors<T: Lane, const N: usize, const C: usize, const UPPER: boo
     }
 }
 
-/// Columns per chunk of [`sub_scaled_chunks`]: a vector register of `f64` with AVX-512.
-const CHUNK: usize = 8;
+/// Columns per chunk of the passes of [`ltdl_inverse_factored_into`] (a vector register of
+/// `f64` with AVX-512): an update of a row covers only the chunks that overlap the columns it
+/// can change. Generated code that unrolls the inverse chunks its updates the same way, so
+/// that its result is this one's to the bit.
+pub const CHUNK: usize = 8;
 
 /// `acc -= k row` ([`axpy`]) on the chunks of [`CHUNK`] columns that overlap `columns` only (a loop of
 /// constant length, so that the compiler still unrolls it and keeps `acc` in registers).

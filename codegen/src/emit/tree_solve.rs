@@ -85,9 +85,9 @@ pub(super) fn substitute_fn(parents: &[Option<usize>], n: &Literal) -> TokenStre
     }
 }
 
-/// Columns per chunk of the runtime's `tree` passes (a vector register of `f64` with
-/// AVX-512): the inverse below updates whole chunks as they do, so that its result is theirs
-/// to the bit.
+/// Columns per chunk of the runtime's `tree` passes (`eomgen_runtime::tree::CHUNK`, which the
+/// library does not depend on; a unit test holds the two equal): the inverse below updates
+/// whole chunks as they do, so that its result is theirs to the bit.
 const CHUNK: usize = 8;
 
 /// Row updates per generated function of the passes below: one function of 50 rows and 760
@@ -322,4 +322,14 @@ fn subtree_ends(parents: &[Option<usize>]) -> Vec<usize> {
         }
     }
     ends
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn chunks_are_the_runtimes() {
+        assert_eq!(CHUNK, eomgen_runtime::tree::CHUNK);
+    }
 }
