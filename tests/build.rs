@@ -186,7 +186,9 @@ fn tree_route() {
         .type_name("AnymalTreeRoute")
         .quantities([
             "inverse_dynamics",
+            "forward_dynamics",
             "mass_matrix",
+            "integrate",
             "inverse_dynamics_derivatives",
             "forward_dynamics_derivatives",
             "mass_matrix_inverse",

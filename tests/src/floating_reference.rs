@@ -101,6 +101,33 @@ pub fn random_state<const NQ: usize, const NV: usize>(
     (q, v, tau)
 }
 
+/// Central differences (step `1e-6`) of `f` in each tangent direction of the configuration
+/// `q` (moved by `integrate`, a generated robot's) and of the velocity `v`: the two NV x NV
+/// matrices of its derivatives, column `k` along direction `k`.
+pub fn tangent_differences<const NQ: usize, const NV: usize>(
+    integrate: impl Fn(&[f64; NQ], &[f64; NV], f64) -> [f64; NQ],
+    q: &[f64; NQ],
+    v: &[f64; NV],
+    f: impl Fn(&[f64; NQ], &[f64; NV]) -> [f64; NV],
+) -> ([[f64; NV]; NV], [[f64; NV]; NV]) {
+    let h = 1e-6;
+    let (mut dq, mut dv) = ([[0.0; NV]; NV], [[0.0; NV]; NV]);
+    for k in 0..NV {
+        let e: [f64; NV] = core::array::from_fn(|i| if i == k { h } else { 0.0 });
+        let (qp, qm) = (integrate(q, &e, 1.0), integrate(q, &e, -1.0));
+        let (vp, vm): ([f64; NV], [f64; NV]) = (
+            core::array::from_fn(|i| v[i] + e[i]),
+            core::array::from_fn(|i| v[i] - e[i]),
+        );
+        let (fqp, fqm, fvp, fvm) = (f(&qp, v), f(&qm, v), f(q, &vp), f(q, &vm));
+        for i in 0..NV {
+            dq[i][k] = (fqp[i] - fqm[i]) / (2.0 * h);
+            dv[i][k] = (fvp[i] - fvm[i]) / (2.0 * h);
+        }
+    }
+    (dq, dv)
+}
+
 /// A reference matrix's rows `rows` and columns `cols`, flat.
 pub fn pick(m: &Value, rows: &[usize], cols: &[usize]) -> Vec<f64> {
     let m: Vec<Vec<f64>> = m.as_array().unwrap().iter().map(numbers).collect();

@@ -6,7 +6,9 @@
 #![allow(clippy::needless_range_loop)]
 
 use eomgen_runtime::prelude::*;
-use eomgen_tests::floating_reference::{flat, normwise, numbers, pick, reference, Order};
+use eomgen_tests::floating_reference::{
+    flat, normwise, numbers, pick, reference, tangent_differences, Order,
+};
 use eomgen_tests::robots::{anymal, anymal_derivatives, anymal_weightless, iris_simple};
 use serde_json::Value;
 
@@ -322,32 +324,6 @@ fn anymal_derivatives_match_pinocchio() {
     assert!(worst.1 <= 1e-8, "d tau / d v off by {:e}", worst.1);
 }
 
-/// Central differences of `f` along each tangent direction of the configuration (through the
-/// generated `integrate`) and of the velocity, as columns.
-fn tangent_differences(
-    r: &anymal_derivatives::AnymalDerivatives<f64>,
-    q: &[f64; 19],
-    v: &[f64; 18],
-    f: impl Fn(&[f64; 19], &[f64; 18]) -> [f64; 18],
-) -> ([[f64; 18]; 18], [[f64; 18]; 18]) {
-    let h = 1e-6;
-    let (mut dq, mut dv) = ([[0.0; 18]; 18], [[0.0; 18]; 18]);
-    for k in 0..18 {
-        let e: [f64; 18] = core::array::from_fn(|i| if i == k { h } else { 0.0 });
-        let (qp, qm) = (r.integrate(q, &e, 1.0), r.integrate(q, &e, -1.0));
-        let (vp, vm): ([f64; 18], [f64; 18]) = (
-            core::array::from_fn(|i| v[i] + e[i]),
-            core::array::from_fn(|i| v[i] - e[i]),
-        );
-        let (fqp, fqm, fvp, fvm) = (f(&qp, v), f(&qm, v), f(q, &vp), f(q, &vm));
-        for i in 0..18 {
-            dq[i][k] = (fqp[i] - fqm[i]) / (2.0 * h);
-            dv[i][k] = (fvp[i] - fvm[i]) / (2.0 * h);
-        }
-    }
-    (dq, dv)
-}
-
 #[test]
 fn anymal_derivatives_match_finite_differences() {
     let r = anymal_derivatives::AnymalDerivatives::<f64>::default();
@@ -355,9 +331,10 @@ fn anymal_derivatives_match_finite_differences() {
         let (q, v) = state(seed);
         let (_, a) = state(seed + 100);
         let tau: [f64; 18] = core::array::from_fn(|i| 10.0 * a[i]);
-        let (id_q, id_v) = tangent_differences(&r, &q, &v, |q, v| r.inverse_dynamics(q, v, &a));
+        let step = |q: &[f64; 19], e: &[f64; 18], s: f64| r.integrate(q, e, s);
+        let (id_q, id_v) = tangent_differences(step, &q, &v, |q, v| r.inverse_dynamics(q, v, &a));
         let (dq, dv) = r.inverse_dynamics_derivatives(&q, &v, &a);
-        let (fd_q, fd_v) = tangent_differences(&r, &q, &v, |q, v| r.forward_dynamics(q, v, &tau));
+        let (fd_q, fd_v) = tangent_differences(step, &q, &v, |q, v| r.forward_dynamics(q, v, &tau));
         let (fq, fv, minv) = r.forward_dynamics_derivatives(&q, &v, &tau);
         for (what, ours, diff) in [
             ("d tau / d q", &dq, &id_q),

@@ -9,7 +9,7 @@
 use eomgen_runtime::tree::{
     ltdl_factor, ltdl_inverse_factored, ltdl_substitute, ltdl_substitute_rows,
 };
-use eomgen_tests::floating_reference::{flat, normwise, random_state};
+use eomgen_tests::floating_reference::{flat, normwise, random_state, tangent_differences};
 use eomgen_tests::robots::anymal_tree_route::AnymalTreeRoute;
 
 const NV: usize = 18;
@@ -72,5 +72,21 @@ fn forward_dynamics_derivatives_are_the_runtime_ones() {
             assert!(e < 1e-10, "seed {seed}: {what} {e:e}");
         }
         assert_eq!(inverse, robot.mass_matrix_inverse(&q), "seed {seed}");
+    }
+}
+
+#[test]
+fn forward_dynamics_derivatives_match_central_differences() {
+    let robot = Robot::default();
+    let step = |q: &[f64; NV + 1], e: &[f64; NV], s: f64| robot.integrate(q, e, s);
+    for seed in 1..4 {
+        let (q, v, tau) = random_state::<{ NV + 1 }, NV>(seed);
+        let (fd_q, fd_v) =
+            tangent_differences(step, &q, &v, |q, v| robot.forward_dynamics(q, v, &tau));
+        let (dq, dv, _) = robot.forward_dynamics_derivatives(&q, &v, &tau);
+        for (what, ours, central) in [("d a / d q", dq, fd_q), ("d a / d v", dv, fd_v)] {
+            let e = normwise(&flat(&ours), &flat(&central));
+            assert!(e < 1e-6, "seed {seed}: {what} off by {e:e}");
+        }
     }
 }
