@@ -7,6 +7,11 @@
 //! joint); unrolled, each update is one load, one fused multiply-add and one store at constant
 //! indices. The code is about `sum over coordinates of depth^2 / 2` lines (3,400 for a 50-DoF
 //! humanoid), small next to the mass matrix it factorizes.
+//!
+//! The same for the passes over many columns: `M^-1` (`tree::ltdl_inverse_factored_into`'s
+//! two passes, each row of the result gathered in registers from its subtree, then from its
+//! ancestors) and `L^-T` of the contact rows (`tree::ltdl_lower_rows`), in `#[inline(never)]`
+//! parts of at most [`PART_UPDATES`] row updates.
 
 use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
