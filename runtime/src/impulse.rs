@@ -7,7 +7,7 @@
 
 use crate::contact::{contact_space, transpose_times};
 use crate::kkt::{axpy, dot, finite_rows, finite_solution, ContactKkt, ImpulseDynamicsDerivatives};
-use crate::tree::ltdl_lower_rows;
+use crate::tree::{ltdl_lower_rows, TreePasses, Walked};
 use crate::{FactorError, Real};
 
 impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
@@ -54,21 +54,33 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
         e: T,
         d: &mut ImpulseDynamicsDerivatives<T, N, K>,
     ) -> Result<(), FactorError> {
-        self.solve_negated_columns_in_place(&mut d.dv_dq, &mut d.dimpulse_dq);
-        d.dimpulse_dv = *self.jacobian();
-        self.lambda_solve_columns(&mut d.dimpulse_dv);
+        self.impulse_derivatives_in_place_by::<Walked>(e, d)
+    }
+
+    /// [`ContactKkt::impulse_derivatives_in_place`] with the substitutions through `M`'s
+    /// factors from the passes `P` (generated code's own, unrolled for the robot's tree).
+    pub fn impulse_derivatives_in_place_by<P: TreePasses<T, N>>(
+        &self,
+        e: T,
+        d: &mut ImpulseDynamicsDerivatives<T, N, K>,
+    ) -> Result<(), FactorError> {
+        self.solve_signed_columns_in_place::<P, N>(&mut d.dv_dq, &mut d.dimpulse_dq, -T::one());
+        // dp/dv = -(1 + e) Lambda^-1 J, the factor applied to J's rows as they are copied.
         let k = -(T::one() + e);
-        for x in d.dimpulse_dv.iter_mut().flatten() {
-            *x *= k;
+        for (p, j) in d.dimpulse_dv.iter_mut().zip(self.jacobian()) {
+            *p = j.map(|x| k * x);
         }
-        // I + Y dp/dv, each row gathered in a local accumulator.
+        self.lambda_solve_columns(&mut d.dimpulse_dv);
+        // I + Y dp/dv, each row gathered in a local accumulator. The identity's one is added
+        // to the row once written: set in the accumulator at a varying index, it kept the
+        // accumulator in memory, whose wide reloads of narrow stores could not be forwarded.
         for (i, row) in d.dv_dv.iter_mut().enumerate() {
             let mut acc = [T::zero(); N];
-            acc[i] = T::one();
             for (yk, pk) in self.inverse_inertia_rows().iter().zip(&d.dimpulse_dv) {
                 axpy(&mut acc, yk[i], pk);
             }
             *row = acc;
+            row[i] += T::one();
         }
         finite_rows(&d.dv_dq, 0)?;
         finite_rows(&d.dv_dv, 0)?;

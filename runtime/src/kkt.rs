@@ -18,7 +18,7 @@
 
 pub(crate) use crate::linalg::axpy;
 use crate::linalg::{Cholesky, FactorError};
-use crate::tree::{ltdl_factor, ltdl_substitute, ltdl_substitute_rows};
+use crate::tree::{ltdl_factor, ltdl_substitute, TreePasses, Walked};
 use crate::Real;
 
 /// The derivatives of contact forward dynamics (`contact_forward_dynamics_derivatives`), as
@@ -144,8 +144,8 @@ impl<T: Real, const NV: usize, const K: usize> ImpulseDynamicsDerivatives<T, NV,
 /// Completes the system whose `M`'s `L^T D L` factors and contact Jacobian are in `factors`
 /// and `j`: zeroes the inactive rows of `J`, writes `Y = M^-1 J^T` into `y` (row `k` a column)
 /// and returns the Cholesky factor of `J M^-1 J^T` (the identity's rows and columns for
-/// inactive rows).
-fn factorize<T: Real, const N: usize, const K: usize>(
+/// inactive rows). `P` substitutes through the factors.
+fn factorize<P: TreePasses<T, N>, T: Real, const N: usize, const K: usize>(
     factors: &[[T; N]; N],
     j: &mut [[T; N]; K],
     y: &mut [[T; N]; K],
@@ -164,7 +164,7 @@ fn factorize<T: Real, const N: usize, const K: usize>(
             *x = jk[i];
         }
     }
-    ltdl_substitute_rows(factors, parent, &mut yt);
+    P::substitute_rows(factors, parent, &mut yt);
     for (k, yk) in y.iter_mut().enumerate() {
         for (y, row) in yk.iter_mut().zip(&yt) {
             *y = row[k];
@@ -302,7 +302,17 @@ impl<T: Real, const N: usize, const K: usize> KktStash<T, N, K> {
         &self,
         d: &mut ContactDynamicsDerivatives<T, N, K>,
     ) -> Result<(), FactorError> {
-        ContactKkt::from_stash(self, d).contact_dynamics_derivatives_in_place(d)
+        self.contact_dynamics_derivatives_in_place_by::<Walked>(d)
+    }
+
+    /// [`KktStash::contact_dynamics_derivatives_in_place`] with the passes `P`, as
+    /// [`ContactKkt::contact_dynamics_derivatives_in_place_by`].
+    #[inline(never)]
+    pub fn contact_dynamics_derivatives_in_place_by<P: TreePasses<T, N>>(
+        &self,
+        d: &mut ContactDynamicsDerivatives<T, N, K>,
+    ) -> Result<(), FactorError> {
+        ContactKkt::from_stash(self, d).contact_dynamics_derivatives_in_place_by::<P>(d)
     }
 }
 
@@ -424,11 +434,22 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
         parent: &[Option<usize>; N],
         active: &[bool; K],
     ) -> Result<(), FactorError> {
+        self.set_up_factored_by::<Walked>(fill, parent, active)
+    }
+
+    /// [`ContactKkt::set_up_factored`] with `M^-1 J^T` from the passes `P` (generated code's
+    /// own, unrolled for the robot's tree; [`Walked`]: the runtime's).
+    pub fn set_up_factored_by<P: TreePasses<T, N>>(
+        &mut self,
+        fill: impl FnOnce(&mut [[T; N]; N], &mut [[T; N]; K]) -> Result<(), FactorError>,
+        parent: &[Option<usize>; N],
+        active: &[bool; K],
+    ) -> Result<(), FactorError> {
         fill(&mut self.factors, &mut self.j)?;
         self.parent = *parent;
         self.active = *active;
         let (factors, j, y) = (&mut self.factors, &mut self.j, &mut self.y);
-        self.lambda = factorize(factors, j, y, parent, active)?;
+        self.lambda = factorize::<P, T, N, K>(factors, j, y, parent, active)?;
         Ok(())
     }
 
@@ -481,6 +502,17 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
         parent: &[Option<usize>; N],
         active: &[bool; K],
     ) -> Result<KktStash<T, N, K>, FactorError> {
+        Self::set_up_in_factored_by::<Walked>(d, fill, parent, active)
+    }
+
+    /// [`ContactKkt::set_up_in_factored`] with `M^-1 J^T` from the passes `P`, as
+    /// [`ContactKkt::set_up_factored_by`].
+    pub fn set_up_in_factored_by<P: TreePasses<T, N>>(
+        d: &mut ContactDynamicsDerivatives<T, N, K>,
+        fill: impl FnOnce(&mut [[T; N]; N], &mut [[T; N]; K]) -> Result<(), FactorError>,
+        parent: &[Option<usize>; N],
+        active: &[bool; K],
+    ) -> Result<KktStash<T, N, K>, FactorError> {
         fill(&mut d.da_dtau, &mut d.df_dtau)?;
         let mut stash = KktStash {
             parent: *parent,
@@ -489,7 +521,7 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
             active: *active,
         };
         let (m, j, y) = (&mut d.da_dtau, &mut d.df_dtau, &mut stash.y);
-        stash.lambda = factorize(m, j, y, parent, active)?;
+        stash.lambda = factorize::<P, T, N, K>(m, j, y, parent, active)?;
         Ok(stash)
     }
 
@@ -555,7 +587,7 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
     /// [`ContactKkt::solve_columns`] in place: `x` holds `top` on entry and `X` on return,
     /// `f` holds `bottom` and then `F`.
     pub fn solve_columns_in_place<const C: usize>(&self, x: &mut [[T; C]; N], f: &mut [[T; C]; K]) {
-        self.solve_signed_columns_in_place(x, f, T::one());
+        self.solve_signed_columns_in_place::<Walked, C>(x, f, T::one());
     }
 
     /// [`ContactKkt::solve_columns_in_place`] for the negated right-hand sides `(-top,
@@ -566,18 +598,19 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
         x: &mut [[T; C]; N],
         f: &mut [[T; C]; K],
     ) {
-        self.solve_signed_columns_in_place(x, f, -T::one());
+        self.solve_signed_columns_in_place::<Walked, C>(x, f, -T::one());
     }
 
     /// The solution for `(sign top, sign bottom)`, `sign` one or minus one: with
     /// `X0 = M^-1 top`, `F = Lambda^-1 sign (bottom - J X0)` and `X = sign X0 + Y F`.
-    fn solve_signed_columns_in_place<const C: usize>(
+    /// `P` substitutes through `M`'s factors.
+    pub(crate) fn solve_signed_columns_in_place<P: TreePasses<T, N>, const C: usize>(
         &self,
         x: &mut [[T; C]; N],
         f: &mut [[T; C]; K],
         sign: T,
     ) {
-        self.substitute_columns(x);
+        P::substitute_rows(&self.factors, &self.parent, x);
         for ((fk, jk), on) in f.iter_mut().zip(&self.j).zip(&self.active) {
             if !*on {
                 *fk = [T::zero(); C];
@@ -611,7 +644,16 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
     /// `J M^-1 = Y^T`. `M^-1` comes from [`crate::tree::ltdl_inverse_factored_into`], which
     /// uses the identity's sparsity and the symmetry, and `J M^-1` is not formed again.
     pub fn solve_identity_in_place(&self, x: &mut [[T; N]; N], f: &mut [[T; N]; K]) {
-        crate::tree::ltdl_inverse_factored_into(&self.factors, &self.parent, x);
+        self.solve_identity_in_place_by::<Walked>(x, f);
+    }
+
+    /// [`ContactKkt::solve_identity_in_place`] with `M^-1` from the passes `P`.
+    fn solve_identity_in_place_by<P: TreePasses<T, N>>(
+        &self,
+        x: &mut [[T; N]; N],
+        f: &mut [[T; N]; K],
+    ) {
+        P::inverse_into(&self.factors, &self.parent, x);
         for (fk, (yk, on)) in f.iter_mut().zip(self.y.iter().zip(&self.active)) {
             *fk = if *on { yk.map(|v| -v) } else { [T::zero(); N] };
         }
@@ -753,9 +795,19 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
         &self,
         d: &mut ContactDynamicsDerivatives<T, N, K>,
     ) -> Result<(), FactorError> {
-        self.solve_negated_columns_in_place(&mut d.da_dq, &mut d.df_dq);
-        self.solve_negated_columns_in_place(&mut d.da_dv, &mut d.df_dv);
-        self.solve_identity_in_place(&mut d.da_dtau, &mut d.df_dtau);
+        self.contact_dynamics_derivatives_in_place_by::<Walked>(d)
+    }
+
+    /// [`ContactKkt::contact_dynamics_derivatives_in_place`] with the substitutions and
+    /// `M^-1` from the passes `P` (generated code's own, unrolled for the robot's tree).
+    pub fn contact_dynamics_derivatives_in_place_by<P: TreePasses<T, N>>(
+        &self,
+        d: &mut ContactDynamicsDerivatives<T, N, K>,
+    ) -> Result<(), FactorError> {
+        let minus = -T::one();
+        self.solve_signed_columns_in_place::<P, N>(&mut d.da_dq, &mut d.df_dq, minus);
+        self.solve_signed_columns_in_place::<P, N>(&mut d.da_dv, &mut d.df_dv, minus);
+        self.solve_identity_in_place_by::<P>(&mut d.da_dtau, &mut d.df_dtau);
         for m in [&d.da_dq, &d.da_dv, &d.da_dtau] {
             finite_rows(m, 0)?;
         }

@@ -12,13 +12,15 @@
 //! `try_forward_dynamics_lanes`) and [`BatchError`] (from the `_batch` methods); for floating-base robots
 //! [`FloatingDynamics`] and, with contact points, [`Contacts`] (and the derivatives' types
 //! [`ContactDynamicsDerivatives`], [`ImpulseDynamicsDerivatives`], and [`Baumgarte`], the
-//! stabilization `contact_forward_dynamics_stabilized` takes); and [`Dimensions`] (`DOF`, `NQ`,
-//! `NV` for any scalar type).
+//! stabilization `contact_forward_dynamics_stabilized` takes, and [`TreePasses`], which robots
+//! with contact or impulse derivatives implement with their unrolled solves); and
+//! [`Dimensions`] (`DOF`, `NQ`, `NV` for any scalar type).
 //!
 //! The prelude is part of the public API: items are added to it only in minor versions and
 //! never removed outside a major one.
 
 pub use crate::batch::BatchError;
+pub use crate::tree::TreePasses;
 pub use crate::{
     Baumgarte, ContactDynamicsDerivatives, Contacts, Dimensions, Dynamics, FactorError,
     FloatingDynamics, Hamiltonian, ImpulseDynamicsDerivatives, LaneError, Pose, Real,

@@ -533,6 +533,52 @@ pub fn ltdl_lower_rows<T: Lane, const N: usize, const C: usize>(
     pull_from_subtrees::<T, N, C, false>(m, parent, x);
 }
 
+/// The passes over the `L^T D L` factors of a mass matrix (as [`ltdl_factor`] leaves them over
+/// the coordinate tree `parent`) that solves with many right-hand sides make: the KKT
+/// system's ([`crate::ContactKkt`]'s `_by` methods) in contact and impulse derivatives.
+/// [`Walked`] walks the tree at run time; generated code implements the trait on the robot's
+/// type with the same passes unrolled for its tree (the walks and branches done at generation
+/// time), and passes itself.
+///
+/// ```
+/// use eomgen_runtime::tree::{ltdl_factor, TreePasses, Walked};
+/// let parent = [None, Some(0)];
+/// let mut m = [[2.0_f64, 0.5], [0.5, 1.0]];
+/// ltdl_factor(&mut m, &parent).unwrap();
+/// let mut x = [[2.0, 0.5], [0.5, 1.0]]; // M itself: M^-1 M = I
+/// Walked::substitute_rows(&m, &parent, &mut x);
+/// let identity = [[1.0, 0.0], [0.0, 1.0]];
+/// assert!(x.iter().flatten().zip(identity.iter().flatten()).all(|(a, b)| (a - b).abs() < 1e-15));
+/// ```
+pub trait TreePasses<T: Lane, const N: usize> {
+    /// `x <- M^-1 x` for the `C` columns of `x`, as [`ltdl_substitute_rows`].
+    fn substitute_rows<const C: usize>(
+        m: &[[T; N]; N],
+        parent: &[Option<usize>; N],
+        x: &mut [[T; C]; N],
+    );
+    /// `M^-1` into `x`, whatever it held, as [`ltdl_inverse_factored_into`].
+    fn inverse_into(m: &[[T; N]; N], parent: &[Option<usize>; N], x: &mut [[T; N]; N]);
+}
+
+/// [`TreePasses`] by the loops of this module over `parent`.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Walked;
+
+impl<T: Lane, const N: usize> TreePasses<T, N> for Walked {
+    fn substitute_rows<const C: usize>(
+        m: &[[T; N]; N],
+        parent: &[Option<usize>; N],
+        x: &mut [[T; C]; N],
+    ) {
+        ltdl_substitute_rows(m, parent, x);
+    }
+
+    fn inverse_into(m: &[[T; N]; N], parent: &[Option<usize>; N], x: &mut [[T; N]; N]) {
+        ltdl_inverse_factored_into(m, parent, x);
+    }
+}
+
 /// `L^-T`: row `a` of `x` less `L[k][a]` times row `k` for every `k` of its subtree, from the
 /// last row up (those rows final by then). Each row is gathered in one accumulator, read once
 /// and written once ("pull"), rather than updated once per descendant ("push"): repeated

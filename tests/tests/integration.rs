@@ -21,6 +21,7 @@ mod regressor;
 mod runtime_solve;
 mod selection;
 mod split;
+mod tree_passes;
 mod tree_route;
 mod underactuated;
 

@@ -247,6 +247,7 @@ impl Emitter<'_> {
         let (ty, allow) = (&self.ty, allow_lints());
         let try_fd = &self.try_forward_dynamics;
         let parents = self.parents_const();
+        let passes = self.tree_passes_impl();
         let identification = super::identification::constants(d, self.quantities);
         let actuation = super::actuation::items(
             self.model,
@@ -288,6 +289,7 @@ impl Emitter<'_> {
             }
             #trait_impl
             #floating_impls
+            #passes
             #batch
         }
     }

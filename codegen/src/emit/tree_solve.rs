@@ -10,8 +10,10 @@
 //!
 //! The same for the passes over many columns: `M^-1` (`tree::ltdl_inverse_factored_into`'s
 //! two passes, each row of the result gathered in registers from its subtree, then from its
-//! ancestors) and `L^-T` of the contact rows (`tree::ltdl_lower_rows`), in `#[inline(never)]`
-//! parts of at most [`PART_UPDATES`] row updates.
+//! ancestors), `L^-T` of the contact rows (`tree::ltdl_lower_rows`) and the substitution of
+//! many columns (`tree::ltdl_substitute_rows`, the KKT systems' of the contact and impulse
+//! derivatives, through the robot's `tree::TreePasses`), in `#[inline(never)]` parts of at
+//! most [`PART_UPDATES`] row updates.
 
 use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
@@ -304,15 +306,35 @@ pub(super) fn inverse_fn(parents: &[Option<usize>], n: &Literal) -> TokenStream 
 /// more), as `tree::ltdl_lower_rows` computes it (to the bit), the tree walks done here.
 pub(super) fn lower_rows_fn(parents: &[Option<usize>], n: &Literal) -> TokenStream {
     let rows = from_subtrees(parents, |_| None, |_| Span::All);
+    let doc = "`x <- L^-T x` for the `C` columns of `x` with the factors of \
+               `ltdl_factor_unrolled` (`eomgen_runtime::tree::ltdl_lower_rows` unrolled).";
+    columns_fn("ltdl_lower_rows", doc, n, rows)
+}
+
+/// `fn ltdl_upper_rows_unrolled::<C>(m, x)`: `x <- L^-1 D^-1 x` for the `C` columns of `x`, the
+/// second half of the substitution after `ltdl_lower_rows_unrolled` (the two together are
+/// `tree::ltdl_substitute_rows`, to the bit), the tree walks done here.
+pub(super) fn upper_rows_fn(parents: &[Option<usize>], n: &Literal) -> TokenStream {
+    let rows = from_ancestors(parents, |_| Span::All);
+    let doc = "`x <- L^-1 D^-1 x` for the `C` columns of `x` with the factors of \
+               `ltdl_factor_unrolled` (the second pass of \
+               `eomgen_runtime::tree::ltdl_substitute_rows` unrolled).";
+    columns_fn("ltdl_upper_rows", doc, n, rows)
+}
+
+/// `fn NAME_unrolled::<C>(m, x)` documented by `doc`, calling the parts (`NAME_part_0`, ...)
+/// that hold `rows` over all `C` columns of `x`.
+fn columns_fn(name: &str, doc: &str, n: &Literal, rows: Vec<(usize, TokenStream)>) -> TokenStream {
     let generics = quote!(<const C: usize>);
     let x = quote!([[T; C]; #n]);
-    let (parts, calls) = in_parts("ltdl_lower_rows_part", generics, quote!(::<C>), x, n, rows);
+    let part = format!("{name}_part");
+    let (parts, calls) = in_parts(&part, generics, quote!(::<C>), x, n, rows);
+    let f = format_ident!("{}_unrolled", name);
     quote! {
         #parts
-        /// `x <- L^-T x` for the `C` columns of `x` with the factors of
-        /// `ltdl_factor_unrolled` (`eomgen_runtime::tree::ltdl_lower_rows` unrolled).
+        #[doc = #doc]
         #[inline(never)]
-        fn ltdl_lower_rows_unrolled<const C: usize>(m: &[[T; #n]; #n], x: &mut [[T; C]; #n]) {
+        fn #f<const C: usize>(m: &[[T; #n]; #n], x: &mut [[T; C]; #n]) {
             #calls
         }
     }

@@ -60,7 +60,7 @@ impl Emitter<'_> {
                     /// Sets `kkt` up for the contacts of `active` at `q`.
                     #[inline(never)]
                     fn contact_kkt_active(&self, q: &[T; #nq], active: &[bool; #c], kkt: &mut #kkt_ty) -> #result {
-                        kkt.set_up_factored(#fill, &Self::PARENTS, &#rows)
+                        kkt.set_up_factored_by::<Self>(#fill, &Self::PARENTS, &#rows)
                     }
                 },
             )
@@ -72,7 +72,7 @@ impl Emitter<'_> {
                     /// Sets `kkt` up for every contact at `q`.
                     #[inline(never)]
                     fn contact_kkt(&self, q: &[T; #nq], kkt: &mut #kkt_ty) -> #result {
-                        kkt.set_up_factored(#fill, &Self::PARENTS, &#rows)
+                        kkt.set_up_factored_by::<Self>(#fill, &Self::PARENTS, &#rows)
                     }
                 },
             )
@@ -236,13 +236,13 @@ impl Emitter<'_> {
                 let (a, f, stash) = self.#solve(q, &rhs, &drift #arg, d)?;
                 #id_derivatives
                 self.#stage(q, qd, &a, &f, d)?;
-                stash.contact_dynamics_derivatives_in_place(d)
+                stash.contact_dynamics_derivatives_in_place_by::<Self>(d)
             }
 
             /// The accelerations and forces, with the KKT system set up in `d`.
             #[inline(never)]
             fn #solve(&self, q: &[T; #nq], rhs: &[T; #n], drift: &[T; #k] #param, d: &mut #ty) -> ::core::result::Result<([T; #n], [T; #k], #stash), #err> {
-                let stash = ::eomgen_runtime::ContactKkt::set_up_in_factored(d, #fill, &Self::PARENTS, &#rows)?;
+                let stash = ::eomgen_runtime::ContactKkt::set_up_in_factored_by::<Self>(d, #fill, &Self::PARENTS, &#rows)?;
                 let substitute = |b: &[T; #n]| Self::ltdl_substitute_unrolled(&d.da_dtau, b);
                 let (a, f) = stash.solve_with(d, rhs, &drift.map(|x| -x), substitute)?;
                 Ok((a, f, stash))
@@ -397,7 +397,7 @@ impl Emitter<'_> {
                 let jump: [T; #n] = ::core::array::from_fn(|i| after[i] - qd[i]);
                 let w: [T; #n] = ::core::array::from_fn(|i| after[i] + restitution * qd[i]);
                 self.#stage(q, &w, &jump, &p, d)?;
-                kkt.impulse_derivatives_in_place(restitution, d)
+                kkt.impulse_derivatives_in_place_by::<Self>(restitution, d)
             }
 
             /// The partials set in `d` in a frame of their own.

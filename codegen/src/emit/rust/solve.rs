@@ -209,9 +209,12 @@ impl Emitter<'_> {
         } else {
             TokenStream::new()
         };
+        // The KKT systems of the contact and impulse derivatives take every pass over many
+        // columns from the robot's `TreePasses` (`tree_passes_impl`).
+        let passes = self.any_eval(kkt_derivatives);
         let inverts =
             |e: &Evaluation| matches!(e, E::MassMatrixInverse | E::ForwardDynamicsDerivatives);
-        let inverse = if self.any_eval(inverts) {
+        let inverse = if passes || self.any_eval(inverts) {
             crate::emit::tree_solve::inverse_fn(&self.parents, n)
         } else {
             TokenStream::new()
@@ -229,8 +232,13 @@ impl Emitter<'_> {
                     )
             )
         };
-        let lower_rows = if self.any_eval(lowers) {
+        let lower_rows = if passes || self.any_eval(lowers) {
             crate::emit::tree_solve::lower_rows_fn(&self.parents, n)
+        } else {
+            TokenStream::new()
+        };
+        let upper_rows = if passes {
+            crate::emit::tree_solve::upper_rows_fn(&self.parents, n)
         } else {
             TokenStream::new()
         };
@@ -241,6 +249,32 @@ impl Emitter<'_> {
             #substitute
             #inverse
             #lower_rows
+            #upper_rows
+        }
+    }
+
+    /// `impl TreePasses for` the robot's type, with its unrolled passes (`emit/tree_solve.rs`),
+    /// where the contact or impulse derivatives solve KKT systems for many columns
+    /// (`ContactKkt::..._by::<Self>`).
+    pub(super) fn tree_passes_impl(&self) -> TokenStream {
+        if !self.any_eval(kkt_derivatives) {
+            return TokenStream::new();
+        }
+        let (ty, n) = (&self.ty, &self.n);
+        quote! {
+            /// The passes over `M`'s tree factors of the contact and impulse derivatives'
+            /// KKT systems, unrolled for this robot's tree.
+            impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::tree::TreePasses<T, #n> for #ty<T> {
+                #[inline(always)]
+                fn substitute_rows<const C: usize>(m: &[[T; #n]; #n], _: &[Option<usize>; #n], x: &mut [[T; C]; #n]) {
+                    Self::ltdl_lower_rows_unrolled::<C>(m, x);
+                    Self::ltdl_upper_rows_unrolled::<C>(m, x);
+                }
+                #[inline(always)]
+                fn inverse_into(m: &[[T; #n]; #n], _: &[Option<usize>; #n], x: &mut [[T; #n]; #n]) {
+                    Self::ltdl_inverse_unrolled(m, x);
+                }
+            }
         }
     }
 
@@ -402,4 +436,16 @@ impl Emitter<'_> {
             }
         }
     }
+}
+
+/// The evaluations whose KKT systems take the robot's `TreePasses`.
+fn kkt_derivatives(e: &Evaluation) -> bool {
+    matches!(
+        e,
+        Evaluation::ContactDynamicsDerivatives { .. }
+            | Evaluation::ImpulseDynamicsDerivatives
+            | Evaluation::ActiveContacts(
+                ActiveContacts::Derivatives { .. } | ActiveContacts::ImpulseDerivatives
+            )
+    )
 }
