@@ -6,7 +6,9 @@
 //! `top = 0`, `bottom = -(1 + e) J v` gives `(v+ - v, p)`.
 
 use crate::contact::{contact_space, transpose_times};
-use crate::kkt::{axpy, dot, finite_rows, finite_solution, ContactKkt, ImpulseDynamicsDerivatives};
+use crate::kkt::{
+    axpy, dot, finite_rows, finite_solution, scaled, ContactKkt, ImpulseDynamicsDerivatives,
+};
 use crate::tree::{ltdl_lower_rows, TreePasses, Walked};
 use crate::{FactorError, Real};
 
@@ -68,7 +70,7 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
         // dp/dv = -(1 + e) Lambda^-1 J, the factor applied to J's rows as they are copied.
         let k = -(T::one() + e);
         for (p, j) in d.dimpulse_dv.iter_mut().zip(self.jacobian()) {
-            *p = j.map(|x| k * x);
+            *p = scaled(j, k);
         }
         self.lambda_solve_columns(&mut d.dimpulse_dv);
         // I + Y dp/dv, each row gathered in a local accumulator. The identity's one is added

@@ -16,7 +16,7 @@
 //! ([`ContactKkt::solve_columns`]), row by row so that the inner loops run over contiguous
 //! columns. Everything lives in fixed-size arrays on the stack.
 
-pub(crate) use crate::linalg::axpy;
+pub(crate) use crate::linalg::{axpy, scaled};
 use crate::linalg::{Cholesky, FactorError};
 use crate::tree::{ltdl_factor, ltdl_substitute, TreePasses, Walked};
 use crate::Real;
@@ -618,7 +618,7 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
             }
             // Each row gathered in a local accumulator (kept in registers), not updated in
             // memory once per term: that form was vectorized across rows, with gathers.
-            let mut acc = fk.map(|v| sign * v);
+            let mut acc = scaled(fk, sign);
             for (jki, xi) in jk.iter().zip(x.iter()) {
                 axpy(&mut acc, -sign * *jki, xi);
             }
@@ -631,7 +631,7 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
     /// `X = sign X + Y F` (`Y = M^-1 J^T`), row by row, each gathered in a local accumulator.
     fn add_y_times<const C: usize>(&self, x: &mut [[T; C]; N], f: &[[T; C]; K], sign: T) {
         for (i, xi) in x.iter_mut().enumerate() {
-            let mut acc = xi.map(|v| sign * v);
+            let mut acc = scaled(xi, sign);
             for (yk, fk) in self.y.iter().zip(f.iter()) {
                 axpy(&mut acc, yk[i], fk);
             }
@@ -655,7 +655,11 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
     ) {
         P::inverse_into(&self.factors, &self.parent, x);
         for (fk, (yk, on)) in f.iter_mut().zip(self.y.iter().zip(&self.active)) {
-            *fk = if *on { yk.map(|v| -v) } else { [T::zero(); N] };
+            *fk = if *on {
+                scaled(yk, -T::one())
+            } else {
+                [T::zero(); N]
+            };
         }
         self.lambda_solve_columns(f);
         self.add_y_times(x, f, T::one());

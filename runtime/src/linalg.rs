@@ -19,6 +19,18 @@ pub(crate) fn axpy<T: Lane, const C: usize>(y: &mut [T; C], a: T, x: &[T; C]) {
     }
 }
 
+/// `a x`, by a loop the compiler vectorizes in place: `x.map(|v| a * v)` on a long array was
+/// left a call of `array::try_map` writing to memory, whose result, read back by wider loads,
+/// stalled on store forwarding (a tenth of a humanoid's contact derivatives).
+#[inline(always)]
+pub(crate) fn scaled<T: Lane, const C: usize>(x: &[T; C], a: T) -> [T; C] {
+    let mut y = *x;
+    for v in y.iter_mut() {
+        *v = a * *v;
+    }
+    y
+}
+
 /// Why a matrix could not be factorized.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum FactorError {
