@@ -305,18 +305,22 @@ impl<T: Real, const N: usize> Cholesky<T, N> {
 
     /// Overwrites `b` with the solution `x` of `M x = b`.
     pub fn solve_in_place(&self, b: &mut [T; N]) {
-        // L y = b
-        for i in 0..N {
-            let s = dot_prefix(&self.l[i], b, i);
-            b[i] = (b[i] - s) * self.diag_inv[i];
-        }
-        // Lᵀ x = y
-        for i in (0..N).rev() {
-            let mut s = T::zero();
-            for (row, bk) in self.l.iter().zip(b.iter()).skip(i + 1) {
-                s += row[i] * *bk;
+        // L y = b by columns: each y_j, once final, taken from the entries below it; then
+        // L^T x = y by rows of L: each x_k taken from the entries above it. Independent
+        // multiply-adds, where a dot product per entry was a chain of dependent ones.
+        for j in 0..N {
+            let y = b[j] * self.diag_inv[j];
+            b[j] = y;
+            for (bi, row) in b.iter_mut().zip(&self.l).skip(j + 1) {
+                *bi = (-row[j]).mul_add(y, *bi);
             }
-            b[i] = (b[i] - s) * self.diag_inv[i];
+        }
+        for k in (0..N).rev() {
+            let x = b[k] * self.diag_inv[k];
+            b[k] = x;
+            for (bi, lki) in b.iter_mut().zip(&self.l[k]).take(k) {
+                *bi = (-*lki).mul_add(x, *bi);
+            }
         }
     }
 
