@@ -274,9 +274,10 @@ impl Builder {
         self
     }
 
-    /// With [`Builder::derivatives`]: `mass_matrix_inverse` and `forward_dynamics_derivatives`
-    /// are straight-line code up to this many operations each (default
-    /// [`crate::dynamics::DERIVATIVES_FLAT_MAX_OPS`], 20,000), and beyond it composed at run
+    /// With [`Builder::derivatives`]: `forward_dynamics_derivatives` is straight-line code up to
+    /// this many operations (default [`crate::dynamics::DERIVATIVES_FLAT_MAX_OPS`], 20,000), and
+    /// `mass_matrix_inverse` up to a fifth of it
+    /// ([`crate::dynamics::MASS_MATRIX_INVERSE_FLAT_DIVISOR`]); beyond, they are composed at run
     /// time from `mass_matrix`, its factorization unrolled for the robot's tree and
     /// `inverse_dynamics_derivatives`. Straight-line code is faster on small robots (an arm); the
     /// composed route compiles faster and is faster from a quadruped on. `0` always composes.

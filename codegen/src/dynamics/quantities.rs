@@ -529,9 +529,10 @@ fn link_jacobian(n: usize) -> Quantity {
     }
 }
 
-/// `mass_matrix_inverse` and `forward_dynamics_derivatives` are straight-line code (sharing `M`,
-/// its factorization and the accelerations) up to this many operations each by default
-/// ([`crate::Builder::derivatives_flat_max_ops`]); beyond, they are composed at run time from
+/// `forward_dynamics_derivatives` is straight-line code (sharing `M`, its factorization and the
+/// accelerations) up to this many operations by default, `mass_matrix_inverse` up to this
+/// divided by [`MASS_MATRIX_INVERSE_FLAT_DIVISOR`] ([`crate::Builder::derivatives_flat_max_ops`]);
+/// beyond, they are composed at run time from
 /// `mass_matrix`, `forward_dynamics` and `inverse_dynamics_derivatives`.
 ///
 /// Since the composed route's inverse is unrolled over the tree too, it is the faster one from
@@ -539,6 +540,14 @@ fn link_jacobian(n: usize) -> Quantity {
 /// 4.60 us composed against 5.07 us flat; the panda's (12,751) 1.96 us against 1.69 us, and its
 /// `M^-1` (1,378) 256 ns against 165 ns (27 November 2026, native, alternated).
 pub const DERIVATIVES_FLAT_MAX_OPS: usize = 20_000;
+
+/// `mass_matrix_inverse` alone is straight-line code up to the derivatives' limit divided by
+/// this (4,000 operations by default). Its flat form shares nothing with other outputs, where
+/// the forward-dynamics derivatives' shares `M`'s factorization and the accelerations, so the
+/// composed route (the tree's inverse unrolled) wins sooner: anymal's `M^-1` (5,569 operations
+/// flat) took 787 ns flat against 698 ns composed, the panda's (1,390) 165 ns against 256 ns
+/// (27 November 2026, native).
+pub const MASS_MATRIX_INVERSE_FLAT_DIVISOR: usize = 5;
 
 /// The derivatives of the dynamics ([`Derivation::add_derivatives`]): inverse dynamics
 /// (straight-line), `M^-1` and forward dynamics (straight-line, or composed at run time when
@@ -551,18 +560,19 @@ pub fn derivatives(d: &Derivation, x: &Derivatives, flat_max_ops: usize) -> Vec<
     let mut fd = flat(&x.forward.dq);
     fd.extend(flat(&x.forward.dqd));
     fd.extend(&minv);
-    let factored = |outputs: Vec<Id>| {
+    let factored = |outputs: Vec<Id>, limit: usize| {
         let all: Vec<Id> = outputs.iter().chain(&x.pivots).copied().collect();
-        (ops(&d.graph, &all) <= flat_max_ops).then(|| Evaluation::Factored {
+        (ops(&d.graph, &all) <= limit).then(|| Evaluation::Factored {
             outputs,
             pivots: x.pivots.clone(),
         })
     };
-    let (minv_route, minv_eval) = match factored(minv) {
+    let minv_limit = flat_max_ops / MASS_MATRIX_INVERSE_FLAT_DIVISOR;
+    let (minv_route, minv_eval) = match factored(minv, minv_limit) {
         Some(e) => ("Route: M as in `mass_matrix`, an unrolled L^T D L factorization without fill-in, one substitution per column.", e),
         None => ("Route: M from `mass_matrix`, the sparse L^T D L factorization over the joint tree, unrolled for this robot, then L^-1 D^-1 L^-T over the tree, unrolled too (eomgen_runtime::tree::ltdl_inverse_factored's operations, in parts of at most 128 row updates).", Evaluation::MassMatrixInverse),
     };
-    let (fd_route, fd_eval) = match factored(fd) {
+    let (fd_route, fd_eval) = match factored(fd, flat_max_ops) {
         Some(e) => ("Route: qdd as in `forward_dynamics`, `inverse_dynamics_derivatives` at (q, qd, qdd), then -M^-1 times them by substitutions through the one unrolled factorization of M, all in one straight-line body.", e),
         None => ("Route: one factorization of M (from `mass_matrix`, the tree L^T D L unrolled): qdd from it and `inverse_dynamics` at zero acceleration, `inverse_dynamics_derivatives` at (q, qd, qdd), then -M^-1 times them by substitutions of all columns at once (eomgen_runtime::tree::ltdl_substitute_rows), and M^-1 from the same factors, unrolled over the tree (eomgen_runtime::tree::ltdl_inverse_factored's operations).", Evaluation::ForwardDynamicsDerivatives),
     };
