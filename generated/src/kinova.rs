@@ -10677,7 +10677,11 @@ impl<T: ::eomgen_runtime::Real> Kinova<T> {
             motion: ::eomgen_runtime::tree::Motion::Rotation,
         },
     ];
-    /// The pose of body `j` in its parent body's frame (a floating base is body 0).
+    /// The pose of body `j` in its parent body's frame (a floating base is body 0), inlined
+    /// into the walks along a chain: returned through memory, its 12 numbers were stored
+    /// one by one and read back as wide vectors, which cannot be forwarded (a third of the
+    /// panda's `link_velocity`).
+    #[inline]
     fn joint_transform(&self, j: usize, q: &[T; 6]) -> ::eomgen_runtime::Pose<T> {
         match j {
             0 => {

@@ -145,6 +145,7 @@ impl<T: Real> Pose<T> {
 
     /// The composition `self ∘ other`: if `self` is "a from b" and `other` is "b from c", the
     /// result is "a from c" (`result.transform_point(p) == self.transform_point(&other.transform_point(p))`).
+    #[inline]
     pub fn compose(&self, other: &Pose<T>) -> Pose<T> {
         let a = &self.rotation;
         let b = &other.rotation;
