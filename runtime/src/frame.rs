@@ -156,30 +156,16 @@ impl<T: Real, F: Fn(usize) -> Pose<T>> Chain<'_, T, F> {
                 &add(&cross(&parent.dw, &r), &cross(&parent.w, &wr)),
             );
         }
-        let Some((col, joint)) = self.joint(b) else {
-            return s;
-        };
-        if joint.motion == Motion::Free {
-            return free_step(s, parent, col, qd, qdd);
-        }
-        let z = pose.transform_vector(&joint.axis.map(T::from_f64));
-        let x = at(qd, col);
-        let (rotates, zx) = (joint.motion == Motion::Rotation, scale(&z, x));
-        if rotates {
-            s.w = add(&s.w, &zx);
-        } else {
-            s.v = add(&s.v, &zx);
-        }
-        if let Some(qdd) = qdd {
-            let zy = scale(&z, at(qdd, col));
-            let wz = cross(&parent.w, &zx);
-            if rotates {
-                s.dw = add(&s.dw, &add(&zy, &wz));
-            } else {
-                s.a = add(&s.a, &add(&zy, &scale(&wz, T::from_f64(2.0))));
+        match self.joint(b) {
+            Some((col, joint)) if joint.motion == Motion::Free => {
+                free_step(s, parent, col, qd, qdd)
             }
+            Some((col, joint)) => {
+                let y = qdd.map(|qdd| at(qdd, col));
+                joint_step(s, parent, joint, at(qd, col), y)
+            }
+            None => s,
         }
-        s
     }
 
     /// The last body's state, calling `visit(b, state)` for every body `b` of the path.
@@ -201,6 +187,34 @@ impl<T: Real, F: Fn(usize) -> Pose<T>> Chain<'_, T, F> {
     fn lever(&self, last: &State<T>) -> [T; 3] {
         last.pose.transform_vector(&self.placement.translation)
     }
+}
+
+/// A revolute or prismatic joint's body state `s` (its pose, and its parent's motion carried
+/// to its origin) with the joint's own motion added: rate `x` and, with accelerations, `y`.
+fn joint_step<T: Real>(
+    mut s: State<T>,
+    parent: &State<T>,
+    joint: TreeJoint,
+    x: T,
+    y: Option<T>,
+) -> State<T> {
+    let z = s.pose.transform_vector(&joint.axis.map(T::from_f64));
+    let (rotates, zx) = (joint.motion == Motion::Rotation, scale(&z, x));
+    if rotates {
+        s.w = add(&s.w, &zx);
+    } else {
+        s.v = add(&s.v, &zx);
+    }
+    if let Some(y) = y {
+        let zy = scale(&z, y);
+        let wz = cross(&parent.w, &zx);
+        if rotates {
+            s.dw = add(&s.dw, &add(&zy, &wz));
+        } else {
+            s.a = add(&s.a, &add(&zy, &scale(&wz, T::from_f64(2.0))));
+        }
+    }
+    s
 }
 
 /// The frame's spatial velocity (Pinocchio's `getFrameVelocity`, `LOCAL_WORLD_ALIGNED`) at the
