@@ -79,14 +79,8 @@ fn at<T: Real>(x: &[T], i: usize) -> T {
 /// in its axes from columns `col..col + 6`. Relative to the parent, the origin moves at
 /// `R lin` and accelerates at `R (dlin + ang x lin)`, the body turns at `R ang` and
 /// accelerates at `R dang`; the parent's rotation `w_p` adds `2 w_p x R lin` (Coriolis) and
-/// `w_p x R ang`.
-fn free_step<T: Real>(
-    mut s: State<T>,
-    parent: &State<T>,
-    col: usize,
-    qd: &[T],
-    qdd: Option<&[T]>,
-) -> State<T> {
+/// `w_p x R ang` (`pw`, the parent's angular velocity).
+fn free_step<T: Real>(s: &mut State<T>, pw: &[T; 3], col: usize, qd: &[T], qdd: Option<&[T]>) {
     let part = |x: &[T], k: usize| [at(x, col + k), at(x, col + k + 1), at(x, col + k + 2)];
     let (lin, ang) = (part(qd, 0), part(qd, 3));
     let (v_rel, w_rel) = (s.pose.transform_vector(&lin), s.pose.transform_vector(&ang));
@@ -94,13 +88,12 @@ fn free_step<T: Real>(
     s.w = add(&s.w, &w_rel);
     if let Some(qdd) = qdd {
         let (dlin, dang) = (part(qdd, 0), part(qdd, 3));
-        let dw = add(&s.pose.transform_vector(&dang), &cross(&parent.w, &w_rel));
+        let dw = add(&s.pose.transform_vector(&dang), &cross(pw, &w_rel));
         s.dw = add(&s.dw, &dw);
         let a_rel = s.pose.transform_vector(&add(&dlin, &cross(&ang, &lin)));
-        let coriolis = scale(&cross(&parent.w, &v_rel), T::from_f64(2.0));
+        let coriolis = scale(&cross(pw, &v_rel), T::from_f64(2.0));
         s.a = add(&s.a, &add(&a_rel, &coriolis));
     }
-    s
 }
 
 impl<T: Real, F: Fn(usize) -> Pose<T>> Chain<'_, T, F> {
@@ -135,36 +128,30 @@ impl<T: Real, F: Fn(usize) -> Pose<T>> Chain<'_, T, F> {
         }
     }
 
-    /// Body `b`'s state from its parent's; without `qdd`, its accelerations are left zero.
-    fn step(&self, parent: &State<T>, b: usize, qd: &[T], qdd: Option<&[T]>) -> State<T> {
+    /// Body `b`'s state in place of its parent's `s`; without `qdd`, the accelerations stay
+    /// as they are (zero from the rest). Updated field by field where it lies: built whole and
+    /// moved, the state was stored in narrow parts and copied back by wide loads, which cannot
+    /// be forwarded (a stall per body).
+    fn step(&self, s: &mut State<T>, b: usize, qd: &[T], qdd: Option<&[T]>) {
         if self.floating && b == 0 {
-            return self.base(qd, qdd.unwrap_or(&[]));
+            *s = self.base(qd, qdd.unwrap_or(&[]));
+            return;
         }
-        let pose = parent.pose.compose(&(self.transform)(b));
-        let r = sub(&pose.translation, &parent.pose.translation);
-        let wr = cross(&parent.w, &r);
-        let mut s = State {
-            pose,
-            w: parent.w,
-            v: add(&parent.v, &wr),
-            ..State::rest()
-        };
+        let (parent, pw, pdw) = (s.pose, s.w, s.dw);
+        s.pose = parent.compose(&(self.transform)(b));
+        let r = sub(&s.pose.translation, &parent.translation);
+        let wr = cross(&pw, &r);
+        s.v = add(&s.v, &wr);
         if qdd.is_some() {
-            s.dw = parent.dw;
-            s.a = add(
-                &parent.a,
-                &add(&cross(&parent.dw, &r), &cross(&parent.w, &wr)),
-            );
+            s.a = add(&s.a, &add(&cross(&pdw, &r), &cross(&pw, &wr)));
         }
         match self.joint(b) {
-            Some((col, joint)) if joint.motion == Motion::Free => {
-                free_step(s, parent, col, qd, qdd)
-            }
+            Some((col, joint)) if joint.motion == Motion::Free => free_step(s, &pw, col, qd, qdd),
             Some((col, joint)) => {
                 let y = qdd.map(|qdd| at(qdd, col));
-                joint_step(s, parent, joint, at(qd, col), y)
+                joint_step(s, &pw, joint, at(qd, col), y);
             }
-            None => s,
+            None => {}
         }
     }
 
@@ -177,7 +164,7 @@ impl<T: Real, F: Fn(usize) -> Pose<T>> Chain<'_, T, F> {
     ) -> State<T> {
         let mut s = State::rest();
         for &b in self.path {
-            s = self.step(&s, b, qd, qdd);
+            self.step(&mut s, b, qd, qdd);
             visit(b, &s);
         }
         s
@@ -190,14 +177,9 @@ impl<T: Real, F: Fn(usize) -> Pose<T>> Chain<'_, T, F> {
 }
 
 /// A revolute or prismatic joint's body state `s` (its pose, and its parent's motion carried
-/// to its origin) with the joint's own motion added: rate `x` and, with accelerations, `y`.
-fn joint_step<T: Real>(
-    mut s: State<T>,
-    parent: &State<T>,
-    joint: TreeJoint,
-    x: T,
-    y: Option<T>,
-) -> State<T> {
+/// to its origin) with the joint's own motion added: rate `x` and, with accelerations, `y`
+/// (`pw`, the parent's angular velocity).
+fn joint_step<T: Real>(s: &mut State<T>, pw: &[T; 3], joint: TreeJoint, x: T, y: Option<T>) {
     let z = s.pose.transform_vector(&joint.axis.map(T::from_f64));
     let (rotates, zx) = (joint.motion == Motion::Rotation, scale(&z, x));
     if rotates {
@@ -207,14 +189,13 @@ fn joint_step<T: Real>(
     }
     if let Some(y) = y {
         let zy = scale(&z, y);
-        let wz = cross(&parent.w, &zx);
+        let wz = cross(pw, &zx);
         if rotates {
             s.dw = add(&s.dw, &add(&zy, &wz));
         } else {
             s.a = add(&s.a, &add(&zy, &scale(&wz, T::from_f64(2.0))));
         }
     }
-    s
 }
 
 /// The frame's spatial velocity (Pinocchio's `getFrameVelocity`, `LOCAL_WORLD_ALIGNED`) at the
