@@ -155,6 +155,7 @@ pub(crate) fn show(a: ShowArgs) -> Result<(), Failure> {
 
 pub(crate) fn info_cmd(a: InfoArgs) -> Result<(), Failure> {
     let b = a.model.builder(&a.urdf, &None);
+    let b = if a.derivatives { b.derivatives() } else { b };
     let start = Instant::now();
     let model = load(&b)?;
     let load_time = start.elapsed();

@@ -444,6 +444,36 @@ fn info_lists_the_run_time_functions() {
     }
 }
 
+/// `info --derivatives` lists the derivatives with the operation counts the generated code
+/// documents (`generate --derivatives`); without the flag they are not derived.
+#[test]
+fn info_counts_the_derivatives_operations() {
+    let urdf = robot("ur5");
+    let out = ok(&["info", &urdf, "--derivatives"]);
+    let code = ok(&["generate", &urdf, "--derivatives"]);
+    for name in [
+        "inverse_dynamics_derivatives",
+        "mass_matrix_inverse",
+        "forward_dynamics_derivatives",
+    ] {
+        let line = out
+            .lines()
+            .find(|l| l.split_whitespace().next() == Some(name))
+            .unwrap_or_else(|| panic!("no line for {name}:\n{out}"));
+        let counts = line.split(" total: ").nth(1).expect("operation counts");
+        // The method's documentation ends with its operation count line.
+        let method = code
+            .split(&format!("fn {name}("))
+            .next()
+            .and_then(|before| before.rsplit("/// Operations: ").next())
+            .and_then(|after| after.lines().next())
+            .unwrap_or_else(|| panic!("no documented count for {name}"));
+        assert_eq!(format!("{counts}."), method, "{name}");
+    }
+    let plain = ok(&["info", &urdf]);
+    assert!(!plain.contains("inverse_dynamics_derivatives"), "{plain}");
+}
+
 fn numbers(v: &serde_json::Value) -> Vec<f64> {
     v.as_array()
         .expect("array")

@@ -256,6 +256,11 @@ pub(crate) struct ShowArgs {
 pub(crate) struct InfoArgs {
     /// The robot's URDF file.
     pub(crate) urdf: PathBuf,
+    /// Also derive the derivatives of the dynamics (as generate --derivatives) and list their
+    /// operation counts: inverse_dynamics_derivatives, mass_matrix_inverse and
+    /// forward_dynamics_derivatives, and with contacts the contact and impulse derivatives
+    #[arg(long)]
+    pub(crate) derivatives: bool,
     #[command(flatten)]
     pub(crate) model: ModelArgs,
 }
