@@ -439,6 +439,25 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
 
     /// [`ContactKkt::set_up_factored`] with `M^-1 J^T` from the passes `P` (generated code's
     /// own, unrolled for the robot's tree; [`Walked`]: the runtime's).
+    ///
+    /// ```
+    /// use eomgen_runtime::tree::{ltdl_factor, Walked};
+    /// use eomgen_runtime::ContactKkt;
+    /// let (m, j, parent) = ([[2.0_f64, 0.5], [0.5, 1.0]], [[1.0, 1.0]], [None, Some(0)]);
+    /// let fill = |mm: &mut [[f64; 2]; 2], jj: &mut [[f64; 2]; 1]| {
+    ///     (*mm, *jj) = (m, j);
+    ///     ltdl_factor(mm, &parent)
+    /// };
+    /// let mut kkt = ContactKkt::zeroed();
+    /// kkt.set_up_factored_by::<Walked>(fill, &parent, &[true]).unwrap();
+    /// // The derivatives in tau: da/dtau = M^-1 - Y (J M^-1 J^T)^-1 Y^T, whose J row is zero.
+    /// let (mut x, mut f) = ([[0.0; 2]; 2], [[0.0; 2]; 1]);
+    /// kkt.solve_identity_in_place(&mut x, &mut f);
+    /// let jx: Vec<f64> = (0..2).map(|c| x[0][c] + x[1][c]).collect();
+    /// assert!(jx.iter().all(|v| v.abs() < 1e-15));
+    /// let walked = ContactKkt::new(m, &parent, j).unwrap();
+    /// assert_eq!(kkt.solve(&[1.0, 2.0], &[0.5]), walked.solve(&[1.0, 2.0], &[0.5]));
+    /// ```
     pub fn set_up_factored_by<P: TreePasses<T, N>>(
         &mut self,
         fill: impl FnOnce(&mut [[T; N]; N], &mut [[T; N]; K]) -> Result<(), FactorError>,
