@@ -128,6 +128,18 @@ fn deep_chain() {
         .unwrap();
 }
 
+/// What the anymal derivative robots generate (`tests/floating.rs`, `tests/tree_route.rs`): the
+/// derivatives and what their checks call.
+const ANYMAL_DERIVATIVES: [&str; 7] = [
+    "inverse_dynamics",
+    "forward_dynamics",
+    "mass_matrix",
+    "integrate",
+    "inverse_dynamics_derivatives",
+    "forward_dynamics_derivatives",
+    "mass_matrix_inverse",
+];
+
 /// The floating-base reference robots: anymal standing on its four feet (contacts), and the same
 /// without gravity (for momentum conservation); the iris drone (a free body, no joints) is in
 /// `eomgen-generated`.
@@ -161,15 +173,7 @@ fn floating() {
         .derivatives()
         .module_name("anymal_derivatives")
         .type_name("AnymalDerivatives")
-        .quantities([
-            "inverse_dynamics",
-            "forward_dynamics",
-            "mass_matrix",
-            "integrate",
-            "inverse_dynamics_derivatives",
-            "forward_dynamics_derivatives",
-            "mass_matrix_inverse",
-        ])
+        .quantities(ANYMAL_DERIVATIVES)
         .compile()
         .unwrap();
 }
@@ -184,15 +188,7 @@ fn tree_route() {
         .derivatives_flat_max_ops(0)
         .module_name("anymal_tree_route")
         .type_name("AnymalTreeRoute")
-        .quantities([
-            "inverse_dynamics",
-            "forward_dynamics",
-            "mass_matrix",
-            "integrate",
-            "inverse_dynamics_derivatives",
-            "forward_dynamics_derivatives",
-            "mass_matrix_inverse",
-        ])
+        .quantities(ANYMAL_DERIVATIVES)
         .compile()
         .unwrap();
 }

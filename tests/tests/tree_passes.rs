@@ -23,6 +23,16 @@ fn factors(seed: u64) -> [[f64; NV]; NV] {
     m
 }
 
+/// Every entry of `x` within 1e-9 of the identity's.
+fn assert_identity(x: &[[f64; NV]; NV], what: &str) {
+    for (i, row) in x.iter().enumerate() {
+        for (j, v) in row.iter().enumerate() {
+            let unit = f64::from(u8::from(i == j));
+            assert!((v - unit).abs() < 1e-9, "{what}: [{i}][{j}] = {v}");
+        }
+    }
+}
+
 /// `C` columns of numbers in [-1, 1].
 fn columns<const C: usize>(seed: u64) -> [[f64; C]; NV] {
     let (_, v, a) = random_state::<{ NV + 1 }, NV>(seed + 100);
@@ -41,6 +51,17 @@ fn substitutions_agree<const C: usize>() {
             columns::<C>(seed),
             "seed {seed}: nothing substituted"
         );
+    }
+}
+
+/// Independently of the runtime: `M^-1` times `M`'s own columns is the identity.
+#[test]
+fn the_substitution_of_m_gives_the_identity() {
+    for seed in 0..4 {
+        let (q, _, _) = random_state::<{ NV + 1 }, NV>(seed);
+        let mut x = Anymal::<f64>::default().mass_matrix(&q);
+        <Robot as TreePasses<f64, NV>>::substitute_rows(&factors(seed), &Robot::PARENTS, &mut x);
+        assert_identity(&x, &format!("seed {seed}: M^-1 M"));
     }
 }
 
@@ -65,14 +86,6 @@ fn the_inverse_is_the_runtime_one_and_inverts_m() {
         let product: [[f64; NV]; NV] = core::array::from_fn(|i| {
             core::array::from_fn(|j| (0..NV).map(|k| mass[i][k] * unrolled[k][j]).sum())
         });
-        for (i, row) in product.iter().enumerate() {
-            for (j, x) in row.iter().enumerate() {
-                let unit = f64::from(u8::from(i == j));
-                assert!(
-                    (x - unit).abs() < 1e-9,
-                    "seed {seed}: (M M^-1)[{i}][{j}] = {x}"
-                );
-            }
-        }
+        assert_identity(&product, &format!("seed {seed}: M M^-1"));
     }
 }
