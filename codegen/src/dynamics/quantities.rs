@@ -574,7 +574,7 @@ pub fn derivatives(d: &Derivation, x: &Derivatives, flat_max_ops: usize) -> Vec<
     };
     let (fd_route, fd_eval) = match factored(fd, flat_max_ops) {
         Some(e) => ("Route: qdd as in `forward_dynamics`, `inverse_dynamics_derivatives` at (q, qd, qdd), then -M^-1 times them by substitutions through the one unrolled factorization of M, all in one straight-line body.", e),
-        None => ("Route: one factorization of M (from `mass_matrix`, the tree L^T D L unrolled): qdd from it and `inverse_dynamics` at zero acceleration, `inverse_dynamics_derivatives` at (q, qd, qdd), then -M^-1 times them by substitutions of all columns at once (eomgen_runtime::tree::ltdl_substitute_rows), and M^-1 from the same factors, unrolled over the tree (eomgen_runtime::tree::ltdl_inverse_factored's operations).", Evaluation::ForwardDynamicsDerivatives),
+        None => ("Route: one factorization of M (from `mass_matrix`, the tree L^T D L unrolled): qdd from it and `inverse_dynamics` at zero acceleration, `inverse_dynamics_derivatives` at (q, qd, qdd), then -M^-1 times them by substitutions of all columns at once (the passes of eomgen_runtime::tree::ltdl_substitute_rows, unrolled for this robot's tree), and M^-1 from the same factors, unrolled over the tree (eomgen_runtime::tree::ltdl_inverse_factored's operations).", Evaluation::ForwardDynamicsDerivatives),
     };
     vec![
         Quantity {

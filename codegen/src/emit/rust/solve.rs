@@ -232,12 +232,15 @@ impl Emitter<'_> {
                     )
             )
         };
-        let lower_rows = if passes || self.any_eval(lowers) {
+        // `forward_dynamics_derivatives` solves for the 2 N columns of d tau/dq and d tau/dqd.
+        let fd_derivatives = |e: &Evaluation| matches!(e, E::ForwardDynamicsDerivatives);
+        let columns = passes || self.any_eval(fd_derivatives);
+        let lower_rows = if columns || self.any_eval(lowers) {
             crate::emit::tree_solve::lower_rows_fn(&self.parents, n)
         } else {
             TokenStream::new()
         };
-        let upper_rows = if passes {
+        let upper_rows = if columns {
             crate::emit::tree_solve::upper_rows_fn(&self.parents, n)
         } else {
             TokenStream::new()
@@ -307,8 +310,9 @@ impl Emitter<'_> {
 
     /// `(d qdd/dq, d qdd/dqd, M^-1)` through one factorization of `M`: `qdd` solves
     /// `M qdd = tau - h` with `h = inverse_dynamics(q, qd, 0)`, then `d tau/dq` and `d tau/dqd`
-    /// there from `inverse_dynamics_derivatives`, both solves at once per matrix
-    /// (`tree::ltdl_substitute_rows`), and `M^-1` from the same factors. Everything is written
+    /// there from `inverse_dynamics_derivatives`, both solves at once per matrix (the two
+    /// passes of `tree::ltdl_substitute_rows`, unrolled for the tree: `ltdl_lower_rows_unrolled`
+    /// and `ltdl_upper_rows_unrolled`), and `M^-1` from the same factors. Everything is written
     /// into the caller's storage (`eomgen_runtime::place`), the derivatives of tau by
     /// `inverse_dynamics_derivatives_fill` where that function was split.
     pub(super) fn forward_dynamics_derivatives_fn(&mut self, q: &Quantity) -> TokenStream {
@@ -337,7 +341,8 @@ impl Emitter<'_> {
                 let qdd = Self::ltdl_substitute_unrolled(&m, &rhs);
                 #id_derivatives
                 for x in [&mut *dq, &mut *dqd] {
-                    ::eomgen_runtime::tree::ltdl_substitute_rows(&m, &Self::PARENTS, x);
+                    Self::ltdl_lower_rows_unrolled::<#n>(&m, x);
+                    Self::ltdl_upper_rows_unrolled::<#n>(&m, x);
                     for v in x.iter_mut().flatten() {
                         *v = -*v;
                     }
