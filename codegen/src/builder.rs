@@ -62,6 +62,8 @@ pub struct Builder {
     regressor: bool,
     /// The most operations of one generated function body ([`Builder::max_function_ops`]).
     max_function_ops: usize,
+    /// The same for the derivatives' bodies ([`Builder::max_derivative_function_ops`]).
+    max_derivative_function_ops: usize,
     /// Straight-line `M^-1` and forward-dynamics derivatives up to this many operations
     /// ([`Builder::derivatives_flat_max_ops`]).
     derivatives_flat_max_ops: usize,
@@ -81,6 +83,14 @@ pub const DEFAULT_MAX_GRAPH_NODES: usize = crate::cas::graph::DEFAULT_MAX_NODES;
 /// 50 joints, with derivatives: 0.9 GiB, against 2.2 GiB unsplit). Splitting costs about 5 to
 /// 10 % of a function's run time at 3,000 operations a block on the panda's derivatives.
 pub const DEFAULT_MAX_FUNCTION_OPS: usize = 8000;
+
+/// The default of [`Builder::max_derivative_function_ops`]. The derivatives' bodies are where
+/// the blocks cost run time: on talos_full_v2 (50 joints, floating, two soles, native CPU) its
+/// inverse-dynamics derivatives (about 60,000 operations) took 13.9 us in blocks of 8,000
+/// operations, 13.1 us at 16,000 and 11.6 us at 32,000, for a build of 54 s and 2.1 GiB
+/// instead of 52 s and 1.6 GiB; g1_29dof's (49,267 operations) 8.9 and 8.1 us, a build of 36 s
+/// and 1.4 GiB instead of 27 s and 1.1 GiB.
+pub const DEFAULT_MAX_DERIVATIVE_FUNCTION_OPS: usize = 32_000;
 
 /// Type names the generated code cannot take: `T` is its generic parameter.
 const RESERVED_TYPE_NAMES: &[&str] = &["T"];
@@ -112,6 +122,7 @@ impl Builder {
             derivatives: false,
             regressor: false,
             max_function_ops: DEFAULT_MAX_FUNCTION_OPS,
+            max_derivative_function_ops: DEFAULT_MAX_DERIVATIVE_FUNCTION_OPS,
             derivatives_flat_max_ops: crate::dynamics::DERIVATIVES_FLAT_MAX_OPS,
         }
     }
@@ -257,20 +268,41 @@ impl Builder {
     }
 
     /// The most arithmetic operations one generated function body may hold (default
-    /// [`DEFAULT_MAX_FUNCTION_OPS`]). A longer body, such as the derivatives of a legged robot
-    /// or a humanoid (tens of thousands of operations), is written as a chain of
-    /// `#[inline(never)]` blocks of at most this many operations that pass their intermediate
-    /// values through a small work array: the compile time and memory of the generated module
-    /// then grow linearly with its size instead of with its longest function. The function's
-    /// signature, results (bit for bit) and operation count do not change. A larger budget
-    /// gives the optimizer longer stretches to schedule at a higher compile memory;
-    /// `usize::MAX` never splits.
+    /// [`DEFAULT_MAX_FUNCTION_OPS`]; the derivatives' bodies have a budget of their own,
+    /// [`Builder::max_derivative_function_ops`], which this sets as well). A longer body, such
+    /// as the dynamics of a 48-joint robot or the derivatives of a humanoid (tens of thousands
+    /// of operations), is written as a chain of `#[inline(never)]` blocks of at most this many
+    /// operations that pass their intermediate values through a small work array: the compile
+    /// time and memory of the generated module then grow linearly with its size instead of with
+    /// its longest function. The function's signature, results (bit for bit) and operation
+    /// count do not change. A larger budget gives the optimizer longer stretches to schedule at
+    /// a higher compile memory; `usize::MAX` never splits.
     ///
     /// ```
     /// let b = eomgen::Builder::new("robots/anymal.urdf").derivatives().max_function_ops(5000);
     /// ```
     pub fn max_function_ops(mut self, limit: usize) -> Builder {
         self.max_function_ops = limit.max(1);
+        self.max_derivative_function_ops = self.max_function_ops;
+        self
+    }
+
+    /// The budget of [`Builder::max_function_ops`] for the bodies of the derivatives
+    /// [`Builder::derivatives`] adds (`inverse_dynamics_derivatives`, straight-line
+    /// `forward_dynamics_derivatives` and `mass_matrix_inverse`, the contact and impulse
+    /// partials; default [`DEFAULT_MAX_DERIVATIVE_FUNCTION_OPS`], 32,000). There the blocks'
+    /// boundaries cost run time (about a sixth of a humanoid's inverse-dynamics derivatives at
+    /// 8,000 operations a block), so they get longer blocks than the dynamics, at some compile
+    /// memory. Set it after `max_function_ops`, which sets both.
+    ///
+    /// ```
+    /// let b = eomgen::Builder::new("robots/anymal.urdf")
+    ///     .derivatives()
+    ///     .max_function_ops(8000)
+    ///     .max_derivative_function_ops(16_000);
+    /// ```
+    pub fn max_derivative_function_ops(mut self, limit: usize) -> Builder {
+        self.max_derivative_function_ops = limit.max(1);
         self
     }
 
@@ -726,6 +758,7 @@ impl Builder {
             source_name,
             regenerate,
             max_function_ops: self.max_function_ops,
+            max_derivative_function_ops: self.max_derivative_function_ops,
         };
         let generated = emit::rust_module(&model, &derivation, &opts)?;
         Ok((generated, model, derivation))
@@ -774,6 +807,27 @@ mod tests {
             .expect("the docs");
         let end = source.find("pub fn quantities<").expect("the method");
         &source[start..end]
+    }
+
+    /// The derivatives' bodies take their own budget: with 1,000 operations for the dynamics
+    /// and none for the derivatives, the UR5's Coriolis matrix (1,160 operations) is cut into
+    /// blocks and its inverse-dynamics derivatives (2,744) are not; with 1,000 for the
+    /// derivatives alone, the reverse; `max_function_ops` alone sets both.
+    #[test]
+    fn the_derivatives_bodies_have_a_budget_of_their_own() {
+        let ur5 = || Builder::new("../tests/robots/ur5.urdf").derivatives();
+        let blocks = |b: Builder, name: &str| {
+            let source = b.generate().unwrap();
+            source.contains(&format!("fn {name}_block_0"))
+        };
+        let dynamics_cut = || ur5().max_function_ops(1000);
+        let derivatives_whole = dynamics_cut().max_derivative_function_ops(usize::MAX);
+        assert!(blocks(derivatives_whole.clone(), "coriolis_matrix"));
+        assert!(!blocks(derivatives_whole, "inverse_dynamics_derivatives"));
+        assert!(blocks(dynamics_cut(), "inverse_dynamics_derivatives"));
+        let derivatives_cut = ur5().max_derivative_function_ops(1000);
+        assert!(!blocks(derivatives_cut.clone(), "coriolis_matrix"));
+        assert!(blocks(derivatives_cut, "inverse_dynamics_derivatives"));
     }
 
     /// Every quantity a catalogue can hold, fixed base and floating, with every option, is

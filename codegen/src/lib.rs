@@ -73,7 +73,10 @@ pub mod spatial;
 pub mod urdf;
 mod wording;
 
-pub use builder::{Builder, DEFAULT_MAX_DOF, DEFAULT_MAX_FUNCTION_OPS, DEFAULT_MAX_GRAPH_NODES};
+pub use builder::{
+    Builder, DEFAULT_MAX_DERIVATIVE_FUNCTION_OPS, DEFAULT_MAX_DOF, DEFAULT_MAX_FUNCTION_OPS,
+    DEFAULT_MAX_GRAPH_NODES,
+};
 pub use cas::OpCount;
 pub use dynamics::{Input, Shape};
 pub use emit::Generated;

@@ -123,6 +123,7 @@ fn generate_modules(src: &Path) -> String {
             source_name: robot.file.clone(),
             regenerate: "selections_compile".into(),
             max_function_ops: eomgen::DEFAULT_MAX_FUNCTION_OPS,
+            max_derivative_function_ops: eomgen::DEFAULT_MAX_DERIVATIVE_FUNCTION_OPS,
         };
         let names = catalogue::names(&all);
         for (k, name) in names.iter().enumerate() {

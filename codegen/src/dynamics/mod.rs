@@ -116,6 +116,9 @@ pub struct Derivation {
     pub fast: Fast,
     /// What generated code evaluates, one entry per generated function.
     pub quantities: Vec<Quantity>,
+    /// The names of the quantities [`Derivation::add_derivatives`] added, whose bodies take
+    /// the derivatives' operation budget (`Builder::max_derivative_function_ops`).
+    pub derivative_quantities: std::collections::BTreeSet<&'static str>,
     /// The regressor and the standard and base parameters, after
     /// [`Derivation::add_regressor`].
     pub identification: Option<Identification>,
@@ -358,6 +361,7 @@ impl Derivation {
             recursive: rec,
             fast,
             quantities: Vec::new(),
+            derivative_quantities: Default::default(),
             identification: None,
             timings: Vec::new(),
         };
@@ -411,16 +415,23 @@ impl Derivation {
         let derived = derivatives::derive(self, model);
         self.graph.check()?;
         let extra = quantities::derivatives(self, &derived, flat_max_ops);
-        self.quantities.extend(extra);
+        self.add_derivative_quantities(extra);
         if !self.centroidal.contact_drift.is_empty() {
             let partials = contact_derivatives::derive(self, model);
             self.graph.check()?;
             let extra = contact_derivatives::quantities(self, &partials);
-            self.quantities.extend(extra);
+            self.add_derivative_quantities(extra);
             let extra = active_contacts::derivatives(self);
-            self.quantities.extend(extra);
+            self.add_derivative_quantities(extra);
         }
         Ok(())
+    }
+
+    /// Appends `extra` to the catalogue as derivatives ([`Derivation::derivative_quantities`]).
+    fn add_derivative_quantities(&mut self, extra: Vec<Quantity>) {
+        self.derivative_quantities
+            .extend(extra.iter().map(|q| q.name));
+        self.quantities.extend(extra);
     }
 
     /// Each body's share of `M` and `b` by the projected Newton-Euler form, from its own

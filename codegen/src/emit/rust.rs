@@ -40,6 +40,9 @@ pub struct EmitOptions {
     /// The most operations one generated function body may hold; longer bodies are split
     /// into non-inlined blocks (`Builder::max_function_ops`).
     pub max_function_ops: usize,
+    /// The same for the derivatives' bodies, `Derivation::derivative_quantities`
+    /// (`Builder::max_derivative_function_ops`).
+    pub max_derivative_function_ops: usize,
 }
 
 /// The lints generated code may trip: long literals, `x * -1.0` and the like.
@@ -103,6 +106,9 @@ struct Emitter<'a> {
     counts: Vec<(String, OpCount)>,
     /// The most operations of one function body ([`Split`]).
     budget: usize,
+    /// The same for the derivatives' bodies, and their names.
+    derivative_budget: usize,
+    derivatives: BTreeSet<&'static str>,
     /// The blocks of split bodies, for the inherent impl.
     blocks: Vec<TokenStream>,
     /// The quantities whose bodies were split, which have a `{name}_fill` method.
@@ -174,6 +180,8 @@ pub fn emit_tokens(
         try_contact_forward_dynamics: TokenStream::new(),
         counts: Vec::new(),
         budget: opts.max_function_ops,
+        derivative_budget: opts.max_derivative_function_ops,
+        derivatives: d.derivative_quantities.clone(),
         blocks: Vec::new(),
         split: BTreeSet::new(),
         helpers: BTreeSet::new(),

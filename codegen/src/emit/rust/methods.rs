@@ -114,7 +114,11 @@ impl Emitter<'_> {
             name,
             params,
             args,
-            budget: self.budget,
+            budget: if self.derivatives.contains(name) {
+                self.derivative_budget
+            } else {
+                self.budget
+            },
             rows: &[],
         }
     }
