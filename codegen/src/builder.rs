@@ -830,6 +830,29 @@ mod tests {
         assert!(blocks(derivatives_cut, "inverse_dynamics_derivatives"));
     }
 
+    /// A body that another function fills is written in blocks even under the budget, so that
+    /// its `_fill` method exists: the inverse-dynamics derivatives for the contact derivatives
+    /// and the impulse partials for the impulse derivatives of a floating double pendulum (a
+    /// few hundred operations each); the UR5's, which nothing fills (its forward-dynamics
+    /// derivatives are straight-line), stays whole.
+    #[test]
+    fn bodies_that_other_functions_fill_have_a_fill_method() {
+        let pendulum = Builder::new("../tests/robots/double_pendulum.urdf")
+            .floating_base()
+            .derivatives()
+            .contact_points(&["link2"])
+            .generate()
+            .unwrap();
+        assert!(pendulum.contains("fn inverse_dynamics_derivatives_fill"));
+        assert!(pendulum.contains("fn impulse_dynamics_partials_fill"));
+        let ur5 = Builder::new("../tests/robots/ur5.urdf")
+            .derivatives()
+            .generate()
+            .unwrap();
+        assert!(ur5.contains("fn inverse_dynamics_derivatives("));
+        assert!(!ur5.contains("fn inverse_dynamics_derivatives_fill"));
+    }
+
     /// Every quantity a catalogue can hold, fixed base and floating, with every option, is
     /// named in `Builder::quantities`'s documentation: the list follows the catalogue.
     #[test]

@@ -39,7 +39,7 @@ pub(super) fn body(
 ) -> Body {
     let program = Program::ordered(g, outputs, Order::Levels);
     let ops = program.ops();
-    let over = split.filter(|s| ops.total() > s.budget);
+    let over = split.filter(|s| s.filled || ops.total() > s.budget);
     let program = if ops.total() > DEPTH_ORDER_MIN_OPS || over.is_some() {
         Program::ordered(g, outputs, Order::Depth)
     } else {

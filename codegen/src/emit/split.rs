@@ -44,6 +44,10 @@ pub(super) struct Split<'a> {
     /// as separate matrices (`o0`, `o1`, ...), so that a caller can have them written into
     /// different places; empty: the whole matrix (`o`).
     pub rows: &'a [usize],
+    /// Another generated function has this one fill its result's storage (`{name}_fill`): the
+    /// body is written in blocks even under the budget (one block then), so that the method
+    /// exists and the result is not built in a local and copied.
+    pub filled: bool,
 }
 
 /// A value crossing blocks: a temporary or a joint angle's sine or cosine.

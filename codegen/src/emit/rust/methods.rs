@@ -120,6 +120,34 @@ impl Emitter<'_> {
                 self.budget
             },
             rows: &[],
+            filled: self.filled_by_another(name),
+        }
+    }
+
+    /// Whether another generated function has the body of `name` fill its own result's
+    /// storage ([`Split::filled`]): the inverse-dynamics derivatives in the composed
+    /// forward-dynamics derivatives and in the contact derivatives, the impulse partials in the
+    /// impulse derivatives. Built in a local and copied out, talos's impulse partials (22 kB)
+    /// took its impulse derivatives beyond a 64 KiB stack.
+    fn filled_by_another(&self, name: &str) -> bool {
+        use Evaluation as E;
+        match name {
+            "inverse_dynamics_derivatives" => self.any_eval(|e| {
+                matches!(
+                    e,
+                    E::ForwardDynamicsDerivatives
+                        | E::ContactDynamicsDerivatives { .. }
+                        | E::ActiveContacts(ActiveContacts::Derivatives { .. })
+                )
+            }),
+            "impulse_dynamics_partials" => self.any_eval(|e| {
+                matches!(
+                    e,
+                    E::ImpulseDynamicsDerivatives
+                        | E::ActiveContacts(ActiveContacts::ImpulseDerivatives)
+                )
+            }),
+            _ => false,
         }
     }
 
