@@ -87,9 +87,10 @@ pub const DEFAULT_MAX_FUNCTION_OPS: usize = 8000;
 /// The default of [`Builder::max_derivative_function_ops`]. The derivatives' bodies are where
 /// the blocks cost run time: on talos_full_v2 (50 joints, floating, two soles, native CPU) its
 /// inverse-dynamics derivatives (about 60,000 operations) took 13.9 us in blocks of 8,000
-/// operations, 13.1 us at 16,000 and 11.6 us at 32,000, for a build of 54 s and 2.1 GiB
-/// instead of 52 s and 1.6 GiB; g1_29dof's (49,267 operations) 8.9 and 8.1 us, a build of 36 s
-/// and 1.4 GiB instead of 27 s and 1.1 GiB.
+/// operations, 13.1 us at 16,000 and 11.6 us at 32,000, for a native build (`scripts/build-cost`)
+/// of 50 s and 2.0 GiB instead of 52 s and 1.6 GiB; g1_29dof's (49,267 operations) 8.9 and
+/// 8.1 us, a build of 35 s and 1.5 GiB instead of 27 s and 1.1 GiB. Whole (64,000), talos's
+/// build took 2.9 GiB, and g1's would come close to issue 30's 2 GB.
 pub const DEFAULT_MAX_DERIVATIVE_FUNCTION_OPS: usize = 32_000;
 
 /// Type names the generated code cannot take: `T` is its generic parameter.
