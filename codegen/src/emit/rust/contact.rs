@@ -367,7 +367,6 @@ impl Emitter<'_> {
         let docs = Self::quantity_doc(q, None);
         let (n, nq, k) = (self.n.clone(), self.nq.clone(), self.k.clone());
         let kkt = self.kkt(active);
-        let partials = self.call("impulse_dynamics_partials");
         let s = self.signature(
             q,
             active,
@@ -375,15 +374,13 @@ impl Emitter<'_> {
         );
         let (name, try_name, param, arg, why) = (&s.name, &s.try_name, &s.param, &s.arg, &s.why);
         let ty = quote!(::eomgen_runtime::ImpulseDynamicsDerivatives<T, #n, #k>);
-        // Split, the partials' blocks write their two row groups straight into `d`.
-        let set_partials = if self.split.contains("impulse_dynamics_partials") {
-            let fill = crate::emit::split::fill_name("impulse_dynamics_partials");
-            quote! {
-                self.#fill(q, w, jump, p, &mut d.dv_dq, &mut d.dimpulse_dq);
-                Ok(())
-            }
-        } else {
-            quote!(d.set_partials(&#partials(self, q, w, jump, p)))
+        // The partials' blocks write their two row groups straight into `d` (a body that its
+        // callers fill is always written in blocks: `methods.rs`, `FILLED`).
+        debug_assert!(self.split.contains("impulse_dynamics_partials"));
+        let fill = crate::emit::split::fill_name("impulse_dynamics_partials");
+        let set_partials = quote! {
+            self.#fill(q, w, jump, p, &mut d.dv_dq, &mut d.dimpulse_dq);
+            Ok(())
         };
         let (into, stage) = (
             format_ident!("{}_into", name),

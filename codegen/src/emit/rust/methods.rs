@@ -10,6 +10,11 @@ use crate::dynamics::{ActiveContacts, Craig, Evaluation, Input, Quantity, Shape}
 use crate::emit::body::{body, factored_body, shape_type, Body};
 use crate::emit::split::Split;
 
+/// The quantities whose callers have them write into the callers' own results
+/// (`{name}_fill`): the inverse-dynamics derivatives (the composed forward-dynamics
+/// derivatives', the contact derivatives') and the impulse partials (the impulse derivatives').
+const FILLED: [&str; 2] = ["inverse_dynamics_derivatives", "impulse_dynamics_partials"];
+
 impl Emitter<'_> {
     pub(super) fn quantity_fn(&mut self, q: &Quantity) -> TokenStream {
         match &q.eval {
@@ -125,30 +130,11 @@ impl Emitter<'_> {
     }
 
     /// Whether another generated function has the body of `name` fill its own result's
-    /// storage ([`Split::filled`]): the inverse-dynamics derivatives in the composed
-    /// forward-dynamics derivatives and in the contact derivatives, the impulse partials in the
-    /// impulse derivatives. Built in a local and copied out, talos's impulse partials (22 kB)
-    /// took its impulse derivatives beyond a 64 KiB stack.
+    /// storage ([`Split::filled`]): a quantity of [`FILLED`] that another quantity of the
+    /// selection needs ([`Quantity::needs`]). Built in a local and copied out, talos's impulse
+    /// partials (22 kB) took its impulse derivatives beyond a 64 KiB stack.
     fn filled_by_another(&self, name: &str) -> bool {
-        use Evaluation as E;
-        match name {
-            "inverse_dynamics_derivatives" => self.any_eval(|e| {
-                matches!(
-                    e,
-                    E::ForwardDynamicsDerivatives
-                        | E::ContactDynamicsDerivatives { .. }
-                        | E::ActiveContacts(ActiveContacts::Derivatives { .. })
-                )
-            }),
-            "impulse_dynamics_partials" => self.any_eval(|e| {
-                matches!(
-                    e,
-                    E::ImpulseDynamicsDerivatives
-                        | E::ActiveContacts(ActiveContacts::ImpulseDerivatives)
-                )
-            }),
-            _ => false,
-        }
+        FILLED.contains(&name) && self.quantities.iter().any(|q| q.needs().contains(&name))
     }
 
     /// The row groups a split body of `name` fills separately ([`Split::rows`]): the impulse

@@ -380,26 +380,18 @@ impl Emitter<'_> {
     }
 
     /// Statements writing `inverse_dynamics_derivatives` at `(q, qd, &qdd)` into the places
-    /// `dq` and `dqd` (of type `[[T; N]; N]`): through its `_fill` method when its body was
-    /// split, so that it is not built in a local and copied. It is emitted before the
-    /// quantities that call this (catalogue order).
+    /// `dq` and `dqd` (of type `[[T; N]; N]`) through its `_fill` method, so that it is not
+    /// built in a local and copied: a body that its callers fill is always written in blocks
+    /// (`methods.rs`, `FILLED`), and it is emitted before them (catalogue order).
     pub(super) fn id_derivatives_into(
         &self,
         dq: TokenStream,
         dqd: TokenStream,
         qdd: TokenStream,
     ) -> TokenStream {
-        if self.split.contains("inverse_dynamics_derivatives") {
-            let fill = crate::emit::split::fill_name("inverse_dynamics_derivatives");
-            quote!(self.#fill(q, qd, &#qdd, &mut #dq, &mut #dqd);)
-        } else {
-            debug_assert!(self
-                .counts
-                .iter()
-                .any(|(c, _)| c == "inverse_dynamics_derivatives"));
-            let f = self.call("inverse_dynamics_derivatives");
-            quote!((#dq, #dqd) = #f(self, q, qd, &#qdd);)
-        }
+        debug_assert!(self.split.contains("inverse_dynamics_derivatives"));
+        let fill = crate::emit::split::fill_name("inverse_dynamics_derivatives");
+        quote!(self.#fill(q, qd, &#qdd, &mut #dq, &mut #dqd);)
     }
 
     /// `try_contact_forward_dynamics` and `contact_forward_dynamics` (NaN on failure).
