@@ -108,7 +108,7 @@ struct Emitter<'a> {
     budget: usize,
     /// The same for the derivatives' bodies, and their names.
     derivative_budget: usize,
-    derivatives: BTreeSet<&'static str>,
+    derivatives: &'a BTreeSet<&'static str>,
     /// The blocks of split bodies, for the inherent impl.
     blocks: Vec<TokenStream>,
     /// The quantities whose bodies were split, which have a `{name}_fill` method.
@@ -181,7 +181,7 @@ pub fn emit_tokens(
         counts: Vec::new(),
         budget: opts.max_function_ops,
         derivative_budget: opts.max_derivative_function_ops,
-        derivatives: d.derivative_quantities.clone(),
+        derivatives: &d.derivative_quantities,
         blocks: Vec::new(),
         split: BTreeSet::new(),
         helpers: BTreeSet::new(),
