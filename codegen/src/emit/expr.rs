@@ -228,7 +228,16 @@ impl Ctx<'_> {
         for (t, k) in terms {
             match self.product_parts(t, *k, trig) {
                 Some((x, y)) => products.push((*k < 0.0, x, y)),
-                None => plain.push((*k < 0.0, self.expr(t, trig).ts)),
+                // A negated sum keeps its parentheses: `a - (x + y)`.
+                None => {
+                    let body = self.expr(t, trig);
+                    let body = if *k < 0.0 {
+                        parenthesized(body)
+                    } else {
+                        body.ts
+                    };
+                    plain.push((*k < 0.0, body));
+                }
             }
         }
         if c != 0.0 {
@@ -335,4 +344,29 @@ fn join_mul(items: Vec<TokenStream>) -> TokenStream {
     let mut it = items.into_iter();
     let first = it.next().unwrap_or_else(|| quote!(T::one()));
     it.fold(first, |acc, x| quote!(#acc * #x))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cas::{Graph, Program, SumFlattening};
+
+    /// `a - (b + c)` with the inner sum kept as one term (as shared sums are): the emitted
+    /// tokens keep its parentheses, where `a - b + c` would be another value.
+    #[test]
+    fn a_negated_sum_keeps_its_parentheses() {
+        let mut g = Graph::new();
+        g.set_flattening(SumFlattening::Shared);
+        let (a, b, c) = (g.q(0), g.q(1), g.q(2));
+        let bc = g.add(b, c);
+        let e = g.sub(a, bc);
+        let p = Program::new(&g, &[e]);
+        let fields = BTreeMap::new();
+        let ctx = Ctx {
+            symbols: &p.symbols,
+            fields: &fields,
+        };
+        let text = ctx.expr(&p.outputs[0], &mut BTreeSet::new()).ts.to_string();
+        assert_eq!(text, "q [0] - (q [1] + q [2])");
+    }
 }
