@@ -115,14 +115,14 @@ fn joint_effects() {
     }
 }
 
-/// A 24-joint serial chain, deep enough that forward dynamics solves at run time instead of
+/// A 28-joint serial chain, deep enough that forward dynamics solves at run time instead of
 /// unrolling (only the functions the tests call, to keep the build small).
 fn deep_chain() {
     let out_dir = std::path::PathBuf::from(std::env::var_os("OUT_DIR").unwrap());
-    let urdf = chain::write_serial_chain(&out_dir, 24).unwrap();
+    let urdf = chain::write_serial_chain(&out_dir, 28).unwrap();
     eomgen::Builder::new(&urdf)
-        .module_name("chain24")
-        .type_name("Chain24")
+        .module_name("chain28")
+        .type_name("Chain28")
         .quantities(["forward_dynamics", "inverse_dynamics"])
         .compile()
         .unwrap();

@@ -3,7 +3,7 @@
 
 use crate::child;
 
-use eomgen::cas::{Graph, Id, Node, Order, Program, Style, Syntax};
+use eomgen::cas::{Graph, Id, Node, Order, Program, Style, SumFlattening, Syntax};
 use proptest::prelude::*;
 
 const NVARS: usize = 3;
@@ -477,6 +477,44 @@ fn programs_compute_each_subexpression_once_and_count_operations() {
             .replace("(x)", "(q1)")
     );
     let _ = unused;
+}
+
+/// Terms of a sum (a lone term for anything else).
+fn terms(g: &Graph, e: Id) -> Vec<(Id, f64)> {
+    match g.node(e) {
+        Node::Add(_, ts) => ts.iter().map(|(t, k)| (*t, k.get())).collect(),
+        _ => vec![(e, 1.0)],
+    }
+}
+
+#[test]
+fn shared_sums_stay_one_term_unless_they_collect() {
+    let mut g = Graph::new();
+    g.set_flattening(SumFlattening::Shared);
+    let (a, b, c, d) = (g.q(0), g.q(1), g.q(2), g.q(3));
+    let s = g.add(a, b);
+    // Used by two sums, computed once: 3 additions, not 4.
+    let x = g.add(s, c);
+    let y = g.add(s, d);
+    let mut want = vec![(s, 1.0), (c, 1.0)];
+    want.sort_by_key(|t| t.0);
+    assert_eq!(terms(&g, x), want);
+    let n = Program::new(&g, &[x, y]).ops();
+    assert_eq!((n.add, n.mul), (3, 0));
+    // A sum that shares a term with another input merges and collects: (a + b) - a = b.
+    assert_eq!(g.sub(s, a), b);
+    // A scaled sum stays one term; a negation merges, so that it shares the terms.
+    let scaled = g.scale(s, 2.5);
+    assert_eq!(terms(&g, scaled), vec![(s, 2.5)]);
+    let neg = g.neg(s);
+    assert_eq!(terms(&g, neg), vec![(a, -1.0), (b, -1.0)]);
+    // Always: every small sum merges into its parent, as before.
+    assert_eq!(
+        g.set_flattening(SumFlattening::Always),
+        SumFlattening::Shared
+    );
+    let z = g.add(s, d);
+    assert_eq!(terms(&g, z).len(), 3);
 }
 
 #[test]

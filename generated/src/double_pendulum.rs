@@ -117,94 +117,55 @@ impl<T: ::eomgen_runtime::Lane> DoublePendulum<T> {
             let t1 = c0;
             let t2 = s1;
             let t3 = c1;
-            let t4 = t1 * t3;
-            let t5 = t0 * t2;
-            let t6 = t1 * t2;
-            let t7 = t0 * t3;
-            let t8 = T::mul_add(
-                T::from_f64(0.7356637062775817),
+            let t4 = T::mul_add(
+                T::from_f64(0.0335304944),
                 t3,
-                T::mul_add(T::from_f64(0.0000000014126230823060105), t2, T::one()),
+                T::from_f64(0.0000000000643853298) * t2,
             );
-            let t9 = t2 * (T::mul_add(T::from_f64(0.1), t3, T::from_f64(0.10088)));
-            let t10 = t3
-                * (T::mul_add(T::from_f64(0.1), t2, T::from_f64(0.00000000019371)));
+            let t5 = {
+                let b = qd[0] + qd[1];
+                b * b
+            };
+            let t6 = T::mul_add(
+                -T::from_f64(0.1),
+                qd[0] * qd[0],
+                T::from_f64(9.81) * t1,
+            );
+            let t7 = T::mul_add(T::from_f64(21.94013895236754), t4, T::one());
+            let t8 = T::mul_add(t2, t6, T::from_f64(9.81) * t0 * t3);
+            let t9 = T::mul_add(-t3, t6, T::from_f64(9.81) * t0 * t2);
+            let t10 = T::mul_add(
+                -T::from_f64(0.0000000000643853298),
+                t9,
+                -T::from_f64(0.0335304944) * t8,
+            );
             let t11 = T::mul_add(
-                -(T::mul_add(
-                    T::from_f64(0.0033530494400000003),
-                    t3,
-                    T::mul_add(
-                        T::from_f64(0.0000000000064385329799999996),
-                        t2,
-                        T::from_f64(0.004557856275072),
-                    ),
-                )),
-                t8,
-                T::mul_add(
-                    T::from_f64(0.006706098880000001),
-                    t3,
-                    T::mul_add(
-                        T::from_f64(0.000000000012877065959999999),
-                        t2,
-                        T::from_f64(0.00863622790870487),
-                    ),
-                ),
+                -(T::mul_add(T::from_f64(0.1), t4, T::from_f64(0.004557856275072))),
+                t7,
+                T::mul_add(T::from_f64(0.2), t4, T::from_f64(0.00863622790870487)),
             );
-            let t12 = qd[0] * qd[0] * (T::from_f64(0.033238000000000004) * (t9 - t10));
-            let t13 = T::one() / t11;
+            let t12 = T::one() / t11;
+            let t13 = t10 - tau[1];
             let t14 = T::mul_add(
-                t8,
-                T::mul_add(
-                    -T::from_f64(0.328934150064),
-                    t6 + t7,
-                    T::mul_add(
-                        T::from_f64(0.0000000006316200853380001),
-                        t4 - t5,
-                        t12 - tau[1],
-                    ),
-                ),
-                T::mul_add(
-                    qd[0],
-                    qd[1] * (T::from_f64(0.06647600000000001) * (t9 - t10)),
-                    T::mul_add(
-                        qd[1],
-                        qd[1]
-                            * (T::mul_add(
-                                -T::from_f64(0.000000000006438532980000001),
-                                t3,
-                                T::from_f64(0.00335304944) * t2,
-                            )),
-                        T::mul_add(
-                            T::from_f64(0.328934150064),
-                            t6 + t7,
-                            T::mul_add(
-                                T::from_f64(0.0000000006316200853380001),
-                                t5 - t4,
-                                T::mul_add(
-                                    -T::from_f64(0.0000056915273546100005),
-                                    t1,
-                                    T::mul_add(T::from_f64(0.42040052957160007), t0, tau[0]),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
+                -t2,
+                T::mul_add(T::from_f64(0.33238), t9, T::from_f64(0.0335304944) * t5),
+                t3
+                    * (T::mul_add(
+                        -T::from_f64(0.33238),
+                        t8,
+                        T::from_f64(0.0000000000643853298) * t5,
+                    )),
             );
+            let t15 = tau[0]
+                - (T::mul_add(
+                    T::from_f64(0.00000569152735461),
+                    t1,
+                    -T::from_f64(0.0943357495716) * t0,
+                ) + T::mul_add(T::from_f64(0.1), t14, t10));
+            let t16 = T::mul_add(t7, t13, t15);
             [
-                t13 * t14,
-                T::mul_add(
-                    -t8,
-                    t13 * t14,
-                    T::mul_add(
-                        T::from_f64(219.4013895236754),
-                        tau[1] - t12,
-                        T::mul_add(
-                            T::from_f64(72.16860958583077),
-                            t6 + t7,
-                            T::from_f64(0.00000013857832437421965) * (t5 - t4),
-                        ),
-                    ),
-                ),
+                t12 * t16,
+                T::mul_add(-t7, t12 * t16, -T::from_f64(219.4013895236754) * t13),
                 t11,
                 T::from_f64(0.004557856275072),
             ]
@@ -217,54 +178,44 @@ impl<T: ::eomgen_runtime::Lane> DoublePendulum<T> {
     /// The generalized momentum p = M(q) qd = dT/dqd (a momentum observer's measurement).
     ///
     /// Route: Newton-Euler at rest without gravity, with qd as the accelerations, O(N).
-    /// Operations: 16 mul, 12 add, 0 div, 1 sin, 1 cos.
+    /// Operations: 13 mul, 8 add, 0 div, 1 sin, 1 cos.
     pub fn generalized_momentum(&self, q: &[T; 2], qd: &[T; 2]) -> [T; 2] {
         let ([s1], [c1]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([q[1]]);
         let t0 = s1;
         let t1 = c1;
-        let t2 = qd[0] * t1;
-        let t3 = qd[0] * t0;
-        let t4 = T::mul_add(
-            T::from_f64(0.1),
-            T::mul_add(
-                t0,
-                T::mul_add(
-                    T::from_f64(0.033238000000000004),
-                    t3,
-                    T::from_f64(0.0000000000643853298) * (qd[0] + qd[1]),
-                ),
-                t1
-                    * (T::mul_add(
-                        T::from_f64(0.033238000000000004),
-                        t2,
-                        T::from_f64(0.0335304944) * (qd[0] + qd[1]),
-                    )),
-            ),
+        let t2 = qd[0] + qd[1];
+        let t3 = qd[0] * t1;
+        let t4 = qd[0] * t0;
+        let t5 = T::mul_add(
+            T::from_f64(0.004557856275072),
+            t2,
             T::mul_add(
                 T::from_f64(0.0000000000064385329799999996),
-                t3,
-                T::mul_add(
-                    T::from_f64(0.0033530494400000003),
-                    t2,
-                    T::mul_add(
-                        T::from_f64(0.004557856275072),
-                        qd[1],
-                        T::from_f64(0.005312427908704868) * qd[0],
-                    ),
-                ),
+                t4,
+                T::from_f64(0.0033530494400000003) * t3,
             ),
         );
-        [
-            t4,
+        let t6 = T::mul_add(
+            t0,
             T::mul_add(
-                T::from_f64(0.0000000000064385329799999996),
-                t3,
-                T::mul_add(
-                    T::from_f64(0.0033530494400000003),
-                    t2,
-                    T::from_f64(0.004557856275072) * (qd[0] + qd[1]),
-                ),
+                T::from_f64(0.033238000000000004),
+                t4,
+                T::from_f64(0.0000000000643853298) * t2,
             ),
+            t1
+                * (T::mul_add(
+                    T::from_f64(0.033238000000000004),
+                    t3,
+                    T::from_f64(0.0335304944) * t2,
+                )),
+        );
+        [
+            T::mul_add(
+                T::from_f64(0.0007545716336328686),
+                qd[0],
+                T::mul_add(T::from_f64(0.1), t6, t5),
+            ),
+            t5,
         ]
     }
     /// Craig's centrifugal matrix C(q): `b = B(q) [qd qd] + C(q) [qd^2]`.
@@ -296,19 +247,16 @@ impl<T: ::eomgen_runtime::Lane> DoublePendulum<T> {
     /// Craig's Coriolis matrix B(q), N x N(N-1)/2 = 2 x 1, columns for qd_j qd_k with j < k in the order (0,1), (0,2), ..., (1,2), ...
     ///
     /// Route: second velocity derivatives of the Newton-Euler bias.
-    /// Operations: 2 mul, 1 add, 0 div, 1 sin, 1 cos.
+    /// Operations: 3 mul, 1 add, 0 div, 1 sin, 1 cos.
     pub fn coriolis_pairs(&self, q: &[T; 2]) -> [[T; 1]; 2] {
         let ([s1], [c1]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([q[1]]);
-        [
-            [
-                T::mul_add(
-                    T::from_f64(0.000000000012877065959999999),
-                    c1,
-                    -T::from_f64(0.006706098880000001) * s1,
-                ),
-            ],
-            [T::zero()],
-        ]
+        let t0 = T::from_f64(0.1)
+            * (T::mul_add(
+                T::from_f64(0.0000000001287706596),
+                c1,
+                -T::from_f64(0.0670609888) * s1,
+            ));
+        [[t0], [T::zero()]]
     }
     /// The centre of mass of the moving bodies in world coordinates (a fixed root link, welded to the world, is not counted).
     ///
@@ -715,34 +663,18 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 2> for DoublePendu
     /// The joint-space mass matrix M(q), symmetric positive definite.
     ///
     /// Route: composite-rigid-body algorithm.
-    /// Operations: 4 mul, 4 add, 0 div, 1 sin, 1 cos.
+    /// Operations: 4 mul, 3 add, 0 div, 1 sin, 1 cos.
     fn mass_matrix(&self, q: &[T; 2]) -> [[T; 2]; 2] {
         let ([s1], [c1]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([q[1]]);
-        let t0 = s1;
-        let t1 = c1;
-        let t2 = T::mul_add(
-            T::from_f64(0.0033530494400000003),
-            t1,
-            T::mul_add(
-                T::from_f64(0.0000000000064385329799999996),
-                t0,
-                T::from_f64(0.004557856275072),
-            ),
+        let t0 = T::mul_add(
+            T::from_f64(0.0335304944),
+            c1,
+            T::from_f64(0.0000000000643853298) * s1,
         );
+        let t1 = T::mul_add(T::from_f64(0.1), t0, T::from_f64(0.004557856275072));
         [
-            [
-                T::mul_add(
-                    T::from_f64(0.006706098880000001),
-                    t1,
-                    T::mul_add(
-                        T::from_f64(0.000000000012877065959999999),
-                        t0,
-                        T::from_f64(0.00863622790870487),
-                    ),
-                ),
-                t2,
-            ],
-            [t2, T::from_f64(0.004557856275072)],
+            [T::mul_add(T::from_f64(0.2), t0, T::from_f64(0.00863622790870487)), t1],
+            [t1, T::from_f64(0.004557856275072)],
         ]
     }
     /// The generalized gravity force G(q) = dV/dq.
@@ -835,7 +767,7 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 2> for DoublePendu
     /// Inverse dynamics: tau = M(q) qdd + b(q, qd) + G(q).
     ///
     /// Route: Newton-Euler.
-    /// Operations: 29 mul, 25 add, 0 div, 2 sin, 2 cos.
+    /// Operations: 25 mul, 17 add, 0 div, 2 sin, 2 cos.
     fn inverse_dynamics(&self, q: &[T; 2], qd: &[T; 2], qdd: &[T; 2]) -> [T; 2] {
         let ([s0, s1], [c0, c1]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
             q[0],
@@ -845,67 +777,52 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 2> for DoublePendu
         let t1 = c0;
         let t2 = s1;
         let t3 = c1;
-        let t4 = qd[0] + qd[1];
-        let t5 = T::mul_add(-T::from_f64(0.1), qd[0] * qd[0], T::from_f64(9.81) * t1);
-        let t6 = T::mul_add(-T::from_f64(9.81), t0, T::from_f64(0.1) * qdd[0]);
-        let t7 = t2 * t5;
-        let t8 = t3 * t5;
-        let t9 = t3 * t6;
-        let t10 = t2 * t6;
-        let t11 = T::mul_add(
-            T::from_f64(0.33238),
-            t8 + t10,
-            T::mul_add(
-                -t4,
-                T::from_f64(0.0335304944) * t4,
-                T::from_f64(0.0000000000643853298) * (qdd[0] + qdd[1]),
-            ),
-        );
-        let t12 = T::mul_add(
-            T::from_f64(0.33238),
-            t9 - t7,
-            T::mul_add(
-                t4,
-                T::from_f64(0.0000000000643853298) * t4,
-                T::from_f64(0.0335304944) * (qdd[0] + qdd[1]),
-            ),
-        );
-        [
-            T::mul_add(
-                T::from_f64(0.1),
-                T::mul_add(t2, t11, t3 * t12),
-                T::mul_add(
-                    T::from_f64(0.0000000000643853298),
-                    t8 + t10,
-                    T::mul_add(
-                        T::from_f64(0.0335304944),
-                        t9 - t7,
-                        T::mul_add(
-                            T::from_f64(0.00000569152735461),
-                            t1,
-                            T::mul_add(
-                                -T::from_f64(0.0943357495716),
-                                t0,
-                                T::mul_add(
-                                    T::from_f64(0.004557856275072),
-                                    qdd[1],
-                                    T::from_f64(0.005312427908704868) * qdd[0],
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
+        let t4 = qdd[0] + qdd[1];
+        let t5 = {
+            let b = qd[0] + qd[1];
+            b * b
+        };
+        let t6 = T::mul_add(-T::from_f64(0.1), qd[0] * qd[0], T::from_f64(9.81) * t1);
+        let t7 = T::mul_add(-T::from_f64(9.81), t0, T::from_f64(0.1) * qdd[0]);
+        let t8 = T::mul_add(-t3, t7, t2 * t6);
+        let t9 = T::mul_add(t2, t7, t3 * t6);
+        let t10 = T::mul_add(
+            T::from_f64(0.004557856275072),
+            t4,
             T::mul_add(
                 T::from_f64(0.0000000000643853298),
-                t8 + t10,
-                T::mul_add(
-                    T::from_f64(0.0335304944),
-                    t9 - t7,
-                    T::from_f64(0.004557856275072) * (qdd[0] + qdd[1]),
-                ),
+                t9,
+                -T::from_f64(0.0335304944) * t8,
             ),
-        ]
+        );
+        let t11 = T::mul_add(
+            -t2,
+            T::mul_add(
+                -T::from_f64(0.0000000000643853298),
+                t4,
+                T::mul_add(-T::from_f64(0.33238), t9, T::from_f64(0.0335304944) * t5),
+            ),
+            t3
+                * (T::mul_add(
+                    T::from_f64(0.0335304944),
+                    t4,
+                    T::mul_add(
+                        -T::from_f64(0.33238),
+                        t8,
+                        T::from_f64(0.0000000000643853298) * t5,
+                    ),
+                )),
+        );
+        let t12 = T::mul_add(
+            T::from_f64(0.0007545716336328686),
+            qdd[0],
+            T::mul_add(
+                T::from_f64(0.00000569152735461),
+                t1,
+                -T::from_f64(0.0943357495716) * t0,
+            ),
+        ) + T::mul_add(T::from_f64(0.1), t11, t10);
+        [t12, t10]
     }
     /// Forward dynamics: qdd = M(q)^-1 (tau - b(q, qd) - G(q)).
     ///
@@ -913,7 +830,7 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 2> for DoublePendu
     /// model and finite inputs); `try_forward_dynamics` says which pivot failed.
     ///
     /// Route: M and b + G as in `mass_matrix` and `bias`, then an unrolled L^T D L solve without fill-in.
-    /// Operations: 38 mul, 32 add, 1 div, 2 sin, 2 cos.
+    /// Operations: 32 mul, 20 add, 1 div, 2 sin, 2 cos.
     fn forward_dynamics(&self, q: &[T; 2], qd: &[T; 2], tau: &[T; 2]) -> [T; 2] {
         match self.forward_dynamics_checked(q, qd, tau) {
             Ok((qdd, failures)) => ::eomgen_runtime::lane::nan_failed(qdd, &failures),
@@ -923,41 +840,26 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 2> for DoublePendu
     /// The kinetic energy T = qd^T M(q) qd / 2.
     ///
     /// Route: the quadratic form of `mass_matrix`.
-    /// Operations: 11 mul, 7 add, 0 div, 1 sin, 1 cos.
+    /// Operations: 11 mul, 6 add, 0 div, 1 sin, 1 cos.
     fn kinetic_energy(&self, q: &[T; 2], qd: &[T; 2]) -> T {
         let ([s1], [c1]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([q[1]]);
-        let t0 = s1;
-        let t1 = c1;
+        let t0 = T::mul_add(
+            T::from_f64(0.0335304944),
+            c1,
+            T::from_f64(0.0000000000643853298) * s1,
+        );
+        let t1 = T::mul_add(T::from_f64(0.1), t0, T::from_f64(0.004557856275072));
         let t2 = T::mul_add(
-            T::from_f64(0.0033530494400000003),
+            qd[1],
             t1,
-            T::mul_add(
-                T::from_f64(0.0000000000064385329799999996),
-                t0,
-                T::from_f64(0.004557856275072),
-            ),
+            qd[0] * (T::mul_add(T::from_f64(0.2), t0, T::from_f64(0.00863622790870487))),
         );
         let t3 = T::mul_add(
             qd[1],
-            t2,
-            qd[0]
-                * (T::mul_add(
-                    T::from_f64(0.006706098880000001),
-                    t1,
-                    T::mul_add(
-                        T::from_f64(0.000000000012877065959999999),
-                        t0,
-                        T::from_f64(0.00863622790870487),
-                    ),
-                )),
+            T::mul_add(qd[0], t1, T::from_f64(0.004557856275072) * qd[1]),
+            qd[0] * t2,
         );
-        let t4 = T::from_f64(0.5)
-            * (T::mul_add(
-                qd[1],
-                T::mul_add(qd[0], t2, T::from_f64(0.004557856275072) * qd[1]),
-                qd[0] * t3,
-            ));
-        t4
+        T::from_f64(0.5) * t3
     }
     /// The gravitational potential energy V = -sum m g.c, zero with every centre of mass at the origin.
     ///

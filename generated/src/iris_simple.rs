@@ -103,39 +103,78 @@ impl<T: ::eomgen_runtime::Lane> IrisSimple<T> {
     /// The Christoffel-form Coriolis matrix C(q, qd): C qd = b, dM/dt - 2C skew-symmetric.
     ///
     /// Route: Echeandia and Wensing's O(N^2) recursion on composite inertias and momenta.
-    /// Operations: 26 mul, 8 add, 0 div, 0 sin, 0 cos.
+    /// Operations: 47 mul, 38 add, 0 div, 0 sin, 0 cos.
     pub fn coriolis_matrix(&self, q: &[T; 7], qd: &[T; 6]) -> [[T; 6]; 6] {
-        let t0 = T::from_f64(0.00045999999999999996) * qd[5];
-        let t1 = -T::from_f64(0.00045999999999999996) * qd[5];
+        let t0 = T::mul_add(
+            -T::from_f64(0.000000000000000000002541098841762901),
+            qd[5],
+            T::from_f64(0.015016740000000002) * qd[3],
+        );
+        let t1 = T::mul_add(
+            -T::from_f64(0.0000000000000000000033881317890172014),
+            qd[5],
+            T::from_f64(0.015287998) * qd[4],
+        );
+        let t2 = T::mul_add(
+            T::from_f64(0.00022999999999999998),
+            qd[4],
+            T::from_f64(0.7674999999999997) * qd[0],
+        );
+        let t3 = T::mul_add(
+            -T::from_f64(0.00022999999999999998),
+            qd[3],
+            T::from_f64(0.7674999999999997) * qd[1],
+        );
+        let t4 = T::mul_add(
+            T::from_f64(0.0000000000000000000033881317890172014),
+            qd[5],
+            T::from_f64(0.028776508000000003) * qd[4],
+        );
+        let t5 = T::mul_add(
+            -T::from_f64(0.000000000000000000002541098841762901),
+            qd[5],
+            -T::from_f64(0.028776508000000003) * qd[3],
+        );
+        let t6 = T::from_f64(0.00045999999999999996) * qd[5];
+        let t7 = -T::from_f64(0.00045999999999999996) * qd[5];
+        let t8 = T::mul_add(
+            -T::from_f64(0.00045999999999999996),
+            qd[3],
+            T::from_f64(1.5349999999999995) * qd[1],
+        ) - t3 - t3;
         [
             [
                 T::zero(),
                 -T::from_f64(1.5349999999999995) * qd[5],
                 T::from_f64(1.5349999999999995) * qd[4],
-                t0,
+                t6,
                 T::zero(),
-                T::zero(),
+                t8,
             ],
             [
                 T::from_f64(1.5349999999999995) * qd[5],
                 T::zero(),
                 -T::from_f64(1.5349999999999995) * qd[3],
                 T::zero(),
-                t0,
+                t6,
                 T::zero(),
             ],
             [
                 -T::from_f64(1.5349999999999995) * qd[4],
                 T::from_f64(1.5349999999999995) * qd[3],
                 T::zero(),
-                -T::from_f64(0.00045999999999999996) * qd[3],
-                -T::from_f64(0.00045999999999999996) * qd[4],
+                T::mul_add(
+                    -T::from_f64(0.00022999999999999998),
+                    qd[3],
+                    T::mul_add(-T::from_f64(0.7674999999999997), qd[1], t3),
+                ),
+                T::mul_add(T::from_f64(1.5349999999999995), qd[0], -t2) - t2,
                 T::zero(),
             ],
             [
-                t1,
+                t7,
                 T::zero(),
-                T::from_f64(0.00045999999999999996) * qd[3],
+                T::mul_add(T::from_f64(0.00045999999999999996), qd[3], t3) - t3,
                 T::zero(),
                 T::mul_add(
                     -T::from_f64(0.001528230000000002),
@@ -147,30 +186,39 @@ impl<T: ::eomgen_runtime::Lane> IrisSimple<T> {
                     ),
                 ),
                 T::mul_add(
-                    T::from_f64(0.000000000000000000006776263578034403),
-                    qd[5],
-                    T::from_f64(0.028505250000000006) * qd[4],
-                ),
+                    T::from_f64(0.015016740000000002),
+                    qd[4],
+                    T::mul_add(T::from_f64(0.00022999999999999998), qd[0], t4),
+                ) - (T::mul_add(T::from_f64(0.00022999999999999998), qd[0], t1)),
             ],
             [
                 T::zero(),
-                t1,
-                T::from_f64(0.00045999999999999996) * qd[4],
+                t7,
                 T::mul_add(
-                    T::from_f64(0.001528230000000002),
+                    T::from_f64(0.00069),
+                    qd[4],
+                    T::mul_add(T::from_f64(0.7674999999999997), qd[0], -t2),
+                ),
+                T::mul_add(
+                    T::from_f64(0.030304738000000005),
                     qd[5],
                     T::mul_add(
-                        T::from_f64(0.000000000000000000006776263578034403),
+                        T::from_f64(0.0000000000000000000033881317890172014),
                         qd[4],
-                        T::from_f64(0.000000000000000000005082197683525802) * qd[3],
+                        T::from_f64(0.000000000000000000002541098841762901) * qd[3],
                     ),
-                ),
+                )
+                    - (T::mul_add(
+                        T::from_f64(0.028776508000000003),
+                        qd[5],
+                        T::mul_add(
+                            -T::from_f64(0.0000000000000000000033881317890172014),
+                            qd[4],
+                            -T::from_f64(0.000000000000000000002541098841762901) * qd[3],
+                        ),
+                    )),
                 T::zero(),
-                T::mul_add(
-                    -T::from_f64(0.000000000000000000005082197683525802),
-                    qd[5],
-                    -T::from_f64(0.029047766000000003) * qd[3],
-                ),
+                T::mul_add(-T::from_f64(0.015287998), qd[3], t0 + t5),
             ],
             [
                 T::zero(),
@@ -179,13 +227,17 @@ impl<T: ::eomgen_runtime::Lane> IrisSimple<T> {
                 T::mul_add(
                     -T::from_f64(0.000000000000000000006776263578034403),
                     qd[5],
-                    -T::from_f64(0.028505250000000006) * qd[4],
+                    T::mul_add(-T::from_f64(0.07256975600000001), qd[4], t1 + t4),
                 ),
                 T::mul_add(
                     T::from_f64(0.000000000000000000005082197683525802),
                     qd[5],
-                    T::from_f64(0.029047766000000003) * qd[3],
-                ),
+                    T::mul_add(
+                        T::from_f64(0.07284101400000001),
+                        qd[3],
+                        T::mul_add(-T::from_f64(0.00022999999999999998), qd[1], t5),
+                    ),
+                ) - (T::mul_add(-T::from_f64(0.00022999999999999998), qd[1], t0)),
                 T::zero(),
             ],
         ]
@@ -223,23 +275,17 @@ impl<T: ::eomgen_runtime::Lane> IrisSimple<T> {
     > {
         let mut failures: <T as ::eomgen_runtime::Lane>::Failures = ::core::default::Default::default();
         let o: [T; 12] = {
-            let t0 = q[3] * q[5];
-            let t1 = q[4] * q[5];
-            let t2 = q[3] * q[6];
-            let t3 = q[4] * q[6];
-            let t4 = qd[3] * qd[5];
-            let t5 = qd[4] * qd[5];
-            let t6 = T::mul_add(
+            let t0 = T::mul_add(
                 -T::from_f64(0.000000000000000000005082197683525802),
                 qd[5],
                 T::from_f64(0.030033480000000005) * qd[3],
             );
-            let t7 = T::mul_add(
+            let t1 = T::mul_add(
                 -T::from_f64(0.000000000000000000006776263578034403),
                 qd[5],
                 T::from_f64(0.030575996) * qd[4],
             );
-            let t8 = T::mul_add(
+            let t2 = T::mul_add(
                 -T::from_f64(0.057553016000000005),
                 qd[5],
                 T::mul_add(
@@ -248,229 +294,122 @@ impl<T: ::eomgen_runtime::Lane> IrisSimple<T> {
                     T::from_f64(0.000000000000000000005082197683525802) * qd[3],
                 ),
             );
-            let t9 = qd[4] * t8;
-            let t10 = qd[5] * t7;
-            let t11 = qd[5] * t6;
-            let t12 = qd[3] * t8;
-            let t13 = qd[3] * t7;
-            let t14 = qd[4] * t6;
-            [
+            let t3 = T::mul_add(
+                T::from_f64(9.81),
+                T::from_f64(2.0) * (T::mul_add(-q[4], q[6], q[3] * q[5])),
+                T::mul_add(-qd[1], qd[5], qd[2] * qd[4]),
+            );
+            let t4 = T::mul_add(
+                T::from_f64(9.81),
+                T::from_f64(2.0) * (T::mul_add(q[3], q[6], q[4] * q[5])),
+                T::mul_add(-qd[2], qd[3], qd[0] * qd[5]),
+            );
+            let t5 = T::mul_add(
+                T::from_f64(9.81),
                 T::mul_add(
+                    T::from_f64(2.0),
+                    T::mul_add(q[4], q[4], q[3] * q[3]),
+                    -T::one(),
+                ),
+                -(T::mul_add(-qd[0], qd[4], qd[1] * qd[3])),
+            );
+            let t6 = T::mul_add(
+                -T::from_f64(1.5349999999999995),
+                t5,
+                -T::from_f64(0.00045999999999999996)
+                    * (T::mul_add(qd[4], qd[4], qd[3] * qd[3])),
+            );
+            let t7 = T::mul_add(
+                -T::from_f64(0.00045999999999999996),
+                t4,
+                T::mul_add(-qd[5], t1, -qd[4] * t2),
+            );
+            let t8 = T::mul_add(
+                T::from_f64(0.00045999999999999996),
+                t3,
+                T::mul_add(qd[3], t2, qd[5] * t0),
+            );
+            let t9 = T::mul_add(-qd[4], t0, qd[3] * t1) - tau[5];
+            let t10 = tau[0]
+                - (T::mul_add(
+                    T::from_f64(1.5349999999999995),
+                    t3,
+                    T::from_f64(0.00045999999999999996) * qd[3] * qd[5],
+                ));
+            let t11 = tau[1]
+                - (T::mul_add(
+                    T::from_f64(1.5349999999999995),
+                    t4,
+                    T::from_f64(0.00045999999999999996) * qd[4] * qd[5],
+                ));
+            let t12 = T::mul_add(
+                -T::from_f64(0.00000000000000000011773950435602546),
+                t9,
+                tau[4] - t8,
+            );
+            let t13 = T::mul_add(
+                T::from_f64(0.000000000000000000000000000000000000019570104479921723),
+                t12,
+                T::mul_add(
+                    -T::from_f64(0.0000000000000000000883046282670191),
+                    t9,
+                    tau[3] - t7,
+                ),
+            );
+            let t14 = T::mul_add(T::from_f64(0.015316240409036846), t13, t11);
+            let t15 = T::mul_add(
+                T::from_f64(
+                    0.00000000000000000000000000000000000000000008982490448154375,
+                ),
+                t14,
+                -(T::mul_add(
                     -T::from_f64(
-                        0.00000000000000000000000000000000000000000005851811690808657,
+                        0.00000000000000000000000000000000000000029974042504445008,
                     ),
-                    tau[1],
-                    T::mul_add(
-                        T::from_f64(0.6514687351558525),
-                        tau[0],
-                        T::mul_add(
-                            T::from_f64(0.0000000000000000000011539659656915366),
-                            t13 - t14 - tau[5],
-                            T::mul_add(
-                                T::from_f64(0.009801009202502908),
-                                t11 + t12 - tau[4],
-                                T::mul_add(
-                                    -T::from_f64(
-                                        0.00000000000000000000000000000000000000019527241185633233,
-                                    ),
-                                    t9 + t10 + tau[3],
-                                    T::mul_add(
-                                        T::from_f64(
-                                            0.00000000000000000000000000000000000000000000002691833377771982,
-                                        ),
-                                        t5,
-                                        T::mul_add(
-                                            -T::from_f64(0.0002996756181716921),
-                                            t4,
-                                            T::mul_add(
-                                                qd[1],
-                                                qd[5],
-                                                T::mul_add(
-                                                    -qd[2],
-                                                    qd[4],
-                                                    T::mul_add(
-                                                        -T::from_f64(
-                                                            0.00000000000000000000000000000000000000000000000000000000020756991446649568,
-                                                        ),
-                                                        t1 + t2,
-                                                        T::from_f64(19.62) * (t3 - t0),
-                                                    ),
-                                                ),
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
+                    t13,
+                    T::mul_add(-T::from_f64(0.015044481298336118), t12, t10),
+                )),
+            );
+            let t16 = T::mul_add(
+                T::from_f64(
+                    0.00000000000000000000000000000000000000000005851811690808657,
                 ),
+                t15,
+                T::from_f64(0.6514687882111966) * t14,
+            );
+            let t17 = T::mul_add(
+                T::from_f64(0.00000000000000000000000000000000000000019527151557878547),
+                t15,
                 T::mul_add(
-                    T::from_f64(0.6514687882111966),
-                    tau[1],
-                    T::mul_add(
-                        -T::from_f64(
-                            0.00000000000000000000000000000000000000000005851811690808657,
-                        ),
-                        tau[0],
-                        T::mul_add(
-                            T::from_f64(0.0000000000000000000008811082238373757),
-                            t14 + tau[5] - t13,
-                            T::mul_add(
-                                T::from_f64(
-                                    0.00000000000000000000000000000000000000019527241185633233,
-                                ),
-                                tau[4] - t11 - t12,
-                                T::mul_add(
-                                    T::from_f64(0.009978052579226597),
-                                    t9 + t10 + tau[3],
-                                    T::mul_add(
-                                        -T::from_f64(0.0002996756425771504),
-                                        t5,
-                                        T::mul_add(
-                                            T::from_f64(
-                                                0.00000000000000000000000000000000000000000000002691833377771982,
-                                            ),
-                                            t4,
-                                            T::mul_add(
-                                                qd[2],
-                                                qd[3],
-                                                T::mul_add(
-                                                    -qd[0],
-                                                    qd[5],
-                                                    T::mul_add(
-                                                        -T::from_f64(19.62),
-                                                        t1 + t2,
-                                                        T::from_f64(
-                                                            0.00000000000000000000000000000000000000000000000000000000031861838222649046,
-                                                        ) * (t3 - t0),
-                                                    ),
-                                                ),
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
+                    T::from_f64(0.015316240409036846),
+                    t16,
+                    T::from_f64(33.296174802254015) * t13,
                 ),
-                T::mul_add(
-                    T::from_f64(0.6514657980456028),
-                    tau[2],
-                    T::mul_add(
-                        T::from_f64(0.00029967426710097723),
-                        T::mul_add(qd[4], qd[4], qd[3] * qd[3]),
-                        T::mul_add(
-                            T::from_f64(0.9999999999999999),
-                            T::mul_add(qd[0], qd[4], -qd[1] * qd[3]),
-                            T::mul_add(
-                                T::from_f64(19.62),
-                                T::mul_add(q[4], q[4], q[3] * q[3]),
-                                -T::from_f64(9.81),
-                            ),
-                        ),
-                    ),
-                ),
-                T::mul_add(
-                    T::from_f64(0.009978052579226597),
-                    tau[1],
-                    T::mul_add(
-                        -T::from_f64(
-                            0.00000000000000000000000000000000000000019527241185633233,
-                        ),
-                        tau[0],
-                        T::mul_add(
-                            T::from_f64(0.0000000000000000029402198338921116),
-                            t14 + tau[5] - t13,
-                            T::mul_add(
-                                T::from_f64(
-                                    0.0000000000000000000000000000000000006516155482597176,
-                                ),
-                                tau[4] - t11 - t12,
-                                T::mul_add(
-                                    T::from_f64(33.296327628506134),
-                                    t9 + t10 + tau[3],
-                                    T::mul_add(
-                                        -T::from_f64(0.000004589904186444234),
-                                        t5,
-                                        T::mul_add(
-                                            T::from_f64(
-                                                0.00000000000000000000000000000000000000000008982530945391287,
-                                            ),
-                                            t4,
-                                            -T::from_f64(0.00000000000000005551115123125783) * (t1 + t2),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
+            );
+            let t18 = T::mul_add(
+                T::from_f64(0.009801009202502908),
+                t15,
                 T::mul_add(
                     T::from_f64(
-                        0.00000000000000000000000000000000000000019527241185633237,
+                        0.000000000000000000000000000000000000019570104479921723,
                     ),
-                    tau[1],
-                    T::mul_add(
-                        -T::from_f64(0.009801009202502908),
-                        tau[0],
-                        T::mul_add(
-                            T::from_f64(0.0000000000000000038507342550793664),
-                            t14 + tau[5] - t13,
-                            T::mul_add(
-                                T::from_f64(32.7055415779173),
-                                tau[4] - t11 - t12,
-                                T::mul_add(
-                                    T::from_f64(
-                                        0.0000000000000000000000000000000000006516155482597176,
-                                    ),
-                                    t9 + t10 + tau[3],
-                                    T::mul_add(
-                                        -T::from_f64(
-                                            0.00000000000000000000000000000000000000000008982530945391287,
-                                        ),
-                                        t5,
-                                        T::mul_add(
-                                            T::from_f64(0.000004508464233151337),
-                                            t4,
-                                            -T::from_f64(
-                                                0.0000000000000000000000000000000000000000000000000000010863559066147548,
-                                            ) * (t1 + t2),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
+                    t17,
+                    T::from_f64(32.70539412681765) * t12,
                 ),
+            );
+            [
+                -T::from_f64(0.6514687351558525) * t15,
+                t16,
+                -T::from_f64(0.6514657980456028) * (t6 - tau[2]),
+                t17,
+                t18,
                 T::mul_add(
-                    T::from_f64(0.0000000000000000000008811082238373757),
-                    tau[1],
+                    T::from_f64(0.0000000000000000000883046282670191),
+                    t17,
                     T::mul_add(
-                        -T::from_f64(0.0000000000000000000011539659656915366),
-                        tau[0],
-                        T::mul_add(
-                            T::from_f64(17.3752840337681),
-                            t14 + tau[5] - t13,
-                            T::mul_add(
-                                T::from_f64(0.000000000000000003850734255079366),
-                                tau[4] - t11 - t12,
-                                T::mul_add(
-                                    T::from_f64(0.0000000000000000029402198338921116),
-                                    t9 + t10 + tau[3],
-                                    T::mul_add(
-                                        -T::from_f64(0.00000000000000000000000040530978296519276),
-                                        t5,
-                                        T::mul_add(
-                                            T::from_f64(0.00000000000000000000000053082434421810685),
-                                            t4,
-                                            -T::from_f64(
-                                                0.000000000000000000000000000000000004901891574150502,
-                                            ) * (t1 + t2),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
+                        T::from_f64(0.00000000000000000011773950435602546),
+                        t18,
+                        -T::from_f64(17.3752840337681) * t9,
                     ),
                 ),
                 T::from_f64(1.5349930795386022),
@@ -495,33 +434,34 @@ impl<T: ::eomgen_runtime::Lane> IrisSimple<T> {
     /// Operations: 18 mul, 11 add, 0 div, 0 sin, 0 cos.
     pub fn kinetic_energy(&self, q: &[T; 7], qd: &[T; 6]) -> T {
         let t0 = T::mul_add(
-            T::from_f64(0.5),
+            -qd[5],
             T::mul_add(
-                -qd[5],
+                -T::from_f64(0.057553016000000005),
+                qd[5],
                 T::mul_add(
-                    -T::from_f64(0.057553016000000005),
-                    qd[5],
-                    T::mul_add(
-                        T::from_f64(0.000000000000000000006776263578034403),
-                        qd[4],
-                        T::from_f64(0.000000000000000000005082197683525802) * qd[3],
-                    ),
-                ),
-                T::mul_add(
+                    T::from_f64(0.000000000000000000006776263578034403),
                     qd[4],
-                    T::mul_add(
-                        -T::from_f64(0.000000000000000000006776263578034403),
-                        qd[5],
-                        T::from_f64(0.030575996) * qd[4],
-                    ),
-                    qd[3]
-                        * (T::mul_add(
-                            -T::from_f64(0.000000000000000000005082197683525802),
-                            qd[5],
-                            T::from_f64(0.030033480000000005) * qd[3],
-                        )),
+                    T::from_f64(0.000000000000000000005082197683525802) * qd[3],
                 ),
             ),
+            T::mul_add(
+                qd[4],
+                T::mul_add(
+                    -T::from_f64(0.000000000000000000006776263578034403),
+                    qd[5],
+                    T::from_f64(0.030575996) * qd[4],
+                ),
+                qd[3]
+                    * (T::mul_add(
+                        -T::from_f64(0.000000000000000000005082197683525802),
+                        qd[5],
+                        T::from_f64(0.030033480000000005) * qd[3],
+                    )),
+            ),
+        );
+        let t1 = T::mul_add(
+            T::from_f64(0.5),
+            t0,
             T::mul_add(
                 T::from_f64(0.7674999999999997),
                 T::mul_add(qd[2], qd[2], T::mul_add(qd[1], qd[1], qd[0] * qd[0])),
@@ -529,7 +469,7 @@ impl<T: ::eomgen_runtime::Lane> IrisSimple<T> {
                     * (T::mul_add(qd[0], qd[4], -qd[1] * qd[3])),
             ),
         );
-        t0
+        t1
     }
     /// The generalized momentum p = M(q) qd = dT/dqd (a momentum observer's measurement).
     ///
@@ -549,21 +489,21 @@ impl<T: ::eomgen_runtime::Lane> IrisSimple<T> {
             ),
             T::from_f64(1.5349999999999995) * qd[2],
             T::mul_add(
-                -T::from_f64(0.000000000000000000005082197683525802),
-                qd[5],
+                -T::from_f64(0.00045999999999999996),
+                qd[1],
                 T::mul_add(
-                    T::from_f64(0.030033480000000005),
-                    qd[3],
-                    -T::from_f64(0.00045999999999999996) * qd[1],
+                    -T::from_f64(0.000000000000000000005082197683525802),
+                    qd[5],
+                    T::from_f64(0.030033480000000005) * qd[3],
                 ),
             ),
             T::mul_add(
-                -T::from_f64(0.000000000000000000006776263578034403),
-                qd[5],
+                T::from_f64(0.00045999999999999996),
+                qd[0],
                 T::mul_add(
-                    T::from_f64(0.030575996),
-                    qd[4],
-                    T::from_f64(0.00045999999999999996) * qd[0],
+                    -T::from_f64(0.000000000000000000006776263578034403),
+                    qd[5],
+                    T::from_f64(0.030575996) * qd[4],
                 ),
             ),
             T::mul_add(
@@ -580,17 +520,19 @@ impl<T: ::eomgen_runtime::Lane> IrisSimple<T> {
     /// The gravitational potential energy V = -sum m g.c, zero with every centre of mass at the origin.
     ///
     /// Route: centres of mass by forward kinematics.
-    /// Operations: 4 mul, 3 add, 0 div, 0 sin, 0 cos.
+    /// Operations: 5 mul, 3 add, 0 div, 0 sin, 0 cos.
     pub fn potential_energy(&self, q: &[T; 7]) -> T {
-        T::mul_add(
-            -T::from_f64(0.009025199999999999),
-            T::mul_add(q[4], q[4], q[3] * q[3]),
-            T::mul_add(
-                T::from_f64(15.058349999999995),
-                q[2],
-                T::from_f64(0.004512599999999999),
-            ),
-        )
+        let t0 = T::from_f64(9.81)
+            * (T::mul_add(
+                -T::from_f64(0.0009199999999999999),
+                T::mul_add(q[4], q[4], q[3] * q[3]),
+                T::mul_add(
+                    T::from_f64(1.5349999999999995),
+                    q[2],
+                    T::from_f64(0.00045999999999999996),
+                ),
+            ));
+        t0
     }
     /// The centre of mass of the moving bodies in world coordinates (a fixed root link, welded to the world, is not counted).
     ///
@@ -855,7 +797,7 @@ impl<T: ::eomgen_runtime::Lane> IrisSimple<T> {
     /// `computeCentroidalMomentumTimeVariation`, its `dhg`).
     ///
     /// Route: Newton-Euler without gravity gives the base's rows, the rate of the robot's momentum at the base origin in base axes, moved to the world and the centre of mass.
-    /// Operations: 86 mul, 69 add, 0 div, 0 sin, 0 cos.
+    /// Operations: 86 mul, 65 add, 0 div, 0 sin, 0 cos.
     pub fn centroidal_momentum_rate(
         &self,
         q: &[T; 7],
@@ -871,21 +813,17 @@ impl<T: ::eomgen_runtime::Lane> IrisSimple<T> {
         let t6 = q[3] * q[6];
         let t7 = q[4] * q[6];
         let t8 = q[5] * q[6];
-        let t9 = qd[2] * qd[4];
-        let t10 = qd[1] * qd[5];
-        let t11 = qd[0] * qd[5];
-        let t12 = qd[2] * qd[3];
-        let t13 = T::mul_add(
+        let t9 = T::mul_add(
             -T::from_f64(0.000000000000000000005082197683525802),
             qd[5],
             T::from_f64(0.030033480000000005) * qd[3],
         );
-        let t14 = T::mul_add(
+        let t10 = T::mul_add(
             -T::from_f64(0.000000000000000000006776263578034403),
             qd[5],
             T::from_f64(0.030575996) * qd[4],
         );
-        let t15 = T::mul_add(
+        let t11 = T::mul_add(
             -T::from_f64(0.057553016000000005),
             qd[5],
             T::mul_add(
@@ -894,42 +832,26 @@ impl<T: ::eomgen_runtime::Lane> IrisSimple<T> {
                 T::from_f64(0.000000000000000000005082197683525802) * qd[3],
             ),
         );
-        let t16 = T::from_f64(2.0) * (t3 - t8);
-        let t17 = T::from_f64(2.0) * (t4 + t7);
-        let t18 = T::from_f64(2.0) * (t3 + t8);
-        let t19 = T::from_f64(2.0) * (t5 - t6);
-        let t20 = T::from_f64(2.0) * (t4 - t7);
-        let t21 = T::from_f64(2.0) * (t5 + t6);
-        let t22 = T::mul_add(T::from_f64(2.0), t1 + t2, -T::one());
-        let t23 = T::mul_add(T::from_f64(2.0), t0 + t2, -T::one());
-        let t24 = T::mul_add(T::from_f64(2.0), t0 + t1, -T::one());
-        let t25 = T::mul_add(
-            T::from_f64(0.00045999999999999996),
-            T::mul_add(qd[3], qd[5], qdd[4]),
-            T::from_f64(1.5349999999999995) * (qdd[0] + t9 - t10),
-        );
-        let t26 = T::mul_add(
-            T::from_f64(0.00045999999999999996),
-            T::mul_add(qd[4], qd[5], -qdd[3]),
-            T::from_f64(1.5349999999999995) * (qdd[1] + t11 - t12),
-        );
-        let t27 = T::mul_add(
-            -T::from_f64(0.00045999999999999996),
-            T::mul_add(qd[4], qd[4], qd[3] * qd[3]),
-            T::from_f64(1.5349999999999995)
-                * (T::mul_add(-qd[0], qd[4], T::mul_add(qd[1], qd[3], qdd[2]))),
-        );
-        let t28 = T::mul_add(
+        let t12 = T::from_f64(2.0) * (t3 - t8);
+        let t13 = T::from_f64(2.0) * (t4 + t7);
+        let t14 = T::from_f64(2.0) * (t3 + t8);
+        let t15 = T::from_f64(2.0) * (t5 - t6);
+        let t16 = T::from_f64(2.0) * (t4 - t7);
+        let t17 = T::from_f64(2.0) * (t5 + t6);
+        let t18 = T::mul_add(T::from_f64(2.0), t1 + t2, -T::one());
+        let t19 = T::mul_add(T::from_f64(2.0), t0 + t2, -T::one());
+        let t20 = T::mul_add(T::from_f64(2.0), t0 + t1, -T::one());
+        let t21 = T::mul_add(
             -T::from_f64(0.0005993485342019545),
             t4 + t7,
             T::from_f64(0.00000000000000011102230246251565) * q[0],
         );
-        let t29 = T::mul_add(
+        let t22 = T::mul_add(
             T::from_f64(0.0005993485342019545),
             t6 - t5,
             T::from_f64(0.00000000000000011102230246251565) * q[1],
         );
-        let t30 = T::mul_add(
+        let t23 = T::mul_add(
             T::from_f64(0.0005993485342019545),
             t0 + t1,
             T::mul_add(
@@ -938,93 +860,66 @@ impl<T: ::eomgen_runtime::Lane> IrisSimple<T> {
                 -T::from_f64(0.00029967426710097723),
             ),
         );
-        let t31 = T::mul_add(
-            qd[3],
-            t15,
-            T::mul_add(
-                qd[5],
-                t13,
+        let t24 = qdd[0] + T::mul_add(-qd[1], qd[5], qd[2] * qd[4]);
+        let t25 = qdd[1] + T::mul_add(-qd[2], qd[3], qd[0] * qd[5]);
+        let t26 = qdd[2] + T::mul_add(-qd[0], qd[4], qd[1] * qd[3]);
+        let t27 = T::mul_add(-qd[4], t9, qd[3] * t10)
+            + T::mul_add(
+                T::from_f64(0.057553016000000005),
+                qdd[5],
                 T::mul_add(
                     -T::from_f64(0.000000000000000000006776263578034403),
-                    qdd[5],
-                    T::mul_add(
-                        T::from_f64(0.030575996),
-                        qdd[4],
-                        T::from_f64(0.00045999999999999996) * (qdd[0] + t9 - t10),
-                    ),
+                    qdd[4],
+                    -T::from_f64(0.000000000000000000005082197683525802) * qdd[3],
                 ),
-            ),
+            );
+        let t28 = T::mul_add(
+            T::from_f64(1.5349999999999995),
+            t24,
+            T::from_f64(0.00045999999999999996) * (T::mul_add(qd[3], qd[5], qdd[4])),
+        );
+        let t29 = T::mul_add(
+            T::from_f64(1.5349999999999995),
+            t26,
+            -T::from_f64(0.00045999999999999996)
+                * (T::mul_add(qd[4], qd[4], qd[3] * qd[3])),
+        );
+        let t30 = T::mul_add(
+            -T::from_f64(0.00045999999999999996),
+            t25,
+            T::mul_add(-qd[5], t10, -qd[4] * t11)
+                + T::mul_add(
+                    -T::from_f64(0.000000000000000000005082197683525802),
+                    qdd[5],
+                    T::from_f64(0.030033480000000005) * qdd[3],
+                ),
+        );
+        let t31 = T::mul_add(
+            T::from_f64(0.00045999999999999996),
+            t24,
+            T::mul_add(qd[3], t11, qd[5] * t9)
+                + T::mul_add(
+                    -T::from_f64(0.000000000000000000006776263578034403),
+                    qdd[5],
+                    T::from_f64(0.030575996) * qdd[4],
+                ),
         );
         let t32 = T::mul_add(
-            qd[5],
-            t14,
-            T::mul_add(
-                qd[4],
-                t15,
-                T::mul_add(
-                    T::from_f64(0.000000000000000000005082197683525802),
-                    qdd[5],
-                    T::mul_add(
-                        -T::from_f64(0.030033480000000005),
-                        qdd[3],
-                        T::from_f64(0.00045999999999999996) * (qdd[1] + t11 - t12),
-                    ),
-                ),
-            ),
+            -T::from_f64(1.5349999999999995),
+            t25,
+            T::from_f64(0.00045999999999999996) * (T::mul_add(-qd[4], qd[5], qdd[3])),
         );
-        let t33 = T::mul_add(
-            qd[4],
-            t13,
-            T::mul_add(
-                -qd[3],
-                t14,
-                T::mul_add(
-                    -T::from_f64(0.057553016000000005),
-                    qdd[5],
-                    T::mul_add(
-                        T::from_f64(0.000000000000000000006776263578034403),
-                        qdd[4],
-                        T::from_f64(0.000000000000000000005082197683525802) * qdd[3],
-                    ),
-                ),
-            ),
-        );
-        let t34 = T::mul_add(t17, t27, T::mul_add(t16, t26, -t22 * t25));
-        let t35 = T::mul_add(t19, t27, T::mul_add(-t23, t26, t18 * t25));
-        let t36 = T::mul_add(-t24, t27, T::mul_add(t21, t26, t20 * t25));
-        let t37 = -t34;
-        [
-            t34,
-            t35,
-            t36,
-            T::mul_add(
-                -t35,
-                t30,
-                T::mul_add(
-                    t36,
-                    t29,
-                    T::mul_add(-t17, t33, T::mul_add(t16, t31, t22 * t32)),
-                ),
-            ),
-            T::mul_add(
-                -t36,
-                t28,
-                T::mul_add(
-                    -t30,
-                    t37,
-                    T::mul_add(-t19, t33, T::mul_add(-t23, t31, -t18 * t32)),
-                ),
-            ),
-            T::mul_add(
-                t29,
-                t37,
-                T::mul_add(
-                    t35,
-                    t28,
-                    T::mul_add(t24, t33, T::mul_add(t21, t31, -t20 * t32)),
-                ),
-            ),
-        ]
+        let t33 = T::mul_add(t13, t29, T::mul_add(-t12, t32, -t18 * t28));
+        let t34 = T::mul_add(t15, t29, T::mul_add(t19, t32, t14 * t28));
+        let t35 = T::mul_add(-t20, t29, T::mul_add(-t17, t32, t16 * t28));
+        let t36 = -t33;
+        let t37 = T::mul_add(t13, t27, T::mul_add(t12, t31, -t18 * t30))
+            + T::mul_add(-t34, t23, t35 * t22);
+        let t38 = T::mul_add(t15, t27, T::mul_add(-t19, t31, t14 * t30))
+            + T::mul_add(-t35, t21, -t23 * t36);
+        let t39 = T::mul_add(-t20, t27, T::mul_add(t17, t31, t16 * t30))
+            + T::mul_add(t22, t36, t34 * t21);
+        [t33, t34, t35, t37, t38, t39]
     }
 }
 #[allow(
@@ -1400,45 +1295,41 @@ for IrisSimple<T> {
     /// The generalized gravity force G(q) = dV/dq.
     ///
     /// Route: Newton-Euler.
-    /// Operations: 11 mul, 6 add, 0 div, 0 sin, 0 cos.
+    /// Operations: 14 mul, 4 add, 0 div, 0 sin, 0 cos.
     fn gravity(&self, q: &[T; 7]) -> [T; 6] {
-        let t0 = q[3] * q[5];
-        let t1 = q[4] * q[5];
-        let t2 = q[3] * q[6];
-        let t3 = q[4] * q[6];
-        [
-            T::from_f64(30.11669999999999) * (t0 - t3),
-            T::from_f64(30.11669999999999) * (t1 + t2),
-            T::mul_add(
-                -T::from_f64(30.11669999999999),
+        let t0 = T::from_f64(2.0) * (T::mul_add(-q[4], q[6], q[3] * q[5]));
+        let t1 = T::from_f64(2.0) * (T::mul_add(q[3], q[6], q[4] * q[5]));
+        let t2 = -T::from_f64(15.058349999999995)
+            * (T::mul_add(
+                T::from_f64(2.0),
                 T::mul_add(q[4], q[4], q[3] * q[3]),
-                T::from_f64(15.058349999999995),
-            ),
-            -T::from_f64(0.009025199999999999) * (t1 + t2),
-            T::from_f64(0.009025199999999999) * (t0 - t3),
+                -T::one(),
+            ));
+        [
+            T::from_f64(15.058349999999995) * t0,
+            T::from_f64(15.058349999999995) * t1,
+            t2,
+            -T::from_f64(0.004512599999999999) * t1,
+            T::from_f64(0.004512599999999999) * t0,
             T::zero(),
         ]
     }
     /// The Coriolis and centrifugal effort b(q, qd) = C(q, qd) qd, without gravity.
     ///
     /// Route: Newton-Euler.
-    /// Operations: 31 mul, 18 add, 0 div, 0 sin, 0 cos.
+    /// Operations: 31 mul, 16 add, 0 div, 0 sin, 0 cos.
     fn bias(&self, q: &[T; 7], qd: &[T; 6]) -> [T; 6] {
-        let t0 = qd[2] * qd[4];
-        let t1 = qd[1] * qd[5];
-        let t2 = qd[0] * qd[5];
-        let t3 = qd[2] * qd[3];
-        let t4 = T::mul_add(
+        let t0 = T::mul_add(
             -T::from_f64(0.000000000000000000005082197683525802),
             qd[5],
             T::from_f64(0.030033480000000005) * qd[3],
         );
-        let t5 = T::mul_add(
+        let t1 = T::mul_add(
             -T::from_f64(0.000000000000000000006776263578034403),
             qd[5],
             T::from_f64(0.030575996) * qd[4],
         );
-        let t6 = T::mul_add(
+        let t2 = T::mul_add(
             -T::from_f64(0.057553016000000005),
             qd[5],
             T::mul_add(
@@ -1446,61 +1337,58 @@ for IrisSimple<T> {
                 qd[4],
                 T::from_f64(0.000000000000000000005082197683525802) * qd[3],
             ),
+        );
+        let t3 = T::mul_add(-qd[1], qd[5], qd[2] * qd[4]);
+        let t4 = T::mul_add(-qd[2], qd[3], qd[0] * qd[5]);
+        let t5 = T::mul_add(
+            T::from_f64(1.5349999999999995),
+            T::mul_add(-qd[0], qd[4], qd[1] * qd[3]),
+            -T::from_f64(0.00045999999999999996)
+                * (T::mul_add(qd[4], qd[4], qd[3] * qd[3])),
+        );
+        let t6 = T::mul_add(
+            -T::from_f64(0.00045999999999999996),
+            t4,
+            T::mul_add(-qd[5], t1, -qd[4] * t2),
+        );
+        let t7 = T::mul_add(
+            T::from_f64(0.00045999999999999996),
+            t3,
+            T::mul_add(qd[3], t2, qd[5] * t0),
         );
         [
             T::mul_add(
                 T::from_f64(0.00045999999999999996),
                 qd[3] * qd[5],
-                T::from_f64(1.5349999999999995) * (t0 - t1),
+                T::from_f64(1.5349999999999995) * t3,
             ),
             T::mul_add(
                 T::from_f64(0.00045999999999999996),
                 qd[4] * qd[5],
-                T::from_f64(1.5349999999999995) * (t2 - t3),
+                T::from_f64(1.5349999999999995) * t4,
             ),
-            T::mul_add(
-                -T::from_f64(0.00045999999999999996),
-                T::mul_add(qd[4], qd[4], qd[3] * qd[3]),
-                T::from_f64(1.5349999999999995)
-                    * (T::mul_add(-qd[0], qd[4], qd[1] * qd[3])),
-            ),
-            T::mul_add(
-                -qd[5],
-                t5,
-                T::mul_add(-qd[4], t6, T::from_f64(0.00045999999999999996) * (t3 - t2)),
-            ),
-            T::mul_add(
-                qd[3],
-                t6,
-                T::mul_add(qd[5], t4, T::from_f64(0.00045999999999999996) * (t0 - t1)),
-            ),
-            T::mul_add(-qd[4], t4, qd[3] * t5),
+            t5,
+            t6,
+            t7,
+            T::mul_add(-qd[4], t0, qd[3] * t1),
         ]
     }
     /// Inverse dynamics: tau = M(q) qdd + b(q, qd) + G(q).
     ///
     /// Route: Newton-Euler.
-    /// Operations: 49 mul, 43 add, 0 div, 0 sin, 0 cos.
+    /// Operations: 50 mul, 35 add, 0 div, 0 sin, 0 cos.
     fn inverse_dynamics(&self, q: &[T; 7], qd: &[T; 6], qdd: &[T; 6]) -> [T; 6] {
-        let t0 = q[3] * q[5];
-        let t1 = q[4] * q[5];
-        let t2 = q[3] * q[6];
-        let t3 = q[4] * q[6];
-        let t4 = qd[2] * qd[4];
-        let t5 = qd[1] * qd[5];
-        let t6 = qd[0] * qd[5];
-        let t7 = qd[2] * qd[3];
-        let t8 = T::mul_add(
+        let t0 = T::mul_add(
             -T::from_f64(0.000000000000000000005082197683525802),
             qd[5],
             T::from_f64(0.030033480000000005) * qd[3],
         );
-        let t9 = T::mul_add(
+        let t1 = T::mul_add(
             -T::from_f64(0.000000000000000000006776263578034403),
             qd[5],
             T::from_f64(0.030575996) * qd[4],
         );
-        let t10 = T::mul_add(
+        let t2 = T::mul_add(
             -T::from_f64(0.057553016000000005),
             qd[5],
             T::mul_add(
@@ -1509,97 +1397,72 @@ for IrisSimple<T> {
                 T::from_f64(0.000000000000000000005082197683525802) * qd[3],
             ),
         );
+        let t3 = T::mul_add(
+            T::from_f64(9.81),
+            T::from_f64(2.0) * (T::mul_add(-q[4], q[6], q[3] * q[5])),
+            qdd[0] + T::mul_add(-qd[1], qd[5], qd[2] * qd[4]),
+        );
+        let t4 = T::mul_add(
+            T::from_f64(9.81),
+            T::from_f64(2.0) * (T::mul_add(q[3], q[6], q[4] * q[5])),
+            qdd[1] + T::mul_add(-qd[2], qd[3], qd[0] * qd[5]),
+        );
+        let t5 = T::mul_add(
+            -T::from_f64(9.81),
+            T::mul_add(T::from_f64(2.0), T::mul_add(q[4], q[4], q[3] * q[3]), -T::one()),
+            qdd[2] + T::mul_add(-qd[0], qd[4], qd[1] * qd[3]),
+        );
+        let t6 = T::mul_add(
+            T::from_f64(1.5349999999999995),
+            t5,
+            -T::from_f64(0.00045999999999999996)
+                * (T::mul_add(qd[4], qd[4], qd[3] * qd[3])),
+        );
+        let t7 = T::mul_add(
+            -T::from_f64(0.00045999999999999996),
+            t4,
+            T::mul_add(-qd[5], t1, -qd[4] * t2)
+                + T::mul_add(
+                    -T::from_f64(0.000000000000000000005082197683525802),
+                    qdd[5],
+                    T::from_f64(0.030033480000000005) * qdd[3],
+                ),
+        );
+        let t8 = T::mul_add(
+            T::from_f64(0.00045999999999999996),
+            t3,
+            T::mul_add(qd[3], t2, qd[5] * t0)
+                + T::mul_add(
+                    -T::from_f64(0.000000000000000000006776263578034403),
+                    qdd[5],
+                    T::from_f64(0.030575996) * qdd[4],
+                ),
+        );
+        let t9 = T::mul_add(-qd[4], t0, qd[3] * t1)
+            + T::mul_add(
+                T::from_f64(0.057553016000000005),
+                qdd[5],
+                T::mul_add(
+                    -T::from_f64(0.000000000000000000006776263578034403),
+                    qdd[4],
+                    -T::from_f64(0.000000000000000000005082197683525802) * qdd[3],
+                ),
+            );
         [
             T::mul_add(
-                T::from_f64(30.11669999999999),
-                t0 - t3,
-                T::mul_add(
-                    T::from_f64(0.00045999999999999996),
-                    T::mul_add(qd[3], qd[5], qdd[4]),
-                    T::from_f64(1.5349999999999995) * (qdd[0] + t4 - t5),
-                ),
+                T::from_f64(1.5349999999999995),
+                t3,
+                T::from_f64(0.00045999999999999996) * (T::mul_add(qd[3], qd[5], qdd[4])),
             ),
             T::mul_add(
-                T::from_f64(30.11669999999999),
-                t1 + t2,
-                T::mul_add(
-                    T::from_f64(0.00045999999999999996),
-                    T::mul_add(qd[4], qd[5], -qdd[3]),
-                    T::from_f64(1.5349999999999995) * (qdd[1] + t6 - t7),
-                ),
+                T::from_f64(1.5349999999999995),
+                t4,
+                T::from_f64(0.00045999999999999996) * (T::mul_add(qd[4], qd[5], -qdd[3])),
             ),
-            T::mul_add(
-                -T::from_f64(0.00045999999999999996),
-                T::mul_add(qd[4], qd[4], qd[3] * qd[3]),
-                T::mul_add(
-                    -T::from_f64(30.11669999999999),
-                    T::mul_add(q[4], q[4], q[3] * q[3]),
-                    T::mul_add(
-                        T::from_f64(1.5349999999999995),
-                        T::mul_add(-qd[0], qd[4], T::mul_add(qd[1], qd[3], qdd[2])),
-                        T::from_f64(15.058349999999995),
-                    ),
-                ),
-            ),
-            T::mul_add(
-                -qd[5],
-                t9,
-                T::mul_add(
-                    -qd[4],
-                    t10,
-                    T::mul_add(
-                        -T::from_f64(0.009025199999999999),
-                        t1 + t2,
-                        T::mul_add(
-                            -T::from_f64(0.000000000000000000005082197683525802),
-                            qdd[5],
-                            T::mul_add(
-                                T::from_f64(0.030033480000000005),
-                                qdd[3],
-                                T::from_f64(0.00045999999999999996) * (t7 - qdd[1] - t6),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
-            T::mul_add(
-                qd[3],
-                t10,
-                T::mul_add(
-                    qd[5],
-                    t8,
-                    T::mul_add(
-                        T::from_f64(0.009025199999999999),
-                        t0 - t3,
-                        T::mul_add(
-                            -T::from_f64(0.000000000000000000006776263578034403),
-                            qdd[5],
-                            T::mul_add(
-                                T::from_f64(0.030575996),
-                                qdd[4],
-                                T::from_f64(0.00045999999999999996) * (qdd[0] + t4 - t5),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
-            T::mul_add(
-                -qd[4],
-                t8,
-                T::mul_add(
-                    qd[3],
-                    t9,
-                    T::mul_add(
-                        T::from_f64(0.057553016000000005),
-                        qdd[5],
-                        T::mul_add(
-                            -T::from_f64(0.000000000000000000006776263578034403),
-                            qdd[4],
-                            -T::from_f64(0.000000000000000000005082197683525802) * qdd[3],
-                        ),
-                    ),
-                ),
-            ),
+            t6,
+            t7,
+            t8,
+            t9,
         ]
     }
     /// Forward dynamics: qdd = M(q)^-1 (tau - b(q, qd) - G(q)).
@@ -1608,7 +1471,7 @@ for IrisSimple<T> {
     /// model and finite inputs); `try_forward_dynamics` says which pivot failed.
     ///
     /// Route: M and b + G as in `mass_matrix` and `bias`, then an unrolled L^T D L solve without fill-in.
-    /// Operations: 75 mul, 89 add, 0 div, 0 sin, 0 cos.
+    /// Operations: 63 mul, 43 add, 0 div, 0 sin, 0 cos.
     fn forward_dynamics(&self, q: &[T; 7], qd: &[T; 6], tau: &[T; 6]) -> [T; 6] {
         match self.forward_dynamics_checked(q, qd, tau) {
             Ok((qdd, failures)) => ::eomgen_runtime::lane::nan_failed(qdd, &failures),

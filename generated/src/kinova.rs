@@ -258,160 +258,153 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                     T::from_f64(0.004705147001603182) * t8,
                 );
                 let t15 = T::mul_add(
+                    -T::from_f64(0.000000000000000000006709516445275485),
+                    t9,
+                    T::from_f64(0.000014022756617410007) * t8,
+                );
+                let t16 = T::mul_add(
                     -T::from_f64(0.00010000000000000503),
                     t9,
                     T::from_f64(0.00000000000000000010842021724855044) * t8,
                 );
-                let t16 = T::mul_add(
-                    -T::from_f64(0.000024397756617410526),
-                    t9,
-                    T::from_f64(0.000000000000000000004539081094261623) * t8,
-                );
-                let t17 = T::mul_add(
-                    T::from_f64(0.000000000000000000004539081094261623),
-                    t9,
+                let t17 = qd[0] * t1;
+                let t18 = qd[0] * qd[1] * t1;
+                let t19 = qd[0] * qd[1] * t0;
+                let t20 = qd[0] * qd[0] * t0 * t1;
+                let t21 = qd[0] * qd[0] * t0 * t0;
+                let t22 = T::mul_add(
+                    T::from_f64(0.10375),
+                    t16,
                     T::mul_add(
-                        T::from_f64(0.000024397756617410526),
-                        t8,
-                        -T::from_f64(0.00006575368432434527),
-                    ),
-                );
-                let t18 = T::mul_add(
-                    T::from_f64(0.00000000000000000010842021724855044),
-                    t9,
-                    T::mul_add(
-                        T::from_f64(0.00010000000000000503),
-                        t8,
-                        T::from_f64(0.000013249995099999913),
-                    ),
-                );
-                let t19 = qd[0] * t1;
-                let t20 = qd[0] * qd[1] * t1;
-                let t21 = qd[0] * qd[1] * t0;
-                let t22 = qd[0] * qd[0] * t0 * t1;
-                let t23 = qd[0] * qd[0] * t0 * t0;
-                let t24 = T::mul_add(
-                    T::from_f64(0.000000000000000005836962631488729),
-                    t9,
-                    T::from_f64(0.03137392584768259) * t8,
-                );
-                let t25 = t8
-                    * (T::mul_add(
-                        T::from_f64(0.0000000000000006979729257032011),
+                        -T::from_f64(0.000014022756617410007),
                         t9,
-                        T::from_f64(0.004894691391055498) * t8,
-                    ));
-                let t26 = t9
-                    * (T::mul_add(
+                        -T::from_f64(0.000000000000000000006709516445275485) * t8,
+                    ),
+                );
+                let t23 = t12 + T::from_f64(0.000013249995099999913);
+                let t24 = T::mul_add(
+                    -T::from_f64(0.10375),
+                    t16,
+                    T::mul_add(
+                        T::from_f64(0.000014022756617410007),
+                        t9,
+                        T::from_f64(0.000000000000000000006709516445275485) * t8,
+                    ),
+                );
+                let t25 = T::mul_add(T::from_f64(0.10375), t12, t15);
+                let t26 = T::mul_add(
+                    T::from_f64(0.00204435),
+                    t17,
+                    T::from_f64(0.05271803549099999) * qd[1],
+                );
+                let t27 = T::mul_add(
+                    T::from_f64(0.0008910000000000028),
+                    t17,
+                    T::from_f64(0.00204435) * qd[1],
+                );
+                let t28 = T::mul_add(-qd[0], t1 * t2, qd[0] * t0 * t3);
+                let t29 = T::mul_add(T::from_f64(0.82), t18, T::from_f64(0.0016) * t10);
+                let t30 = T::mul_add(qd[0], t1 * t3, qd[0] * t0 * t2);
+                let t31 = T::mul_add(-T::from_f64(0.41), t20, T::from_f64(9.81) * t0);
+                let t32 = T::mul_add(
+                    T::from_f64(1285.9348644085492),
+                    t15,
+                    T::from_f64(133.41574218238696) * t12,
+                );
+                let t33 = T::mul_add(
+                    t9,
+                    T::mul_add(
                         T::from_f64(0.004705147001603182),
                         t9,
                         T::from_f64(0.0000000000000006979729257032011) * t8,
-                    ));
-                let t27 = t7 * t15;
-                let t28 = t6 * t15;
-                let t29 = t6 * t16;
-                let t30 = t7 * t16;
-                let t31 = t7 * t17;
-                let t32 = t4 * t7 * t12;
-                let t33 = t5 * t15;
+                    ),
+                    t8
+                        * (T::mul_add(
+                            T::from_f64(0.0000000000000006979729257032011),
+                            t9,
+                            T::from_f64(0.004894691391055498) * t8,
+                        )),
+                );
                 let t34 = T::mul_add(
-                    T::from_f64(0.00204435),
-                    t19,
-                    T::from_f64(0.05271803549099999) * qd[1],
-                );
-                let t35 = T::mul_add(
-                    T::from_f64(0.0008910000000000028),
-                    t19,
-                    T::from_f64(0.00204435) * qd[1],
-                );
-                let t36 = T::mul_add(-qd[0], t1 * t2, qd[0] * t0 * t3);
-                let t37 = T::mul_add(qd[0], t1 * t3, qd[0] * t0 * t2);
-                let t38 = T::mul_add(-T::from_f64(0.41), t22, T::from_f64(9.81) * t0);
-                let t39 = T::mul_add(
-                    T::from_f64(0.41),
-                    T::mul_add(qd[1], qd[1], t23),
-                    T::from_f64(9.81) * t1,
-                );
-                let t40 = T::mul_add(T::from_f64(0.1948923726334637), t6, t27);
-                let t41 = T::mul_add(T::from_f64(0.1948923726334637), t7, -t28);
-                let t42 = T::mul_add(
-                    -t8,
-                    t14,
-                    T::mul_add(t9, t13, -T::from_f64(0.026156895147716352)),
-                );
-                let t43 = T::mul_add(t9, t14, t8 * t13);
-                let t44 = T::mul_add(T::from_f64(0.0008740216642230976), t6, -t30);
-                let t45 = T::mul_add(
-                    -T::from_f64(0.2075),
-                    t28,
-                    T::mul_add(
-                        T::from_f64(0.04044016732144372),
-                        t7,
-                        -t25 - t26 - T::from_f64(0.04401578389602839),
-                    ),
-                );
-                let t46 = T::mul_add(
-                    T::from_f64(0.1948923726334637),
-                    t7,
-                    -t28 - T::from_f64(0.6402493299819001),
-                );
-                let t47 = T::mul_add(
                     -T::from_f64(0.10375),
-                    t28,
+                    t12,
                     T::mul_add(
-                        T::from_f64(0.02022008366072186),
-                        t7,
-                        -t25 - t26 - T::from_f64(0.02615311784766557),
-                    ),
-                );
-                let t48 = T::mul_add(
-                    -T::from_f64(0.10375),
-                    t7 * t12,
-                    T::mul_add(
-                        T::from_f64(0.000000000000000000004539081094261623),
+                        T::from_f64(0.000000000000000000006709516445275485),
                         t9,
-                        T::from_f64(0.000024397756617410526) * t8,
+                        -T::from_f64(0.000014022756617410007) * t8,
                     ),
+                ) + T::from_f64(0.00006575368432434527);
+                let t35 = T::mul_add(t7, t16, T::from_f64(0.1948923726334637) * t6);
+                let t36 = T::mul_add(-t6, t16, T::from_f64(0.1948923726334637) * t7);
+                let t37 = t6 * t22;
+                let t38 = T::mul_add(t9, t14, t8 * t13);
+                let t39 = t7 * t22;
+                let t40 = t6 * t24;
+                let t41 = T::mul_add(-T::from_f64(0.10375), t7 * t12, t25);
+                let t42 = T::mul_add(-t5, t16, t4 * t7 * t12);
+                let t43 = T::mul_add(t4, t16, t5 * t7 * t12);
+                let t44 = T::mul_add(
+                    T::from_f64(0.054780300000000004),
+                    t11,
+                    T::from_f64(0.00581618) * t30,
+                );
+                let t45 = t28 * t30;
+                let t46 = t28 * t11;
+                let t47 = t28 * t28;
+                let t48 = T::mul_add(
+                    T::from_f64(0.0058574286190799995),
+                    t11,
+                    T::from_f64(0.00047111058) * t30,
                 );
                 let t49 = T::mul_add(
-                    -T::from_f64(0.000010375000000000522),
-                    t9,
-                    T::mul_add(
-                        T::from_f64(0.000000000000000000011248597539537108),
-                        t8,
-                        T::mul_add(T::from_f64(0.0007776443641723163), t6, -t30),
-                    ),
-                );
-                let t50 = T::mul_add(T::from_f64(0.0007776443641723163), t7, t29);
-                let t51 = T::mul_add(t4, t15, t5 * t7 * t12);
-                let t52 = T::mul_add(
-                    T::from_f64(0.00581618),
-                    t37,
-                    T::from_f64(0.054780300000000004) * t11,
-                );
-                let t53 = T::from_f64(0.00581618) * t36;
-                let t54 = T::from_f64(0.054780300000000004) * t36;
-                let t55 = T::from_f64(0.00590744776708) * t36;
-                let t56 = T::mul_add(
                     T::from_f64(0.00047111058),
-                    t37,
-                    T::from_f64(0.0058574286190799995) * t11,
+                    t11,
+                    T::from_f64(0.00035435414799999976) * t30,
                 );
-                let t57 = T::mul_add(
-                    T::from_f64(0.00035435414799999976),
-                    t37,
-                    T::from_f64(0.00047111058) * t11,
+                let t50 = T::mul_add(
+                    T::from_f64(0.2073),
+                    t11,
+                    T::from_f64(0.0114) * t30,
                 );
-                let t58 = T::mul_add(
-                    T::from_f64(0.0114),
-                    t37,
-                    T::from_f64(0.2073) * t11,
+                let t51 = qd[3] + t30;
+                let t52 = T::mul_add(
+                    T::from_f64(9.81),
+                    t1,
+                    T::from_f64(0.41) * (T::mul_add(qd[1], qd[1], t21)),
                 );
-                let t59 = T::from_f64(0.0114) * t36;
-                let t60 = T::from_f64(0.2073) * t36;
-                let t61 = t37 + qd[3];
-                let t62 = t3 * t38;
-                let t63 = t2 * t39;
+                let t53 = T::mul_add(t8, t14, -t9 * t13)
+                    + T::from_f64(0.026156895147716352);
+                let t54 = T::mul_add(T::from_f64(0.0008740216642230976), t6, -t39);
+                let t55 = t36 - T::from_f64(0.6402493299819001);
+                let t56 = T::mul_add(
+                    -T::from_f64(0.10375),
+                    t36,
+                    t33 + T::from_f64(0.02615311784766557),
+                );
+                let t57 = t5 * t36;
+                let t58 = t4 * t36;
+                let t59 = T::mul_add(T::from_f64(0.0007776443641723163), t7, -t40);
+                let t60 = T::mul_add(
+                    T::from_f64(0.20443499999999998),
+                    t21,
+                    qd[1]
+                        * (T::mul_add(
+                            T::from_f64(0.0099),
+                            t17,
+                            T::from_f64(0.20443499999999998) * qd[1],
+                        )),
+                );
+                let t61 = T::mul_add(
+                    -qd[2],
+                    t30,
+                    T::mul_add(qd[0], qd[1] * t0 * t2, qd[0] * qd[1] * t1 * t3),
+                );
+                let t62 = T::mul_add(
+                    -qd[2],
+                    t28,
+                    T::mul_add(qd[0], qd[1] * t0 * t3, -qd[0] * qd[1] * t1 * t2),
+                );
+                let t63 = T::mul_add(t5, t11, t4 * t28);
                 (
                     t0,
                     t1,
@@ -545,150 +538,203 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                 t126,
                 t127,
             ) = {
-                let t64 = t2 * t38;
-                let t65 = t3 * t39;
-                let t66 = T::mul_add(
-                    -(T::mul_add(
-                        T::from_f64(0.000000000000000000004539081094261623),
-                        t9,
-                        T::from_f64(0.000024397756617410526) * t8,
-                    )),
-                    t24,
-                    t25 + t26 + T::from_f64(0.02615311784766557),
-                );
-                let t67 = T::mul_add(T::from_f64(1285.9348644085492), t29, t7);
-                let t68 = t6 * t43;
-                let t69 = t7 * (T::mul_add(T::from_f64(0.0008740216642230976), t7, t29));
-                let t70 = t5 * t41;
-                let t71 = t4 * t41;
-                let t72 = t5 * t47;
-                let t73 = t4 * t49;
-                let t74 = t5 * t48;
-                let t75 = T::mul_add(
-                    T::from_f64(0.0114),
-                    t51,
-                    T::mul_add(T::from_f64(0.0007776443641723163), t7, t29),
-                );
-                let t76 = T::mul_add(
-                    -qd[2],
-                    t37,
-                    T::mul_add(qd[0], qd[1] * t0 * t2, qd[0] * qd[1] * t1 * t3),
-                );
-                let t77 = T::mul_add(
-                    qd[2],
+                let t64 = T::mul_add(-t4, t11, t5 * t28);
+                let t65 = T::mul_add(-t25, t32, t33 + T::from_f64(0.02615311784766557));
+                let t66 = T::mul_add(-T::from_f64(1285.9348644085492), t40, t7);
+                let t67 = T::mul_add(t6, t34, t7 * t38);
+                let t68 = T::mul_add(t7, t34, -t6 * t38);
+                let t69 = T::mul_add(
+                    -T::from_f64(0.2075),
                     t36,
-                    T::mul_add(-qd[0], qd[1] * t0 * t3, qd[0] * qd[1] * t1 * t2),
+                    t33 + T::from_f64(0.04222386316016557),
+                ) + T::from_f64(0.0017919207358628258);
+                let t70 = T::mul_add(-t5, t23, -t4 * t35);
+                let t71 = T::mul_add(-t4, t23, t5 * t35);
+                let t72 = T::mul_add(t2, t35, t3 * t5 * t36);
+                let t73 = T::mul_add(
+                    T::from_f64(0.10375),
+                    t16,
+                    -(T::mul_add(-t7, t24, -T::from_f64(0.0007776443641723163) * t6)),
                 );
-                let t78 = t36 * t57;
-                let t79 = t37 * t55;
-                let t80 = T::mul_add(t5, t11, t4 * t36);
-                let t81 = t11 * t58;
-                let t82 = t36 * t60;
-                let t83 = T::mul_add(-t4, t11, t5 * t36);
-                let t84 = T::one() / t66;
-                let t85 = T::mul_add(t7, t42, t29);
-                let t86 = T::mul_add(-t6, t17, t7 * t43);
-                let t87 = T::mul_add(
-                    T::from_f64(0.000000000000000000011248597539537108),
-                    t9,
-                    T::mul_add(
-                        T::from_f64(0.000010375000000000522),
-                        t8,
-                        -t68 - t31 - T::from_f64(0.00006481854695392561),
-                    ),
+                let t74 = T::mul_add(T::from_f64(0.0114), t43, t59);
+                let t75 = T::mul_add(t2, t6 * t12, t3 * t43);
+                let t76 = T::mul_add(-t11, t50, -T::from_f64(0.2073) * t47);
+                let t77 = t63 * t64;
+                let t78 = t51 * t64;
+                let t79 = T::mul_add(
+                    T::from_f64(0.0013357060146000001),
+                    t51,
+                    T::from_f64(0.0250914799819) * t63,
                 );
-                let t88 = T::mul_add(-t4, t18, t5 * t40);
-                let t89 = T::mul_add(t5, t18, t4 * t40);
-                let t90 = T::mul_add(T::from_f64(0.0114), t70, t68 + t31);
-                let t91 = T::mul_add(t2, t40, t3 * t5 * t41);
-                let t92 = T::mul_add(
-                    t4,
-                    t48,
-                    T::mul_add(
-                        t5,
-                        t49,
-                        T::mul_add(
-                            T::from_f64(0.2073),
-                            t33 - t32,
-                            T::from_f64(0.0114) * t6 * t12,
-                        ),
-                    ),
-                );
-                let t93 = T::mul_add(T::from_f64(0.2073), t51, t73 - t74);
-                let t94 = T::mul_add(t2, t6 * t12, t3 * t51);
-                let t95 = T::mul_add(
-                    -t37,
-                    t58,
-                    T::mul_add(
-                        -t36,
-                        t59,
-                        T::mul_add(
-                            -T::from_f64(0.2073),
-                            t76,
-                            T::mul_add(T::from_f64(0.82), t20, T::from_f64(0.0016) * t10),
-                        ),
-                    ),
-                );
-                let t96 = T::from_f64(0.0250914799819) * t83;
-                let t97 = T::from_f64(0.0013357060146000001) * t83;
-                let t98 = T::mul_add(
-                    T::from_f64(0.0250914799819),
-                    t80,
-                    T::from_f64(0.0013357060146000001) * t61,
-                );
-                let t99 = T::mul_add(
-                    T::from_f64(0.0017919207358628258),
-                    t80,
-                    T::from_f64(0.00007238626506919941) * t61,
-                );
-                let t100 = T::mul_add(
+                let t80 = t64 * t64;
+                let t81 = T::mul_add(
                     T::from_f64(0.00007238626506919941),
-                    t80,
-                    T::from_f64(0.00009645337053442467) * t61,
+                    t51,
+                    T::from_f64(0.0017919207358628258) * t63,
                 );
-                let t101 = T::from_f64(0.0017957741063972504) * t83;
-                let t102 = t7 * t77;
-                let t103 = T::from_f64(0.10375) * t83;
-                let t104 = T::from_f64(0.10375) * t80;
-                let t105 = t80 + qd[4];
-                let t106 = T::mul_add(
-                    t11,
-                    t59,
+                let t82 = T::mul_add(
+                    T::from_f64(0.00009645337053442467),
+                    t51,
+                    T::from_f64(0.00007238626506919941) * t63,
+                );
+                let t83 = t63 * t51;
+                let t84 = qd[4] + t63;
+                let t85 = T::mul_add(
+                    -T::from_f64(0.05281703549099999),
+                    t18,
+                    T::mul_add(qd[1], t27, -qd[0] * t1 * t26)
+                        + T::mul_add(
+                            -T::from_f64(0.000327096),
+                            t10,
+                            T::from_f64(0.09711900000000001) * t1,
+                        ),
+                );
+                let t86 = T::mul_add(
+                    T::from_f64(0.0008910000000000028),
+                    t19,
                     T::mul_add(
-                        -t37,
-                        t60,
-                        T::mul_add(T::from_f64(0.0114), t77, t63 - t62),
+                        -T::from_f64(0.09711900000000001),
+                        t0,
+                        T::mul_add(
+                            qd[0],
+                            t0 * t26,
+                            -T::from_f64(0.05281703549099999) * t19,
+                        ),
                     ),
                 );
-                let t107 = T::mul_add(
-                    T::from_f64(1285.9348644085492),
-                    t73 - t74,
-                    T::from_f64(266.5742973918923) * t51,
+                let t87 = T::mul_add(
+                    -T::from_f64(0.00204435),
+                    t19,
+                    T::mul_add(
+                        T::from_f64(2.00550735),
+                        t0,
+                        T::mul_add(
+                            qd[0],
+                            t0 * t27,
+                            -T::from_f64(0.05281703549099999) * t20,
+                        ),
+                    ),
                 );
-                let t108 = T::mul_add(-t50, t24, t68 + t31);
-                let t109 = t6 * (T::mul_add(-t6, t42, t30));
-                let t110 = t4 * t86;
-                let t111 = t5 * t86;
-                let t112 = t5 * t87;
-                let t113 = T::mul_add(
-                    -T::from_f64(0.41),
+                let t88 = T::mul_add(t2, t52, -t3 * t31);
+                let t89 = T::mul_add(t3, t52, t2 * t31);
+                let t90 = T::one() / t65;
+                let t91 = T::mul_add(t7, t53, -t37);
+                let t92 = t4 * t67;
+                let t93 = t5 * t67;
+                let t94 = -t70;
+                let t95 = T::mul_add(
+                    T::from_f64(0.054780300000000004),
+                    t61,
+                    T::mul_add(
+                        -T::from_f64(0.6763),
+                        t29,
+                        T::mul_add(t30, t44, T::from_f64(0.00581618) * t47),
+                    ),
+                );
+                let t96 = T::mul_add(
+                    T::from_f64(0.2073),
+                    t61,
+                    T::mul_add(-T::from_f64(0.82), t18, -T::from_f64(0.0016) * t10)
+                        + T::mul_add(t30, t50, T::from_f64(0.0114) * t47),
+                );
+                let t97 = T::mul_add(qd[3], t64, t4 * t61);
+                let t98 = T::mul_add(-qd[3], t63, t5 * t61);
+                let t99 = T::mul_add(t6, t51, t7 * t64);
+                let t100 = T::mul_add(-t7, t51, t6 * t64);
+                let t101 = -t88;
+                let t102 = T::mul_add(
+                    T::from_f64(0.6763),
+                    t89,
+                    T::mul_add(
+                        T::from_f64(0.00581618),
+                        t61,
+                        T::mul_add(-T::from_f64(0.054780300000000004), t47, -t11 * t44),
+                    ),
+                );
+                let t103 = T::mul_add(T::from_f64(0.0114), t61, t76 + t89);
+                let t104 = T::mul_add(
+                    T::from_f64(0.0114),
+                    t62,
+                    -(T::mul_add(T::from_f64(0.0114), t46, -T::from_f64(0.2073) * t45))
+                        - t88,
+                );
+                let t105 = T::mul_add(-t59, t32, -t68);
+                let t106 = T::mul_add(
+                    T::from_f64(0.10375),
+                    t12,
+                    t68 - T::from_f64(0.00013720481202312502),
+                ) + T::from_f64(0.00007238626506919941);
+                let t107 = T::mul_add(-t4, t69, t93);
+                let t108 = T::mul_add(
+                    T::from_f64(0.0114),
                     t94,
-                    T::mul_add(T::from_f64(0.2073), t51, t73 - t74),
+                    T::mul_add(
+                        -T::from_f64(0.2073),
+                        t36,
+                        T::from_f64(0.037311974675247876),
+                    ),
                 );
-                let t114 = t1 * t94;
-                let t115 = t0 * (T::mul_add(-t3, t6 * t12, t2 * t51));
-                let t116 = t4 * t95;
-                let t117 = t5 * t95;
-                let t118 = T::mul_add(qd[3], t83, t4 * t76);
-                let t119 = T::mul_add(-qd[3], t80, t5 * t76);
-                let t120 = t83 * t96;
-                let t121 = t80 * t98;
-                let t122 = t83 * t99;
-                let t123 = t80 * t101;
-                let t124 = T::mul_add(t6, t61, t7 * t83);
-                let t125 = t61 * t104;
-                let t126 = T::mul_add(-t7, t61, t6 * t83);
-                let t127 = T::from_f64(0.10375) * t105;
+                let t109 = T::mul_add(-t2, t55, t3 * t71);
+                let t110 = T::mul_add(-t3, t55, -t2 * t71);
+                let t111 = T::mul_add(-t5, t56, -t92);
+                let t112 = T::mul_add(T::from_f64(0.0114), t57, -t68);
+                let t113 = T::mul_add(t0, T::mul_add(-t3, t35, t2 * t5 * t36), t1 * t72);
+                let t114 = T::mul_add(-t5, t41, t4 * t73);
+                let t115 = T::mul_add(t0, T::mul_add(-t3, t6 * t12, t2 * t43), t1 * t75);
+                let t116 = t99 * t100;
+                let t117 = t99 * t84;
+                let t118 = T::mul_add(
+                    -T::from_f64(0.0013224560195000002),
+                    t100,
+                    T::from_f64(0.0230207699865) * t84,
+                );
+                let t119 = t99 * t99;
+                let t120 = T::mul_add(
+                    -T::from_f64(0.00009637730005078133),
+                    t100,
+                    T::from_f64(0.00006575368432434527) * t84,
+                );
+                let t121 = T::mul_add(
+                    -T::from_f64(0.00006575368432434527),
+                    t100,
+                    T::from_f64(0.0015767446734206029) * t84,
+                );
+                let t122 = qd[5] + t100;
+                let t123 = T::mul_add(
+                    T::from_f64(0.00590744776708),
+                    t61,
+                    T::mul_add(-t11, t49, t30 * t48)
+                        + T::mul_add(
+                            T::from_f64(0.00581618),
+                            t89,
+                            -T::from_f64(0.054780300000000004) * t29,
+                        ),
+                );
+                let t124 = T::mul_add(
+                    T::from_f64(0.00581618),
+                    t101,
+                    T::mul_add(
+                        T::from_f64(0.00035435414799999976),
+                        t62,
+                        T::mul_add(t28, t48, -T::from_f64(0.00590744776708) * t46),
+                    ),
+                );
+                let t125 = T::mul_add(
+                    T::from_f64(0.054780300000000004),
+                    t101,
+                    T::mul_add(
+                        T::from_f64(0.00047111058),
+                        t62,
+                        T::mul_add(-t28, t49, T::from_f64(0.00590744776708) * t45),
+                    ),
+                );
+                let t126 = T::from_f64(0.10375) * (T::mul_add(t63, t63, t80))
+                    + T::mul_add(-T::from_f64(0.0114), t61, -t76 - t89);
+                let t127 = T::mul_add(
+                    t7,
+                    T::mul_add(T::from_f64(0.0008740216642230976), t7, t37),
+                    t6 * (T::mul_add(t6, t53, t39)),
+                );
                 (
                     t64,
                     t65,
@@ -822,238 +868,264 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                 t190,
                 t191,
             ) = {
-                let t128 = t5 * t106;
-                let t129 = t4 * t106;
-                let t130 = T::mul_add(
-                    -T::from_f64(527.2332944075051),
-                    t94,
-                    T::mul_add(
-                        T::from_f64(1285.9348644085492),
-                        t73 - t74,
-                        T::from_f64(266.5742973918923) * t51,
-                    ),
-                );
-                let t131 = T::mul_add(
-                    t7,
-                    t44,
-                    T::mul_add(
-                        t6,
-                        t85,
-                        T::mul_add(
-                            T::from_f64(0.10375),
-                            t27,
-                            T::from_f64(0.02022008366072186) * t6,
-                        ),
-                    ),
-                );
-                let t132 = T::mul_add(
-                    -t6,
-                    t44,
-                    T::mul_add(
-                        t7,
-                        t85,
-                        T::mul_add(
-                            -T::from_f64(0.2075),
-                            t28,
-                            T::mul_add(
-                                T::from_f64(0.04044016732144372),
-                                t7,
-                                -T::from_f64(0.017866519418897248),
-                            ),
-                        ),
-                    ),
-                );
-                let t133 = T::mul_add(t4, t45, t111);
-                let t134 = T::mul_add(
-                    T::from_f64(0.0228),
-                    t89,
-                    t109 + t69 + T::from_f64(0.0007050092785344214),
-                );
-                let t135 = T::mul_add(-t2, t46, t3 * t88);
-                let t136 = T::mul_add(t3, t46, t2 * t88);
-                let t137 = T::mul_add(
-                    T::from_f64(0.0114),
-                    t89,
-                    t109 + t69 + T::from_f64(0.00009645337053442467),
-                );
-                let t138 = T::mul_add(
-                    -T::from_f64(0.2073),
-                    t71,
-                    T::mul_add(
-                        -t4,
-                        t47,
-                        T::mul_add(
-                            T::from_f64(0.0114),
-                            t27,
-                            T::mul_add(T::from_f64(0.0022217730480214863), t6, -t111),
-                        ),
-                    ),
-                );
-                let t139 = t6 * t119;
-                let t140 = qd[4] * t124;
-                let t141 = T::from_f64(0.0013224560195000002) * t124;
-                let t142 = T::from_f64(0.0230207699865) * t124;
-                let t143 = T::mul_add(
-                    -T::from_f64(0.0013224560195000002),
-                    t126,
-                    T::from_f64(0.0230207699865) * t105,
-                );
-                let t144 = T::from_f64(0.0015805219734713843) * t124;
-                let t145 = T::mul_add(
-                    -T::from_f64(0.00009637730005078133),
-                    t126,
-                    T::from_f64(0.00006575368432434527) * t105,
-                );
-                let t146 = T::mul_add(
-                    -T::from_f64(0.00006575368432434527),
-                    t126,
-                    T::from_f64(0.0015767446734206029) * t105,
-                );
-                let t147 = t8 * t118;
-                let t148 = t9 * t118;
-                let t149 = T::from_f64(0.10375) * t124;
-                let t150 = t105 * t127;
-                let t151 = t126 + qd[5];
-                let t152 = T::mul_add(
-                    -t61,
-                    t103,
-                    T::mul_add(T::from_f64(0.10375), t118, t128 - t116),
-                );
-                let t153 = T::mul_add(
-                    -t80,
-                    t104,
-                    T::mul_add(
-                        -t83,
-                        t103,
-                        T::mul_add(T::from_f64(0.0114), t76, t64 + t65 - t81 - t82),
-                    ),
-                );
-                let t154 = T::mul_add(
-                    -t84,
-                    t108 * t108,
-                    T::mul_add(
-                        -t50,
-                        t67,
-                        t109 + t69 + T::from_f64(0.00009645337053442467),
-                    ),
-                );
-                let t155 = T::mul_add(
-                    -T::from_f64(0.2073),
-                    t70,
-                    T::mul_add(t93, t24, t110 - t72),
-                );
-                let t156 = t4 * t131;
-                let t157 = t5 * (T::mul_add(-t5, t45, t110));
-                let t158 = t0 * t135;
-                let t159 = t0
-                    * (T::mul_add(
-                        -t2,
-                        t75,
-                        T::mul_add(t3, t92, T::from_f64(0.41) * (t32 - t33)),
-                    ));
-                let t160 = t1 * (T::mul_add(t3, t75, t2 * t92));
-                let t161 = T::mul_add(-qd[4], t126, T::mul_add(t6, t77, t7 * t119));
-                let t162 = t124 * t141;
-                let t163 = t126 * t143;
-                let t164 = t124 * t145;
-                let t165 = t126 * t144;
-                let t166 = T::mul_add(-t9, t105, t8 * t124);
-                let t167 = t124 * t149;
-                let t168 = T::mul_add(t8, t105, t9 * t124);
-                let t169 = t7 * t152;
-                let t170 = t6 * t153;
-                let t171 = t6 * t152;
-                let t172 = t7 * t153;
-                let t173 = T::mul_add(
-                    T::from_f64(0.41),
-                    t91,
-                    T::mul_add(
+                let t128 = -t110;
+                let t129 = t0 * t109;
+                let t130 = T::mul_add(t4, t56, -t93)
+                    + T::mul_add(-T::from_f64(0.2073), t58, T::from_f64(0.0114) * t35);
+                let t131 = T::mul_add(t4, t41, t5 * t73)
+                    + T::mul_add(
                         -T::from_f64(0.2073),
-                        t70,
-                        T::mul_add(t113, t24, t110 - t72),
+                        t42,
+                        T::from_f64(0.0114) * t6 * t12,
+                    );
+                let t132 = T::mul_add(T::from_f64(0.2073), t43, t114);
+                let t133 = T::mul_add(-T::from_f64(0.2073), t43, -t114);
+                let t134 = T::mul_add(-t9, t84, t8 * t99);
+                let t135 = T::mul_add(t8, t84, t9 * t99);
+                let t136 = T::mul_add(t5, t104, -t4 * t96);
+                let t137 = T::mul_add(-t4, t104, -t5 * t96);
+                let t138 = T::mul_add(
+                    -T::from_f64(0.463),
+                    t103,
+                    T::mul_add(
+                        -T::from_f64(0.0013357060146000001),
+                        t98,
+                        T::mul_add(t63, t79, T::from_f64(0.0250914799819) * t80),
                     ),
                 );
-                let t174 = T::one() / t154;
-                let t175 = T::mul_add(t5, t132, t110);
-                let t176 = T::mul_add(
-                    -t4,
-                    t87,
-                    T::mul_add(t5, t131, T::from_f64(0.2073) * t88),
+                let t139 = T::mul_add(
+                    T::from_f64(266.5742973918923),
+                    t43,
+                    T::from_f64(1285.9348644085492) * t114,
                 );
-                let t177 = T::mul_add(
-                    -T::from_f64(0.2073),
-                    t89,
+                let t140 = T::mul_add(
+                    -T::from_f64(0.2075),
+                    t36,
+                    T::mul_add(t6, t54, t7 * t91) + T::from_f64(0.0160707453125),
+                );
+                let t141 = T::mul_add(
+                    T::from_f64(0.10375),
+                    t35,
+                    T::mul_add(t7, t54, -t6 * t91),
+                );
+                let t142 = T::mul_add(
+                    T::from_f64(0.0114),
+                    t94,
+                    t127 + T::from_f64(0.00009645337053442467),
+                );
+                let t143 = T::mul_add(T::from_f64(0.41), t75, t133);
+                let t144 = T::mul_add(-qd[4], t100, T::mul_add(-t6, t62, t7 * t98));
+                let t145 = T::mul_add(-qd[4], t99, T::mul_add(-t7, t62, -t6 * t98));
+                let t146 = T::mul_add(
+                    T::from_f64(0.00000000000000000010842021724855044),
+                    t135,
+                    T::from_f64(0.00010000000000000503) * t134,
+                );
+                let t147 = T::mul_add(
+                    T::from_f64(0.0650091026469637),
+                    t135,
+                    T::from_f64(0.00010000000000000503) * t122,
+                );
+                let t148 = T::mul_add(
+                    -T::from_f64(0.00000000000000000010842021724855044),
+                    t122,
+                    T::from_f64(0.0650091026469637) * t134,
+                );
+                let t149 = T::mul_add(
+                    -T::from_f64(0.004894691391055498),
+                    t135,
                     T::mul_add(
-                        -T::from_f64(0.0114),
-                        t28,
+                        -T::from_f64(0.000014022756617410007),
+                        t122,
+                        T::from_f64(0.0000000000000006979729257032011) * t134,
+                    ),
+                );
+                let t150 = T::mul_add(
+                    -T::from_f64(0.0000000000000006979729257032011),
+                    t135,
+                    T::mul_add(
+                        T::from_f64(0.000000000000000000006709516445275485),
+                        t122,
+                        T::from_f64(0.004705147001603182) * t134,
+                    ),
+                );
+                let t151 = T::mul_add(
+                    T::from_f64(0.000014022756617410007),
+                    t135,
+                    T::mul_add(
+                        T::from_f64(0.0007776443641723163),
+                        t122,
+                        T::from_f64(0.000000000000000000006709516445275485) * t134,
+                    ),
+                );
+                let t152 = -t136;
+                let t153 = -t137;
+                let t154 = T::mul_add(T::from_f64(0.10375), t97 - t78, -t136);
+                let t155 = T::mul_add(T::from_f64(0.10375), t98 + t83, -t137);
+                let t156 = T::mul_add(
+                    T::from_f64(1285.9348644085492),
+                    t133,
+                    T::from_f64(527.2332944075051) * t75,
+                );
+                let t157 = T::mul_add(
+                    -t90,
+                    t105 * t105,
+                    T::mul_add(-t59, t66, t127 + T::from_f64(0.00009645337053442467)),
+                );
+                let t158 = t140 + T::from_f64(0.0017957741063972504);
+                let t159 = T::mul_add(
+                    T::from_f64(2.0),
+                    t108,
+                    T::mul_add(
+                        T::from_f64(0.4146),
+                        t36,
+                        t127 - T::from_f64(0.07427329421996133),
+                    ),
+                ) + T::from_f64(0.00035435414799999976);
+                let t160 = T::mul_add(t1, t110 - T::from_f64(1.2836779999999999), t129);
+                let t161 = T::mul_add(
+                    -T::from_f64(0.463),
+                    t153,
+                    T::mul_add(
+                        -T::from_f64(0.0250914799819),
+                        t98,
+                        T::mul_add(-T::from_f64(0.0013357060146000001), t80, -t51 * t79),
+                    ),
+                );
+                let t162 = T::mul_add(
+                    T::from_f64(0.0250914799819),
+                    t152,
+                    T::mul_add(
+                        T::from_f64(0.0017919207358628258),
+                        t97,
+                        -T::from_f64(0.00007238626506919941) * t62,
+                    ) + T::mul_add(t64, t82, -T::from_f64(0.0017957741063972504) * t78),
+                );
+                let t163 = T::mul_add(
+                    T::from_f64(0.0013357060146000001),
+                    t152,
+                    T::mul_add(
+                        T::from_f64(0.00007238626506919941),
+                        t97,
+                        -T::from_f64(0.00009645337053442467) * t62,
+                    ) + T::mul_add(-t64, t81, T::from_f64(0.0017957741063972504) * t77),
+                );
+                let t164 = T::mul_add(
+                    -T::from_f64(0.463),
+                    t155,
+                    T::mul_add(
+                        T::from_f64(0.0230207699865),
+                        t144,
                         T::mul_add(
-                            T::from_f64(0.0022217730480214863),
-                            t7,
-                            -t156 - t112 - T::from_f64(0.007145457521793661),
+                            -t100,
+                            t118,
+                            T::from_f64(0.0013224560195000002) * t119,
                         ),
                     ),
                 );
-                let t178 = T::mul_add(T::from_f64(0.0016), t114 + t115, t159 - t160);
-                let t179 = t9 * t161;
-                let t180 = t8 * t161;
-                let t181 = qd[5] * t166;
-                let t182 = qd[5] * t168;
-                let t183 = T::mul_add(
-                    -T::from_f64(0.0650091026469637),
-                    t166,
-                    T::from_f64(0.00000000000000000010842021724855044) * t151,
+                let t165 = T::mul_add(
+                    T::from_f64(0.10375),
+                    T::mul_add(-t84, t100, t144),
+                    T::mul_add(-T::from_f64(0.10375), t98 + t83, t137),
                 );
-                let t184 = T::mul_add(
-                    T::from_f64(0.00010000000000000503),
-                    t166,
-                    T::from_f64(0.00000000000000000010842021724855044) * t168,
+                let t166 = T::mul_add(
+                    -t132,
+                    t32,
+                    T::mul_add(T::from_f64(0.2073), t57, t111),
                 );
+                let t167 = T::one() / t157;
+                let t168 = T::mul_add(t4, t106, -t5 * t141);
+                let t169 = T::mul_add(-t5, t106, -t4 * t141);
+                let t170 = T::mul_add(
+                    T::from_f64(0.41),
+                    t58,
+                    -(T::mul_add(t2, t112, -t3 * t130)),
+                );
+                let t171 = T::mul_add(
+                    T::from_f64(0.41),
+                    t42,
+                    -(T::mul_add(t2, t74, -t3 * t131)),
+                );
+                let t172 = T::mul_add(
+                    -T::from_f64(0.0017957741063972504),
+                    t98,
+                    T::mul_add(-t51, t81, t63 * t82)
+                        + T::mul_add(
+                            -T::from_f64(0.0250914799819),
+                            t153,
+                            -T::from_f64(0.0013357060146000001) * t103,
+                        ),
+                );
+                let t173 = T::mul_add(t6, t126, t7 * t154);
+                let t174 = T::mul_add(t7, t126, -t6 * t154);
+                let t175 = T::mul_add(
+                    -t143,
+                    t32,
+                    T::mul_add(
+                        T::from_f64(0.41),
+                        t72,
+                        T::mul_add(-T::from_f64(0.2073), t57, -t111),
+                    ),
+                );
+                let t176 = T::mul_add(t5, t158, -t92);
+                let t177 = T::mul_add(-T::from_f64(0.2073), t71, t168);
+                let t178 = T::mul_add(qd[5], t134, T::mul_add(-t8, t97, -t9 * t144));
+                let t179 = T::mul_add(qd[5], t135, T::mul_add(-t9, t97, t8 * t144));
+                let t180 = -t174;
+                let t181 = T::mul_add(
+                    -T::from_f64(0.0013224560195000002),
+                    t173,
+                    T::mul_add(
+                        T::from_f64(0.00009637730005078133),
+                        t145,
+                        T::from_f64(0.00006575368432434527) * t97,
+                    ) + T::mul_add(-t99, t121, T::from_f64(0.0015805219734713843) * t117),
+                );
+                let t182 = T::mul_add(
+                    -T::from_f64(0.0230207699865),
+                    t173,
+                    T::mul_add(
+                        T::from_f64(0.00006575368432434527),
+                        t145,
+                        T::from_f64(0.0015767446734206029) * t97,
+                    ) + T::mul_add(t99, t120, T::from_f64(0.0015805219734713843) * t116),
+                );
+                let t183 = -T::from_f64(0.10375) * (T::mul_add(t84, t84, t119)) + t174;
+                let t184 = T::mul_add(T::from_f64(0.10375), t97 + t116, -t173);
                 let t185 = T::mul_add(
-                    T::from_f64(0.0650091026469637),
-                    t168,
-                    T::from_f64(0.00010000000000000503) * t151,
+                    -T::from_f64(0.2073),
+                    t94,
+                    T::mul_add(t166, t90 * t105, T::mul_add(t132, t66, t169)),
                 );
-                let t186 = T::mul_add(
-                    T::from_f64(0.004705147001603182),
-                    t166,
-                    T::mul_add(
-                        -T::from_f64(0.0000000000000006979729257032011),
-                        t168,
-                        T::from_f64(0.000000000000000000006709516445275485) * t151,
-                    ),
-                );
-                let t187 = T::mul_add(
-                    T::from_f64(0.000000000000000000006709516445275485),
-                    t166,
-                    T::mul_add(
-                        T::from_f64(0.000014022756617410007),
-                        t168,
-                        T::from_f64(0.0007776443641723163) * t151,
-                    ),
-                );
-                let t188 = T::mul_add(
-                    -T::from_f64(0.0000000000000006979729257032011),
-                    t166,
-                    T::mul_add(
-                        T::from_f64(0.004894691391055498),
-                        t168,
-                        T::from_f64(0.000014022756617410007) * t151,
-                    ),
-                );
+                let t186 = T::mul_add(T::from_f64(0.2073), t71, -t168);
+                let t187 = T::mul_add(-t1, T::mul_add(t3, t112, t2 * t130), t0 * t170);
+                let t188 = T::mul_add(-t1, T::mul_add(t3, t74, t2 * t131), t0 * t171);
                 let t189 = T::mul_add(
-                    t126,
-                    t149,
-                    T::mul_add(T::from_f64(0.10375), t118, t170 - t169),
+                    -T::from_f64(0.463),
+                    t180,
+                    T::mul_add(
+                        T::from_f64(0.0013224560195000002),
+                        t144,
+                        T::mul_add(-T::from_f64(0.0230207699865), t119, -t84 * t118),
+                    ),
                 );
                 let t190 = T::mul_add(
-                    t126,
-                    t127,
-                    T::mul_add(T::from_f64(0.10375), t119 - t161, t125 - t117 - t129),
+                    -t175,
+                    t90 * t105,
+                    T::mul_add(
+                        -t143,
+                        t66,
+                        T::mul_add(
+                            T::from_f64(0.41),
+                            t3 * t94,
+                            -(T::mul_add(T::from_f64(0.2073), t94, -t169)),
+                        ),
+                    ),
                 );
                 let t191 = T::mul_add(
-                    T::from_f64(1285.9348644085492),
-                    t159 - t160,
-                    T::from_f64(2.0574957830536786) * (t114 + t115),
+                    t5,
+                    T::mul_add(t5, t69, t92),
+                    t4 * (T::mul_add(t4, t158, t93)),
                 );
                 (
                     t128,
@@ -1189,685 +1261,339 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                 t255,
             ) = {
                 let t192 = T::mul_add(
-                    t84,
-                    t108 * t155,
+                    T::from_f64(0.2073),
+                    t94,
                     T::mul_add(
-                        -t93,
-                        t67,
-                        T::mul_add(T::from_f64(0.2073), t89, t156 + t112),
+                        -T::from_f64(0.0114),
+                        t36,
+                        -t169 + T::from_f64(0.0066743469417936616),
                     ),
-                );
-                let t193 = t4 * (T::mul_add(-t4, t132, t111));
-                let t194 = t2 * t176;
-                let t195 = t3 * t176;
-                let t196 = t168 * t186;
-                let t197 = t166 * t188;
-                let t198 = t9 * t189;
-                let t199 = t8 * t190;
-                let t200 = t8 * t189;
-                let t201 = t9 * t190;
-                let t202 = T::mul_add(
-                    -T::from_f64(0.41),
-                    t3 * t89,
-                    T::mul_add(
-                        t173,
-                        t84 * t108,
-                        T::mul_add(
-                            -t113,
-                            t67,
-                            T::mul_add(T::from_f64(0.2073), t89, t156 + t112),
+                ) + T::from_f64(0.00047111058);
+                let t193 = t2 * t186;
+                let t194 = t3 * t186;
+                let t195 = T::mul_add(T::from_f64(0.0016), t115, t188);
+                let t196 = T::mul_add(
+                    T::from_f64(0.0015805219734713843),
+                    t144,
+                    T::mul_add(-t84, t120, -t100 * t121)
+                        + T::mul_add(
+                            -T::from_f64(0.0013224560195000002),
+                            t180,
+                            -T::from_f64(0.0230207699865) * t155,
                         ),
-                    ),
+                );
+                let t197 = T::mul_add(-t8, t165, t9 * t184);
+                let t198 = T::mul_add(t9, t165, t8 * t184);
+                let t199 = T::mul_add(
+                    T::from_f64(1.03),
+                    t183,
+                    -(T::mul_add(
+                        T::from_f64(0.00010000000000000503),
+                        t179,
+                        -T::from_f64(0.00000000000000000010842021724855044) * t178,
+                    )) - (T::mul_add(t134, t148, t135 * t147)),
+                );
+                let t200 = T::mul_add(
+                    T::from_f64(2.0574957830536786),
+                    t115,
+                    T::from_f64(1285.9348644085492) * t188,
+                );
+                let t201 = T::mul_add(
+                    T::from_f64(2.0),
+                    t108,
+                    T::mul_add(-t4, t107, t5 * t176) + T::from_f64(0.08430995700000002),
+                );
+                let t202 = T::mul_add(
+                    -T::from_f64(0.0114),
+                    t71,
+                    T::mul_add(t5, t107, t4 * t176),
                 );
                 let t203 = T::mul_add(
-                    t4,
-                    t133,
+                    T::from_f64(2.0),
+                    t108,
                     T::mul_add(
-                        t5,
-                        t175,
-                        T::mul_add(
-                            -T::from_f64(0.0228),
-                            t89,
-                            T::mul_add(
-                                -T::from_f64(0.4146),
-                                t28,
-                                T::mul_add(
-                                    T::from_f64(0.08080237769383405),
-                                    t7,
-                                    -T::from_f64(0.16484135411757578),
-                                ),
-                            ),
-                        ),
+                        -T::from_f64(0.0228),
+                        t94,
+                        t191 + T::from_f64(0.08405575524000002),
                     ),
                 );
-                let t204 = T::mul_add(
-                    -t5,
-                    t133,
-                    T::mul_add(t4, t175, T::from_f64(0.0114) * t88),
+                let t204 = T::mul_add(-t2, t159, t194);
+                let t205 = T::mul_add(
+                    T::from_f64(0.41),
+                    t71,
+                    -(T::mul_add(-t2, t142, -t3 * t177)),
                 );
-                let t205 = T::mul_add(-t2, t134, t195);
                 let t206 = T::mul_add(
                     T::from_f64(1.03),
-                    t198 + t199,
+                    t197,
                     T::mul_add(
-                        t151,
-                        t185,
-                        T::mul_add(
-                            t166,
-                            t184,
-                            T::mul_add(
-                                T::from_f64(0.0650091026469637),
-                                t148 - t180 - t182,
-                                T::from_f64(0.00000000000000000010842021724855044)
-                                    * (t139 + t140 - t102),
-                            ),
-                        ),
-                    ),
+                        -T::from_f64(0.0650091026469637),
+                        t179,
+                        -T::from_f64(0.00000000000000000010842021724855044) * t145,
+                    ) + T::mul_add(t122, t147, t134 * t146),
                 );
                 let t207 = T::mul_add(
-                    -T::from_f64(0.0650091026469637),
-                    t198 + t199,
+                    -T::from_f64(1.03),
+                    t198,
                     T::mul_add(
-                        t168,
-                        t187,
-                        T::mul_add(
-                            -t151,
-                            t188,
-                            T::mul_add(
-                                T::from_f64(0.00010000000000000503),
-                                t150 + t167 + t171 + t172,
-                                T::mul_add(
-                                    T::from_f64(0.004705147001603182),
-                                    t180 + t182 - t148,
-                                    T::mul_add(
-                                        T::from_f64(0.0000000000000006979729257032011),
-                                        t181 - t179 - t147,
-                                        T::from_f64(0.000000000000000000006709516445275485)
-                                            * (t139 + t140 - t102),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
+                        T::from_f64(0.0650091026469637),
+                        t178,
+                        T::from_f64(0.00010000000000000503) * t145,
+                    ) + T::mul_add(t135, t146, -t122 * t148),
                 );
-                let t208 = T::mul_add(
-                    T::from_f64(0.0650091026469637),
-                    t200 - t201,
-                    T::mul_add(
-                        t151,
-                        t186,
-                        T::mul_add(
-                            -t166,
-                            t187,
-                            T::mul_add(
-                                T::from_f64(0.00000000000000000010842021724855044),
-                                t150 + t167 + t171 + t172,
-                                T::mul_add(
-                                    T::from_f64(0.0000000000000006979729257032011),
-                                    t148 - t180 - t182,
-                                    T::mul_add(
-                                        T::from_f64(0.004894691391055498),
-                                        t179 + t147 - t181,
-                                        T::from_f64(0.000014022756617410007) * (t139 + t140 - t102),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                );
-                let t209 = T::mul_add(
-                    T::from_f64(1.03),
-                    t200 - t201,
-                    T::mul_add(
-                        -t168,
-                        t184,
-                        T::mul_add(
-                            -t151,
-                            t183,
-                            T::mul_add(
-                                T::from_f64(0.0650091026469637),
-                                t179 + t147 - t181,
-                                T::from_f64(0.00010000000000000503) * (t139 + t140 - t102),
-                            ),
-                        ),
-                    ),
-                );
+                let t208 = t189 + t199;
+                let t209 = t201 + T::from_f64(0.00590744776708);
                 let t210 = T::mul_add(
-                    -T::from_f64(1.493),
-                    t171 + t172,
+                    T::from_f64(0.0000000000000006979729257032011),
+                    t179,
                     T::mul_add(
-                        -T::from_f64(1.03),
-                        t150 + t167,
-                        T::mul_add(
-                            T::from_f64(0.00010000000000000503),
-                            t148 - t180 - t182,
-                            T::mul_add(
-                                T::from_f64(0.00000000000000000010842021724855044),
-                                t181 - t179 - t147,
-                                T::mul_add(
-                                    t166,
-                                    t183,
-                                    T::mul_add(
-                                        -t168,
-                                        t185,
-                                        T::mul_add(
-                                            -t124,
-                                            t142,
-                                            T::mul_add(
-                                                -t105,
-                                                t143,
-                                                T::from_f64(0.0013224560195000002) * t161,
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
+                        T::from_f64(0.004894691391055498),
+                        t178,
+                        T::from_f64(0.000014022756617410007) * t145,
                     ),
-                );
+                ) + T::mul_add(-t122, t150, t134 * t151)
+                    + T::mul_add(
+                        -T::from_f64(0.0650091026469637),
+                        t198,
+                        T::from_f64(0.00000000000000000010842021724855044) * t183,
+                    );
                 let t211 = T::mul_add(
-                    T::from_f64(0.00010000000000000503),
-                    t201 - t200,
+                    T::from_f64(0.004705147001603182),
+                    t179,
                     T::mul_add(
-                        -T::from_f64(0.00000000000000000010842021724855044),
-                        t198 + t199,
-                        T::mul_add(
-                            T::from_f64(0.0013224560195000002),
-                            t170 - t169,
-                            T::mul_add(
-                                T::from_f64(0.000000000000000000006709516445275485),
-                                t148 - t180 - t182,
-                                T::mul_add(
-                                    T::from_f64(0.000014022756617410007),
-                                    t181 - t179 - t147,
-                                    T::mul_add(
-                                        -t124,
-                                        t146,
-                                        T::mul_add(
-                                            t105,
-                                            t144,
-                                            T::mul_add(
-                                                T::from_f64(0.0008740216642230976),
-                                                t102 - t139 - t140,
-                                                T::mul_add(
-                                                    T::from_f64(0.00006575368432434527),
-                                                    t118,
-                                                    t196 - t197,
-                                                ),
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
+                        T::from_f64(0.0000000000000006979729257032011),
+                        t178,
+                        -T::from_f64(0.000000000000000000006709516445275485) * t145,
                     ),
-                );
+                ) + T::mul_add(t135, t151, t122 * t149)
+                    + T::mul_add(
+                        -T::from_f64(0.0650091026469637),
+                        t197,
+                        -T::from_f64(0.00010000000000000503) * t183,
+                    );
                 let t212 = T::mul_add(
-                    -t178,
-                    t24,
+                    T::from_f64(0.000000000000000000006709516445275485),
+                    t179,
                     T::mul_add(
-                        -t1,
-                        T::mul_add(t3, t90, t2 * t138),
-                        T::mul_add(
-                            t0,
-                            T::mul_add(
-                                -t2,
-                                t90,
-                                T::mul_add(t3, t138, T::from_f64(0.41) * t71),
-                            ),
-                            T::from_f64(0.0016)
-                                * (T::mul_add(
-                                    t0,
-                                    T::mul_add(-t3, t40, t2 * t5 * t41),
-                                    t1 * t91,
-                                )),
-                        ),
+                        -T::from_f64(0.000014022756617410007),
+                        t178,
+                        -T::from_f64(0.0007776443641723163) * t145,
                     ),
-                );
+                ) + T::mul_add(-t134, t149, -t135 * t150)
+                    + T::mul_add(
+                        T::from_f64(0.00010000000000000503),
+                        t198,
+                        T::from_f64(0.00000000000000000010842021724855044) * t197,
+                    );
                 let t213 = T::mul_add(
-                    -t174,
-                    t192 * t192,
-                    T::mul_add(
-                        -t84,
-                        t155 * t155,
-                        T::mul_add(
-                            -t93,
-                            t107,
-                            T::mul_add(
-                                T::from_f64(0.4146),
-                                t28,
-                                T::mul_add(
-                                    -T::from_f64(0.08080237769383405),
-                                    t7,
-                                    t193 + t157 + T::from_f64(0.16453713320957578),
-                                ),
-                            ),
-                        ),
-                    ),
+                    T::from_f64(0.0016),
+                    t113,
+                    T::mul_add(-t195, t32, t187),
                 );
                 let t214 = T::mul_add(
-                    T::from_f64(0.00010000000000000503),
-                    t200 - t201,
+                    -t185,
+                    t185 * t167,
                     T::mul_add(
-                        T::from_f64(0.00000000000000000010842021724855044),
-                        t198 + t199,
+                        -t166,
+                        t166 * t90,
                         T::mul_add(
-                            T::from_f64(0.000000000000000000006709516445275485),
-                            t180 + t182 - t148,
+                            -t132,
+                            t139,
+                            t203 + T::from_f64(0.0058574286190799995),
+                        ),
+                    ),
+                );
+                let t215 = T::mul_add(
+                    T::from_f64(0.41),
+                    t128,
+                    T::mul_add(
+                        -t185,
+                        t167 * t190,
+                        T::mul_add(
+                            t166,
+                            t175 * t90,
                             T::mul_add(
-                                T::from_f64(0.000014022756617410007),
-                                t179 + t147 - t181,
-                                T::mul_add(
-                                    T::from_f64(0.0007776443641723163),
-                                    t139 + t140 - t102,
-                                    t197 - t196 - tau[5],
-                                ),
+                                t143,
+                                t139,
+                                t203 + T::from_f64(0.0058574286190799995),
                             ),
                         ),
                     ),
                 );
-                let t215 = t9 * t206;
-                let t216 = t8 * t209;
-                let t217 = t8 * t206;
-                let t218 = t9 * t209;
-                let t219 = t8 * t208;
-                let t220 = t9 * t207;
-                let t221 = t6 * t210;
-                let t222 = t7 * t210;
-                let t223 = t7 * t211;
+                let t216 = T::mul_add(t3, t192, t2 * t202);
+                let t217 = T::mul_add(-t1, T::mul_add(-t3, t142, t2 * t177), t0 * t205);
+                let t218 = T::mul_add(t8, t207, -t9 * t206);
+                let t219 = T::mul_add(-t9, t207, -t8 * t206);
+                let t220 = T::one() / t214;
+                let t221 = t212 - tau[5];
+                let t222 = T::mul_add(t3, t209, -t193);
+                let t223 = t0 * (T::mul_add(-t2, t192, t3 * t202));
                 let t224 = T::mul_add(
-                    -T::from_f64(0.41),
-                    t136,
+                    T::from_f64(0.463),
+                    t173,
                     T::mul_add(
-                        t202,
-                        t174 * t192,
+                        -T::from_f64(0.0013224560195000002),
+                        t145,
+                        -T::from_f64(0.0230207699865) * t97,
+                    )
+                        + T::mul_add(
+                            -T::from_f64(0.0013224560195000002),
+                            t117,
+                            -T::from_f64(0.0230207699865) * t116,
+                        ),
+                ) + t218;
+                let t225 = t164 + t219;
+                let t226 = t181 + -t212;
+                let t227 = T::mul_add(
+                    -t213,
+                    t90 * t105,
+                    T::mul_add(
+                        -t195,
+                        t66,
                         T::mul_add(
-                            t173,
-                            t84 * t155,
-                            T::mul_add(
-                                t113,
-                                t107,
-                                T::mul_add(
-                                    -T::from_f64(0.4146),
-                                    t28,
-                                    T::mul_add(
-                                        T::from_f64(0.08080237769383405),
-                                        t7,
-                                        -t193 - t157 - T::from_f64(0.16453713320957578),
-                                    ),
-                                ),
-                            ),
+                            T::from_f64(0.0016),
+                            T::mul_add(t0, t2 * t94, t1 * t3 * t94),
+                            -t217,
                         ),
                     ),
                 );
-                let t225 = T::one() / t213;
-                let t226 = T::mul_add(t3, t203, t194);
-                let t227 = T::mul_add(t3, t177, t2 * t204);
                 let t228 = T::mul_add(
-                    T::from_f64(0.10375),
-                    t217 - t218,
-                    T::mul_add(
-                        T::from_f64(0.0013224560195000002),
-                        t171 + t172,
-                        T::mul_add(
-                            -t8,
-                            t207,
-                            T::mul_add(
-                                -t9,
-                                t208,
-                                T::mul_add(
-                                    t105,
-                                    t145,
-                                    T::mul_add(
-                                        t126,
-                                        t146,
-                                        T::mul_add(
-                                            -T::from_f64(0.0015805219734713843),
-                                            t161,
-                                            T::mul_add(
-                                                T::from_f64(0.0230207699865),
-                                                t125 - t117 - t129,
-                                                T::from_f64(0.0023884048860993747) * t119,
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
+                    -T::from_f64(0.10375),
+                    -t219,
+                    T::mul_add(t8, t211, -t9 * t210),
                 );
                 let t229 = T::mul_add(
-                    T::from_f64(0.463),
-                    t170 - t169,
-                    T::mul_add(
-                        t105,
-                        t141,
-                        T::mul_add(
-                            t126,
-                            t142,
-                            T::mul_add(
-                                T::from_f64(0.0013224560195000002),
-                                t102 - t139 - t140,
-                                T::mul_add(T::from_f64(0.0230207699865), t118, t215 + t216),
-                            ),
-                        ),
-                    ),
+                    T::from_f64(0.10375),
+                    -t218,
+                    T::mul_add(-t9, t211, -t8 * t210),
                 );
-                let t230 = T::mul_add(
-                    T::from_f64(0.463),
-                    t125,
-                    T::mul_add(
-                        -T::from_f64(0.0230207699865),
-                        t161,
-                        T::mul_add(
-                            t83,
-                            t97,
-                            T::mul_add(
-                                t61,
-                                t98,
-                                T::mul_add(
-                                    -T::from_f64(0.926),
-                                    t117 + t129,
-                                    T::mul_add(
-                                        T::from_f64(0.07312772998190001),
-                                        t119,
-                                        t163 + t217 - t162 - t218,
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                );
+                let t230 = t161 + t225;
                 let t231 = T::mul_add(
-                    -t212,
-                    t84 * t108,
+                    -t220,
+                    t215 * t215,
                     T::mul_add(
-                        -t178,
-                        t67,
+                        -t167,
+                        t190 * t190,
                         T::mul_add(
-                            -t1,
-                            T::mul_add(t3, t137, t194),
+                            -t175,
+                            t175 * t90,
                             T::mul_add(
-                                -t0,
+                                -t143,
+                                t156,
                                 T::mul_add(
-                                    t2,
-                                    t137,
-                                    T::mul_add(T::from_f64(0.41), t88, -t195),
-                                ),
-                                T::from_f64(0.0016)
-                                    * (T::mul_add(t0, t2 * t89, t1 * t3 * t89)),
+                                    T::from_f64(0.82),
+                                    t128,
+                                    t203 + T::from_f64(0.44834705861908),
+                                ) + T::from_f64(0.05271803549099999),
                             ),
                         ),
                     ),
                 );
                 let t232 = T::mul_add(
-                    T::from_f64(0.10375),
-                    t215 + t216,
+                    t3,
+                    T::mul_add(t3, t159, t193),
+                    t2 * (T::mul_add(t2, t209, t194)),
+                );
+                let t233 = T::mul_add(
+                    -T::from_f64(0.41),
+                    t70,
+                    -t216 + T::from_f64(0.011526977800000001),
+                ) - T::from_f64(0.00204435);
+                let t234 = t196 + t228;
+                let t235 = t182 + t229;
+                let t236 = T::mul_add(t6, t208, -t7 * t224);
+                let t237 = T::mul_add(
+                    T::from_f64(0.0016),
+                    T::mul_add(-t1, t128, t129),
                     T::mul_add(
-                        T::from_f64(0.0230207699865),
-                        t170 - t169,
+                        t185,
+                        t167 * t227,
                         T::mul_add(
-                            -t24,
-                            t214,
-                            T::mul_add(
-                                T::from_f64(0.00006575368432434527),
-                                t102 - t139 - t140,
-                                T::mul_add(
-                                    T::from_f64(0.0015767446734206029),
-                                    t118,
-                                    t164 + t165 + t219 - t220 - tau[4],
-                                ),
-                            ),
+                            -t166,
+                            t213 * t90,
+                            T::mul_add(-t195, t139, T::mul_add(-t1, t216, t223)),
                         ),
                     ),
                 );
-                let t233 = t0 * (T::mul_add(-t2, t177, t3 * t204));
-                let t234 = t7 * t229;
-                let t235 = t6 * t229;
-                let t236 = t6 * t228;
-                let t237 = t4 * t230;
-                let t238 = t5 * t230;
+                let t238 = T::one() / t231;
                 let t239 = T::mul_add(
                     T::from_f64(0.82),
-                    t136,
-                    T::mul_add(
-                        -t224,
-                        t224 * t225,
-                        T::mul_add(
-                            -t202,
-                            t202 * t174,
-                            T::mul_add(
-                                -t173,
-                                t173 * t84,
-                                T::mul_add(
-                                    -t113,
-                                    t130,
-                                    T::mul_add(
-                                        T::from_f64(0.4146),
-                                        t28,
-                                        T::mul_add(
-                                            -T::from_f64(0.08080237769383405),
-                                            t7,
-                                            t193 + t157 + T::from_f64(0.6597447987005757),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
+                    t128,
+                    T::mul_add(-t2, t204, t3 * t222) + T::from_f64(0.44248962999999997),
                 );
                 let t240 = T::mul_add(
-                    -t3,
-                    t205,
-                    T::mul_add(t2, t226, T::from_f64(0.41) * t135),
+                    T::from_f64(0.41),
+                    t109,
+                    T::mul_add(-t3, t204, -t2 * t222),
                 );
                 let t241 = T::mul_add(
-                    t3,
-                    T::mul_add(t3, t134, t194),
+                    -T::from_f64(0.463),
+                    t152,
                     T::mul_add(
-                        t2,
-                        T::mul_add(-t2, t203, t195),
-                        T::from_f64(0.0008910000000000028),
-                    ),
-                );
-                let t242 = T::mul_add(
-                    T::from_f64(0.10375),
-                    t215 + t216 - t234 - t221,
-                    T::mul_add(
-                        T::from_f64(0.0230207699865),
-                        t170 - t169,
-                        T::mul_add(
-                            T::from_f64(0.00006575368432434527),
-                            t102 - t139 - t140,
-                            T::mul_add(
-                                t83,
-                                t100,
-                                T::mul_add(
-                                    -t61,
-                                    t101,
-                                    T::mul_add(
-                                        T::from_f64(0.0250914799819),
-                                        t128 - t116,
-                                        T::mul_add(
-                                            T::from_f64(0.0033686654092834286),
-                                            t118,
-                                            T::mul_add(
-                                                T::from_f64(0.00007238626506919941),
-                                                t77,
-                                                t164 + t165 + t219 - t220,
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                );
-                let t243 = T::mul_add(
-                    T::from_f64(0.10375),
-                    t163 + t217 - t162 - t218,
-                    T::mul_add(
-                        T::from_f64(0.04803625),
-                        t125,
-                        T::mul_add(
-                            -T::from_f64(0.0023884048860993747),
-                            t161,
-                            T::mul_add(
-                                -t6,
-                                t211,
-                                T::mul_add(
-                                    -t7,
-                                    t228,
-                                    T::mul_add(
-                                        t61,
-                                        t99,
-                                        T::mul_add(
-                                            -t80,
-                                            t100,
-                                            T::mul_add(
-                                                -T::from_f64(0.07312772998190001),
-                                                t117 + t129,
-                                                T::mul_add(
-                                                    T::from_f64(0.0013357060146000001),
-                                                    t64 + t65 - t81 - t82,
-                                                    T::mul_add(
-                                                        T::from_f64(0.00677953504389725),
-                                                        t119,
-                                                        T::from_f64(0.000015227048566440002) * t76,
-                                                    ),
-                                                ),
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                );
-                let t244 = T::mul_add(
-                    -t61,
-                    t96,
-                    T::mul_add(
-                        t80,
+                        -T::from_f64(0.0250914799819),
                         t97,
-                        T::mul_add(
-                            T::from_f64(0.463),
-                            t128 - t116,
-                            T::mul_add(
-                                T::from_f64(0.0250914799819),
-                                t118,
-                                T::mul_add(
-                                    T::from_f64(0.0013357060146000001),
-                                    t77,
-                                    -t234 - t221,
-                                ),
-                            ),
+                        T::from_f64(0.0013357060146000001) * t62,
+                    )
+                        + T::mul_add(
+                            T::from_f64(0.0250914799819),
+                            t78,
+                            -T::from_f64(0.0013357060146000001) * t77,
                         ),
-                    ),
+                ) + t236;
+                let t242 = t138 + T::mul_add(t7, t208, t6 * t224);
+                let t243 = T::mul_add(t32, t221, tau[4] - t235);
+                let t244 = T::mul_add(
+                    t1,
+                    t232 + T::from_f64(0.0008910000000000028),
+                    t0 * t240,
                 );
                 let t245 = T::mul_add(
-                    T::from_f64(1.1393),
-                    t64 + t65,
+                    T::from_f64(0.10375),
+                    t225,
+                    T::mul_add(t6, t226, -t7 * t234),
+                );
+                let t246 = t162 + T::mul_add(T::from_f64(0.10375), -t236, t235);
+                let t247 = t163 + T::mul_add(t7, t226, t6 * t234);
+                let t248 = T::mul_add(t4, t230, -t5 * t241);
+                let t249 = T::mul_add(-t5, t230, -t4 * t241);
+                let t250 = t102 + -t242;
+                let t251 = T::mul_add(
+                    -T::from_f64(0.0016),
+                    t160,
                     T::mul_add(
-                        -T::from_f64(0.463),
-                        t81 + t82,
+                        t237,
+                        t220 * t215,
                         T::mul_add(
-                            T::from_f64(0.0013357060146000001),
-                            t119,
+                            -t167,
+                            t190 * t227,
                             T::mul_add(
-                                -t36,
-                                t54,
-                                T::mul_add(
-                                    -t11,
-                                    t52,
-                                    T::mul_add(
-                                        T::from_f64(0.011094380000000001),
-                                        t76,
-                                        t235 - t120 - t121 - t222,
-                                    ),
-                                ),
+                                -t175,
+                                t213 * t90,
+                                T::mul_add(-t195, t156, T::mul_add(-t1, t233, -t223)),
                             ),
                         ),
                     ),
                 );
-                let t246 = T::mul_add(
-                    -t174,
-                    t192 * t231,
-                    T::mul_add(
-                        t212,
-                        t84 * t155,
-                        T::mul_add(
-                            -t178,
-                            t107,
-                            T::mul_add(
-                                t1,
-                                t227,
-                                T::mul_add(
-                                    T::from_f64(0.0016),
-                                    T::mul_add(-t1, t136, t158),
-                                    -t233,
-                                ),
-                            ),
-                        ),
-                    ),
-                );
-                let t247 = T::one() / t239;
-                let t248 = T::mul_add(
-                    t84,
-                    t108 * t232,
-                    T::mul_add(
-                        t67,
-                        t214,
-                        T::mul_add(
-                            T::from_f64(0.0013357060146000001),
-                            t128 - t116,
-                            T::mul_add(
-                                T::from_f64(0.00007238626506919941),
-                                t118,
-                                T::mul_add(
-                                    T::from_f64(0.00009645337053442467),
-                                    t77,
-                                    t123 + t223 - t122 - t236 - tau[3],
-                                ),
-                            ),
-                        ),
-                    ),
-                );
-                let t249 = t5 * t244;
-                let t250 = t4 * t244;
-                let t251 = t4 * t243;
-                let t252 = t5 * t242;
-                let t253 = t2 * t245;
-                let t254 = T::mul_add(
+                let t252 = T::mul_add(
                     t0,
-                    T::mul_add(
-                        -t2,
-                        t205,
-                        T::mul_add(
-                            -t3,
-                            t226,
-                            T::mul_add(
-                                T::from_f64(0.82),
-                                t136,
-                                T::from_f64(0.49530666549099994),
-                            ),
-                        ),
-                    ),
+                    t239 + T::from_f64(0.05281703549099999),
                     t1 * t240,
                 );
+                let t253 = t172 + t245;
+                let t254 = -t248;
                 let t255 = T::mul_add(
-                    T::from_f64(0.6763),
-                    t63 - t62,
+                    -T::from_f64(0.6763),
+                    t101,
                     T::mul_add(
-                        t11,
-                        t53,
+                        -T::from_f64(0.00581618),
+                        t62,
                         T::mul_add(
-                            -t37,
-                            t54,
-                            T::mul_add(T::from_f64(0.00581618), t77, t249 - t237),
+                            T::from_f64(0.00581618),
+                            t46,
+                            -T::from_f64(0.054780300000000004) * t45,
                         ),
                     ),
-                );
+                ) + t248;
                 (
                     t192,
                     t193,
@@ -1953,405 +1679,168 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                 t270,
                 t271,
                 t272,
+                t273,
+                t274,
+                t275,
+                t276,
+                t277,
+                t278,
+                t279,
+                t280,
+                t281,
+                t282,
+                t283,
+                t284,
+                t285,
+                t286,
+                t287,
             ) = {
-                let t256 = T::mul_add(
-                    -T::from_f64(0.2073),
-                    t250 + t238,
-                    T::mul_add(
-                        -T::from_f64(0.011094380000000001),
-                        t64 + t65,
-                        T::mul_add(
-                            T::from_f64(0.0114),
-                            t120 + t121 + t222 - t235,
-                            T::mul_add(
-                                T::from_f64(0.0052782),
-                                t81 + t82,
-                                T::mul_add(
-                                    -T::from_f64(0.000015227048566440002),
-                                    t119,
-                                    T::mul_add(
-                                        -t4,
-                                        t242,
-                                        T::mul_add(
-                                            -t5,
-                                            t243,
-                                            T::mul_add(
-                                                t11,
-                                                t57,
-                                                T::mul_add(
-                                                    -t37,
-                                                    t56,
-                                                    T::mul_add(
-                                                        -T::from_f64(0.00596761924708),
-                                                        t76,
-                                                        T::mul_add(
-                                                            T::from_f64(0.044919846),
-                                                            t20,
-                                                            T::from_f64(0.00008764848) * t10,
-                                                        ),
-                                                    ),
-                                                ),
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                );
-                let t257 = T::mul_add(
-                    T::from_f64(0.0114),
-                    t249 - t237,
-                    T::mul_add(
-                        T::from_f64(0.00581618),
-                        t63 - t62,
-                        T::mul_add(
-                            T::from_f64(0.0013357060146000001),
-                            t128 - t116,
-                            T::mul_add(
-                                T::from_f64(0.00007238626506919941),
-                                t118,
-                                T::mul_add(
-                                    -t36,
-                                    t56,
-                                    T::mul_add(
-                                        t11,
-                                        t55,
-                                        T::mul_add(
-                                            T::from_f64(0.00045080751853442445),
-                                            t77,
-                                            t123 + t223 - t122 - t236,
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                );
+                let t256 = t124 + T::mul_add(T::from_f64(0.0114), t254, -t247);
+                let t257 = T::mul_add(t2, t250, -t3 * t255);
                 let t258 = T::mul_add(
-                    t224,
-                    t246 * t225,
-                    T::mul_add(
-                        -t202,
-                        t174 * t231,
-                        T::mul_add(
-                            t173,
-                            t212 * t84,
-                            T::mul_add(
-                                -t178,
-                                t130,
-                                T::mul_add(
-                                    t1,
-                                    T::mul_add(
-                                        T::from_f64(0.41),
-                                        t89,
-                                        t227 + T::from_f64(0.0094826278),
-                                    ),
-                                    T::mul_add(
-                                        T::from_f64(0.0016),
-                                        T::mul_add(
-                                            -t1,
-                                            t136 + T::from_f64(1.2836779999999999),
-                                            t158,
-                                        ),
-                                        -t233,
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
+                    t90,
+                    t105 * t243,
+                    T::mul_add(-t66, t221, tau[3] - t247),
                 );
                 let t259 = T::mul_add(
-                    T::from_f64(0.2073),
-                    t249 - t237,
+                    T::from_f64(2.0),
                     T::mul_add(
-                        T::from_f64(0.054780300000000004),
-                        t63 - t62,
+                        T::from_f64(0.11875),
+                        t160,
                         T::mul_add(
-                            -t174,
-                            t192 * t248,
-                            T::mul_add(
-                                -t84,
-                                t155 * t232,
-                                T::mul_add(
-                                    t107,
-                                    t214,
-                                    T::mul_add(
-                                        T::from_f64(0.00047111058),
-                                        t77,
-                                        t78 + t252 + tau[2] - t79 - t251,
-                                    ),
-                                ),
-                            ),
+                            T::from_f64(0.0016),
+                            t70,
+                            -T::from_f64(0.000029143328000000003),
                         ),
+                    ),
+                    T::mul_add(
+                        -T::from_f64(0.2375),
+                        t160,
+                        T::mul_add(t1, t244, t0 * t252)
+                            + T::from_f64(0.000009273088000001482),
                     ),
                 );
-                let t260 = t3 * t255;
+                let t260 = T::mul_add(t4, t246, -t5 * t253)
+                    + T::mul_add(
+                        -T::from_f64(0.2073),
+                        -t249,
+                        -T::from_f64(0.0114) * t242,
+                    );
                 let t261 = T::mul_add(
-                    T::from_f64(0.20443499999999998),
-                    t23,
-                    T::mul_add(
-                        t3,
-                        t245,
-                        T::mul_add(
-                            t2,
-                            t255,
-                            T::mul_add(
-                                qd[1],
-                                T::mul_add(
-                                    T::from_f64(0.0099),
-                                    t19,
-                                    T::from_f64(0.20443499999999998) * qd[1],
-                                ),
-                                T::mul_add(
-                                    -T::from_f64(0.0099),
-                                    t20,
-                                    T::from_f64(9.7119) * t1,
-                                ),
-                            ),
-                        ),
-                    ),
+                    T::from_f64(0.2073),
+                    t254,
+                    T::mul_add(-t5, t246, -t4 * t253),
                 );
                 let t262 = T::mul_add(
-                    -t247,
-                    t258 * t258,
+                    -T::from_f64(0.0099),
+                    t19,
                     T::mul_add(
-                        -t246,
-                        t246 * t225,
+                        T::from_f64(9.7119),
+                        t0,
                         T::mul_add(
-                            -t174,
-                            t231 * t231,
-                            T::mul_add(
-                                -t212,
-                                t212 * t84,
-                                T::mul_add(
-                                    -t178,
-                                    t191,
-                                    T::mul_add(
-                                        t1,
-                                        T::mul_add(t1, t241, t0 * t240),
-                                        T::mul_add(
-                                            t0,
-                                            t254,
-                                            T::mul_add(
-                                                -T::from_f64(0.0032),
-                                                t89,
-                                                T::from_f64(0.0005521372320000016),
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
+                            -T::from_f64(0.20443499999999998),
+                            t20,
+                            T::from_f64(0.0099) * t19,
                         ),
                     ),
-                );
+                ) + t257;
                 let t263 = T::mul_add(
-                    T::from_f64(0.41),
-                    t253 - t260,
+                    -T::from_f64(0.0099),
+                    t18,
+                    T::mul_add(T::from_f64(9.7119), t1, t60),
+                ) + T::mul_add(t3, t250, t2 * t255);
+                let t264 = t123 + t260;
+                let t265 = t125 + t261;
+                let t266 = T::mul_add(
+                    -t251,
+                    t251 * t238,
                     T::mul_add(
-                        T::from_f64(0.2073),
-                        t249 - t237,
+                        -t237,
+                        t237 * t220,
                         T::mul_add(
-                            T::from_f64(0.054780300000000004),
-                            t63 - t62,
+                            -t167,
+                            t227 * t227,
                             T::mul_add(
-                                T::from_f64(0.00047111058),
-                                t77,
+                                -t213,
+                                t213 * t90,
                                 T::mul_add(
-                                    t224,
-                                    t225 * t259,
-                                    T::mul_add(
-                                        -t202,
-                                        t174 * t248,
-                                        T::mul_add(
-                                            -t173,
-                                            t84 * t232,
-                                            T::mul_add(
-                                                t130,
-                                                t214,
-                                                T::mul_add(
-                                                    qd[0],
-                                                    t0 * t35,
-                                                    T::mul_add(
-                                                        -T::from_f64(0.05281703549099999),
-                                                        t22,
-                                                        T::mul_add(
-                                                            -T::from_f64(0.00204435),
-                                                            t21,
-                                                            T::mul_add(
-                                                                T::from_f64(2.00550735),
-                                                                t0,
-                                                                t78 + t252 - t79 - t251 - tau[1],
-                                                            ),
-                                                        ),
-                                                    ),
-                                                ),
-                                            ),
-                                        ),
-                                    ),
+                                    -t195,
+                                    t200,
+                                    t259 + T::from_f64(0.0006011508000000001),
                                 ),
                             ),
                         ),
                     ),
                 );
-                let t264 = T::one() / t262;
-                let t265 = T::mul_add(
-                    t247,
-                    t258 * t263,
-                    T::mul_add(
-                        t246,
-                        t225 * t259,
-                        T::mul_add(
-                            t174,
-                            t231 * t248,
-                            T::mul_add(
-                                -t212,
-                                t84 * t232,
-                                T::mul_add(
-                                    -t191,
-                                    t214,
-                                    T::mul_add(
-                                        t1,
-                                        T::mul_add(
-                                            t3,
-                                            t257,
-                                            T::mul_add(
-                                                t2,
-                                                t256,
-                                                T::mul_add(
-                                                    -qd[0],
-                                                    t0 * t34,
-                                                    T::mul_add(
-                                                        T::from_f64(0.051926035490999986),
-                                                        t21,
-                                                        T::from_f64(0.09711900000000001) * t0,
-                                                    ),
-                                                ),
-                                            ),
-                                        ),
-                                        T::mul_add(
-                                            -t0,
-                                            T::mul_add(
-                                                T::from_f64(0.41),
-                                                T::mul_add(t37, t52, T::mul_add(t36, t53, t250 + t238)),
-                                                T::mul_add(
-                                                    T::from_f64(0.022459923),
-                                                    t76,
-                                                    T::mul_add(
-                                                        -t2,
-                                                        t257,
-                                                        T::mul_add(
-                                                            t3,
-                                                            t256,
-                                                            T::mul_add(
-                                                                qd[1],
-                                                                t35,
-                                                                T::mul_add(
-                                                                    -qd[0],
-                                                                    t1 * t34,
-                                                                    T::mul_add(
-                                                                        -T::from_f64(0.28018909549099996),
-                                                                        t20,
-                                                                        T::mul_add(
-                                                                            -T::from_f64(0.0007707488),
-                                                                            t10,
-                                                                            T::from_f64(0.09711900000000001) * t1,
-                                                                        ),
-                                                                    ),
-                                                                ),
-                                                            ),
-                                                        ),
-                                                    ),
-                                                ),
-                                            ),
-                                            T::mul_add(
-                                                T::from_f64(0.0016),
-                                                T::mul_add(
-                                                    -t0,
-                                                    t261,
-                                                    t1
-                                                        * (T::mul_add(
-                                                            -T::from_f64(0.20443499999999998),
-                                                            t22,
-                                                            T::mul_add(T::from_f64(9.7119), t0, t253 - t260),
-                                                        )),
-                                                ),
-                                                -tau[0],
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                );
-                let t266 = T::mul_add(-t247, t258 * t264 * t265, -t247 * t263);
-                let t267 = -t266;
+                let t267 = T::one() / t266;
                 let t268 = T::mul_add(
-                    t246,
-                    t225 * t264 * t265,
-                    T::mul_add(t224, t225 * t267, t225 * t259),
+                    T::from_f64(0.41),
+                    t95 + t249,
+                    T::mul_add(t2, t256, -t3 * t264),
                 );
-                let t269 = T::mul_add(
-                    -t174,
-                    t231 * t264 * t265,
-                    T::mul_add(
-                        t202,
-                        t174 * t267,
-                        T::mul_add(t174, t192 * t268, -t174 * t248),
-                    ),
-                );
-                let t270 = -t269;
+                let t269 = t86 + T::mul_add(t3, t256, t2 * t264);
+                let t270 = t87 + T::mul_add(-T::from_f64(0.41), -t257, -t265);
                 let t271 = T::mul_add(
-                    t212,
-                    t84 * t264 * t265,
-                    T::mul_add(
-                        t173,
-                        t84 * t267,
-                        T::mul_add(
-                            t84,
-                            t155 * t268,
-                            T::mul_add(-t84, t108 * t270, -t84 * t232),
-                        ),
-                    ),
+                    -t166,
+                    t90 * t243,
+                    T::mul_add(t139, t221, tau[2] - t265),
                 );
-                let t272 = T::mul_add(
-                    T::from_f64(0.12859348644086138),
-                    t201 - t200,
-                    T::mul_add(
-                        -T::from_f64(0.00000000000000013942133736666016),
-                        t198 + t199,
-                        T::mul_add(
-                            T::from_f64(1285.9348644085492),
-                            t196 + tau[5] - t197,
-                            T::mul_add(
-                                T::from_f64(0.000000000000000008628001120302262),
-                                t148 - t180 - t182,
-                                T::mul_add(
-                                    T::from_f64(0.018032351629443222),
-                                    t181 - t179 - t147,
-                                    T::mul_add(
-                                        t191,
-                                        t264 * t265,
-                                        T::mul_add(
-                                            -t130,
-                                            t267,
-                                            T::mul_add(
-                                                -t107,
-                                                t268,
-                                                T::mul_add(
-                                                    -t67,
-                                                    t270,
-                                                    T::mul_add(t24, -t271, t102 - t139 - t140),
-                                                ),
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
+                let t272 = T::mul_add(-t185, t167 * t258, t271);
+                let t273 = T::mul_add(-t1, t269, -t0 * (t85 + t268));
+                let t274 = T::mul_add(
+                    -t175,
+                    t90 * t243,
+                    T::mul_add(t156, t221, tau[1] - t270),
                 );
+                let t275 = T::mul_add(
+                    T::from_f64(0.0016),
+                    T::mul_add(-t0, t263, t1 * t262),
+                    t273,
+                );
+                let t276 = T::mul_add(
+                    t220,
+                    t215 * t272,
+                    T::mul_add(t167, t190 * t258, t274),
+                );
+                let t277 = T::mul_add(
+                    -t213,
+                    t90 * t243,
+                    T::mul_add(t200, t221, tau[0] - t275),
+                );
+                let t278 = T::mul_add(
+                    -t237,
+                    t220 * t272,
+                    T::mul_add(t167, t227 * t258, t277),
+                );
+                let t279 = T::mul_add(-t251, t238 * t276, t278);
+                let t280 = T::mul_add(-t251, t238 * t267 * t279, t238 * t276);
+                let t281 = T::mul_add(
+                    -t237,
+                    t220 * t267 * t279,
+                    T::mul_add(t220, t215 * t280, t220 * t272),
+                );
+                let t282 = T::mul_add(
+                    t167,
+                    t190 * t280,
+                    T::mul_add(-t185, t167 * t281, t167 * t258),
+                );
+                let t283 = T::mul_add(t167, t227 * t267 * t279, t282);
+                let t284 = T::mul_add(
+                    -t166,
+                    t90 * t281,
+                    T::mul_add(t90, t105 * t283, t90 * t243),
+                );
+                let t285 = T::mul_add(
+                    -t213,
+                    t90 * t267 * t279,
+                    T::mul_add(-t175, t90 * t280, t284),
+                );
+                let t286 = T::mul_add(
+                    t66,
+                    t283,
+                    T::mul_add(-t32, t285, -T::from_f64(1285.9348644085492) * t221),
+                );
+                let t287 = T::mul_add(-t156, t280, T::mul_add(-t139, t281, t286));
                 (
                     t256,
                     t257,
@@ -2370,20 +1859,35 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                     t270,
                     t271,
                     t272,
+                    t273,
+                    t274,
+                    t275,
+                    t276,
+                    t277,
+                    t278,
+                    t279,
+                    t280,
+                    t281,
+                    t282,
+                    t283,
+                    t284,
+                    t285,
+                    t286,
+                    t287,
                 )
             };
             [
-                -t264 * t265,
+                t267 * t279,
+                t280,
+                t281,
+                t283,
+                t285,
+                T::mul_add(-t200, t267 * t279, t287),
                 t266,
-                t268,
-                t269,
-                t271,
-                t272,
-                t262,
-                t239,
-                t213,
-                t154,
-                t66,
+                t231,
+                t214,
+                t157,
+                t65,
                 T::from_f64(0.0007776443641723163),
             ]
         };
@@ -2398,7 +1902,7 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
     /// The generalized momentum p = M(q) qd = dT/dqd (a momentum observer's measurement).
     ///
     /// Route: Newton-Euler at rest without gravity, with qd as the accelerations, O(N).
-    /// Operations: 198 mul, 216 add, 0 div, 5 sin, 5 cos.
+    /// Operations: 182 mul, 138 add, 0 div, 5 sin, 5 cos.
     pub fn generalized_momentum(&self, q: &[T; 6], qd: &[T; 6]) -> [T; 6] {
         let ([s1, s2, s3, s4, s5], [c1, c2, c3, c4, c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
             q[1],
@@ -2487,158 +1991,192 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
             let t11 = qd[0] * t0;
             let t12 = qd[0] * t1;
             let t13 = qd[0] * t0 * t3;
-            let t14 = qd[0] * t1 * t2;
-            let t15 = qd[0] * t0 * t2;
-            let t16 = qd[0] * t1 * t3;
-            let t17 = t5 * t10;
-            let t18 = t13 - t14;
-            let t19 = qd[3] + t15 + t16;
-            let t20 = T::mul_add(T::from_f64(0.0016), t12, T::from_f64(0.41) * qd[1]);
-            let t21 = t4 * t18;
-            let t22 = t7 * t19;
-            let t23 = t3 * t20;
-            let t24 = t2 * t20;
-            let t25 = T::mul_add(-T::from_f64(0.2073), t18, T::from_f64(0.41) * t11);
-            let t26 = T::mul_add(-t4, t10, t5 * t18);
-            let t27 = qd[4] + t21 + t17;
+            let t14 = qd[0] * t0 * t2;
+            let t15 = T::mul_add(-qd[0], t1 * t2, t13);
+            let t16 = T::mul_add(qd[0], t1 * t3, t14);
+            let t17 = T::mul_add(T::from_f64(0.0016), t12, T::from_f64(0.41) * qd[1]);
+            let t18 = qd[3] + t16;
+            let t19 = t3 * t17;
+            let t20 = t2 * t17;
+            let t21 = T::mul_add(-T::from_f64(0.2073), t15, T::from_f64(0.41) * t11);
+            let t22 = T::mul_add(t5, t10, t4 * t15);
+            let t23 = T::mul_add(-t4, t10, t5 * t15);
+            let t24 = T::mul_add(T::from_f64(0.0016), t13, -t20);
+            let t25 = T::mul_add(T::from_f64(0.0016), t14, t19);
+            let t26 = qd[4] + t22;
+            let t27 = T::mul_add(T::from_f64(0.2073), t10, T::from_f64(0.0114) * t16)
+                + T::mul_add(-T::from_f64(0.0016), t14, -t19);
             let t28 = T::mul_add(
                 T::from_f64(0.0114),
-                t16,
-                T::mul_add(
-                    T::from_f64(0.0098),
-                    t15,
-                    T::mul_add(T::from_f64(0.2073), t10, -t23),
-                ),
+                t15,
+                T::mul_add(-T::from_f64(0.0016), t13, t20),
             );
-            let t29 = T::mul_add(
-                -T::from_f64(0.0114),
-                t14,
-                T::mul_add(T::from_f64(0.0098), t13, t24),
+            let t29 = T::mul_add(t6, t18, t7 * t23);
+            let t30 = T::mul_add(-t7, t18, t6 * t23);
+            let t31 = qd[5] + t30;
+            let t32 = T::mul_add(t4, t21, -t5 * t27);
+            let t33 = T::mul_add(t5, t21, t4 * t27);
+            let t34 = T::mul_add(-t9, t26, t8 * t29);
+            let t35 = T::mul_add(t8, t26, t9 * t29);
+            let t36 = T::mul_add(T::from_f64(0.10375), t22, -t32);
+            let t37 = T::mul_add(T::from_f64(0.10375), t23, -t33);
+            let t38 = -t32;
+            let t39 = T::mul_add(
+                T::from_f64(0.10375),
+                t29,
+                T::mul_add(-T::from_f64(0.10375), t23, t33),
             );
-            let t30 = t4 * t25;
-            let t31 = t5 * t25;
-            let t32 = t6 * t26;
-            let t33 = t8 * t27;
-            let t34 = t9 * t27;
-            let t35 = t5 * t28;
-            let t36 = t4 * t28;
-            let t37 = t6 * t29;
-            let t38 = t7 * t29;
-            let t39 = T::mul_add(t6, t19, t7 * t26);
-            let t40 = T::mul_add(T::from_f64(0.10375), t21 + t17, t35 - t30);
-            let t41 = t9 * t39;
-            let t42 = t8 * t39;
-            let t43 = t7 * t40;
-            let t44 = t6 * t40;
-            let t45 = T::mul_add(T::from_f64(0.10375), t26 - t39, -t36 - t31);
-            let t46 = T::mul_add(T::from_f64(0.10375), t27, t37 - t43);
-            let t47 = t8 * t45;
-            let t48 = t9 * t45;
-            let t49 = T::mul_add(
+            let t40 = T::mul_add(-t6, t28, t7 * t36);
+            let t41 = T::mul_add(t7, t28, t6 * t36);
+            let t42 = T::mul_add(T::from_f64(0.10375), t26, -t40);
+            let t43 = T::mul_add(
                 -T::from_f64(1.493),
-                t44 + t38,
+                t41,
                 T::mul_add(
-                    T::from_f64(0.00010000000000000503),
-                    t34 - t42,
-                    T::mul_add(
-                        -T::from_f64(0.00000000000000000010842021724855044),
-                        t41 + t33,
-                        T::from_f64(0.0013224560195000002) * t39,
-                    ),
+                    T::from_f64(0.0013224560195000002),
+                    t29,
+                    -(T::mul_add(
+                        T::from_f64(0.00000000000000000010842021724855044),
+                        t35,
+                        T::from_f64(0.00010000000000000503) * t34,
+                    )),
                 ),
             );
-            let t50 = t9 * t46;
-            let t51 = t8 * t46;
-            let t52 = t6 * t49;
-            let t53 = t7 * t49;
-            let t54 = T::mul_add(
+            let t44 = T::mul_add(-t8, t39, t9 * t42);
+            let t45 = T::mul_add(t9, t39, t8 * t42);
+            let t46 = T::mul_add(
                 T::from_f64(1.03),
-                t50 + t47,
-                T::mul_add(
-                    T::from_f64(0.0650091026469637),
-                    t34 - t42,
-                    T::from_f64(0.00000000000000000010842021724855044)
-                        * (qd[5] + t32 - t22),
-                ),
-            );
-            let t55 = T::mul_add(
-                -T::from_f64(0.0650091026469637),
-                t50 + t47,
-                T::mul_add(
-                    T::from_f64(0.00010000000000000503),
-                    t44 + t38,
-                    T::mul_add(
-                        T::from_f64(0.004705147001603182),
-                        t42 - t34,
-                        T::mul_add(
-                            -T::from_f64(0.0000000000000006979729257032011),
-                            t41 + t33,
-                            T::from_f64(0.000000000000000000006709516445275485)
-                                * (qd[5] + t32 - t22),
-                        ),
-                    ),
-                ),
-            );
-            let t56 = T::mul_add(
-                T::from_f64(0.0650091026469637),
-                t51 - t48,
+                t44,
                 T::mul_add(
                     T::from_f64(0.00000000000000000010842021724855044),
-                    t44 + t38,
-                    T::mul_add(
-                        T::from_f64(0.0000000000000006979729257032011),
-                        t34 - t42,
-                        T::mul_add(
-                            T::from_f64(0.004894691391055498),
-                            t41 + t33,
-                            T::from_f64(0.000014022756617410007) * (qd[5] + t32 - t22),
-                        ),
-                    ),
+                    t31,
+                    -T::from_f64(0.0650091026469637) * t34,
                 ),
+            );
+            let t47 = T::mul_add(
+                -T::from_f64(1.03),
+                t45,
+                T::mul_add(
+                    -T::from_f64(0.0650091026469637),
+                    t35,
+                    -T::from_f64(0.00010000000000000503) * t31,
+                ),
+            );
+            let t48 = T::mul_add(
+                -T::from_f64(0.004894691391055498),
+                t35,
+                T::mul_add(
+                    -T::from_f64(0.000014022756617410007),
+                    t31,
+                    T::from_f64(0.0000000000000006979729257032011) * t34,
+                ),
+            )
+                + T::mul_add(
+                    -T::from_f64(0.0650091026469637),
+                    t45,
+                    -T::from_f64(0.00000000000000000010842021724855044) * t41,
+                );
+            let t49 = T::mul_add(
+                -T::from_f64(0.0000000000000006979729257032011),
+                t35,
+                T::mul_add(
+                    T::from_f64(0.000000000000000000006709516445275485),
+                    t31,
+                    T::from_f64(0.004705147001603182) * t34,
+                ),
+            )
+                + T::mul_add(
+                    -T::from_f64(0.0650091026469637),
+                    t44,
+                    T::from_f64(0.00010000000000000503) * t41,
+                );
+            let t50 = T::mul_add(
+                T::from_f64(0.000014022756617410007),
+                t35,
+                T::mul_add(
+                    T::from_f64(0.0007776443641723163),
+                    t31,
+                    T::from_f64(0.000000000000000000006709516445275485) * t34,
+                ),
+            )
+                + T::mul_add(
+                    T::from_f64(0.00010000000000000503),
+                    t45,
+                    T::from_f64(0.00000000000000000010842021724855044) * t44,
+                );
+            let t51 = T::mul_add(t8, t47, -t9 * t46);
+            let t52 = T::mul_add(-t9, t47, -t8 * t46);
+            let t53 = T::mul_add(
+                T::from_f64(0.463),
+                t40,
+                T::mul_add(
+                    T::from_f64(0.0013224560195000002),
+                    t30,
+                    -T::from_f64(0.0230207699865) * t26,
+                ),
+            ) + t51;
+            let t54 = T::mul_add(
+                -T::from_f64(0.463),
+                t37,
+                T::from_f64(0.0230207699865) * t29,
+            ) + t52;
+            let t55 = T::mul_add(
+                -T::from_f64(0.0013224560195000002),
+                t40,
+                T::mul_add(
+                    -T::from_f64(0.00009637730005078133),
+                    t30,
+                    T::from_f64(0.00006575368432434527) * t26,
+                ),
+            ) + -t50;
+            let t56 = T::mul_add(
+                -T::from_f64(0.10375),
+                -t52,
+                T::mul_add(t8, t49, -t9 * t48),
             );
             let t57 = T::mul_add(
-                T::from_f64(1.03),
-                t51 - t48,
-                T::mul_add(
-                    T::from_f64(0.0650091026469637),
-                    t41 + t33,
-                    T::from_f64(0.00010000000000000503) * (qd[5] + t32 - t22),
-                ),
+                T::from_f64(0.10375),
+                -t51,
+                T::mul_add(-t9, t49, -t8 * t48),
             );
             let t58 = T::mul_add(
-                T::from_f64(0.00010000000000000503),
-                t48 - t51,
+                T::from_f64(0.463),
+                t33,
+                -T::from_f64(0.0250914799819) * t23,
+            ) + t54;
+            let t59 = T::mul_add(
+                T::from_f64(0.0015805219734713843),
+                t29,
                 T::mul_add(
-                    -T::from_f64(0.00000000000000000010842021724855044),
-                    t50 + t47,
-                    T::mul_add(
-                        T::from_f64(0.0013224560195000002),
-                        t37 - t43,
-                        T::mul_add(
-                            T::from_f64(0.000000000000000000006709516445275485),
-                            t34 - t42,
-                            T::mul_add(
-                                -T::from_f64(0.000014022756617410007),
-                                t41 + t33,
-                                T::mul_add(
-                                    T::from_f64(0.0008740216642230976),
-                                    t22 - t32,
-                                    T::mul_add(
-                                        -T::from_f64(0.0007776443641723163),
-                                        qd[5],
-                                        T::from_f64(0.00006575368432434527) * t27,
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
+                    -T::from_f64(0.0013224560195000002),
+                    t41,
+                    -T::from_f64(0.0230207699865) * t37,
                 ),
-            );
-            let t59 = t9 * t54;
-            let t60 = t8 * t57;
-            let t61 = t8 * t54;
-            let t62 = t9 * t57;
-            let t63 = t8 * t56;
+            ) + t56;
+            let t60 = T::mul_add(
+                -T::from_f64(0.0230207699865),
+                t40,
+                T::mul_add(
+                    -T::from_f64(0.00006575368432434527),
+                    t30,
+                    T::from_f64(0.0015767446734206029) * t26,
+                ),
+            ) + t57;
+            let t61 = T::mul_add(t6, t43, -t7 * t53);
+            let t62 = T::mul_add(
+                -T::from_f64(0.463),
+                t38,
+                T::mul_add(
+                    -T::from_f64(0.0013357060146000001),
+                    t18,
+                    -T::from_f64(0.0250914799819) * t22,
+                ),
+            ) + t61;
+            let t63 = T::mul_add(
+                -T::from_f64(0.463),
+                t28,
+                -T::from_f64(0.0013357060146000001) * t23,
+            ) + T::mul_add(t7, t43, t6 * t53);
             (
                 t0,
                 t1,
@@ -2729,285 +2267,141 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
             t83,
             t84,
             t85,
-            t86,
-            t87,
         ) = {
-            let t64 = t9 * t55;
-            let t65 = t7 * t58;
-            let t66 = T::mul_add(
-                -t8,
-                t55,
-                T::mul_add(
-                    -t9,
-                    t56,
-                    T::mul_add(
-                        T::from_f64(0.10375),
-                        t61 - t62,
-                        T::mul_add(
-                            T::from_f64(0.0013224560195000002),
-                            t44 + t38,
-                            T::mul_add(
-                                -T::from_f64(0.0230207699865),
-                                t36 + t31,
-                                T::mul_add(
-                                    -T::from_f64(0.0015805219734713843),
-                                    t39,
-                                    T::from_f64(0.0023884048860993747) * t26,
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t67 = T::mul_add(
-                T::from_f64(0.463),
-                t37 - t43,
-                T::mul_add(
-                    T::from_f64(0.0013224560195000002),
-                    t22 - t32,
-                    T::mul_add(T::from_f64(0.0230207699865), t27, t59 + t60),
-                ),
-            );
-            let t68 = T::mul_add(
-                -T::from_f64(0.926),
-                t36 + t31,
-                T::mul_add(
-                    -T::from_f64(0.0230207699865),
-                    t39,
-                    T::mul_add(T::from_f64(0.07312772998190001), t26, t61 - t62),
-                ),
-            );
-            let t69 = t7 * t67;
-            let t70 = t6 * t67;
-            let t71 = t6 * t66;
-            let t72 = t4 * t68;
-            let t73 = t5 * t68;
-            let t74 = T::mul_add(
+            let t64 = T::mul_add(
                 T::from_f64(0.10375),
-                t59 + t60 - t69 - t52,
-                T::mul_add(
-                    T::from_f64(0.0230207699865),
-                    t37 - t43,
-                    T::mul_add(
-                        T::from_f64(0.0250914799819),
-                        t35 - t30,
-                        T::mul_add(
-                            T::from_f64(0.00006575368432434527),
-                            t22 - t32,
-                            T::mul_add(
-                                T::from_f64(0.0033686654092834286),
-                                t21 + t17,
-                                T::mul_add(
-                                    T::from_f64(0.0015767446734206029),
-                                    qd[4],
-                                    T::mul_add(
-                                        T::from_f64(0.00007238626506919941),
-                                        t19,
-                                        t63 - t64,
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
+                t54,
+                T::mul_add(t6, t55, -t7 * t59),
             );
-            let t75 = T::mul_add(
-                -t6,
-                t58,
+            let t65 = T::mul_add(
+                T::from_f64(0.0250914799819),
+                t38,
                 T::mul_add(
-                    -t7,
-                    t66,
-                    T::mul_add(
-                        T::from_f64(0.10375),
-                        t61 - t62,
-                        T::mul_add(
-                            -T::from_f64(0.07312772998190001),
-                            t36 + t31,
-                            T::mul_add(
-                                T::from_f64(0.0013357060146000001),
-                                t24,
-                                T::mul_add(
-                                    -T::from_f64(0.0023884048860993747),
-                                    t39,
-                                    T::mul_add(
-                                        T::from_f64(0.00677953504389725),
-                                        t26,
-                                        T::mul_add(
-                                            -T::from_f64(0.000015227048566440002),
-                                            t14,
-                                            T::from_f64(0.000013089918943080001) * t13,
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
+                    T::from_f64(0.00007238626506919941),
+                    t18,
+                    T::from_f64(0.0017919207358628258) * t22,
                 ),
-            );
-            let t76 = T::mul_add(
-                T::from_f64(0.463),
-                t35 - t30,
+            ) + T::mul_add(T::from_f64(0.10375), -t61, t60);
+            let t66 = T::mul_add(
+                T::from_f64(0.0013357060146000001),
+                t38,
                 T::mul_add(
-                    T::from_f64(0.0250914799819),
-                    t21 + t17,
-                    T::mul_add(T::from_f64(0.0013357060146000001), t19, -t69 - t52),
+                    T::from_f64(0.00009645337053442467),
+                    t18,
+                    T::from_f64(0.00007238626506919941) * t22,
                 ),
-            );
-            let t77 = T::mul_add(
-                T::from_f64(1.1393),
-                t24,
-                T::mul_add(
-                    T::from_f64(0.0013357060146000001),
-                    t26,
-                    T::mul_add(
-                        -T::from_f64(0.011094380000000001),
-                        t14,
-                        T::mul_add(T::from_f64(0.0092715), t13, t70 - t53),
-                    ),
-                ),
-            );
-            let t78 = t5 * t76;
-            let t79 = t4 * t76;
-            let t80 = t4 * t75;
-            let t81 = t5 * t74;
-            let t82 = t2 * t77;
-            let t83 = T::mul_add(
+            ) + T::mul_add(t7, t55, t6 * t59);
+            let t67 = T::mul_add(t4, t58, -t5 * t62);
+            let t68 = T::mul_add(-t5, t58, -t4 * t62);
+            let t69 = T::mul_add(
                 -T::from_f64(0.6763),
+                t24,
+                T::from_f64(0.00581618) * t15,
+            ) + -t63;
+            let t70 = T::mul_add(
+                -T::from_f64(0.0017957741063972504),
                 t23,
                 T::mul_add(
-                    T::from_f64(0.00581618),
-                    t16,
-                    T::mul_add(
-                        T::from_f64(0.0047341),
-                        t15,
-                        T::mul_add(T::from_f64(0.054780300000000004), t10, t78 - t72),
-                    ),
+                    T::from_f64(0.0250914799819),
+                    t33,
+                    -T::from_f64(0.0013357060146000001) * t28,
                 ),
-            );
-            let t84 = T::mul_add(
-                -t4,
-                t74,
+            ) + t64;
+            let t71 = -t67;
+            let t72 = T::mul_add(
+                -T::from_f64(0.6763),
+                t25,
                 T::mul_add(
-                    -t5,
-                    t75,
-                    T::mul_add(
-                        -T::from_f64(0.2073),
-                        t79 + t73,
-                        T::mul_add(
-                            T::from_f64(0.0114),
-                            t53 - t70,
-                            T::mul_add(
-                                -T::from_f64(0.011094380000000001),
-                                t24,
-                                T::mul_add(
-                                    -T::from_f64(0.000015227048566440002),
-                                    t26,
-                                    T::mul_add(
-                                        T::from_f64(0.00596761924708),
-                                        t14,
-                                        T::mul_add(
-                                            -T::from_f64(0.005949868239079999),
-                                            t13,
-                                            T::from_f64(0.022459923) * t11,
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
+                    T::from_f64(0.054780300000000004),
+                    t10,
+                    T::from_f64(0.00581618) * t16,
                 ),
+            ) + t67;
+            let t73 = T::mul_add(
+                T::from_f64(0.00581618),
+                t25,
+                T::mul_add(
+                    -T::from_f64(0.00047111058),
+                    t10,
+                    -T::from_f64(0.00035435414799999976) * t16,
+                ),
+            ) + T::mul_add(T::from_f64(0.0114), t71, -t66);
+            let t74 = T::mul_add(t2, t69, -t3 * t72);
+            let t75 = T::mul_add(t4, t65, -t5 * t70)
+                + T::mul_add(-T::from_f64(0.2073), -t68, -T::from_f64(0.0114) * t63);
+            let t76 = T::mul_add(
+                T::from_f64(0.2073),
+                t71,
+                T::mul_add(-t5, t65, -t4 * t70),
+            );
+            let t77 = T::mul_add(
+                T::from_f64(0.0015840000000000001),
+                t12,
+                T::mul_add(
+                    T::from_f64(0.0099),
+                    t12,
+                    T::from_f64(0.20443499999999998) * qd[1],
+                ),
+            ) + t74;
+            let t78 = T::mul_add(
+                T::from_f64(0.011484000000000001),
+                t11,
+                -(T::mul_add(t3, t69, t2 * t72)),
+            );
+            let t79 = T::mul_add(
+                T::from_f64(0.00590744776708),
+                t15,
+                T::mul_add(
+                    -T::from_f64(0.00581618),
+                    t24,
+                    -T::from_f64(0.022459923) * t11,
+                ),
+            ) + t75;
+            let t80 = T::mul_add(
+                T::from_f64(0.054780300000000004),
+                t25,
+                T::mul_add(
+                    -T::from_f64(0.0058574286190799995),
+                    t10,
+                    -T::from_f64(0.00047111058) * t16,
+                ),
+            ) + t76;
+            let t81 = T::mul_add(
+                T::from_f64(0.41),
+                T::mul_add(
+                    T::from_f64(0.054780300000000004),
+                    t15,
+                    -T::from_f64(0.277283) * t11,
+                ) + t68,
+                T::mul_add(t2, t73, -t3 * t79),
+            );
+            let t82 = T::mul_add(
+                -T::from_f64(0.00001584),
+                t12,
+                T::mul_add(
+                    -T::from_f64(0.0008910000000000028),
+                    t12,
+                    -T::from_f64(0.00204435) * qd[1],
+                ),
+            ) + T::mul_add(t3, t73, t2 * t79);
+            let t83 = T::mul_add(
+                T::from_f64(0.000327096),
+                t12,
+                T::mul_add(
+                    T::from_f64(0.00204435),
+                    t12,
+                    T::from_f64(0.05271803549099999) * qd[1],
+                ),
+            ) + T::mul_add(-T::from_f64(0.41), -t74, -t80);
+            let t84 = T::mul_add(
+                -t1,
+                t82,
+                t0 * (T::mul_add(T::from_f64(0.05283287549099999), t11, -t81)),
             );
             let t85 = T::mul_add(
-                T::from_f64(0.0114),
-                t78 - t72,
-                T::mul_add(
-                    T::from_f64(0.0013357060146000001),
-                    t35 - t30,
-                    T::mul_add(
-                        -T::from_f64(0.00581618),
-                        t23,
-                        T::mul_add(
-                            T::from_f64(0.00007238626506919941),
-                            t21 + t17,
-                            T::mul_add(
-                                T::from_f64(0.00045080751853442445),
-                                t16,
-                                T::mul_add(
-                                    T::from_f64(0.00044150163053442444),
-                                    t15,
-                                    T::mul_add(
-                                        T::from_f64(0.00009645337053442467),
-                                        qd[3],
-                                        T::mul_add(T::from_f64(0.00047111058), t10, t65 - t71),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t86 = t3 * t83;
-            let t87 = T::mul_add(
-                t1,
-                T::mul_add(
-                    t3,
-                    t85,
-                    T::mul_add(
-                        t2,
-                        t84,
-                        T::mul_add(
-                            T::from_f64(0.0009068400000000028),
-                            t12,
-                            T::from_f64(0.00204435) * qd[1],
-                        ),
-                    ),
-                ),
-                T::mul_add(
-                    t0,
-                    T::mul_add(
-                        t2,
-                        t85,
-                        T::mul_add(
-                            -t3,
-                            t84,
-                            T::mul_add(
-                                -T::from_f64(0.41),
-                                t79 + t73,
-                                T::mul_add(
-                                    -T::from_f64(0.022459923),
-                                    t18,
-                                    T::from_f64(0.16651890549099999) * t11,
-                                ),
-                            ),
-                        ),
-                    ),
-                    T::mul_add(
-                        T::from_f64(0.0016),
-                        T::mul_add(
-                            t0,
-                            T::mul_add(
-                                -t3,
-                                t77,
-                                T::mul_add(
-                                    -t2,
-                                    t83,
-                                    T::from_f64(0.011484000000000001) * t11,
-                                ),
-                            ),
-                            t1
-                                * (T::mul_add(
-                                    T::from_f64(0.011484000000000001),
-                                    t12,
-                                    T::mul_add(
-                                        T::from_f64(0.20443499999999998),
-                                        qd[1],
-                                        t82 - t86,
-                                    ),
-                                )),
-                        ),
-                        T::from_f64(0.0006011508000000001) * qd[0],
-                    ),
-                ),
+                T::from_f64(0.0016),
+                T::mul_add(t0, t78, t1 * t77),
+                t84,
             );
             (
                 t64,
@@ -3032,111 +2426,21 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                 t83,
                 t84,
                 t85,
-                t86,
-                t87,
             )
         };
         [
-            t87,
-            T::mul_add(
-                T::from_f64(0.41),
-                t82 - t86,
-                T::mul_add(
-                    T::from_f64(0.2073),
-                    t78 - t72,
-                    T::mul_add(
-                        -T::from_f64(0.054780300000000004),
-                        t23,
-                        T::mul_add(
-                            T::from_f64(0.00047111058),
-                            t16,
-                            T::mul_add(
-                                T::from_f64(0.00038346210000000003),
-                                t15,
-                                T::mul_add(
-                                    T::from_f64(0.0023714459999999997),
-                                    t12,
-                                    T::mul_add(
-                                        -T::from_f64(0.0058574286190799995),
-                                        qd[2],
-                                        T::mul_add(
-                                            T::from_f64(0.05857546411007999),
-                                            qd[1],
-                                            t81 - t80,
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
-            T::mul_add(
-                T::from_f64(0.2073),
-                t72 - t78,
-                T::mul_add(
-                    T::from_f64(0.054780300000000004),
-                    t23,
-                    T::mul_add(
-                        -T::from_f64(0.00047111058),
-                        t16,
-                        T::mul_add(
-                            -T::from_f64(0.00038346210000000003),
-                            t15,
-                            T::mul_add(
-                                -T::from_f64(0.0058574286190799995),
-                                t10,
-                                t80 - t81,
-                            ),
-                        ),
-                    ),
-                ),
-            ),
-            T::mul_add(
-                T::from_f64(0.0013357060146000001),
-                t35 - t30,
-                T::mul_add(
-                    T::from_f64(0.00007238626506919941),
-                    t21 + t17,
-                    T::mul_add(T::from_f64(0.00009645337053442467), t19, t65 - t71),
-                ),
-            ),
-            T::mul_add(
-                T::from_f64(0.10375),
-                t59 + t60,
-                T::mul_add(
-                    T::from_f64(0.0230207699865),
-                    t37 - t43,
-                    T::mul_add(
-                        T::from_f64(0.00006575368432434527),
-                        t22 - t32,
-                        T::mul_add(T::from_f64(0.0015767446734206029), t27, t63 - t64),
-                    ),
-                ),
-            ),
-            T::mul_add(
-                T::from_f64(0.00010000000000000503),
-                t51 - t48,
-                T::mul_add(
-                    T::from_f64(0.00000000000000000010842021724855044),
-                    t50 + t47,
-                    T::mul_add(
-                        T::from_f64(0.000000000000000000006709516445275485),
-                        t42 - t34,
-                        T::mul_add(
-                            T::from_f64(0.000014022756617410007),
-                            t41 + t33,
-                            T::from_f64(0.0007776443641723163) * (qd[5] + t32 - t22),
-                        ),
-                    ),
-                ),
-            ),
+            T::mul_add(T::from_f64(0.0006011508000000001), qd[0], t85),
+            t83,
+            t80,
+            t66,
+            t60,
+            t50,
         ]
     }
     /// Craig's centrifugal matrix C(q): `b = B(q) [qd qd] + C(q) [qd^2]`.
     ///
     /// Route: second velocity derivatives of the Newton-Euler bias.
-    /// Operations: 852 mul, 617 add, 0 div, 5 sin, 5 cos.
+    /// Operations: 810 mul, 464 add, 0 div, 5 sin, 5 cos.
     pub fn centrifugal(&self, q: &[T; 6]) -> [[T; 6]; 6] {
         let ([s1, s2, s3, s4, s5], [c1, c2, c3, c4, c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
             q[1],
@@ -3247,83 +2551,77 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                 t9,
                 T::from_f64(0.00000000000000000010842021724855044) * t8,
             );
-            let t28 = t0 * t1 * t3;
-            let t29 = t0 * t0 * t2;
-            let t30 = t0 * t1 * t2;
-            let t31 = t0 * t0 * t3;
-            let t32 = t2 * t5 * t7;
-            let t33 = t2 * t5 * t6;
-            let t34 = t4 * t5 * t7;
-            let t35 = t4 * t5 * t6 * t8;
-            let t36 = t4 * t5 * t6 * t9;
-            let t37 = T::mul_add(
+            let t28 = t0 * t1 * t2;
+            let t29 = t0 * t0 * t3;
+            let t30 = t2 * t5 * t7;
+            let t31 = t4 * t5 * t7;
+            let t32 = T::mul_add(
                 T::from_f64(0.0000000000000000002168404344971009),
                 t9,
                 T::from_f64(0.00020000000000001007) * t8,
             );
-            let t38 = T::mul_add(
-                T::from_f64(0.000000000000000000009078162188523246),
-                t9,
-                T::from_f64(0.00004879551323482105) * t8,
-            );
-            let t39 = T::mul_add(
+            let t33 = T::mul_add(
                 -T::from_f64(0.00020000000000001007),
                 t9,
                 T::from_f64(0.0000000000000000002168404344971009) * t8,
             );
-            let t40 = T::mul_add(t1, t3, t0 * t2);
-            let t41 = T::mul_add(-t1, t2, t0 * t3);
-            let t42 = T::mul_add(-t5, t8, t4 * t7 * t9);
-            let t43 = T::mul_add(t5, t9, t4 * t7 * t8);
-            let t44 = T::mul_add(
+            let t34 = T::mul_add(
+                T::from_f64(0.00004879551323482105),
+                t9,
+                -T::from_f64(0.000000000000000000009078162188523246) * t8,
+            );
+            let t35 = T::mul_add(
+                T::from_f64(0.000000000000000000009078162188523246),
+                t9,
+                T::from_f64(0.00004879551323482105) * t8,
+            );
+            let t36 = T::mul_add(t1, t3, t0 * t2);
+            let t37 = T::mul_add(-t1, t2, t0 * t3);
+            let t38 = T::mul_add(-t5, t8, t4 * t7 * t9);
+            let t39 = T::mul_add(-t5, t9, -t4 * t7 * t8);
+            let t40 = t9
+                * (T::mul_add(
+                    T::from_f64(0.0000000000000006979729257032011),
+                    t9,
+                    T::from_f64(0.004894691391055498) * t8,
+                ));
+            let t41 = t8
+                * (T::mul_add(
+                    T::from_f64(0.004705147001603182),
+                    t9,
+                    T::from_f64(0.0000000000000006979729257032011) * t8,
+                ));
+            let t42 = T::mul_add(
                 T::from_f64(0.0013224560195000002),
                 t12,
                 T::from_f64(0.0230207699865) * t5,
             );
-            let t45 = T::mul_add(
+            let t43 = T::mul_add(
                 T::from_f64(0.00009637730005078133),
                 t12,
                 T::from_f64(0.00006575368432434527) * t5,
             );
-            let t46 = T::mul_add(
+            let t44 = T::mul_add(
                 T::from_f64(0.00006575368432434527),
                 t12,
                 T::from_f64(0.0015767446734206029) * t5,
             );
-            let t47 = T::mul_add(
+            let t45 = T::mul_add(
                 T::from_f64(0.00010000000000000503),
                 t14,
                 T::from_f64(0.00000000000000000010842021724855044) * t13,
             );
-            let t48 = T::mul_add(
+            let t46 = T::mul_add(
                 -T::from_f64(0.0650091026469637),
                 t13,
                 T::from_f64(0.00010000000000000503) * t7,
             );
-            let t49 = T::mul_add(
+            let t47 = T::mul_add(
                 T::from_f64(0.0650091026469637),
                 t14,
                 T::from_f64(0.00000000000000000010842021724855044) * t7,
             );
-            let t50 = T::mul_add(
-                -T::from_f64(0.000000000000000000006709516445275485),
-                t14,
-                T::mul_add(
-                    -T::from_f64(0.000014022756617410007),
-                    t13,
-                    T::from_f64(0.0007776443641723163) * t7,
-                ),
-            );
-            let t51 = T::mul_add(
-                -T::from_f64(0.004705147001603182),
-                t14,
-                T::mul_add(
-                    T::from_f64(0.0000000000000006979729257032011),
-                    t13,
-                    T::from_f64(0.000000000000000000006709516445275485) * t7,
-                ),
-            );
-            let t52 = T::mul_add(
+            let t48 = T::mul_add(
                 T::from_f64(0.0000000000000006979729257032011),
                 t14,
                 T::mul_add(
@@ -3332,29 +2630,45 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                     T::from_f64(0.000014022756617410007) * t7,
                 ),
             );
-            let t53 = T::mul_add(
-                -T::from_f64(0.2075),
-                t17 + t18,
-                T::mul_add(T::from_f64(0.82), t3, -T::from_f64(0.4146)),
+            let t49 = T::mul_add(
+                -T::from_f64(0.000000000000000000006709516445275485),
+                t14,
+                T::mul_add(
+                    -T::from_f64(0.000014022756617410007),
+                    t13,
+                    T::from_f64(0.0007776443641723163) * t7,
+                ),
             );
-            let t54 = T::mul_add(
+            let t50 = T::mul_add(
+                -T::from_f64(0.004705147001603182),
+                t14,
+                T::mul_add(
+                    T::from_f64(0.0000000000000006979729257032011),
+                    t13,
+                    T::from_f64(0.000000000000000000006709516445275485) * t7,
+                ),
+            );
+            let t51 = T::from_f64(0.82) * (T::mul_add(t0, t0 * t2, t0 * t1 * t3));
+            let t52 = T::from_f64(0.82) * (t29 - t28);
+            let t53 = T::from_f64(0.82) * (t28 - t29);
+            let t54 = T::from_f64(0.0501829599638) * (t17 + t18);
+            let t55 = T::from_f64(0.2075) * (t17 + t18);
+            let t56 = T::mul_add(
+                T::from_f64(0.0026449120390000004),
+                t31,
+                -T::from_f64(0.046041539973) * t23,
+            );
+            let t57 = -T::from_f64(0.2075) * (t18 + t20);
+            let t58 = T::mul_add(
                 T::from_f64(0.2075),
                 t4 * t5 * t6,
                 T::from_f64(0.82) * t11,
             );
-            let t55 = T::mul_add(T::from_f64(0.2075), t17 + t18, T::from_f64(0.4146));
-            let t56 = t9 * t9 * t27;
-            let t57 = t8 * t8 * t27;
-            let t58 = T::mul_add(
-                T::from_f64(0.1300182052939274),
-                T::mul_add(t8, t8, t9 * t9),
-                T::from_f64(0.259766539973),
-            );
-            let t59 = t6 * t38;
-            let t60 = t4 * t7 * t39;
-            let t61 = t5 * t37;
-            let t62 = t41 * t4;
-            let t63 = t41 * t41 * t5 * t5;
+            let t59 = t9 * t9 * t27;
+            let t60 = t8 * t8 * t27;
+            let t61 = t6 * t35;
+            let t62 = t37 * t4;
+            let t63 = -t38;
             (
                 t0,
                 t1,
@@ -3488,199 +2802,224 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
             t126,
             t127,
         ) = {
-            let t64 = t41 * t41 * t4 * t4;
-            let t65 = t41 * t41 * t4 * t5;
-            let t66 = T::from_f64(0.054780300000000004) * t41;
-            let t67 = T::from_f64(0.00047111058) * t40;
-            let t68 = T::from_f64(0.2073) * t41;
-            let t69 = T::mul_add(
-                T::from_f64(0.00010000000000000503),
-                t43,
-                T::from_f64(0.00000000000000000010842021724855044) * t42,
-            );
-            let t70 = T::mul_add(
+            let t64 = -t39;
+            let t65 = t37 * t37 * t5 * t5;
+            let t66 = t37 * t37 * t4 * t4;
+            let t67 = t37 * t37 * t4 * t5;
+            let t68 = T::mul_add(
                 T::from_f64(0.0650091026469637),
-                t42,
-                T::from_f64(0.00010000000000000503) * t12,
-            );
-            let t71 = T::mul_add(
-                -T::from_f64(0.0650091026469637),
-                t43,
+                t39,
                 T::from_f64(0.00000000000000000010842021724855044) * t12,
             );
-            let t72 = T::mul_add(
-                T::from_f64(0.000000000000000000006709516445275485),
-                t43,
-                T::mul_add(
-                    T::from_f64(0.000014022756617410007),
-                    t42,
-                    T::from_f64(0.0007776443641723163) * t12,
-                ),
+            let t69 = T::mul_add(
+                T::from_f64(0.0650091026469637),
+                t38,
+                T::from_f64(0.00010000000000000503) * t12,
             );
-            let t73 = T::mul_add(
-                T::from_f64(0.004705147001603182),
-                t43,
-                T::mul_add(
-                    -T::from_f64(0.0000000000000006979729257032011),
-                    t42,
-                    T::from_f64(0.000000000000000000006709516445275485) * t12,
-                ),
-            );
-            let t74 = T::mul_add(
-                -T::from_f64(0.0000000000000006979729257032011),
-                t43,
-                T::mul_add(
-                    T::from_f64(0.004894691391055498),
-                    t42,
-                    T::from_f64(0.000014022756617410007) * t12,
-                ),
-            );
-            let t75 = t40 * t41 * t5;
-            let t76 = t40 * t41 * t4;
-            let t77 = t6 * t53;
-            let t78 = t7 * t53;
-            let t79 = t5 * t44;
-            let t80 = t4 * t6 * t44;
-            let t81 = t4 * t6 * t46;
-            let t82 = t5 * t45;
-            let t83 = t4 * t7 * t46;
-            let t84 = t4 * t7 * t45;
-            let t85 = t8 * t54;
-            let t86 = t9 * t54;
-            let t87 = t6 * t55;
-            let t88 = t7 * t55;
-            let t89 = t6 * t9 * t51;
-            let t90 = t6 * t8 * t52;
-            let t91 = T::mul_add(
+            let t70 = t36 * t37;
+            let t71 = t37 * t37;
+            let t72 = t36 * t36;
+            let t73 = t36 * t37 * t5;
+            let t74 = T::mul_add(T::from_f64(0.82), t3, -t55 - T::from_f64(0.4146));
+            let t75 = t55 + T::from_f64(0.4146);
+            let t76 = T::mul_add(
                 T::from_f64(2.0),
                 t8 * t26,
                 T::from_f64(0.000020750000000001043),
             );
-            let t92 = T::mul_add(
+            let t77 = T::mul_add(
                 T::from_f64(2.0),
                 t9 * t26,
                 T::from_f64(0.000000000000000000022497195079074216),
             );
-            let t93 = T::from_f64(2.0) * (t56 + t57);
-            let t94 = T::mul_add(
-                t8,
-                T::mul_add(
-                    T::from_f64(0.004705147001603182),
-                    t9,
-                    T::from_f64(0.0000000000000006979729257032011) * t8,
-                ),
-                -t9
+            let t78 = T::from_f64(2.0) * (t59 + t60);
+            let t79 = T::from_f64(0.1300182052939274) * (T::mul_add(t8, t8, t9 * t9))
+                + T::from_f64(0.259766539973);
+            let t80 = T::from_f64(2.0) * (t40 - t41);
+            let t81 = T::mul_add(
+                t7,
+                t35,
+                T::from_f64(0.10375)
                     * (T::mul_add(
-                        T::from_f64(0.0000000000000006979729257032011),
+                        -T::from_f64(0.0000000000000000002168404344971009),
                         t9,
-                        T::from_f64(0.004894691391055498) * t8,
+                        -T::from_f64(0.00020000000000001007) * t8,
                     )),
             );
-            let t95 = T::mul_add(
-                -t7,
-                t38,
-                T::mul_add(
-                    T::from_f64(0.000000000000000000022497195079074216),
-                    t9,
-                    T::from_f64(0.000020750000000001043) * t8,
-                ),
-            );
-            let t96 = T::mul_add(
-                -T::from_f64(0.10375),
-                t7 * t39,
-                T::mul_add(
-                    -T::from_f64(0.00004879551323482105),
-                    t9,
-                    T::from_f64(0.000000000000000000009078162188523246) * t8,
-                ),
-            );
-            let t97 = T::mul_add(-t4, t37, t5 * t7 * t39);
-            let t98 = T::mul_add(-t40, t7, t41 * t5 * t6);
-            let t99 = T::mul_add(t40, t6, t41 * t5 * t7);
-            let t100 = T::mul_add(
+            let t82 = T::mul_add(T::from_f64(0.10375), t7 * t33, t34);
+            let t83 = T::mul_add(-t4, t32, t5 * t7 * t33);
+            let t84 = T::mul_add(t5, t32, t4 * t7 * t33);
+            let t85 = T::mul_add(-t36, t7, t37 * t5 * t6);
+            let t86 = T::mul_add(t36, t6, t37 * t5 * t7);
+            let t87 = T::mul_add(
                 T::from_f64(0.0250914799819),
                 t62,
-                T::from_f64(0.0013357060146000001) * t40,
+                T::from_f64(0.0013357060146000001) * t36,
             );
-            let t101 = T::mul_add(
+            let t88 = T::mul_add(
                 T::from_f64(0.0017919207358628258),
                 t62,
-                T::from_f64(0.00007238626506919941) * t40,
+                T::from_f64(0.00007238626506919941) * t36,
             );
-            let t102 = T::mul_add(
+            let t89 = T::mul_add(
                 T::from_f64(0.00007238626506919941),
                 t62,
-                T::from_f64(0.00009645337053442467) * t40,
+                T::from_f64(0.00009645337053442467) * t36,
             );
-            let t103 = t41 * (T::from_f64(0.00035435414799999976) * t40);
-            let t104 = t40 * (T::from_f64(0.00590744776708) * t41);
-            let t105 = t41 * t68;
-            let t106 = T::mul_add(
-                -T::from_f64(0.82),
-                t32,
-                T::mul_add(T::from_f64(0.2075), t23, t77),
+            let t90 = T::mul_add(
+                T::from_f64(0.00000000000000000010842021724855044),
+                t63,
+                T::from_f64(0.00010000000000000503) * t39,
             );
-            let t107 = t43 * t69;
-            let t108 = t4 * t6 * t70;
-            let t109 = t4 * t6 * t71;
-            let t110 = t42 * t69;
-            let t111 = t42 * t70;
-            let t112 = t43 * t71;
-            let t113 = t43 * t72;
-            let t114 = t4 * t6 * t73;
-            let t115 = t4 * t6 * t74;
-            let t116 = t42 * t72;
-            let t117 = t42 * t73;
-            let t118 = t43 * t74;
-            let t119 = T::mul_add(T::from_f64(0.2075), t23, -t87);
-            let t120 = T::mul_add(
-                -T::from_f64(2.0),
-                T::mul_add(t7, t48, t6 * t8 * t47),
-                T::from_f64(0.213725) * t24,
+            let t91 = T::mul_add(
+                -T::from_f64(0.0650091026469637),
+                t63,
+                T::from_f64(0.00010000000000000503) * t12,
             );
-            let t121 = T::mul_add(
-                T::from_f64(2.0),
-                T::mul_add(t6, t9 * t47, t7 * t49),
-                T::from_f64(0.213725) * t25,
-            );
-            let t122 = T::mul_add(
-                T::from_f64(2.0),
-                T::mul_add(t7, t51, t6 * t8 * t50),
+            let t92 = T::mul_add(
+                -T::from_f64(0.004894691391055498),
+                t63,
                 T::mul_add(
-                    -T::from_f64(0.013489388799244969),
-                    t25,
-                    T::from_f64(0.000000000000000000022497195079074216) * t22,
+                    T::from_f64(0.0000000000000006979729257032011),
+                    t39,
+                    T::from_f64(0.000014022756617410007) * t12,
                 ),
             );
-            let t123 = T::mul_add(
-                -T::from_f64(2.0),
-                T::mul_add(t6, t9 * t50, t7 * t52),
+            let t93 = T::mul_add(
+                -T::from_f64(0.000014022756617410007),
+                t63,
                 T::mul_add(
+                    -T::from_f64(0.000000000000000000006709516445275485),
+                    t39,
+                    T::from_f64(0.0007776443641723163) * t12,
+                ),
+            );
+            let t94 = T::mul_add(
+                T::from_f64(0.0000000000000006979729257032011),
+                t63,
+                T::mul_add(
+                    -T::from_f64(0.004705147001603182),
+                    t39,
+                    T::from_f64(0.000000000000000000006709516445275485) * t12,
+                ),
+            );
+            let t95 = T::mul_add(
+                T::from_f64(0.00010000000000000503),
+                t64,
+                T::from_f64(0.00000000000000000010842021724855044) * t38,
+            );
+            let t96 = T::mul_add(
+                -T::from_f64(0.0650091026469637),
+                t64,
+                T::from_f64(0.00000000000000000010842021724855044) * t12,
+            );
+            let t97 = T::mul_add(
+                T::from_f64(0.004705147001603182),
+                t64,
+                T::mul_add(
+                    -T::from_f64(0.0000000000000006979729257032011),
+                    t38,
+                    T::from_f64(0.000000000000000000006709516445275485) * t12,
+                ),
+            );
+            let t98 = T::mul_add(
+                T::from_f64(0.000000000000000000006709516445275485),
+                t64,
+                T::mul_add(
+                    T::from_f64(0.000014022756617410007),
+                    t38,
+                    T::from_f64(0.0007776443641723163) * t12,
+                ),
+            );
+            let t99 = T::mul_add(
+                -T::from_f64(0.0000000000000006979729257032011),
+                t64,
+                T::mul_add(
+                    T::from_f64(0.004894691391055498),
+                    t38,
+                    T::from_f64(0.000014022756617410007) * t12,
+                ),
+            );
+            let t100 = T::mul_add(-T::from_f64(0.4146), t70, t51);
+            let t101 = T::mul_add(-T::from_f64(0.4146), t71, t52);
+            let t102 = t6 * t74;
+            let t103 = T::mul_add(
+                -T::from_f64(2.0),
+                t5 * t42,
+                -T::from_f64(0.046041539973) * t20,
+            );
+            let t104 = T::mul_add(
+                T::from_f64(2.0),
+                t4 * t6 * t42,
+                T::from_f64(0.0026449120390000004) * t20,
+            );
+            let t105 = T::from_f64(2.0) * (T::mul_add(-t5, t43, t4 * t6 * t44));
+            let t106 = T::mul_add(
+                T::from_f64(2.0),
+                t4 * t7 * t44,
+                -T::from_f64(0.0031610439469427687) * t31,
+            );
+            let t107 = T::mul_add(
+                -T::from_f64(2.0),
+                t4 * t7 * t43,
+                T::from_f64(0.0031610439469427687) * t23,
+            );
+            let t108 = t6 * t75;
+            let t109 = t7 * t75;
+            let t110 = -t83;
+            let t111 = T::mul_add(
+                -T::from_f64(0.0013224560195000002),
+                t85,
+                T::from_f64(0.0230207699865) * t62,
+            );
+            let t112 = T::mul_add(
+                -T::from_f64(0.00009637730005078133),
+                t85,
+                T::from_f64(0.00006575368432434527) * t62,
+            );
+            let t113 = T::mul_add(
+                -T::from_f64(0.00006575368432434527),
+                t85,
+                T::from_f64(0.0015767446734206029) * t62,
+            );
+            let t114 = T::from_f64(0.0228) * (t71 + t72) - T::from_f64(0.0032);
+            let t115 = T::mul_add(T::from_f64(0.4146), t71, -t52)
+                + T::from_f64(0.2075) * (t65 + t66);
+            let t116 = t85 * t86;
+            let t117 = t37 * t4 * t86;
+            let t118 = t86 * t86;
+            let t119 = T::mul_add(-t7, t74, -T::from_f64(0.82) * t2 * t5 * t6);
+            let t120 = T::mul_add(-T::from_f64(0.82), t30, t102);
+            let t121 = t57 + t109;
+            let t122 = T::mul_add(T::from_f64(0.2075), t23, -t108);
+            let t123 = -T::from_f64(2.0) * (T::mul_add(t7, t50, t6 * t8 * t49))
+                + T::mul_add(
+                    T::from_f64(0.013489388799244969),
+                    t25,
+                    -T::from_f64(0.000000000000000000022497195079074216) * t22,
+                );
+            let t124 = -T::from_f64(2.0) * (T::mul_add(t6, t9 * t49, t7 * t48))
+                + T::mul_add(
                     T::from_f64(0.013489388799244969),
                     t24,
                     T::from_f64(0.000020750000000001043) * t22,
-                ),
-            );
-            let t124 = T::mul_add(
-                T::from_f64(2.0),
-                T::mul_add(t6, t8 * t49, -t6 * t9 * t48),
-                T::from_f64(0.259766539973) * t22,
-            );
-            let t125 = T::mul_add(
-                T::from_f64(2.0),
-                t89 - t90,
-                T::mul_add(
+                );
+            let t125 = T::from_f64(2.0) * (T::mul_add(-t6, t8 * t48, t6 * t9 * t50))
+                + T::mul_add(
                     -T::from_f64(0.000020750000000001043),
                     t25,
-                    T::mul_add(
-                        -T::from_f64(0.000000000000000000022497195079074216),
-                        t24,
-                        T::from_f64(0.00013150736864869054) * t19,
-                    ),
-                ),
+                    -T::from_f64(0.000000000000000000022497195079074216) * t24,
+                );
+            let t126 = T::mul_add(
+                T::from_f64(0.213725),
+                t24,
+                -(T::from_f64(2.0) * (T::mul_add(t7, t46, t6 * t8 * t45))),
             );
-            let t126 = t8 * t92;
-            let t127 = t9 * t91;
+            let t127 = T::mul_add(
+                T::from_f64(0.213725),
+                t25,
+                T::from_f64(2.0) * (T::mul_add(t6, t9 * t45, t7 * t47)),
+            );
             (
                 t64,
                 t65,
@@ -3814,283 +3153,223 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
             t190,
             t191,
         ) = {
-            let t128 = -T::from_f64(2.0) * t94;
-            let t129 = t4 * t95;
-            let t130 = t5 * t96;
-            let t131 = T::mul_add(-T::from_f64(0.0114), t97, t59);
-            let t132 = T::from_f64(0.0013224560195000002) * t99;
-            let t133 = T::from_f64(0.0230207699865) * t99;
-            let t134 = T::mul_add(
-                -T::from_f64(0.0013224560195000002),
-                t98,
-                T::from_f64(0.0230207699865) * t62,
+            let t128 = T::mul_add(
+                -T::from_f64(0.213725),
+                t22,
+                -(T::from_f64(2.0) * (T::mul_add(t6, t8 * t47, -t6 * t9 * t46))),
             );
-            let t135 = T::from_f64(0.0015805219734713843) * t99;
+            let t129 = T::mul_add(-t7, t79, t6 * t78);
+            let t130 = T::mul_add(t6, t79, t7 * t78);
+            let t131 = T::mul_add(T::from_f64(0.0114), t110, t61);
+            let t132 = T::mul_add(t2, t6 * t33, t3 * t83);
+            let t133 = T::mul_add(t37, t4 * t8, t86 * t9);
+            let t134 = T::mul_add(-t37, t4 * t9, t86 * t8);
+            let t135 = t119 + t57;
             let t136 = T::mul_add(
-                -T::from_f64(0.00009637730005078133),
-                t98,
-                T::from_f64(0.00006575368432434527) * t62,
+                T::from_f64(0.2075),
+                t23,
+                -(T::mul_add(T::from_f64(0.82), t30, -t102)),
             );
-            let t137 = T::mul_add(
-                -T::from_f64(0.00006575368432434527),
-                t98,
-                T::from_f64(0.0015767446734206029) * t62,
+            let t137 = T::mul_add(T::from_f64(0.046041539973), t22, -t128);
+            let t138 = T::mul_add(
+                T::from_f64(0.10375),
+                -T::from_f64(2.0) * (t59 + t60),
+                T::mul_add(-t9, t76, t8 * t77),
             );
-            let t138 = T::from_f64(0.10375) * t99;
-            let t139 = T::mul_add(
-                -T::from_f64(2.0),
-                t40 * t68,
-                T::from_f64(0.82) * (t28 + t29),
-            );
-            let t140 = T::mul_add(
-                T::from_f64(2.0),
-                T::mul_add(
-                    t40,
-                    T::from_f64(0.0114) * t40,
-                    t41 * (T::from_f64(0.0114) * t41),
-                ),
-                -T::from_f64(0.0032),
-            );
-            let t141 = t41 * t4 * t100;
-            let t142 = t41 * t5 * t101;
+            let t139 = T::mul_add(t8, t76, t9 * t77)
+                - T::from_f64(0.00013150736864869054);
+            let t140 = t5 * t130;
+            let t141 = t4 * t130;
+            let t142 = T::mul_add(t4, t82, -t5 * t81)
+                + T::mul_add(
+                    -T::from_f64(0.2073),
+                    -t84,
+                    -T::from_f64(0.0114) * t6 * t33,
+                );
             let t143 = T::mul_add(
-                T::from_f64(2.0),
-                t105,
-                T::mul_add(
-                    T::from_f64(0.82),
-                    t30 - t31,
-                    T::from_f64(0.2075) * (t63 + t64),
-                ),
+                T::from_f64(0.2073),
+                t110,
+                T::mul_add(-t5, t82, -t4 * t81),
             );
-            let t144 = t9 * t106;
-            let t145 = t8 * t106;
+            let t144 = T::mul_add(
+                T::from_f64(0.00010000000000000503),
+                t134,
+                T::from_f64(0.00000000000000000010842021724855044) * t133,
+            );
+            let t145 = T::mul_add(
+                T::from_f64(0.0650091026469637),
+                t133,
+                T::from_f64(0.00010000000000000503) * t85,
+            );
             let t146 = T::mul_add(
-                T::from_f64(2.0),
-                t79 + t111 - t112,
+                -T::from_f64(0.0650091026469637),
+                t134,
+                T::from_f64(0.00000000000000000010842021724855044) * t85,
+            );
+            let t147 = T::mul_add(
+                T::from_f64(0.004705147001603182),
+                t134,
                 T::mul_add(
-                    T::from_f64(1.493),
-                    t78,
-                    T::mul_add(
-                        T::from_f64(1.22426),
-                        t33,
-                        T::mul_add(
-                            T::from_f64(0.259766539973),
-                            t20,
-                            T::from_f64(0.213725) * t18,
-                        ),
-                    ),
+                    -T::from_f64(0.0000000000000006979729257032011),
+                    t133,
+                    T::from_f64(0.000000000000000000006709516445275485) * t85,
                 ),
             );
-            let t147 = t9 * t119;
-            let t148 = t8 * t119;
+            let t148 = T::mul_add(
+                T::from_f64(0.000000000000000000006709516445275485),
+                t134,
+                T::mul_add(
+                    T::from_f64(0.000014022756617410007),
+                    t133,
+                    T::from_f64(0.0007776443641723163) * t85,
+                ),
+            );
             let t149 = T::mul_add(
-                -T::from_f64(1.493),
-                t88,
+                -T::from_f64(0.0000000000000006979729257032011),
+                t134,
+                T::mul_add(
+                    T::from_f64(0.004894691391055498),
+                    t133,
+                    T::from_f64(0.000014022756617410007) * t85,
+                ),
+            );
+            let t150 = T::mul_add(-t4, t114, -t5 * t100);
+            let t151 = T::mul_add(-t5, t114, t4 * t100);
+            let t152 = T::mul_add(
+                -T::from_f64(0.463),
+                t101,
                 T::mul_add(
                     T::from_f64(2.0),
-                    t79 + t111 - t112,
-                    T::mul_add(
-                        T::from_f64(0.259766539973),
-                        t20,
-                        T::from_f64(0.213725) * t18,
-                    ),
+                    t37 * t4 * t87,
+                    T::from_f64(0.0501829599638) * t65,
                 ),
             );
-            let t150 = t9 * t120;
-            let t151 = t8 * t121;
-            let t152 = t8 * t120;
-            let t153 = t9 * t121;
-            let t154 = t8 * t122;
-            let t155 = t9 * t123;
-            let t156 = t7 * t125;
-            let t157 = T::mul_add(
-                t8,
-                t91,
-                T::mul_add(t9, t92, -T::from_f64(0.00013150736864869054)),
+            let t153 = T::mul_add(
+                T::from_f64(1.03),
+                t135,
+                -(T::from_f64(2.0) * (T::mul_add(-t64, t68, t38 * t91))),
             );
-            let t158 = t7 * t128;
-            let t159 = T::mul_add(t6, t58, t7 * t93);
-            let t160 = T::mul_add(-t7, t58, t6 * t93);
-            let t161 = T::mul_add(
-                t4,
-                t96,
+            let t154 = T::mul_add(t9, t122, -T::from_f64(0.2075) * t4 * t5 * t6 * t8);
+            let t155 = T::mul_add(t8, t122, T::from_f64(0.2075) * t4 * t5 * t6 * t9);
+            let t156 = T::mul_add(
+                T::from_f64(1.03),
+                t121,
+                -(T::from_f64(2.0) * (T::mul_add(-t64, t96, t38 * t69))),
+            );
+            let t157 = T::mul_add(t8, t127, t9 * t126);
+            let t158 = T::mul_add(-t9, t127, t8 * t126);
+            let t159 = T::mul_add(T::from_f64(0.00013150736864869054), t19, -(-t125));
+            let t160 = T::mul_add(T::from_f64(0.10375), t130, t138);
+            let t161 = T::mul_add(t2, t129, t3 * t5 * t130);
+            let t162 = T::mul_add(-t0, T::mul_add(-t3, t6 * t33, t2 * t83), -t1 * t132);
+            let t163 = -t150;
+            let t164 = T::mul_add(
+                T::from_f64(0.463),
+                t151,
                 T::mul_add(
-                    -t5,
-                    t95,
-                    T::mul_add(
-                        -T::from_f64(0.2073),
-                        t60 + t61,
-                        T::from_f64(0.0114) * t6 * t39,
-                    ),
+                    -T::from_f64(2.0),
+                    t36 * t87,
+                    -T::from_f64(0.0026714120292000002) * t65,
                 ),
             );
-            let t162 = T::mul_add(t2, t6 * t39, t3 * t97);
-            let t163 = T::mul_add(t41, t4 * t8, t99 * t9);
-            let t164 = T::mul_add(-t41, t4 * t9, t99 * t8);
-            let t165 = t5 * t139;
-            let t166 = t4 * t140;
-            let t167 = t4 * t139;
-            let t168 = t5 * t140;
-            let t169 = t6 * t143;
-            let t170 = t7 * t143;
-            let t171 = t99 * t132;
-            let t172 = t98 * t134;
-            let t173 = t99 * t136;
-            let t174 = t98 * t135;
-            let t175 = t99 * t138;
-            let t176 = T::mul_add(
-                T::from_f64(2.0),
-                t107 + t108,
-                T::from_f64(1.03) * (t144 - t85),
+            let t165 = T::mul_add(T::from_f64(0.2075), t73, t150);
+            let t166 = T::mul_add(-T::from_f64(0.2075), t36 * t37 * t4, t151);
+            let t167 = T::mul_add(-t8, t58, t9 * t136);
+            let t168 = T::mul_add(t9, t58, t8 * t136);
+            let t169 = T::mul_add(T::from_f64(0.463), t119, t103) + t153;
+            let t170 = T::mul_add(
+                T::from_f64(1.03),
+                t154,
+                T::from_f64(2.0) * (T::mul_add(t4, t6 * t69, t64 * t95)),
             );
-            let t177 = T::mul_add(
-                T::from_f64(2.0),
-                t116 - t115,
-                T::mul_add(
-                    T::from_f64(0.0650091026469637),
-                    t85 - t144,
-                    T::mul_add(
-                        T::from_f64(0.00010000000000000503),
-                        t78,
-                        T::mul_add(
-                            T::from_f64(0.00008200000000000412),
-                            t33,
-                            T::from_f64(0.000020750000000001043) * (t18 + t20),
-                        ),
-                    ),
-                ),
+            let t171 = T::mul_add(
+                T::from_f64(1.03),
+                t155,
+                -(T::from_f64(2.0) * (T::mul_add(t38, t95, t4 * t6 * t96))),
             );
+            let t172 = T::mul_add(T::from_f64(0.463), t109, t103) + t156;
+            let t173 = T::mul_add(T::from_f64(0.046041539973), t19, t157);
+            let t174 = T::from_f64(0.0026449120390000004) * (t21 + t22) + t158;
+            let t175 = T::mul_add(t7, t80, t6 * t139);
+            let t176 = T::mul_add(-t6, t80, t7 * t139);
+            let t177 = T::from_f64(2.0) * (T::mul_add(-t36, t88, t37 * t4 * t89))
+                + T::mul_add(
+                    T::from_f64(0.0250914799819),
+                    t151,
+                    -T::from_f64(0.0013357060146000001) * t101,
+                );
             let t178 = T::mul_add(
-                T::from_f64(2.0),
-                t114 - t113,
+                T::from_f64(0.0250914799819),
+                t163,
                 T::mul_add(
-                    T::from_f64(0.0650091026469637),
-                    t145 + t86,
-                    T::mul_add(
-                        T::from_f64(0.00000000000000000010842021724855044),
-                        t78,
-                        T::mul_add(
-                            T::from_f64(0.00000000000000000008890457814381136),
-                            t33,
-                            T::from_f64(0.000000000000000000022497195079074216)
-                                * (t18 + t20),
-                        ),
-                    ),
+                    T::from_f64(2.0),
+                    t37 * t5 * t89,
+                    -T::from_f64(0.0035915482127945007) * t73,
                 ),
             );
             let t179 = T::mul_add(
-                -T::from_f64(2.0),
-                t109 + t110,
-                T::from_f64(1.03) * (t145 + t86),
-            );
-            let t180 = t6 * t146;
-            let t181 = t7 * t146;
-            let t182 = T::mul_add(
-                T::from_f64(0.00010000000000000503),
-                t145 + t86,
+                T::from_f64(0.0013357060146000001),
+                t163,
                 T::mul_add(
-                    T::from_f64(0.00000000000000000010842021724855044),
-                    t144 - t85,
-                    T::mul_add(
-                        T::from_f64(2.0),
-                        t118 - t83 - t117,
-                        T::mul_add(
-                            T::from_f64(0.0031610439469427687),
-                            t34,
-                            T::mul_add(
-                                -T::from_f64(0.0013224560195000002),
-                                t77,
-                                T::from_f64(0.0010844139359900001) * t32,
-                            ),
-                        ),
-                    ),
+                    -T::from_f64(2.0),
+                    t37 * t5 * t88,
+                    T::from_f64(0.0035915482127945007) * t67,
                 ),
+            );
+            let t180 = T::mul_add(
+                T::from_f64(0.463),
+                t166,
+                T::mul_add(
+                    -T::from_f64(2.0),
+                    t85 * t111,
+                    T::from_f64(0.0026449120390000004) * t118,
+                ),
+            );
+            let t181 = T::mul_add(-T::from_f64(0.2075), t37 * t4 * t85, t166);
+            let t182 = T::mul_add(
+                T::from_f64(1.03),
+                t167,
+                T::from_f64(2.0) * (T::mul_add(t4, t6 * t91, -t64 * t90)),
             );
             let t183 = T::mul_add(
-                -T::from_f64(0.213725),
-                t35,
-                T::mul_add(T::from_f64(1.03), t147, T::from_f64(2.0) * (t107 + t108)),
+                T::from_f64(1.03),
+                t168,
+                -(T::from_f64(2.0) * (T::mul_add(-t38, t90, t4 * t6 * t68))),
             );
-            let t184 = T::mul_add(
-                -T::from_f64(0.213725),
-                t36,
-                T::mul_add(-T::from_f64(1.03), t148, T::from_f64(2.0) * (t109 + t110)),
-            );
-            let t185 = T::mul_add(
-                T::from_f64(0.013489388799244969),
-                t36,
-                T::mul_add(
-                    T::from_f64(0.0650091026469637),
-                    t148,
-                    T::mul_add(
-                        -T::from_f64(0.00000000000000000010842021724855044),
-                        t88,
-                        T::mul_add(
-                            T::from_f64(2.0),
-                            t114 - t113,
-                            T::from_f64(0.000000000000000000022497195079074216)
-                                * (t18 + t20),
-                        ),
-                    ),
-                ),
-            );
-            let t186 = T::mul_add(
-                T::from_f64(0.013489388799244969),
-                t35,
-                T::mul_add(
+            let t184 = T::from_f64(2.0) * (T::mul_add(-t4, t6 * t97, t64 * t98))
+                + T::mul_add(
                     -T::from_f64(0.0650091026469637),
-                    t147,
-                    T::mul_add(
-                        -T::from_f64(0.00010000000000000503),
-                        t88,
-                        T::mul_add(
-                            T::from_f64(2.0),
-                            t116 - t115,
-                            T::from_f64(0.000020750000000001043) * (t18 + t20),
-                        ),
-                    ),
-                ),
-            );
-            let t187 = t6 * t149;
-            let t188 = t7 * t149;
-            let t189 = T::mul_add(
-                T::from_f64(0.000020750000000001043),
-                t36,
-                T::mul_add(
+                    t155,
+                    T::from_f64(0.00000000000000000010842021724855044) * t121,
+                );
+            let t185 = T::from_f64(2.0) * (T::mul_add(t38, t98, -t4 * t6 * t99))
+                + T::mul_add(
+                    -T::from_f64(0.0650091026469637),
+                    t154,
+                    -T::from_f64(0.00010000000000000503) * t121,
+                );
+            let t186 = T::from_f64(2.0) * (T::mul_add(t64, t99, -t38 * t97))
+                + T::mul_add(
                     T::from_f64(0.00010000000000000503),
-                    t148,
-                    T::mul_add(
-                        -T::from_f64(0.000000000000000000022497195079074216),
-                        t35,
-                        T::mul_add(
-                            T::from_f64(0.00000000000000000010842021724855044),
-                            t147,
-                            T::mul_add(
-                                T::from_f64(0.0013224560195000002),
-                                t87,
-                                T::mul_add(
-                                    T::from_f64(2.0),
-                                    t118 - t83 - t117,
-                                    T::from_f64(0.0031610439469427687) * t34,
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
+                    t155,
+                    T::from_f64(0.00000000000000000010842021724855044) * t154,
+                );
+            let t187 = T::mul_add(
+                -T::from_f64(0.10375),
+                -t158,
+                T::mul_add(t8, t124, -t9 * t123),
             );
-            let t190 = T::mul_add(T::from_f64(0.046041539973), t19, t150 + t151);
+            let t188 = T::mul_add(
+                T::from_f64(0.10375),
+                -t157,
+                T::mul_add(-t9, t124, -t8 * t123),
+            );
+            let t189 = t174 - T::from_f64(0.0026714120292000002);
+            let t190 = T::mul_add(T::from_f64(0.0114), t140, t175);
             let t191 = T::mul_add(
-                t8,
-                t123,
-                T::mul_add(
-                    t9,
-                    t122,
-                    T::mul_add(
-                        T::from_f64(0.10375),
-                        t152 - t153,
-                        T::from_f64(0.00013150736864869054) * t21,
-                    ),
-                ),
+                -t0,
+                T::mul_add(-t3, t129, t2 * t5 * t130),
+                -t1 * t161,
             );
             (
                 t128,
@@ -4226,241 +3505,188 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
             t255,
         ) = {
             let t192 = T::mul_add(
-                T::from_f64(0.0026449120390000004),
-                t21 + t22,
-                t152 - t153 - T::from_f64(0.0026714120292000002),
+                T::from_f64(0.41),
+                t84,
+                T::mul_add(t2, t131, -t3 * t142),
             );
-            let t193 = t6 * t157;
-            let t194 = t5 * t159;
-            let t195 = t4 * t159;
-            let t196 = T::mul_add(
-                -T::from_f64(0.10375),
-                t159,
-                T::mul_add(T::from_f64(0.2075), t56 + t57, t127 - t126),
-            );
-            let t197 = T::mul_add(
-                -T::from_f64(0.0650091026469637),
-                t164,
-                T::from_f64(0.00000000000000000010842021724855044) * t98,
-            );
-            let t198 = T::mul_add(
-                T::from_f64(0.00010000000000000503),
-                t164,
-                T::from_f64(0.00000000000000000010842021724855044) * t163,
-            );
-            let t199 = T::mul_add(
-                T::from_f64(0.0650091026469637),
-                t163,
-                T::from_f64(0.00010000000000000503) * t98,
-            );
-            let t200 = T::mul_add(
-                T::from_f64(0.004705147001603182),
-                t164,
+            let t193 = T::mul_add(t6, t115, -t7 * t165);
+            let t194 = T::mul_add(t7, t115, t6 * t165);
+            let t195 = T::from_f64(2.0) * (T::mul_add(-t4, t6 * t94, t64 * t93))
+                + T::mul_add(
+                    -T::from_f64(0.0650091026469637),
+                    t168,
+                    T::from_f64(0.00000000000000000010842021724855044) * t135,
+                );
+            let t196 = T::from_f64(2.0) * (T::mul_add(t38, t93, -t4 * t6 * t92))
+                + T::mul_add(
+                    -T::from_f64(0.0650091026469637),
+                    t167,
+                    -T::from_f64(0.00010000000000000503) * t135,
+                );
+            let t197 = T::from_f64(2.0) * (T::mul_add(t64, t92, -t38 * t94))
+                + T::mul_add(
+                    T::from_f64(0.00010000000000000503),
+                    t168,
+                    T::from_f64(0.00000000000000000010842021724855044) * t167,
+                );
+            let t198 = T::mul_add(-t8, t171, -t9 * t170);
+            let t199 = T::mul_add(t9, t171, -t8 * t170);
+            let t200 = T::mul_add(T::from_f64(0.00013150736864869054), t21, t187);
+            let t201 = T::mul_add(-T::from_f64(0.002968289346841206), t19, t188);
+            let t202 = T::mul_add(-t7, t137, t6 * t173);
+            let t203 = T::mul_add(t6, t137, t7 * t173);
+            let t204 = -t193;
+            let t205 = T::mul_add(
+                T::from_f64(0.463),
+                t194,
                 T::mul_add(
-                    -T::from_f64(0.0000000000000006979729257032011),
-                    t163,
-                    T::from_f64(0.000000000000000000006709516445275485) * t98,
+                    -T::from_f64(0.046041539973),
+                    t118,
+                    -T::from_f64(2.0) * t37 * t4 * t111,
                 ),
             );
-            let t201 = T::mul_add(
-                T::from_f64(0.000000000000000000006709516445275485),
-                t164,
+            let t206 = t194 + -T::from_f64(0.2075) * (t66 + t118);
+            let t207 = T::mul_add(-T::from_f64(0.2075), t116, t193);
+            let t208 = T::mul_add(-t8, t183, -t9 * t182);
+            let t209 = T::mul_add(t9, t183, -t8 * t182);
+            let t210 = T::mul_add(T::from_f64(0.463), t108, t56) + t198;
+            let t211 = t104 + t199;
+            let t212 = T::mul_add(-T::from_f64(0.0013224560195000002), t108, t106)
+                + -t186;
+            let t213 = T::mul_add(T::from_f64(0.10375), t203, t201);
+            let t214 = T::mul_add(t4, t160, t5 * t176)
+                + T::mul_add(T::from_f64(0.2073), t141, -T::from_f64(0.0114) * t129);
+            let t215 = T::mul_add(
+                -T::from_f64(0.2073),
+                t140,
+                T::mul_add(-t5, t160, t4 * t176),
+            );
+            let t216 = T::mul_add(-t1, T::mul_add(t3, t131, t2 * t142), -t0 * t192);
+            let t217 = -T::from_f64(2.0) * (T::mul_add(t37, t4 * t112, t85 * t113))
+                + T::mul_add(
+                    T::from_f64(0.0013224560195000002),
+                    t194,
+                    T::from_f64(0.0230207699865) * t166,
+                );
+            let t218 = T::mul_add(
+                T::from_f64(0.0013224560195000002),
+                t204,
                 T::mul_add(
-                    T::from_f64(0.000014022756617410007),
-                    t163,
-                    T::from_f64(0.0007776443641723163) * t98,
+                    -T::from_f64(2.0),
+                    t86 * t113,
+                    T::from_f64(0.0031610439469427687) * t117,
                 ),
             );
-            let t202 = T::mul_add(
-                -T::from_f64(0.0000000000000006979729257032011),
-                t164,
-                T::mul_add(
-                    T::from_f64(0.004894691391055498),
-                    t163,
-                    T::from_f64(0.000014022756617410007) * t98,
-                ),
-            );
-            let t203 = T::mul_add(-T::from_f64(0.2075), t75, t165 + t166);
-            let t204 = T::mul_add(
-                -T::from_f64(0.2075),
-                T::mul_add(t41, t4 * t98, t76),
-                t167 - t168,
-            );
-            let t205 = t9 * t176;
-            let t206 = t8 * t179;
-            let t207 = t8 * t176;
-            let t208 = t9 * t179;
-            let t209 = t8 * t178;
-            let t210 = t9 * t177;
-            let t211 = t7 * t182;
-            let t212 = t9 * t183;
-            let t213 = t8 * t184;
-            let t214 = t8 * t183;
-            let t215 = t9 * t184;
-            let t216 = t8 * t185;
-            let t217 = t9 * t186;
-            let t218 = t7 * t189;
-            let t219 = t6 * t191;
-            let t220 = t5 * t192;
-            let t221 = T::mul_add(-t6, t128, t7 * t157);
-            let t222 = t5 * t196;
-            let t223 = T::mul_add(T::from_f64(0.0114), t194, t193 + t158);
-            let t224 = T::mul_add(t2, t160, t3 * t5 * t159);
-            let t225 = t7 * t203;
-            let t226 = t6 * t203;
-            let t227 = t8 * t204;
-            let t228 = t9 * t204;
-            let t229 = t163 * t200;
-            let t230 = t164 * t202;
-            let t231 = T::mul_add(
-                -T::from_f64(0.0026449120390000004),
-                t34,
-                T::mul_add(
-                    T::from_f64(0.463),
-                    t77,
-                    T::mul_add(
-                        -T::from_f64(0.37966),
-                        t32,
-                        T::mul_add(T::from_f64(0.046041539973), t23, t205 + t206),
-                    ),
-                ),
-            );
-            let t232 = T::mul_add(
-                t8,
-                t177,
-                T::mul_add(
-                    t9,
-                    t178,
-                    T::mul_add(
-                        T::from_f64(0.10375),
-                        t208 - t207,
-                        T::mul_add(
-                            T::from_f64(2.0),
-                            t81 - t82,
-                            T::mul_add(
-                                -T::from_f64(0.0013224560195000002),
-                                t78,
-                                T::mul_add(
-                                    -T::from_f64(0.0010844139359900001),
-                                    t33,
-                                    T::from_f64(0.01887703138893) * t11,
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t233 = T::mul_add(
-                T::from_f64(2.0),
-                t80,
-                T::mul_add(
-                    T::from_f64(0.0026449120390000004),
-                    t20,
-                    T::mul_add(
-                        -T::from_f64(0.0026714120292000002),
-                        t17,
-                        T::mul_add(T::from_f64(0.75932), t11, t208 - t207),
-                    ),
-                ),
-            );
-            let t234 = T::mul_add(
-                -T::from_f64(0.463),
-                t87,
-                T::mul_add(
-                    -T::from_f64(0.0026449120390000004),
-                    t34,
-                    T::mul_add(T::from_f64(0.046041539973), t23, t212 - t213),
-                ),
-            );
-            let t235 = T::mul_add(
-                t8,
-                t186,
-                T::mul_add(
-                    t9,
-                    t185,
-                    T::mul_add(
-                        -T::from_f64(0.10375),
-                        t214 + t215,
-                        T::mul_add(
-                            T::from_f64(0.0013224560195000002),
-                            t88,
-                            T::from_f64(2.0) * (t81 - t82),
-                        ),
-                    ),
-                ),
-            );
-            let t236 = T::mul_add(
-                -T::from_f64(2.0),
-                t80,
-                T::mul_add(
-                    -T::from_f64(0.0026449120390000004),
-                    t20,
-                    T::mul_add(T::from_f64(0.0026714120292000002), t17, t214 + t215),
-                ),
-            );
-            let t237 = T::mul_add(t6, t124, t7 * t190);
-            let t238 = T::mul_add(
-                -t6,
-                t125,
-                T::mul_add(
-                    -t7,
-                    t191,
-                    T::mul_add(
-                        T::from_f64(0.10375),
-                        t152 - t153,
-                        T::mul_add(
-                            T::from_f64(0.00027440962404625004),
-                            t21 + t22,
-                            -T::from_f64(0.00014477253013839883),
-                        ),
-                    ),
-                ),
-            );
-            let t239 = T::mul_add(-t7, t124, t6 * t190);
-            let t240 = t4 * t221;
-            let t241 = T::mul_add(-T::from_f64(2.0), t98 * t138, t225 + t169);
-            let t242 = T::mul_add(
-                T::from_f64(2.06),
-                t175,
+            let t219 = T::mul_add(
+                T::from_f64(0.0230207699865),
+                t204,
                 T::mul_add(
                     T::from_f64(2.0),
-                    T::mul_add(
-                        -t164,
-                        t197,
-                        T::mul_add(t163, t199, T::mul_add(t99, t133, t41 * t4 * t134)),
-                    ),
-                    T::mul_add(
-                        T::from_f64(1.493),
-                        t226 - t170,
-                        T::from_f64(0.213725) * t64,
-                    ),
+                    t86 * t112,
+                    T::from_f64(0.0031610439469427687) * t116,
                 ),
             );
-            let t243 = t7 * t231;
-            let t244 = t6 * t231;
-            let t245 = t6 * t232;
-            let t246 = t4 * t233;
-            let t247 = t5 * t233;
-            let t248 = t7 * t234;
-            let t249 = t6 * t234;
-            let t250 = t6 * t235;
-            let t251 = t5 * t236;
-            let t252 = t4 * t237;
-            let t253 = T::mul_add(
+            let t220 = T::mul_add(
+                T::from_f64(1.03),
+                t206,
+                -(T::from_f64(2.0) * (T::mul_add(-t134, t146, t133 * t145))),
+            );
+            let t221 = T::mul_add(-T::from_f64(0.463), t120, t56) + t208;
+            let t222 = T::mul_add(T::from_f64(0.37966), t11, t104) + t209;
+            let t223 = T::mul_add(T::from_f64(0.0013224560195000002), t120, t106)
+                + -t197;
+            let t224 = T::mul_add(
+                -T::from_f64(0.10375),
+                -t199,
+                T::mul_add(t8, t185, -t9 * t184),
+            );
+            let t225 = T::mul_add(
                 T::from_f64(0.10375),
-                t150 + t151 - t237,
-                T::mul_add(T::from_f64(0.002968289346841206), t19, t155 - t154),
+                -t198,
+                T::mul_add(-t9, t185, -t8 * t184),
             );
-            let t254 = t4 * t238;
+            let t226 = T::mul_add(T::from_f64(0.0026714120292000002), t17, -t211);
+            let t227 = T::mul_add(-t7, t159, t6 * t200);
+            let t228 = T::mul_add(t4, t189, t5 * t203);
+            let t229 = T::mul_add(-t5, t189, t4 * t203);
+            let t230 = T::mul_add(-t8, t181, -t9 * t207);
+            let t231 = T::mul_add(t9, t181, -t8 * t207);
+            let t232 = t205 + t220;
+            let t233 = T::mul_add(
+                -T::from_f64(0.10375),
+                -t209,
+                T::mul_add(t8, t196, -t9 * t195),
+            );
+            let t234 = T::mul_add(
+                T::from_f64(0.10375),
+                -t208,
+                T::mul_add(-t9, t196, -t8 * t195),
+            );
+            let t235 = T::mul_add(
+                -T::from_f64(0.0026714120292000002),
+                t17,
+                T::from_f64(0.37966) * t11,
+            ) + t222;
+            let t236 = T::mul_add(T::from_f64(0.0013224560195000002), t109, t105) + t224;
+            let t237 = T::mul_add(-T::from_f64(0.0230207699865), t108, t107) + t225;
+            let t238 = T::mul_add(t6, t172, -t7 * t210);
+            let t239 = T::mul_add(t7, t172, t6 * t210);
+            let t240 = T::mul_add(
+                T::from_f64(0.10375),
+                t174,
+                T::mul_add(-t6, t159, -t7 * t200),
+            );
+            let t241 = -t228;
+            let t242 = T::mul_add(
+                T::from_f64(1.03),
+                t230,
+                T::from_f64(2.0) * (T::mul_add(t85, t145, t134 * t144)),
+            );
+            let t243 = T::mul_add(
+                T::from_f64(1.03),
+                t231,
+                -(T::from_f64(2.0) * (T::mul_add(t133, t144, t85 * t146))),
+            );
+            let t244 = t105
+                + T::mul_add(
+                    T::from_f64(0.0013224560195000002),
+                    t119,
+                    T::from_f64(0.01887703138893) * t11,
+                ) + t233;
+            let t245 = T::mul_add(T::from_f64(0.0230207699865), t120, t107) + t234;
+            let t246 = T::mul_add(t6, t169, -t7 * t221);
+            let t247 = T::mul_add(T::from_f64(0.0026714120292000002), t16, t238);
+            let t248 = t240 - T::from_f64(0.00014477253013839883);
+            let t249 = T::mul_add(-T::from_f64(0.0114), t241, t227);
+            let t250 = T::mul_add(t2, t202, t3 * t228);
+            let t251 = T::mul_add(
+                T::from_f64(0.41),
+                t141,
+                T::mul_add(-t2, t190, -t3 * t214),
+            );
+            let t252 = T::from_f64(2.0) * (T::mul_add(-t85, t147, t134 * t148))
+                + T::mul_add(
+                    -T::from_f64(0.0650091026469637),
+                    t231,
+                    T::from_f64(0.00000000000000000010842021724855044) * t206,
+                );
+            let t253 = T::from_f64(2.0) * (T::mul_add(t133, t148, -t85 * t149))
+                + T::mul_add(
+                    -T::from_f64(0.0650091026469637),
+                    t230,
+                    -T::from_f64(0.00010000000000000503) * t206,
+                );
+            let t254 = T::from_f64(2.0) * (T::mul_add(t134, t149, -t133 * t147))
+                + T::mul_add(
+                    T::from_f64(0.00010000000000000503),
+                    t231,
+                    T::from_f64(0.00000000000000000010842021724855044) * t230,
+                );
             let t255 = T::mul_add(
-                t4,
-                t196,
-                T::mul_add(
-                    -t5,
-                    t221,
-                    T::mul_add(-T::from_f64(0.2073), t195, T::from_f64(0.0114) * t160),
-                ),
-            );
+                T::from_f64(0.0026714120292000002),
+                t16,
+                -T::from_f64(0.37966) * t10,
+            ) + t246;
             (
                 t192,
                 t193,
@@ -4595,471 +3821,208 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
             t319,
         ) = {
             let t256 = T::mul_add(
-                T::from_f64(0.5),
-                T::mul_add(
-                    t1,
-                    T::mul_add(-t3, t131, t2 * t161),
-                    -t0
-                        * (T::mul_add(
-                            t2,
-                            t131,
-                            T::mul_add(t3, t161, T::from_f64(0.41) * (t60 + t61)),
-                        )),
-                ),
-                -T::from_f64(0.0008)
-                    * (T::mul_add(t0, T::mul_add(-t3, t6 * t39, t2 * t97), t1 * t162)),
-            );
-            let t257 = t9 * t241;
-            let t258 = t8 * t241;
-            let t259 = t6 * t242;
-            let t260 = t7 * t242;
+                -T::from_f64(0.37966),
+                t3,
+                t54 + T::from_f64(0.1919598),
+            ) + T::mul_add(t7, t169, t6 * t221);
+            let t257 = T::mul_add(t7, t212, t6 * t236);
+            let t258 = -t54 - t239 - T::from_f64(0.1919598)
+                - T::from_f64(0.10956060000000001);
+            let t259 = T::mul_add(-t8, t243, -t9 * t242);
+            let t260 = T::mul_add(t9, t243, -t8 * t242);
             let t261 = T::mul_add(
-                -T::from_f64(0.0026714120292000002),
-                t16,
-                T::mul_add(T::from_f64(0.37966), t10, t180 - t243),
+                T::from_f64(0.10375),
+                t211,
+                T::mul_add(t6, t212, -t7 * t236),
             );
-            let t262 = T::mul_add(
-                t6,
-                t182,
-                T::mul_add(
-                    t7,
-                    t232,
-                    T::mul_add(
-                        T::from_f64(0.10375),
-                        t207 - t208,
-                        T::mul_add(
-                            -T::from_f64(0.2075),
-                            t80,
-                            T::mul_add(
-                                -T::from_f64(0.00027440962404625004),
-                                t20,
-                                T::mul_add(
-                                    -T::from_f64(0.00014477253013839883),
-                                    t18,
-                                    T::mul_add(
-                                        -T::from_f64(0.059964738585158),
-                                        t11,
-                                        T::mul_add(
-                                            T::from_f64(0.001095278931972),
-                                            t3,
-                                            -T::from_f64(0.0005537837136531601),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
+            let t262 = T::mul_add(t5, t226, -t4 * t247);
             let t263 = T::mul_add(
+                T::from_f64(0.00014477253013839883),
+                t16,
+                -(T::mul_add(T::from_f64(0.10375), -t238, t237)),
+            );
+            let t264 = T::mul_add(t4, t226, t5 * t247);
+            let t265 = T::mul_add(-t0, T::mul_add(-t3, t202, t2 * t228), -t1 * t250);
+            let t266 = T::mul_add(-t1, T::mul_add(-t3, t190, t2 * t214), -t0 * t251);
+            let t267 = T::mul_add(
+                -T::from_f64(0.463),
+                t204,
+                T::mul_add(
+                    -T::from_f64(0.0026449120390000004),
+                    t117,
+                    -T::from_f64(0.046041539973) * t116,
+                ),
+            ) + t259;
+            let t268 = t180 + t260;
+            let t269 = t218 + -t254;
+            let t270 = T::mul_add(
                 T::from_f64(0.10375),
-                t205 + t206 + t180 - t243,
-                T::mul_add(
-                    -T::from_f64(2.0),
-                    t84,
-                    T::mul_add(
-                        T::from_f64(0.0230207699865),
-                        t77,
-                        T::mul_add(
-                            -T::from_f64(0.01887703138893),
-                            t32,
-                            T::mul_add(
-                                T::from_f64(0.0031610439469427687),
-                                t23,
-                                T::mul_add(
-                                    -T::from_f64(0.00014477253013839883),
-                                    t16,
-                                    T::mul_add(
-                                        T::from_f64(0.020575013585157998),
-                                        t10,
-                                        t209 - t210,
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
+                t222,
+                T::mul_add(t6, t223, -t7 * t244),
             );
-            let t264 = T::mul_add(
-                -T::from_f64(0.0501829599638),
-                t17 + t18,
-                T::mul_add(
-                    T::from_f64(0.9342259999999999),
-                    t3,
-                    t244 + t181 - T::from_f64(0.3015204),
-                ),
-            );
-            let t265 = T::mul_add(
-                T::from_f64(0.10375),
-                t213 + t248 - t212 - t187,
-                T::mul_add(
-                    T::from_f64(0.0230207699865),
-                    t87,
-                    T::mul_add(
-                        T::from_f64(2.0),
-                        t84,
-                        T::mul_add(
-                            -T::from_f64(0.0031610439469427687),
-                            t23,
-                            T::mul_add(
-                                T::from_f64(0.00014477253013839883),
-                                t16,
-                                t217 - t216,
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t266 = T::mul_add(
-                -t6,
-                t189,
-                T::mul_add(
-                    -t7,
-                    t235,
-                    T::mul_add(
-                        -T::from_f64(0.10375),
-                        t214 + t215,
-                        T::mul_add(
-                            T::from_f64(0.2075),
-                            t80,
-                            T::mul_add(
-                                T::from_f64(0.00027440962404625004),
-                                t20,
-                                T::mul_add(
-                                    T::from_f64(0.00014477253013839883),
-                                    t18,
-                                    T::from_f64(0.0005537837136531601),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t267 = T::mul_add(T::from_f64(0.0026714120292000002), t16, t248 - t187);
-            let t268 = T::mul_add(
-                T::from_f64(0.0501829599638),
-                t17 + t18,
-                T::from_f64(0.3015204) - t249 - t188,
-            );
-            let t269 = t5 * t253;
-            let t270 = T::mul_add(t4, t192, t5 * t237);
             let t271 = T::mul_add(
-                T::from_f64(2.0),
-                T::mul_add(t163, t201, -t98 * t202),
-                T::mul_add(
-                    T::from_f64(0.0650091026469637),
-                    t257 + t227,
-                    T::mul_add(
-                        T::from_f64(0.00020000000000001007),
-                        t175,
-                        T::mul_add(
-                            T::from_f64(0.00010000000000000503),
-                            t226 - t170,
-                            T::from_f64(0.000020750000000001043) * t64,
-                        ),
-                    ),
-                ),
-            );
+                -T::from_f64(0.00014477253013839883),
+                t16,
+                T::from_f64(0.020575013585157998) * t10,
+            ) + T::mul_add(T::from_f64(0.10375), -t246, t245);
             let t272 = T::mul_add(
-                T::from_f64(2.0),
-                T::mul_add(t98, t200, -t164 * t201),
-                T::mul_add(
-                    T::from_f64(0.0650091026469637),
-                    t228 - t258,
-                    T::mul_add(
-                        T::from_f64(0.0000000000000000002168404344971009),
-                        t175,
-                        T::mul_add(
-                            T::from_f64(0.00000000000000000010842021724855044),
-                            t226 - t170,
-                            T::from_f64(0.000000000000000000022497195079074216) * t64,
-                        ),
-                    ),
-                ),
-            );
-            let t273 = T::mul_add(
-                -T::from_f64(2.0),
-                T::mul_add(t98, t199, t164 * t198),
-                T::from_f64(1.03) * (t257 + t227),
-            );
-            let t274 = T::mul_add(
-                T::from_f64(2.0),
-                T::mul_add(t163, t198, t98 * t197),
-                T::from_f64(1.03) * (t258 - t228),
-            );
+                -T::from_f64(0.0000077067410688492),
+                t16,
+                T::from_f64(0.001095278931972) * t10,
+            ) + T::mul_add(t7, t223, t6 * t244);
+            let t273 = T::mul_add(t4, t235, -t5 * t255);
+            let t274 = T::mul_add(-t5, t235, -t4 * t255);
             let t275 = T::mul_add(
-                T::from_f64(0.00010000000000000503),
-                t228 - t258,
-                T::mul_add(
-                    -T::from_f64(0.00000000000000000010842021724855044),
-                    t257 + t227,
-                    T::mul_add(
-                        T::from_f64(2.0),
-                        T::mul_add(t99, t137, T::mul_add(-t41, t4 * t135, t230 - t229)),
-                        T::from_f64(0.0013224560195000002) * (t225 + t169),
-                    ),
-                ),
+                T::from_f64(0.554566),
+                t3,
+                -t256 - T::from_f64(0.10956060000000001),
             );
-            let t276 = t5 * t261;
-            let t277 = t4 * t261;
-            let t278 = t4 * t262;
-            let t279 = t5 * t263;
-            let t280 = t4 * t267;
-            let t281 = t4 * t266;
-            let t282 = t5 * t265;
-            let t283 = T::mul_add(
-                t4,
-                t253,
-                T::mul_add(
-                    t5,
-                    t238,
-                    T::mul_add(
-                        T::from_f64(0.2073),
-                        t220 - t252,
-                        T::from_f64(0.0114) * t239,
-                    ),
-                ),
+            let t276 = T::mul_add(
+                T::from_f64(0.00014477253013839883),
+                t18,
+                t261 + T::from_f64(0.0005537837136531601),
             );
-            let t284 = T::mul_add(T::from_f64(0.0114), t270, t219 - t156);
-            let t285 = t9 * t273;
-            let t286 = t8 * t274;
-            let t287 = t8 * t273;
-            let t288 = t9 * t274;
-            let t289 = t8 * t272;
-            let t290 = t9 * t271;
-            let t291 = t7 * t275;
-            let t292 = T::mul_add(T::from_f64(0.554566), t2, t276 + t246);
-            let t293 = T::mul_add(
-                t4,
-                t263,
-                T::mul_add(
-                    t5,
-                    t262,
-                    T::mul_add(
-                        T::from_f64(0.2073),
-                        t277 - t247,
-                        T::mul_add(
-                            T::from_f64(0.0114),
-                            t244 + t181,
-                            T::mul_add(
-                                -T::from_f64(0.00057208574358732),
-                                t17 + t18,
-                                T::mul_add(
-                                    T::from_f64(0.009097391600000001),
-                                    t3,
-                                    -T::from_f64(0.00313056288),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t294 = T::mul_add(
+            let t277 = T::mul_add(
                 T::from_f64(0.0114),
-                t276 + t246,
-                T::mul_add(
-                    -T::from_f64(0.0000077067410688492),
-                    t16,
-                    T::mul_add(
-                        T::from_f64(0.001095278931972),
-                        t10,
-                        T::mul_add(T::from_f64(0.004769267599999999), t2, t245 - t211),
-                    ),
-                ),
+                t264,
+                T::mul_add(T::from_f64(0.0000077067410688492), t16, -t257),
             );
-            let t295 = T::mul_add(t4, t236, t5 * t267);
-            let t296 = T::mul_add(
-                t4,
-                t265,
-                T::mul_add(
-                    t5,
-                    t266,
-                    T::mul_add(
-                        T::from_f64(0.2073),
-                        t280 - t251,
-                        T::mul_add(
-                            -T::from_f64(0.0114),
-                            t249 + t188,
-                            T::mul_add(
-                                T::from_f64(0.00057208574358732),
-                                t17 + t18,
-                                T::from_f64(0.00313056288),
-                            ),
-                        ),
-                    ),
-                ),
+            let t278 = T::mul_add(t4, t213, -t5 * t248)
+                + T::mul_add(-T::from_f64(0.2073), -t229, -T::from_f64(0.0114) * t202);
+            let t279 = T::mul_add(
+                T::from_f64(0.2073),
+                t241,
+                T::mul_add(-t5, t213, -t4 * t248),
             );
-            let t297 = T::mul_add(t2, t239, t3 * t270);
-            let t298 = T::mul_add(
-                -T::from_f64(2.0),
-                T::mul_add(t41, t4 * t132, t98 * t133),
-                T::mul_add(T::from_f64(0.463), t225 + t169, t285 + t286),
+            let t280 = T::mul_add(
+                -T::from_f64(0.10375),
+                -t260,
+                T::mul_add(t8, t253, -t9 * t252),
             );
-            let t299 = T::mul_add(
-                t8,
-                t271,
-                T::mul_add(
-                    t9,
-                    t272,
-                    T::mul_add(
-                        T::from_f64(0.10375),
-                        t287 - t288,
-                        T::mul_add(
-                            -T::from_f64(2.0),
-                            T::mul_add(t41, t4 * t136, t98 * t137),
-                            T::mul_add(
-                                T::from_f64(0.0013224560195000002),
-                                t170 - t226,
-                                T::mul_add(
-                                    -T::from_f64(0.004776809772198749),
-                                    t76,
-                                    T::from_f64(0.0230207699865) * (t167 - t168),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t300 = T::mul_add(
-                T::from_f64(0.0960725),
-                t76,
-                T::mul_add(
-                    T::from_f64(2.0),
-                    T::mul_add(t40, t100, t172 - t171),
-                    T::mul_add(
-                        T::from_f64(0.926),
-                        t168 - t167,
-                        T::mul_add(T::from_f64(0.0026714120292000002), t63, t288 - t287),
-                    ),
-                ),
-            );
-            let t301 = T::mul_add(
-                T::from_f64(0.0114),
-                t295,
-                T::mul_add(T::from_f64(0.0000077067410688492), t16, t218 - t250),
-            );
-            let t302 = T::mul_add(
-                T::from_f64(0.5),
-                T::mul_add(
-                    t1,
-                    T::mul_add(t3, t223, t2 * t255),
-                    -t0
-                        * (T::mul_add(
-                            -t2,
-                            t223,
-                            T::mul_add(t3, t255, T::from_f64(0.41) * t195),
-                        )),
-                ),
-                -T::from_f64(0.0008)
-                    * (T::mul_add(t0, T::mul_add(-t3, t160, t2 * t5 * t159), t1 * t224)),
-            );
-            let t303 = t7 * t298;
-            let t304 = t6 * t298;
-            let t305 = t6 * t299;
-            let t306 = t4 * t300;
-            let t307 = t5 * t300;
-            let t308 = T::mul_add(-t2, t264, t3 * t292);
-            let t309 = T::mul_add(-t2, t268, t3 * t295);
-            let t310 = T::mul_add(
+            let t281 = T::mul_add(
                 T::from_f64(0.10375),
-                t303 + t259 - t285 - t286,
+                -t259,
+                T::mul_add(-t9, t253, -t8 * t252),
+            );
+            let t282 = t164 + t268;
+            let t283 = T::mul_add(
+                T::from_f64(0.00014477253013839883),
+                t18,
                 T::mul_add(
-                    -T::from_f64(0.0230207699865),
-                    t225 + t169,
+                    T::from_f64(0.020575013585157998),
+                    t11,
                     T::mul_add(
-                        T::from_f64(2.0),
-                        T::mul_add(t41, t5 * t102, t173 + t174),
-                        T::mul_add(
-                            -T::from_f64(0.0035915482127945007),
-                            t75,
-                            T::mul_add(
-                                T::from_f64(0.0250914799819),
-                                t165 + t166,
-                                t289 - t290,
-                            ),
-                        ),
+                        -T::from_f64(0.001095278931972),
+                        t3,
+                        T::from_f64(0.0005537837136531601),
                     ),
                 ),
-            );
-            let t311 = T::mul_add(
-                -T::from_f64(0.0501829599638),
-                t75,
+            ) + t270;
+            let t284 = -t273;
+            let t285 = T::mul_add(T::from_f64(0.554566), t2, t273);
+            let t286 = T::mul_add(-t2, t258, -t3 * t264);
+            let t287 = t217 + t280;
+            let t288 = t219 + t281;
+            let t289 = T::mul_add(t6, t232, -t7 * t267);
+            let t290 = T::mul_add(
+                -T::from_f64(0.463),
+                t163,
                 T::mul_add(
-                    T::from_f64(0.463),
-                    t165 + t166,
-                    T::mul_add(T::from_f64(0.0026714120292000002), t65, t303 + t259),
+                    T::from_f64(0.0501829599638),
+                    t73,
+                    -T::from_f64(0.0026714120292000002) * t67,
                 ),
+            ) + t289;
+            let t291 = t152 + T::mul_add(t7, t232, t6 * t267);
+            let t292 = T::mul_add(
+                T::from_f64(0.004769267599999999),
+                t2,
+                -(T::mul_add(T::from_f64(0.0114), t284, -t272)),
             );
+            let t293 = T::mul_add(-t2, t275, t3 * t285);
+            let t294 = T::mul_add(-t4, t263, -t5 * t276)
+                + T::mul_add(
+                    -T::from_f64(0.2073),
+                    -t262,
+                    -T::from_f64(0.0114) * (t54 + t239 + T::from_f64(0.1919598)),
+                );
+            let t295 = T::mul_add(
+                T::from_f64(0.2073),
+                t264,
+                T::mul_add(t5, t263, -t4 * t276),
+            );
+            let t296 = T::mul_add(
+                T::from_f64(0.41),
+                t229,
+                T::mul_add(-t2, t249, -t3 * t278),
+            );
+            let t297 = T::mul_add(t4, t271, -t5 * t283)
+                + T::mul_add(-T::from_f64(0.2073), -t274, -T::from_f64(0.0114) * t256);
+            let t298 = T::mul_add(
+                T::from_f64(0.2073),
+                t284,
+                T::mul_add(-t5, t271, -t4 * t283),
+            );
+            let t299 = T::mul_add(t3, t275, t2 * t285)
+                + T::from_f64(0.40886999999999996);
+            let t300 = t294 - T::from_f64(0.00094222116);
+            let t301 = T::mul_add(t0, T::mul_add(-t3, t258, t2 * t264), t1 * (-t286));
+            let t302 = T::mul_add(
+                T::from_f64(0.10375),
+                t268,
+                T::mul_add(t6, t269, -t7 * t287),
+            );
+            let t303 = t178 + T::mul_add(T::from_f64(0.10375), -t289, t288);
+            let t304 = t179 + T::mul_add(t7, t269, t6 * t287);
+            let t305 = T::mul_add(t4, t282, -t5 * t290);
+            let t306 = T::mul_add(-t5, t282, -t4 * t290);
+            let t307 = T::mul_add(
+                -T::from_f64(0.10956060000000001),
+                t71,
+                -T::from_f64(0.6763) * t53,
+            ) + -t291;
+            let t308 = T::mul_add(
+                T::from_f64(0.004769267599999999),
+                t3,
+                t297 - T::from_f64(0.00094222116),
+            );
+            let t309 = T::mul_add(-t1, T::mul_add(-t3, t249, t2 * t278), -t0 * t296);
+            let t310 = t177 + t302;
+            let t311 = -t305;
             let t312 = T::mul_add(
-                -t6,
-                t275,
-                T::mul_add(
-                    -t7,
-                    t299,
-                    T::mul_add(
-                        T::from_f64(0.10375),
-                        t287 - t288,
-                        T::mul_add(
-                            T::from_f64(0.2075),
-                            t171 - t172,
-                            T::mul_add(
-                                -T::from_f64(0.009967521875),
-                                t76,
-                                T::mul_add(
-                                    T::from_f64(2.0),
-                                    T::mul_add(-t40, t101, t41 * t4 * t102),
-                                    T::mul_add(
-                                        T::from_f64(0.07312772998190001),
-                                        t167 - t168,
-                                        T::mul_add(
-                                            T::from_f64(0.0026714120292000002),
-                                            t105,
-                                            T::from_f64(0.001095278931972) * (t30 - t31),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
+                -T::from_f64(0.10956060000000001),
+                t70,
+                T::from_f64(0.6763) * t51,
+            ) + t305;
             let t313 = T::mul_add(
-                T::from_f64(0.926),
-                t105,
-                T::mul_add(
-                    T::from_f64(2.0),
-                    T::mul_add(t41, t66, t141),
-                    T::mul_add(
-                        -T::from_f64(0.9342259999999999),
-                        t31,
-                        T::mul_add(
-                            T::from_f64(0.934226),
-                            t30,
-                            T::mul_add(T::from_f64(0.0501829599638), t63, t304 - t260),
-                        ),
-                    ),
-                ),
+                T::from_f64(0.41),
+                t262,
+                T::mul_add(t2, t277, -t3 * t300),
             );
-            let t314 = T::mul_add(
-                T::from_f64(0.5),
-                T::mul_add(
-                    t1,
-                    T::mul_add(t3, t284, t2 * t283),
-                    -t0
-                        * (T::mul_add(
-                            -t2,
-                            t284,
-                            T::mul_add(t3, t283, T::from_f64(0.41) * (t252 - t220)),
-                        )),
-                ),
-                -T::from_f64(0.0008)
-                    * (T::mul_add(t0, T::mul_add(-t3, t239, t2 * t270), t1 * t297)),
+            let t314 = T::from_f64(0.5)
+                * (T::mul_add(
+                    -T::from_f64(0.41),
+                    t293,
+                    T::mul_add(T::from_f64(0.044919846), t2, -t298),
+                ));
+            let t315 = T::mul_add(
+                T::from_f64(0.00094222116),
+                t70,
+                -T::from_f64(0.00581618) * t51,
+            ) + T::mul_add(T::from_f64(0.0114), t311, -t304);
+            let t316 = T::mul_add(t2, t307, -t3 * t312);
+            let t317 = T::mul_add(
+                T::from_f64(0.41),
+                t274,
+                T::mul_add(-t2, t292, -t3 * t308),
             );
-            let t315 = t5 * t311;
-            let t316 = t4 * t311;
-            let t317 = t4 * t312;
-            let t318 = t5 * t310;
-            let t319 = t2 * t313;
+            let t318 = T::mul_add(t4, t303, -t5 * t310)
+                + T::mul_add(-T::from_f64(0.2073), -t306, -T::from_f64(0.0114) * t291);
+            let t319 = T::mul_add(
+                T::from_f64(0.2073),
+                t311,
+                T::mul_add(-t5, t303, -t4 * t310),
+            );
             (
                 t256,
                 t257,
@@ -5127,415 +4090,113 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                 t319,
             )
         };
-        let (t320, t321, t322, t323, t324, t325, t326, t327) = {
+        let (t320, t321, t322, t323, t324, t325, t326, t327, t328, t329, t330) = {
             let t320 = T::mul_add(
-                -T::from_f64(0.5),
-                T::mul_add(
-                    t1,
-                    T::mul_add(-t3, t294, t2 * t293),
-                    t0
-                        * (T::mul_add(
-                            -t2,
-                            t294,
-                            T::mul_add(
-                                -t3,
-                                t293,
-                                T::mul_add(
-                                    T::from_f64(0.41),
-                                    t277 - t247,
-                                    T::from_f64(0.0040887),
-                                ),
-                            ),
-                        )),
-                ),
-                -T::from_f64(0.0008)
-                    * (T::mul_add(
-                        t0,
-                        T::mul_add(
-                            t3,
-                            t264,
-                            T::mul_add(t2, t292, T::from_f64(0.40886999999999996)),
-                        ),
-                        t1 * t308,
-                    )),
+                T::from_f64(0.40886999999999996),
+                t0 * t0,
+                T::mul_add(t3, t307, t2 * t312),
             );
-            let t321 = T::mul_add(
-                -T::from_f64(2.0),
-                t40 * t66,
-                T::mul_add(T::from_f64(0.554566), t28 + t29, t315 - t306),
-            );
+            let t321 = T::mul_add(-t1, T::mul_add(t3, t277, t2 * t300), -t0 * t313);
             let t322 = T::mul_add(
-                -t4,
-                t310,
-                T::mul_add(
-                    t5,
-                    t312,
-                    T::mul_add(
-                        -T::from_f64(0.2073),
-                        t316 + t307,
-                        T::mul_add(
-                            T::from_f64(0.0114),
-                            t304 - t260,
-                            T::mul_add(
-                                T::from_f64(0.0228),
-                                t141,
-                                T::mul_add(
-                                    T::from_f64(0.0105564),
-                                    t105,
-                                    T::mul_add(
-                                        -T::from_f64(2.0),
-                                        t40 * t67,
-                                        T::mul_add(
-                                            -T::from_f64(0.009097391600000001),
-                                            t31,
-                                            T::mul_add(
-                                                T::from_f64(0.0090973916),
-                                                t30,
-                                                T::mul_add(
-                                                    T::from_f64(0.00057208574358732),
-                                                    t63,
-                                                    T::from_f64(0.00017529696),
-                                                ),
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
+                T::from_f64(0.00094222116),
+                t72,
+                T::mul_add(-T::from_f64(0.00581618), t53, -T::from_f64(0.00017529696)),
+            ) + t318;
             let t323 = T::mul_add(
-                T::from_f64(0.0114),
-                t315 - t306,
-                T::mul_add(
-                    T::from_f64(0.0013357060146000001),
-                    t165 + t166,
-                    T::mul_add(
-                        -T::from_f64(2.0),
-                        T::mul_add(t41, t67, t142),
-                        T::mul_add(
-                            T::from_f64(0.004769267599999999),
-                            t28 + t29,
-                            T::mul_add(
-                                T::from_f64(0.0035915482127945007),
-                                t65,
-                                t305 - t291,
-                            ),
-                        ),
-                    ),
-                ),
-            );
+                T::from_f64(0.01110618723816),
+                t70,
+                -T::from_f64(0.054780300000000004) * t51,
+            ) + t319;
             let t324 = T::mul_add(
-                T::from_f64(0.5),
-                T::mul_add(
-                    t1,
-                    T::mul_add(-t3, t301, t2 * t296),
-                    t0
-                        * (T::mul_add(
-                            -t2,
-                            t301,
-                            T::mul_add(-t3, t296, T::from_f64(0.41) * (t280 - t251)),
-                        )),
-                ),
-                T::from_f64(0.0008)
-                    * (T::mul_add(t0, T::mul_add(t3, t268, t2 * t295), t1 * t309)),
+                -t0,
+                t320,
+                -t1 * (T::mul_add(T::from_f64(0.40886999999999996), t15, -t316)),
             );
-            let t325 = t3 * t321;
+            let t325 = T::mul_add(
+                -t1,
+                T::mul_add(-t3, t292, t2 * t308),
+                -t0 * (t317 + T::from_f64(0.0040887)),
+            );
             let t326 = T::mul_add(
-                t2,
-                t323,
-                T::mul_add(
-                    -t3,
-                    t322,
-                    T::mul_add(
-                        -T::from_f64(0.41),
-                        t316 + t307,
-                        T::mul_add(
-                            -T::from_f64(0.82),
-                            T::mul_add(
-                                t40,
-                                T::from_f64(0.00581618) * t40,
-                                t41 * (T::from_f64(0.00581618) * t41),
-                            ),
-                            T::mul_add(
-                                T::from_f64(0.0040887),
-                                t1 * t1,
-                                T::from_f64(0.0015414976),
-                            ),
-                        ),
-                    ),
-                ),
+                T::from_f64(0.0016),
+                T::mul_add(-t0, t299, -t1 * t293),
+                t325,
             );
             let t327 = T::mul_add(
-                T::from_f64(0.5),
-                T::mul_add(
-                    -t1,
-                    T::mul_add(
-                        -t3,
-                        t323,
-                        T::mul_add(-t2, t322, T::from_f64(0.0040887) * t15),
-                    ),
-                    t0 * t326,
-                ),
-                -T::from_f64(0.0008)
+                T::from_f64(0.41),
+                T::from_f64(0.01163236) * (t71 + t72) + t306 - T::from_f64(0.00216416),
+                T::mul_add(t2, t315, -t3 * t322),
+            );
+            let t328 = T::mul_add(
+                T::from_f64(0.0040887),
+                t15,
+                T::mul_add(t3, t315, t2 * t322),
+            );
+            let t329 = T::mul_add(
+                -T::from_f64(0.10385207098199997),
+                t15,
+                T::mul_add(-T::from_f64(0.41), -t316, -t323),
+            );
+            let t330 = T::mul_add(
+                -t1,
+                t328,
+                t0
                     * (T::mul_add(
-                        t0,
-                        T::mul_add(
-                            -t3,
-                            t313,
-                            T::mul_add(
-                                t2,
-                                t321,
-                                T::from_f64(0.40886999999999996) * t0 * t0,
-                            ),
-                        ),
-                        t1
-                            * (T::mul_add(
-                                T::from_f64(0.40886999999999996),
-                                t15,
-                                t325 + t319,
-                            )),
+                        T::from_f64(0.0040887),
+                        t1 * t1,
+                        T::from_f64(0.000654192) - t327,
                     )),
             );
-            (t320, t321, t322, t323, t324, t325, t326, t327)
+            (t320, t321, t322, t323, t324, t325, t326, t327, t328, t329, t330)
         };
         [
-            [t327, t320, t324, t314, t302, t256],
             [
-                T::mul_add(
-                    -T::from_f64(0.205),
-                    t325 + t319,
-                    T::mul_add(
-                        T::from_f64(0.5),
-                        t317 + t318,
-                        T::mul_add(
-                            T::from_f64(0.10365),
-                            t315 - t306,
-                            T::mul_add(
-                                T::from_f64(0.022459923),
-                                t28 + t29,
-                                T::mul_add(
-                                    -T::from_f64(0.051926035490999986),
-                                    t15,
-                                    t103 - t104,
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-                T::mul_add(
-                    -T::from_f64(0.205),
-                    t308,
-                    T::mul_add(
-                        T::from_f64(0.5),
-                        t279 - t278,
-                        T::mul_add(
-                            T::from_f64(0.10365),
-                            t276 + t246,
-                            T::from_f64(0.022459923) * t2,
-                        ),
-                    ),
-                ),
-                T::mul_add(
-                    T::from_f64(0.205),
-                    t309,
-                    T::mul_add(
-                        T::from_f64(0.5),
-                        t281 - t282,
-                        -T::from_f64(0.10365) * t295,
-                    ),
-                ),
-                T::mul_add(
-                    -T::from_f64(0.205),
-                    t297,
-                    T::mul_add(
-                        T::from_f64(0.5),
-                        t254 - t269,
-                        T::from_f64(0.10365) * t270,
-                    ),
-                ),
-                T::mul_add(
-                    -T::from_f64(0.205),
-                    t224,
-                    T::mul_add(
-                        -T::from_f64(0.5),
-                        t240 + t222,
-                        T::from_f64(0.10365) * t194,
-                    ),
-                ),
-                T::mul_add(
-                    -T::from_f64(0.205),
-                    t162,
-                    T::mul_add(
-                        -T::from_f64(0.5),
-                        t129 + t130,
-                        T::from_f64(0.10365) * t97,
-                    ),
-                ),
+                T::from_f64(0.5) * (T::mul_add(T::from_f64(0.0016), t324, t330)),
+                T::from_f64(0.5) * t326,
+                T::from_f64(0.5) * (T::mul_add(T::from_f64(0.0016), t301, t321)),
+                T::from_f64(0.5) * (T::mul_add(T::from_f64(0.0016), t265, t309)),
+                T::from_f64(0.5) * (T::mul_add(T::from_f64(0.0016), t191, t266)),
+                T::from_f64(0.5) * (T::mul_add(T::from_f64(0.0016), t162, t216)),
             ],
             [
-                T::mul_add(
-                    -T::from_f64(0.5),
-                    t317 + t318,
-                    T::mul_add(
-                        T::from_f64(0.10365),
-                        t306 - t315,
-                        T::mul_add(-T::from_f64(0.022459923), t28 + t29, t104 - t103),
-                    ),
-                ),
-                T::mul_add(
-                    T::from_f64(0.5),
-                    t278 - t279,
-                    T::mul_add(
-                        -T::from_f64(0.10365),
-                        t276 + t246,
-                        -T::from_f64(0.022459923) * t2,
-                    ),
-                ),
-                T::mul_add(T::from_f64(0.5), t282 - t281, T::from_f64(0.10365) * t295),
-                T::mul_add(T::from_f64(0.5), t269 - t254, -T::from_f64(0.10365) * t270),
-                T::mul_add(T::from_f64(0.5), t240 + t222, -T::from_f64(0.10365) * t194),
-                T::mul_add(T::from_f64(0.5), t129 + t130, -T::from_f64(0.10365) * t97),
+                T::from_f64(0.5) * t329,
+                t314,
+                T::from_f64(0.5) * (T::mul_add(-T::from_f64(0.41), t286, -t295)),
+                T::from_f64(0.5) * (T::mul_add(-T::from_f64(0.41), t250, -t279)),
+                T::from_f64(0.5) * (T::mul_add(-T::from_f64(0.41), t161, -t215)),
+                T::from_f64(0.5) * (T::mul_add(-T::from_f64(0.41), t132, -t143)),
             ],
             [
-                T::mul_add(
-                    T::from_f64(0.5),
-                    t305 - t291,
-                    T::mul_add(
-                        T::from_f64(0.0006678530073000001),
-                        t165 + t166,
-                        T::mul_add(T::from_f64(0.0017957741063972504), t65, -t142),
-                    ),
-                ),
-                T::mul_add(
-                    T::from_f64(0.5),
-                    t245 - t211,
-                    T::mul_add(
-                        -T::from_f64(0.0000038533705344246),
-                        t16,
-                        T::from_f64(0.000547639465986) * t10,
-                    ),
-                ),
-                T::mul_add(
-                    T::from_f64(0.5),
-                    t250 - t218,
-                    -T::from_f64(0.0000038533705344246) * t16,
-                ),
-                T::from_f64(0.5) * (t219 - t156),
-                T::from_f64(0.5) * (t193 + t158),
-                -T::from_f64(0.5) * t59,
+                T::from_f64(0.5) * t323,
+                T::from_f64(0.5) * (T::mul_add(-T::from_f64(0.044919846), t2, t298)),
+                T::from_f64(0.5) * t295,
+                T::from_f64(0.5) * t279,
+                T::from_f64(0.5) * t215,
+                T::from_f64(0.5) * t143,
             ],
             [
-                T::mul_add(
-                    T::from_f64(0.5),
-                    t289 - t290,
-                    T::mul_add(
-                        -T::from_f64(0.051875),
-                        t285 + t286,
-                        T::mul_add(
-                            -T::from_f64(0.01151038499325),
-                            t225 + t169,
-                            t173 + t174,
-                        ),
-                    ),
-                ),
-                T::mul_add(
-                    T::from_f64(0.5),
-                    t209 - t210,
-                    T::mul_add(
-                        T::from_f64(0.051875),
-                        t205 + t206,
-                        T::mul_add(
-                            T::from_f64(0.01151038499325),
-                            t77,
-                            T::mul_add(
-                                -T::from_f64(0.009438515694465),
-                                t32,
-                                T::mul_add(T::from_f64(0.0015805219734713843), t23, -t84),
-                            ),
-                        ),
-                    ),
-                ),
-                T::mul_add(
-                    T::from_f64(0.5),
-                    t216 - t217,
-                    T::mul_add(
-                        T::from_f64(0.051875),
-                        t212 - t213,
-                        T::mul_add(
-                            -T::from_f64(0.01151038499325),
-                            t87,
-                            T::mul_add(T::from_f64(0.0015805219734713843), t23, -t84),
-                        ),
-                    ),
-                ),
-                T::mul_add(
-                    T::from_f64(0.5),
-                    t154 - t155,
-                    T::mul_add(
-                        -T::from_f64(0.051875),
-                        t150 + t151,
-                        -T::from_f64(0.001484144673420603) * t19,
-                    ),
-                ),
-                T::mul_add(
-                    T::from_f64(0.5),
-                    t126 - t127,
-                    -T::from_f64(0.10375) * (t56 + t57),
-                ),
-                T::mul_add(
-                    T::from_f64(0.000024397756617410526),
-                    t9,
-                    -T::from_f64(0.000000000000000000004539081094261623) * t8,
-                ),
+                T::from_f64(0.5) * t304,
+                T::from_f64(0.5) * t272,
+                T::from_f64(0.5)
+                    * (T::mul_add(-T::from_f64(0.0000077067410688492), t16, t257)),
+                T::from_f64(0.5) * t227,
+                T::from_f64(0.5) * t175,
+                -T::from_f64(0.5) * t61,
             ],
             [
-                T::mul_add(
-                    T::from_f64(0.000050000000000002516),
-                    t228 - t258,
-                    T::mul_add(
-                        -T::from_f64(0.00000000000000000005421010862427522),
-                        t257 + t227,
-                        t230 - t229,
-                    ),
-                ),
-                T::mul_add(
-                    T::from_f64(0.000050000000000002516),
-                    t145 + t86,
-                    T::mul_add(
-                        T::from_f64(0.00000000000000000005421010862427522),
-                        t144 - t85,
-                        t118 - t117,
-                    ),
-                ),
-                T::mul_add(
-                    T::from_f64(0.000010375000000000522),
-                    t36,
-                    T::mul_add(
-                        T::from_f64(0.000050000000000002516),
-                        t148,
-                        T::mul_add(
-                            -T::from_f64(0.000000000000000000011248597539537108),
-                            t35,
-                            T::mul_add(
-                                T::from_f64(0.00000000000000000005421010862427522),
-                                t147,
-                                t118 - t117,
-                            ),
-                        ),
-                    ),
-                ),
-                T::mul_add(
-                    -T::from_f64(0.000010375000000000522),
-                    t25,
-                    T::mul_add(
-                        -T::from_f64(0.000000000000000000011248597539537108),
-                        t24,
-                        t89 - t90,
-                    ),
-                ),
-                t94,
+                T::from_f64(0.5) * t288,
+                T::from_f64(0.5) * t245,
+                T::from_f64(0.5) * t237,
+                T::from_f64(0.5) * t201,
+                T::from_f64(0.5) * t138,
+                T::from_f64(0.5) * t34,
+            ],
+            [
+                T::from_f64(0.5) * t254,
+                T::from_f64(0.5) * t197,
+                T::from_f64(0.5) * t186,
+                T::from_f64(0.5) * t125,
+                T::from_f64(0.5) * (T::from_f64(2.0) * (t41 - t40)),
                 T::zero(),
             ],
         ]
@@ -5543,7 +4204,7 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
     /// Craig's Coriolis matrix B(q), N x N(N-1)/2 = 6 x 15, columns for qd_j qd_k with j < k in the order (0,1), (0,2), ..., (1,2), ...
     ///
     /// Route: second velocity derivatives of the Newton-Euler bias.
-    /// Operations: 1563 mul, 1348 add, 0 div, 5 sin, 5 cos.
+    /// Operations: 1701 mul, 1214 add, 0 div, 5 sin, 5 cos.
     pub fn coriolis_pairs(&self, q: &[T; 6]) -> [[T; 15]; 6] {
         let ([s1, s2, s3, s4, s5], [c1, c2, c3, c4, c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
             q[1],
@@ -5639,108 +4300,77 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
             let t18 = t4 * t6 * t7;
             let t19 = t5 * t7;
             let t20 = t5 * t6;
-            let t21 = t5 * t7 * t9;
-            let t22 = t4 * t8;
-            let t23 = t5 * t7 * t8;
-            let t24 = t4 * t9;
-            let t25 = t4 * t6 * t9;
-            let t26 = t4 * t6 * t8;
-            let t27 = t7 * t9;
-            let t28 = t7 * t8;
-            let t29 = t4 * t4 * t6 * t7;
-            let t30 = t4 * t7 * t7;
-            let t31 = t4 * t6 * t6;
-            let t32 = T::mul_add(
+            let t21 = t4 * t6 * t9;
+            let t22 = t4 * t6 * t8;
+            let t23 = t7 * t9;
+            let t24 = t7 * t8;
+            let t25 = t4 * t4 * t6 * t7;
+            let t26 = t4 * t7 * t7;
+            let t27 = t4 * t6 * t6;
+            let t28 = T::mul_add(
                 -T::from_f64(0.000000000000000000006709516445275485),
                 t9,
                 T::from_f64(0.000014022756617410007) * t8,
             );
-            let t33 = T::mul_add(
+            let t29 = T::mul_add(
                 T::from_f64(0.0000000000000006979729257032011),
                 t9,
                 T::from_f64(0.004894691391055498) * t8,
             );
-            let t34 = T::mul_add(
+            let t30 = T::mul_add(
                 T::from_f64(0.004705147001603182),
                 t9,
                 T::from_f64(0.0000000000000006979729257032011) * t8,
             );
-            let t35 = T::mul_add(
+            let t31 = T::mul_add(
                 -T::from_f64(0.00010000000000000503),
                 t9,
                 T::from_f64(0.00000000000000000010842021724855044) * t8,
             );
-            let t36 = t4 * t5 * t7;
-            let t37 = t4 * t5 * t6 * t8;
-            let t38 = t4 * t5 * t6 * t9;
-            let t39 = T::mul_add(
-                -T::from_f64(0.0009671887536246331),
-                t9,
-                T::from_f64(0.0000000000000013959458514064022) * t8,
-            );
-            let t40 = T::mul_add(
-                -T::from_f64(0.0000000000000013959458514064022),
-                t9,
-                T::from_f64(0.0005880999747199997) * t8,
-            );
-            let t41 = T::mul_add(
+            let t32 = t4 * t5 * t7;
+            let t33 = T::mul_add(
                 T::from_f64(0.0000000000000000002168404344971009),
                 t9,
                 T::from_f64(0.00020000000000001007) * t8,
             );
-            let t42 = T::mul_add(t1, t3, t0 * t2);
-            let t43 = T::mul_add(-t1, t2, t0 * t3);
-            let t44 = T::mul_add(-t5, t8, t4 * t7 * t9);
-            let t45 = T::mul_add(t5, t9, t4 * t7 * t8);
-            let t46 = T::mul_add(
+            let t34 = T::mul_add(t1, t2, -t0 * t3);
+            let t35 = T::mul_add(t1, t3, t0 * t2);
+            let t36 = T::mul_add(-t5, t8, t4 * t7 * t9);
+            let t37 = T::mul_add(-t5, t9, -t4 * t7 * t8);
+            let t38 = T::mul_add(t4, t8, t5 * t7 * t9);
+            let t39 = T::mul_add(-t4, t9, t5 * t7 * t8);
+            let t40 = t26 - t27;
+            let t41 = T::mul_add(
                 T::from_f64(0.0013224560195000002),
                 t11,
                 T::from_f64(0.0230207699865) * t5,
             );
-            let t47 = T::mul_add(
+            let t42 = T::mul_add(
                 T::from_f64(0.00009637730005078133),
                 t11,
                 T::from_f64(0.00006575368432434527) * t5,
             );
-            let t48 = T::mul_add(
+            let t43 = T::mul_add(
                 T::from_f64(0.00006575368432434527),
                 t11,
                 T::from_f64(0.0015767446734206029) * t5,
             );
-            let t49 = T::mul_add(
+            let t44 = T::mul_add(
                 T::from_f64(0.00010000000000000503),
                 t13,
                 T::from_f64(0.00000000000000000010842021724855044) * t12,
             );
-            let t50 = T::mul_add(
+            let t45 = T::mul_add(
                 -T::from_f64(0.0650091026469637),
                 t12,
                 T::from_f64(0.00010000000000000503) * t7,
             );
-            let t51 = T::mul_add(
+            let t46 = T::mul_add(
                 T::from_f64(0.0650091026469637),
                 t13,
                 T::from_f64(0.00000000000000000010842021724855044) * t7,
             );
-            let t52 = T::mul_add(
-                -T::from_f64(0.000000000000000000006709516445275485),
-                t13,
-                T::mul_add(
-                    -T::from_f64(0.000014022756617410007),
-                    t12,
-                    T::from_f64(0.0007776443641723163) * t7,
-                ),
-            );
-            let t53 = T::mul_add(
-                -T::from_f64(0.004705147001603182),
-                t13,
-                T::mul_add(
-                    T::from_f64(0.0000000000000006979729257032011),
-                    t12,
-                    T::from_f64(0.000000000000000000006709516445275485) * t7,
-                ),
-            );
-            let t54 = T::mul_add(
+            let t47 = T::mul_add(
                 T::from_f64(0.0000000000000006979729257032011),
                 t13,
                 T::mul_add(
@@ -5749,42 +4379,53 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                     T::from_f64(0.000014022756617410007) * t7,
                 ),
             );
-            let t55 = T::mul_add(T::from_f64(0.2075), t15 + t16, T::from_f64(0.4146));
-            let t56 = T::from_f64(0.10375) * (t4 + t31 - t30);
+            let t48 = T::mul_add(
+                -T::from_f64(0.000000000000000000006709516445275485),
+                t13,
+                T::mul_add(
+                    -T::from_f64(0.000014022756617410007),
+                    t12,
+                    T::from_f64(0.0007776443641723163) * t7,
+                ),
+            );
+            let t49 = T::mul_add(
+                -T::from_f64(0.004705147001603182),
+                t13,
+                T::mul_add(
+                    T::from_f64(0.0000000000000006979729257032011),
+                    t12,
+                    T::from_f64(0.000000000000000000006709516445275485) * t7,
+                ),
+            );
+            let t50 = -T::from_f64(0.0501829599638) * (t15 + t16);
+            let t51 = t4 * t6 * t30;
+            let t52 = t4 * t6 * t29;
+            let t53 = T::mul_add(
+                -T::from_f64(0.0000000000000000002168404344971009),
+                t13,
+                T::from_f64(0.00020000000000001007) * t12,
+            );
+            let t54 = t5 * t6 * t33;
+            let t55 = t4 * t6 * t33;
+            let t56 = T::mul_add(
+                -T::from_f64(0.005672335755227815),
+                t9,
+                T::mul_add(T::from_f64(0.0000000000000006979729257032011), t8, t30),
+            );
             let t57 = T::mul_add(
-                -T::from_f64(0.0000000000000000002168404344971009),
-                t26,
-                T::from_f64(0.00020000000000001007) * t25,
+                -T::from_f64(0.0000000000000006979729257032011),
+                t9,
+                T::mul_add(T::from_f64(0.005482791365775498), t8, -t29),
             );
-            let t58 = T::mul_add(
-                T::from_f64(0.00020000000000001007),
-                t26,
-                T::from_f64(0.0000000000000000002168404344971009) * t25,
-            );
-            let t59 = t6 * t9 * t34;
-            let t60 = t6 * t8 * t33;
-            let t61 = T::mul_add(
-                T::from_f64(0.0009671887536246331),
-                t13,
-                T::mul_add(
-                    T::from_f64(0.0000000000000013959458514064022),
-                    t12,
-                    T::from_f64(0.00000000000000000001341903289055097) * t7,
-                ),
-            );
-            let t62 = T::mul_add(
-                T::from_f64(0.0000000000000013959458514064022),
-                t13,
-                T::mul_add(
-                    T::from_f64(0.0005880999747199997),
-                    t12,
-                    T::from_f64(0.000028045513234820013) * t7,
-                ),
-            );
+            let t58 = -t34;
+            let t59 = -t35;
+            let t60 = -t36;
+            let t61 = -t37;
+            let t62 = t35 * t4;
             let t63 = T::mul_add(
-                -T::from_f64(0.0000000000000000002168404344971009),
-                t28,
-                T::from_f64(0.00020000000000001007) * t27,
+                T::from_f64(0.0650091026469637),
+                t37,
+                T::from_f64(0.00000000000000000010842021724855044) * t11,
             );
             (
                 t0,
@@ -5920,137 +4561,169 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
             t127,
         ) = {
             let t64 = T::mul_add(
-                -T::from_f64(0.0000000000000000002168404344971009),
-                t13,
-                T::from_f64(0.00020000000000001007) * t12,
-            );
-            let t65 = T::mul_add(
-                T::from_f64(0.00020000000000001007),
-                t28,
-                T::from_f64(0.0000000000000000002168404344971009) * t27,
-            );
-            let t66 = t5 * t6 * t41;
-            let t67 = t4 * t6 * t41;
-            let t68 = t43 * t5;
-            let t69 = t43 * t4;
-            let t70 = t43 * t4 * t5;
-            let t71 = t42 * t4;
-            let t72 = t42 * t5 * t6;
-            let t73 = t43 * t7;
-            let t74 = t42 * t4 * t8;
-            let t75 = t42 * t4 * t9;
-            let t76 = t43 * t4 * t7;
-            let t77 = t43 * t4 * t6;
-            let t78 = t43 * t4 * t7 * t9;
-            let t79 = t43 * t5 * t8;
-            let t80 = t43 * t4 * t7 * t8;
-            let t81 = t43 * t5 * t9;
-            let t82 = t43 * t5 * t5;
-            let t83 = t43 * t4 * t4;
-            let t84 = T::mul_add(
-                T::from_f64(0.00010000000000000503),
-                t45,
-                T::from_f64(0.00000000000000000010842021724855044) * t44,
-            );
-            let t85 = T::mul_add(
                 T::from_f64(0.0650091026469637),
-                t44,
+                t36,
                 T::from_f64(0.00010000000000000503) * t11,
             );
-            let t86 = T::mul_add(
+            let t65 = t35 * t5;
+            let t66 = T::mul_add(-T::from_f64(0.4146), t35, T::from_f64(0.82) * t1);
+            let t67 = -T::from_f64(0.2075) * (t15 + t16) - T::from_f64(0.4146);
+            let t68 = t7 * t41;
+            let t69 = t7 * t43;
+            let t70 = t6 * t43;
+            let t71 = t6 * t42;
+            let t72 = -t39;
+            let t73 = T::from_f64(0.10375) * (t4 - t40);
+            let t74 = t4 * t6 * t45;
+            let t75 = t4 * t6 * t46;
+            let t76 = t36 * t44;
+            let t77 = t36 * t45;
+            let t78 = t4 * t6 * t49;
+            let t79 = t4 * t6 * t47;
+            let t80 = t36 * t48;
+            let t81 = t36 * t49;
+            let t82 = t36 * t31;
+            let t83 = t8 * t36;
+            let t84 = t36 * t28;
+            let t85 = t36 * t30;
+            let t86 = -t40;
+            let t87 = -t38;
+            let t88 = T::mul_add(-t2, t7 * t33, t3 * t5 * t6 * t33);
+            let t89 = t58 * t5;
+            let t90 = t58 * t4;
+            let t91 = t58 * t4 * t5;
+            let t92 = t58 * t4 * t7;
+            let t93 = t58 * t4 * t6;
+            let t94 = t58 * t5 * t5;
+            let t95 = t58 * t4 * t4;
+            let t96 = T::mul_add(
+                T::from_f64(0.00000000000000000010842021724855044),
+                t60,
+                T::from_f64(0.00010000000000000503) * t37,
+            );
+            let t97 = T::mul_add(
                 -T::from_f64(0.0650091026469637),
-                t45,
-                T::from_f64(0.00000000000000000010842021724855044) * t11,
+                t60,
+                T::from_f64(0.00010000000000000503) * t11,
             );
-            let t87 = T::mul_add(
-                T::from_f64(0.000000000000000000006709516445275485),
-                t45,
+            let t98 = T::mul_add(
+                -T::from_f64(0.004894691391055498),
+                t60,
                 T::mul_add(
-                    T::from_f64(0.000014022756617410007),
-                    t44,
-                    T::from_f64(0.0007776443641723163) * t11,
-                ),
-            );
-            let t88 = T::mul_add(
-                T::from_f64(0.004705147001603182),
-                t45,
-                T::mul_add(
-                    -T::from_f64(0.0000000000000006979729257032011),
-                    t44,
-                    T::from_f64(0.000000000000000000006709516445275485) * t11,
-                ),
-            );
-            let t89 = T::mul_add(
-                -T::from_f64(0.0000000000000006979729257032011),
-                t45,
-                T::mul_add(
-                    T::from_f64(0.004894691391055498),
-                    t44,
+                    T::from_f64(0.0000000000000006979729257032011),
+                    t37,
                     T::from_f64(0.000014022756617410007) * t11,
                 ),
             );
-            let t90 = t42 * t5;
-            let t91 = T::mul_add(-T::from_f64(0.4146), t42, T::from_f64(0.82) * t1);
-            let t92 = t43 * t4 * t4 * t7;
-            let t93 = t43 * t4 * t46;
-            let t94 = t43 * t4 * t47;
-            let t95 = t43 * t4 * t4 * t6;
-            let t96 = T::from_f64(0.4146) * t42;
-            let t97 = t4 * t6 * t46;
-            let t98 = t4 * t7 * t47;
-            let t99 = t6 * t55;
-            let t100 = t7 * t55;
-            let t101 = t7 * t46;
-            let t102 = t6 * t47;
-            let t103 = t9 * t56;
-            let t104 = t8 * t56;
-            let t105 = t44 * t53;
-            let t106 = t45 * t54;
-            let t107 = t45 * t35;
-            let t108 = t44 * t35;
-            let t109 = t44 * t34;
-            let t110 = t45 * t33;
-            let t111 = T::mul_add(
-                -T::from_f64(0.0009671887536246331),
-                t45,
+            let t99 = T::mul_add(
+                -T::from_f64(0.000014022756617410007),
+                t60,
                 T::mul_add(
-                    -T::from_f64(0.0000000000000013959458514064022),
-                    t44,
-                    T::from_f64(0.00000000000000000001341903289055097) * t11,
+                    -T::from_f64(0.000000000000000000006709516445275485),
+                    t37,
+                    T::from_f64(0.0007776443641723163) * t11,
                 ),
             );
-            let t112 = T::mul_add(
-                -T::from_f64(0.0000000000000013959458514064022),
-                t45,
+            let t100 = T::mul_add(
+                T::from_f64(0.0000000000000006979729257032011),
+                t60,
                 T::mul_add(
-                    -T::from_f64(0.0005880999747199997),
-                    t44,
-                    T::from_f64(0.000028045513234820013) * t11,
+                    -T::from_f64(0.004705147001603182),
+                    t37,
+                    T::from_f64(0.000000000000000000006709516445275485) * t11,
                 ),
             );
-            let t113 = T::mul_add(
+            let t101 = T::mul_add(
+                T::from_f64(0.00010000000000000503),
+                t61,
+                T::from_f64(0.00000000000000000010842021724855044) * t36,
+            );
+            let t102 = T::mul_add(
+                -T::from_f64(0.0650091026469637),
+                t61,
+                T::from_f64(0.00000000000000000010842021724855044) * t11,
+            );
+            let t103 = T::mul_add(
+                T::from_f64(0.004705147001603182),
+                t61,
+                T::mul_add(
+                    -T::from_f64(0.0000000000000006979729257032011),
+                    t36,
+                    T::from_f64(0.000000000000000000006709516445275485) * t11,
+                ),
+            );
+            let t104 = T::mul_add(
+                T::from_f64(0.000000000000000000006709516445275485),
+                t61,
+                T::mul_add(
+                    T::from_f64(0.000014022756617410007),
+                    t36,
+                    T::from_f64(0.0007776443641723163) * t11,
+                ),
+            );
+            let t105 = T::mul_add(
+                -T::from_f64(0.0000000000000006979729257032011),
+                t61,
+                T::mul_add(
+                    T::from_f64(0.004894691391055498),
+                    t36,
+                    T::from_f64(0.000014022756617410007) * t11,
+                ),
+            );
+            let t106 = t4 * t66;
+            let t107 = t5 * t66;
+            let t108 = t6 * t67;
+            let t109 = t7 * t67;
+            let t110 = t9 * t73;
+            let t111 = t8 * t73;
+            let t112 = t61 * t44;
+            let t113 = t61 * t46;
+            let t114 = t61 * t48;
+            let t115 = t61 * t47;
+            let t116 = t61 * t31;
+            let t117 = t9 * t61;
+            let t118 = t61 * t28;
+            let t119 = t61 * t29;
+            let t120 = T::from_f64(0.0114) * (t34 + t58);
+            let t121 = -T::from_f64(0.0114) * (t35 + t59);
+            let t122 = T::from_f64(0.0114) * (t35 + t59);
+            let t123 = T::from_f64(0.10375) * (t4 + t86);
+            let t124 = T::mul_add(
                 -T::from_f64(0.0000000000000000002168404344971009),
-                t45,
-                T::from_f64(0.00020000000000001007) * t44,
+                t61,
+                T::from_f64(0.00020000000000001007) * t36,
             );
-            let t114 = t5 * t58;
-            let t115 = t8 * t53;
-            let t116 = t9 * t54;
-            let t117 = t8 * t61;
-            let t118 = t9 * t62;
-            let t119 = t5 * t65;
-            let t120 = T::mul_add(-t9, t40, -t8 * t39);
-            let t121 = T::mul_add(-t8, t40, t9 * t39);
-            let t122 = T::mul_add(-t2, t7 * t41, t3 * t5 * t6 * t41);
-            let t123 = T::mul_add(-t42, t7, t43 * t5 * t6);
-            let t124 = T::mul_add(t42, t6, t43 * t5 * t7);
-            let t125 = T::mul_add(-t43, t6, t42 * t5 * t7);
+            let t125 = T::mul_add(
+                T::from_f64(0.0000000000000006979729257032011),
+                t13,
+                T::mul_add(
+                    T::from_f64(0.005482791365775498),
+                    t12,
+                    T::mul_add(T::from_f64(0.000014022756617410007), t7, t47),
+                ),
+            );
             let t126 = T::mul_add(
-                T::from_f64(0.00007238626506919941),
-                t69,
-                T::from_f64(0.00009645337053442467) * t42,
+                T::from_f64(0.0650091026469637),
+                t13,
+                -(T::mul_add(
+                    T::from_f64(0.00000000000000000010842021724855044),
+                    t7,
+                    t46,
+                )),
             );
-            let t127 = t4 * t91;
+            let t127 = T::mul_add(
+                T::from_f64(0.005672335755227815),
+                t13,
+                T::mul_add(
+                    T::from_f64(0.0000000000000006979729257032011),
+                    t12,
+                    -(T::mul_add(
+                        -T::from_f64(0.000000000000000000006709516445275485),
+                        t7,
+                        -t49,
+                    )),
+                ),
+            );
             (
                 t64,
                 t65,
@@ -6184,201 +4857,208 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
             t190,
             t191,
         ) = {
-            let t128 = t5 * t91;
-            let t129 = t4 * t96;
-            let t130 = t5 * t96;
-            let t131 = t44 * t88;
-            let t132 = t45 * t89;
-            let t133 = T::mul_add(T::from_f64(0.2075), t29, -t99);
-            let t134 = t6 * t9 * t88;
-            let t135 = t6 * t8 * t89;
-            let t136 = t9 * t84;
-            let t137 = t8 * t84;
-            let t138 = t8 * t88;
-            let t139 = t9 * t89;
-            let t140 = t8 * t111;
-            let t141 = t9 * t112;
-            let t142 = T::mul_add(
-                t6,
-                t8 * t35,
-                T::mul_add(
-                    -t9,
-                    t49,
-                    T::mul_add(
-                        -T::from_f64(0.3437432052939274),
-                        t28,
-                        T::from_f64(0.00000000000000000010842021724855044) * t6,
-                    ),
-                ),
+            let t128 = T::mul_add(
+                T::from_f64(0.0650091026469637),
+                t12,
+                -(T::mul_add(-T::from_f64(0.00010000000000000503), t7, -t45)),
             );
+            let t129 = T::mul_add(-t9, t57, -t8 * t56);
+            let t130 = T::mul_add(-t8, t57, t9 * t56);
+            let t131 = T::mul_add(-t35, t7, t58 * t5 * t6);
+            let t132 = T::mul_add(t35, t6, t58 * t5 * t7);
+            let t133 = T::mul_add(-t58, t6, t35 * t5 * t7);
+            let t134 = T::mul_add(t58, t7, t35 * t5 * t6);
+            let t135 = T::mul_add(-t58, t5 * t9, -t58 * t4 * t7 * t8);
+            let t136 = t94 - t95;
+            let t137 = T::mul_add(-t58, t5 * t8, t58 * t4 * t7 * t9);
+            let t138 = T::mul_add(
+                T::from_f64(0.0250914799819),
+                t90,
+                T::from_f64(0.0013357060146000001) * t35,
+            );
+            let t139 = T::mul_add(
+                T::from_f64(0.0017919207358628258),
+                t90,
+                T::from_f64(0.00007238626506919941) * t35,
+            );
+            let t140 = T::mul_add(
+                T::from_f64(0.00007238626506919941),
+                t90,
+                T::from_f64(0.00009645337053442467) * t35,
+            );
+            let t141 = T::mul_add(-T::from_f64(0.2075), t65, t107);
+            let t142 = T::mul_add(T::from_f64(0.2075), t62, -t106);
             let t143 = T::mul_add(
-                t6,
-                t9 * t32,
-                T::mul_add(
-                    -t8,
-                    t52,
-                    T::mul_add(
-                        t7,
-                        t33,
-                        T::mul_add(
-                            T::from_f64(0.01819453580084815),
-                            t28,
-                            T::mul_add(
-                                -T::from_f64(0.0000000000000006979729257032011),
-                                t27,
-                                T::from_f64(0.000000000000000000006709516445275485) * t6,
-                            ),
-                        ),
-                    ),
-                ),
+                T::from_f64(0.463),
+                t109,
+                T::mul_add(T::from_f64(2.0), t5 * t41, T::from_f64(0.046041539973) * t17),
             );
             let t144 = T::mul_add(
-                t7,
-                t34,
-                T::mul_add(
-                    -t6,
-                    t8 * t32,
-                    T::mul_add(
-                        -t9,
-                        t52,
-                        T::mul_add(
-                            -T::from_f64(0.0000000000000006979729257032011),
-                            t28,
-                            T::mul_add(
-                                T::from_f64(0.018384080190300467),
-                                t27,
-                                T::from_f64(0.000014022756617410007) * t6,
-                            ),
-                        ),
-                    ),
-                ),
+                T::from_f64(0.0013224560195000002),
+                t109,
+                T::from_f64(2.0) * (T::mul_add(t5, t42, -t4 * t6 * t43)),
             );
             let t145 = T::mul_add(
-                -t6,
-                t9 * t35,
+                -T::from_f64(0.0013224560195000002),
+                t108,
                 T::mul_add(
-                    -t8,
-                    t49,
-                    T::mul_add(
-                        T::from_f64(0.3437432052939274),
-                        t27,
-                        T::from_f64(0.00010000000000000503) * t6,
-                    ),
+                    -T::from_f64(2.0),
+                    t4 * t7 * t43,
+                    T::from_f64(0.0031610439469427687) * t32,
                 ),
             );
             let t146 = T::mul_add(
-                -t9,
-                t51,
-                T::mul_add(
-                    -t8,
-                    t50,
-                    T::mul_add(
-                        T::from_f64(0.00010000000000000503),
-                        t28,
-                        T::from_f64(0.00000000000000000010842021724855044) * t27,
-                    ),
-                ),
-            );
-            let t147 = T::mul_add(
-                -T::from_f64(0.00000000000000000001578767863379873),
-                t28,
-                T::mul_add(
-                    T::from_f64(0.00003477275661741105),
-                    t27,
-                    T::mul_add(
-                        T::from_f64(0.0008702443641723162),
-                        t6,
-                        t115 + t59 + t116 + t60,
-                    ),
-                ),
-            );
-            let t148 = T::mul_add(
-                t8,
-                t62,
-                T::mul_add(
-                    -t9,
-                    t61,
-                    T::mul_add(
-                        T::from_f64(0.000020750000000001043),
-                        t28,
-                        T::from_f64(0.000000000000000000022497195079074216) * t27,
-                    ),
-                ),
-            );
-            let t149 = T::mul_add(t6, t64, t7 * t63);
-            let t150 = T::mul_add(-t7, t64, t6 * t63);
-            let t151 = t6 * t121;
-            let t152 = T::mul_add(-T::from_f64(0.10375), t6 * t41, -t120);
-            let t153 = t4 * t7 * t121;
-            let t154 = t4 * t7 * t124;
-            let t155 = t6 * t124;
-            let t156 = t7 * t123;
-            let t157 = t9 * t125;
-            let t158 = t8 * t125;
-            let t159 = t123 * t9;
-            let t160 = t123 * t8;
-            let t161 = t4 * t7 * t123;
-            let t162 = t7 * t124;
-            let t163 = t6 * t123;
-            let t164 = T::from_f64(0.0013224560195000002) * t124;
-            let t165 = T::from_f64(0.0230207699865) * t124;
-            let t166 = T::mul_add(
-                -T::from_f64(0.0013224560195000002),
-                t123,
-                T::from_f64(0.0230207699865) * t69,
-            );
-            let t167 = T::from_f64(0.0015805219734713843) * t124;
-            let t168 = T::mul_add(
-                -T::from_f64(0.00009637730005078133),
-                t123,
-                T::from_f64(0.00006575368432434527) * t69,
-            );
-            let t169 = T::mul_add(
-                -T::from_f64(0.00006575368432434527),
-                t123,
-                T::from_f64(0.0015767446734206029) * t69,
-            );
-            let t170 = T::from_f64(0.10375) * t124;
-            let t171 = t5
-                * (T::mul_add(
-                    T::from_f64(0.0250914799819),
-                    t69,
-                    T::from_f64(0.0013357060146000001) * t42,
-                ));
-            let t172 = t5 * t126;
-            let t173 = t4 * t126;
-            let t174 = t4
-                * (T::mul_add(
-                    T::from_f64(0.0017919207358628258),
-                    t69,
-                    T::from_f64(0.00007238626506919941) * t42,
-                ));
-            let t175 = T::mul_add(T::from_f64(0.2075), t71, -t127);
-            let t176 = t123 * t46;
-            let t177 = t123 * t48;
-            let t178 = t124 * t48;
-            let t179 = t124 * t47;
-            let t180 = t5 * t123;
-            let t181 = t123 * t85;
-            let t182 = t123 * t86;
-            let t183 = t123 * t88;
-            let t184 = t123 * t89;
-            let t185 = T::mul_add(T::from_f64(0.2075), t71, t129);
-            let t186 = T::from_f64(0.2075) * t123;
-            let t187 = T::from_f64(0.00020000000000001007) * t123;
-            let t188 = T::from_f64(0.0000000000000000002168404344971009) * t123;
-            let t189 = t9 * t133;
-            let t190 = t8 * t133;
-            let t191 = T::mul_add(
-                -T::from_f64(1.493),
-                t100,
+                -T::from_f64(0.0230207699865),
+                t108,
                 T::mul_add(
                     T::from_f64(2.0),
-                    T::mul_add(-t45, t86, T::mul_add(t44, t85, t5 * t46)),
+                    t4 * t7 * t42,
+                    -T::from_f64(0.0031610439469427687) * t25,
+                ),
+            );
+            let t147 = t109 + T::from_f64(0.2075) * (t16 + t17);
+            let t148 = T::mul_add(T::from_f64(0.2075), t25, t108);
+            let t149 = t5 * t120;
+            let t150 = t4 * t120;
+            let t151 = t9 * t123;
+            let t152 = t8 * t123;
+            let t153 = t6 * t124;
+            let t154 = t7 * t124;
+            let t155 = T::mul_add(
+                -T::from_f64(0.3437432052939274),
+                t24,
+                T::mul_add(
+                    T::from_f64(0.00000000000000000010842021724855044),
+                    t6,
+                    T::mul_add(t6, t8 * t31, -t9 * t44),
+                ),
+            );
+            let t156 = T::mul_add(-t7, t30, T::mul_add(t6, t8 * t28, t9 * t48));
+            let t157 = T::mul_add(t7, t29, T::mul_add(t6, t9 * t28, -t8 * t48));
+            let t158 = -(T::mul_add(-t6, t9 * t30, -t8 * t49))
+                - (T::mul_add(-t6, t8 * t29, -t9 * t47));
+            let t159 = T::mul_add(
+                T::from_f64(0.3437432052939274),
+                t23,
+                T::mul_add(
+                    T::from_f64(0.00010000000000000503),
+                    t6,
+                    -(T::mul_add(t6, t9 * t31, t8 * t44)),
+                ),
+            );
+            let t160 = T::mul_add(
+                T::from_f64(0.00010000000000000503),
+                t24,
+                T::from_f64(0.00000000000000000010842021724855044) * t23,
+            ) + T::mul_add(-t9, t46, -t8 * t45);
+            let t161 = T::mul_add(
+                -T::from_f64(0.0015805219734713843),
+                t11,
+                T::mul_add(
+                    -T::from_f64(0.0015767446734206029),
+                    t11,
+                    -(T::mul_add(-T::from_f64(0.00006575368432434527), t5, -t42)),
+                ),
+            );
+            let t162 = T::mul_add(
+                -t0,
+                T::mul_add(t3, t7 * t33, t2 * t5 * t6 * t33),
+                -t1 * t88,
+            );
+            let t163 = T::mul_add(
+                T::from_f64(0.0650091026469637),
+                t61,
+                T::mul_add(T::from_f64(0.00000000000000000010842021724855044), t11, t63),
+            );
+            let t164 = T::mul_add(
+                T::from_f64(0.0650091026469637),
+                t36,
+                -(T::mul_add(T::from_f64(0.00010000000000000503), t11, t64)),
+            );
+            let t165 = t6 * t130;
+            let t166 = T::mul_add(T::from_f64(0.10375), t6 * t33, t129);
+            let t167 = t4 * t7 * t132;
+            let t168 = t6 * t132;
+            let t169 = t7 * t131;
+            let t170 = -t133;
+            let t171 = t131 * t9;
+            let t172 = t131 * t8;
+            let t173 = -t134;
+            let t174 = t7 * t132;
+            let t175 = t6 * t131;
+            let t176 = T::mul_add(
+                -T::from_f64(0.0013224560195000002),
+                t131,
+                T::from_f64(0.0230207699865) * t90,
+            );
+            let t177 = T::mul_add(
+                -T::from_f64(0.00009637730005078133),
+                t131,
+                T::from_f64(0.00006575368432434527) * t90,
+            );
+            let t178 = T::mul_add(
+                -T::from_f64(0.00006575368432434527),
+                t131,
+                T::from_f64(0.0015767446734206029) * t90,
+            );
+            let t179 = t5 * t138;
+            let t180 = t5 * t140;
+            let t181 = t4 * t140;
+            let t182 = t4 * t139;
+            let t183 = t7 * t142;
+            let t184 = t6 * t142;
+            let t185 = T::mul_add(
+                -T::from_f64(0.0015805219734713843),
+                t19,
+                T::mul_add(
+                    -T::from_f64(0.00009637730005078133),
+                    t19,
+                    -(T::mul_add(-T::from_f64(0.00006575368432434527), t18, -t69)),
+                ),
+            );
+            let t186 = T::mul_add(T::from_f64(0.4146), t65, t150);
+            let t187 = T::mul_add(T::from_f64(0.6221), t62, -t149);
+            let t188 = T::mul_add(
+                T::from_f64(0.013489388799244969),
+                t24,
+                T::mul_add(
+                    T::from_f64(0.004705147001603182),
+                    t24,
                     T::mul_add(
-                        T::from_f64(0.259766539973),
-                        t17,
-                        T::from_f64(0.213725) * t16,
+                        -T::from_f64(0.0000000000000006979729257032011),
+                        t23,
+                        T::from_f64(0.000000000000000000006709516445275485) * t6,
+                    ),
+                ) + t157,
+            );
+            let t189 = T::mul_add(
+                T::from_f64(0.013489388799244969),
+                t23,
+                -(T::mul_add(
+                    T::from_f64(0.0000000000000006979729257032011),
+                    t24,
+                    T::mul_add(
+                        -T::from_f64(0.004894691391055498),
+                        t23,
+                        -T::from_f64(0.000014022756617410007) * t6,
+                    ),
+                )) - t156,
+            );
+            let t190 = T::mul_add(
+                T::from_f64(0.0650091026469637),
+                t36,
+                T::mul_add(-T::from_f64(0.00010000000000000503), t11, -t97),
+            );
+            let t191 = T::mul_add(
+                T::from_f64(0.005672335755227815),
+                t61,
+                T::mul_add(
+                    T::from_f64(0.0000000000000006979729257032011),
+                    t36,
+                    T::mul_add(
+                        -T::from_f64(0.000000000000000000006709516445275485),
+                        t11,
+                        -t100,
                     ),
                 ),
             );
@@ -6516,442 +5196,195 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
             t255,
         ) = {
             let t192 = T::mul_add(
-                -t4,
-                t6 * t50,
+                T::from_f64(0.0000000000000006979729257032011),
+                t61,
                 T::mul_add(
-                    -t7,
-                    t85,
-                    T::mul_add(
-                        t45,
-                        t49,
-                        T::mul_add(
-                            t6,
-                            t8 * t84,
-                            T::mul_add(
-                                T::from_f64(1.03),
-                                t103,
-                                T::mul_add(
-                                    T::from_f64(0.0650091026469637),
-                                    t24 - t23,
-                                    T::from_f64(0.00000000000000000010842021724855044) * t20,
-                                ),
-                            ),
-                        ),
-                    ),
+                    T::from_f64(0.005482791365775498),
+                    t36,
+                    -(T::mul_add(T::from_f64(0.000014022756617410007), t11, t98)),
                 ),
             );
             let t193 = T::mul_add(
-                -t44,
-                t49,
+                T::from_f64(0.005672335755227815),
+                t61,
                 T::mul_add(
-                    -t6,
-                    t9 * t84,
-                    T::mul_add(
-                        t4,
-                        t6 * t51,
-                        T::mul_add(
-                            t7,
-                            t86,
-                            T::mul_add(
-                                T::from_f64(1.03),
-                                t104,
-                                T::mul_add(
-                                    T::from_f64(0.0650091026469637),
-                                    t21 + t22,
-                                    T::from_f64(0.00010000000000000503) * t20,
-                                ),
-                            ),
-                        ),
-                    ),
+                    T::from_f64(0.0000000000000006979729257032011),
+                    t36,
+                    -(T::mul_add(
+                        T::from_f64(0.000000000000000000006709516445275485),
+                        t11,
+                        t103,
+                    )),
                 ),
             );
             let t194 = T::mul_add(
-                -t4,
-                t6 * t53,
+                T::from_f64(0.0000000000000006979729257032011),
+                t61,
                 T::mul_add(
-                    -t7,
-                    t88,
-                    T::mul_add(
-                        t45,
-                        t52,
-                        T::mul_add(
-                            -t6,
-                            t8 * t87,
-                            T::mul_add(
-                                T::from_f64(0.0650091026469637),
-                                t104,
-                                T::mul_add(
-                                    T::from_f64(0.0000000000000006979729257032011),
-                                    t24 - t23,
-                                    T::mul_add(
-                                        T::from_f64(0.004894691391055498),
-                                        t21 + t22,
-                                        T::mul_add(
-                                            T::from_f64(0.000014022756617410007),
-                                            t20,
-                                            T::from_f64(0.000000000000000000022497195079074216) * t18,
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
+                    T::from_f64(0.005482791365775498),
+                    t36,
+                    T::mul_add(-T::from_f64(0.000014022756617410007), t11, -t105),
                 ),
             );
             let t195 = T::mul_add(
-                -t44,
-                t52,
-                T::mul_add(
-                    t6,
-                    t9 * t87,
-                    T::mul_add(
-                        t4,
-                        t6 * t54,
-                        T::mul_add(
-                            t7,
-                            t89,
-                            T::mul_add(
-                                -T::from_f64(0.0650091026469637),
-                                t103,
-                                T::mul_add(
-                                    T::from_f64(0.004705147001603182),
-                                    t23 - t24,
-                                    T::mul_add(
-                                        -T::from_f64(0.0000000000000006979729257032011),
-                                        t21 + t22,
-                                        T::mul_add(
-                                            T::from_f64(0.000000000000000000006709516445275485),
-                                            t20,
-                                            T::from_f64(0.000020750000000001043) * t18,
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t196 = T::mul_add(
-                t45,
-                t51,
-                T::mul_add(
-                    -t6,
-                    t8 * t86,
-                    T::mul_add(
-                        -t44,
-                        t50,
-                        T::mul_add(
-                            t6,
-                            t9 * t85,
-                            T::mul_add(
-                                T::from_f64(0.00010000000000000503),
-                                t23 - t24,
-                                T::mul_add(
-                                    T::from_f64(0.00000000000000000010842021724855044),
-                                    t21 + t22,
-                                    T::mul_add(
-                                        -T::from_f64(0.0026449120390000004),
-                                        t19,
-                                        T::from_f64(0.259766539973) * t18,
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t197 = T::mul_add(
-                -T::from_f64(0.00010000000000000503),
-                t104,
-                T::mul_add(
-                    -T::from_f64(0.00000000000000000010842021724855044),
-                    t103,
-                    T::mul_add(
-                        t6,
-                        t48,
-                        T::mul_add(
-                            T::from_f64(0.000000000000000000006709516445275485),
-                            t24 - t23,
-                            T::mul_add(
-                                -T::from_f64(0.000014022756617410007),
-                                t21 + t22,
-                                T::mul_add(
-                                    -T::from_f64(0.002454543637694482),
-                                    t20,
-                                    T::mul_add(
-                                        T::from_f64(0.00006575368432434527),
-                                        t4 - t30,
-                                        t134 + t106 - t105 - t135,
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t198 = T::mul_add(
-                -t44,
-                t32,
-                T::mul_add(
-                    -t8,
-                    t87,
-                    T::mul_add(
-                        t4,
-                        t6 * t33,
-                        T::mul_add(
-                            T::from_f64(0.01819453580084815),
-                            t26,
-                            T::mul_add(
-                                -T::from_f64(0.0000000000000006979729257032011),
-                                t25,
-                                T::mul_add(
-                                    -T::from_f64(0.000000000000000000006709516445275485),
-                                    t10,
-                                    T::from_f64(0.000020750000000001043) * t5,
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t199 = T::mul_add(
-                t4,
-                t6 * t34,
-                T::mul_add(
-                    t45,
-                    t32,
-                    T::mul_add(
-                        -t9,
-                        t87,
-                        T::mul_add(
-                            -T::from_f64(0.0000000000000006979729257032011),
-                            t26,
-                            T::mul_add(
-                                T::from_f64(0.018384080190300467),
-                                t25,
-                                T::mul_add(
-                                    -T::from_f64(0.000014022756617410007),
-                                    t10,
-                                    T::from_f64(0.000000000000000000022497195079074216) * t5,
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t200 = T::mul_add(
-                T::from_f64(0.3437432052939274),
-                t26,
-                T::mul_add(
-                    T::from_f64(0.00000000000000000010842021724855044),
-                    t10,
-                    t107 - t136,
-                ),
-            );
-            let t201 = T::mul_add(
-                -T::from_f64(0.3437432052939274),
-                t25,
-                T::mul_add(T::from_f64(0.00010000000000000503), t10, -t137 - t108),
-            );
-            let t202 = T::mul_add(
-                T::from_f64(0.00000000000000000001578767863379873),
-                t26,
-                T::mul_add(
-                    -T::from_f64(0.00003477275661741105),
-                    t25,
-                    T::mul_add(
-                        T::from_f64(0.0008702443641723162),
-                        t10,
-                        t109 + t110 - t138 - t139,
-                    ),
-                ),
-            );
-            let t203 = T::mul_add(
-                t8,
-                t112,
-                T::mul_add(
-                    -t9,
-                    t111,
-                    T::mul_add(
-                        T::from_f64(0.000020750000000001043),
-                        t26,
-                        T::from_f64(0.000000000000000000022497195079074216) * t25,
-                    ),
-                ),
-            );
-            let t204 = T::mul_add(-t6, t113, t7 * t57);
-            let t205 = T::mul_add(t7, t113, t6 * t57);
-            let t206 = t8 * t142;
-            let t207 = t9 * t145;
-            let t208 = t8 * t144;
-            let t209 = t9 * t143;
-            let t210 = t6 * t148;
-            let t211 = t4 * t149;
-            let t212 = T::mul_add(
-                -T::from_f64(0.10375),
-                t149,
-                T::mul_add(
-                    -T::from_f64(0.000000000000000000022497195079074216),
-                    t28,
-                    T::mul_add(T::from_f64(0.000020750000000001043), t27, t117 + t118),
-                ),
-            );
-            let t213 = T::mul_add(
                 T::from_f64(0.0650091026469637),
-                T::mul_add(t9, t45, -t8 * t44),
-                T::mul_add(
-                    -t9,
-                    t86,
-                    T::mul_add(
-                        -t8,
-                        t85,
-                        T::mul_add(
-                            T::from_f64(0.00010000000000000503),
-                            t26,
-                            T::mul_add(
-                                T::from_f64(0.00000000000000000010842021724855044),
-                                t25,
-                                T::from_f64(0.25976653997300003) * t5,
-                            ),
-                        ),
-                    ),
-                ),
+                t61,
+                -(T::mul_add(
+                    -T::from_f64(0.00000000000000000010842021724855044),
+                    t11,
+                    -t102,
+                )),
             );
-            let t214 = T::mul_add(
-                T::from_f64(0.34374320529392743),
-                t26,
+            let t196 = T::mul_add(t9, t128, t8 * t126);
+            let t197 = T::mul_add(t8, t128, -t9 * t126);
+            let t198 = T::mul_add(T::from_f64(0.0114), t54, -t165);
+            let t199 = T::mul_add(t58, t4 * t8, t132 * t9);
+            let t200 = T::mul_add(-t58, t4 * t9, t132 * t8);
+            let t201 = T::mul_add(t35, t4 * t8, t9 * t133);
+            let t202 = T::mul_add(-t35, t4 * t9, t8 * t133);
+            let t203 = T::mul_add(-t4, t7 * t131, -t4 * t6 * t132);
+            let t204 = T::mul_add(t5, t132, -t58 * t4 * t4 * t7);
+            let t205 = T::mul_add(-t58, t4 * t4 * t6, t5 * t131);
+            let t206 = t175 - t174;
+            let t207 = T::mul_add(T::from_f64(0.2075), t4 * t5 * t6 * t8, -t9 * t148);
+            let t208 = T::mul_add(-T::from_f64(0.2075), t4 * t5 * t6 * t9, -t8 * t148);
+            let t209 = T::mul_add(-t61, t101, t61 * t96)
+                + T::mul_add(-t4, t6 * t64, -t4 * t6 * t97);
+            let t210 = T::mul_add(-t36, t101, t36 * t96)
+                - (T::mul_add(t4, t6 * t102, t4 * t6 * t63));
+            let t211 = T::mul_add(-t36, t64, -t36 * t97)
+                + T::mul_add(t61, t102, t61 * t63);
+            let t212 = T::mul_add(-t61, t104, -t61 * t99)
+                - (T::mul_add(-t4, t6 * t103, -t4 * t6 * t100));
+            let t213 = T::mul_add(t4, t6 * t105, t4 * t6 * t98)
+                + T::mul_add(-t36, t104, -t36 * t99);
+            let t214 = -(T::mul_add(-t36, t103, -t36 * t100))
+                - (T::mul_add(t61, t105, t61 * t98));
+            let t215 = T::mul_add(t6, t8 * t96, -t112) + T::mul_add(t7, t97, t74);
+            let t216 = T::mul_add(t6, t9 * t96, -t76) - (T::mul_add(-t7, t63, -t75));
+            let t217 = T::mul_add(-t6, t9 * t97, t77) + T::mul_add(t6, t8 * t63, -t113);
+            let t218 = T::mul_add(-t6, t8 * t99, t114) - (T::mul_add(t7, t100, t78));
+            let t219 = T::mul_add(-t7, t98, -t79) + T::mul_add(-t6, t9 * t99, t80);
+            let t220 = -(T::mul_add(-t6, t9 * t100, t81))
+                - (T::mul_add(t6, t8 * t98, -t115));
+            let t221 = T::mul_add(-T::from_f64(0.0650091026469637), t83, -t8 * t97)
+                + T::mul_add(T::from_f64(0.0650091026469637), t117, -t9 * t63);
+            let t222 = T::mul_add(t9, t99, -t118) - t51;
+            let t223 = t52 + T::mul_add(-t8, t99, -t84);
+            let t224 = -(T::mul_add(-t8, t100, t85)) - (T::mul_add(-t9, t98, t119));
+            let t225 = T::mul_add(
+                T::from_f64(0.3437432052939274),
+                t22,
                 T::mul_add(
                     T::from_f64(0.00000000000000000010842021724855044),
                     t10,
-                    t107 - t136,
+                    -(T::mul_add(-t9, t96, -t116)),
                 ),
             );
-            let t215 = T::mul_add(
-                -T::from_f64(0.34374320529392743),
-                t25,
-                T::mul_add(T::from_f64(0.00010000000000000503), t10, -t137 - t108),
-            );
-            let t216 = t5 * t152;
-            let t217 = T::mul_add(-T::from_f64(0.0114), t66, t151);
-            let t218 = T::mul_add(t43, t4 * t8, t124 * t9);
-            let t219 = T::mul_add(-t43, t4 * t9, t124 * t8);
-            let t220 = t7 * t175;
-            let t221 = t6 * t175;
-            let t222 = t4 * t6 * t165;
-            let t223 = t5 * t164;
-            let t224 = t5 * t166;
-            let t225 = t4 * t7 * t165;
-            let t226 = t4 * t7 * t164;
-            let t227 = t4 * t6 * t166;
-            let t228 = t4 * t6 * t169;
-            let t229 = t5 * t168;
-            let t230 = t5 * t167;
-            let t231 = t4 * t7 * t169;
-            let t232 = t4 * t7 * t168;
-            let t233 = t4 * t6 * t167;
-            let t234 = t4 * t6 * t170;
-            let t235 = t4 * t7 * t170;
-            let t236 = T::mul_add(
-                -T::from_f64(0.2075),
-                t90,
-                T::mul_add(T::from_f64(0.10375), t125 + t95 - t180, t128),
-            );
-            let t237 = t7 * t185;
-            let t238 = t6 * t185;
-            let t239 = T::mul_add(
-                -T::from_f64(0.2075),
-                t90,
-                T::mul_add(T::from_f64(0.10375), t125 + t95 - t180, -t130),
-            );
-            let t240 = t6 * t164;
-            let t241 = t7 * t166;
-            let t242 = t6 * t168;
-            let t243 = t7 * t167;
-            let t244 = t6 * t170;
-            let t245 = t8 * t186;
-            let t246 = t9 * t186;
-            let t247 = T::mul_add(
-                -T::from_f64(0.213725),
-                t37,
-                T::mul_add(
-                    T::from_f64(1.03),
-                    t189,
-                    T::from_f64(2.0) * (T::mul_add(t4, t6 * t85, t45 * t84)),
-                ),
-            );
-            let t248 = T::mul_add(
-                -T::from_f64(0.213725),
-                t38,
-                T::mul_add(
-                    -T::from_f64(1.03),
-                    t190,
-                    T::from_f64(2.0) * (T::mul_add(t44, t84, t4 * t6 * t86)),
-                ),
-            );
-            let t249 = T::mul_add(
-                T::from_f64(0.013489388799244969),
-                t38,
-                T::mul_add(
-                    T::from_f64(0.0650091026469637),
-                    t190,
-                    T::mul_add(
-                        -T::from_f64(0.00000000000000000010842021724855044),
-                        t100,
-                        T::mul_add(
-                            T::from_f64(2.0),
-                            T::mul_add(t4, t6 * t88, -t45 * t87),
-                            T::from_f64(0.000000000000000000022497195079074216)
-                                * (t16 + t17),
-                        ),
-                    ),
-                ),
-            );
-            let t250 = T::mul_add(
-                T::from_f64(0.013489388799244969),
-                t37,
-                T::mul_add(
-                    -T::from_f64(0.0650091026469637),
-                    t189,
-                    T::mul_add(
-                        -T::from_f64(0.00010000000000000503),
-                        t100,
-                        T::mul_add(
-                            T::from_f64(2.0),
-                            T::mul_add(t44, t87, -t4 * t6 * t89),
-                            T::from_f64(0.000020750000000001043) * (t16 + t17),
-                        ),
-                    ),
-                ),
-            );
-            let t251 = t6 * t191;
-            let t252 = t7 * t191;
-            let t253 = T::mul_add(
-                T::from_f64(0.000020750000000001043),
-                t38,
+            let t226 = T::mul_add(
+                -T::from_f64(0.3437432052939274),
+                t21,
                 T::mul_add(
                     T::from_f64(0.00010000000000000503),
-                    t190,
-                    T::mul_add(
-                        -T::from_f64(0.000000000000000000022497195079074216),
-                        t37,
-                        T::mul_add(
-                            T::from_f64(0.00000000000000000010842021724855044),
-                            t189,
-                            T::mul_add(
-                                T::from_f64(0.0013224560195000002),
-                                t99,
-                                T::mul_add(
-                                    T::from_f64(2.0),
-                                    T::mul_add(-t4, t7 * t48, t132 - t131),
-                                    T::from_f64(0.0031610439469427687) * t36,
-                                ),
-                            ),
-                        ),
-                    ),
+                    t10,
+                    T::mul_add(t8, t96, -t82),
                 ),
             );
-            let t254 = t9 * t192;
-            let t255 = t8 * t193;
+            let t227 = T::mul_add(T::from_f64(0.2075), t65, t186);
+            let t228 = T::mul_add(t6, t8 * t101, t112) + T::mul_add(-t7, t64, -t74);
+            let t229 = T::mul_add(t6, t9 * t101, t76) - (T::mul_add(t7, t102, t75));
+            let t230 = T::mul_add(t6, t9 * t64, -t77) + T::mul_add(-t6, t8 * t102, t113);
+            let t231 = T::mul_add(t6, t8 * t104, -t114) - (T::mul_add(-t7, t103, -t78));
+            let t232 = T::mul_add(t7, t105, t79) + T::mul_add(t6, t9 * t104, -t80);
+            let t233 = -(T::mul_add(t6, t9 * t103, -t81))
+                - (T::mul_add(-t6, t8 * t105, t115));
+            let t234 = T::mul_add(t8, t64, T::from_f64(0.0650091026469637) * t83)
+                + T::mul_add(t9, t102, -T::from_f64(0.0650091026469637) * t117);
+            let t235 = T::mul_add(
+                T::from_f64(0.3437432052939274),
+                t22,
+                T::mul_add(
+                    T::from_f64(0.00000000000000000010842021724855044),
+                    t10,
+                    T::mul_add(-t9, t101, t116),
+                ),
+            );
+            let t236 = t51 + T::mul_add(-t9, t104, t118);
+            let t237 = T::mul_add(t8, t104, t84) - t52;
+            let t238 = -(T::mul_add(t8, t103, -t85)) - (T::mul_add(t9, t105, -t119));
+            let t239 = T::mul_add(
+                -T::from_f64(0.3437432052939274),
+                t21,
+                T::mul_add(
+                    T::from_f64(0.00010000000000000503),
+                    t10,
+                    -(T::mul_add(t8, t101, t82)),
+                ),
+            );
+            let t240 = T::mul_add(t9, t159, -t8 * t155);
+            let t241 = T::mul_add(t8, t159, t9 * t155);
+            let t242 = T::mul_add(
+                T::from_f64(0.00009259999999999985),
+                t6,
+                -(T::mul_add(
+                    T::from_f64(0.00000000000000000001578767863379873),
+                    t24,
+                    T::mul_add(
+                        -T::from_f64(0.00003477275661741105),
+                        t23,
+                        T::mul_add(-T::from_f64(0.0007776443641723163), t6, -t158),
+                    ),
+                )),
+            );
+            let t243 = -t197;
+            let t244 = -t201;
+            let t245 = -t202;
+            let t246 = -t203;
+            let t247 = T::mul_add(
+                T::from_f64(0.00010000000000000503),
+                t200,
+                T::from_f64(0.00000000000000000010842021724855044) * t199,
+            );
+            let t248 = T::mul_add(
+                T::from_f64(0.0650091026469637),
+                t199,
+                T::from_f64(0.00010000000000000503) * t131,
+            );
+            let t249 = T::mul_add(
+                -T::from_f64(0.0650091026469637),
+                t200,
+                T::from_f64(0.00000000000000000010842021724855044) * t131,
+            );
+            let t250 = T::mul_add(
+                T::from_f64(0.004705147001603182),
+                t200,
+                T::mul_add(
+                    -T::from_f64(0.0000000000000006979729257032011),
+                    t199,
+                    T::from_f64(0.000000000000000000006709516445275485) * t131,
+                ),
+            );
+            let t251 = T::mul_add(
+                T::from_f64(0.000000000000000000006709516445275485),
+                t200,
+                T::mul_add(
+                    T::from_f64(0.000014022756617410007),
+                    t199,
+                    T::from_f64(0.0007776443641723163) * t131,
+                ),
+            );
+            let t252 = T::mul_add(
+                -T::from_f64(0.0000000000000006979729257032011),
+                t200,
+                T::mul_add(
+                    T::from_f64(0.004894691391055498),
+                    t199,
+                    T::from_f64(0.000014022756617410007) * t131,
+                ),
+            );
+            let t253 = T::mul_add(t58, t4 * t41, t5 * t176);
+            let t254 = T::mul_add(t131, t41, -t4 * t6 * t176);
+            let t255 = T::mul_add(t131, t43, -t4 * t6 * t178);
             (
                 t192,
                 t193,
@@ -7085,162 +5518,345 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
             t318,
             t319,
         ) = {
-            let t256 = t8 * t192;
-            let t257 = t9 * t193;
-            let t258 = t8 * t194;
-            let t259 = t9 * t195;
-            let t260 = t7 * t196;
-            let t261 = t8 * t200;
-            let t262 = t9 * t201;
-            let t263 = t9 * t199;
-            let t264 = t8 * t198;
-            let t265 = t8 * t199;
-            let t266 = t9 * t198;
-            let t267 = t6 * t202;
-            let t268 = t7 * t202;
-            let t269 = t6 * t203;
-            let t270 = t4 * t204;
-            let t271 = T::mul_add(
-                -T::from_f64(0.10375),
-                t204,
-                T::mul_add(
-                    -T::from_f64(0.000000000000000000022497195079074216),
-                    t26,
-                    T::mul_add(T::from_f64(0.000020750000000001043), t25, t140 + t141),
-                ),
+            let t256 = T::mul_add(t58, t4 * t42, t5 * t177);
+            let t257 = T::mul_add(t132, t43, -t4 * t7 * t178);
+            let t258 = T::mul_add(t132, t42, -t4 * t7 * t177);
+            let t259 = T::from_f64(0.2075) * (t167 - t91) - t184;
+            let t260 = T::mul_add(T::from_f64(0.10375), t133 - t205, t141);
+            let t261 = T::mul_add(T::from_f64(0.10375), t62 + t203, -t183);
+            let t262 = -t204;
+            let t263 = T::from_f64(0.10375) * (t89 + t206);
+            let t264 = T::mul_add(
+                -T::from_f64(0.0000000000000000002168404344971009),
+                t200,
+                T::from_f64(0.00020000000000001007) * t199,
             );
-            let t272 = T::mul_add(t8, t145, t9 * t142);
-            let t273 = T::mul_add(
-                t8,
-                t143,
+            let t265 = T::mul_add(T::from_f64(1.03), t207, t209);
+            let t266 = T::mul_add(T::from_f64(1.03), t208, -t210);
+            let t267 = T::mul_add(
+                T::from_f64(0.0000000000000006979729257032011),
+                t72,
                 T::mul_add(
-                    t9,
-                    t144,
+                    T::from_f64(0.004894691391055498),
+                    t38,
+                    T::from_f64(0.000014022756617410007) * t20,
+                ),
+            ) + t218
+                + T::mul_add(
+                    T::from_f64(0.0650091026469637),
+                    t111,
+                    T::from_f64(0.000000000000000000022497195079074216) * t18,
+                );
+            let t268 = T::mul_add(
+                T::from_f64(0.004705147001603182),
+                t72,
+                T::mul_add(
+                    T::from_f64(0.0000000000000006979729257032011),
+                    t38,
+                    -T::from_f64(0.000000000000000000006709516445275485) * t20,
+                ),
+            ) + t219
+                + T::mul_add(
+                    T::from_f64(0.0650091026469637),
+                    t110,
+                    -T::from_f64(0.000020750000000001043) * t18,
+                );
+            let t269 = T::mul_add(
+                T::from_f64(0.000000000000000000006709516445275485),
+                t72,
+                T::mul_add(
+                    -T::from_f64(0.000014022756617410007),
+                    t38,
+                    -T::from_f64(0.0007776443641723163) * t20,
+                ),
+            ) + t220
+                + T::mul_add(
+                    -T::from_f64(0.00010000000000000503),
+                    t111,
+                    -T::from_f64(0.00000000000000000010842021724855044) * t110,
+                );
+            let t270 = T::mul_add(
+                T::from_f64(1.03),
+                t110,
+                -(T::mul_add(
+                    -T::from_f64(0.0650091026469637),
+                    t72,
+                    -T::from_f64(0.00000000000000000010842021724855044) * t20,
+                )) - t215,
+            );
+            let t271 = T::mul_add(
+                T::from_f64(1.03),
+                t111,
+                T::mul_add(
+                    T::from_f64(0.0650091026469637),
+                    t38,
+                    T::from_f64(0.00010000000000000503) * t20,
+                ) + t216,
+            );
+            let t272 = T::mul_add(
+                T::from_f64(0.01819453580084815),
+                t22,
+                T::mul_add(
+                    -T::from_f64(0.0000000000000006979729257032011),
+                    t21,
                     T::mul_add(
-                        T::from_f64(0.10375),
-                        t207 - t206,
-                        T::from_f64(0.0030608893468412057) * t7,
+                        -T::from_f64(0.000000000000000000006709516445275485),
+                        t10,
+                        T::mul_add(T::from_f64(0.000020750000000001043), t5, t223),
                     ),
                 ),
             );
-            let t274 = T::mul_add(T::from_f64(0.046041539973), t7, t207 - t206);
-            let t275 = T::mul_add(
-                -t7,
-                t148,
+            let t273 = T::mul_add(
+                -T::from_f64(0.0000000000000006979729257032011),
+                t22,
                 T::mul_add(
-                    T::from_f64(0.000020750000000001043),
-                    t28,
-                    T::from_f64(0.000000000000000000022497195079074216) * t27,
+                    T::from_f64(0.018384080190300467),
+                    t21,
+                    T::mul_add(
+                        -T::from_f64(0.000014022756617410007),
+                        t10,
+                        T::mul_add(
+                            T::from_f64(0.000000000000000000022497195079074216),
+                            t5,
+                            -t222,
+                        ),
+                    ),
                 ),
             );
-            let t276 = t5 * t212;
-            let t277 = T::mul_add(t4, t65, t5 * t149);
-            let t278 = t6 * t213;
-            let t279 = t7 * t213;
-            let t280 = t8 * t214;
-            let t281 = t9 * t215;
-            let t282 = T::mul_add(
-                -t4,
-                t152,
+            let t274 = T::mul_add(t6, t122, -t7 * t187);
+            let t275 = T::mul_add(t7, t122, t6 * t187);
+            let t276 = T::mul_add(
+                T::from_f64(1.03),
+                t151,
                 T::mul_add(
-                    -t5,
-                    t7 * t121,
-                    T::mul_add(T::from_f64(0.2073), t67, T::from_f64(0.0114) * t7 * t41),
+                    -T::from_f64(0.0650091026469637),
+                    t39,
+                    T::from_f64(0.00000000000000000010842021724855044) * t20,
+                ) + t228,
+            );
+            let t277 = T::mul_add(
+                T::from_f64(0.004894691391055498),
+                t87,
+                T::mul_add(
+                    T::from_f64(0.0000000000000006979729257032011),
+                    t39,
+                    -T::from_f64(0.000014022756617410007) * t20,
+                ),
+            ) + t231
+                + T::mul_add(
+                    -T::from_f64(0.0650091026469637),
+                    t152,
+                    -T::from_f64(0.000000000000000000022497195079074216) * t18,
+                );
+            let t278 = T::mul_add(
+                T::from_f64(0.0000000000000006979729257032011),
+                t87,
+                T::mul_add(
+                    T::from_f64(0.004705147001603182),
+                    t39,
+                    T::from_f64(0.000000000000000000006709516445275485) * t20,
+                ),
+            ) + t232
+                + T::mul_add(
+                    -T::from_f64(0.0650091026469637),
+                    t151,
+                    T::from_f64(0.000020750000000001043) * t18,
+                );
+            let t279 = T::mul_add(
+                -T::from_f64(0.000014022756617410007),
+                t87,
+                T::mul_add(
+                    T::from_f64(0.000000000000000000006709516445275485),
+                    t39,
+                    T::from_f64(0.0007776443641723163) * t20,
+                ),
+            ) + t233
+                + T::mul_add(
+                    T::from_f64(0.00010000000000000503),
+                    t152,
+                    T::from_f64(0.00000000000000000010842021724855044) * t151,
+                );
+            let t280 = T::mul_add(
+                T::from_f64(1.03),
+                t152,
+                -(T::mul_add(
+                    T::from_f64(0.0650091026469637),
+                    t87,
+                    -T::from_f64(0.00010000000000000503) * t20,
+                )) - t229,
+            );
+            let t281 = T::mul_add(
+                -T::from_f64(0.0026449120390000004),
+                t19,
+                T::mul_add(
+                    T::from_f64(0.259766539973),
+                    t18,
+                    T::mul_add(
+                        -T::from_f64(0.00000000000000000010842021724855044),
+                        t87,
+                        T::from_f64(0.00010000000000000503) * t39,
+                    ) + t230,
+                ),
+            );
+            let t282 = T::mul_add(
+                -T::from_f64(0.0000000000000006979729257032011),
+                t22,
+                T::mul_add(
+                    T::from_f64(0.018384080190300467),
+                    t21,
+                    T::mul_add(
+                        -T::from_f64(0.000014022756617410007),
+                        t10,
+                        T::mul_add(
+                            T::from_f64(0.000000000000000000022497195079074216),
+                            t5,
+                            t236,
+                        ),
+                    ),
                 ),
             );
             let t283 = T::mul_add(
-                -T::from_f64(0.0650091026469637),
-                t219,
-                T::from_f64(0.00000000000000000010842021724855044) * t123,
-            );
-            let t284 = T::mul_add(
-                T::from_f64(0.00010000000000000503),
-                t219,
-                T::from_f64(0.00000000000000000010842021724855044) * t218,
-            );
-            let t285 = T::mul_add(
-                T::from_f64(0.0650091026469637),
-                t218,
-                T::from_f64(0.00010000000000000503) * t123,
-            );
-            let t286 = T::mul_add(
-                T::from_f64(0.004705147001603182),
-                t219,
+                T::from_f64(0.01819453580084815),
+                t22,
                 T::mul_add(
                     -T::from_f64(0.0000000000000006979729257032011),
-                    t218,
-                    T::from_f64(0.000000000000000000006709516445275485) * t123,
+                    t21,
+                    T::mul_add(
+                        -T::from_f64(0.000000000000000000006709516445275485),
+                        t10,
+                        T::mul_add(T::from_f64(0.000020750000000001043), t5, -t237),
+                    ),
                 ),
             );
-            let t287 = T::mul_add(
-                T::from_f64(0.000000000000000000006709516445275485),
-                t219,
+            let t284 = T::mul_add(
+                T::from_f64(0.0017957741063972504),
+                t90,
                 T::mul_add(
-                    T::from_f64(0.000014022756617410007),
-                    t218,
-                    T::from_f64(0.0007776443641723163) * t123,
+                    T::from_f64(0.00009645337053442467),
+                    t90,
+                    -(T::mul_add(T::from_f64(0.00007238626506919941), t35, t139)),
                 ),
             );
-            let t288 = T::mul_add(
-                -T::from_f64(0.0000000000000006979729257032011),
-                t219,
-                T::mul_add(
-                    T::from_f64(0.004894691391055498),
-                    t218,
-                    T::from_f64(0.000014022756617410007) * t123,
-                ),
+            let t285 = T::mul_add(T::from_f64(0.046041539973), t7, t240);
+            let t286 = T::mul_add(t9, t163, -t8 * t190);
+            let t287 = T::mul_add(t8, t163, t9 * t190);
+            let t288 = T::mul_add(t8, t195, t9 * t164);
+            let t289 = T::mul_add(-t9, t195, t8 * t164);
+            let t290 = T::mul_add(
+                -T::from_f64(0.10375),
+                t243,
+                T::mul_add(-t9, t127, t8 * t125),
             );
-            let t289 = T::mul_add(T::from_f64(0.10375), t71 - t161, -t220 - t234);
-            let t290 = t8 * t236;
-            let t291 = t9 * t236;
-            let t292 = t219 * t84;
-            let t293 = t218 * t84;
-            let t294 = t218 * t85;
-            let t295 = t219 * t86;
-            let t296 = t219 * t87;
-            let t297 = t218 * t87;
-            let t298 = t218 * t88;
-            let t299 = t219 * t89;
-            let t300 = T::mul_add(T::from_f64(0.10375), t71 - t161, -t234 - t237);
-            let t301 = t8 * t239;
-            let t302 = t9 * t239;
-            let t303 = T::mul_add(-t7, t170, T::from_f64(0.10375) * (t68 + t163));
-            let t304 = t218 * t53;
-            let t305 = t219 * t54;
-            let t306 = t218 * t34;
-            let t307 = t219 * t33;
+            let t291 = T::mul_add(
+                T::from_f64(0.10375),
+                -t196,
+                T::mul_add(-t8, t127, -t9 * t125),
+            );
+            let t292 = T::mul_add(t6, t196, -t7 * t53);
+            let t293 = T::mul_add(t7, t196, t6 * t53);
+            let t294 = T::mul_add(
+                T::from_f64(0.2073),
+                t55,
+                T::from_f64(0.0114) * t7 * t33,
+            ) + T::mul_add(t4, t166, -t5 * t7 * t130);
+            let t295 = T::mul_add(
+                -T::from_f64(0.2073),
+                t54,
+                T::mul_add(-t5, t166, -t4 * t7 * t130),
+            );
+            let t296 = t61 * t247;
+            let t297 = t4 * t6 * t248;
+            let t298 = t4 * t6 * t249;
+            let t299 = t36 * t247;
+            let t300 = t36 * t248;
+            let t301 = t61 * t249;
+            let t302 = t61 * t251;
+            let t303 = t4 * t6 * t250;
+            let t304 = t4 * t6 * t252;
+            let t305 = t36 * t251;
+            let t306 = t36 * t250;
+            let t307 = t61 * t252;
             let t308 = T::mul_add(
-                -T::from_f64(0.0009671887536246331),
-                t219,
-                T::mul_add(
-                    -T::from_f64(0.0000000000000013959458514064022),
-                    t218,
-                    T::from_f64(0.00000000000000000001341903289055097) * t123,
-                ),
+                T::from_f64(0.0026449120390000004),
+                t168,
+                -(T::mul_add(-t7, t176, T::from_f64(0.0013224560195000002) * t169)),
             );
             let t309 = T::mul_add(
-                -T::from_f64(0.0000000000000013959458514064022),
-                t219,
+                -T::from_f64(0.00009637730005078133),
+                t92,
+                -(T::mul_add(-t7, t178, T::from_f64(0.00006575368432434527) * t169)),
+            );
+            let t310 = T::mul_add(
+                T::from_f64(0.0016768992735221656),
+                t93,
                 T::mul_add(
-                    -T::from_f64(0.0005880999747199997),
-                    t218,
-                    T::from_f64(0.000028045513234820013) * t123,
+                    T::from_f64(0.00006575368432434527),
+                    t89,
+                    -(T::mul_add(t6, t178, T::from_f64(0.00006575368432434527) * t174)),
                 ),
             );
-            let t310 = T::mul_add(-t8, t188, t9 * t187);
-            let t311 = T::mul_add(t9, t188, t8 * t187);
-            let t312 = T::mul_add(
-                -T::from_f64(0.0000000000000000002168404344971009),
-                t219,
-                T::from_f64(0.00020000000000001007) * t218,
+            let t311 = T::mul_add(
+                T::from_f64(0.00006575368432434527),
+                t93,
+                T::from_f64(0.0015767446734206029) * t89,
+            )
+                + T::mul_add(
+                    t6,
+                    t177,
+                    T::mul_add(
+                        T::from_f64(0.0015805219734713843),
+                        t175,
+                        -T::from_f64(0.001484144673420603) * t174,
+                    ),
+                );
+            let t312 = t9 * t263;
+            let t313 = t8 * t263;
+            let t314 = T::mul_add(
+                -T::from_f64(0.0013357060146000001),
+                t65,
+                T::mul_add(
+                    -T::from_f64(0.0501829599638),
+                    t91,
+                    T::mul_add(T::from_f64(0.0250914799819), t91, t179),
+                ),
             );
-            let t313 = t9 * t247;
-            let t314 = t8 * t248;
-            let t315 = t8 * t247;
-            let t316 = t9 * t248;
-            let t317 = t8 * t249;
-            let t318 = t9 * t250;
-            let t319 = t7 * t253;
+            let t315 = t212
+                + T::mul_add(
+                    -T::from_f64(0.0650091026469637),
+                    t208,
+                    T::from_f64(0.00000000000000000010842021724855044) * t147,
+                );
+            let t316 = t213
+                + T::mul_add(
+                    -T::from_f64(0.0650091026469637),
+                    t207,
+                    -T::from_f64(0.00010000000000000503) * t147,
+                );
+            let t317 = t214
+                + T::mul_add(
+                    T::from_f64(0.00010000000000000503),
+                    t208,
+                    T::from_f64(0.00000000000000000010842021724855044) * t207,
+                );
+            let t318 = t143 + T::mul_add(T::from_f64(1.03), t147, -t211);
+            let t319 = T::mul_add(
+                -T::from_f64(0.0013224560195000002),
+                t19,
+                T::mul_add(
+                    -T::from_f64(0.0013224560195000002),
+                    t19,
+                    T::from_f64(0.046041539973) * t18,
+                ),
+            )
+                + T::mul_add(
+                    T::from_f64(0.213725),
+                    t18,
+                    -(T::mul_add(
+                        T::from_f64(0.00010000000000000503),
+                        t72,
+                        -T::from_f64(0.00000000000000000010842021724855044) * t38,
+                    )) - t217,
+                );
             (
                 t256,
                 t257,
@@ -7374,370 +5990,214 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
             t382,
             t383,
         ) = {
-            let t320 = T::mul_add(
-                -T::from_f64(0.0026449120390000004),
-                t20,
-                T::mul_add(T::from_f64(0.0230207699865), t4 + t31 - t30, t254 + t255),
-            );
-            let t321 = T::mul_add(
-                T::from_f64(0.10375),
-                t256 - t257,
+            let t320 = T::mul_add(-t9, t226, t8 * t225);
+            let t321 = T::mul_add(-t8, t226, -t9 * t225);
+            let t322 = T::mul_add(
+                T::from_f64(0.00009259999999999985),
+                t10,
                 T::mul_add(
-                    -t8,
-                    t195,
+                    T::from_f64(0.00000000000000000001578767863379873),
+                    t22,
                     T::mul_add(
-                        -t9,
-                        t194,
-                        T::mul_add(
-                            t7,
-                            t48,
-                            T::mul_add(
-                                -T::from_f64(0.0016768992735221656),
-                                t19,
-                                T::from_f64(0.00006575368432434527) * t18,
-                            ),
-                        ),
+                        -T::from_f64(0.00003477275661741105),
+                        t21,
+                        T::mul_add(T::from_f64(0.0007776443641723163), t10, -t224),
                     ),
                 ),
             );
-            let t322 = T::mul_add(t8, t201, t9 * t200);
             let t323 = T::mul_add(
+                T::from_f64(0.0017957741063972504),
+                t65,
+                T::mul_add(
+                    T::from_f64(0.0017919207358628258),
+                    t65,
+                    T::mul_add(-T::from_f64(0.00007238626506919941), t91, -t180),
+                )
+                    + T::mul_add(
+                        T::from_f64(0.0250914799819),
+                        t186,
+                        -T::from_f64(0.0013357060146000001) * t121,
+                    ),
+            );
+            let t324 = -t274;
+            let t325 = T::from_f64(0.2075) * (t91 - t167) + t275;
+            let t326 = T::mul_add(T::from_f64(0.10375), t170 - (-t205), t227);
+            let t327 = T::mul_add(T::from_f64(0.10375), t62 - t246, t274);
+            let t328 = T::mul_add(t9, t239, -t8 * t235);
+            let t329 = T::mul_add(t8, t239, t9 * t235);
+            let t330 = T::mul_add(
+                -T::from_f64(0.10375),
+                -t240,
+                T::mul_add(t8, t188, t9 * t189),
+            );
+            let t331 = T::mul_add(
                 T::from_f64(0.10375),
-                t262 - t261,
+                t241,
+                T::mul_add(-t9, t188, t8 * t189),
+            );
+            let t332 = T::mul_add(-t6, t160, t7 * t241);
+            let t333 = T::mul_add(-t7, t160, -t6 * t241);
+            let t334 = T::mul_add(
+                -T::from_f64(0.0015805219734713843),
+                t131,
                 T::mul_add(
-                    -T::from_f64(0.0030608893468412057),
+                    -T::from_f64(0.0015767446734206029),
+                    t131,
+                    -(T::mul_add(T::from_f64(0.00006575368432434527), t90, t177)),
+                ),
+            );
+            let t335 = T::mul_add(
+                -T::from_f64(0.213725),
+                t5,
+                -(T::mul_add(
+                    T::from_f64(0.00010000000000000503),
+                    t22,
+                    T::from_f64(0.00000000000000000010842021724855044) * t21,
+                )) - t221,
+            )
+                + T::mul_add(
+                    T::from_f64(0.0013224560195000002),
                     t11,
-                    T::mul_add(T::from_f64(0.00013150736864869054), t5, -t263 - t264),
-                ),
+                    -(T::mul_add(T::from_f64(0.0230207699865), t5, t41)),
+                );
+            let t336 = T::mul_add(
+                T::from_f64(0.213725),
+                t5,
+                -(T::mul_add(
+                    -T::from_f64(0.00010000000000000503),
+                    t22,
+                    -T::from_f64(0.00000000000000000010842021724855044) * t21,
+                )) - t234,
+            )
+                + T::mul_add(
+                    -T::from_f64(0.0013224560195000002),
+                    t11,
+                    -(T::mul_add(-T::from_f64(0.0230207699865), t5, -t41)),
+                );
+            let t337 = T::mul_add(
+                T::from_f64(0.00009259999999999985),
+                t10,
+                -(T::mul_add(
+                    -T::from_f64(0.00000000000000000001578767863379873),
+                    t22,
+                    T::mul_add(
+                        T::from_f64(0.00003477275661741105),
+                        t21,
+                        T::mul_add(-T::from_f64(0.0007776443641723163), t10, -t238),
+                    ),
+                )),
             );
-            let t324 = T::mul_add(T::from_f64(0.046041539973), t11, t261 - t262);
-            let t325 = T::mul_add(
-                -t7,
-                t203,
-                T::mul_add(
-                    T::from_f64(0.000020750000000001043),
-                    t26,
-                    T::from_f64(0.000000000000000000022497195079074216) * t25,
-                ),
-            );
-            let t326 = t5 * t271;
-            let t327 = T::mul_add(t4, t58, t5 * t204);
-            let t328 = T::mul_add(
-                T::from_f64(0.0230207699865),
-                t19,
-                T::mul_add(T::from_f64(0.0013224560195000002), t18, t257 - t101 - t256),
-            );
-            let t329 = t5 * t274;
-            let t330 = t4 * t275;
-            let t331 = T::mul_add(T::from_f64(0.0114), t277, t210);
-            let t332 = T::mul_add(t8, t215, t9 * t214);
-            let t333 = T::mul_add(
+            let t338 = -t286;
+            let t339 = T::mul_add(
                 T::from_f64(0.10375),
-                t281 - t280,
+                t287,
+                T::mul_add(t9, t192, t8 * t191),
+            );
+            let t340 = t6 * t290;
+            let t341 = T::mul_add(T::from_f64(0.10375), t293, t291);
+            let t342 = -t292;
+            let t343 = T::mul_add(-t8, t260, t9 * t261);
+            let t344 = T::mul_add(t9, t260, t8 * t261);
+            let t345 = T::mul_add(
+                T::from_f64(0.005672335755227815),
+                t200,
                 T::mul_add(
-                    -T::from_f64(0.0030608893468412057),
-                    t11,
-                    T::mul_add(T::from_f64(0.00013150736864869054), t5, -t263 - t264),
+                    T::from_f64(0.0000000000000006979729257032011),
+                    t199,
+                    -(T::mul_add(
+                        T::from_f64(0.000000000000000000006709516445275485),
+                        t131,
+                        t250,
+                    )),
                 ),
             );
-            let t334 = T::mul_add(T::from_f64(0.046041539973), t11, t280 - t281);
-            let t335 = t9 * t289;
-            let t336 = t8 * t289;
-            let t337 = t45 * t284;
-            let t338 = t4 * t6 * t285;
-            let t339 = t4 * t6 * t283;
-            let t340 = t44 * t284;
-            let t341 = t44 * t285;
-            let t342 = t45 * t283;
-            let t343 = t45 * t287;
-            let t344 = t4 * t6 * t286;
-            let t345 = t4 * t6 * t288;
-            let t346 = t44 * t287;
-            let t347 = t44 * t286;
-            let t348 = t45 * t288;
-            let t349 = t9 * t300;
-            let t350 = t8 * t300;
-            let t351 = t9 * t303;
-            let t352 = t8 * t303;
-            let t353 = t6 * t9 * t286;
-            let t354 = t6 * t8 * t288;
-            let t355 = t8 * t286;
-            let t356 = t9 * t288;
-            let t357 = t8 * t308;
-            let t358 = t9 * t309;
-            let t359 = t5 * t311;
+            let t346 = T::mul_add(
+                T::from_f64(0.0650091026469637),
+                t199,
+                -(T::mul_add(T::from_f64(0.00010000000000000503), t131, t248)),
+            );
+            let t347 = T::mul_add(-t8, t266, -t9 * t265);
+            let t348 = T::mul_add(t9, t266, -t8 * t265);
+            let t349 = T::mul_add(t8, t271, t9 * t270);
+            let t350 = T::mul_add(-t9, t271, t8 * t270);
+            let t351 = T::mul_add(
+                T::from_f64(0.0016768992735221656),
+                t20,
+                T::mul_add(
+                    -T::from_f64(0.00006575368432434527),
+                    t4,
+                    -(T::mul_add(-T::from_f64(0.00006575368432434527), t26, t70)),
+                ),
+            ) + -t269;
+            let t352 = T::mul_add(T::from_f64(0.046041539973), t11, t320);
+            let t353 = -t321;
+            let t354 = T::mul_add(-t8, t280, -t9 * t276);
+            let t355 = T::mul_add(t9, t280, -t8 * t276);
+            let t356 = T::mul_add(
+                -T::from_f64(0.0016768992735221656),
+                t20,
+                T::mul_add(
+                    T::from_f64(0.00006575368432434527),
+                    t4,
+                    -(T::mul_add(T::from_f64(0.00006575368432434527), t26, -t70)),
+                ),
+            ) + -t279;
+            let t357 = T::mul_add(T::from_f64(0.046041539973), t11, -t328);
+            let t358 = T::mul_add(T::from_f64(0.0030608893468412057), t7, t330);
+            let t359 = -t333;
             let t360 = T::mul_add(
-                -T::from_f64(0.463),
-                t99,
+                T::from_f64(0.0000000000000006979729257032011),
+                t200,
                 T::mul_add(
-                    -T::from_f64(0.0026449120390000004),
-                    t36,
-                    T::mul_add(T::from_f64(0.046041539973), t29, t313 - t314),
+                    T::from_f64(0.005482791365775498),
+                    t199,
+                    T::mul_add(-T::from_f64(0.000014022756617410007), t131, -t252),
                 ),
             );
             let t361 = T::mul_add(
-                t8,
-                t250,
-                T::mul_add(
-                    t9,
-                    t249,
-                    T::mul_add(
-                        -T::from_f64(0.10375),
-                        t315 + t316,
-                        T::mul_add(
-                            T::from_f64(0.0013224560195000002),
-                            t100,
-                            T::from_f64(2.0) * (T::mul_add(-t5, t47, t4 * t6 * t48)),
-                        ),
-                    ),
-                ),
+                T::from_f64(0.0650091026469637),
+                t200,
+                -(T::mul_add(
+                    -T::from_f64(0.00000000000000000010842021724855044),
+                    t131,
+                    -t249,
+                )),
             );
             let t362 = T::mul_add(
-                -T::from_f64(2.0),
-                t97,
-                T::mul_add(
-                    -T::from_f64(0.0026449120390000004),
-                    t17,
-                    T::mul_add(T::from_f64(0.0026714120292000002), t15, t315 + t316),
-                ),
+                -T::from_f64(0.10375),
+                t338,
+                T::mul_add(-t8, t192, t9 * t191),
             );
-            let t363 = t6 * t320;
-            let t364 = t5 * t324;
-            let t365 = t4 * t325;
-            let t366 = T::mul_add(T::from_f64(0.0114), t327, t269);
-            let t367 = t5 * t328;
-            let t368 = T::mul_add(-t6, t146, t7 * t272);
-            let t369 = T::mul_add(-t7, t147, t6 * t273);
-            let t370 = T::mul_add(
-                -t6,
-                t147,
-                T::mul_add(
-                    -t7,
-                    t273,
-                    T::mul_add(
-                        T::from_f64(0.10375),
-                        t207 - t206,
-                        T::from_f64(0.004776809772198749) * t7,
-                    ),
-                ),
+            let t363 = T::mul_add(t7, t287, t153);
+            let t364 = T::mul_add(-t6, t287, t154);
+            let t365 = T::mul_add(
+                -T::from_f64(0.10375),
+                -t289,
+                T::mul_add(t8, t194, -t9 * t193),
             );
-            let t371 = T::mul_add(t7, t146, t6 * t272);
-            let t372 = T::mul_add(
-                t4,
-                t212,
-                T::mul_add(
-                    t5,
-                    t275,
-                    T::mul_add(
-                        T::from_f64(0.2073),
-                        t119 - t211,
-                        T::from_f64(0.0114) * t150,
-                    ),
-                ),
+            let t366 = T::mul_add(
+                T::from_f64(0.10375),
+                -t288,
+                T::mul_add(-t9, t194, -t8 * t193),
             );
-            let t373 = T::mul_add(t2, t150, t3 * t277);
-            let t374 = t5 * t334;
-            let t375 = T::mul_add(
-                T::from_f64(1.03),
-                t335 - t290,
-                T::mul_add(
-                    T::from_f64(0.0650091026469637),
-                    t75 - t158,
-                    T::mul_add(
-                        T::from_f64(0.00000000000000000010842021724855044),
-                        t72 + t73,
-                        -t337 - t292 - t338 - t181,
-                    ),
-                ),
-            );
-            let t376 = T::mul_add(
-                T::from_f64(0.0650091026469637),
-                t290 - t335,
-                T::mul_add(
-                    T::from_f64(0.00010000000000000503),
-                    t221 - t235,
-                    T::mul_add(
-                        T::from_f64(0.004705147001603182),
-                        t158 - t75,
-                        T::mul_add(
-                            -T::from_f64(0.0000000000000006979729257032011),
-                            t157 + t74,
-                            T::mul_add(
-                                T::from_f64(0.000000000000000000006709516445275485),
-                                t72 + t73,
-                                T::mul_add(
-                                    -T::from_f64(0.000010375000000000522),
-                                    t154,
-                                    T::mul_add(
-                                        T::from_f64(0.000020750000000001043),
-                                        t70,
-                                        t345 + t184 - t346 - t297,
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t377 = T::mul_add(
-                T::from_f64(0.0650091026469637),
-                t336 + t291,
-                T::mul_add(
-                    T::from_f64(0.00000000000000000010842021724855044),
-                    t221 - t235,
-                    T::mul_add(
-                        T::from_f64(0.0000000000000006979729257032011),
-                        t75 - t158,
-                        T::mul_add(
-                            T::from_f64(0.004894691391055498),
-                            t157 + t74,
-                            T::mul_add(
-                                T::from_f64(0.000014022756617410007),
-                                t72 + t73,
-                                T::mul_add(
-                                    -T::from_f64(0.000000000000000000011248597539537108),
-                                    t154,
-                                    T::mul_add(
-                                        T::from_f64(0.000000000000000000022497195079074216),
-                                        t70,
-                                        t343 + t296 - t344 - t183,
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t378 = T::mul_add(
-                T::from_f64(1.03),
-                t336 + t291,
-                T::mul_add(
-                    T::from_f64(0.0650091026469637),
-                    t157 + t74,
-                    T::mul_add(
-                        T::from_f64(0.00010000000000000503),
-                        t72 + t73,
-                        t339 + t182 + t340 + t293,
-                    ),
-                ),
-            );
-            let t379 = T::mul_add(
-                -T::from_f64(0.00010000000000000503),
-                t336 + t291,
-                T::mul_add(
-                    T::from_f64(0.00000000000000000010842021724855044),
-                    t290 - t335,
-                    T::mul_add(
-                        -T::from_f64(0.0015805219734713843),
-                        t92,
-                        T::mul_add(
-                            -T::from_f64(0.0013224560195000002),
-                            t220,
-                            T::mul_add(
-                                T::from_f64(0.000000000000000000006709516445275485),
-                                t75 - t158,
-                                T::mul_add(
-                                    -T::from_f64(0.000014022756617410007),
-                                    t157 + t74,
-                                    T::mul_add(
-                                        -T::from_f64(0.0008740216642230976),
-                                        t72 + t73,
-                                        T::mul_add(
-                                            T::from_f64(0.00006575368432434527),
-                                            t71,
-                                            t230 + t231 + t348 + t299 - t178 - t347 - t298,
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t380 = T::mul_add(
-                -T::from_f64(1.03),
-                t235,
-                T::mul_add(
-                    T::from_f64(1.493),
-                    t221,
-                    T::mul_add(
-                        T::from_f64(0.00010000000000000503),
-                        t158 - t75,
-                        T::mul_add(
-                            T::from_f64(0.00000000000000000010842021724855044),
-                            t157 + t74,
-                            T::mul_add(
-                                -T::from_f64(0.0013224560195000002),
-                                t125,
-                                T::mul_add(
-                                    -T::from_f64(0.1298832699865),
-                                    t154,
-                                    T::mul_add(
-                                        T::from_f64(0.213725),
-                                        t70,
-                                        t224 + t93 + t342 + t295 - t225 - t341 - t294,
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t381 = T::mul_add(
-                T::from_f64(1.03),
-                t349 - t301,
-                T::mul_add(
-                    T::from_f64(0.0650091026469637),
-                    t75 - t158,
-                    T::mul_add(
-                        T::from_f64(0.00000000000000000010842021724855044),
-                        t72 + t73,
-                        -t337 - t292 - t338 - t181,
-                    ),
-                ),
-            );
-            let t382 = T::mul_add(
-                T::from_f64(1.03),
-                t350 + t302,
-                T::mul_add(
-                    T::from_f64(0.0650091026469637),
-                    t157 + t74,
-                    T::mul_add(
-                        T::from_f64(0.00010000000000000503),
-                        t72 + t73,
-                        t339 + t182 + t340 + t293,
-                    ),
-                ),
-            );
-            let t383 = T::mul_add(
-                T::from_f64(0.0650091026469637),
-                t350 + t302,
-                T::mul_add(
-                    T::from_f64(0.00000000000000000010842021724855044),
-                    t238 - t235,
-                    T::mul_add(
-                        T::from_f64(0.0000000000000006979729257032011),
-                        t75 - t158,
-                        T::mul_add(
-                            T::from_f64(0.004894691391055498),
-                            t157 + t74,
-                            T::mul_add(
-                                T::from_f64(0.000014022756617410007),
-                                t72 + t73,
-                                T::mul_add(
-                                    -T::from_f64(0.000000000000000000011248597539537108),
-                                    t154,
-                                    T::mul_add(
-                                        T::from_f64(0.000000000000000000022497195079074216),
-                                        t70,
-                                        t343 + t296 - t344 - t183,
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
+            let t367 = T::mul_add(t6, t288, -t154);
+            let t368 = T::mul_add(t7, t288, t153);
+            let t369 = T::mul_add(-t7, t290, T::from_f64(0.10375) * t197);
+            let t370 = T::mul_add(-t4, t243, t5 * t293);
+            let t371 = T::mul_add(t5, t243, t4 * t293);
+            let t372 = T::mul_add(t200, t96, -t296) + T::mul_add(-t131, t97, -t297);
+            let t373 = T::mul_add(t199, t96, -t299) - (T::mul_add(t131, t63, t298));
+            let t374 = T::mul_add(-t199, t97, -t300) + T::mul_add(t200, t63, t301);
+            let t375 = T::mul_add(-t200, t99, -t302) - (T::mul_add(-t131, t100, -t303));
+            let t376 = T::mul_add(t131, t98, t304) + T::mul_add(-t199, t99, -t305);
+            let t377 = -(T::mul_add(-t199, t100, -t306)) - (T::mul_add(t200, t98, t307));
+            let t378 = T::mul_add(t200, t101, t296) + T::mul_add(t131, t64, t297);
+            let t379 = T::mul_add(t199, t101, t299) - (T::mul_add(-t131, t102, -t298));
+            let t380 = T::mul_add(t199, t64, t300) + T::mul_add(-t200, t102, -t301);
+            let t381 = T::mul_add(t200, t104, t302) - (T::mul_add(t131, t103, t303));
+            let t382 = T::mul_add(-t131, t105, -t304) + T::mul_add(t199, t104, t305);
+            let t383 = -(T::mul_add(t199, t103, t306))
+                - (T::mul_add(-t200, t105, -t307));
             (
                 t320,
                 t321,
@@ -7871,522 +6331,367 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
             t446,
             t447,
         ) = {
-            let t384 = T::mul_add(
-                T::from_f64(0.0650091026469637),
-                t301 - t349,
-                T::mul_add(
-                    T::from_f64(0.00010000000000000503),
-                    t238 - t235,
-                    T::mul_add(
-                        T::from_f64(0.004705147001603182),
-                        t158 - t75,
-                        T::mul_add(
-                            -T::from_f64(0.0000000000000006979729257032011),
-                            t157 + t74,
-                            T::mul_add(
-                                T::from_f64(0.000000000000000000006709516445275485),
-                                t72 + t73,
-                                T::mul_add(
-                                    -T::from_f64(0.000010375000000000522),
-                                    t154,
-                                    T::mul_add(
-                                        T::from_f64(0.000020750000000001043),
-                                        t70,
-                                        t345 + t184 - t346 - t297,
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t385 = T::mul_add(
-                T::from_f64(1.493),
-                t238,
-                T::mul_add(
-                    -T::from_f64(1.03),
-                    t235,
-                    T::mul_add(
-                        T::from_f64(0.00010000000000000503),
-                        t158 - t75,
-                        T::mul_add(
-                            T::from_f64(0.00000000000000000010842021724855044),
-                            t157 + t74,
-                            T::mul_add(
-                                -T::from_f64(0.0013224560195000002),
-                                t125,
-                                T::mul_add(
-                                    -T::from_f64(0.1298832699865),
-                                    t154,
-                                    T::mul_add(
-                                        T::from_f64(0.213725),
-                                        t70,
-                                        t224 + t93 + t342 + t295 - t225 - t341 - t294,
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t386 = T::mul_add(
-                -T::from_f64(0.00010000000000000503),
-                t350 + t302,
+            let t384 = T::mul_add(t200, t44, t6 * t8 * t247)
+                + T::mul_add(-t131, t45, -t7 * t248);
+            let t385 = T::mul_add(t199, t44, t6 * t9 * t247)
+                - (T::mul_add(t131, t46, t7 * t249));
+            let t386 = T::mul_add(-t199, t45, t6 * t9 * t248)
+                + T::mul_add(t200, t46, -t6 * t8 * t249);
+            let t387 = T::mul_add(-t200, t48, t6 * t8 * t251)
+                - (T::mul_add(-t131, t49, -t7 * t250));
+            let t388 = T::mul_add(t131, t47, t7 * t252)
+                + T::mul_add(-t199, t48, t6 * t9 * t251);
+            let t389 = -(T::mul_add(-t199, t49, t6 * t9 * t250))
+                - (T::mul_add(t200, t47, -t6 * t8 * t252));
+            let t390 = T::mul_add(T::from_f64(0.0650091026469637), t8 * t199, t8 * t248)
+                + T::mul_add(-T::from_f64(0.0650091026469637), t9 * t200, t9 * t249);
+            let t391 = T::mul_add(
+                T::from_f64(0.3437432052939274),
+                t172,
                 T::mul_add(
                     T::from_f64(0.00000000000000000010842021724855044),
-                    t301 - t349,
-                    T::mul_add(
-                        -T::from_f64(0.0013224560195000002),
-                        t237,
-                        T::mul_add(
-                            -T::from_f64(0.0015805219734713843),
-                            t92,
-                            T::mul_add(
-                                T::from_f64(0.000000000000000000006709516445275485),
-                                t75 - t158,
-                                T::mul_add(
-                                    -T::from_f64(0.000014022756617410007),
-                                    t157 + t74,
-                                    T::mul_add(
-                                        -T::from_f64(0.0008740216642230976),
-                                        t72 + t73,
-                                        T::mul_add(
-                                            T::from_f64(0.00006575368432434527),
-                                            t71,
-                                            t230 + t231 + t348 + t299 - t178 - t347 - t298,
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
+                    t132,
+                    T::mul_add(t200, t31, -t9 * t247),
                 ),
             );
-            let t387 = T::mul_add(
-                t123,
-                t50,
-                T::mul_add(
-                    t7,
-                    t285,
-                    T::mul_add(
-                        -t219,
-                        t49,
-                        T::mul_add(
-                            -t6,
-                            t8 * t284,
-                            T::mul_add(
-                                -T::from_f64(1.03),
-                                t351,
-                                T::mul_add(
-                                    -T::from_f64(0.0650091026469637),
-                                    t80 + t81,
-                                    T::from_f64(0.00000000000000000010842021724855044) * t77,
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t388 = T::mul_add(
-                t218,
-                t49,
-                T::mul_add(
-                    t6,
-                    t9 * t284,
-                    T::mul_add(
-                        -t123,
-                        t51,
-                        T::mul_add(
-                            -t7,
-                            t283,
-                            T::mul_add(
-                                -T::from_f64(1.03),
-                                t352,
-                                T::mul_add(
-                                    T::from_f64(0.0650091026469637),
-                                    t78 - t79,
-                                    T::from_f64(0.00010000000000000503) * t77,
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t389 = T::mul_add(
-                -t123,
-                t53,
-                T::mul_add(
-                    -t7,
-                    t286,
-                    T::mul_add(
-                        t219,
-                        t52,
-                        T::mul_add(
-                            -t6,
-                            t8 * t287,
-                            T::mul_add(
-                                T::from_f64(0.0650091026469637),
-                                t352,
-                                T::mul_add(
-                                    T::from_f64(0.00000000000000000010842021724855044),
-                                    t244,
-                                    T::mul_add(
-                                        T::from_f64(0.0000000000000006979729257032011),
-                                        t80 + t81,
-                                        T::mul_add(
-                                            T::from_f64(0.004894691391055498),
-                                            t79 - t78,
-                                            T::mul_add(
-                                                -T::from_f64(0.000014022756617410007),
-                                                t77,
-                                                T::from_f64(0.000000000000000000011248597539537108) * t155,
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t390 = T::mul_add(
-                -t218,
-                t52,
-                T::mul_add(
-                    t6,
-                    t9 * t287,
-                    T::mul_add(
-                        t123,
-                        t54,
-                        T::mul_add(
-                            t7,
-                            t288,
-                            T::mul_add(
-                                -T::from_f64(0.0650091026469637),
-                                t351,
-                                T::mul_add(
-                                    T::from_f64(0.00010000000000000503),
-                                    t244,
-                                    T::mul_add(
-                                        -T::from_f64(0.004705147001603182),
-                                        t80 + t81,
-                                        T::mul_add(
-                                            T::from_f64(0.0000000000000006979729257032011),
-                                            t78 - t79,
-                                            T::mul_add(
-                                                -T::from_f64(0.000000000000000000006709516445275485),
-                                                t77,
-                                                T::from_f64(0.000010375000000000522) * t155,
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t391 = T::mul_add(
-                -T::from_f64(0.00010000000000000503),
-                t352,
-                T::mul_add(
-                    -T::from_f64(0.00000000000000000010842021724855044),
-                    t351,
-                    T::mul_add(
-                        -t6,
-                        t169,
-                        T::mul_add(
-                            T::from_f64(0.000000000000000000006709516445275485),
-                            t80 + t81,
-                            T::mul_add(
-                                T::from_f64(0.000014022756617410007),
-                                t78 - t79,
-                                T::mul_add(
-                                    T::from_f64(0.002454543637694482),
-                                    t77,
-                                    T::mul_add(
-                                        T::from_f64(0.00006575368432434527),
-                                        t68 - t162,
-                                        t353 + t305 - t304 - t354,
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t392 = T::mul_add(
-                T::from_f64(1.03),
-                t244,
-                T::mul_add(
-                    t219,
-                    t51,
-                    T::mul_add(
-                        -t6,
-                        t8 * t283,
-                        T::mul_add(
-                            -t218,
-                            t50,
-                            T::mul_add(
-                                t6,
-                                t9 * t285,
-                                T::mul_add(
-                                    t6,
-                                    t165,
-                                    T::mul_add(
-                                        -T::from_f64(0.00010000000000000503),
-                                        t80 + t81,
-                                        T::mul_add(
-                                            T::from_f64(0.00000000000000000010842021724855044),
-                                            t79 - t78,
-                                            T::mul_add(
-                                                T::from_f64(0.0026449120390000004),
-                                                t76,
-                                                T::from_f64(0.1298832699865) * t155,
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t393 = T::mul_add(
-                t219,
-                t35,
-                T::mul_add(
-                    -t9,
-                    t284,
-                    T::mul_add(
-                        T::from_f64(1.03),
-                        t245,
-                        T::mul_add(
-                            T::from_f64(0.1300182052939274),
-                            t160,
-                            T::from_f64(0.00000000000000000010842021724855044) * t124,
-                        ),
-                    ),
-                ),
-            );
-            let t394 = T::mul_add(
-                t218,
-                t32,
-                T::mul_add(
-                    t8,
-                    t287,
-                    T::mul_add(
-                        -t123,
-                        t33,
-                        T::mul_add(
-                            -T::from_f64(0.0650091026469637),
-                            t245,
-                            T::mul_add(
-                                -T::from_f64(0.004705147001603182),
-                                t160,
-                                T::mul_add(
-                                    T::from_f64(0.0000000000000006979729257032011),
-                                    t159,
-                                    T::mul_add(
-                                        T::from_f64(0.000000000000000000006709516445275485),
-                                        t124,
-                                        T::from_f64(0.000020750000000001043) * t69,
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
+            let t392 = T::mul_add(t131, t30, T::mul_add(t200, t28, -t9 * t251));
+            let t393 = T::mul_add(-t131, t29, T::mul_add(t199, t28, t8 * t251));
+            let t394 = -(T::mul_add(-t199, t30, t8 * t250))
+                - (T::mul_add(-t200, t29, t9 * t252));
             let t395 = T::mul_add(
-                -t123,
-                t34,
+                -T::from_f64(0.3437432052939274),
+                t171,
                 T::mul_add(
-                    -t219,
-                    t32,
-                    T::mul_add(
-                        t9,
-                        t287,
-                        T::mul_add(
-                            -T::from_f64(0.0650091026469637),
-                            t246,
-                            T::mul_add(
-                                T::from_f64(0.0000000000000006979729257032011),
-                                t160,
-                                T::mul_add(
-                                    -T::from_f64(0.004894691391055498),
-                                    t159,
-                                    T::mul_add(
-                                        T::from_f64(0.000014022756617410007),
-                                        t124,
-                                        T::from_f64(0.000000000000000000022497195079074216) * t69,
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
+                    T::from_f64(0.00010000000000000503),
+                    t132,
+                    -(T::mul_add(t199, t31, t8 * t247)),
                 ),
             );
             let t396 = T::mul_add(
-                -t218,
-                t35,
+                T::from_f64(0.463),
+                t108,
                 T::mul_add(
-                    -t8,
-                    t284,
-                    T::mul_add(
-                        -T::from_f64(1.03),
-                        t246,
-                        T::mul_add(
-                            -T::from_f64(0.1300182052939274),
-                            t159,
-                            T::from_f64(0.00010000000000000503) * t124,
-                        ),
-                    ),
+                    -T::from_f64(0.0026449120390000004),
+                    t32,
+                    T::from_f64(0.046041539973) * t25,
                 ),
-            );
+            ) + t347;
             let t397 = T::mul_add(
-                -T::from_f64(0.00010000000000000503),
-                t246,
-                T::mul_add(
-                    T::from_f64(0.00000000000000000010842021724855044),
-                    t245,
-                    T::mul_add(
-                        -T::from_f64(0.000000000000000000006709516445275485),
-                        t160,
-                        T::mul_add(
-                            -T::from_f64(0.000014022756617410007),
-                            t159,
-                            T::mul_add(
-                                T::from_f64(0.0008702443641723162),
-                                t124,
-                                t306 + t307 - t355 - t356,
-                            ),
-                        ),
-                    ),
-                ),
+                -T::from_f64(2.0),
+                t4 * t6 * t41,
+                -T::from_f64(0.0026449120390000004) * t17,
+            ) + t348;
+            let t398 = t145 + -t317;
+            let t399 = T::mul_add(
+                -T::from_f64(0.0026449120390000004),
+                t20,
+                T::from_f64(0.0230207699865) * (t4 - t40),
+            ) + t349;
+            let t400 = T::mul_add(
+                -T::from_f64(0.10375),
+                -t320,
+                T::mul_add(t8, t272, t9 * t273),
             );
-            let t398 = T::mul_add(
-                t8,
-                t309,
-                T::mul_add(-t9, t308, T::from_f64(0.10375) * t311),
-            );
-            let t399 = T::mul_add(-t6, t312, t7 * t310);
-            let t400 = T::mul_add(t7, t312, t6 * t310);
-            let t401 = t7 * t360;
-            let t402 = t6 * t360;
-            let t403 = t6 * t361;
-            let t404 = t5 * t362;
-            let t405 = T::mul_add(-t7, t197, t6 * t321);
-            let t406 = T::mul_add(-t6, t196, t7 * t320);
-            let t407 = T::mul_add(T::from_f64(0.0026714120292000002), t5, t363 + t260);
-            let t408 = T::mul_add(-t6, t323, t268);
-            let t409 = T::mul_add(
-                t7,
-                t323,
-                T::mul_add(
-                    T::from_f64(0.10375),
-                    t261 - t262,
-                    T::mul_add(T::from_f64(0.004776809772198749), t11, t267),
-                ),
-            );
-            let t410 = T::mul_add(
-                t4,
-                t271,
-                T::mul_add(
-                    t5,
-                    t325,
-                    T::mul_add(
-                        T::from_f64(0.2073),
-                        t114 - t270,
-                        T::from_f64(0.0114) * t205,
-                    ),
-                ),
-            );
-            let t411 = T::mul_add(t2, t205, t3 * t327);
-            let t412 = T::mul_add(
-                -t6,
-                t197,
-                T::mul_add(
-                    -t7,
-                    t321,
-                    T::mul_add(
-                        T::from_f64(0.10375),
-                        t101 + t256 - t257,
-                        T::mul_add(
-                            -T::from_f64(0.0023884048860993747),
-                            t19,
-                            T::mul_add(
-                                -T::from_f64(0.00013720481202312502),
-                                t18,
-                                T::from_f64(0.00010030674106884884) * t5,
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t413 = T::mul_add(T::from_f64(0.10375), t272 - t368, t208 - t209);
-            let t414 = t4 * t368;
-            let t415 = t4 * t370;
-            let t416 = T::mul_add(
-                T::from_f64(0.0650091026469637),
-                T::mul_add(-t9, t219, t8 * t218),
-                T::mul_add(
-                    t9,
-                    t283,
-                    T::mul_add(
-                        t8,
-                        t285,
-                        T::mul_add(
-                            -T::from_f64(0.00010000000000000503),
-                            t160,
-                            T::mul_add(
-                                -T::from_f64(0.00000000000000000010842021724855044),
-                                t159,
-                                T::from_f64(0.25976653997300003) * t69,
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t417 = T::mul_add(t7, t322, t278);
-            let t418 = T::mul_add(t6, t322, -t279);
-            let t419 = T::mul_add(t6, t333, -t268);
-            let t420 = T::mul_add(
+            let t401 = T::mul_add(
                 T::from_f64(0.10375),
-                t280 - t281,
+                t321,
+                T::mul_add(-t9, t272, t8 * t273),
+            );
+            let t402 = T::mul_add(
+                T::from_f64(0.463),
+                t275,
                 T::mul_add(
-                    t7,
-                    t333,
-                    T::mul_add(T::from_f64(0.004776809772198749), t11, t267),
+                    T::from_f64(0.0013224560195000002),
+                    t170,
+                    T::mul_add(-T::from_f64(0.046041539973), t167, -(-t253)),
                 ),
             );
-            let t421 = T::mul_add(t7, t332, t278);
-            let t422 = T::mul_add(-t6, t332, t279);
-            let t423 = t9 * t375;
-            let t424 = t8 * t378;
-            let t425 = t8 * t375;
-            let t426 = t9 * t378;
-            let t427 = t8 * t377;
-            let t428 = t9 * t376;
-            let t429 = t6 * t380;
-            let t430 = t7 * t380;
-            let t431 = t7 * t379;
-            let t432 = t9 * t381;
-            let t433 = t8 * t382;
-            let t434 = t8 * t381;
-            let t435 = t9 * t382;
-            let t436 = t8 * t383;
-            let t437 = t9 * t384;
-            let t438 = t6 * t385;
-            let t439 = t7 * t385;
-            let t440 = t7 * t386;
-            let t441 = t9 * t387;
-            let t442 = t8 * t388;
-            let t443 = t8 * t387;
-            let t444 = t9 * t388;
-            let t445 = t8 * t389;
-            let t446 = t9 * t390;
-            let t447 = t7 * t392;
+            let t403 = T::mul_add(
+                T::from_f64(0.463),
+                t227,
+                T::mul_add(
+                    T::from_f64(0.0230207699865),
+                    t170,
+                    T::mul_add(T::from_f64(0.0026449120390000004), t167, -(-t254)),
+                ),
+            );
+            let t404 = T::mul_add(
+                T::from_f64(0.0015805219734713843),
+                t170,
+                -(-t255) - (-t256)
+                    + T::mul_add(
+                        T::from_f64(0.0013224560195000002),
+                        t275,
+                        T::from_f64(0.0230207699865) * t227,
+                    ),
+            );
+            let t405 = T::mul_add(
+                T::from_f64(0.0013224560195000002),
+                t324,
+                T::mul_add(
+                    T::from_f64(0.00009637730005078133),
+                    t134,
+                    -T::from_f64(0.00006575368432434527) * t62,
+                ) + T::mul_add(T::from_f64(0.0015805219734713843), t262, -(-t257)),
+            );
+            let t406 = T::mul_add(
+                T::from_f64(0.0230207699865),
+                t324,
+                T::mul_add(
+                    T::from_f64(0.00006575368432434527),
+                    t134,
+                    -T::from_f64(0.0015767446734206029) * t62,
+                ) + T::mul_add(T::from_f64(0.0015805219734713843), t246, -t258),
+            );
+            let t407 = T::mul_add(-t8, t326, -t9 * t327);
+            let t408 = T::mul_add(t9, t326, -t8 * t327);
+            let t409 = T::mul_add(
+                T::from_f64(0.0026449120390000004),
+                t20,
+                -T::from_f64(0.0230207699865) * (t4 + t86),
+            ) + t354;
+            let t410 = T::mul_add(
+                T::from_f64(0.0230207699865),
+                t19,
+                T::mul_add(T::from_f64(0.0013224560195000002), t18, -t68),
+            ) + t355;
+            let t411 = T::mul_add(
+                -T::from_f64(0.10375),
+                -t328,
+                T::mul_add(-t8, t283, -t9 * t282),
+            );
+            let t412 = T::mul_add(
+                T::from_f64(0.10375),
+                t329,
+                T::mul_add(t9, t283, -t8 * t282),
+            );
+            let t413 = t350
+                + T::mul_add(
+                    -T::from_f64(0.0230207699865),
+                    t19,
+                    T::mul_add(-T::from_f64(0.0013224560195000002), t18, t68),
+                );
+            let t414 = T::mul_add(T::from_f64(0.10375), -t332, t331);
+            let t415 = T::mul_add(-t5, t285, -t4 * t332);
+            let t416 = T::mul_add(-t4, t285, t5 * t332);
+            let t417 = T::mul_add(t6, t336, t7 * t329);
+            let t418 = T::mul_add(t7, t336, -t6 * t329);
+            let t419 = t6 * t362;
+            let t420 = t6 * t365;
+            let t421 = T::mul_add(T::from_f64(0.10375), t368, t366);
+            let t422 = -t367;
+            let t423 = -t370;
+            let t424 = T::mul_add(
+                T::from_f64(0.41),
+                t55,
+                T::mul_add(-t2, t198, -t3 * t294),
+            );
+            let t425 = T::mul_add(
+                T::from_f64(1.03),
+                t343,
+                T::mul_add(
+                    -T::from_f64(0.00000000000000000010842021724855044),
+                    t173,
+                    -T::from_f64(0.0650091026469637) * t202,
+                ) + t372,
+            );
+            let t426 = T::mul_add(
+                T::from_f64(0.004894691391055498),
+                t244,
+                T::mul_add(
+                    T::from_f64(0.000014022756617410007),
+                    t173,
+                    T::from_f64(0.0000000000000006979729257032011) * t202,
+                ),
+            ) + t375
+                + T::mul_add(
+                    -T::from_f64(0.0650091026469637),
+                    t344,
+                    T::from_f64(0.00000000000000000010842021724855044) * t259,
+                );
+            let t427 = T::mul_add(
+                T::from_f64(0.0000000000000006979729257032011),
+                t244,
+                T::mul_add(
+                    -T::from_f64(0.000000000000000000006709516445275485),
+                    t173,
+                    T::from_f64(0.004705147001603182) * t202,
+                ),
+            ) + t376
+                + T::mul_add(
+                    -T::from_f64(0.0650091026469637),
+                    t343,
+                    -T::from_f64(0.00010000000000000503) * t259,
+                );
+            let t428 = T::mul_add(
+                -T::from_f64(0.000014022756617410007),
+                t244,
+                T::mul_add(
+                    -T::from_f64(0.0007776443641723163),
+                    t173,
+                    T::from_f64(0.000000000000000000006709516445275485) * t202,
+                ),
+            ) + t377
+                + T::mul_add(
+                    T::from_f64(0.00010000000000000503),
+                    t344,
+                    T::from_f64(0.00000000000000000010842021724855044) * t343,
+                );
+            let t429 = T::mul_add(
+                T::from_f64(1.03),
+                t344,
+                -(T::mul_add(
+                    T::from_f64(0.0650091026469637),
+                    t244,
+                    T::from_f64(0.00010000000000000503) * t173,
+                )) - t373,
+            );
+            let t430 = T::mul_add(
+                T::from_f64(1.03),
+                t312,
+                T::mul_add(
+                    -T::from_f64(0.0650091026469637),
+                    t135,
+                    -T::from_f64(0.00000000000000000010842021724855044) * t93,
+                ) + t384,
+            );
+            let t431 = T::mul_add(
+                T::from_f64(0.004894691391055498),
+                t137,
+                T::mul_add(
+                    T::from_f64(0.0000000000000006979729257032011),
+                    t135,
+                    T::from_f64(0.000014022756617410007) * t93,
+                ),
+            ) + t387
+                + T::mul_add(
+                    -T::from_f64(0.0650091026469637),
+                    t313,
+                    -T::from_f64(0.000000000000000000022497195079074216) * t168,
+                );
+            let t432 = T::mul_add(
+                T::from_f64(0.0000000000000006979729257032011),
+                t137,
+                T::mul_add(
+                    T::from_f64(0.004705147001603182),
+                    t135,
+                    -T::from_f64(0.000000000000000000006709516445275485) * t93,
+                ),
+            ) + t388
+                + T::mul_add(
+                    -T::from_f64(0.0650091026469637),
+                    t312,
+                    T::from_f64(0.000020750000000001043) * t168,
+                );
+            let t433 = T::mul_add(
+                -T::from_f64(0.000014022756617410007),
+                t137,
+                T::mul_add(
+                    T::from_f64(0.000000000000000000006709516445275485),
+                    t135,
+                    -T::from_f64(0.0007776443641723163) * t93,
+                ),
+            ) + t389
+                + T::mul_add(
+                    T::from_f64(0.00010000000000000503),
+                    t313,
+                    T::from_f64(0.00000000000000000010842021724855044) * t312,
+                );
+            let t434 = T::mul_add(
+                T::from_f64(1.03),
+                t313,
+                -(T::mul_add(
+                    T::from_f64(0.0650091026469637),
+                    t137,
+                    T::from_f64(0.00010000000000000503) * t93,
+                )) - t385,
+            );
+            let t435 = T::mul_add(
+                -T::from_f64(0.01819453580084815),
+                t172,
+                T::mul_add(
+                    T::from_f64(0.0000000000000006979729257032011),
+                    t171,
+                    T::mul_add(
+                        T::from_f64(0.000000000000000000006709516445275485),
+                        t132,
+                        T::mul_add(T::from_f64(0.000020750000000001043), t90, t393),
+                    ),
+                ),
+            );
+            let t436 = T::mul_add(
+                T::from_f64(0.0000000000000006979729257032011),
+                t172,
+                T::mul_add(
+                    -T::from_f64(0.018384080190300467),
+                    t171,
+                    T::mul_add(
+                        T::from_f64(0.000014022756617410007),
+                        t132,
+                        T::mul_add(
+                            T::from_f64(0.000000000000000000022497195079074216),
+                            t90,
+                            -t392,
+                        ),
+                    ),
+                ),
+            );
+            let t437 = T::mul_add(
+                -T::from_f64(0.10375),
+                -t348,
+                T::mul_add(t8, t316, -t9 * t315),
+            );
+            let t438 = T::mul_add(
+                T::from_f64(0.10375),
+                -t347,
+                T::mul_add(-t9, t316, -t8 * t315),
+            );
+            let t439 = T::mul_add(T::from_f64(0.0026714120292000002), t15, t397);
+            let t440 = T::mul_add(
+                -T::from_f64(0.10375),
+                -t350,
+                T::mul_add(t8, t268, -t9 * t267),
+            );
+            let t441 = T::mul_add(
+                T::from_f64(0.10375),
+                -t349,
+                T::mul_add(-t9, t268, -t8 * t267),
+            );
+            let t442 = T::mul_add(
+                T::from_f64(1.03),
+                t407,
+                T::mul_add(
+                    -T::from_f64(0.0650091026469637),
+                    t245,
+                    -T::from_f64(0.00000000000000000010842021724855044) * t134,
+                ) + t378,
+            );
+            let t443 = T::mul_add(
+                -T::from_f64(1.03),
+                t408,
+                T::mul_add(
+                    T::from_f64(0.0650091026469637),
+                    t201,
+                    T::from_f64(0.00010000000000000503) * t134,
+                ) + t379,
+            );
+            let t444 = T::mul_add(
+                -T::from_f64(0.10375),
+                -t355,
+                T::mul_add(t8, t278, -t9 * t277),
+            );
+            let t445 = T::mul_add(
+                T::from_f64(0.10375),
+                -t354,
+                T::mul_add(-t9, t278, -t8 * t277),
+            );
+            let t446 = t400
+                + T::mul_add(
+                    T::from_f64(0.003157266646891987),
+                    t11,
+                    -(T::mul_add(T::from_f64(0.00006575368432434527), t5, t42)),
+                );
+            let t447 = T::mul_add(t7, t335, t6 * t353);
             (
                 t384,
                 t385,
@@ -8520,343 +6825,220 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
             t510,
             t511,
         ) = {
-            let t448 = t8 * t393;
-            let t449 = t9 * t396;
-            let t450 = t8 * t395;
-            let t451 = t9 * t394;
-            let t452 = t6 * t398;
-            let t453 = T::mul_add(T::from_f64(0.10375), t310 - t399, t357 + t358);
-            let t454 = t4 * t399;
-            let t455 = T::mul_add(
-                T::from_f64(0.10375),
-                t314 + t401 - t313 - t251,
-                T::mul_add(
-                    T::from_f64(0.0230207699865),
-                    t99,
-                    T::mul_add(
-                        T::from_f64(2.0),
-                        t98,
-                        T::mul_add(
-                            -T::from_f64(0.0031610439469427687),
-                            t29,
-                            T::mul_add(
-                                T::from_f64(0.00014477253013839883),
-                                t14,
-                                t318 - t317,
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t456 = T::mul_add(
-                -t6,
-                t253,
-                T::mul_add(
-                    -t7,
-                    t361,
-                    T::mul_add(
-                        -T::from_f64(0.10375),
-                        t315 + t316,
-                        T::mul_add(
-                            T::from_f64(0.2075),
-                            t97,
-                            T::mul_add(
-                                T::from_f64(0.00027440962404625004),
-                                t17,
-                                T::mul_add(
-                                    T::from_f64(0.00014477253013839883),
-                                    t16,
-                                    T::from_f64(0.0005537837136531601),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t457 = T::mul_add(T::from_f64(0.0026714120292000002), t14, t401 - t251);
-            let t458 = T::mul_add(
-                T::from_f64(0.0501829599638),
-                t15 + t16,
-                T::from_f64(0.3015204) - t402 - t252,
-            );
-            let t459 = t4 * t406;
-            let t460 = T::mul_add(
-                T::from_f64(0.10375),
-                t254 + t255 - t406,
-                T::mul_add(
-                    T::from_f64(0.0015805219734713843),
-                    t31,
-                    T::mul_add(
-                        -T::from_f64(0.001484144673420603),
-                        t30,
-                        T::mul_add(
-                            -T::from_f64(0.00006575368432434527),
-                            t20,
-                            T::mul_add(
-                                T::from_f64(0.0016693446734206028),
-                                t4,
-                                t258 - t102 - t259,
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t461 = t4 * t409;
-            let t462 = t1 * t411;
-            let t463 = t0 * (T::mul_add(-t3, t205, t2 * t327));
-            let t464 = t4 * t412;
-            let t465 = t5 * t413;
-            let t466 = T::mul_add(-t4, t274, t5 * t368);
-            let t467 = t4 * t417;
-            let t468 = T::mul_add(T::from_f64(0.10375), t322 - t417, t266 - t265);
-            let t469 = t4 * t421;
-            let t470 = T::mul_add(T::from_f64(0.10375), t421 - t332, t265 - t266);
-            let t471 = t4 * t420;
-            let t472 = T::mul_add(
-                -t1,
-                T::mul_add(t3, t217, t2 * t282),
-                T::mul_add(
-                    -t0,
-                    T::mul_add(t2, t217, T::mul_add(-t3, t282, T::from_f64(0.41) * t67)),
-                    -T::from_f64(0.0016)
-                        * (T::mul_add(
-                            t0,
-                            T::mul_add(t3, t7 * t41, t2 * t5 * t6 * t41),
-                            t1 * t122,
-                        )),
-                ),
-            );
-            let t473 = T::mul_add(
+            let t448 = T::mul_add(-t6, t335, t7 * t353);
+            let t449 = t411 + t161;
+            let t450 = -t418;
+            let t451 = T::mul_add(-t7, t242, t6 * t358);
+            let t452 = T::mul_add(t8, t361, t9 * t346);
+            let t453 = T::mul_add(-t9, t361, t8 * t346);
+            let t454 = T::mul_add(-t7, t362, T::from_f64(0.10375) * t286);
+            let t455 = T::mul_add(T::from_f64(0.10375), -t363, t339);
+            let t456 = T::mul_add(t5, t338, -t4 * t363);
+            let t457 = T::mul_add(t4, t338, t5 * t363);
+            let t458 = T::mul_add(-t7, t365, T::from_f64(0.10375) * t289);
+            let t459 = T::mul_add(t4, t289, t5 * t368);
+            let t460 = T::mul_add(-t5, t289, t4 * t368);
+            let t461 = T::mul_add(-T::from_f64(0.0114), t423, t340);
+            let t462 = T::mul_add(-t2, t342, t3 * t370);
+            let t463 = T::mul_add(
                 -T::from_f64(0.463),
-                t220,
-                T::mul_add(
-                    -T::from_f64(0.0013224560195000002),
-                    t72 + t73 + t92,
-                    T::mul_add(
-                        T::from_f64(0.0230207699865),
-                        t71 - t161,
-                        t223 + t423 + t424 - t222,
-                    ),
-                ),
-            );
-            let t474 = T::mul_add(
-                T::from_f64(0.10375),
-                t426 - t425,
-                T::mul_add(
-                    t8,
-                    t376,
-                    T::mul_add(
-                        t9,
-                        t377,
-                        T::mul_add(
-                            -T::from_f64(0.0013224560195000002),
-                            t221,
-                            T::mul_add(
-                                T::from_f64(0.0230207699865),
-                                t128,
-                                T::mul_add(
-                                    -T::from_f64(0.004776809772198749),
-                                    t90,
-                                    T::mul_add(
-                                        T::from_f64(0.0015805219734713843),
-                                        t125,
-                                        t228 - t177 - t229 - t94,
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t475 = T::mul_add(
-                T::from_f64(0.926),
-                t128,
-                T::mul_add(
-                    -T::from_f64(0.14625545996380002),
-                    t90,
-                    T::mul_add(
-                        T::from_f64(0.0230207699865),
-                        t125,
-                        T::mul_add(
-                            -T::from_f64(0.0013224560195000002),
-                            t154,
-                            T::mul_add(
-                                T::from_f64(0.0026714120292000002),
-                                t70,
-                                t227 + t426 - t226 - t176 - t425,
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t476 = T::mul_add(
-                -T::from_f64(0.463),
-                t237,
-                T::mul_add(
-                    -T::from_f64(0.0013224560195000002),
-                    t72 + t73 + t92,
-                    T::mul_add(
-                        T::from_f64(0.0230207699865),
-                        t71 - t161,
-                        t223 + t432 + t433 - t222,
-                    ),
-                ),
-            );
-            let t477 = T::mul_add(
-                T::from_f64(0.10375),
-                t435 - t434,
-                T::mul_add(
-                    -T::from_f64(0.0013224560195000002),
-                    t238,
-                    T::mul_add(
-                        -T::from_f64(0.0230207699865),
-                        t130,
-                        T::mul_add(
-                            t8,
-                            t384,
-                            T::mul_add(
-                                t9,
-                                t383,
-                                T::mul_add(
-                                    -T::from_f64(0.004776809772198749),
-                                    t90,
-                                    T::mul_add(
-                                        T::from_f64(0.0015805219734713843),
-                                        t125,
-                                        t228 - t177 - t229 - t94,
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t478 = T::mul_add(
-                -T::from_f64(0.926),
-                t130,
-                T::mul_add(
-                    -T::from_f64(0.14625545996380002),
-                    t90,
-                    T::mul_add(
-                        T::from_f64(0.0230207699865),
-                        t125,
-                        T::mul_add(
-                            -T::from_f64(0.0013224560195000002),
-                            t154,
-                            T::mul_add(
-                                T::from_f64(0.0026714120292000002),
-                                t70,
-                                t227 + t435 - t226 - t176 - t434,
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t479 = T::mul_add(
-                T::from_f64(0.10375),
-                t444 - t443,
-                T::mul_add(
-                    -t8,
-                    t390,
-                    T::mul_add(
-                        -t9,
-                        t389,
-                        T::mul_add(
-                            -t7,
-                            t169,
-                            T::mul_add(
-                                T::from_f64(0.0016768992735221656),
-                                t76,
-                                T::from_f64(0.00006575368432434527) * t156,
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t480 = T::mul_add(
-                -t7,
-                t165,
-                T::mul_add(
-                    T::from_f64(0.0026449120390000004),
-                    t77,
-                    T::mul_add(T::from_f64(0.0230207699865), t68 + t163, -t441 - t442),
-                ),
-            );
-            let t481 = T::mul_add(
-                T::from_f64(0.0230207699865),
-                t76,
+                t184,
                 T::mul_add(
                     T::from_f64(0.0013224560195000002),
-                    t156 - t155,
-                    T::mul_add(
-                        -T::from_f64(0.000000000000000006938893903907228),
-                        t69,
-                        T::mul_add(
-                            T::from_f64(0.0026714120292000002),
-                            t42,
-                            t444 - t240 - t241 - t443,
-                        ),
-                    ),
+                    t133,
+                    T::mul_add(T::from_f64(0.046041539973), t167, -t253),
                 ),
-            );
-            let t482 = T::mul_add(t8, t396, t9 * t393);
-            let t483 = T::mul_add(
-                -t8,
-                t394,
+            )
+                + T::mul_add(
+                    T::from_f64(1.03),
+                    t259,
+                    -(T::mul_add(
+                        -T::from_f64(0.00000000000000000010842021724855044),
+                        t244,
+                        T::from_f64(0.00010000000000000503) * t202,
+                    )) - t374,
+                );
+            let t464 = T::mul_add(
+                -T::from_f64(0.0013224560195000002),
+                t92,
                 T::mul_add(
-                    -t9,
-                    t395,
-                    T::mul_add(
-                        T::from_f64(0.10375),
-                        t448 - t449,
-                        T::mul_add(
-                            T::from_f64(0.0030608893468412057),
-                            t123,
-                            T::from_f64(0.00013150736864869054) * t69,
-                        ),
-                    ),
+                    -T::from_f64(0.0013224560195000002),
+                    t92,
+                    -T::from_f64(0.046041539973) * t168,
                 ),
+            )
+                + T::mul_add(
+                    -T::from_f64(0.213725),
+                    t168,
+                    -(T::mul_add(
+                        -T::from_f64(0.00000000000000000010842021724855044),
+                        t137,
+                        T::from_f64(0.00010000000000000503) * t135,
+                    )) - t386,
+                );
+            let t465 = T::mul_add(t9, t395, -t8 * t391);
+            let t466 = T::mul_add(t8, t395, t9 * t391);
+            let t467 = T::mul_add(
+                T::from_f64(0.00009259999999999985),
+                t132,
+                -(T::mul_add(
+                    -T::from_f64(0.00000000000000000001578767863379873),
+                    t172,
+                    T::mul_add(
+                        T::from_f64(0.00003477275661741105),
+                        t171,
+                        T::mul_add(-T::from_f64(0.0007776443641723163), t132, -t394),
+                    ),
+                )),
             );
-            let t484 = T::mul_add(T::from_f64(0.046041539973), t123, t448 - t449);
-            let t485 = T::mul_add(-t7, t398, T::from_f64(0.10375) * t311);
-            let t486 = t5 * t453;
-            let t487 = T::mul_add(t4, t311, t5 * t399);
-            let t488 = t4 * t457;
-            let t489 = t4 * t456;
-            let t490 = t5 * t455;
-            let t491 = t5 * t460;
-            let t492 = T::mul_add(-t4, t328, t5 * t406);
-            let t493 = T::mul_add(
-                t4,
-                t413,
+            let t468 = t144 + t437;
+            let t469 = t146 + t438;
+            let t470 = T::mul_add(t6, t318, -t7 * t396);
+            let t471 = T::mul_add(t7, t318, t6 * t396);
+            let t472 = t185 + t440;
+            let t473 = T::mul_add(
+                T::from_f64(0.00006575368432434527),
+                t20,
+                -T::from_f64(0.0015767446734206029) * t4,
+            )
+                + T::mul_add(
+                    -T::from_f64(0.0015805219734713843),
+                    t27,
+                    T::mul_add(T::from_f64(0.001484144673420603), t26, t71),
+                ) + t441;
+            let t474 = T::mul_add(-t6, t319, t7 * t399);
+            let t475 = T::mul_add(
+                T::from_f64(0.0000000000000006979729257032011),
+                t245,
                 T::mul_add(
-                    -t5,
-                    t370,
-                    T::mul_add(
-                        -T::from_f64(0.2073),
-                        t414 + t329,
-                        T::from_f64(0.0114) * t371,
-                    ),
+                    T::from_f64(0.004894691391055498),
+                    t201,
+                    T::from_f64(0.000014022756617410007) * t134,
                 ),
+            ) + t381
+                + T::mul_add(
+                    -T::from_f64(0.0650091026469637),
+                    t408,
+                    T::from_f64(0.00000000000000000010842021724855044) * t325,
+                );
+            let t476 = T::mul_add(
+                T::from_f64(0.004705147001603182),
+                t245,
+                T::mul_add(
+                    T::from_f64(0.0000000000000006979729257032011),
+                    t201,
+                    -T::from_f64(0.000000000000000000006709516445275485) * t134,
+                ),
+            ) + t382
+                + T::mul_add(
+                    -T::from_f64(0.0650091026469637),
+                    t407,
+                    -T::from_f64(0.00010000000000000503) * t325,
+                );
+            let t477 = T::mul_add(
+                T::from_f64(0.000000000000000000006709516445275485),
+                t245,
+                T::mul_add(
+                    -T::from_f64(0.000014022756617410007),
+                    t201,
+                    -T::from_f64(0.0007776443641723163) * t134,
+                ),
+            ) + t383
+                + T::mul_add(
+                    T::from_f64(0.00010000000000000503),
+                    t408,
+                    T::from_f64(0.00000000000000000010842021724855044) * t407,
+                );
+            let t478 = t402
+                + T::mul_add(
+                    T::from_f64(1.03),
+                    t325,
+                    -(T::mul_add(
+                        T::from_f64(0.00010000000000000503),
+                        t245,
+                        -T::from_f64(0.00000000000000000010842021724855044) * t201,
+                    )) - t380,
+                );
+            let t479 = T::mul_add(
+                T::from_f64(0.0016768992735221656),
+                t19,
+                -(T::mul_add(T::from_f64(0.00006575368432434527), t18, t69)),
+            ) + t444;
+            let t480 = T::mul_add(
+                -T::from_f64(0.00006575368432434527),
+                t20,
+                T::from_f64(0.0015767446734206029) * t4,
+            )
+                + T::mul_add(
+                    T::from_f64(0.0015805219734713843),
+                    t27,
+                    T::mul_add(-T::from_f64(0.001484144673420603), t26, -t71),
+                ) + t445;
+            let t481 = T::mul_add(-t7, t281, t6 * t409);
+            let t482 = T::mul_add(t6, t281, t7 * t409);
+            let t483 = T::mul_add(t2, t359, t3 * t416);
+            let t484 = T::mul_add(
+                -T::from_f64(0.213725),
+                t90,
+                -(T::mul_add(
+                    -T::from_f64(0.00010000000000000503),
+                    t172,
+                    -T::from_f64(0.00000000000000000010842021724855044) * t171,
+                )) - t390,
+            )
+                + T::mul_add(
+                    -T::from_f64(0.0013224560195000002),
+                    t131,
+                    -(T::mul_add(T::from_f64(0.0230207699865), t90, t176)),
+                );
+            let t485 = T::mul_add(T::from_f64(0.10375), t448, t401);
+            let t486 = T::mul_add(T::from_f64(0.10375), -t417, t412);
+            let t487 = T::mul_add(-t4, t417, t5 * t357);
+            let t488 = T::mul_add(t5, t417, t4 * t357);
+            let t489 = T::mul_add(
+                T::from_f64(0.10375),
+                t285,
+                T::mul_add(-t6, t242, -t7 * t358),
             );
-            let t494 = T::mul_add(-T::from_f64(0.0114), t466, t369);
-            let t495 = t5 * t468;
-            let t496 = T::mul_add(t5, t417, t4 * t324);
-            let t497 = t5 * t470;
-            let t498 = T::mul_add(t4, t334, t5 * t421);
-            let t499 = t7 * t473;
-            let t500 = t6 * t473;
-            let t501 = t6 * t474;
-            let t502 = t5 * t475;
-            let t503 = t7 * t476;
-            let t504 = t6 * t476;
-            let t505 = t6 * t477;
-            let t506 = t5 * t478;
-            let t507 = t6 * t480;
-            let t508 = t5 * t481;
-            let t509 = t5 * t484;
-            let t510 = t4 * t485;
-            let t511 = T::mul_add(T::from_f64(0.0114), t487, t452);
+            let t490 = T::mul_add(T::from_f64(0.0114), t416, -t451);
+            let t491 = T::mul_add(-T::from_f64(0.0114), t457, t419);
+            let t492 = -t459;
+            let t493 = T::mul_add(t4, t341, -t5 * t369)
+                + T::mul_add(-T::from_f64(0.2073), -t371, -T::from_f64(0.0114) * t292);
+            let t494 = T::mul_add(
+                T::from_f64(0.2073),
+                t423,
+                T::mul_add(-t5, t341, -t4 * t369),
+            );
+            let t495 = T::mul_add(-t1, T::mul_add(-t3, t198, t2 * t294), -t0 * t424);
+            let t496 = T::mul_add(-t8, t429, -t9 * t425);
+            let t497 = T::mul_add(t9, t429, -t8 * t425);
+            let t498 = T::mul_add(
+                -T::from_f64(0.0013224560195000002),
+                t183,
+                T::mul_add(
+                    T::from_f64(0.00009637730005078133),
+                    t173,
+                    T::from_f64(0.00006575368432434527) * t62,
+                ) + T::mul_add(T::from_f64(0.0015805219734713843), t204, -t257),
+            ) + -t428;
+            let t499 = T::mul_add(-t8, t434, -t9 * t430);
+            let t500 = T::mul_add(t9, t434, -t8 * t430);
+            let t501 = t310 + -t433;
+            let t502 = T::mul_add(T::from_f64(0.046041539973), t131, -t465);
+            let t503 = T::mul_add(T::from_f64(0.0026714120292000002), t14, -t470);
+            let t504 = T::mul_add(
+                T::from_f64(0.0026714120292000002),
+                t5,
+                T::mul_add(t7, t319, t6 * t399),
+            );
+            let t505 = T::mul_add(t8, t443, -t9 * t442);
+            let t506 = T::mul_add(-t9, t443, -t8 * t442);
+            let t507 = T::mul_add(T::from_f64(0.0026714120292000002), t5, -t481);
+            let t508 = T::mul_add(t6, t446, t7 * t322);
+            let t509 = T::mul_add(t5, t448, t4 * t352);
+            let t510 = T::mul_add(t4, t448, -t5 * t352);
+            let t511 = T::mul_add(-t7, t337, t6 * t449);
             (
                 t448,
                 t449,
@@ -8990,514 +7172,215 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
             t574,
             t575,
         ) = {
-            let t512 = T::mul_add(t4, t362, t5 * t457);
+            let t512 = T::mul_add(
+                -T::from_f64(0.10375),
+                -t453,
+                T::mul_add(t8, t360, -t9 * t345),
+            );
             let t513 = T::mul_add(
-                t4,
-                t455,
-                T::mul_add(
-                    t5,
-                    t456,
-                    T::mul_add(
-                        T::from_f64(0.2073),
-                        t488 - t404,
-                        T::mul_add(
-                            -T::from_f64(0.0114),
-                            t402 + t252,
-                            T::mul_add(
-                                T::from_f64(0.00057208574358732),
-                                t15 + t16,
-                                T::from_f64(0.00313056288),
-                            ),
-                        ),
-                    ),
-                ),
+                T::from_f64(0.10375),
+                -t452,
+                T::mul_add(-t9, t360, -t8 * t345),
             );
-            let t514 = t0
-                * (T::mul_add(
-                    -t2,
-                    t366,
-                    T::mul_add(t3, t410, T::from_f64(0.41) * (t270 - t114)),
-                ));
-            let t515 = t1 * (T::mul_add(t3, t366, t2 * t410));
-            let t516 = T::mul_add(
-                t5,
-                t412,
-                T::mul_add(
-                    t4,
-                    t460,
-                    T::mul_add(
-                        -T::from_f64(0.2073),
-                        t459 + t367,
-                        T::mul_add(
-                            T::from_f64(0.0114),
-                            t363 + t260,
-                            T::from_f64(0.000030454097132880003) * t5,
-                        ),
-                    ),
-                ),
-            );
-            let t517 = T::mul_add(T::from_f64(0.0114), t492, t405);
-            let t518 = T::mul_add(t2, t371, t3 * t466);
-            let t519 = T::mul_add(
-                t1,
-                T::mul_add(t3, t331, t2 * t372),
-                T::mul_add(
-                    -t0,
-                    T::mul_add(
-                        -t2,
-                        t331,
-                        T::mul_add(t3, t372, T::from_f64(0.41) * (t211 - t119)),
-                    ),
-                    -T::from_f64(0.0016)
-                        * (T::mul_add(t0, T::mul_add(-t3, t150, t2 * t277), t1 * t373)),
-                ),
-            );
+            let t514 = T::mul_add(t6, t452, -t7 * t264);
+            let t515 = T::mul_add(t7, t452, t6 * t264);
+            let t516 = T::mul_add(t2, t364, -t3 * t457);
+            let t517 = T::mul_add(-T::from_f64(0.0114), t492, t420);
+            let t518 = T::mul_add(-t2, t422, t3 * t459);
+            let t519 = T::mul_add(-t0, T::mul_add(t3, t342, t2 * t370), -t1 * t462);
             let t520 = T::mul_add(
-                t4,
-                t468,
-                T::mul_add(
-                    t5,
-                    t409,
-                    T::mul_add(
-                        T::from_f64(0.2073),
-                        t364 - t467,
-                        T::from_f64(0.0114) * t418,
-                    ),
-                ),
-            );
-            let t521 = T::mul_add(-T::from_f64(0.0114), t496, -t408);
-            let t522 = T::mul_add(
-                t4,
-                t470,
-                T::mul_add(
-                    -t5,
-                    t420,
-                    T::mul_add(
-                        T::from_f64(0.2073),
-                        t469 - t374,
-                        T::from_f64(0.0114) * t422,
-                    ),
-                ),
-            );
-            let t523 = T::mul_add(T::from_f64(0.0114), t498, -t419);
-            let t524 = T::mul_add(
                 T::from_f64(0.463),
-                t127,
+                t183,
                 T::mul_add(
-                    -T::from_f64(0.0501829599638),
-                    t71,
-                    T::mul_add(
-                        T::from_f64(0.0013357060146000001),
-                        t43 + t83 - t82,
-                        t499 - t429,
+                    -T::from_f64(0.0013224560195000002),
+                    t173,
+                    -T::from_f64(0.0230207699865) * t62,
+                )
+                    + T::mul_add(
+                        -T::from_f64(0.0013224560195000002),
+                        t204,
+                        -T::from_f64(0.0230207699865) * t203,
                     ),
+            ) + t496;
+            let t521 = T::mul_add(
+                T::from_f64(0.463),
+                t141,
+                T::mul_add(
+                    T::from_f64(0.0230207699865),
+                    t133,
+                    T::mul_add(-T::from_f64(0.0026449120390000004), t167, -t254),
                 ),
+            ) + t497;
+            let t522 = T::mul_add(
+                -T::from_f64(0.0026449120390000004),
+                t93,
+                -T::from_f64(0.0230207699865) * (t89 + t206),
+            ) + t499;
+            let t523 = T::mul_add(-T::from_f64(0.0230207699865), t92, t308) + t500;
+            let t524 = T::mul_add(
+                -T::from_f64(0.10375),
+                -t465,
+                T::mul_add(t8, t435, t9 * t436),
             );
             let t525 = T::mul_add(
                 T::from_f64(0.10375),
-                t227 + t426 - t226 - t176 - t425,
-                T::mul_add(
-                    t6,
-                    t379,
-                    T::mul_add(
-                        -t7,
-                        t474,
-                        T::mul_add(
-                            T::from_f64(0.07312772998190001),
-                            t128,
-                            T::mul_add(
-                                -T::from_f64(0.013555216717260076),
-                                t90,
-                                T::mul_add(
-                                    T::from_f64(0.0023884048860993747),
-                                    t125,
-                                    T::mul_add(
-                                        -T::from_f64(0.00013720481202312502),
-                                        t154,
-                                        T::mul_add(T::from_f64(0.00007238626506919941), t70, t172),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
+                t466,
+                T::mul_add(-t9, t435, t8 * t436),
             );
-            let t526 = T::mul_add(
-                T::from_f64(0.10375),
-                t499 - t423 - t424 - t429,
-                T::mul_add(
-                    T::from_f64(0.0230207699865),
-                    t220,
-                    T::mul_add(
-                        T::from_f64(0.0250914799819),
-                        t127,
-                        T::mul_add(
-                            T::from_f64(0.0015805219734713843),
-                            t161,
-                            T::mul_add(
-                                T::from_f64(0.00006575368432434527),
-                                t72 + t73,
-                                T::mul_add(
-                                    -T::from_f64(0.0051644395156806785),
-                                    t71,
-                                    T::mul_add(
-                                        T::from_f64(0.00007238626506919941),
-                                        t43 - t82,
-                                        t173 + t232 + t233 + t428 - t179 - t427,
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t527 = T::mul_add(
-                T::from_f64(0.0013357060146000001),
-                t90,
-                T::mul_add(
-                    T::from_f64(0.0250914799819),
-                    t70,
-                    T::mul_add(
-                        T::from_f64(0.0000000000000000008673617379884035),
-                        t42,
-                        t500 + t430 - t171,
-                    ),
-                ),
-            );
-            let t528 = T::mul_add(
-                T::from_f64(0.10375),
-                t503 - t432 - t433 - t438,
-                T::mul_add(
-                    T::from_f64(0.0230207699865),
-                    t237,
-                    T::mul_add(
-                        -T::from_f64(0.0250914799819),
-                        t129,
-                        T::mul_add(
-                            T::from_f64(0.0015805219734713843),
-                            t161,
-                            T::mul_add(
-                                T::from_f64(0.00006575368432434527),
-                                t72 + t73,
-                                T::mul_add(
-                                    -T::from_f64(0.0051644395156806785),
-                                    t71,
-                                    T::mul_add(
-                                        T::from_f64(0.00007238626506919941),
-                                        t43 - t82,
-                                        t173 + t232 + t233 + t437 - t179 - t436,
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
+            let t526 = T::mul_add(t7, t398, t6 * t468);
+            let t527 = T::from_f64(0.1919598) - t50 - t471
+                + T::from_f64(0.10956060000000001);
+            let t528 = T::mul_add(t7, t351, t6 * t472);
             let t529 = T::mul_add(
-                -T::from_f64(0.07312772998190001),
-                t130,
-                T::mul_add(
-                    T::from_f64(0.10375),
-                    t227 + t435 - t226 - t176 - t434,
-                    T::mul_add(
-                        t6,
-                        t386,
-                        T::mul_add(
-                            -t7,
-                            t477,
-                            T::mul_add(
-                                -T::from_f64(0.013555216717260076),
-                                t90,
-                                T::mul_add(
-                                    T::from_f64(0.0023884048860993747),
-                                    t125,
-                                    T::mul_add(
-                                        -T::from_f64(0.00013720481202312502),
-                                        t154,
-                                        T::mul_add(T::from_f64(0.00007238626506919941), t70, t172),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
+                T::from_f64(0.00009259999999999997),
+                t4,
+                -(T::mul_add(T::from_f64(0.10375), t474, t473)),
             );
             let t530 = T::mul_add(
                 -T::from_f64(0.463),
-                t129,
+                t324,
+                T::mul_add(
+                    -T::from_f64(0.0013224560195000002),
+                    t134,
+                    T::from_f64(0.0230207699865) * t62,
+                )
+                    + T::mul_add(
+                        -T::from_f64(0.0013224560195000002),
+                        t262,
+                        -T::from_f64(0.0230207699865) * t246,
+                    ),
+            ) + t505;
+            let t531 = t403 + t506;
+            let t532 = t405 + -t477;
+            let t533 = T::mul_add(t7, t356, t6 * t479);
+            let t534 = T::mul_add(
+                T::from_f64(0.00009259999999999997),
+                t4,
+                T::mul_add(T::from_f64(0.10375), t482, t480),
+            );
+            let t535 = T::mul_add(t4, t410, t5 * t482);
+            let t536 = T::mul_add(-t5, t410, t4 * t482);
+            let t537 = T::mul_add(t4, t413, t5 * t474);
+            let t538 = T::mul_add(-t5, t413, t4 * t474);
+            let t539 = T::mul_add(t0, T::mul_add(-t3, t359, t2 * t416), t1 * t483);
+            let t540 = T::mul_add(t6, t484, t7 * t466);
+            let t541 = T::mul_add(t7, t484, -t6 * t466);
+            let t542 = T::mul_add(
+                T::from_f64(0.10375),
+                t352,
+                T::mul_add(-t7, t446, t6 * t322),
+            );
+            let t543 = -t509;
+            let t544 = T::mul_add(
+                T::from_f64(0.10375),
+                T::mul_add(-T::from_f64(0.046041539973), t11, t328),
+                T::mul_add(-t6, t337, -t7 * t449),
+            );
+            let t545 = T::mul_add(-T::from_f64(0.0114), t488, t511);
+            let t546 = T::mul_add(-t2, t450, -t3 * t488);
+            let t547 = t6 * t512;
+            let t548 = T::mul_add(T::from_f64(0.10375), t515, t513);
+            let t549 = -t514;
+            let t550 = T::mul_add(t4, t455, -t5 * t454)
+                + T::mul_add(-T::from_f64(0.2073), -t456, -T::from_f64(0.0114) * t364);
+            let t551 = T::mul_add(
+                T::from_f64(0.2073),
+                t457,
+                T::mul_add(-t5, t455, -t4 * t454),
+            );
+            let t552 = T::mul_add(t4, t421, -t5 * t458)
+                + T::mul_add(-T::from_f64(0.2073), -t460, -T::from_f64(0.0114) * t367);
+            let t553 = T::mul_add(
+                T::from_f64(0.2073),
+                t492,
+                T::mul_add(-t5, t421, -t4 * t458),
+            );
+            let t554 = T::mul_add(
+                -T::from_f64(0.10375),
+                -t497,
+                T::mul_add(t8, t427, -t9 * t426),
+            );
+            let t555 = T::mul_add(
+                T::from_f64(0.10375),
+                -t496,
+                T::mul_add(-t9, t427, -t8 * t426),
+            );
+            let t556 = T::mul_add(
+                T::from_f64(0.463),
+                t107,
                 T::mul_add(
                     -T::from_f64(0.0501829599638),
-                    t71,
-                    T::mul_add(
-                        T::from_f64(0.0013357060146000001),
-                        t43 + t83 - t82,
-                        t503 - t438,
-                    ),
+                    t65,
+                    T::from_f64(0.0026714120292000002) * t91,
                 ),
-            );
-            let t531 = T::mul_add(
-                T::from_f64(0.0013357060146000001),
-                t90,
-                T::mul_add(
-                    T::from_f64(0.0250914799819),
-                    t70,
-                    T::mul_add(
-                        T::from_f64(0.0000000000000000008673617379884035),
-                        t42,
-                        t504 + t439 - t171,
-                    ),
-                ),
-            );
-            let t532 = T::mul_add(-t6, t392, t7 * t480);
-            let t533 = T::mul_add(t7, t391, -t6 * t479);
-            let t534 = T::mul_add(
-                -t6,
-                t391,
-                T::mul_add(
-                    -t7,
-                    t479,
-                    T::mul_add(
-                        T::from_f64(0.10375),
-                        t444 - t240 - t241 - t443,
-                        T::mul_add(
-                            T::from_f64(0.0023884048860993747),
-                            t76,
-                            T::mul_add(
-                                T::from_f64(0.00013720481202312502),
-                                t156 - t155,
-                                T::mul_add(
-                                    -T::from_f64(0.00010030674106885004),
-                                    t69,
-                                    T::from_f64(0.00014477253013839883) * t42,
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t535 = T::mul_add(T::from_f64(0.0026714120292000002), t69, -t507 - t447);
-            let t536 = T::mul_add(-t7, t397, -t6 * t483);
-            let t537 = T::mul_add(
-                t6,
-                t397,
-                T::mul_add(
-                    -t7,
-                    t483,
-                    T::mul_add(
-                        T::from_f64(0.10375),
-                        t448 - t449,
-                        T::from_f64(0.004776809772198749) * t123,
-                    ),
-                ),
-            );
-            let t538 = T::mul_add(
-                t4,
-                t453,
-                T::mul_add(
-                    t5,
-                    t485,
-                    T::mul_add(
-                        T::from_f64(0.2073),
-                        t359 - t454,
-                        T::from_f64(0.0114) * t400,
-                    ),
-                ),
-            );
-            let t539 = T::mul_add(t2, t400, t3 * t487);
-            let t540 = T::mul_add(
-                T::from_f64(0.0114),
-                t512,
-                T::mul_add(T::from_f64(0.0000077067410688492), t14, t319 - t403),
-            );
-            let t541 = T::mul_add(t3, t492, t2 * t407);
-            let t542 = T::mul_add(-t6, t416, t7 * t482);
-            let t543 = T::mul_add(t7, t416, t6 * t482);
-            let t544 = T::mul_add(t2, t418, t3 * t496);
-            let t545 = T::mul_add(-t2, t422, t3 * t498);
-            let t546 = t4 * t524;
-            let t547 = t4 * t525;
-            let t548 = t5 * t526;
-            let t549 = t4 * t530;
-            let t550 = t4 * t529;
-            let t551 = t5 * t528;
-            let t552 = T::mul_add(
+            ) + t521;
+            let t557 = T::mul_add(
                 -T::from_f64(0.10375),
-                t532 + t441 + t442,
-                T::mul_add(
-                    T::from_f64(0.0015805219734713843),
-                    t163,
-                    T::mul_add(
-                        T::from_f64(0.00009637730005078133),
-                        t162,
-                        T::mul_add(
-                            T::from_f64(0.00006575368432434527),
-                            t77,
-                            T::mul_add(
-                                T::from_f64(0.0016693446734206028),
-                                t68,
-                                t242 + t445 - t243 - t446,
-                            ),
-                        ),
-                    ),
-                ),
+                -t500,
+                T::mul_add(t8, t432, -t9 * t431),
             );
-            let t553 = t4 * t532;
-            let t554 = t4 * t534;
-            let t555 = t4 * t537;
-            let t556 = T::mul_add(-t2, t458, t3 * t512);
-            let t557 = t1 * t541;
-            let t558 = t0 * (T::mul_add(-t2, t492, t3 * t407));
-            let t559 = T::mul_add(T::from_f64(0.10375), t482 - t542, t450 - t451);
-            let t560 = t4 * t542;
-            let t561 = T::mul_add(-t4, t475, t5 * t524);
-            let t562 = T::mul_add(
-                t4,
-                t526,
-                T::mul_add(
-                    t5,
-                    t525,
-                    T::mul_add(
-                        T::from_f64(0.2073),
-                        t546 + t502,
-                        T::mul_add(
-                            T::from_f64(0.0114),
-                            t171 - t500 - t430,
-                            T::mul_add(
-                                -T::from_f64(0.000015227048566440002),
-                                t90,
-                                T::mul_add(
-                                    -T::from_f64(0.00028604287179366),
-                                    t70,
-                                    T::mul_add(
-                                        -T::from_f64(0.01141052223816),
-                                        t42,
-                                        T::from_f64(0.044919846) * t1,
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
+            let t558 = T::mul_add(
+                T::from_f64(0.10375),
+                -t499,
+                T::mul_add(-t9, t432, -t8 * t431),
             );
-            let t563 = T::mul_add(-t4, t478, t5 * t530);
+            let t559 = T::mul_add(
+                T::from_f64(0.0250914799819),
+                t90,
+                -(T::mul_add(T::from_f64(0.0013357060146000001), t35, t138)),
+            ) + t523;
+            let t560 = T::mul_add(
+                T::from_f64(0.10375),
+                t397,
+                T::mul_add(t6, t398, -t7 * t468),
+            );
+            let t561 = T::mul_add(
+                T::from_f64(0.00014477253013839883),
+                t14,
+                T::mul_add(T::from_f64(0.10375), -t470, t469),
+            );
+            let t562 = T::mul_add(t4, t439, t5 * t503);
+            let t563 = T::mul_add(-t5, t439, t4 * t503);
             let t564 = T::mul_add(
-                -t4,
-                t528,
-                T::mul_add(
-                    -t5,
-                    t529,
-                    T::mul_add(
-                        -T::from_f64(0.2073),
-                        t549 + t506,
-                        T::mul_add(
-                            T::from_f64(0.0114),
-                            t504 + t439 - t171,
-                            T::mul_add(
-                                T::from_f64(0.000015227048566440002),
-                                t90,
-                                T::mul_add(
-                                    T::from_f64(0.00028604287179366),
-                                    t70,
-                                    T::from_f64(0.01141052223816) * t42,
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
+                -T::from_f64(0.10375),
+                -t506,
+                T::mul_add(t8, t476, -t9 * t475),
             );
-            let t565 = t5 * t552;
-            let t566 = T::mul_add(t4, t481, t5 * t532);
-            let t567 = t0
-                * (T::mul_add(
-                    -t2,
-                    t517,
-                    T::mul_add(t3, t516, T::from_f64(0.41) * (t459 + t367)),
-                ));
-            let t568 = t1 * (T::mul_add(t3, t517, t2 * t516));
+            let t565 = T::mul_add(
+                T::from_f64(0.10375),
+                -t505,
+                T::mul_add(-t9, t476, -t8 * t475),
+            );
+            let t566 = T::mul_add(
+                T::from_f64(0.463),
+                t150,
+                T::mul_add(
+                    T::from_f64(0.24214275996380002),
+                    t65,
+                    -T::from_f64(0.0026714120292000002) * t91,
+                ),
+            ) + t531;
+            let t567 = T::mul_add(
+                T::from_f64(0.10375),
+                t410,
+                T::mul_add(t6, t356, -t7 * t479),
+            );
+            let t568 = -t535;
             let t569 = T::mul_add(
-                -t1,
-                T::mul_add(-t3, t494, t2 * t493),
-                T::mul_add(
-                    t0,
-                    T::mul_add(
-                        t2,
-                        t494,
-                        T::mul_add(t3, t493, T::from_f64(0.41) * (t414 + t329)),
-                    ),
-                    T::from_f64(0.0016)
-                        * (T::mul_add(t0, T::mul_add(-t3, t371, t2 * t466), t1 * t518)),
-                ),
+                T::from_f64(0.10375),
+                t413,
+                T::mul_add(t6, t351, -t7 * t472),
             );
-            let t570 = t5 * t559;
-            let t571 = T::mul_add(t5, t542, t4 * t484);
-            let t572 = T::mul_add(
-                T::from_f64(0.0114),
-                t561,
-                T::mul_add(
-                    T::from_f64(0.0013357060146000001),
-                    t127,
-                    T::mul_add(
-                        T::from_f64(0.0017957741063972504),
-                        t83,
-                        T::mul_add(
-                            -T::from_f64(0.0000038533705344246),
-                            t82,
-                            T::mul_add(
-                                -T::from_f64(0.00007238626506919941),
-                                t71,
-                                T::mul_add(
-                                    T::from_f64(0.00040078837053442434),
-                                    t43,
-                                    -t174 - t501 - t431,
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t573 = T::mul_add(
-                T::from_f64(0.0114),
-                t563,
-                T::mul_add(
-                    -T::from_f64(0.0013357060146000001),
-                    t129,
-                    T::mul_add(
-                        T::from_f64(0.0017957741063972504),
-                        t83,
-                        T::mul_add(
-                            -T::from_f64(0.0000038533705344246),
-                            t82,
-                            T::mul_add(
-                                -T::from_f64(0.00007238626506919941),
-                                t71,
-                                T::mul_add(
-                                    T::from_f64(0.00040078837053442434),
-                                    t43,
-                                    -t174 - t505 - t440,
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t574 = T::mul_add(
-                -t4,
-                t552,
-                T::mul_add(
-                    -t5,
-                    t534,
-                    T::mul_add(
-                        T::from_f64(0.2073),
-                        t553 - t508,
-                        T::mul_add(
-                            -T::from_f64(0.0114),
-                            t507 + t447,
-                            T::from_f64(0.000030454097132880003) * t69,
-                        ),
-                    ),
-                ),
-            );
-            let t575 = T::mul_add(T::from_f64(0.0114), t566, -t533);
+            let t570 = -t537;
+            let t571 = t524 + t334;
+            let t572 = -t541;
+            let t573 = T::mul_add(-T::from_f64(0.0114), t543, t508);
+            let t574 = T::mul_add(t2, t447, t3 * t509);
+            let t575 = T::mul_add(
+                -T::from_f64(0.2073),
+                -t415,
+                -T::from_f64(0.0114) * t333,
+            ) + T::mul_add(-t5, t489, t4 * t414);
             (
                 t512,
                 t513,
@@ -9580,161 +7463,246 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
             t587,
             t588,
             t589,
+            t590,
+            t591,
+            t592,
+            t593,
+            t594,
+            t595,
+            t596,
+            t597,
+            t598,
+            t599,
+            t600,
+            t601,
+            t602,
+            t603,
+            t604,
+            t605,
+            t606,
+            t607,
+            t608,
+            t609,
+            t610,
+            t611,
+            t612,
+            t613,
+            t614,
+            t615,
+            t616,
+            t617,
+            t618,
+            t619,
+            t620,
+            t621,
+            t622,
+            t623,
+            t624,
+            t625,
+            t626,
+            t627,
+            t628,
+            t629,
+            t630,
+            t631,
+            t632,
+            t633,
+            t634,
+            t635,
+            t636,
+            t637,
+            t638,
+            t639,
         ) = {
             let t576 = T::mul_add(
-                t4,
-                t559,
-                T::mul_add(
-                    t5,
-                    t537,
-                    T::mul_add(
-                        T::from_f64(0.2073),
-                        t509 - t560,
-                        T::from_f64(0.0114) * t543,
-                    ),
-                ),
+                T::from_f64(0.2073),
+                t416,
+                T::mul_add(-t4, t489, -t5 * t414),
             );
-            let t577 = T::mul_add(T::from_f64(0.0114), t571, -t536);
-            let t578 = T::mul_add(
-                t1,
-                T::mul_add(-t3, t521, t2 * t520),
-                T::mul_add(
-                    t0,
-                    T::mul_add(
-                        -t2,
-                        t521,
-                        T::mul_add(-t3, t520, T::from_f64(0.41) * (t364 - t467)),
-                    ),
-                    -T::from_f64(0.0016)
-                        * (T::mul_add(t0, T::mul_add(-t3, t418, t2 * t496), t1 * t544)),
-                ),
+            let t577 = T::mul_add(-t7, t512, T::from_f64(0.10375) * t453);
+            let t578 = T::mul_add(t4, t453, t5 * t515);
+            let t579 = T::mul_add(-t5, t453, t4 * t515);
+            let t580 = T::mul_add(-t0, T::mul_add(t3, t422, t2 * t459), -t1 * t518);
+            let t581 = T::mul_add(
+                T::from_f64(0.41),
+                t371,
+                T::mul_add(-t2, t461, -t3 * t493),
             );
-            let t579 = T::mul_add(
-                t1,
-                T::mul_add(-t3, t523, t2 * t522),
-                T::mul_add(
-                    t0,
-                    T::mul_add(
-                        -t2,
-                        t523,
-                        T::mul_add(-t3, t522, T::from_f64(0.41) * (t469 - t374)),
+            let t582 = T::mul_add(
+                T::from_f64(0.0015805219734713843),
+                t133,
+                -t255 - t256
+                    + T::mul_add(
+                        -T::from_f64(0.0013224560195000002),
+                        t184,
+                        T::from_f64(0.0230207699865) * t141,
                     ),
-                    T::from_f64(0.0016)
-                        * (T::mul_add(t0, T::mul_add(t3, t422, t2 * t498), t1 * t545)),
-                ),
-            );
-            let t580 = T::mul_add(t2, t527, t3 * t561);
-            let t581 = T::mul_add(t2, t531, t3 * t563);
-            let t582 = T::mul_add(-t2, t535, t3 * t566);
+            ) + t554;
             let t583 = T::mul_add(
-                -t1,
-                T::mul_add(t3, t511, t2 * t538),
+                -T::from_f64(0.0230207699865),
+                t183,
                 T::mul_add(
-                    t0,
-                    T::mul_add(
-                        -t2,
-                        t511,
-                        T::mul_add(t3, t538, T::from_f64(0.41) * (t454 - t359)),
-                    ),
-                    T::from_f64(0.0016)
-                        * (T::mul_add(t0, T::mul_add(-t3, t400, t2 * t487), t1 * t539)),
-                ),
-            );
-            let t584 = T::mul_add(
-                -t1,
-                T::mul_add(-t3, t540, t2 * t513),
-                T::mul_add(
-                    -t0,
-                    T::mul_add(
-                        -t2,
-                        t540,
-                        T::mul_add(-t3, t513, T::from_f64(0.41) * (t488 - t404)),
-                    ),
-                    -T::from_f64(0.0016)
-                        * (T::mul_add(t0, T::mul_add(t3, t458, t2 * t512), t1 * t556)),
-                ),
-            );
-            let t585 = T::mul_add(t2, t543, t3 * t571);
-            let t586 = T::mul_add(
-                -t1,
-                T::mul_add(
-                    t3,
-                    t572,
-                    T::mul_add(-t2, t562, T::from_f64(0.000792000000000001) * t0),
-                ),
-                T::mul_add(
-                    t0,
-                    T::mul_add(
-                        -t2,
-                        t572,
-                        T::mul_add(
-                            -t3,
-                            t562,
-                            T::mul_add(
-                                T::from_f64(0.41),
-                                t546 + t502,
-                                T::mul_add(
-                                    -T::from_f64(0.044919846),
-                                    t42,
-                                    T::from_f64(0.332016130982) * t1,
-                                ),
-                            ),
-                        ),
-                    ),
-                    T::from_f64(0.0016)
-                        * (T::mul_add(t0, T::mul_add(-t3, t527, t2 * t561), t1 * t580)),
-                ),
-            );
-            let t587 = T::mul_add(
-                t1,
-                T::mul_add(t3, t573, t2 * t564),
-                T::mul_add(
-                    t0,
-                    T::mul_add(
-                        t2,
-                        t573,
-                        T::mul_add(
-                            -t3,
-                            t564,
-                            T::mul_add(
-                                -T::from_f64(0.41),
-                                t549 + t506,
-                                T::from_f64(0.044919846) * t42,
-                            ),
-                        ),
-                    ),
-                    -T::from_f64(0.0016)
-                        * (T::mul_add(t0, T::mul_add(-t3, t531, t2 * t563), t1 * t581)),
-                ),
-            );
+                    T::from_f64(0.00006575368432434527),
+                    t173,
+                    T::from_f64(0.0015767446734206029) * t62,
+                ) + T::mul_add(T::from_f64(0.0015805219734713843), t203, t258),
+            ) + t555;
+            let t584 = T::mul_add(t6, t463, -t7 * t520);
+            let t585 = T::mul_add(-T::from_f64(0.0015805219734713843), t92, t309) + t557;
+            let t586 = t311 + t558;
+            let t587 = T::mul_add(-t6, t464, t7 * t522);
             let t588 = T::mul_add(
-                t1,
-                T::mul_add(-t3, t575, t2 * t574),
-                T::mul_add(
-                    t0,
-                    T::mul_add(
-                        -t2,
-                        t575,
-                        T::mul_add(-t3, t574, T::from_f64(0.41) * (t553 - t508)),
-                    ),
-                    T::from_f64(0.0016)
-                        * (T::mul_add(t0, T::mul_add(t3, t535, t2 * t566), t1 * t582)),
-                ),
+                T::from_f64(0.00014477253013839883),
+                t16,
+                T::from_f64(0.0005537837136531601) - t560,
             );
-            let t589 = T::mul_add(
-                -t1,
-                T::mul_add(t3, t577, t2 * t576),
+            let t589 = -t562;
+            let t590 = t404 + t564;
+            let t591 = t406 + t565;
+            let t592 = T::mul_add(t6, t478, -t7 * t530);
+            let t593 = T::mul_add(T::from_f64(0.00010030674106884917), t5, -t567);
+            let t594 = T::mul_add(-T::from_f64(0.0114), t568, t533);
+            let t595 = T::mul_add(-t2, t507, t3 * t535);
+            let t596 = T::mul_add(T::from_f64(0.00010030674106884917), t5, t569);
+            let t597 = T::mul_add(-T::from_f64(0.0114), t570, t528);
+            let t598 = T::mul_add(t3, t537, t2 * t504);
+            let t599 = T::mul_add(T::from_f64(0.10375), -t540, t525);
+            let t600 = T::mul_add(-t4, t540, t5 * t502);
+            let t601 = T::mul_add(t5, t540, t4 * t502);
+            let t602 = -t578;
+            let t603 = T::mul_add(t0, T::mul_add(t3, t364, t2 * t457), t1 * (-t516));
+            let t604 = T::mul_add(
+                T::from_f64(0.463),
+                t106,
                 T::mul_add(
-                    -t0,
-                    T::mul_add(
-                        t2,
-                        t577,
-                        T::mul_add(-t3, t576, T::from_f64(0.41) * (t509 - t560)),
-                    ),
-                    T::from_f64(0.0016)
-                        * (T::mul_add(t0, T::mul_add(-t3, t543, t2 * t571), t1 * t585)),
+                    -T::from_f64(0.0501829599638),
+                    t62,
+                    T::from_f64(0.0013357060146000001) * (t58 - t136),
                 ),
+            ) + t584;
+            let t605 = T::mul_add(
+                T::from_f64(0.0026714120292000002),
+                t90,
+                T::mul_add(t7, t464, t6 * t522),
             );
+            let t606 = T::mul_add(t7, t463, t6 * t520) + t314;
+            let t607 = T::mul_add(
+                T::from_f64(0.0114),
+                t589,
+                T::mul_add(-T::from_f64(0.0000077067410688492), t14, -t526),
+            );
+            let t608 = T::mul_add(-t2, t527, t3 * t562);
+            let t609 = T::mul_add(
+                -T::from_f64(0.463),
+                t149,
+                T::mul_add(
+                    T::from_f64(0.24214275996380002),
+                    t62,
+                    -T::from_f64(0.0013357060146000001) * (t58 + -t136),
+                ),
+            ) + t592;
+            let t610 = T::mul_add(
+                -T::from_f64(0.463),
+                t121,
+                T::mul_add(
+                    T::from_f64(0.0013357060146000001),
+                    t65,
+                    T::mul_add(T::from_f64(0.0250914799819), t91, -t179),
+                ),
+            ) + T::mul_add(t7, t478, t6 * t530);
+            let t611 = T::mul_add(t6, t571, -t7 * t467);
+            let t612 = T::mul_add(t4, t485, -t5 * t542)
+                + T::mul_add(-T::from_f64(0.2073), -t510, -T::from_f64(0.0114) * t447);
+            let t613 = T::mul_add(
+                T::from_f64(0.2073),
+                t543,
+                T::mul_add(-t5, t485, -t4 * t542),
+            );
+            let t614 = T::mul_add(-t0, T::mul_add(-t3, t447, t2 * t509), -t1 * t574);
+            let t615 = T::mul_add(t4, t486, -t5 * t544)
+                + T::mul_add(-T::from_f64(0.2073), -t487, -T::from_f64(0.0114) * t418);
+            let t616 = T::mul_add(
+                T::from_f64(0.2073),
+                t488,
+                T::mul_add(-t5, t486, -t4 * t544),
+            );
+            let t617 = T::mul_add(t0, T::mul_add(-t3, t450, t2 * t488), t1 * (-t546));
+            let t618 = T::mul_add(-T::from_f64(0.0114), t602, t547);
+            let t619 = T::mul_add(-t2, t549, t3 * t578);
+            let t620 = T::mul_add(
+                T::from_f64(0.41),
+                t456,
+                T::mul_add(-t2, t491, -t3 * t550),
+            );
+            let t621 = T::mul_add(
+                T::from_f64(0.41),
+                t460,
+                T::mul_add(-t2, t517, -t3 * t552),
+            );
+            let t622 = T::mul_add(-t1, T::mul_add(-t3, t461, t2 * t493), -t0 * t581);
+            let t623 = T::mul_add(t7, t501, t6 * t585);
+            let t624 = T::mul_add(
+                T::from_f64(0.00009259999999999997),
+                t89,
+                T::mul_add(T::from_f64(0.10375), t587, t586),
+            );
+            let t625 = T::mul_add(t4, t559, t5 * t587);
+            let t626 = T::mul_add(-t5, t559, t4 * t587);
+            let t627 = T::mul_add(-t0, T::mul_add(t3, t507, t2 * t535), -t1 * t595);
+            let t628 = T::mul_add(t0, T::mul_add(-t2, t537, t3 * t504), -t1 * t598);
+            let t629 = T::mul_add(
+                T::from_f64(0.10375),
+                T::mul_add(-T::from_f64(0.046041539973), t131, t465),
+                T::mul_add(-t7, t571, -t6 * t467),
+            );
+            let t630 = T::mul_add(t2, t572, t3 * t601);
+            let t631 = T::mul_add(-T::from_f64(0.0114), t601, t611);
+            let t632 = T::mul_add(
+                T::from_f64(0.41),
+                t415,
+                T::mul_add(t2, t490, -t3 * t575),
+            );
+            let t633 = T::mul_add(t4, t548, -t5 * t577)
+                + T::mul_add(-T::from_f64(0.2073), -t579, -T::from_f64(0.0114) * t514);
+            let t634 = T::mul_add(
+                T::from_f64(0.2073),
+                t602,
+                T::mul_add(-t5, t548, -t4 * t577),
+            );
+            let t635 = T::mul_add(
+                T::from_f64(0.10375),
+                t521,
+                T::mul_add(t6, t498, -t7 * t582),
+            );
+            let t636 = T::mul_add(
+                -T::from_f64(0.0250914799819),
+                t106,
+                T::mul_add(
+                    T::from_f64(0.003587694842260076),
+                    t62,
+                    T::mul_add(
+                        -T::from_f64(0.00007238626506919941),
+                        t58,
+                        T::mul_add(T::from_f64(0.00007238626506919941), t94, -t181),
+                    ),
+                ),
+            ) + T::mul_add(T::from_f64(0.10375), -t584, t583);
+            let t637 = T::mul_add(
+                -T::from_f64(0.0013357060146000001),
+                t106,
+                T::mul_add(
+                    T::from_f64(0.00007238626506919941),
+                    t62,
+                    -T::from_f64(0.00009645337053442467) * t58,
+                )
+                    + T::mul_add(
+                        -T::from_f64(0.0017957741063972504),
+                        t95,
+                        T::mul_add(T::from_f64(0.0000038533705344246), t94, t182),
+                    ),
+            ) + T::mul_add(t7, t498, t6 * t582);
+            let t638 = T::mul_add(-t5, t556, -t4 * t604);
+            let t639 = T::mul_add(-t4, t556, t5 * t604);
             (
                 t576,
                 t577,
@@ -9750,506 +7718,557 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                 t587,
                 t588,
                 t589,
+                t590,
+                t591,
+                t592,
+                t593,
+                t594,
+                t595,
+                t596,
+                t597,
+                t598,
+                t599,
+                t600,
+                t601,
+                t602,
+                t603,
+                t604,
+                t605,
+                t606,
+                t607,
+                t608,
+                t609,
+                t610,
+                t611,
+                t612,
+                t613,
+                t614,
+                t615,
+                t616,
+                t617,
+                t618,
+                t619,
+                t620,
+                t621,
+                t622,
+                t623,
+                t624,
+                t625,
+                t626,
+                t627,
+                t628,
+                t629,
+                t630,
+                t631,
+                t632,
+                t633,
+                t634,
+                t635,
+                t636,
+                t637,
+                t638,
+                t639,
             )
+        };
+        let (
+            t640,
+            t641,
+            t642,
+            t643,
+            t644,
+            t645,
+            t646,
+            t647,
+            t648,
+            t649,
+            t650,
+            t651,
+            t652,
+            t653,
+            t654,
+            t655,
+            t656,
+            t657,
+            t658,
+            t659,
+            t660,
+            t661,
+            t662,
+            t663,
+            t664,
+            t665,
+            t666,
+            t667,
+            t668,
+            t669,
+            t670,
+            t671,
+            t672,
+            t673,
+            t674,
+            t675,
+            t676,
+            t677,
+            t678,
+            t679,
+            t680,
+            t681,
+            t682,
+            t683,
+            t684,
+            t685,
+            t686,
+            t687,
+            t688,
+            t689,
+            t690,
+            t691,
+            t692,
+            t693,
+            t694,
+            t695,
+            t696,
+            t697,
+            t698,
+            t699,
+            t700,
+            t701,
+            t702,
+            t703,
+        ) = {
+            let t640 = T::mul_add(
+                T::from_f64(0.10375),
+                t523,
+                T::mul_add(t6, t501, -t7 * t585),
+            );
+            let t641 = -t625;
+            let t642 = T::mul_add(t4, t561, t5 * t588)
+                + T::mul_add(
+                    -T::from_f64(0.2073),
+                    -t563,
+                    -T::from_f64(0.0114) * (t50 + t471 - T::from_f64(0.1919598)),
+                );
+            let t643 = T::mul_add(
+                T::from_f64(0.2073),
+                t589,
+                T::mul_add(-t5, t561, t4 * t588),
+            );
+            let t644 = T::mul_add(-t0, T::mul_add(t3, t527, t2 * t562), -t1 * t608);
+            let t645 = T::mul_add(
+                T::from_f64(0.10375),
+                t531,
+                T::mul_add(t6, t532, -t7 * t590),
+            );
+            let t646 = T::mul_add(
+                T::from_f64(0.0250914799819),
+                t149,
+                T::mul_add(
+                    -T::from_f64(0.013990622442755816),
+                    t62,
+                    T::mul_add(
+                        T::from_f64(0.00007238626506919941),
+                        t58,
+                        T::mul_add(-T::from_f64(0.00007238626506919941), t94, t181),
+                    ),
+                ),
+            ) + T::mul_add(T::from_f64(0.10375), -t592, t591);
+            let t647 = T::mul_add(
+                T::from_f64(0.0013357060146000001),
+                t149,
+                T::mul_add(
+                    -T::from_f64(0.0006261699787223594),
+                    t62,
+                    T::mul_add(
+                        T::from_f64(0.00009645337053442467),
+                        t58,
+                        T::mul_add(
+                            T::from_f64(0.0017957741063972504),
+                            t95,
+                            T::mul_add(-T::from_f64(0.0000038533705344246), t94, -t182),
+                        ),
+                    ),
+                ),
+            ) + T::mul_add(t7, t532, t6 * t590);
+            let t648 = T::mul_add(t4, t566, -t5 * t609);
+            let t649 = T::mul_add(-t5, t566, -t4 * t609);
+            let t650 = -T::from_f64(0.00581618) * (t35 + t59) + -t610;
+            let t651 = T::mul_add(t4, t534, t5 * t593)
+                + T::mul_add(
+                    -T::from_f64(0.2073),
+                    -t536,
+                    -T::from_f64(0.0114)
+                        * (T::mul_add(-T::from_f64(0.0026714120292000002), t5, t481)),
+                );
+            let t652 = T::mul_add(
+                T::from_f64(0.2073),
+                t568,
+                T::mul_add(-t5, t534, t4 * t593),
+            );
+            let t653 = T::mul_add(-t5, t596, -t4 * t529)
+                + T::mul_add(-T::from_f64(0.2073), -t538, -T::from_f64(0.0114) * t504);
+            let t654 = T::mul_add(
+                T::from_f64(0.2073),
+                t570,
+                T::mul_add(-t4, t596, t5 * t529),
+            );
+            let t655 = T::mul_add(-t0, T::mul_add(t3, t549, t2 * t578), -t1 * t619);
+            let t656 = T::mul_add(-t1, T::mul_add(-t3, t491, t2 * t550), -t0 * t620);
+            let t657 = T::mul_add(-t1, T::mul_add(-t3, t517, t2 * t552), -t0 * t621);
+            let t658 = T::mul_add(
+                T::from_f64(0.0250914799819),
+                t107,
+                T::mul_add(
+                    -T::from_f64(0.003587694842260076),
+                    t65,
+                    T::mul_add(T::from_f64(0.00007238626506919941), t91, t180),
+                ),
+            ) + t635;
+            let t659 = T::mul_add(-T::from_f64(0.0114), t641, t623);
+            let t660 = T::mul_add(t2, t605, t3 * t625);
+            let t661 = t642 + T::from_f64(0.00094222116);
+            let t662 = t323 + t645;
+            let t663 = -t648;
+            let t664 = T::from_f64(0.00581618) * (t34 + t58) + t648;
+            let t665 = t640 + t284;
+            let t666 = T::mul_add(t0, T::mul_add(-t3, t572, t2 * t601), t1 * t630);
+            let t667 = T::mul_add(
+                T::from_f64(0.41),
+                t510,
+                T::mul_add(-t2, t573, -t3 * t612),
+            );
+            let t668 = T::mul_add(
+                T::from_f64(0.41),
+                t487,
+                T::mul_add(-t2, t545, -t3 * t615),
+            );
+            let t669 = T::mul_add(-t1, T::mul_add(t3, t490, t2 * t575), -t0 * t632);
+            let t670 = T::mul_add(-t2, t606, t3 * t639);
+            let t671 = T::mul_add(t4, t599, -t5 * t629)
+                + T::mul_add(-T::from_f64(0.2073), -t600, -T::from_f64(0.0114) * t541);
+            let t672 = T::mul_add(
+                T::from_f64(0.2073),
+                t601,
+                T::mul_add(-t5, t599, -t4 * t629),
+            );
+            let t673 = T::mul_add(
+                T::from_f64(0.41),
+                t579,
+                T::mul_add(-t2, t618, -t3 * t633),
+            );
+            let t674 = T::mul_add(
+                T::from_f64(0.0003043349999999994),
+                t58,
+                T::mul_add(T::from_f64(0.0114), t639, -t637),
+            );
+            let t675 = T::mul_add(-t0, T::mul_add(-t3, t605, t2 * t625), -t1 * t660);
+            let t676 = T::mul_add(
+                -T::from_f64(0.00035435414799999976),
+                t58,
+                T::mul_add(
+                    -T::from_f64(0.0058574286190799995),
+                    t58,
+                    -T::from_f64(0.00590744776708) * t34,
+                ),
+            ) + T::mul_add(T::from_f64(0.0114), t663, -t647);
+            let t677 = T::mul_add(-t2, t650, t3 * t664);
+            let t678 = T::mul_add(
+                T::from_f64(0.41),
+                t536,
+                T::mul_add(-t2, t594, -t3 * t651),
+            );
+            let t679 = T::mul_add(
+                T::from_f64(0.41),
+                t538,
+                T::mul_add(-t2, t597, -t3 * t653),
+            );
+            let t680 = T::mul_add(-t1, T::mul_add(-t3, t573, t2 * t612), -t0 * t667);
+            let t681 = T::mul_add(-t1, T::mul_add(-t3, t545, t2 * t615), -t0 * t668);
+            let t682 = T::mul_add(
+                T::from_f64(0.2073),
+                t639,
+                T::mul_add(-t5, t636, -t4 * t658),
+            );
+            let t683 = T::mul_add(t4, t636, -t5 * t658)
+                + T::mul_add(-T::from_f64(0.0114), t606, -T::from_f64(0.2073) * (-t638));
+            let t684 = T::mul_add(t0, T::mul_add(t3, t606, t2 * t639), t1 * t670);
+            let t685 = T::mul_add(
+                T::from_f64(0.41),
+                t563,
+                T::mul_add(t2, t607, -t3 * t661),
+            );
+            let t686 = T::mul_add(t4, t646, -t5 * t662)
+                + T::mul_add(-T::from_f64(0.2073), -t649, -T::from_f64(0.0114) * t610);
+            let t687 = T::mul_add(
+                T::from_f64(0.2073),
+                t663,
+                T::mul_add(-t5, t646, -t4 * t662),
+            );
+            let t688 = T::mul_add(
+                -T::from_f64(0.2073),
+                -t626,
+                -T::from_f64(0.0114) * t605,
+            ) + T::mul_add(-t5, t665, t4 * t624);
+            let t689 = T::mul_add(
+                T::from_f64(0.2073),
+                t641,
+                T::mul_add(-t4, t665, -t5 * t624),
+            );
+            let t690 = T::mul_add(-t1, T::mul_add(-t3, t618, t2 * t633), -t0 * t673);
+            let t691 = T::mul_add(
+                T::from_f64(0.01141052223816),
+                t35,
+                -T::from_f64(0.044919846) * t1,
+            ) + t683;
+            let t692 = T::mul_add(
+                -T::from_f64(0.00590744776708),
+                t35,
+                T::mul_add(
+                    -T::from_f64(0.00035435414799999976),
+                    t59,
+                    -T::from_f64(0.0058574286190799995) * t35,
+                ),
+            ) + t686;
+            let t693 = T::mul_add(-t0, T::mul_add(t3, t650, t2 * t664), -t1 * t677);
+            let t694 = T::mul_add(-t1, T::mul_add(-t3, t594, t2 * t651), -t0 * t678);
+            let t695 = T::mul_add(-t1, T::mul_add(-t3, t597, t2 * t653), -t0 * t679);
+            let t696 = T::mul_add(
+                T::from_f64(0.41),
+                t600,
+                T::mul_add(-t2, t631, -t3 * t671),
+            );
+            let t697 = T::mul_add(-t1, T::mul_add(t3, t607, t2 * t661), -t0 * t685);
+            let t698 = T::mul_add(
+                T::from_f64(0.41),
+                t626,
+                T::mul_add(-t3, t688, -t2 * t659),
+            );
+            let t699 = T::mul_add(-t1, T::mul_add(-t3, t631, t2 * t671), -t0 * t696);
+            let t700 = T::mul_add(
+                T::from_f64(0.41),
+                T::mul_add(
+                    T::from_f64(0.10956060000000001),
+                    t35,
+                    -T::from_f64(0.554566) * t1,
+                ) + t638,
+                T::mul_add(-t3, t691, t2 * t674),
+            );
+            let t701 = T::mul_add(
+                T::from_f64(0.000792000000000001),
+                t0,
+                T::mul_add(t2, t691, t3 * t674),
+            );
+            let t702 = T::mul_add(
+                T::from_f64(0.41),
+                T::mul_add(-T::from_f64(0.10956060000000001), t35, t649),
+                T::mul_add(t2, t676, -t3 * t692),
+            );
+            let t703 = T::mul_add(t1, T::mul_add(-t2, t688, t3 * t659), -t0 * t698);
+            (
+                t640,
+                t641,
+                t642,
+                t643,
+                t644,
+                t645,
+                t646,
+                t647,
+                t648,
+                t649,
+                t650,
+                t651,
+                t652,
+                t653,
+                t654,
+                t655,
+                t656,
+                t657,
+                t658,
+                t659,
+                t660,
+                t661,
+                t662,
+                t663,
+                t664,
+                t665,
+                t666,
+                t667,
+                t668,
+                t669,
+                t670,
+                t671,
+                t672,
+                t673,
+                t674,
+                t675,
+                t676,
+                t677,
+                t678,
+                t679,
+                t680,
+                t681,
+                t682,
+                t683,
+                t684,
+                t685,
+                t686,
+                t687,
+                t688,
+                t689,
+                t690,
+                t691,
+                t692,
+                t693,
+                t694,
+                t695,
+                t696,
+                t697,
+                t698,
+                t699,
+                t700,
+                t701,
+                t702,
+                t703,
+            )
+        };
+        let (t704, t705) = {
+            let t704 = T::mul_add(-t1, T::mul_add(t3, t676, t2 * t692), -t0 * t702);
+            let t705 = T::mul_add(
+                -t1,
+                t701,
+                t0 * (T::mul_add(T::from_f64(0.10464407098199997), t1, -t700)),
+            );
+            (t704, t705)
         };
         [
             [
-                t586,
-                t587,
-                t588,
-                t589,
-                t583,
-                t584,
-                T::mul_add(T::from_f64(0.0016), t558 - t557, t568 - t567),
-                t578,
-                T::mul_add(-T::from_f64(0.0016), t462 + t463, t515 - t514),
-                T::mul_add(T::from_f64(0.0016), t557 - t558, t567 - t568),
-                t579,
-                T::mul_add(T::from_f64(0.0016), t462 + t463, t514 - t515),
-                t569,
-                t519,
-                t472,
+                T::mul_add(T::from_f64(0.0016), t684, t705),
+                T::mul_add(T::from_f64(0.0016), t693, t704),
+                T::mul_add(T::from_f64(0.0016), t675, t703),
+                T::mul_add(T::from_f64(0.0016), t666, t699),
+                T::mul_add(T::from_f64(0.0016), t655, t690),
+                T::mul_add(T::from_f64(0.0016), t644, t697),
+                T::mul_add(T::from_f64(0.0016), t628, t695),
+                T::mul_add(T::from_f64(0.0016), t614, t680),
+                T::mul_add(T::from_f64(0.0016), t603, t656),
+                T::mul_add(T::from_f64(0.0016), t627, t694),
+                T::mul_add(T::from_f64(0.0016), t617, t681),
+                T::mul_add(T::from_f64(0.0016), t580, t657),
+                T::mul_add(T::from_f64(0.0016), t539, t669),
+                T::mul_add(T::from_f64(0.0016), t519, t622),
+                T::mul_add(T::from_f64(0.0016), t162, t495),
             ],
             [
-                T::mul_add(
-                    T::from_f64(0.41),
-                    t580,
-                    T::mul_add(-T::from_f64(0.2073), t561, t547 - t548),
-                ),
-                T::mul_add(
-                    -T::from_f64(0.41),
-                    t581,
-                    T::mul_add(T::from_f64(0.2073), t563, t551 - t550),
-                ),
-                T::mul_add(
-                    T::from_f64(0.41),
-                    t582,
-                    T::mul_add(-T::from_f64(0.2073), t566, t565 - t554),
-                ),
-                T::mul_add(
-                    T::from_f64(0.41),
-                    t585,
-                    T::mul_add(-T::from_f64(0.2073), t571, t570 - t555),
-                ),
-                T::mul_add(
-                    T::from_f64(0.41),
-                    t539,
-                    T::mul_add(-T::from_f64(0.2073), t487, t486 - t510),
-                ),
-                T::mul_add(
-                    -T::from_f64(0.41),
-                    t556,
-                    T::mul_add(T::from_f64(0.2073), t512, t490 - t489),
-                ),
-                T::mul_add(
-                    -T::from_f64(0.41),
-                    t541,
-                    T::mul_add(T::from_f64(0.2073), t492, t464 - t491),
-                ),
-                T::mul_add(
-                    -T::from_f64(0.41),
-                    t544,
-                    T::mul_add(T::from_f64(0.2073), t496, t461 - t495),
-                ),
-                T::mul_add(
-                    -T::from_f64(0.41),
-                    t411,
-                    T::mul_add(T::from_f64(0.2073), t327, t365 - t326),
-                ),
-                T::mul_add(
-                    T::from_f64(0.41),
-                    t541,
-                    T::mul_add(-T::from_f64(0.2073), t492, t491 - t464),
-                ),
-                T::mul_add(
-                    T::from_f64(0.41),
-                    t545,
-                    T::mul_add(-T::from_f64(0.2073), t498, -t471 - t497),
-                ),
-                T::mul_add(
-                    T::from_f64(0.41),
-                    t411,
-                    T::mul_add(-T::from_f64(0.2073), t327, t326 - t365),
-                ),
-                T::mul_add(
-                    T::from_f64(0.41),
-                    t518,
-                    T::mul_add(-T::from_f64(0.2073), t466, t415 + t465),
-                ),
-                T::mul_add(
-                    -T::from_f64(0.41),
-                    t373,
-                    T::mul_add(T::from_f64(0.2073), t277, t330 - t276),
-                ),
-                T::mul_add(
-                    -T::from_f64(0.41),
-                    t122,
-                    T::mul_add(T::from_f64(0.2073), t66, t153 - t216),
-                ),
+                T::mul_add(-T::from_f64(0.41), -t670, -t682),
+                T::mul_add(-T::from_f64(0.41), t677, -t687),
+                T::mul_add(-T::from_f64(0.41), t660, -t689),
+                T::mul_add(-T::from_f64(0.41), -t630, -t672),
+                T::mul_add(-T::from_f64(0.41), t619, -t634),
+                T::mul_add(-T::from_f64(0.41), t608, -t643),
+                T::mul_add(-T::from_f64(0.41), t598, -t654),
+                T::mul_add(-T::from_f64(0.41), t574, -t613),
+                T::mul_add(-T::from_f64(0.41), t516, -t551),
+                T::mul_add(-T::from_f64(0.41), t595, -t652),
+                T::mul_add(-T::from_f64(0.41), t546, -t616),
+                T::mul_add(-T::from_f64(0.41), t518, -t553),
+                T::mul_add(-T::from_f64(0.41), -t483, -t576),
+                T::mul_add(-T::from_f64(0.41), t462, -t494),
+                T::mul_add(-T::from_f64(0.41), t88, -t295),
             ],
             [
-                T::mul_add(T::from_f64(0.2073), t561, t548 - t547),
-                T::mul_add(-T::from_f64(0.2073), t563, t550 - t551),
-                T::mul_add(T::from_f64(0.2073), t566, t554 - t565),
-                T::mul_add(T::from_f64(0.2073), t571, t555 - t570),
-                T::mul_add(T::from_f64(0.2073), t487, t510 - t486),
-                T::mul_add(-T::from_f64(0.2073), t512, t489 - t490),
-                T::mul_add(-T::from_f64(0.2073), t492, t491 - t464),
-                T::mul_add(-T::from_f64(0.2073), t496, t495 - t461),
-                T::mul_add(-T::from_f64(0.2073), t327, t326 - t365),
-                T::mul_add(T::from_f64(0.2073), t492, t464 - t491),
-                T::mul_add(T::from_f64(0.2073), t498, t471 + t497),
-                T::mul_add(T::from_f64(0.2073), t327, t365 - t326),
-                T::mul_add(T::from_f64(0.2073), t466, -t415 - t465),
-                T::mul_add(-T::from_f64(0.2073), t277, t276 - t330),
-                T::mul_add(-T::from_f64(0.2073), t66, t216 - t153),
+                t682,
+                t687,
+                t689,
+                t672,
+                t634,
+                t643,
+                t654,
+                t613,
+                t551,
+                t652,
+                t616,
+                t553,
+                t576,
+                t494,
+                t295,
             ],
             [
-                T::mul_add(
-                    -T::from_f64(0.0013357060146000001),
-                    t127,
-                    T::mul_add(
-                        -T::from_f64(0.0017957741063972504),
-                        t83,
-                        T::mul_add(
-                            T::from_f64(0.0000038533705344246),
-                            t82,
-                            T::mul_add(
-                                T::from_f64(0.00007238626506919941),
-                                t71,
-                                T::mul_add(
-                                    -T::from_f64(0.00009645337053442467),
-                                    t43,
-                                    t174 + t501 + t431,
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-                T::mul_add(
-                    -T::from_f64(0.0013357060146000001),
-                    t129,
-                    T::mul_add(
-                        T::from_f64(0.0017957741063972504),
-                        t83,
-                        T::mul_add(
-                            -T::from_f64(0.0000038533705344246),
-                            t82,
-                            T::mul_add(
-                                -T::from_f64(0.00007238626506919941),
-                                t71,
-                                T::mul_add(
-                                    T::from_f64(0.00009645337053442467),
-                                    t43,
-                                    -t174 - t505 - t440,
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-                t533,
-                t536,
-                -t452,
-                T::mul_add(T::from_f64(0.0000077067410688492), t14, t319 - t403),
-                t405,
-                t408,
-                t269,
-                -t405,
+                t637,
+                t647,
+                t623,
+                t611,
+                t547,
+                T::mul_add(T::from_f64(0.0000077067410688492), t14, t526),
+                t528,
+                t508,
                 t419,
-                -t269,
-                t369,
-                t210,
-                -t151,
+                t533,
+                t511,
+                t420,
+                t451,
+                t340,
+                -t165,
             ],
             [
-                T::mul_add(
-                    T::from_f64(0.10375),
-                    t423 + t424,
-                    T::mul_add(
-                        -T::from_f64(0.0230207699865),
-                        t220,
-                        T::mul_add(
-                            -T::from_f64(0.0015805219734713843),
-                            t161,
-                            T::mul_add(
-                                -T::from_f64(0.00006575368432434527),
-                                t72 + t73,
-                                T::mul_add(
-                                    T::from_f64(0.0015767446734206029),
-                                    t71,
-                                    t179 + t427 - t232 - t233 - t428,
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-                T::mul_add(
-                    -T::from_f64(0.10375),
-                    t432 + t433,
-                    T::mul_add(
-                        T::from_f64(0.0230207699865),
-                        t237,
-                        T::mul_add(
-                            T::from_f64(0.0015805219734713843),
-                            t161,
-                            T::mul_add(
-                                T::from_f64(0.00006575368432434527),
-                                t72 + t73,
-                                T::mul_add(
-                                    -T::from_f64(0.0015767446734206029),
-                                    t71,
-                                    t232 + t233 + t437 - t179 - t436,
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-                T::mul_add(
-                    -T::from_f64(0.10375),
-                    t441 + t442,
-                    T::mul_add(
-                        T::from_f64(0.0015805219734713843),
-                        t163,
-                        T::mul_add(
-                            T::from_f64(0.00009637730005078133),
-                            t162,
-                            T::mul_add(
-                                T::from_f64(0.00006575368432434527),
-                                t77,
-                                T::mul_add(
-                                    T::from_f64(0.0015767446734206029),
-                                    t68,
-                                    t242 + t445 - t243 - t446,
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-                T::mul_add(T::from_f64(0.10375), t482, t450 - t451),
-                T::mul_add(T::from_f64(0.10375), t310, t357 + t358),
-                T::mul_add(
-                    T::from_f64(0.10375),
-                    t314 - t313,
-                    T::mul_add(
-                        T::from_f64(0.0230207699865),
-                        t99,
-                        T::mul_add(
-                            T::from_f64(2.0),
-                            t98,
-                            T::mul_add(
-                                -T::from_f64(0.0031610439469427687),
-                                t29,
-                                t318 - t317,
-                            ),
-                        ),
-                    ),
-                ),
-                T::mul_add(
-                    -T::from_f64(0.10375),
-                    t254 + t255,
-                    T::mul_add(
-                        -T::from_f64(0.0015805219734713843),
-                        t31,
-                        T::mul_add(
-                            T::from_f64(0.001484144673420603),
-                            t30,
-                            T::mul_add(
-                                T::from_f64(0.00006575368432434527),
-                                t20,
-                                T::mul_add(
-                                    -T::from_f64(0.0015767446734206029),
-                                    t4,
-                                    t102 + t259 - t258,
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-                T::mul_add(-T::from_f64(0.10375), t322, t265 - t266),
-                T::mul_add(
-                    T::from_f64(0.000000000000000000022497195079074216),
-                    t26,
-                    T::mul_add(-T::from_f64(0.000020750000000001043), t25, -t140 - t141),
-                ),
-                T::mul_add(
-                    T::from_f64(0.10375),
-                    t254 + t255,
-                    T::mul_add(
-                        T::from_f64(0.0015805219734713843),
-                        t31,
-                        T::mul_add(
-                            -T::from_f64(0.001484144673420603),
-                            t30,
-                            T::mul_add(
-                                -T::from_f64(0.00006575368432434527),
-                                t20,
-                                T::mul_add(
-                                    T::from_f64(0.0015767446734206029),
-                                    t4,
-                                    t258 - t102 - t259,
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-                T::mul_add(T::from_f64(0.10375), t332, t266 - t265),
-                T::mul_add(
-                    -T::from_f64(0.000000000000000000022497195079074216),
-                    t26,
-                    T::mul_add(T::from_f64(0.000020750000000001043), t25, t140 + t141),
-                ),
-                T::mul_add(T::from_f64(0.10375), t272, t208 - t209),
-                T::mul_add(
-                    T::from_f64(0.000000000000000000022497195079074216),
-                    t28,
-                    T::mul_add(-T::from_f64(0.000020750000000001043), t27, -t117 - t118),
-                ),
-                t120,
+                t583,
+                t591,
+                t586,
+                t525,
+                t513,
+                t469,
+                t473,
+                t401,
+                t339,
+                t480,
+                t412,
+                t366,
+                t331,
+                t291,
+                t129,
             ],
             [
-                T::mul_add(
-                    T::from_f64(0.00010000000000000503),
-                    t336 + t291,
-                    T::mul_add(
-                        T::from_f64(0.00000000000000000010842021724855044),
-                        t335 - t290,
-                        T::mul_add(
-                            T::from_f64(0.000000000000000000006709516445275485),
-                            t158 - t75,
-                            T::mul_add(
-                                T::from_f64(0.000014022756617410007),
-                                t157 + t74,
-                                T::mul_add(
-                                    T::from_f64(0.0007776443641723163),
-                                    t72 + t73,
-                                    t347 + t298 - t348 - t299,
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-                T::mul_add(
-                    -T::from_f64(0.00010000000000000503),
-                    t350 + t302,
-                    T::mul_add(
-                        T::from_f64(0.00000000000000000010842021724855044),
-                        t301 - t349,
-                        T::mul_add(
-                            T::from_f64(0.000000000000000000006709516445275485),
-                            t75 - t158,
-                            T::mul_add(
-                                -T::from_f64(0.000014022756617410007),
-                                t157 + t74,
-                                T::mul_add(
-                                    -T::from_f64(0.0007776443641723163),
-                                    t72 + t73,
-                                    t348 + t299 - t347 - t298,
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-                T::mul_add(
-                    T::from_f64(0.00010000000000000503),
-                    t352,
-                    T::mul_add(
-                        T::from_f64(0.00000000000000000010842021724855044),
-                        t351,
-                        T::mul_add(
-                            -T::from_f64(0.000000000000000000006709516445275485),
-                            t80 + t81,
-                            T::mul_add(
-                                T::from_f64(0.000014022756617410007),
-                                t79 - t78,
-                                T::mul_add(
-                                    -T::from_f64(0.0007776443641723163),
-                                    t77,
-                                    t304 + t354 - t353 - t305,
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-                T::mul_add(
-                    -T::from_f64(0.00010000000000000503),
-                    t246,
-                    T::mul_add(
-                        T::from_f64(0.00000000000000000010842021724855044),
-                        t245,
-                        T::mul_add(
-                            -T::from_f64(0.000000000000000000006709516445275485),
-                            t160,
-                            T::mul_add(
-                                -T::from_f64(0.000014022756617410007),
-                                t159,
-                                T::mul_add(
-                                    T::from_f64(0.0007776443641723163),
-                                    t124,
-                                    t306 + t307 - t355 - t356,
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-                T::zero(),
-                T::mul_add(
-                    -T::from_f64(0.000020750000000001043),
-                    t38,
-                    T::mul_add(
-                        -T::from_f64(0.00010000000000000503),
-                        t190,
-                        T::mul_add(
-                            T::from_f64(0.000000000000000000022497195079074216),
-                            t37,
-                            T::mul_add(
-                                -T::from_f64(0.00000000000000000010842021724855044),
-                                t189,
-                                T::from_f64(2.0) * (t131 - t132),
-                            ),
-                        ),
-                    ),
-                ),
-                T::mul_add(
-                    -T::from_f64(0.00010000000000000503),
-                    t104,
-                    T::mul_add(
-                        -T::from_f64(0.00000000000000000010842021724855044),
-                        t103,
-                        T::mul_add(
-                            T::from_f64(0.000000000000000000006709516445275485),
-                            t24 - t23,
-                            T::mul_add(
-                                -T::from_f64(0.000014022756617410007),
-                                t21 + t22,
-                                T::mul_add(
-                                    -T::from_f64(0.0007776443641723163),
-                                    t20,
-                                    t134 + t106 - t105 - t135,
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-                T::mul_add(
-                    -T::from_f64(0.00000000000000000001578767863379873),
-                    t26,
-                    T::mul_add(
-                        T::from_f64(0.00003477275661741105),
-                        t25,
-                        T::mul_add(
-                            -T::from_f64(0.0007776443641723163),
-                            t10,
-                            t138 + t139 - t109 - t110,
-                        ),
-                    ),
-                ),
-                T::zero(),
-                T::mul_add(
-                    T::from_f64(0.00010000000000000503),
-                    t104,
-                    T::mul_add(
-                        T::from_f64(0.00000000000000000010842021724855044),
-                        t103,
-                        T::mul_add(
-                            T::from_f64(0.000000000000000000006709516445275485),
-                            t23 - t24,
-                            T::mul_add(
-                                T::from_f64(0.000014022756617410007),
-                                t21 + t22,
-                                T::mul_add(
-                                    T::from_f64(0.0007776443641723163),
-                                    t20,
-                                    t105 + t135 - t134 - t106,
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
+                t428,
+                t477,
+                t433,
                 T::mul_add(
                     T::from_f64(0.00000000000000000001578767863379873),
-                    t26,
+                    t172,
                     T::mul_add(
                         -T::from_f64(0.00003477275661741105),
-                        t25,
-                        T::mul_add(
-                            T::from_f64(0.0007776443641723163),
-                            t10,
-                            t109 + t110 - t138 - t139,
-                        ),
+                        t171,
+                        T::mul_add(T::from_f64(0.0007776443641723163), t132, t394),
+                    ),
+                ),
+                T::zero(),
+                t317,
+                t269,
+                T::mul_add(
+                    -T::from_f64(0.00000000000000000001578767863379873),
+                    t22,
+                    T::mul_add(
+                        T::from_f64(0.00003477275661741105),
+                        t21,
+                        T::mul_add(-T::from_f64(0.0007776443641723163), t10, t224),
+                    ),
+                ),
+                T::zero(),
+                t279,
+                T::mul_add(
+                    T::from_f64(0.00000000000000000001578767863379873),
+                    t22,
+                    T::mul_add(
+                        -T::from_f64(0.00003477275661741105),
+                        t21,
+                        T::mul_add(T::from_f64(0.0007776443641723163), t10, t238),
                     ),
                 ),
                 T::zero(),
                 T::mul_add(
                     -T::from_f64(0.00000000000000000001578767863379873),
-                    t28,
+                    t24,
                     T::mul_add(
                         T::from_f64(0.00003477275661741105),
-                        t27,
-                        T::mul_add(
-                            T::from_f64(0.0007776443641723163),
-                            t6,
-                            t115 + t59 + t116 + t60,
-                        ),
+                        t23,
+                        T::mul_add(T::from_f64(0.0007776443641723163), t6, t158),
                     ),
                 ),
                 T::zero(),
@@ -11121,7 +9140,7 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Kinova<T> {
     /// The joint-space mass matrix M(q), symmetric positive definite.
     ///
     /// Route: composite-rigid-body algorithm.
-    /// Operations: 216 mul, 172 add, 0 div, 5 sin, 5 cos.
+    /// Operations: 214 mul, 167 add, 0 div, 5 sin, 5 cos.
     fn mass_matrix(&self, q: &[T; 6]) -> [[T; 6]; 6] {
         let ([s1, s2, s3, s4, s5], [c1, c2, c3, c4, c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
             q[1],
@@ -11227,185 +9246,129 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Kinova<T> {
                 T::from_f64(0.00000000000000000010842021724855044) * t8,
             );
             let t14 = T::mul_add(
-                -T::from_f64(0.000024397756617410526),
-                t9,
-                T::from_f64(0.000000000000000000004539081094261623) * t8,
-            );
-            let t15 = T::mul_add(
-                T::from_f64(0.000000000000000000004539081094261623),
-                t9,
+                T::from_f64(0.10375),
+                t13,
                 T::mul_add(
-                    T::from_f64(0.000024397756617410526),
-                    t8,
-                    -T::from_f64(0.00006575368432434527),
+                    -T::from_f64(0.000014022756617410007),
+                    t9,
+                    -T::from_f64(0.000000000000000000006709516445275485) * t8,
                 ),
             );
+            let t15 = t10 + T::from_f64(0.000013249995099999913);
             let t16 = T::mul_add(
-                T::from_f64(0.00000000000000000010842021724855044),
-                t9,
+                -T::from_f64(0.10375),
+                t13,
                 T::mul_add(
-                    T::from_f64(0.00010000000000000503),
-                    t8,
-                    T::from_f64(0.000013249995099999913),
+                    T::from_f64(0.000014022756617410007),
+                    t9,
+                    T::from_f64(0.000000000000000000006709516445275485) * t8,
                 ),
             );
             let t17 = T::mul_add(
-                T::from_f64(0.000000000000000000004539081094261623),
-                t9,
-                T::from_f64(0.000024397756617410526) * t8,
-            );
-            let t18 = t8
-                * (T::mul_add(
-                    T::from_f64(0.0000000000000006979729257032011),
+                T::from_f64(0.10375),
+                t10,
+                T::mul_add(
+                    -T::from_f64(0.000000000000000000006709516445275485),
                     t9,
-                    T::from_f64(0.004894691391055498) * t8,
-                ));
-            let t19 = t9
-                * (T::mul_add(
+                    T::from_f64(0.000014022756617410007) * t8,
+                ),
+            );
+            let t18 = T::mul_add(
+                t9,
+                T::mul_add(
                     T::from_f64(0.004705147001603182),
                     t9,
                     T::from_f64(0.0000000000000006979729257032011) * t8,
-                ));
-            let t20 = t7 * t13;
-            let t21 = t6 * t13;
-            let t22 = t6 * t14;
-            let t23 = t7 * t14;
-            let t24 = t4 * t7 * t10;
-            let t25 = t5 * t13;
-            let t26 = T::mul_add(T::from_f64(0.1948923726334637), t6, t20);
-            let t27 = T::mul_add(T::from_f64(0.1948923726334637), t7, -t21);
-            let t28 = T::mul_add(
-                -t8,
-                t12,
-                T::mul_add(t9, t11, -T::from_f64(0.026156895147716352)),
+                ),
+                t8
+                    * (T::mul_add(
+                        T::from_f64(0.0000000000000006979729257032011),
+                        t9,
+                        T::from_f64(0.004894691391055498) * t8,
+                    )),
             );
-            let t29 = T::mul_add(t9, t12, t8 * t11);
-            let t30 = T::mul_add(T::from_f64(0.0008740216642230976), t6, -t23);
-            let t31 = T::mul_add(
+            let t19 = T::mul_add(
+                -T::from_f64(0.10375),
+                t10,
+                T::mul_add(
+                    T::from_f64(0.000000000000000000006709516445275485),
+                    t9,
+                    -T::from_f64(0.000014022756617410007) * t8,
+                ),
+            ) + T::from_f64(0.00006575368432434527);
+            let t20 = T::mul_add(t7, t13, T::from_f64(0.1948923726334637) * t6);
+            let t21 = T::mul_add(-t6, t13, T::from_f64(0.1948923726334637) * t7);
+            let t22 = t6 * t14;
+            let t23 = T::mul_add(t9, t12, t8 * t11);
+            let t24 = t7 * t14;
+            let t25 = t6 * t16;
+            let t26 = T::mul_add(-T::from_f64(0.10375), t7 * t10, t17);
+            let t27 = T::mul_add(-t5, t13, t4 * t7 * t10);
+            let t28 = T::mul_add(t4, t13, t5 * t7 * t10);
+            let t29 = T::mul_add(t8, t12, -t9 * t11) + T::from_f64(0.026156895147716352);
+            let t30 = T::mul_add(T::from_f64(0.0008740216642230976), t6, -t24);
+            let t31 = t21 - T::from_f64(0.6402493299819001);
+            let t32 = T::mul_add(
+                -T::from_f64(0.10375),
+                t21,
+                t18 + T::from_f64(0.02615311784766557),
+            );
+            let t33 = t5 * t21;
+            let t34 = t4 * t21;
+            let t35 = T::mul_add(-T::from_f64(0.0007776443641723163), t7, t25);
+            let t36 = T::mul_add(t6, t19, t7 * t23);
+            let t37 = T::mul_add(t7, t19, -t6 * t23);
+            let t38 = T::mul_add(
                 -T::from_f64(0.2075),
                 t21,
-                T::mul_add(
-                    T::from_f64(0.04044016732144372),
-                    t7,
-                    -t18 - t19 - T::from_f64(0.04401578389602839),
-                ),
+                t18 + T::from_f64(0.04222386316016557),
+            ) + T::from_f64(0.0017919207358628258);
+            let t39 = T::mul_add(-t5, t15, -t4 * t20);
+            let t40 = T::mul_add(-t4, t15, t5 * t20);
+            let t41 = T::mul_add(t2, t20, t3 * t5 * t21);
+            let t42 = T::mul_add(
+                T::from_f64(0.10375),
+                t13,
+                -(T::mul_add(-t7, t16, -T::from_f64(0.0007776443641723163) * t6)),
             );
-            let t32 = T::mul_add(
-                T::from_f64(0.1948923726334637),
-                t7,
-                -t21 - T::from_f64(0.6402493299819001),
-            );
-            let t33 = T::mul_add(
-                -T::from_f64(0.10375),
-                t21,
-                T::mul_add(
-                    T::from_f64(0.02022008366072186),
-                    t7,
-                    -t18 - t19 - T::from_f64(0.02615311784766557),
-                ),
-            );
-            let t34 = T::mul_add(-T::from_f64(0.0007776443641723163), t7, -t22);
-            let t35 = T::mul_add(
-                -T::from_f64(0.10375),
-                t7 * t10,
-                T::mul_add(
-                    T::from_f64(0.000000000000000000004539081094261623),
-                    t9,
-                    T::from_f64(0.000024397756617410526) * t8,
-                ),
-            );
-            let t36 = T::mul_add(
-                -T::from_f64(0.000010375000000000522),
-                t9,
-                T::mul_add(
-                    T::from_f64(0.000000000000000000011248597539537108),
-                    t8,
-                    T::mul_add(T::from_f64(0.0007776443641723163), t6, -t23),
-                ),
-            );
-            let t37 = T::mul_add(t4, t13, t5 * t7 * t10);
-            let t38 = t7 * (T::mul_add(T::from_f64(0.0008740216642230976), t7, t22));
-            let t39 = t5 * t27;
-            let t40 = t4 * t27;
-            let t41 = t5 * t33;
-            let t42 = t4 * t36;
-            let t43 = t5 * t35;
-            let t44 = T::mul_add(
+            let t43 = T::mul_add(
                 T::from_f64(0.0114),
-                t37,
-                T::mul_add(T::from_f64(0.0007776443641723163), t7, t22),
+                t28,
+                T::mul_add(T::from_f64(0.0007776443641723163), t7, -t25),
             );
-            let t45 = T::mul_add(t7, t28, t22);
-            let t46 = T::mul_add(-t6, t15, t7 * t29);
-            let t47 = T::mul_add(-t7, t15, -t6 * t29);
-            let t48 = T::mul_add(-t4, t16, t5 * t26);
-            let t49 = T::mul_add(t5, t16, t4 * t26);
-            let t50 = T::mul_add(t2, t26, t3 * t5 * t27);
+            let t44 = T::mul_add(t2, t6 * t10, t3 * t28);
+            let t45 = T::mul_add(t7, t29, -t22);
+            let t46 = t4 * t36;
+            let t47 = t5 * t36;
+            let t48 = -t39;
+            let t49 = T::mul_add(
+                T::from_f64(0.10375),
+                t10,
+                t37 - T::from_f64(0.00013720481202312502),
+            ) + T::from_f64(0.00007238626506919941);
+            let t50 = T::mul_add(-t4, t38, t47);
             let t51 = T::mul_add(
-                t4,
-                t35,
-                T::mul_add(
-                    t5,
-                    t36,
-                    T::mul_add(
-                        T::from_f64(0.2073),
-                        t25 - t24,
-                        T::from_f64(0.0114) * t6 * t10,
-                    ),
-                ),
+                T::from_f64(0.0114),
+                t48,
+                T::mul_add(-T::from_f64(0.2073), t21, T::from_f64(0.037311974675247876)),
             );
-            let t52 = T::mul_add(T::from_f64(0.2073), t37, t42 - t43);
-            let t53 = T::mul_add(t2, t6 * t10, t3 * t37);
-            let t54 = t6 * (T::mul_add(-t6, t28, t23));
-            let t55 = T::mul_add(
-                T::from_f64(0.000000000000000000011248597539537108),
-                t9,
-                T::mul_add(
-                    T::from_f64(0.000010375000000000522),
-                    t8,
-                    t47 - T::from_f64(0.00006481854695392561),
-                ),
-            );
-            let t56 = t4 * t46;
-            let t57 = t5 * t46;
-            let t58 = T::mul_add(T::from_f64(0.0114), t39, -t47);
+            let t52 = T::mul_add(-t2, t31, t3 * t40);
+            let t53 = T::mul_add(-t3, t31, -t2 * t40);
+            let t54 = T::mul_add(-t5, t32, -t46);
+            let t55 = T::mul_add(T::from_f64(0.0114), t33, -t37);
+            let t56 = T::mul_add(t0, T::mul_add(-t3, t20, t2 * t5 * t21), t1 * t41);
+            let t57 = T::mul_add(-t5, t26, t4 * t42);
+            let t58 = T::mul_add(t0, T::mul_add(-t3, t6 * t10, t2 * t28), t1 * t44);
             let t59 = T::mul_add(
-                T::from_f64(0.41),
-                t53,
-                T::mul_add(-T::from_f64(0.2073), t37, t43 - t42),
-            );
-            let t60 = T::mul_add(
                 t7,
-                t30,
-                T::mul_add(
-                    t6,
-                    t45,
-                    T::mul_add(
-                        T::from_f64(0.10375),
-                        t20,
-                        T::from_f64(0.02022008366072186) * t6,
-                    ),
-                ),
+                T::mul_add(T::from_f64(0.0008740216642230976), t7, t22),
+                t6 * (T::mul_add(t6, t29, t24)),
             );
-            let t61 = T::mul_add(
-                -t6,
-                t30,
-                T::mul_add(
-                    t7,
-                    t45,
-                    T::mul_add(
-                        -T::from_f64(0.2075),
-                        t21,
-                        T::mul_add(
-                            T::from_f64(0.04044016732144372),
-                            t7,
-                            -T::from_f64(0.017866519418897248),
-                        ),
-                    ),
-                ),
-            );
-            let t62 = t5 * t55;
-            let t63 = T::mul_add(t4, t31, t57);
+            let t60 = -t53;
+            let t61 = t0 * t52;
+            let t62 = T::mul_add(t4, t32, -t47)
+                + T::mul_add(-T::from_f64(0.2073), t34, T::from_f64(0.0114) * t20);
+            let t63 = T::mul_add(T::from_f64(0.2073), t33, t54);
             (
                 t0,
                 t1,
@@ -11508,197 +9471,197 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Kinova<T> {
             t95,
             t96,
             t97,
+            t98,
+            t99,
+            t100,
+            t101,
+            t102,
+            t103,
+            t104,
+            t105,
+            t106,
+            t107,
+            t108,
+            t109,
+            t110,
+            t111,
         ) = {
-            let t64 = T::mul_add(
-                T::from_f64(0.0228),
-                t49,
-                t54 + t38 + T::from_f64(0.0007050092785344214),
+            let t64 = T::mul_add(t4, t26, t5 * t42)
+                + T::mul_add(-T::from_f64(0.2073), t27, T::from_f64(0.0114) * t6 * t10);
+            let t65 = T::mul_add(T::from_f64(0.2073), t28, t57);
+            let t66 = T::mul_add(
+                -T::from_f64(0.2075),
+                t21,
+                T::mul_add(t6, t30, t7 * t45) + T::from_f64(0.0160707453125),
             );
-            let t65 = T::mul_add(-t2, t32, t3 * t48);
-            let t66 = T::mul_add(t3, t32, t2 * t48);
             let t67 = T::mul_add(
-                T::from_f64(0.0114),
-                t49,
-                t54 + t38 + T::from_f64(0.00009645337053442467),
+                T::from_f64(0.10375),
+                t20,
+                T::mul_add(t7, t30, -t6 * t45),
             );
             let t68 = T::mul_add(
-                -T::from_f64(0.2073),
-                t40,
-                T::mul_add(
-                    -t4,
-                    t33,
-                    T::mul_add(
-                        T::from_f64(0.0114),
-                        t20,
-                        T::mul_add(T::from_f64(0.0022217730480214863), t6, -t57),
-                    ),
-                ),
+                T::from_f64(0.0114),
+                t48,
+                t59 + T::from_f64(0.00009645337053442467),
             );
-            let t69 = T::mul_add(T::from_f64(0.2073), t39, t41 - t56);
+            let t69 = T::mul_add(
+                T::from_f64(0.41),
+                t41,
+                T::mul_add(-T::from_f64(0.2073), t33, -t54),
+            );
             let t70 = T::mul_add(
                 T::from_f64(0.41),
-                t50,
-                T::mul_add(-T::from_f64(0.2073), t39, t56 - t41),
+                t44,
+                T::mul_add(-T::from_f64(0.2073), t28, -t57),
             );
-            let t71 = t4 * t60;
-            let t72 = t5 * (T::mul_add(-t5, t31, t56));
-            let t73 = t0 * t65;
-            let t74 = T::mul_add(t5, t61, t56);
-            let t75 = T::mul_add(
-                -t4,
-                t55,
-                T::mul_add(t5, t60, T::from_f64(0.2073) * t48),
-            );
+            let t71 = t66 + T::from_f64(0.0017957741063972504);
+            let t72 = T::mul_add(
+                T::from_f64(2.0),
+                t51,
+                T::mul_add(
+                    T::from_f64(0.4146),
+                    t21,
+                    t59 - T::from_f64(0.07427329421996133),
+                ),
+            ) + T::from_f64(0.00035435414799999976);
+            let t73 = T::mul_add(t1, t53 - T::from_f64(1.2836779999999999), t61);
+            let t74 = T::mul_add(t4, t49, -t5 * t67);
+            let t75 = T::mul_add(-t5, t49, -t4 * t67);
             let t76 = T::mul_add(
-                -T::from_f64(0.2073),
-                t49,
+                T::from_f64(0.41),
+                t34,
+                -(T::mul_add(t2, t55, -t3 * t62)),
+            );
+            let t77 = T::mul_add(
+                T::from_f64(0.41),
+                t27,
+                -(T::mul_add(t2, t43, -t3 * t64)),
+            );
+            let t78 = T::mul_add(t5, t71, -t46);
+            let t79 = T::mul_add(-T::from_f64(0.2073), t40, t74);
+            let t80 = T::mul_add(-T::from_f64(0.2073), t48, t75);
+            let t81 = T::mul_add(T::from_f64(0.2073), t40, -t74);
+            let t82 = T::mul_add(
+                -T::from_f64(0.41),
+                t3 * t48,
+                T::mul_add(T::from_f64(0.2073), t48, -t75),
+            );
+            let t83 = T::mul_add(-t1, T::mul_add(t3, t55, t2 * t62), t0 * t76);
+            let t84 = T::mul_add(-t1, T::mul_add(t3, t43, t2 * t64), t0 * t77);
+            let t85 = T::mul_add(
+                t5,
+                T::mul_add(t5, t38, t46),
+                t4 * (T::mul_add(t4, t71, t47)),
+            );
+            let t86 = T::mul_add(
+                T::from_f64(0.2073),
+                t48,
                 T::mul_add(
                     -T::from_f64(0.0114),
                     t21,
-                    T::mul_add(
-                        T::from_f64(0.0022217730480214863),
-                        t7,
-                        -t71 - t62 - T::from_f64(0.007145457521793661),
-                    ),
+                    -t75 + T::from_f64(0.0066743469417936616),
                 ),
+            ) + T::from_f64(0.00047111058);
+            let t87 = t2 * t81;
+            let t88 = t3 * t81;
+            let t89 = T::mul_add(T::from_f64(0.0016), t56, t83);
+            let t90 = T::mul_add(T::from_f64(0.0016), t58, t84);
+            let t91 = T::mul_add(
+                T::from_f64(2.0),
+                t51,
+                T::mul_add(-t4, t50, t5 * t78) + T::from_f64(0.08430995700000002),
             );
-            let t77 = T::mul_add(-T::from_f64(0.2073), t49, -t71 - t62);
-            let t78 = T::mul_add(
-                -T::from_f64(0.41),
-                t3 * t49,
-                T::mul_add(T::from_f64(0.2073), t49, t71 + t62),
+            let t92 = T::mul_add(
+                -T::from_f64(0.0114),
+                t40,
+                T::mul_add(t5, t50, t4 * t78),
             );
-            let t79 = T::mul_add(
-                -t1,
-                T::mul_add(t3, t44, t2 * t51),
-                T::mul_add(
-                    t0,
-                    T::mul_add(
-                        -t2,
-                        t44,
-                        T::mul_add(t3, t51, T::from_f64(0.41) * (t24 - t25)),
-                    ),
-                    T::from_f64(0.0016)
-                        * (T::mul_add(t0, T::mul_add(-t3, t6 * t10, t2 * t37), t1 * t53)),
-                ),
-            );
-            let t80 = t4 * (T::mul_add(-t4, t61, t57));
-            let t81 = t2 * t75;
-            let t82 = t3 * t75;
-            let t83 = T::mul_add(
-                t4,
-                t63,
-                T::mul_add(
-                    t5,
-                    t74,
-                    T::mul_add(
-                        -T::from_f64(0.0228),
-                        t49,
-                        T::mul_add(
-                            -T::from_f64(0.4146),
-                            t21,
-                            T::mul_add(
-                                T::from_f64(0.08080237769383405),
-                                t7,
-                                -T::from_f64(0.16484135411757578),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t84 = T::mul_add(
-                -t5,
-                t63,
-                T::mul_add(t4, t74, T::from_f64(0.0114) * t48),
-            );
-            let t85 = T::mul_add(-t2, t64, t82);
-            let t86 = T::mul_add(
-                -T::from_f64(0.41),
-                t66,
-                T::mul_add(
-                    -T::from_f64(0.4146),
-                    t21,
-                    T::mul_add(
-                        T::from_f64(0.08080237769383405),
-                        t7,
-                        -t80 - t72 - T::from_f64(0.16453713320957578),
-                    ),
-                ),
-            );
-            let t87 = T::mul_add(
-                -t1,
-                T::mul_add(t3, t58, t2 * t68),
-                T::mul_add(
-                    t0,
-                    T::mul_add(-t2, t58, T::mul_add(t3, t68, T::from_f64(0.41) * t40)),
-                    T::from_f64(0.0016)
-                        * (T::mul_add(t0, T::mul_add(-t3, t26, t2 * t5 * t27), t1 * t50)),
-                ),
-            );
-            let t88 = T::mul_add(t3, t83, t81);
-            let t89 = T::mul_add(t3, t76, t2 * t84);
-            let t90 = T::mul_add(
-                t1,
-                T::mul_add(t3, t67, t81),
-                T::mul_add(
-                    t0,
-                    T::mul_add(t2, t67, T::mul_add(T::from_f64(0.41), t48, -t82)),
-                    -T::from_f64(0.0016) * (T::mul_add(t0, t2 * t49, t1 * t3 * t49)),
-                ),
-            );
-            let t91 = t0 * (T::mul_add(-t2, t76, t3 * t84));
-            let t92 = T::mul_add(-t3, t85, T::mul_add(t2, t88, T::from_f64(0.41) * t65));
             let t93 = T::mul_add(
-                t3,
-                T::mul_add(t3, t64, t81),
+                T::from_f64(2.0),
+                t51,
                 T::mul_add(
-                    t2,
-                    T::mul_add(-t2, t83, t82),
-                    T::from_f64(0.0008910000000000028),
+                    -T::from_f64(0.0228),
+                    t48,
+                    t85 + T::from_f64(0.08405575524000002),
                 ),
             );
-            let t94 = T::mul_add(
-                t1,
-                t89,
-                T::mul_add(T::from_f64(0.0016), T::mul_add(-t1, t66, t73), -t91),
-            );
+            let t94 = T::mul_add(-t2, t72, t88);
             let t95 = T::mul_add(
-                -t1,
-                T::mul_add(T::from_f64(0.41), t49, t89 + T::from_f64(0.0094826278)),
-                T::mul_add(
-                    T::from_f64(0.0016),
-                    T::mul_add(t1, t66 + T::from_f64(1.2836779999999999), -t73),
-                    t91,
-                ),
+                T::from_f64(0.41),
+                t40,
+                -(T::mul_add(-t2, t68, -t3 * t79)),
             );
-            let t96 = T::mul_add(
-                t0,
-                T::mul_add(
-                    -t2,
-                    t85,
-                    T::mul_add(
-                        -t3,
-                        t88,
-                        T::mul_add(
-                            T::from_f64(0.82),
-                            t66,
-                            T::from_f64(0.49530666549099994),
-                        ),
-                    ),
-                ),
-                t1 * t92,
-            );
+            let t96 = t91 + T::from_f64(0.00590744776708);
             let t97 = T::mul_add(
+                -T::from_f64(0.41),
+                t60,
+                -t93 - T::from_f64(0.0058574286190799995),
+            );
+            let t98 = T::mul_add(t3, t86, t2 * t92);
+            let t99 = T::mul_add(-t1, T::mul_add(-t3, t68, t2 * t79), t0 * t95);
+            let t100 = T::mul_add(t3, t96, -t87);
+            let t101 = t0 * (T::mul_add(-t2, t86, t3 * t92));
+            let t102 = T::mul_add(
+                -T::from_f64(0.0016),
+                T::mul_add(t0, t2 * t48, t1 * t3 * t48),
+                t99,
+            );
+            let t103 = T::mul_add(
+                t3,
+                T::mul_add(t3, t72, t87),
+                t2 * (T::mul_add(t2, t96, t88)),
+            );
+            let t104 = T::mul_add(
+                -T::from_f64(0.41),
+                t39,
+                -t98 + T::from_f64(0.011526977800000001),
+            ) - T::from_f64(0.00204435);
+            let t105 = T::mul_add(
+                T::from_f64(0.0016),
+                T::mul_add(-t1, t60, t61),
+                T::mul_add(-t1, t98, t101),
+            );
+            let t106 = T::mul_add(
+                T::from_f64(0.82),
+                t60,
+                T::mul_add(-t2, t94, t3 * t100) + T::from_f64(0.44248962999999997),
+            );
+            let t107 = T::mul_add(
+                T::from_f64(0.41),
+                t52,
+                T::mul_add(-t3, t94, -t2 * t100),
+            );
+            let t108 = T::mul_add(
                 t1,
-                T::mul_add(t1, t93, t0 * t92),
+                t103 + T::from_f64(0.0008910000000000028),
+                t0 * t107,
+            );
+            let t109 = T::mul_add(
+                -T::from_f64(0.0016),
+                t73,
+                T::mul_add(-t1, t104, -t101),
+            );
+            let t110 = T::mul_add(
+                t0,
+                t106 + T::from_f64(0.05281703549099999),
+                t1 * t107,
+            );
+            let t111 = T::mul_add(
+                T::from_f64(2.0),
                 T::mul_add(
-                    t0,
-                    t96,
+                    T::from_f64(0.11875),
+                    t73,
                     T::mul_add(
-                        -T::from_f64(0.0032),
-                        t49,
-                        T::from_f64(0.0005521372320000016),
+                        T::from_f64(0.0016),
+                        t39,
+                        -T::from_f64(0.000029143328000000003),
                     ),
+                ),
+                T::mul_add(
+                    -T::from_f64(0.2375),
+                    t73,
+                    T::mul_add(t1, t108, t0 * t110)
+                        + T::from_f64(0.000009273088000001482),
                 ),
             );
             (
@@ -11736,49 +9699,37 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Kinova<T> {
                 t95,
                 t96,
                 t97,
+                t98,
+                t99,
+                t100,
+                t101,
+                t102,
+                t103,
+                t104,
+                t105,
+                t106,
+                t107,
+                t108,
+                t109,
+                t110,
+                t111,
             )
         };
         [
-            [t97, t95, t94, t90, t87, t79],
+            [t111 + T::from_f64(0.0006011508000000001), t109, t105, t102, t89, t90],
             [
-                t95,
-                T::mul_add(
-                    T::from_f64(0.82),
-                    t66,
-                    T::mul_add(
-                        T::from_f64(0.4146),
-                        t21,
-                        T::mul_add(
-                            -T::from_f64(0.08080237769383405),
-                            t7,
-                            t80 + t72 + T::from_f64(0.6597447987005757),
-                        ),
-                    ),
-                ),
-                t86,
-                t78,
-                t70,
-                t59,
-            ],
-            [
-                t94,
-                t86,
-                T::mul_add(
-                    T::from_f64(0.4146),
-                    t21,
-                    T::mul_add(
-                        -T::from_f64(0.08080237769383405),
-                        t7,
-                        t80 + t72 + T::from_f64(0.16453713320957578),
-                    ),
-                ),
-                t77,
+                t109,
+                T::mul_add(T::from_f64(0.82), t60, t93 + T::from_f64(0.44834705861908))
+                    + T::from_f64(0.05271803549099999),
+                t97,
+                t82,
                 t69,
-                t52,
+                t70,
             ],
-            [t90, t78, t77, t54 + t38 + T::from_f64(0.00009645337053442467), t47, t34],
-            [t87, t70, t69, t47, t18 + t19 + T::from_f64(0.02615311784766557), t17],
-            [t79, t59, t52, t34, t17, T::from_f64(0.0007776443641723163)],
+            [t105, t97, t93 + T::from_f64(0.0058574286190799995), t80, t63, t65],
+            [t102, t82, t80, t59 + T::from_f64(0.00009645337053442467), t37, t35],
+            [t89, t69, t63, t37, t18 + T::from_f64(0.02615311784766557), t17],
+            [t90, t70, t65, t35, t17, T::from_f64(0.0007776443641723163)],
         ]
     }
     /// The generalized gravity force G(q) = dV/dq.
@@ -11888,7 +9839,7 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Kinova<T> {
     /// The Coriolis and centrifugal effort b(q, qd) = C(q, qd) qd, without gravity.
     ///
     /// Route: Newton-Euler.
-    /// Operations: 370 mul, 346 add, 0 div, 5 sin, 5 cos.
+    /// Operations: 346 mul, 239 add, 0 div, 5 sin, 5 cos.
     fn bias(&self, q: &[T; 6], qd: &[T; 6]) -> [T; 6] {
         let ([s1, s2, s3, s4, s5], [c1, c2, c3, c4, c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
             q[1],
@@ -11980,117 +9931,172 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Kinova<T> {
             let t14 = qd[0] * qd[1] * t0;
             let t15 = qd[0] * qd[0] * t0 * t1;
             let t16 = qd[0] * qd[0] * t0 * t0;
-            let t17 = qd[0] * qd[0] * t0 * t1 * t3;
-            let t18 = qd[0] * qd[0] * t0 * t1 * t2;
-            let t19 = T::mul_add(
+            let t17 = qd[0] * qd[0] * t0 * t1 * t2;
+            let t18 = T::mul_add(
                 T::from_f64(0.00204435),
                 t12,
                 T::from_f64(0.05271803549099999) * qd[1],
             );
-            let t20 = T::mul_add(
+            let t19 = T::mul_add(
                 T::from_f64(0.0008910000000000028),
                 t12,
                 T::from_f64(0.00204435) * qd[1],
             );
-            let t21 = T::mul_add(-qd[0], t1 * t2, qd[0] * t0 * t3);
-            let t22 = T::from_f64(0.41) * (T::mul_add(qd[1], qd[1], t16));
+            let t20 = T::mul_add(-qd[0], t1 * t2, qd[0] * t0 * t3);
+            let t21 = T::from_f64(0.41) * (T::mul_add(qd[1], qd[1], t16));
+            let t22 = T::mul_add(T::from_f64(0.82), t13, T::from_f64(0.0016) * t10);
             let t23 = T::mul_add(qd[0], t1 * t3, qd[0] * t0 * t2);
-            let t24 = t2 * t22;
-            let t25 = t3 * t22;
-            let t26 = T::mul_add(
-                T::from_f64(0.00581618),
-                t23,
-                T::from_f64(0.054780300000000004) * t11,
+            let t24 = t3 * t21;
+            let t25 = T::mul_add(
+                T::from_f64(0.054780300000000004),
+                t11,
+                T::from_f64(0.00581618) * t23,
             );
-            let t27 = T::from_f64(0.00581618) * t21;
-            let t28 = T::from_f64(0.054780300000000004) * t21;
-            let t29 = T::from_f64(0.00590744776708) * t21;
+            let t26 = t20 * t23;
+            let t27 = t20 * t11;
+            let t28 = t20 * t20;
+            let t29 = T::mul_add(
+                T::from_f64(0.0058574286190799995),
+                t11,
+                T::from_f64(0.00047111058) * t23,
+            );
             let t30 = T::mul_add(
                 T::from_f64(0.00047111058),
-                t23,
-                T::from_f64(0.0058574286190799995) * t11,
+                t11,
+                T::from_f64(0.00035435414799999976) * t23,
             );
-            let t31 = T::mul_add(
-                T::from_f64(0.00035435414799999976),
-                t23,
-                T::from_f64(0.00047111058) * t11,
+            let t31 = T::mul_add(T::from_f64(0.2073), t11, T::from_f64(0.0114) * t23);
+            let t32 = qd[3] + t23;
+            let t33 = T::mul_add(
+                T::from_f64(0.20443499999999998),
+                t16,
+                qd[1]
+                    * (T::mul_add(
+                        T::from_f64(0.0099),
+                        t12,
+                        T::from_f64(0.20443499999999998) * qd[1],
+                    )),
             );
-            let t32 = T::mul_add(T::from_f64(0.0114), t23, T::from_f64(0.2073) * t11);
-            let t33 = T::from_f64(0.0114) * t21;
-            let t34 = T::from_f64(0.2073) * t21;
-            let t35 = t23 + qd[3];
+            let t34 = T::mul_add(
+                t2,
+                t21,
+                T::from_f64(0.41) * qd[0] * qd[0] * t0 * t1 * t3,
+            );
+            let t35 = T::mul_add(-T::from_f64(0.41), t17, t24);
             let t36 = T::mul_add(
                 -qd[2],
                 t23,
                 T::mul_add(qd[0], qd[1] * t0 * t2, qd[0] * qd[1] * t1 * t3),
             );
             let t37 = T::mul_add(
-                qd[2],
-                t21,
-                T::mul_add(-qd[0], qd[1] * t0 * t3, qd[0] * qd[1] * t1 * t2),
+                -qd[2],
+                t20,
+                T::mul_add(qd[0], qd[1] * t0 * t3, -qd[0] * qd[1] * t1 * t2),
             );
-            let t38 = t21 * t31;
-            let t39 = t23 * t29;
-            let t40 = T::mul_add(t5, t11, t4 * t21);
-            let t41 = t11 * t32;
-            let t42 = t21 * t34;
-            let t43 = T::mul_add(-t4, t11, t5 * t21);
-            let t44 = T::mul_add(
-                t11,
-                t33,
+            let t38 = T::mul_add(T::from_f64(0.41), t17, -t24);
+            let t39 = T::mul_add(t5, t11, t4 * t20);
+            let t40 = T::mul_add(-t4, t11, t5 * t20);
+            let t41 = T::mul_add(
+                -T::from_f64(0.05281703549099999),
+                t13,
                 T::mul_add(
-                    -t23,
-                    t34,
-                    T::mul_add(
-                        T::from_f64(0.41),
-                        t17,
-                        T::mul_add(T::from_f64(0.0114), t37, t24),
-                    ),
+                    -T::from_f64(0.000327096),
+                    t10,
+                    T::mul_add(qd[1], t19, -qd[0] * t1 * t18),
                 ),
             );
+            let t42 = T::mul_add(
+                T::from_f64(0.0008910000000000028),
+                t14,
+                T::mul_add(qd[0], t0 * t18, -T::from_f64(0.05281703549099999) * t14),
+            );
+            let t43 = T::mul_add(
+                -T::from_f64(0.00204435),
+                t14,
+                T::mul_add(qd[0], t0 * t19, -T::from_f64(0.05281703549099999) * t15),
+            );
+            let t44 = T::mul_add(-t11, t31, -T::from_f64(0.2073) * t28);
             let t45 = T::mul_add(
-                -t23,
-                t32,
-                T::mul_add(
-                    -t21,
-                    t33,
-                    T::mul_add(
-                        -T::from_f64(0.2073),
-                        t36,
-                        T::mul_add(T::from_f64(0.82), t13, T::from_f64(0.0016) * t10),
-                    ),
-                ),
+                -T::from_f64(0.0114),
+                t37,
+                t34 + T::mul_add(T::from_f64(0.0114), t27, -T::from_f64(0.2073) * t26),
             );
-            let t46 = T::from_f64(0.0250914799819) * t43;
-            let t47 = T::from_f64(0.0013357060146000001) * t43;
+            let t46 = t39 * t40;
+            let t47 = t32 * t40;
             let t48 = T::mul_add(
-                T::from_f64(0.0250914799819),
-                t40,
-                T::from_f64(0.0013357060146000001) * t35,
+                T::from_f64(0.0013357060146000001),
+                t32,
+                T::from_f64(0.0250914799819) * t39,
             );
-            let t49 = T::mul_add(
-                T::from_f64(0.0017919207358628258),
-                t40,
-                T::from_f64(0.00007238626506919941) * t35,
-            );
+            let t49 = t40 * t40;
             let t50 = T::mul_add(
                 T::from_f64(0.00007238626506919941),
-                t40,
-                T::from_f64(0.00009645337053442467) * t35,
+                t32,
+                T::from_f64(0.0017919207358628258) * t39,
             );
-            let t51 = T::from_f64(0.0017957741063972504) * t43;
-            let t52 = t7 * t37;
-            let t53 = T::from_f64(0.10375) * t43;
-            let t54 = T::from_f64(0.10375) * t40;
-            let t55 = t40 + qd[4];
-            let t56 = t5 * t44;
-            let t57 = t4 * t45;
-            let t58 = t4 * t44;
-            let t59 = t5 * t45;
-            let t60 = T::mul_add(qd[3], t43, t4 * t36);
-            let t61 = T::mul_add(-qd[3], t40, t5 * t36);
-            let t62 = t43 * t46;
-            let t63 = t40 * t48;
+            let t51 = T::mul_add(
+                T::from_f64(0.00009645337053442467),
+                t32,
+                T::from_f64(0.00007238626506919941) * t39,
+            );
+            let t52 = qd[4] + t39;
+            let t53 = T::mul_add(
+                -T::from_f64(0.6763),
+                t38,
+                T::mul_add(
+                    T::from_f64(0.00581618),
+                    t36,
+                    T::mul_add(-T::from_f64(0.054780300000000004), t28, -t11 * t25),
+                ),
+            );
+            let t54 = T::mul_add(
+                T::from_f64(0.054780300000000004),
+                t36,
+                T::mul_add(
+                    -T::from_f64(0.6763),
+                    t22,
+                    T::mul_add(t23, t25, T::from_f64(0.00581618) * t28),
+                ),
+            );
+            let t55 = T::mul_add(
+                T::from_f64(0.00590744776708),
+                t36,
+                T::mul_add(-t11, t30, t23 * t29)
+                    + T::mul_add(
+                        -T::from_f64(0.00581618),
+                        t38,
+                        -T::from_f64(0.054780300000000004) * t22,
+                    ),
+            );
+            let t56 = T::mul_add(
+                T::from_f64(0.00035435414799999976),
+                t37,
+                T::mul_add(
+                    -T::from_f64(0.00581618),
+                    t34,
+                    T::mul_add(t20, t29, -T::from_f64(0.00590744776708) * t27),
+                ),
+            );
+            let t57 = T::mul_add(
+                T::from_f64(0.00047111058),
+                t37,
+                T::mul_add(
+                    -T::from_f64(0.054780300000000004),
+                    t34,
+                    T::mul_add(-t20, t30, T::from_f64(0.00590744776708) * t26),
+                ),
+            );
+            let t58 = T::mul_add(T::from_f64(0.0114), t36, t35 + t44);
+            let t59 = T::mul_add(
+                T::from_f64(0.2073),
+                t36,
+                T::mul_add(-T::from_f64(0.82), t13, -T::from_f64(0.0016) * t10)
+                    + T::mul_add(t23, t31, T::from_f64(0.0114) * t28),
+            );
+            let t60 = T::mul_add(qd[3], t40, t4 * t36);
+            let t61 = T::mul_add(-qd[3], t39, t5 * t36);
+            let t62 = T::mul_add(t6, t32, t7 * t40);
+            let t63 = T::mul_add(-t7, t32, t6 * t40);
             (
                 t0,
                 t1,
@@ -12224,292 +10230,302 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Kinova<T> {
             t126,
             t127,
         ) = {
-            let t64 = t43 * t49;
-            let t65 = t40 * t51;
-            let t66 = T::mul_add(t6, t35, t7 * t43);
-            let t67 = t35 * t54;
-            let t68 = T::mul_add(-t7, t35, t6 * t43);
-            let t69 = T::from_f64(0.10375) * t55;
-            let t70 = t6 * t61;
-            let t71 = T::mul_add(
-                -t35,
-                t53,
-                T::mul_add(T::from_f64(0.10375), t60, t56 - t57),
+            let t64 = T::mul_add(-T::from_f64(0.0114), t36, -t35 - t44)
+                + T::from_f64(0.10375) * (T::mul_add(t39, t39, t49));
+            let t65 = t62 * t63;
+            let t66 = t62 * t52;
+            let t67 = T::mul_add(
+                -T::from_f64(0.0013224560195000002),
+                t63,
+                T::from_f64(0.0230207699865) * t52,
             );
-            let t72 = T::mul_add(
-                -t40,
-                t54,
+            let t68 = t62 * t62;
+            let t69 = T::mul_add(
+                -T::from_f64(0.00009637730005078133),
+                t63,
+                T::from_f64(0.00006575368432434527) * t52,
+            );
+            let t70 = T::mul_add(
+                -T::from_f64(0.00006575368432434527),
+                t63,
+                T::from_f64(0.0015767446734206029) * t52,
+            );
+            let t71 = qd[5] + t63;
+            let t72 = T::mul_add(-t4, t59, -t5 * t45);
+            let t73 = T::mul_add(-t5, t59, t4 * t45);
+            let t74 = T::mul_add(
+                -T::from_f64(0.0013357060146000001),
+                t61,
                 T::mul_add(
-                    -t43,
-                    t53,
-                    T::mul_add(
-                        -T::from_f64(0.41),
-                        t18,
-                        T::mul_add(T::from_f64(0.0114), t36, t25 - t41 - t42),
-                    ),
+                    -T::from_f64(0.463),
+                    t58,
+                    T::mul_add(t39, t48, T::from_f64(0.0250914799819) * t49),
                 ),
             );
-            let t73 = qd[4] * t66;
-            let t74 = T::from_f64(0.0013224560195000002) * t66;
-            let t75 = T::from_f64(0.0230207699865) * t66;
-            let t76 = T::mul_add(
-                -T::from_f64(0.0013224560195000002),
-                t68,
-                T::from_f64(0.0230207699865) * t55,
-            );
-            let t77 = T::from_f64(0.0015805219734713843) * t66;
+            let t75 = T::mul_add(-t9, t52, t8 * t62);
+            let t76 = T::mul_add(t8, t52, t9 * t62);
+            let t77 = -t72;
             let t78 = T::mul_add(
-                -T::from_f64(0.00009637730005078133),
-                t68,
-                T::from_f64(0.00006575368432434527) * t55,
+                -T::from_f64(0.0250914799819),
+                t61,
+                T::mul_add(
+                    T::from_f64(0.463),
+                    t73,
+                    T::mul_add(-T::from_f64(0.0013357060146000001), t49, -t32 * t48),
+                ),
             );
-            let t79 = T::mul_add(
-                -T::from_f64(0.00006575368432434527),
-                t68,
-                T::from_f64(0.0015767446734206029) * t55,
+            let t79 = T::mul_add(T::from_f64(0.10375), t47 - t60, t72);
+            let t80 = T::mul_add(-T::from_f64(0.10375), T::mul_add(t39, t32, t61), t73);
+            let t81 = T::mul_add(-qd[4], t63, T::mul_add(-t6, t37, t7 * t61));
+            let t82 = T::mul_add(-qd[4], t62, T::mul_add(-t7, t37, -t6 * t61));
+            let t83 = T::mul_add(
+                T::from_f64(0.00000000000000000010842021724855044),
+                t76,
+                T::from_f64(0.00010000000000000503) * t75,
             );
-            let t80 = t8 * t60;
-            let t81 = t9 * t60;
-            let t82 = T::from_f64(0.10375) * t66;
-            let t83 = t55 * t69;
-            let t84 = t68 + qd[5];
-            let t85 = t7 * t71;
-            let t86 = t6 * t72;
-            let t87 = t6 * t71;
-            let t88 = t7 * t72;
-            let t89 = T::mul_add(-qd[4], t68, T::mul_add(t6, t37, t7 * t61));
-            let t90 = t66 * t74;
-            let t91 = t68 * t76;
-            let t92 = t66 * t78;
-            let t93 = t68 * t77;
-            let t94 = T::mul_add(-t9, t55, t8 * t66);
-            let t95 = t66 * t82;
-            let t96 = T::mul_add(t8, t55, t9 * t66);
-            let t97 = t9 * t89;
-            let t98 = t8 * t89;
-            let t99 = T::mul_add(
-                t68,
-                t82,
-                T::mul_add(T::from_f64(0.10375), t60, t86 - t85),
+            let t84 = T::mul_add(
+                T::from_f64(0.0650091026469637),
+                t76,
+                T::from_f64(0.00010000000000000503) * t71,
             );
-            let t100 = T::mul_add(
-                t68,
-                t69,
-                T::mul_add(T::from_f64(0.10375), t61 - t89, t67 - t58 - t59),
+            let t85 = T::mul_add(
+                -T::from_f64(0.00000000000000000010842021724855044),
+                t71,
+                T::from_f64(0.0650091026469637) * t75,
             );
-            let t101 = qd[5] * t94;
-            let t102 = qd[5] * t96;
+            let t86 = T::mul_add(
+                -T::from_f64(0.004894691391055498),
+                t76,
+                T::mul_add(
+                    -T::from_f64(0.000014022756617410007),
+                    t71,
+                    T::from_f64(0.0000000000000006979729257032011) * t75,
+                ),
+            );
+            let t87 = T::mul_add(
+                -T::from_f64(0.0000000000000006979729257032011),
+                t76,
+                T::mul_add(
+                    T::from_f64(0.000000000000000000006709516445275485),
+                    t71,
+                    T::from_f64(0.004705147001603182) * t75,
+                ),
+            );
+            let t88 = T::mul_add(
+                T::from_f64(0.000014022756617410007),
+                t76,
+                T::mul_add(
+                    T::from_f64(0.0007776443641723163),
+                    t71,
+                    T::from_f64(0.000000000000000000006709516445275485) * t75,
+                ),
+            );
+            let t89 = T::mul_add(
+                -T::from_f64(0.0017957741063972504),
+                t61,
+                T::mul_add(-t32, t50, t39 * t51)
+                    + T::mul_add(
+                        T::from_f64(0.0250914799819),
+                        t73,
+                        -T::from_f64(0.0013357060146000001) * t58,
+                    ),
+            );
+            let t90 = T::mul_add(
+                T::from_f64(0.0250914799819),
+                t77,
+                T::mul_add(
+                    T::from_f64(0.0017919207358628258),
+                    t60,
+                    -T::from_f64(0.00007238626506919941) * t37,
+                ) + T::mul_add(t40, t51, -T::from_f64(0.0017957741063972504) * t47),
+            );
+            let t91 = T::mul_add(
+                T::from_f64(0.0013357060146000001),
+                t77,
+                T::mul_add(
+                    T::from_f64(0.00007238626506919941),
+                    t60,
+                    -T::from_f64(0.00009645337053442467) * t37,
+                ) + T::mul_add(-t40, t50, T::from_f64(0.0017957741063972504) * t46),
+            );
+            let t92 = T::mul_add(
+                T::from_f64(0.0230207699865),
+                t81,
+                T::mul_add(
+                    T::from_f64(0.463),
+                    t80,
+                    T::mul_add(-t63, t67, T::from_f64(0.0013224560195000002) * t68),
+                ),
+            );
+            let t93 = T::mul_add(T::from_f64(0.10375), T::mul_add(-t52, t63, t81), t80);
+            let t94 = T::mul_add(t6, t64, -t7 * t79);
+            let t95 = T::mul_add(t7, t64, t6 * t79);
+            let t96 = -t94;
+            let t97 = T::mul_add(
+                T::from_f64(0.0013224560195000002),
+                t81,
+                T::mul_add(
+                    T::from_f64(0.463),
+                    t95,
+                    T::mul_add(-T::from_f64(0.0230207699865), t68, -t52 * t67),
+                ),
+            );
+            let t98 = t95 + -T::from_f64(0.10375) * (T::mul_add(t52, t52, t68));
+            let t99 = T::mul_add(T::from_f64(0.10375), t60 + t65, -t94);
+            let t100 = T::mul_add(qd[5], t75, T::mul_add(-t8, t60, -t9 * t81));
+            let t101 = T::mul_add(qd[5], t76, T::mul_add(-t9, t60, t8 * t81));
+            let t102 = T::mul_add(
+                T::from_f64(0.0015805219734713843),
+                t81,
+                T::mul_add(-t52, t69, -t63 * t70)
+                    + T::mul_add(
+                        T::from_f64(0.0013224560195000002),
+                        t95,
+                        T::from_f64(0.0230207699865) * t80,
+                    ),
+            );
             let t103 = T::mul_add(
-                -T::from_f64(0.0650091026469637),
-                t94,
-                T::from_f64(0.00000000000000000010842021724855044) * t84,
+                T::from_f64(0.0013224560195000002),
+                t96,
+                T::mul_add(
+                    T::from_f64(0.00009637730005078133),
+                    t82,
+                    T::from_f64(0.00006575368432434527) * t60,
+                ) + T::mul_add(-t62, t70, T::from_f64(0.0015805219734713843) * t66),
             );
             let t104 = T::mul_add(
-                T::from_f64(0.00010000000000000503),
-                t94,
-                T::from_f64(0.00000000000000000010842021724855044) * t96,
-            );
-            let t105 = T::mul_add(
-                T::from_f64(0.0650091026469637),
+                T::from_f64(0.0230207699865),
                 t96,
-                T::from_f64(0.00010000000000000503) * t84,
-            );
-            let t106 = T::mul_add(
-                T::from_f64(0.004705147001603182),
-                t94,
                 T::mul_add(
-                    -T::from_f64(0.0000000000000006979729257032011),
-                    t96,
-                    T::from_f64(0.000000000000000000006709516445275485) * t84,
-                ),
+                    T::from_f64(0.00006575368432434527),
+                    t82,
+                    T::from_f64(0.0015767446734206029) * t60,
+                ) + T::mul_add(t62, t69, T::from_f64(0.0015805219734713843) * t65),
             );
+            let t105 = T::mul_add(-t8, t93, t9 * t99);
+            let t106 = T::mul_add(t9, t93, t8 * t99);
             let t107 = T::mul_add(
-                T::from_f64(0.000000000000000000006709516445275485),
-                t94,
-                T::mul_add(
-                    T::from_f64(0.000014022756617410007),
-                    t96,
-                    T::from_f64(0.0007776443641723163) * t84,
-                ),
+                T::from_f64(1.03),
+                t98,
+                -(T::mul_add(
+                    T::from_f64(0.00010000000000000503),
+                    t101,
+                    -T::from_f64(0.00000000000000000010842021724855044) * t100,
+                )) - (T::mul_add(t75, t85, t76 * t84)),
             );
             let t108 = T::mul_add(
-                -T::from_f64(0.0000000000000006979729257032011),
-                t94,
-                T::mul_add(
-                    T::from_f64(0.004894691391055498),
-                    t96,
-                    T::from_f64(0.000014022756617410007) * t84,
-                ),
-            );
-            let t109 = t9 * t99;
-            let t110 = t8 * t100;
-            let t111 = t8 * t99;
-            let t112 = t9 * t100;
-            let t113 = t96 * t106;
-            let t114 = t94 * t108;
-            let t115 = T::mul_add(
-                t84,
+                T::from_f64(1.03),
                 t105,
                 T::mul_add(
-                    t94,
-                    t104,
-                    T::mul_add(
-                        T::from_f64(1.03),
-                        t109 + t110,
-                        T::mul_add(
-                            T::from_f64(0.0650091026469637),
-                            t81 - t98 - t102,
-                            T::from_f64(0.00000000000000000010842021724855044)
-                                * (t70 + t73 - t52),
-                        ),
-                    ),
-                ),
+                    -T::from_f64(0.0650091026469637),
+                    t101,
+                    -T::from_f64(0.00000000000000000010842021724855044) * t82,
+                ) + T::mul_add(t71, t84, t75 * t83),
             );
-            let t116 = T::mul_add(
-                t96,
-                t107,
-                T::mul_add(
-                    -t84,
-                    t108,
-                    T::mul_add(
-                        -T::from_f64(0.0650091026469637),
-                        t109 + t110,
-                        T::mul_add(
-                            T::from_f64(0.004705147001603182),
-                            t98 + t102 - t81,
-                            T::mul_add(
-                                T::from_f64(0.0000000000000006979729257032011),
-                                t101 - t97 - t80,
-                                T::mul_add(
-                                    T::from_f64(0.00010000000000000503),
-                                    t87 + t88 + t83 + t95,
-                                    T::from_f64(0.000000000000000000006709516445275485)
-                                        * (t70 + t73 - t52),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t117 = T::mul_add(
-                t84,
+            let t109 = T::mul_add(
+                T::from_f64(1.03),
                 t106,
-                T::mul_add(
-                    -t94,
-                    t107,
-                    T::mul_add(
-                        T::from_f64(0.0650091026469637),
-                        t111 - t112,
-                        T::mul_add(
-                            T::from_f64(0.0000000000000006979729257032011),
-                            t81 - t98 - t102,
-                            T::mul_add(
-                                T::from_f64(0.004894691391055498),
-                                t97 + t80 - t101,
-                                T::mul_add(
-                                    T::from_f64(0.00000000000000000010842021724855044),
-                                    t87 + t88 + t83 + t95,
-                                    T::from_f64(0.000014022756617410007) * (t70 + t73 - t52),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
+                -(T::mul_add(
+                    T::from_f64(0.0650091026469637),
+                    t100,
+                    T::from_f64(0.00010000000000000503) * t82,
+                )) - (T::mul_add(t76, t83, -t71 * t85)),
             );
-            let t118 = T::mul_add(
-                -t96,
-                t104,
+            let t110 = t97 + t107;
+            let t111 = T::mul_add(
+                T::from_f64(0.0000000000000006979729257032011),
+                t101,
                 T::mul_add(
-                    -t84,
-                    t103,
-                    T::mul_add(
-                        T::from_f64(1.03),
-                        t111 - t112,
-                        T::mul_add(
-                            T::from_f64(0.0650091026469637),
-                            t97 + t80 - t101,
-                            T::from_f64(0.00010000000000000503) * (t70 + t73 - t52),
-                        ),
-                    ),
+                    T::from_f64(0.004894691391055498),
+                    t100,
+                    T::from_f64(0.000014022756617410007) * t82,
                 ),
-            );
-            let t119 = T::mul_add(
-                -T::from_f64(1.03),
-                t83 + t95,
+            ) + T::mul_add(-t71, t87, t75 * t88)
+                + T::mul_add(
+                    -T::from_f64(0.0650091026469637),
+                    t106,
+                    T::from_f64(0.00000000000000000010842021724855044) * t98,
+                );
+            let t112 = T::mul_add(
+                T::from_f64(0.004705147001603182),
+                t101,
                 T::mul_add(
+                    T::from_f64(0.0000000000000006979729257032011),
+                    t100,
+                    -T::from_f64(0.000000000000000000006709516445275485) * t82,
+                ),
+            ) + T::mul_add(t76, t88, t71 * t86)
+                + T::mul_add(
+                    -T::from_f64(0.0650091026469637),
+                    t105,
+                    -T::from_f64(0.00010000000000000503) * t98,
+                );
+            let t113 = T::mul_add(
+                T::from_f64(0.000000000000000000006709516445275485),
+                t101,
+                T::mul_add(
+                    -T::from_f64(0.000014022756617410007),
+                    t100,
+                    -T::from_f64(0.0007776443641723163) * t82,
+                ),
+            ) + T::mul_add(-t75, t86, -t76 * t87)
+                + T::mul_add(
                     T::from_f64(0.00010000000000000503),
-                    t81 - t98 - t102,
-                    T::mul_add(
-                        T::from_f64(0.00000000000000000010842021724855044),
-                        t101 - t97 - t80,
-                        T::mul_add(
-                            t94,
-                            t103,
-                            T::mul_add(
-                                -t96,
-                                t105,
-                                T::mul_add(
-                                    -t66,
-                                    t75,
-                                    T::mul_add(
-                                        -t55,
-                                        t76,
-                                        T::mul_add(
-                                            -T::from_f64(1.493),
-                                            t87 + t88,
-                                            T::from_f64(0.0013224560195000002) * t89,
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
+                    t106,
+                    T::from_f64(0.00000000000000000010842021724855044) * t105,
+                );
+            let t114 = T::mul_add(-t8, t109, -t9 * t108);
+            let t115 = T::mul_add(t9, t109, -t8 * t108);
+            let t116 = T::mul_add(
+                -T::from_f64(0.463),
+                t96,
+                T::mul_add(
+                    -T::from_f64(0.0013224560195000002),
+                    t82,
+                    -T::from_f64(0.0230207699865) * t60,
+                )
+                    + T::mul_add(
+                        -T::from_f64(0.0013224560195000002),
+                        t66,
+                        -T::from_f64(0.0230207699865) * t65,
                     ),
-                ),
+            ) + t114;
+            let t117 = t92 + t115;
+            let t118 = t103 + -t113;
+            let t119 = T::mul_add(
+                -T::from_f64(0.10375),
+                -t115,
+                T::mul_add(t8, t112, -t9 * t111),
             );
             let t120 = T::mul_add(
-                T::from_f64(0.00010000000000000503),
-                t112 - t111,
-                T::mul_add(
-                    -T::from_f64(0.00000000000000000010842021724855044),
-                    t109 + t110,
-                    T::mul_add(
-                        T::from_f64(0.000000000000000000006709516445275485),
-                        t81 - t98 - t102,
-                        T::mul_add(
-                            T::from_f64(0.000014022756617410007),
-                            t101 - t97 - t80,
-                            T::mul_add(
-                                -t66,
-                                t79,
-                                T::mul_add(
-                                    t55,
-                                    t77,
-                                    T::mul_add(
-                                        T::from_f64(0.0013224560195000002),
-                                        t86 - t85,
-                                        T::mul_add(
-                                            T::from_f64(0.0008740216642230976),
-                                            t52 - t70 - t73,
-                                            T::mul_add(
-                                                T::from_f64(0.00006575368432434527),
-                                                t60,
-                                                t113 - t114,
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
+                T::from_f64(0.10375),
+                -t114,
+                T::mul_add(-t9, t112, -t8 * t111),
             );
-            let t121 = t9 * t115;
-            let t122 = t8 * t118;
-            let t123 = t8 * t115;
-            let t124 = t9 * t118;
-            let t125 = t8 * t117;
-            let t126 = t9 * t116;
-            let t127 = t6 * t119;
+            let t121 = t78 + t117;
+            let t122 = t102 + t119;
+            let t123 = t104 + t120;
+            let t124 = T::mul_add(t6, t110, -t7 * t116);
+            let t125 = T::mul_add(
+                -T::from_f64(0.463),
+                t77,
+                T::mul_add(
+                    -T::from_f64(0.0250914799819),
+                    t60,
+                    T::from_f64(0.0013357060146000001) * t37,
+                )
+                    + T::mul_add(
+                        T::from_f64(0.0250914799819),
+                        t47,
+                        -T::from_f64(0.0013357060146000001) * t46,
+                    ),
+            ) + t124;
+            let t126 = t74 + T::mul_add(t7, t110, t6 * t116);
+            let t127 = T::mul_add(
+                T::from_f64(0.10375),
+                t117,
+                T::mul_add(t6, t118, -t7 * t122),
+            );
             (
                 t64,
                 t65,
@@ -12599,405 +10615,61 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Kinova<T> {
             t146,
             t147,
             t148,
-            t149,
-            t150,
-            t151,
-            t152,
         ) = {
-            let t128 = t7 * t119;
-            let t129 = t7 * t120;
-            let t130 = T::mul_add(
-                T::from_f64(0.10375),
-                t123 - t124,
+            let t128 = t90 + T::mul_add(T::from_f64(0.10375), -t124, t123);
+            let t129 = t91 + T::mul_add(t7, t118, t6 * t122);
+            let t130 = T::mul_add(t4, t121, -t5 * t125);
+            let t131 = T::mul_add(-t5, t121, -t4 * t125);
+            let t132 = t53 + -t126;
+            let t133 = t89 + t127;
+            let t134 = -t130;
+            let t135 = T::mul_add(
+                -T::from_f64(0.00581618),
+                t37,
                 T::mul_add(
-                    -t8,
-                    t116,
+                    T::from_f64(0.6763),
+                    t34,
                     T::mul_add(
-                        -t9,
-                        t117,
-                        T::mul_add(
-                            t55,
-                            t78,
-                            T::mul_add(
-                                t68,
-                                t79,
-                                T::mul_add(
-                                    T::from_f64(0.0013224560195000002),
-                                    t87 + t88,
-                                    T::mul_add(
-                                        -T::from_f64(0.0015805219734713843),
-                                        t89,
-                                        T::mul_add(
-                                            T::from_f64(0.0230207699865),
-                                            t67 - t58 - t59,
-                                            T::from_f64(0.0023884048860993747) * t61,
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
+                        T::from_f64(0.00581618),
+                        t27,
+                        -T::from_f64(0.054780300000000004) * t26,
                     ),
                 ),
-            );
-            let t131 = T::mul_add(
-                t55,
-                t74,
-                T::mul_add(
-                    t68,
-                    t75,
-                    T::mul_add(
-                        T::from_f64(0.463),
-                        t86 - t85,
-                        T::mul_add(
-                            T::from_f64(0.0013224560195000002),
-                            t52 - t70 - t73,
-                            T::mul_add(T::from_f64(0.0230207699865), t60, t121 + t122),
-                        ),
-                    ),
-                ),
-            );
-            let t132 = T::mul_add(
-                T::from_f64(0.463),
-                t67,
-                T::mul_add(
-                    -T::from_f64(0.0230207699865),
-                    t89,
-                    T::mul_add(
-                        t43,
-                        t47,
-                        T::mul_add(
-                            t35,
-                            t48,
-                            T::mul_add(
-                                -T::from_f64(0.926),
-                                t58 + t59,
-                                T::mul_add(
-                                    T::from_f64(0.07312772998190001),
-                                    t61,
-                                    t91 + t123 - t90 - t124,
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t133 = t7 * t131;
-            let t134 = t6 * t131;
-            let t135 = t6 * t130;
-            let t136 = t4 * t132;
-            let t137 = t5 * t132;
-            let t138 = T::mul_add(
-                T::from_f64(0.10375),
-                t121 + t122 - t133 - t127,
-                T::mul_add(
-                    T::from_f64(0.0230207699865),
-                    t86 - t85,
-                    T::mul_add(
-                        T::from_f64(0.00006575368432434527),
-                        t52 - t70 - t73,
-                        T::mul_add(
-                            t43,
-                            t50,
-                            T::mul_add(
-                                -t35,
-                                t51,
-                                T::mul_add(
-                                    T::from_f64(0.0250914799819),
-                                    t56 - t57,
-                                    T::mul_add(
-                                        T::from_f64(0.0033686654092834286),
-                                        t60,
-                                        T::mul_add(
-                                            T::from_f64(0.00007238626506919941),
-                                            t37,
-                                            t92 + t93 + t125 - t126,
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
+            ) + t130;
+            let t136 = t56 + T::mul_add(T::from_f64(0.0114), t134, -t129);
+            let t137 = T::mul_add(t2, t132, -t3 * t135);
+            let t138 = T::mul_add(t4, t128, -t5 * t133)
+                + T::mul_add(-T::from_f64(0.2073), -t131, -T::from_f64(0.0114) * t126);
             let t139 = T::mul_add(
-                T::from_f64(0.10375),
-                t91 + t123 - t90 - t124,
-                T::mul_add(
-                    T::from_f64(0.04803625),
-                    t67,
-                    T::mul_add(
-                        -T::from_f64(0.0023884048860993747),
-                        t89,
-                        T::mul_add(
-                            -t6,
-                            t120,
-                            T::mul_add(
-                                -t7,
-                                t130,
-                                T::mul_add(
-                                    t35,
-                                    t49,
-                                    T::mul_add(
-                                        -t40,
-                                        t50,
-                                        T::mul_add(
-                                            -T::from_f64(0.07312772998190001),
-                                            t58 + t59,
-                                            T::mul_add(
-                                                T::from_f64(0.00677953504389725),
-                                                t61,
-                                                T::mul_add(
-                                                    T::from_f64(0.0013357060146000001),
-                                                    t25 - t41 - t42,
-                                                    T::mul_add(
-                                                        -T::from_f64(0.000547639465986),
-                                                        t18,
-                                                        T::from_f64(0.000015227048566440002) * t36,
-                                                    ),
-                                                ),
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
+                T::from_f64(0.2073),
+                t134,
+                T::mul_add(-t5, t128, -t4 * t133),
             );
             let t140 = T::mul_add(
-                -t35,
-                t46,
+                -T::from_f64(0.0099),
+                t14,
                 T::mul_add(
-                    t40,
-                    t47,
-                    T::mul_add(
-                        T::from_f64(0.463),
-                        t56 - t57,
-                        T::mul_add(
-                            T::from_f64(0.0250914799819),
-                            t60,
-                            T::mul_add(
-                                T::from_f64(0.0013357060146000001),
-                                t37,
-                                -t133 - t127,
-                            ),
-                        ),
-                    ),
+                    -T::from_f64(0.20443499999999998),
+                    t15,
+                    T::from_f64(0.0099) * t14,
                 ),
+            ) + t137;
+            let t141 = T::mul_add(-T::from_f64(0.0099), t13, t33)
+                + T::mul_add(t3, t132, t2 * t135);
+            let t142 = t55 + t138;
+            let t143 = t57 + t139;
+            let t144 = T::mul_add(
+                T::from_f64(0.41),
+                t54 + t131,
+                T::mul_add(t2, t136, -t3 * t142),
             );
-            let t141 = T::mul_add(
-                -T::from_f64(0.463),
-                t41 + t42,
-                T::mul_add(
-                    T::from_f64(0.0013357060146000001),
-                    t61,
-                    T::mul_add(
-                        -t21,
-                        t28,
-                        T::mul_add(
-                            -t11,
-                            t26,
-                            T::mul_add(
-                                T::from_f64(1.1393),
-                                t25,
-                                T::mul_add(
-                                    -T::from_f64(0.467113),
-                                    t18,
-                                    T::mul_add(
-                                        T::from_f64(0.011094380000000001),
-                                        t36,
-                                        t134 - t62 - t63 - t128,
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t142 = t5 * t140;
-            let t143 = t4 * t140;
-            let t144 = t4 * t139;
-            let t145 = t5 * t138;
-            let t146 = t2 * t141;
-            let t147 = T::mul_add(
-                t11,
-                t27,
-                T::mul_add(
-                    -t23,
-                    t28,
-                    T::mul_add(
-                        T::from_f64(0.6763),
-                        t24,
-                        T::mul_add(
-                            T::from_f64(0.277283),
-                            t17,
-                            T::mul_add(T::from_f64(0.00581618), t37, t142 - t136),
-                        ),
-                    ),
-                ),
-            );
+            let t145 = t42 + T::mul_add(t3, t136, t2 * t142);
+            let t146 = t43 + T::mul_add(-T::from_f64(0.41), -t137, -t143);
+            let t147 = T::mul_add(-t1, t145, -t0 * (t41 + t144));
             let t148 = T::mul_add(
-                -T::from_f64(0.2073),
-                t143 + t137,
-                T::mul_add(
-                    T::from_f64(0.0114),
-                    t62 + t63 + t128 - t134,
-                    T::mul_add(
-                        T::from_f64(0.0052782),
-                        t41 + t42,
-                        T::mul_add(
-                            -T::from_f64(0.000015227048566440002),
-                            t61,
-                            T::mul_add(
-                                -t4,
-                                t138,
-                                T::mul_add(
-                                    -t5,
-                                    t139,
-                                    T::mul_add(
-                                        t11,
-                                        t31,
-                                        T::mul_add(
-                                            -t23,
-                                            t30,
-                                            T::mul_add(
-                                                -T::from_f64(0.011094380000000001),
-                                                t25,
-                                                T::mul_add(
-                                                    T::from_f64(0.0045486958),
-                                                    t18,
-                                                    T::mul_add(
-                                                        -T::from_f64(0.00596761924708),
-                                                        t36,
-                                                        T::mul_add(
-                                                            T::from_f64(0.044919846),
-                                                            t13,
-                                                            T::from_f64(0.00008764848) * t10,
-                                                        ),
-                                                    ),
-                                                ),
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t149 = T::mul_add(
-                T::from_f64(0.0114),
-                t142 - t136,
-                T::mul_add(
-                    T::from_f64(0.0013357060146000001),
-                    t56 - t57,
-                    T::mul_add(
-                        T::from_f64(0.00007238626506919941),
-                        t60,
-                        T::mul_add(
-                            -t21,
-                            t30,
-                            T::mul_add(
-                                t11,
-                                t29,
-                                T::mul_add(
-                                    T::from_f64(0.00581618),
-                                    t24,
-                                    T::mul_add(
-                                        T::from_f64(0.0023846337999999996),
-                                        t17,
-                                        T::mul_add(
-                                            T::from_f64(0.00045080751853442445),
-                                            t37,
-                                            t65 + t129 - t64 - t135,
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t150 = t3 * t147;
-            let t151 = T::mul_add(
-                -T::from_f64(0.20443499999999998),
-                t16,
-                T::mul_add(
-                    -t3,
-                    t141,
-                    T::mul_add(
-                        -t2,
-                        t147,
-                        T::mul_add(
-                            -qd[1],
-                            T::mul_add(
-                                T::from_f64(0.0099),
-                                t12,
-                                T::from_f64(0.20443499999999998) * qd[1],
-                            ),
-                            T::from_f64(0.0099) * t13,
-                        ),
-                    ),
-                ),
-            );
-            let t152 = T::mul_add(
-                t1,
-                T::mul_add(
-                    t3,
-                    t149,
-                    T::mul_add(
-                        t2,
-                        t148,
-                        T::mul_add(
-                            -qd[0],
-                            t0 * t19,
-                            T::from_f64(0.051926035490999986) * t14,
-                        ),
-                    ),
-                ),
-                T::mul_add(
-                    t0,
-                    T::mul_add(
-                        -T::from_f64(0.41),
-                        T::mul_add(t23, t26, T::mul_add(t21, t27, t143 + t137)),
-                        T::mul_add(
-                            -T::from_f64(0.022459923),
-                            t36,
-                            T::mul_add(
-                                t2,
-                                t149,
-                                T::mul_add(
-                                    -t3,
-                                    t148,
-                                    T::mul_add(
-                                        -qd[1],
-                                        t20,
-                                        T::mul_add(
-                                            qd[0],
-                                            t1 * t19,
-                                            T::mul_add(
-                                                T::from_f64(0.28018909549099996),
-                                                t13,
-                                                T::from_f64(0.0007707488) * t10,
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                    T::from_f64(0.0016)
-                        * (T::mul_add(
-                            t0,
-                            t151,
-                            -t1
-                                * (T::mul_add(
-                                    T::from_f64(0.20443499999999998),
-                                    t15,
-                                    t150 - t146,
-                                )),
-                        )),
-                ),
+                T::from_f64(0.0016),
+                T::mul_add(-t0, t141, t1 * t140),
+                t147,
             );
             (
                 t128,
@@ -13021,121 +10693,14 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Kinova<T> {
                 t146,
                 t147,
                 t148,
-                t149,
-                t150,
-                t151,
-                t152,
             )
         };
-        [
-            t152,
-            T::mul_add(
-                T::from_f64(0.41),
-                t146 - t150,
-                T::mul_add(
-                    T::from_f64(0.2073),
-                    t142 - t136,
-                    T::mul_add(
-                        T::from_f64(0.054780300000000004),
-                        t24,
-                        T::mul_add(
-                            T::from_f64(0.022459923),
-                            t17,
-                            T::mul_add(
-                                T::from_f64(0.00047111058),
-                                t37,
-                                T::mul_add(
-                                    qd[0],
-                                    t0 * t20,
-                                    T::mul_add(
-                                        -T::from_f64(0.05281703549099999),
-                                        t15,
-                                        T::mul_add(
-                                            -T::from_f64(0.00204435),
-                                            t14,
-                                            t38 + t145 - t39 - t144,
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
-            T::mul_add(
-                T::from_f64(0.2073),
-                t136 - t142,
-                T::mul_add(
-                    -T::from_f64(0.054780300000000004),
-                    t24,
-                    T::mul_add(
-                        -T::from_f64(0.022459923),
-                        t17,
-                        T::mul_add(
-                            -T::from_f64(0.00047111058),
-                            t37,
-                            t39 + t144 - t38 - t145,
-                        ),
-                    ),
-                ),
-            ),
-            T::mul_add(
-                T::from_f64(0.0013357060146000001),
-                t56 - t57,
-                T::mul_add(
-                    T::from_f64(0.00007238626506919941),
-                    t60,
-                    T::mul_add(
-                        T::from_f64(0.00009645337053442467),
-                        t37,
-                        t65 + t129 - t64 - t135,
-                    ),
-                ),
-            ),
-            T::mul_add(
-                T::from_f64(0.10375),
-                t121 + t122,
-                T::mul_add(
-                    T::from_f64(0.0230207699865),
-                    t86 - t85,
-                    T::mul_add(
-                        T::from_f64(0.00006575368432434527),
-                        t52 - t70 - t73,
-                        T::mul_add(
-                            T::from_f64(0.0015767446734206029),
-                            t60,
-                            t92 + t93 + t125 - t126,
-                        ),
-                    ),
-                ),
-            ),
-            T::mul_add(
-                T::from_f64(0.00010000000000000503),
-                t111 - t112,
-                T::mul_add(
-                    T::from_f64(0.00000000000000000010842021724855044),
-                    t109 + t110,
-                    T::mul_add(
-                        T::from_f64(0.000000000000000000006709516445275485),
-                        t98 + t102 - t81,
-                        T::mul_add(
-                            T::from_f64(0.000014022756617410007),
-                            t97 + t80 - t101,
-                            T::mul_add(
-                                T::from_f64(0.0007776443641723163),
-                                t70 + t73 - t52,
-                                t114 - t113,
-                            ),
-                        ),
-                    ),
-                ),
-            ),
-        ]
+        [t148, t146, t143, t129, t123, t113]
     }
     /// The Christoffel-form Coriolis matrix C(q, qd): C qd = b, dM/dt - 2C skew-symmetric.
     ///
     /// Route: Echeandia and Wensing's O(N^2) recursion on composite inertias and momenta.
-    /// Operations: 960 mul, 912 add, 0 div, 5 sin, 5 cos.
+    /// Operations: 878 mul, 671 add, 0 div, 5 sin, 5 cos.
     fn coriolis_matrix(&self, q: &[T; 6], qd: &[T; 6]) -> [[T; 6]; 6] {
         let ([s1, s2, s3, s4, s5], [c1, c2, c3, c4, c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
             q[1],
@@ -13241,153 +10806,129 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Kinova<T> {
                 t9,
                 T::from_f64(0.00000000000000000010842021724855044) * t8,
             );
-            let t15 = T::mul_add(
-                -T::from_f64(0.000024397756617410526),
-                t9,
-                T::from_f64(0.000000000000000000004539081094261623) * t8,
-            );
-            let t16 = T::mul_add(
-                T::from_f64(0.00000000000000000010842021724855044),
-                t9,
+            let t15 = qd[0] * t0;
+            let t16 = qd[0] * t1;
+            let t17 = qd[0] * t0 * t3;
+            let t18 = qd[0] * t0 * t2;
+            let t19 = T::mul_add(
+                T::from_f64(0.10375),
+                t14,
                 T::mul_add(
-                    T::from_f64(0.00010000000000000503),
-                    t8,
-                    -T::from_f64(0.0013224560195000002),
-                ),
-            );
-            let t17 = T::mul_add(
-                T::from_f64(0.000000000000000000004539081094261623),
-                t9,
-                T::mul_add(
-                    T::from_f64(0.000024397756617410526),
-                    t8,
-                    -T::from_f64(0.00006575368432434527),
-                ),
-            );
-            let t18 = T::mul_add(
-                T::from_f64(0.00000000000000000010842021724855044),
-                t9,
-                T::mul_add(
-                    T::from_f64(0.00010000000000000503),
-                    t8,
-                    T::from_f64(0.000013249995099999913),
-                ),
-            );
-            let t19 = qd[0] * t0;
-            let t20 = qd[0] * t1;
-            let t21 = qd[0] * t0 * t3;
-            let t22 = qd[0] * t1 * t2;
-            let t23 = qd[0] * t0 * t2;
-            let t24 = qd[0] * t1 * t3;
-            let t25 = t8
-                * (T::mul_add(
-                    T::from_f64(0.0000000000000006979729257032011),
+                    -T::from_f64(0.000014022756617410007),
                     t9,
-                    T::from_f64(0.004894691391055498) * t8,
-                ));
-            let t26 = t9
-                * (T::mul_add(
+                    -T::from_f64(0.000000000000000000006709516445275485) * t8,
+                ),
+            );
+            let t20 = t11 - T::from_f64(0.0013224560195000002);
+            let t21 = t11 + T::from_f64(0.000013249995099999913);
+            let t22 = T::mul_add(
+                -T::from_f64(0.10375),
+                t14,
+                T::mul_add(
+                    T::from_f64(0.000014022756617410007),
+                    t9,
+                    T::from_f64(0.000000000000000000006709516445275485) * t8,
+                ),
+            );
+            let t23 = T::mul_add(-qd[0], t1 * t2, t17);
+            let t24 = T::mul_add(qd[0], t1 * t3, t18);
+            let t25 = T::mul_add(T::from_f64(0.0016), t16, T::from_f64(0.41) * qd[1]);
+            let t26 = T::mul_add(
+                t9,
+                T::mul_add(
                     T::from_f64(0.004705147001603182),
                     t9,
                     T::from_f64(0.0000000000000006979729257032011) * t8,
-                ));
-            let t27 = t7 * t14;
-            let t28 = t6 * t14;
-            let t29 = t6 * t15;
-            let t30 = t7 * t15;
-            let t31 = t7 * t17;
-            let t32 = t4 * t7 * t11;
-            let t33 = t5 * t14;
-            let t34 = t21 - t22;
-            let t35 = t23 + t24;
-            let t36 = T::mul_add(T::from_f64(0.0016), t20, T::from_f64(0.41) * qd[1]);
-            let t37 = T::mul_add(T::from_f64(0.1948923726334637), t6, t27);
-            let t38 = T::mul_add(T::from_f64(0.1948923726334637), t7, -t28);
-            let t39 = T::mul_add(
-                -t8,
-                t13,
-                T::mul_add(t9, t12, -T::from_f64(0.026156895147716352)),
-            );
-            let t40 = T::mul_add(t9, t13, t8 * t12);
-            let t41 = T::mul_add(T::from_f64(0.0008740216642230976), t6, -t30);
-            let t42 = T::mul_add(
-                T::from_f64(0.1948923726334637),
-                t7,
-                -t28 - T::from_f64(0.1799902299819),
-            );
-            let t43 = T::mul_add(
-                -T::from_f64(0.2075),
-                t28,
-                T::mul_add(
-                    T::from_f64(0.04044016732144372),
-                    t7,
-                    -t25 - t26 - T::from_f64(0.04401578389602839),
                 ),
+                t8
+                    * (T::mul_add(
+                        T::from_f64(0.0000000000000006979729257032011),
+                        t9,
+                        T::from_f64(0.004894691391055498) * t8,
+                    )),
             );
-            let t44 = T::mul_add(
-                T::from_f64(0.1948923726334637),
-                t7,
-                -t28 - T::from_f64(0.6402493299819001),
-            );
-            let t45 = T::mul_add(
+            let t27 = T::mul_add(
                 -T::from_f64(0.10375),
-                t28,
+                t11,
                 T::mul_add(
-                    T::from_f64(0.02022008366072186),
-                    t7,
-                    -t25 - t26 - T::from_f64(0.02615311784766557),
+                    T::from_f64(0.000000000000000000006709516445275485),
+                    t9,
+                    -T::from_f64(0.000014022756617410007) * t8,
                 ),
-            );
-            let t46 = T::mul_add(
+            ) + T::from_f64(0.00006575368432434527);
+            let t28 = T::mul_add(t7, t14, T::from_f64(0.1948923726334637) * t6);
+            let t29 = T::mul_add(-t6, t14, T::from_f64(0.1948923726334637) * t7);
+            let t30 = t6 * t19;
+            let t31 = T::mul_add(t9, t13, t8 * t12);
+            let t32 = t7 * t19;
+            let t33 = T::mul_add(
                 -T::from_f64(0.10375),
                 t7 * t11,
                 T::mul_add(
-                    T::from_f64(0.000000000000000000004539081094261623),
-                    t9,
-                    T::from_f64(0.000024397756617410526) * t8,
+                    T::from_f64(0.10375),
+                    t11,
+                    T::mul_add(
+                        -T::from_f64(0.000000000000000000006709516445275485),
+                        t9,
+                        T::from_f64(0.000014022756617410007) * t8,
+                    ),
                 ),
             );
-            let t47 = T::mul_add(
-                -T::from_f64(0.000010375000000000522),
-                t9,
-                T::mul_add(
-                    T::from_f64(0.000000000000000000011248597539537108),
-                    t8,
-                    T::mul_add(T::from_f64(0.0007776443641723163), t6, -t30),
-                ),
+            let t34 = T::mul_add(-t5, t14, t4 * t7 * t11);
+            let t35 = T::mul_add(t4, t14, t5 * t7 * t11);
+            let t36 = qd[3] + t24;
+            let t37 = t3 * t25;
+            let t38 = t2 * t25;
+            let t39 = T::mul_add(-T::from_f64(0.2073), t23, T::from_f64(0.41) * t15);
+            let t40 = T::mul_add(t8, t13, -t9 * t12) + T::from_f64(0.026156895147716352);
+            let t41 = T::mul_add(T::from_f64(0.0008740216642230976), t6, -t32);
+            let t42 = t29 - T::from_f64(0.1799902299819);
+            let t43 = t29 - T::from_f64(0.6402493299819001);
+            let t44 = T::mul_add(
+                -T::from_f64(0.10375),
+                t29,
+                t26 + T::from_f64(0.02615311784766557),
             );
-            let t48 = T::mul_add(t4, t14, t5 * t7 * t11);
-            let t49 = t35 + qd[3];
-            let t50 = t3 * t36;
-            let t51 = t2 * t36;
-            let t52 = T::mul_add(-T::from_f64(0.2073), t34, T::from_f64(0.41) * t19);
-            let t53 = t6 * t40;
-            let t54 = t7 * (T::mul_add(T::from_f64(0.0008740216642230976), t7, t29));
-            let t55 = t4 * t38;
+            let t45 = t4 * t29;
+            let t46 = T::mul_add(t5, t10, t4 * t23);
+            let t47 = T::mul_add(-t4, t10, t5 * t23);
+            let t48 = T::mul_add(T::from_f64(0.0016), t17, -t38);
+            let t49 = T::mul_add(T::from_f64(0.0016), t18, t37);
+            let t50 = T::mul_add(t6, t27, t7 * t31);
+            let t51 = T::mul_add(t7, t27, -t6 * t31);
+            let t52 = T::mul_add(
+                -T::from_f64(0.2075),
+                t29,
+                t26 + T::from_f64(0.04222386316016557),
+            ) + T::from_f64(0.0017919207358628258);
+            let t53 = T::mul_add(-t5, t21, -t4 * t28);
+            let t54 = T::mul_add(-t4, t21, t5 * t28);
+            let t55 = T::mul_add(
+                T::from_f64(0.10375),
+                t14,
+                -(T::mul_add(-t7, t22, -T::from_f64(0.0007776443641723163) * t6)),
+            );
             let t56 = T::mul_add(
                 T::from_f64(0.0114),
-                t48,
-                T::mul_add(T::from_f64(0.0007776443641723163), t7, t29),
+                t35,
+                T::mul_add(-t6, t22, T::from_f64(0.0007776443641723163) * t7),
             );
-            let t57 = T::mul_add(t5, t10, t4 * t34);
-            let t58 = T::mul_add(-t4, t10, t5 * t34);
+            let t57 = qd[4] + t46;
+            let t58 = T::mul_add(T::from_f64(0.2073), t10, T::from_f64(0.0114) * t24)
+                + T::mul_add(-T::from_f64(0.0016), t18, -t37);
             let t59 = T::mul_add(
                 T::from_f64(0.0114),
-                t24,
-                T::mul_add(
-                    T::from_f64(0.0098),
-                    t23,
-                    T::mul_add(T::from_f64(0.2073), t10, -t50),
-                ),
+                t23,
+                T::mul_add(-T::from_f64(0.0016), t17, t38),
             );
             let t60 = T::mul_add(
-                -T::from_f64(0.0114),
-                t22,
-                T::mul_add(T::from_f64(0.0098), t21, t51),
+                -T::from_f64(0.027390150000000002),
+                t48,
+                T::from_f64(0.0011923168999999998) * t15,
             );
-            let t61 = T::mul_add(T::from_f64(0.0016), t21, -t51);
-            let t62 = T::mul_add(T::from_f64(0.0016), t23, t50);
-            let t63 = T::mul_add(t7, t39, t29);
+            let t61 = T::mul_add(t7, t40, -t30);
+            let t62 = t5 * t50;
+            let t63 = -t53;
             (
                 t0,
                 t1,
@@ -13521,195 +11062,179 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Kinova<T> {
             t126,
             t127,
         ) = {
-            let t64 = T::mul_add(-t6, t17, t7 * t40);
-            let t65 = T::mul_add(
-                T::from_f64(0.000000000000000000011248597539537108),
-                t9,
-                T::mul_add(
-                    T::from_f64(0.000010375000000000522),
-                    t8,
-                    -t53 - t31 - T::from_f64(0.00006481854695392561),
-                ),
-            );
-            let t66 = T::mul_add(-t4, t18, t5 * t37);
-            let t67 = T::mul_add(t5, t18, t4 * t37);
-            let t68 = T::mul_add(T::from_f64(0.0114), t5 * t38, t53 + t31);
-            let t69 = T::mul_add(
-                t4,
-                t46,
-                T::mul_add(
-                    t5,
-                    t47,
-                    T::mul_add(
-                        T::from_f64(0.2073),
-                        t33 - t32,
-                        T::from_f64(0.0114) * t6 * t11,
-                    ),
-                ),
-            );
-            let t70 = t57 + qd[4];
-            let t71 = t44 * t61;
-            let t72 = t6 * (T::mul_add(-t6, t39, t30));
-            let t73 = t5 * t64;
-            let t74 = t67 + T::from_f64(0.028114580000000004);
-            let t75 = t67 + T::from_f64(0.01821458);
-            let t76 = T::mul_add(t6, t49, t7 * t58);
-            let t77 = T::mul_add(-t7, t49, t6 * t58);
-            let t78 = t8 * t70;
-            let t79 = t9 * t70;
-            let t80 = T::mul_add(t5, t52, t4 * t59);
-            let t81 = T::mul_add(-t4, t52, t5 * t59);
-            let t82 = t66 * t62;
-            let t83 = t64 * t57;
-            let t84 = t65 * t58;
-            let t85 = T::mul_add(-t37, t58, t18 * t57);
-            let t86 = T::mul_add(
-                t7,
-                t41,
-                T::mul_add(
-                    t6,
-                    t63,
-                    T::mul_add(
-                        T::from_f64(0.10375),
-                        t27,
-                        T::from_f64(0.02022008366072186) * t6,
-                    ),
-                ),
-            );
-            let t87 = T::mul_add(
-                -t6,
-                t41,
-                T::mul_add(
-                    t7,
-                    t63,
-                    T::mul_add(
-                        -T::from_f64(0.2075),
-                        t28,
-                        T::mul_add(
-                            T::from_f64(0.04044016732144372),
-                            t7,
-                            -T::from_f64(0.017866519418897248),
-                        ),
-                    ),
-                ),
-            );
-            let t88 = T::mul_add(t4, t43, t73);
-            let t89 = T::mul_add(
-                T::from_f64(0.0228),
-                t67,
-                t72 + t54 + T::from_f64(0.0007050092785344214),
-            );
-            let t90 = T::mul_add(-t2, t44, t3 * t66);
-            let t91 = T::mul_add(t3, t44, t2 * t66);
-            let t92 = T::mul_add(
+            let t64 = t53 - T::from_f64(0.028114580000000004);
+            let t65 = t53 - T::from_f64(0.01821458);
+            let t66 = T::mul_add(t6, t36, t7 * t47);
+            let t67 = T::mul_add(-t7, t36, t6 * t47);
+            let t68 = t50 * t46;
+            let t69 = T::mul_add(-t28, t47, t21 * t46);
+            let t70 = T::mul_add(
+                T::from_f64(0.10375),
+                t11,
+                t51 - T::from_f64(0.00013720481202312502),
+            ) + T::from_f64(0.00007238626506919941);
+            let t71 = T::mul_add(-t4, t52, t62);
+            let t72 = T::mul_add(
                 T::from_f64(0.0114),
-                t67,
-                t72 + t54 + T::from_f64(0.00009645337053442467),
+                t63,
+                T::mul_add(-T::from_f64(0.2073), t29, T::from_f64(0.037311974675247876)),
             );
-            let t93 = T::mul_add(
-                -T::from_f64(0.2073),
-                t55,
-                T::mul_add(
-                    -t4,
-                    t45,
-                    T::mul_add(
-                        T::from_f64(0.0114),
-                        t27,
-                        T::mul_add(T::from_f64(0.0022217730480214863), t6, -t73),
-                    ),
-                ),
+            let t73 = T::mul_add(-t2, t43, t3 * t54);
+            let t74 = T::mul_add(-t3, t43, -t2 * t54);
+            let t75 = T::mul_add(T::from_f64(0.0114), t5 * t29, -t51);
+            let t76 = qd[5] + t67;
+            let t77 = T::mul_add(t4, t39, -t5 * t58);
+            let t78 = T::mul_add(t5, t39, t4 * t58);
+            let t79 = qd[0] * t1 * t65;
+            let t80 = qd[0] * t0 * t65;
+            let t81 = T::from_f64(0.0016)
+                * (T::mul_add(
+                    qd[0],
+                    t1 * (T::mul_add(-t3, t28, t2 * t5 * t29)),
+                    -qd[0] * t0 * (T::mul_add(t2, t28, t3 * t5 * t29)),
+                ));
+            let t82 = T::from_f64(0.0016)
+                * (T::mul_add(
+                    qd[0],
+                    t1 * (T::mul_add(-t3, t6 * t11, t2 * t35)),
+                    -qd[0] * t0 * (T::mul_add(t2, t6 * t11, t3 * t35)),
+                ));
+            let t83 = T::mul_add(
+                t7,
+                T::mul_add(T::from_f64(0.0008740216642230976), t7, t30),
+                t6 * (T::mul_add(t6, t40, t32)),
             );
-            let t94 = t9 * t76;
-            let t95 = t8 * t76;
-            let t96 = T::mul_add(T::from_f64(0.10375), t57, t81);
-            let t97 = T::mul_add(T::from_f64(0.10375), t58 - t76, -t80);
-            let t98 = qd[0] * t1 * t75;
-            let t99 = qd[0] * t0 * t75;
-            let t100 = t37 * t81;
-            let t101 = t18 * t80;
-            let t102 = t15 * t77;
-            let t103 = t40 * t77;
-            let t104 = t17 * t76;
-            let t105 = t14 * t76;
-            let t106 = T::from_f64(0.00010000000000000503) * (t77 + qd[5]);
-            let t107 = T::from_f64(0.00000000000000000010842021724855044)
-                * (t77 + qd[5]);
-            let t108 = t8 * t97;
-            let t109 = t9 * t97;
-            let t110 = qd[0] * t1 * t90;
-            let t111 = t86 * t57;
-            let t112 = T::mul_add(
-                t16,
+            let t84 = -t74;
+            let t85 = T::mul_add(t4, t44, -t62)
+                + T::mul_add(-T::from_f64(0.2073), t45, T::from_f64(0.0114) * t28);
+            let t86 = T::mul_add(t4, t33, t5 * t55)
+                + T::mul_add(-T::from_f64(0.2073), t34, T::from_f64(0.0114) * t6 * t11);
+            let t87 = T::mul_add(-t9, t57, t8 * t66);
+            let t88 = T::mul_add(t8, t57, t9 * t66);
+            let t89 = T::mul_add(T::from_f64(0.10375), t46, -t77);
+            let t90 = T::mul_add(T::from_f64(0.10375), t47, -t78);
+            let t91 = -t77;
+            let t92 = T::mul_add(
+                T::from_f64(0.0006678530073000001),
+                t78,
+                T::from_f64(0.01254573999095) * t59,
+            );
+            let t93 = qd[0] * t1 * t73;
+            let t94 = T::mul_add(t14, t66, T::from_f64(0.1948923726334637) * t67);
+            let t95 = T::mul_add(
+                -T::from_f64(0.2075),
+                t29,
+                T::mul_add(t6, t41, t7 * t61) + T::from_f64(0.0160707453125),
+            );
+            let t96 = T::mul_add(
+                T::from_f64(0.10375),
+                t28,
+                T::mul_add(t7, t41, -t6 * t61),
+            );
+            let t97 = T::mul_add(
+                T::from_f64(0.0114),
+                t63,
+                t83 + T::from_f64(0.00009645337053442467),
+            );
+            let t98 = T::mul_add(
+                T::from_f64(0.10375),
+                t66,
+                T::mul_add(-T::from_f64(0.10375), t47, t78),
+            );
+            let t99 = T::mul_add(
+                T::from_f64(0.00000000000000000005421010862427522),
                 t76,
+                -T::from_f64(0.03250455132348185) * t87,
+            );
+            let t100 = T::mul_add(
+                -T::from_f64(0.03250455132348185),
+                t88,
+                -T::from_f64(0.000050000000000002516) * t76,
+            );
+            let t101 = T::mul_add(
+                T::from_f64(0.00000000000000000005421010862427522),
+                t88,
+                T::from_f64(0.000050000000000002516) * t87,
+            );
+            let t102 = T::mul_add(t42, t78, T::mul_add(t52, t47, t68));
+            let t103 = T::mul_add(t29, t78, T::mul_add(t44, t47, t68));
+            let t104 = T::mul_add(
+                -T::from_f64(0.00010000000000000503),
+                t88,
+                T::from_f64(0.00000000000000000010842021724855044) * t87,
+            );
+            let t105 = t95 + T::from_f64(0.0017957741063972504);
+            let t106 = T::mul_add(
+                T::from_f64(2.0),
+                t72,
                 T::mul_add(
-                    T::from_f64(0.00010000000000000503),
-                    t79 - t95,
-                    T::mul_add(
-                        -T::from_f64(0.00000000000000000010842021724855044),
-                        t94 + t78,
-                        T::from_f64(0.0013224560195000002) * t76,
-                    ),
+                    T::from_f64(0.4146),
+                    t29,
+                    t83 - T::from_f64(0.07427329421996133),
                 ),
+            ) + T::from_f64(0.00035435414799999976);
+            let t107 = T::mul_add(-t6, t59, t7 * t89);
+            let t108 = T::mul_add(t7, t59, t6 * t89);
+            let t109 = T::from_f64(0.0016)
+                * (T::mul_add(
+                    qd[0],
+                    t0 * (t74 - T::from_f64(1.2836779999999999)),
+                    -t93,
+                ));
+            let t110 = T::mul_add(
+                T::from_f64(2.0),
+                t99,
+                T::from_f64(0.0650091026469637) * t87,
             );
-            let t113 = T::mul_add(T::from_f64(0.1948923726334637), t77, t105);
-            let t114 = T::mul_add(
-                T::from_f64(0.00000000000000000010842021724855044),
-                t79 - t95,
-                T::from_f64(0.00010000000000000503) * (t94 + t78),
+            let t111 = T::mul_add(t4, t70, -t5 * t96);
+            let t112 = T::mul_add(
+                T::from_f64(0.41),
+                t45,
+                -(T::mul_add(t2, t75, -t3 * t85)),
             );
+            let t113 = T::mul_add(
+                T::from_f64(0.41),
+                t34,
+                -(T::mul_add(t2, t56, -t3 * t86)),
+            );
+            let t114 = T::mul_add(T::from_f64(0.10375), t57, -t107);
             let t115 = T::mul_add(
-                T::from_f64(0.00048359437681231654),
-                t79 - t95,
+                -T::from_f64(0.01151038499325),
+                t108,
+                T::from_f64(0.0006612280097500001) * t90,
+            );
+            let t116 = T::mul_add(T::from_f64(0.515), t108, t101);
+            let t117 = T::mul_add(
+                -T::from_f64(0.7465),
+                t108,
+                T::mul_add(T::from_f64(0.0006612280097500001), t66, -t101),
+            );
+            let t118 = T::mul_add(-t75, t23, -t85 * t24)
+                + T::mul_add(t28, t49, t5 * t29 * t48);
+            let t119 = T::mul_add(t33, t47, -t55 * t46)
+                + T::mul_add(-t14, t91, t7 * t11 * t78);
+            let t120 = T::mul_add(-t56, t23, -t86 * t24)
+                + T::mul_add(t6, t11 * t49, t35 * t48);
+            let t121 = T::mul_add(-t4, t50, t5 * t105);
+            let t122 = T::mul_add(
+                T::from_f64(0.2073),
+                t63,
                 T::mul_add(
-                    -T::from_f64(0.0000000000000006979729257032011),
-                    t94 + t78,
-                    T::from_f64(0.000000000000000000006709516445275485) * (t77 + qd[5]),
+                    -T::from_f64(0.0114),
+                    t29,
+                    T::mul_add(t5, t70, t4 * t96) + T::from_f64(0.0066743469417936616),
                 ),
             );
-            let t116 = T::mul_add(
-                T::from_f64(0.0000000000000006979729257032011),
-                t79 - t95,
-                T::mul_add(
-                    -T::from_f64(0.00029404998735999997),
-                    t94 + t78,
-                    T::from_f64(0.000014022756617410007) * (t77 + qd[5]),
-                ),
+            let t123 = T::mul_add(-T::from_f64(0.2073), t54, t111);
+            let t124 = T::mul_add(t70, t47, t96 * t46)
+                + T::mul_add(-t21, t78, t28 * t91);
+            let t125 = T::mul_add(t20, t107, T::mul_add(-t19, t66, -t40 * t67));
+            let t126 = T::mul_add(
+                -t20,
+                t108,
+                T::mul_add(-t19, t67, -T::from_f64(0.0008740216642230976) * t66),
             );
-            let t117 = T::mul_add(t4, t64, t5 * t87);
-            let t118 = T::mul_add(
-                -t4,
-                t65,
-                T::mul_add(t5, t86, T::from_f64(0.2073) * t66),
-            );
-            let t119 = T::mul_add(
-                -t5,
-                t65,
-                T::mul_add(
-                    -t4,
-                    t86,
-                    T::mul_add(
-                        -T::from_f64(0.2073),
-                        t67,
-                        T::mul_add(
-                            -T::from_f64(0.0114),
-                            t28,
-                            T::mul_add(
-                                T::from_f64(0.0022217730480214863),
-                                t7,
-                                -T::from_f64(0.007145457521793661),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t120 = T::mul_add(-t6, t60, t7 * t96);
-            let t121 = T::mul_add(t7, t60, t6 * t96);
-            let t122 = t5 * t113;
-            let t123 = t8 * t115;
-            let t124 = t9 * t116;
-            let t125 = T::mul_add(t9, t107, t8 * t106);
-            let t126 = T::mul_add(-t8, t107, t9 * t106);
-            let t127 = t2 * t118;
+            let t127 = T::mul_add(-t20, t66, -T::from_f64(1.493) * t108) - t117;
             (
                 t64,
                 t65,
@@ -13843,380 +11368,389 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Kinova<T> {
             t190,
             t191,
         ) = {
-            let t128 = t3 * t118;
-            let t129 = T::mul_add(T::from_f64(0.10375), t70, -t120);
-            let t130 = T::mul_add(
-                -T::from_f64(0.7465),
-                t121,
-                T::mul_add(
-                    T::from_f64(0.000050000000000002516),
-                    t79 - t95,
-                    T::mul_add(
-                        -T::from_f64(0.00000000000000000005421010862427522),
-                        t94 + t78,
-                        T::from_f64(0.0006612280097500001) * t76,
-                    ),
-                ),
+            let t128 = T::mul_add(
+                t11,
+                t108,
+                T::mul_add(-t22, t67, T::from_f64(0.0007776443641723163) * t66),
             );
-            let t131 = t118 * t35;
-            let t132 = t119 * t34;
-            let t133 = t14 * t120;
-            let t134 = T::mul_add(
-                T::from_f64(0.00000000000000000010842021724855044),
-                t121,
-                T::mul_add(
-                    T::from_f64(0.0000000000000006979729257032011),
-                    t79 - t95,
-                    T::from_f64(0.00048359437681231654) * (t94 + t78),
-                ),
-            );
-            let t135 = T::mul_add(
-                -T::from_f64(0.00010000000000000503),
-                t121,
-                T::mul_add(
-                    T::from_f64(0.00029404998735999997),
-                    t79 - t95,
-                    T::from_f64(0.0000000000000006979729257032011) * (t94 + t78),
-                ),
-            );
+            let t129 = T::mul_add(T::from_f64(0.2073), t54, -t111);
+            let t130 = t122 + T::from_f64(0.00047111058);
+            let t131 = T::mul_add(-t8, t98, t9 * t114);
+            let t132 = T::mul_add(t9, t98, t8 * t114);
+            let t133 = T::mul_add(-t42, t91, T::mul_add(t50, t47, t105 * t46));
+            let t134 = T::mul_add(-t27, t66, t31 * t67)
+                + T::mul_add(t14, t107, T::from_f64(0.1948923726334637) * t108);
+            let t135 = t117 - t127;
             let t136 = T::mul_add(
-                t8,
-                t116,
-                T::mul_add(-t9, t115, T::from_f64(0.10375) * t125),
+                qd[0],
+                t0 * (T::mul_add(t3, t75, t2 * t85)),
+                qd[0] * t1 * t112,
             );
-            let t137 = t5 * t125;
-            let t138 = T::mul_add(
-                t4,
-                t88,
+            let t137 = T::mul_add(
+                qd[0],
+                t0 * (T::mul_add(t3, t56, t2 * t86)),
+                qd[0] * t1 * t113,
+            );
+            let t138 = t2 * t129;
+            let t139 = t3 * t129;
+            let t140 = T::mul_add(T::from_f64(0.515), t131, t99);
+            let t141 = T::mul_add(-T::from_f64(0.515), t132, t100);
+            let t142 = T::mul_add(
+                T::from_f64(0.00000000000000000005421010862427522),
+                t132,
                 T::mul_add(
-                    t5,
-                    t117,
-                    T::mul_add(
-                        -T::from_f64(0.0228),
-                        t67,
-                        T::mul_add(
-                            -T::from_f64(0.4146),
-                            t28,
-                            T::mul_add(
-                                T::from_f64(0.08080237769383405),
-                                t7,
-                                -T::from_f64(0.16484135411757578),
-                            ),
-                        ),
-                    ),
+                    -T::from_f64(0.000050000000000002516),
+                    t131,
+                    -T::from_f64(0.03250455132348185) * t108,
                 ),
             );
-            let t139 = T::mul_add(
-                -t5,
-                t88,
-                T::mul_add(t4, t117, T::from_f64(0.0114) * t66),
-            );
-            let t140 = T::mul_add(-t2, t89, t128);
-            let t141 = t9 * t129;
-            let t142 = t8 * t129;
-            let t143 = t6 * t130;
-            let t144 = t7 * t130;
-            let t145 = T::mul_add(-t6, t114, t7 * t126);
-            let t146 = t6 * t136;
-            let t147 = T::mul_add(t7, t114, t6 * t126);
-            let t148 = T::mul_add(
-                -T::from_f64(0.03250455132348185),
-                t141 + t108,
-                T::mul_add(
-                    T::from_f64(0.000050000000000002516),
-                    t121,
-                    T::mul_add(
-                        T::from_f64(0.002352573500801591),
-                        t95 - t79,
-                        T::mul_add(
-                            -T::from_f64(0.00000000000000034898646285160055),
-                            t94 + t78,
-                            T::from_f64(0.0000000000000000000033547582226377425)
-                                * (t77 + qd[5]),
-                        ),
-                    ),
-                ),
-            );
-            let t149 = T::mul_add(
-                T::from_f64(0.515),
-                t141 + t108,
-                T::mul_add(
-                    T::from_f64(0.03250455132348185),
-                    t79 - t95,
-                    T::from_f64(0.00000000000000000005421010862427522) * (t77 + qd[5]),
-                ),
-            );
-            let t150 = T::mul_add(
-                T::from_f64(0.000050000000000002516),
-                t109 - t142,
+            let t143 = T::mul_add(
+                -T::from_f64(0.000050000000000002516),
+                t132,
                 T::mul_add(
                     T::from_f64(0.00000000000000000005421010862427522),
-                    t141 + t108,
+                    t131,
                     T::mul_add(
-                        T::from_f64(0.0000000000000000000033547582226377425),
-                        t95 - t79,
+                        -T::from_f64(0.000007011378308705003),
+                        t88,
                         T::mul_add(
-                            -T::from_f64(0.000007011378308705003),
-                            t94 + t78,
-                            T::from_f64(0.00009477219472615829) * (t77 + qd[5]),
+                            T::from_f64(0.00009477219472615829),
+                            t76,
+                            T::from_f64(0.0000000000000000000033547582226377425) * t87,
                         ),
                     ),
                 ),
             );
-            let t151 = T::mul_add(
-                -T::from_f64(0.00010000000000000503),
-                t141 + t108,
+            let t144 = T::mul_add(T::from_f64(0.515), t132, -t100);
+            let t145 = T::mul_add(
+                -T::from_f64(0.03250455132348185),
+                t131,
                 T::mul_add(
-                    -T::from_f64(0.0650091026469637),
-                    t121,
+                    -T::from_f64(0.000050000000000002516),
+                    t108,
                     T::mul_add(
-                        T::from_f64(0.000000000000000000006709516445275485),
-                        t94 + t78,
-                        T::from_f64(0.0000000000000006979729257032011) * (t77 + qd[5]),
+                        T::from_f64(0.00000000000000034898646285160055),
+                        t88,
+                        T::mul_add(
+                            T::from_f64(0.0000000000000000000033547582226377425),
+                            t76,
+                            T::from_f64(0.002058523513441591) * t87,
+                        ),
                     ),
                 ),
             );
-            let t152 = T::mul_add(
-                T::from_f64(0.515),
-                t142 - t109,
+            let t146 = T::mul_add(
+                T::from_f64(0.03250455132348185),
+                t132,
                 T::mul_add(
-                    T::from_f64(0.03250455132348185),
-                    t94 + t78,
-                    T::from_f64(0.000050000000000002516) * (t77 + qd[5]),
+                    -T::from_f64(0.00000000000000000005421010862427522),
+                    t108,
+                    T::mul_add(
+                        T::from_f64(0.0019637513187154326),
+                        t88,
+                        T::mul_add(
+                            T::from_f64(0.000007011378308705003),
+                            t76,
+                            T::from_f64(0.00000000000000034898646285160055) * t87,
+                        ),
+                    ),
                 ),
             );
-            let t153 = T::mul_add(
-                T::from_f64(0.00000000000000000010842021724855044),
-                t109 - t142,
+            let t147 = T::mul_add(
+                T::from_f64(2.0),
+                t72,
+                T::mul_add(-t4, t71, t5 * t121) + T::from_f64(0.08430995700000002),
+            );
+            let t148 = T::mul_add(
+                -T::from_f64(0.0114),
+                t54,
+                T::mul_add(t5, t71, t4 * t121),
+            );
+            let t149 = T::mul_add(-t2, t106, t139);
+            let t150 = T::mul_add(
+                T::from_f64(0.41),
+                t54,
+                -(T::mul_add(-t2, t97, -t3 * t123)),
+            );
+            let t151 = T::mul_add(
+                -T::from_f64(0.002447345695527749),
+                t88,
                 T::mul_add(
-                    T::from_f64(0.0650091026469637),
-                    t121,
+                    -T::from_f64(0.000007011378308705003),
+                    t76,
+                    T::from_f64(0.00000000000000034898646285160055) * t87,
+                ),
+            )
+                + T::mul_add(
+                    -T::from_f64(0.03250455132348185),
+                    t132,
+                    -T::from_f64(0.00000000000000000005421010862427522) * t108,
+                );
+            let t152 = T::mul_add(
+                -T::from_f64(0.00000000000000034898646285160055),
+                t88,
+                T::mul_add(
+                    T::from_f64(0.0000000000000000000033547582226377425),
+                    t76,
+                    T::from_f64(0.002352573500801591) * t87,
+                ),
+            )
+                + T::mul_add(
+                    -T::from_f64(0.03250455132348185),
+                    t131,
+                    T::from_f64(0.000050000000000002516) * t108,
+                );
+            let t153 = T::mul_add(
+                T::from_f64(2.0),
+                t142,
+                T::mul_add(
+                    -T::from_f64(0.00000000000000000010842021724855044),
+                    t132,
                     T::mul_add(
-                        T::from_f64(0.000014022756617410007),
-                        t95 - t79,
-                        T::from_f64(0.0000000000000006979729257032011) * (t77 + qd[5]),
+                        T::from_f64(0.000000000000000000006709516445275485),
+                        t88,
+                        T::from_f64(0.0000000000000006979729257032011) * t76,
                     ),
                 ),
             );
             let t154 = T::mul_add(
-                -T::from_f64(0.03250455132348185),
-                t141 + t108,
+                T::from_f64(2.0),
+                t142,
                 T::mul_add(
-                    -T::from_f64(0.000050000000000002516),
-                    t121,
+                    T::from_f64(0.0650091026469637),
+                    t108,
                     T::mul_add(
-                        T::from_f64(0.002058523513441591),
-                        t95 - t79,
-                        T::mul_add(
-                            T::from_f64(0.00000000000000034898646285160055),
-                            t94 + t78,
-                            T::from_f64(0.0000000000000000000033547582226377425)
-                                * (t77 + qd[5]),
-                        ),
+                        -T::from_f64(0.000000000000000000006709516445275485),
+                        t88,
+                        T::from_f64(0.000014022756617410007) * t87,
                     ),
                 ),
             );
             let t155 = T::mul_add(
-                T::from_f64(0.03250455132348185),
-                t142 - t109,
-                T::mul_add(
-                    -T::from_f64(0.00000000000000000005421010862427522),
-                    t121,
-                    T::mul_add(
-                        T::from_f64(0.00000000000000034898646285160055),
-                        t95 - t79,
-                        T::mul_add(
-                            T::from_f64(0.0019637513187154326),
-                            t94 + t78,
-                            T::from_f64(0.000007011378308705003) * (t77 + qd[5]),
-                        ),
-                    ),
-                ),
-            );
-            let t156 = T::mul_add(
-                T::from_f64(0.00000000000000000010842021724855044),
-                t109 - t142,
-                T::mul_add(
-                    T::from_f64(0.00010000000000000503),
-                    t141 + t108,
-                    T::mul_add(
-                        T::from_f64(0.000014022756617410007),
-                        t79 - t95,
-                        T::from_f64(0.000000000000000000006709516445275485) * (t94 + t78),
-                    ),
-                ),
-            );
-            let t157 = T::mul_add(
-                T::from_f64(0.00000000000000000010842021724855044),
-                t142 - t109,
+                -T::from_f64(2.0),
+                t142,
                 T::mul_add(
                     -T::from_f64(0.00010000000000000503),
-                    t141 + t108,
+                    t131,
                     T::mul_add(
-                        -T::from_f64(0.0013224560195000002),
-                        t80,
-                        T::mul_add(
-                            T::from_f64(0.000014022756617410007),
-                            t95 - t79,
-                            T::mul_add(
-                                -T::from_f64(0.000000000000000000006709516445275485),
-                                t94 + t78,
-                                T::mul_add(
-                                    -T::from_f64(0.00006575368432434527),
-                                    t76,
-                                    T::from_f64(0.00013720481202312502) * t58,
-                                ),
-                            ),
-                        ),
+                        T::from_f64(0.0000000000000006979729257032011),
+                        t76,
+                        T::from_f64(0.000014022756617410007) * t87,
                     ),
                 ),
             );
+            let t156 = t8 * t143;
+            let t157 = t9 * t143;
             let t158 = T::mul_add(
-                T::from_f64(0.03250455132348185),
-                t142 - t109,
+                -T::from_f64(2.0),
+                t115 + t142,
                 T::mul_add(
-                    T::from_f64(0.00000000000000000005421010862427522),
-                    t121,
+                    -T::from_f64(0.08802987263346371),
+                    t108,
                     T::mul_add(
-                        T::from_f64(0.00000000000000034898646285160055),
-                        t79 - t95,
+                        T::from_f64(0.000000000000000000006709516445275485),
+                        t88,
                         T::mul_add(
-                            T::from_f64(0.002447345695527749),
-                            t94 + t78,
-                            T::from_f64(0.000007011378308705003) * (t77 + qd[5]),
+                            -T::from_f64(0.000014022756617410007),
+                            t87,
+                            T::from_f64(0.00006575368432434527) * t66,
                         ),
                     ),
                 ),
             );
-            let t159 = T::mul_add(
-                T::from_f64(0.000050000000000002516),
-                t109 - t142,
+            let t159 = T::mul_add(-t63, t48, T::mul_add(t97, t23, -t123 * t24));
+            let t160 = t147 + T::from_f64(0.00590744776708);
+            let t161 = T::mul_add(-t8, t144, -t9 * t140);
+            let t162 = T::mul_add(t9, t144, -t8 * t140);
+            let t163 = T::mul_add(
+                -T::from_f64(0.0006612280097500001),
+                t107,
                 T::mul_add(
-                    -T::from_f64(0.00000000000000000005421010862427522),
-                    t141 + t108,
+                    -T::from_f64(0.000048188650025390665),
+                    t67,
+                    T::from_f64(0.000032876842162172635) * t57,
+                ),
+            )
+                + -(T::mul_add(
+                    T::from_f64(0.000007011378308705003),
+                    t88,
                     T::mul_add(
-                        -T::from_f64(0.0006612280097500001),
-                        t120,
+                        T::from_f64(0.00038882218208615815),
+                        t76,
+                        T::from_f64(0.0000000000000000000033547582226377425) * t87,
+                    ),
+                ))
+                - (T::mul_add(
+                    T::from_f64(0.000050000000000002516),
+                    t132,
+                    T::from_f64(0.00000000000000000005421010862427522) * t131,
+                ));
+            let t164 = T::mul_add(-t64, t48, T::mul_add(-t106, t23, -t129 * t24));
+            let t165 = t154
+                + T::mul_add(
+                    T::from_f64(0.000000000000000000006709516445275485),
+                    t88,
+                    -T::from_f64(0.000014022756617410007) * t87,
+                )
+                + T::mul_add(
+                    -T::from_f64(0.00000000000000000010842021724855044),
+                    t132,
+                    T::from_f64(0.00010000000000000503) * t131,
+                );
+            let t166 = t151
+                + T::mul_add(
+                    T::from_f64(0.03250455132348185),
+                    t132,
+                    T::mul_add(
+                        T::from_f64(0.00000000000000000005421010862427522),
+                        t108,
                         T::mul_add(
-                            T::from_f64(0.0000000000000000000033547582226377425),
-                            t79 - t95,
+                            -T::from_f64(0.0019637513187154326),
+                            t88,
                             T::mul_add(
                                 -T::from_f64(0.000007011378308705003),
-                                t94 + t78,
+                                t76,
                                 T::mul_add(
-                                    -T::from_f64(0.0004370108321115488),
-                                    t77,
+                                    -T::from_f64(0.00000000000000034898646285160055),
+                                    t87,
                                     T::mul_add(
-                                        -T::from_f64(0.00038882218208615815),
-                                        qd[5],
-                                        T::from_f64(0.000032876842162172635) * t70,
+                                        T::from_f64(0.004705147001603182),
+                                        t88,
+                                        T::from_f64(0.0000000000000006979729257032011) * t87,
                                     ),
                                 ),
                             ),
                         ),
                     ),
-                ),
-            );
-            let t160 = t139 * t35;
-            let t161 = T::mul_add(t8, t134, t9 * t135);
-            let t162 = T::mul_add(-t9, t134, t8 * t135);
-            let t163 = T::mul_add(T::from_f64(0.10375), t126 - t145, t123 + t124);
-            let t164 = T::mul_add(-t7, t136, T::from_f64(0.10375) * t125);
-            let t165 = t4 * t145;
-            let t166 = T::mul_add(t3, t138, t127);
-            let t167 = T::mul_add(t3, t119, t2 * t139);
-            let t168 = t9 * t149;
-            let t169 = t8 * t152;
-            let t170 = t8 * t149;
-            let t171 = t9 * t152;
-            let t172 = t8 * t150;
-            let t173 = t9 * t150;
-            let t174 = t8 * t154;
-            let t175 = t9 * t155;
-            let t176 = t9 * t158;
-            let t177 = t8 * t148;
-            let t178 = t8 * t158;
-            let t179 = t9 * t148;
-            let t180 = t6 * t159;
-            let t181 = t7 * t159;
-            let t182 = t4 * t164;
-            let t183 = t5 * t163;
-            let t184 = T::mul_add(t4, t125, t5 * t145);
-            let t185 = t5 * t162;
-            let t186 = T::mul_add(t9, t153, t172);
-            let t187 = T::mul_add(-t8, t151, t173);
-            let t188 = T::mul_add(
-                t8,
-                t155,
-                T::mul_add(
-                    -t9,
-                    t154,
+                );
+            let t167 = t152
+                + T::mul_add(
+                    T::from_f64(0.03250455132348185),
+                    t131,
                     T::mul_add(
-                        T::from_f64(0.10375),
-                        t168 + t169,
+                        T::from_f64(0.000050000000000002516),
+                        t108,
                         T::mul_add(
-                            -T::from_f64(0.01151038499325),
-                            t120,
+                            -T::from_f64(0.00000000000000034898646285160055),
+                            t88,
                             T::mul_add(
-                                -T::from_f64(0.000032876842162172635),
-                                t77,
-                                T::from_f64(0.0007420723367103015) * t70,
+                                -T::from_f64(0.0000000000000000000033547582226377425),
+                                t76,
+                                -T::from_f64(0.002058523513441591) * t87,
                             ),
                         ),
                     ),
-                ),
-            );
-            let t189 = T::mul_add(
-                T::from_f64(0.10375),
-                t170 - t171,
-                T::mul_add(
-                    -T::from_f64(0.0006612280097500001),
-                    t121,
+                );
+            let t168 = t152
+                - (T::mul_add(
+                    -T::from_f64(0.03250455132348185),
+                    t131,
                     T::mul_add(
-                        -T::from_f64(0.01151038499325),
-                        t80,
+                        T::from_f64(0.000050000000000002516),
+                        t108,
                         T::mul_add(
-                            -T::from_f64(0.0007401836866849108),
-                            t76,
+                            -T::from_f64(0.00000000000000034898646285160055),
+                            t88,
                             T::mul_add(
-                                T::from_f64(0.0011942024430496873),
-                                t58,
-                                -t174 - t175,
+                                -T::from_f64(0.0000000000000000000033547582226377425),
+                                t76,
+                                T::mul_add(
+                                    -T::from_f64(0.002058523513441591),
+                                    t87,
+                                    T::mul_add(
+                                        T::from_f64(0.0000000000000006979729257032011),
+                                        t88,
+                                        T::from_f64(0.004894691391055498) * t87,
+                                    ),
+                                ),
                             ),
                         ),
                     ),
-                ),
-            );
-            let t190 = T::mul_add(
-                -T::from_f64(0.2315),
-                t120,
-                T::mul_add(
-                    -T::from_f64(0.0006612280097500001),
-                    t77,
-                    T::mul_add(T::from_f64(0.01151038499325), t70, t168 + t169),
-                ),
-            );
-            let t191 = T::mul_add(
-                T::from_f64(0.10375),
-                t170 - t171,
+                ));
+            let t169 = t141
+                - (T::mul_add(
+                    -T::from_f64(1.03),
+                    t132,
+                    -T::from_f64(0.0650091026469637) * t88,
+                ) - t141);
+            let t170 = t151
+                - (T::mul_add(
+                    -T::from_f64(0.03250455132348185),
+                    t132,
+                    T::mul_add(
+                        T::from_f64(0.00000000000000000005421010862427522),
+                        t108,
+                        T::mul_add(
+                            -T::from_f64(0.0019637513187154326),
+                            t88,
+                            T::mul_add(
+                                -T::from_f64(0.000007011378308705003),
+                                t76,
+                                -T::from_f64(0.00000000000000034898646285160055) * t87,
+                            ),
+                        ),
+                    ),
+                ));
+            let t171 = T::mul_add(t3, t130, t2 * t148);
+            let t172 = T::mul_add(t9, t155, t156);
+            let t173 = T::mul_add(-t8, t153, t157);
+            let t174 = -t161;
+            let t175 = -t162;
+            let t176 = T::mul_add(
+                T::from_f64(0.2315),
+                t107,
                 T::mul_add(
                     T::from_f64(0.0006612280097500001),
-                    t121,
-                    T::mul_add(
-                        -T::from_f64(0.01151038499325),
-                        t80,
-                        T::mul_add(
-                            -T::from_f64(0.0007902609867356922),
-                            t76,
-                            T::mul_add(
-                                T::from_f64(0.0011942024430496873),
-                                t58,
-                                -t176 - t177,
-                            ),
-                        ),
-                    ),
+                    t67,
+                    -T::from_f64(0.01151038499325) * t57,
                 ),
+            ) + t161;
+            let t177 = T::mul_add(
+                -T::from_f64(0.2315),
+                t90,
+                T::from_f64(0.01151038499325) * t66,
+            ) + t162;
+            let t178 = T::mul_add(
+                qd[0],
+                t0 * (T::mul_add(-t3, t97, t2 * t123)),
+                qd[0] * t1 * t150,
             );
+            let t179 = T::mul_add(t3, t160, -t138);
+            let t180 = T::mul_add(
+                T::from_f64(0.10375),
+                t174,
+                T::mul_add(t8, t146, -t9 * t145),
+            );
+            let t181 = T::mul_add(
+                T::from_f64(0.10375),
+                t175,
+                T::mul_add(-t9, t146, -t8 * t145),
+            );
+            let t182 = T::mul_add(
+                -T::from_f64(0.10375),
+                t175,
+                T::mul_add(t8, t152, -t9 * t151),
+            );
+            let t183 = T::mul_add(
+                T::from_f64(0.10375),
+                t174,
+                T::mul_add(-t9, t152, -t8 * t151),
+            );
+            let t184 = T::mul_add(
+                T::from_f64(0.2315),
+                t78,
+                -T::from_f64(0.01254573999095) * t47,
+            ) + t177;
+            let t185 = qd[0] * t1 * (T::mul_add(-t2, t130, t3 * t148));
+            let t186 = T::mul_add(-t130, t23, -t148 * t24)
+                + T::mul_add(-t43, t48, -t54 * t49);
+            let t187 = t178
+                + T::from_f64(0.0016)
+                    * (T::mul_add(-qd[0], t1 * t2 * t63, qd[0] * t0 * t3 * t63));
+            let t188 = t176 + T::mul_add(t20, t67, -T::from_f64(1.493) * t107);
+            let t189 = T::mul_add(t8, t110, t9 * t169);
+            let t190 = T::mul_add(-t9, t110, t8 * t169);
+            let t191 = T::mul_add(t9, t170, -t8 * t167);
             (
                 t128,
                 t129,
@@ -14350,609 +11884,233 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Kinova<T> {
             t254,
             t255,
         ) = {
-            let t192 = T::mul_add(
-                -T::from_f64(0.463),
-                t80,
-                T::mul_add(
-                    -T::from_f64(0.01151038499325),
-                    t76,
-                    T::mul_add(T::from_f64(0.036563864990950004), t58, t170 - t171),
-                ),
+            let t192 = T::mul_add(t8, t170, t9 * t167);
+            let t193 = T::mul_add(
+                t9,
+                T::mul_add(t9, t153, t156),
+                t8 * (T::mul_add(-t8, t155, t157)),
             );
-            let t193 = qd[0] * t1 * (T::mul_add(-t2, t119, t3 * t139));
             let t194 = T::mul_add(
-                t42,
-                t58,
+                -T::from_f64(0.01151038499325),
+                t107,
                 T::mul_add(
-                    T::from_f64(2.0),
-                    t170 - t171,
-                    T::mul_add(
-                        T::from_f64(1.03),
-                        t80,
-                        T::mul_add(
-                            -T::from_f64(0.0230207699865),
-                            t76,
-                            T::from_f64(0.07312772998190001) * t58,
-                        ),
-                    ),
-                ),
-            );
-            let t195 = T::mul_add(
-                T::from_f64(0.2075),
-                t170 - t171,
-                T::mul_add(
-                    -T::from_f64(0.0230207699865),
-                    t80,
-                    T::mul_add(
-                        -T::from_f64(0.0015304446734206029),
-                        t76,
-                        T::mul_add(
-                            T::from_f64(0.0023884048860993747),
-                            t58,
-                            -t174 - t175 - t176 - t177,
-                        ),
-                    ),
-                ),
-            );
-            let t196 = T::mul_add(
-                t16,
-                t121,
-                T::mul_add(
-                    T::from_f64(0.0013224560195000002),
-                    t121,
-                    T::mul_add(
-                        T::from_f64(0.0008239443641723163),
-                        t76,
-                        t174 + t175 + t102 - t176 - t177,
-                    ),
-                ),
-            );
-            let t197 = T::mul_add(
-                -t16,
-                t77,
-                T::mul_add(
-                    T::from_f64(2.0),
-                    t168 + t169,
-                    T::mul_add(
-                        T::from_f64(1.03),
-                        t120,
-                        T::mul_add(
-                            -T::from_f64(0.0013224560195000002),
-                            t77,
-                            T::from_f64(0.0230207699865) * t70,
-                        ),
-                    ),
-                ),
-            );
-            let t198 = T::mul_add(t7, t156, t6 * t161);
-            let t199 = T::mul_add(-t6, t156, t7 * t161);
-            let t200 = T::mul_add(
-                t4,
-                t163,
-                T::mul_add(
-                    t5,
-                    t164,
-                    T::mul_add(
-                        T::from_f64(0.2073),
-                        t137 - t165,
-                        T::from_f64(0.0114) * t147,
-                    ),
-                ),
-            );
-            let t201 = T::mul_add(T::from_f64(0.0114), t184, t146);
-            let t202 = T::mul_add(
-                -t3,
-                t140,
-                T::mul_add(t2, t166, T::from_f64(0.41) * t90),
-            );
-            let t203 = T::mul_add(
-                t3,
-                T::mul_add(t3, t89, t127),
-                T::mul_add(
-                    t2,
-                    T::mul_add(-t2, t138, t128),
-                    T::from_f64(0.0008910000000000028),
-                ),
-            );
-            let t204 = t8 * t186;
-            let t205 = t9 * t187;
-            let t206 = t8 * (T::mul_add(-t8, t153, t173));
-            let t207 = t9 * (T::mul_add(t9, t151, t172));
-            let t208 = t7 * t190;
-            let t209 = t6 * t190;
-            let t210 = t6 * t188;
-            let t211 = t7 * t188;
-            let t212 = t7 * t189;
-            let t213 = t7 * t191;
-            let t214 = t6 * t191;
-            let t215 = t4 * t192;
-            let t216 = t5 * t192;
-            let t217 = t4 * t194;
-            let t218 = t4 * t199;
-            let t219 = T::mul_add(t2, t147, t3 * t184);
-            let t220 = T::mul_add(
-                -t8,
-                t187,
-                T::mul_add(
-                    -t9,
-                    t186,
-                    T::mul_add(
-                        -T::from_f64(0.1298832699865),
-                        t121,
-                        T::mul_add(
-                            -T::from_f64(0.0013224560195000002),
-                            t80,
-                            T::mul_add(
-                                T::from_f64(0.000010375000000000522),
-                                t79 - t95,
-                                T::mul_add(
-                                    -T::from_f64(0.000000000000000000011248597539537108),
-                                    t94 + t78,
-                                    T::from_f64(0.00013720481202312502) * t58,
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t221 = T::mul_add(
-                -T::from_f64(0.1298832699865),
-                t121,
-                T::mul_add(
-                    T::from_f64(0.000010375000000000522),
-                    t79 - t95,
-                    T::mul_add(
-                        -T::from_f64(0.000000000000000000011248597539537108),
-                        t94 + t78,
-                        T::mul_add(T::from_f64(0.00006575368432434527), t76, t206 + t207),
-                    ),
-                ),
-            );
-            let t222 = T::mul_add(
-                -T::from_f64(0.0006612280097500001),
-                t120,
-                T::mul_add(
-                    -T::from_f64(0.0000018886500253907385),
-                    t77,
-                    T::mul_add(T::from_f64(0.000032876842162172635), t70, t204 - t205),
-                ),
-            );
-            let t223 = T::mul_add(-t6, t157, t211);
-            let t224 = T::mul_add(
-                T::from_f64(0.2075),
-                t209 - t144,
-                T::mul_add(
-                    -T::from_f64(0.1298832699865),
-                    t121,
-                    T::mul_add(
-                        T::from_f64(0.0250914799819),
-                        t51,
-                        T::mul_add(
-                            T::from_f64(0.000010375000000000522),
-                            t79 - t95,
-                            T::mul_add(
-                                -T::from_f64(0.000000000000000000011248597539537108),
-                                t94 + t78,
-                                T::mul_add(
-                                    T::from_f64(0.00006575368432434527),
-                                    t76,
-                                    T::mul_add(
-                                        T::from_f64(0.00007238626506919941),
-                                        t58,
-                                        T::mul_add(
-                                            -T::from_f64(0.00028604287179366),
-                                            t22,
-                                            T::mul_add(
-                                                T::from_f64(0.00024589650382261997),
-                                                t21,
-                                                t206 + t207,
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t225 = T::mul_add(
-                T::from_f64(0.2315),
-                t81,
-                T::mul_add(
-                    T::from_f64(0.01254573999095),
+                    T::from_f64(0.0007902609867356922),
                     t57,
-                    T::mul_add(T::from_f64(0.0006678530073000001), t49, -t208 - t143),
+                    T::mul_add(
+                        -T::from_f64(0.000032876842162172635),
+                        t67,
+                        -T::from_f64(0.000048188650025390665) * t57,
+                    ),
                 ),
-            );
-            let t226 = T::mul_add(
-                T::from_f64(0.56965),
-                t51,
+            ) + t180;
+            let t195 = T::mul_add(
+                -T::from_f64(0.0006612280097500001),
+                t108,
                 T::mul_add(
-                    T::from_f64(0.0006678530073000001),
-                    t58,
-                    T::mul_add(
-                        -T::from_f64(0.0055471900000000005),
-                        t22,
-                        T::mul_add(T::from_f64(0.00463575), t21, t209 - t144),
-                    ),
+                    T::from_f64(0.01151038499325),
+                    t90,
+                    -T::from_f64(0.0007401836866849108) * t66,
                 ),
-            );
-            let t227 = T::mul_add(
-                -t74,
-                t34,
+            ) + t181;
+            let t196 = T::mul_add(
+                T::from_f64(0.0007902609867356922),
+                t66,
                 T::mul_add(
-                    T::from_f64(2.0),
-                    t209 - t144,
-                    T::mul_add(
-                        -T::from_f64(1.4930000000000005),
-                        t51,
-                        T::mul_add(
-                            T::from_f64(0.0013357060146000001),
-                            t58,
-                            T::mul_add(
-                                -T::from_f64(0.011094380000000001),
-                                t22,
-                                T::from_f64(0.01348318) * t21,
-                            ),
-                        ),
-                    ),
+                    -T::from_f64(0.0006612280097500001),
+                    t108,
+                    -T::from_f64(0.01151038499325) * t90,
                 ),
-            );
-            let t228 = T::mul_add(
-                t42,
-                t57,
+            ) + t182;
+            let t197 = T::mul_add(
+                -T::from_f64(0.01151038499325),
+                t107,
                 T::mul_add(
-                    -T::from_f64(2.0),
-                    t208 + t143,
-                    T::mul_add(
-                        -T::from_f64(1.493),
-                        t81,
-                        T::mul_add(
-                            T::from_f64(0.0250914799819),
-                            t57,
-                            T::from_f64(0.0013357060146000001) * t49,
-                        ),
-                    ),
+                    -T::from_f64(0.000032876842162172635),
+                    t67,
+                    T::from_f64(0.0007883723367103014) * t57,
                 ),
+            ) + t183;
+            let t198 = T::mul_add(t6, t117, -t7 * t176);
+            let t199 = T::mul_add(t7, t117, t6 * t176);
+            let t200 = T::mul_add(-t64, t49, T::mul_add(-t129, t23, -t160 * t24));
+            let t201 = T::mul_add(t42, t47, T::from_f64(1.9560000000000002) * t78)
+                - t184;
+            let t202 = t176 + t188;
+            let t203 = T::mul_add(
+                T::from_f64(0.10375),
+                t190,
+                T::mul_add(t8, t166, t9 * t168),
             );
-            let t229 = T::mul_add(
-                -t16,
-                t120,
-                T::mul_add(
-                    t15,
-                    t76,
-                    T::mul_add(
-                        -t39,
-                        t77,
-                        T::mul_add(
-                            T::from_f64(0.000050000000000002516),
-                            t109 - t142,
-                            T::mul_add(
-                                -T::from_f64(0.00000000000000000005421010862427522),
-                                t141 + t108,
-                                T::mul_add(
-                                    -T::from_f64(0.0013224560195000002),
-                                    t120,
-                                    T::mul_add(
-                                        T::from_f64(0.0000000000000000000033547582226377425),
-                                        t79 - t95,
-                                        T::mul_add(
-                                            -T::from_f64(0.000007011378308705003),
-                                            t94 + t78,
-                                            T::mul_add(
-                                                -T::from_f64(0.00043889948213693956),
-                                                t77,
-                                                T::mul_add(
-                                                    -T::from_f64(0.00038882218208615815),
-                                                    qd[5],
-                                                    T::mul_add(
-                                                        T::from_f64(0.00006575368432434527),
-                                                        t70,
-                                                        t204 - t205,
-                                                    ),
-                                                ),
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t230 = T::mul_add(-t6, t197, t7 * t112);
-            let t231 = T::mul_add(t7, t197, t6 * t112);
-            let t232 = T::mul_add(
-                T::from_f64(0.000050000000000002516),
-                t142 - t109,
-                T::mul_add(
-                    T::from_f64(0.00000000000000000005421010862427522),
-                    t141 + t108,
-                    T::mul_add(
-                        T::from_f64(0.0000000000000000000033547582226377425),
-                        t95 - t79,
-                        T::mul_add(
-                            T::from_f64(0.000007011378308705003),
-                            t94 + t78,
-                            T::mul_add(
-                                T::from_f64(0.0004351221820861581),
-                                t77,
-                                T::mul_add(
-                                    T::from_f64(0.00038882218208615815),
-                                    qd[5],
-                                    t204 - t205,
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t233 = T::mul_add(t4, t162, t5 * t199);
-            let t234 = T::mul_add(
-                T::from_f64(0.0016),
-                T::mul_add(
-                    qd[0],
-                    t1 * (T::mul_add(-t3, t6 * t11, t2 * t48)),
-                    -qd[0] * t0 * (T::mul_add(t2, t6 * t11, t3 * t48)),
-                ),
-                T::mul_add(
-                    qd[0],
-                    t0 * (T::mul_add(t3, t56, t2 * t69)),
-                    T::mul_add(
-                        qd[0],
-                        t1
-                            * (T::mul_add(
-                                -t2,
-                                t56,
-                                T::mul_add(t3, t69, T::from_f64(0.41) * (t32 - t33)),
-                            )),
-                        t185 - t218,
-                    ),
-                ),
-            );
-            let t235 = t6 * t222;
-            let t236 = t7 * t223;
-            let t237 = t7 * (T::mul_add(t7, t157, t210));
-            let t238 = t5 * t225;
-            let t239 = t4 * t225;
-            let t240 = t5
-                * (T::mul_add(
-                    T::from_f64(0.10375),
-                    t170 - t171,
-                    T::mul_add(
-                        -T::from_f64(0.036563864990950004),
-                        t80,
-                        T::mul_add(
-                            T::from_f64(0.0006678530073000001),
-                            t51,
-                            T::mul_add(
-                                -T::from_f64(0.0011942024430496873),
-                                t76,
-                                T::mul_add(
-                                    T::from_f64(0.003389767521948625),
-                                    t58,
-                                    T::mul_add(
-                                        -T::from_f64(0.000007613524283220001),
-                                        t22,
-                                        T::mul_add(
-                                            T::from_f64(0.0000065449594715400005),
-                                            t21,
-                                            -t213 - t180,
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ));
-            let t241 = t4
-                * (T::mul_add(
-                    T::from_f64(0.10375),
-                    t168 + t169 - t208 - t143,
-                    T::mul_add(
-                        -T::from_f64(0.01151038499325),
-                        t120,
-                        T::mul_add(
-                            T::from_f64(0.01254573999095),
-                            t81,
-                            T::mul_add(
-                                -T::from_f64(0.000032876842162172635),
-                                t77,
-                                T::mul_add(
-                                    T::from_f64(0.0016843327046417143),
-                                    t57,
-                                    T::mul_add(
-                                        T::from_f64(0.0007883723367103014),
-                                        qd[4],
-                                        T::mul_add(
-                                            T::from_f64(0.000036193132534599707),
-                                            t49,
-                                            t178 - t179,
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ));
-            let t242 = t2 * t226;
-            let t243 = t3 * t226;
-            let t244 = t5 * t228;
-            let t245 = T::mul_add(
+            let t204 = T::mul_add(
                 -T::from_f64(0.10375),
-                t230,
-                T::mul_add(
-                    T::from_f64(0.06500910264696372),
-                    t121,
-                    T::mul_add(
-                        T::from_f64(0.000010375000000000522),
-                        t79 - t95,
-                        T::mul_add(
-                            -T::from_f64(0.000000000000000000011248597539537108),
-                            t94 + t78,
-                            T::mul_add(
-                                T::from_f64(0.00006575368432434527),
-                                t76,
-                                t206 + t207 + t103 + t104 + t133,
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t246 = t4 * t230;
-            let t247 = t5 * t221;
-            let t248 = T::mul_add(t7, t220, -t210);
-            let t249 = T::mul_add(
-                t6,
                 t189,
+                T::mul_add(-t9, t166, t8 * t168),
+            );
+            let t205 = -t191;
+            let t206 = T::mul_add(
+                t3,
+                T::mul_add(t3, t106, t138),
+                t2 * (T::mul_add(t2, t160, t139)),
+            );
+            let t207 = T::mul_add(
+                -T::from_f64(0.41),
+                t53,
+                -t171 + T::from_f64(0.011526977800000001),
+            ) - T::from_f64(0.00204435);
+            let t208 = T::mul_add(
+                -T::from_f64(0.2075),
+                t116,
+                T::mul_add(-t8, t173, -t9 * t172),
+            );
+            let t209 = T::mul_add(
+                T::from_f64(0.0006612280097500001),
+                t107,
                 T::mul_add(
-                    t7,
-                    t222,
+                    T::from_f64(0.0007902609867356922),
+                    t67,
                     T::mul_add(
-                        T::from_f64(0.0006678530073000001),
-                        t81,
-                        T::mul_add(
-                            T::from_f64(0.000036193132534599707),
-                            t57,
-                            T::from_f64(0.0000019266852672123) * t49,
-                        ),
+                        -T::from_f64(0.0007883723367103014),
+                        t67,
+                        -T::from_f64(0.000032876842162172635) * t57,
                     ),
                 ),
+            ) + T::mul_add(t9, t173, -t8 * t172);
+            let t210 = t6 * t194;
+            let t211 = t7 * t194;
+            let t212 = -t198;
+            let t213 = T::mul_add(
+                -T::from_f64(0.2315),
+                t91,
+                T::mul_add(
+                    -T::from_f64(0.0006678530073000001),
+                    t36,
+                    -T::from_f64(0.01254573999095) * t46,
+                ),
+            ) + t198;
+            let t214 = T::mul_add(
+                -T::from_f64(0.2315),
+                t59,
+                -T::from_f64(0.0006678530073000001) * t47,
+            ) + t199;
+            let t215 = T::mul_add(qd[0], t0 * t171, t185)
+                + T::from_f64(0.0016) * (T::mul_add(qd[0], t0 * t84, t93));
+            let t216 = t184 - t201;
+            let t217 = t195 - t196;
+            let t218 = T::mul_add(t7, t104, t6 * t189);
+            let t219 = T::mul_add(-t6, t104, t7 * t189);
+            let t220 = T::mul_add(-t6, t154, t7 * t192);
+            let t221 = T::mul_add(-t7, t154, -t6 * t192);
+            let t222 = T::mul_add(
+                T::from_f64(0.82),
+                t84,
+                T::mul_add(-t2, t149, t3 * t179) + T::from_f64(0.44248962999999997),
             );
+            let t223 = T::mul_add(
+                T::from_f64(0.41),
+                t73,
+                T::mul_add(-t3, t149, -t2 * t179),
+            );
+            let t224 = T::mul_add(T::from_f64(2.0), t115, t208);
+            let t225 = T::mul_add(
+                T::from_f64(2.0),
+                t115,
+                T::mul_add(
+                    -T::from_f64(0.0013224560195000002),
+                    t90,
+                    T::from_f64(0.00006575368432434527) * t66,
+                ),
+            ) + T::mul_add(-T::from_f64(0.2075), t116, t193);
+            let t226 = T::mul_add(t6, t158, t211);
+            let t227 = t213
+                + T::mul_add(-t42, t46, T::from_f64(1.9560000000000002) * t91);
+            let t228 = t196 + t195 + t126;
+            let t229 = t209 + t163;
+            let t230 = T::mul_add(t6, t202, t7 * t135);
+            let t231 = T::mul_add(-t7, t202, t6 * t135);
+            let t232 = T::mul_add(-t7, t165, t6 * t203);
+            let t233 = T::mul_add(T::from_f64(0.10375), t219, t204);
+            let t234 = -t221;
+            let t235 = T::mul_add(
+                T::from_f64(0.10375),
+                t177,
+                T::mul_add(t6, t163, -t7 * t196),
+            );
+            let t236 = T::mul_add(
+                T::from_f64(0.01254573999095),
+                t91,
+                T::mul_add(
+                    T::from_f64(0.000036193132534599707),
+                    t36,
+                    T::from_f64(0.0008959603679314129) * t46,
+                ),
+            ) + T::mul_add(T::from_f64(0.10375), t212, t197);
+            let t237 = T::mul_add(t4, t184, -t5 * t213);
+            let t238 = T::mul_add(-t5, t184, -t4 * t213);
+            let t239 = T::mul_add(
+                -T::from_f64(0.33815),
+                t48,
+                T::from_f64(0.00290809) * t23,
+            ) + -t214;
+            let t240 = -(T::mul_add(
+                T::from_f64(0.0006678530073000001),
+                t91,
+                T::mul_add(
+                    T::from_f64(0.000048226685267212334),
+                    t36,
+                    T::from_f64(0.000036193132534599707) * t46,
+                ),
+            )) - (T::mul_add(t7, t163, t6 * t196));
+            let t241 = t213 + t227;
+            let t242 = t225 + t134;
+            let t243 = t163 - (t209 + t125);
+            let t244 = T::mul_add(
+                T::from_f64(0.10375),
+                t190,
+                T::mul_add(-t6, t165, -t7 * t203),
+            );
+            let t245 = T::mul_add(t4, t190, t5 * t219);
+            let t246 = T::mul_add(-t5, t190, t4 * t219);
+            let t247 = T::mul_add(t5, t205, -t4 * t220);
+            let t248 = T::mul_add(t4, t205, t5 * t220);
+            let t249 = T::mul_add(t7, t224, -t210);
             let t250 = T::mul_add(
                 T::from_f64(0.10375),
-                t171 - t170,
-                T::mul_add(
-                    T::from_f64(0.036563864990950004),
-                    t80,
-                    T::mul_add(
-                        T::from_f64(0.0006678530073000001),
-                        t51,
-                        T::mul_add(
-                            T::from_f64(0.0011942024430496873),
-                            t76,
-                            T::mul_add(
-                                -T::from_f64(0.0033396141514142005),
-                                t58,
-                                T::mul_add(
-                                    -T::from_f64(0.000007613524283220001),
-                                    t22,
-                                    T::mul_add(
-                                        T::from_f64(0.0000065449594715400005),
-                                        t21,
-                                        t212 - t235,
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
+                t177,
+                T::mul_add(t7, t195, t6 * t209),
             );
             let t251 = T::mul_add(
-                -T::from_f64(0.33815),
-                t50,
+                T::from_f64(0.0006678530073000001),
+                t91,
                 T::mul_add(
-                    T::from_f64(0.00290809),
-                    t24,
+                    T::from_f64(0.0008978870531986252),
+                    t36,
                     T::mul_add(
-                        T::from_f64(0.00236705),
-                        t23,
-                        T::mul_add(T::from_f64(0.027390150000000002), t10, t238 - t215),
+                        -T::from_f64(0.0008959603679314129),
+                        t36,
+                        T::from_f64(0.000036193132534599707) * t46,
                     ),
                 ),
-            );
+            ) + T::mul_add(t6, t195, -t7 * t209);
             let t252 = T::mul_add(
-                -T::from_f64(0.2073),
-                t239 + t216,
+                T::from_f64(2.0),
+                t92,
                 T::mul_add(
-                    T::from_f64(0.0114),
-                    t144 - t209,
-                    T::mul_add(
-                        -T::from_f64(0.0055471900000000005),
-                        t51,
-                        T::mul_add(
-                            -T::from_f64(0.000007613524283220001),
-                            t58,
-                            T::mul_add(
-                                T::from_f64(0.00298380962354),
-                                t22,
-                                T::mul_add(
-                                    -T::from_f64(0.0029749341195399997),
-                                    t21,
-                                    T::mul_add(T::from_f64(0.0112299615), t19, -t240 - t241),
-                                ),
-                            ),
-                        ),
-                    ),
+                    -T::from_f64(0.0013357060146000001),
+                    t78,
+                    T::from_f64(0.00007238626506919941) * t47,
                 ),
-            );
+            ) + T::mul_add(-T::from_f64(0.2075), t199, t225);
             let t253 = T::mul_add(
-                T::from_f64(0.0114),
-                t238 - t215,
+                -T::from_f64(0.0008978870531986252),
+                t47,
                 T::mul_add(
-                    T::from_f64(0.0006678530073000001),
-                    t81,
-                    T::mul_add(
-                        -T::from_f64(0.00290809),
-                        t50,
-                        T::mul_add(
-                            T::from_f64(0.000036193132534599707),
-                            t57,
-                            T::mul_add(
-                                T::from_f64(0.00022540375926721222),
-                                t24,
-                                T::mul_add(
-                                    T::from_f64(0.00022075081526721222),
-                                    t23,
-                                    T::mul_add(
-                                        T::from_f64(0.000048226685267212334),
-                                        qd[3],
-                                        T::mul_add(T::from_f64(0.00023555529), t10, t181 - t214),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
+                    T::from_f64(0.01254573999095),
+                    t78,
+                    -T::from_f64(0.0006678530073000001) * t59,
                 ),
-            );
-            let t254 = T::mul_add(
-                -t74,
-                t35,
-                T::mul_add(
-                    T::from_f64(2.0),
-                    t238 - t215,
-                    T::mul_add(
-                        T::from_f64(1.9560000000000002),
-                        t50,
-                        T::mul_add(
-                            T::from_f64(0.00581618),
-                            t24,
-                            T::mul_add(
-                                T::from_f64(0.00894578),
-                                t23,
-                                T::from_f64(0.054780300000000004) * t10,
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t255 = T::mul_add(
-                T::from_f64(0.0013357060146000001),
-                t51,
-                T::mul_add(
-                    T::from_f64(0.00005015337053442459),
-                    t58,
-                    T::mul_add(
-                        -T::from_f64(0.000015227048566440002),
-                        t22,
-                        T::mul_add(
-                            T::from_f64(0.000013089918943080001),
-                            t21,
-                            t212 - t235 - t213 - t180,
-                        ),
-                    ),
-                ),
-            );
+            ) + t235;
+            let t254 = -t237;
+            let t255 = -t238;
             (
                 t192,
                 t193,
@@ -15087,541 +12245,196 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Kinova<T> {
             t319,
         ) = {
             let t256 = T::mul_add(
-                -t42,
-                t80,
+                -T::from_f64(0.33815),
+                t49,
                 T::mul_add(
-                    t43,
-                    t58,
-                    T::mul_add(
-                        T::from_f64(0.2075),
-                        t170 - t171,
-                        T::mul_add(
-                            -T::from_f64(0.07312772998190001),
-                            t80,
-                            T::mul_add(
-                                -T::from_f64(0.0023884048860993747),
-                                t76,
-                                T::mul_add(
-                                    T::from_f64(0.006729381673362825),
-                                    t58,
-                                    t235 - t212 - t213 - t180 - t83,
-                                ),
-                            ),
-                        ),
-                    ),
+                    T::from_f64(0.027390150000000002),
+                    t10,
+                    T::from_f64(0.00290809) * t24,
                 ),
+            ) + t237;
+            let t257 = T::mul_add(
+                T::from_f64(0.027390150000000002),
+                t23,
+                -T::from_f64(0.1386415) * t15,
+            ) + t238;
+            let t258 = T::mul_add(
+                qd[0],
+                t0 * (t206 + T::from_f64(0.0008910000000000028)),
+                -qd[0] * t1 * t223,
             );
-            let t257 = T::mul_add(t4, t228, t5 * t194);
-            let t258 = T::mul_add(-t7, t196, -t6 * t229);
-            let t259 = T::mul_add(t6, t195, t7 * t232);
-            let t260 = T::mul_add(
-                t6,
-                t196,
+            let t259 = T::mul_add(qd[0], t0 * t207, -t185) + t109;
+            let t260 = T::mul_add(-t64, t23, -T::from_f64(2.6323000000000003) * t48)
+                - t239;
+            let t261 = T::mul_add(-T::from_f64(0.10375), t230, t242);
+            let t262 = T::mul_add(t7, t217, t6 * t229);
+            let t263 = T::mul_add(-t6, t217, t7 * t229);
+            let t264 = T::mul_add(-t5, t94, t4 * t230);
+            let t265 = T::mul_add(t4, t94, t5 * t230);
+            let t266 = T::mul_add(T::from_f64(0.0114), t245, -(-t232));
+            let t267 = T::mul_add(
+                T::from_f64(0.01254573999095),
+                t78,
                 T::mul_add(
-                    -t7,
-                    t229,
-                    T::mul_add(
-                        T::from_f64(0.10375),
-                        t105,
-                        T::from_f64(0.02022008366072186) * t77,
-                    ),
+                    T::from_f64(0.0006678530073000001),
+                    t59,
+                    -T::from_f64(0.0008477336826642006) * t47,
                 ),
+            ) + t250;
+            let t268 = t4 * t251;
+            let t269 = t5 * t251;
+            let t270 = T::mul_add(
+                T::from_f64(0.0114),
+                t255,
+                -T::from_f64(0.2073) * t214,
             );
-            let t261 = T::mul_add(-t7, t195, t6 * t232);
-            let t262 = t5 * t245;
-            let t263 = T::mul_add(t4, t113, t5 * t230);
-            let t264 = T::mul_add(
-                -t1,
-                T::mul_add(t3, t201, t2 * t200),
-                T::mul_add(
-                    t0,
-                    T::mul_add(
-                        -t2,
-                        t201,
-                        T::mul_add(t3, t200, T::from_f64(0.41) * (t165 - t137)),
-                    ),
-                    T::from_f64(0.0016)
-                        * (T::mul_add(t0, T::mul_add(-t3, t147, t2 * t184), t1 * t219)),
-                ),
+            let t271 = T::mul_add(
+                qd[0],
+                t0 * t223,
+                -qd[0] * t1 * (t222 + T::from_f64(0.05281703549099999)),
             );
-            let t265 = t6 * t248;
-            let t266 = t6 * (T::mul_add(t6, t220, t211));
-            let t267 = t4 * t249;
-            let t268 = t5 * t249;
-            let t269 = t5 * t250;
-            let t270 = t3 * t251;
-            let t271 = t2 * t251;
-            let t272 = t3 * t252;
-            let t273 = t2 * t253;
-            let t274 = t2 * t252;
-            let t275 = t3 * t253;
-            let t276 = t5 * t256;
-            let t277 = t5 * t255;
-            let t278 = t4 * t260;
-            let t279 = T::mul_add(T::from_f64(0.0114), t263, -t258);
-            let t280 = t4 * t259;
+            let t272 = t256
+                + T::mul_add(t64, t24, T::from_f64(2.6323000000000003) * t49);
+            let t273 = t239 - t260;
+            let t274 = T::mul_add(t4, t241, t5 * t216);
+            let t275 = T::mul_add(-t5, t241, t4 * t216);
+            let t276 = T::mul_add(t7, t228, -t6 * t243);
+            let t277 = T::mul_add(-t5, t233, -t4 * t244);
+            let t278 = T::mul_add(t2, t218, t3 * t245);
+            let t279 = T::mul_add(
+                t7,
+                T::mul_add(-t7, t158, t210),
+                t6 * (T::mul_add(t6, t224, t211)),
+            );
+            let t280 = T::mul_add(-t4, t252, t269);
             let t281 = T::mul_add(
-                -t6,
-                t223,
+                T::from_f64(0.00290809),
+                t49,
                 T::mul_add(
-                    t7,
-                    t248,
-                    T::mul_add(
-                        T::from_f64(0.2075),
-                        t209 - t144,
-                        T::mul_add(
-                            T::from_f64(0.0013357060146000001),
-                            t80,
-                            T::mul_add(
-                                T::from_f64(0.0250914799819),
-                                t51,
-                                T::mul_add(
-                                    -T::from_f64(0.00028604287179366),
-                                    t22,
-                                    T::from_f64(0.00024589650382261997) * t21,
-                                ),
-                            ),
-                        ),
-                    ),
+                    -T::from_f64(0.00023555529),
+                    t10,
+                    -T::from_f64(0.00017717707399999988) * t24,
                 ),
-            );
-            let t282 = T::mul_add(
-                -T::from_f64(0.10375),
-                t208 + t143,
-                T::mul_add(
-                    T::from_f64(0.01254573999095),
-                    t81,
-                    T::mul_add(
-                        T::from_f64(0.0008496603679314129),
-                        t57,
-                        T::mul_add(
-                            T::from_f64(0.000036193132534599707),
-                            t49,
-                            t265 + t236,
-                        ),
-                    ),
-                ),
-            );
-            let t283 = T::mul_add(
-                -T::from_f64(0.0013357060146000001),
-                t80,
-                T::mul_add(T::from_f64(0.00007238626506919941), t58, -t266 - t237),
-            );
-            let t284 = T::mul_add(-t4, t224, t268);
-            let t285 = T::mul_add(
-                -T::from_f64(0.0228),
-                t239 + t216,
-                T::mul_add(
-                    T::from_f64(0.0013357060146000001),
-                    t80,
-                    T::mul_add(
-                        -T::from_f64(0.00007238626506919941),
-                        t58,
-                        T::mul_add(
-                            -T::from_f64(0.00047111058),
-                            t34,
-                            T::mul_add(
-                                T::from_f64(0.0023846337999999996),
-                                t19,
-                                t266 + t237,
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t286 = T::mul_add(t2, t254, t3 * t227);
-            let t287 = T::mul_add(
+            ) + T::mul_add(T::from_f64(0.0114), t254, t240);
+            let t282 = T::mul_add(t2, t239, -t3 * t256);
+            let t283 = T::mul_add(t3, t239, t2 * t256);
+            let t284 = t256 + t272;
+            let t285 = t267 - t253;
+            let t286 = T::mul_add(
                 T::from_f64(0.10375),
-                t168 + t169,
-                T::mul_add(
-                    -T::from_f64(0.01151038499325),
-                    t120,
-                    T::mul_add(
-                        -T::from_f64(0.000032876842162172635),
-                        t77,
-                        T::mul_add(
-                            T::from_f64(0.0008346723367103014),
-                            t57,
-                            T::mul_add(
-                                T::from_f64(0.0007883723367103014),
-                                qd[4],
-                                t178 - t179 - t265 - t236,
-                            ),
-                        ),
-                    ),
-                ),
+                t94,
+                -(T::mul_add(t6, t228, t7 * t243)),
             );
-            let t288 = T::mul_add(
-                -T::from_f64(0.2075),
-                t208 + t143,
-                T::mul_add(
-                    t42,
-                    t81,
-                    T::mul_add(
-                        -t64,
-                        t58,
-                        T::mul_add(
-                            t87,
-                            t57,
-                            T::mul_add(
-                                T::from_f64(0.10375),
-                                t168 + t169,
-                                T::mul_add(
-                                    -T::from_f64(0.01151038499325),
-                                    t120,
-                                    T::mul_add(
-                                        T::from_f64(0.0250914799819),
-                                        t81,
-                                        T::mul_add(
-                                            -T::from_f64(0.000032876842162172635),
-                                            t77,
-                                            T::mul_add(
-                                                T::from_f64(0.002533993072573127),
-                                                t57,
-                                                T::mul_add(
-                                                    T::from_f64(0.0007883723367103014),
-                                                    qd[4],
-                                                    T::mul_add(
-                                                        T::from_f64(0.00007238626506919941),
-                                                        t49,
-                                                        t178 + t265 + t236 - t179,
-                                                    ),
-                                                ),
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t289 = T::mul_add(
-                T::from_f64(0.0114),
-                t257,
-                T::mul_add(
-                    -T::from_f64(0.0013357060146000001),
-                    t80,
-                    T::mul_add(
-                        T::from_f64(0.00007238626506919941),
-                        t58,
-                        t101 - t266 - t237 - t111 - t84 - t100,
-                    ),
-                ),
-            );
-            let t290 = T::mul_add(-t2, t85, t3 * t257);
+            let t287 = T::mul_add(t4, t225, t5 * t263);
+            let t288 = T::mul_add(-t5, t225, t4 * t263);
+            let t289 = T::mul_add(t2, t231, t3 * t265);
+            let t290 = T::mul_add(t4, t233, -t5 * t244)
+                + T::mul_add(T::from_f64(0.2073), t246, -T::from_f64(0.0114) * t218);
             let t291 = T::mul_add(
-                t4,
-                t245,
-                T::mul_add(
-                    t5,
-                    t260,
-                    T::mul_add(
-                        T::from_f64(0.2073),
-                        t122 - t246,
-                        T::from_f64(0.0114) * t231,
-                    ),
-                ),
+                -T::from_f64(0.2075),
+                t199,
+                T::mul_add(-t6, t226, t7 * t249),
             );
-            let t292 = T::mul_add(-t4, t221, t5 * t259);
-            let t293 = T::mul_add(t2, t231, t3 * t263);
-            let t294 = T::mul_add(
-                T::from_f64(0.0016),
-                T::mul_add(
-                    qd[0],
-                    t1 * (T::mul_add(-t3, t37, t2 * t5 * t38)),
-                    -qd[0] * t0 * (T::mul_add(t2, t37, t3 * t5 * t38)),
-                ),
-                T::mul_add(
-                    qd[0],
-                    t0 * (T::mul_add(t3, t68, t2 * t93)),
-                    T::mul_add(
-                        qd[0],
-                        t1
-                            * (T::mul_add(
-                                -t2,
-                                t68,
-                                T::mul_add(t3, t93, T::from_f64(0.41) * t55),
-                            )),
-                        t280 + t247,
-                    ),
-                ),
+            let t292 = T::mul_add(
+                -T::from_f64(0.10375),
+                t212,
+                T::mul_add(-t7, t226, -t6 * t249),
             );
+            let t293 = T::mul_add(
+                T::from_f64(2.0),
+                t92,
+                T::mul_add(
+                    -T::from_f64(0.0250914799819),
+                    t59,
+                    -T::from_f64(0.00007238626506919941) * t47,
+                ),
+            ) + t279;
+            let t294 = T::mul_add(t4, t236, -t5 * t253)
+                + T::mul_add(-T::from_f64(0.2073), t255, -T::from_f64(0.0114) * t214);
             let t295 = T::mul_add(
-                -t1,
-                T::mul_add(-t3, t198, t2 * t233),
-                t0 * (T::mul_add(t2, t198, t3 * t233)),
-            );
-            let t296 = t4 * t282;
-            let t297 = t5 * t284;
-            let t298 = t5 * (T::mul_add(t5, t224, t267));
-            let t299 = t4 * t288;
-            let t300 = t4 * t287;
-            let t301 = T::mul_add(t5, t281, -t267);
-            let t302 = T::mul_add(
-                -T::from_f64(0.2073),
-                t239 + t216,
+                T::from_f64(0.0007920000000000001),
+                t16,
                 T::mul_add(
-                    T::from_f64(0.0114),
-                    t209 - t144,
-                    T::mul_add(
-                        T::from_f64(0.0055471900000000005),
-                        t51,
-                        T::mul_add(
-                            T::from_f64(0.000007613524283220001),
-                            t58,
-                            T::mul_add(
-                                T::from_f64(0.00272145149554),
-                                t22,
-                                T::mul_add(
-                                    -T::from_f64(0.00273032699954),
-                                    t21,
-                                    T::mul_add(T::from_f64(0.0112299615), t19, t269 - t296),
-                                ),
-                            ),
-                        ),
-                    ),
+                    T::from_f64(0.00495),
+                    t16,
+                    T::from_f64(0.10221749999999999) * qd[1],
                 ),
+            ) + t282;
+            let t296 = T::mul_add(-T::from_f64(0.005742000000000001), t15, t283);
+            let t297 = t253 + t267 + t102;
+            let t298 = T::mul_add(t2, t69, t3 * t274);
+            let t299 = T::mul_add(T::from_f64(0.0114), t265, -t276);
+            let t300 = T::mul_add(t0, T::mul_add(-t3, t218, t2 * t245), t1 * t278);
+            let t301 = T::mul_add(
+                t1,
+                T::mul_add(-t3, t234, t2 * t248),
+                -t0 * (T::mul_add(t2, t234, t3 * t248)),
             );
+            let t302 = T::mul_add(T::from_f64(2.0), t92, t291);
             let t303 = T::mul_add(
-                t4,
-                t250,
+                -T::from_f64(0.01254573999095),
+                t91,
                 T::mul_add(
-                    t5,
-                    t282,
+                    -T::from_f64(0.0008978870531986252),
+                    t46,
                     T::mul_add(
-                        T::from_f64(0.2073),
-                        t238 - t215,
-                        T::mul_add(
-                            -T::from_f64(0.027390150000000002),
-                            t50,
-                            T::mul_add(
-                                T::from_f64(0.00023555529),
-                                t24,
-                                T::mul_add(
-                                    T::from_f64(0.00019173105000000001),
-                                    t23,
-                                    T::from_f64(0.00277654680954) * t10,
-                                ),
-                            ),
-                        ),
+                        -T::from_f64(0.000036193132534599707),
+                        t36,
+                        T::from_f64(0.000048226685267212334) * t46,
                     ),
                 ),
-            );
+            ) + t292;
             let t304 = T::mul_add(
-                t74,
-                t61,
-                T::mul_add(
-                    -t89,
-                    t34,
-                    T::mul_add(
-                        T::from_f64(0.0228),
-                        t209 - t144,
-                        T::mul_add(
-                            T::from_f64(0.011094380000000001),
-                            t51,
-                            T::mul_add(
-                                T::from_f64(0.000015227048566440002),
-                                t58,
-                                T::mul_add(
-                                    -T::from_f64(0.0002623581280000002),
-                                    t22,
-                                    T::mul_add(
-                                        T::from_f64(0.0002446071199999995),
-                                        t21,
-                                        t269 + t240 + t241 - t296 - t131,
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t305 = T::mul_add(
-                -T::from_f64(0.4146),
-                t239 + t216,
-                T::mul_add(
-                    -T::from_f64(0.00570526111908),
-                    t34,
-                    T::mul_add(T::from_f64(0.022459923), t19, t269 - t296 - t240 - t241),
-                ),
-            );
-            let t306 = T::mul_add(
-                t4,
-                t256,
-                T::mul_add(
-                    -t5,
-                    t288,
-                    T::mul_add(
-                        T::from_f64(0.2073),
-                        t217 - t244,
-                        T::from_f64(0.0114) * t85,
-                    ),
-                ),
-            );
-            let t307 = T::mul_add(-t4, t255, t5 * t287);
-            let t308 = T::mul_add(
-                T::from_f64(0.0016),
-                T::mul_add(-qd[0], t1 * t2 * t67, qd[0] * t0 * t3 * t67),
-                T::mul_add(
-                    -qd[0],
-                    t0 * (T::mul_add(t3, t92, t127)),
-                    T::mul_add(
-                        qd[0],
-                        t1
-                            * (T::mul_add(
-                                t2,
-                                t92,
-                                T::mul_add(T::from_f64(0.41), t66, -t128),
-                            )),
-                        t300 + t277,
-                    ),
-                ),
-            );
-            let t309 = t4 * t301;
-            let t310 = t4 * (T::mul_add(t4, t281, t268));
-            let t311 = t2 * t303;
-            let t312 = t3 * t303;
-            let t313 = t2 * t302;
-            let t314 = t3 * t302;
-            let t315 = T::mul_add(
-                -t4,
-                t284,
-                T::mul_add(
-                    t5,
-                    t301,
-                    T::mul_add(
-                        -T::from_f64(0.0228),
-                        t239 + t216,
-                        T::mul_add(
-                            T::from_f64(0.4146),
-                            t209 - t144,
-                            T::mul_add(
-                                T::from_f64(0.1507602),
-                                t51,
-                                T::mul_add(
-                                    T::from_f64(0.00027689185682658004),
-                                    t58,
-                                    T::mul_add(
-                                        -T::from_f64(0.00109417086),
-                                        t22,
-                                        T::mul_add(
-                                            T::from_f64(0.0008529545400000002),
-                                            t21,
-                                            T::from_f64(0.0023846337999999996) * t19,
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t316 = T::mul_add(
-                T::from_f64(0.0114),
-                t238 - t215,
+                T::from_f64(0.00295372388354),
+                t23,
                 T::mul_add(
                     -T::from_f64(0.00290809),
-                    t50,
-                    T::mul_add(
-                        T::from_f64(0.00002500957400000019),
-                        t24,
-                        T::mul_add(
-                            T::from_f64(0.00002035663000000019),
-                            t23,
-                            T::mul_add(T::from_f64(0.00023555529), t10, t309 + t297),
-                        ),
-                    ),
+                    t48,
+                    -T::from_f64(0.0112299615) * t15,
                 ),
+            ) + t294;
+            let t305 = T::mul_add(t2, t284, t3 * t273);
+            let t306 = t293 + t124;
+            let t307 = T::mul_add(-t5, t261, t4 * t286);
+            let t308 = T::mul_add(t0, T::mul_add(-t3, t231, t2 * t265), t1 * t289);
+            let t309 = T::mul_add(
+                T::from_f64(2.0),
+                t60,
+                T::mul_add(
+                    T::from_f64(0.054780300000000004),
+                    t48,
+                    -T::from_f64(0.00047111058) * t23,
+                ),
+            )
+                + T::mul_add(
+                    T::from_f64(2.0),
+                    t270,
+                    T::mul_add(T::from_f64(0.4146), t214, t293),
+                );
+            let t310 = T::mul_add(
+                -t1,
+                T::mul_add(T::from_f64(0.005742000000000001), t15, -t283),
+                t0 * t295,
             );
-            let t317 = T::mul_add(t2, t285, t312);
+            let t311 = t295 + t295 + T::mul_add(-T::from_f64(0.00579568), t16, -t79);
+            let t312 = t296 - (T::mul_add(-T::from_f64(0.00579568), t15, -t80) - t296);
+            let t313 = t303 + t236;
+            let t314 = T::mul_add(t0, T::mul_add(-t3, t69, t2 * t274), t1 * t298);
+            let t315 = T::mul_add(t4, t261, t5 * t286)
+                + T::mul_add(-T::from_f64(0.2073), t264, T::from_f64(0.0114) * t231);
+            let t316 = T::mul_add(
+                T::from_f64(0.41),
+                t246,
+                T::mul_add(-t2, t266, -t3 * t290),
+            );
+            let t317 = T::mul_add(t5, t302, -t268);
             let t318 = T::mul_add(
-                -T::from_f64(0.0016),
-                T::mul_add(qd[0], t0 * (t91 + T::from_f64(1.2836779999999999)), t110),
-                T::mul_add(
-                    -T::from_f64(0.82),
-                    t271 + t243,
-                    T::mul_add(
-                        qd[0],
-                        t0
-                            * (T::mul_add(
-                                T::from_f64(0.41),
-                                t67,
-                                t167 + T::from_f64(0.0094826278),
-                            )),
-                        T::mul_add(
-                            T::from_f64(0.4146),
-                            t209 - t144,
-                            T::mul_add(
-                                T::from_f64(0.1507602),
-                                t51,
-                                T::mul_add(
-                                    T::from_f64(0.00027689185682658004),
-                                    t58,
-                                    T::mul_add(
-                                        -T::from_f64(0.00156528144),
-                                        t22,
-                                        T::mul_add(
-                                            T::from_f64(0.00132406512),
-                                            t21,
-                                            T::mul_add(
-                                                T::from_f64(0.0023714459999999997),
-                                                t19,
-                                                t310 + t298 + t193,
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
+                T::from_f64(0.11875),
+                t310,
+                -T::from_f64(0.0016)
+                    * (T::mul_add(T::from_f64(0.10221749999999999), t15, -t257)),
             );
-            let t319 = T::mul_add(
-                T::from_f64(0.0228),
-                t238 - t215,
-                T::mul_add(
-                    t74,
-                    t62,
-                    T::mul_add(
-                        -t118,
-                        t34,
-                        T::mul_add(
-                            t138,
-                            t35,
-                            T::mul_add(
-                                T::from_f64(0.0006678530073000001),
-                                t81,
-                                T::mul_add(
-                                    -T::from_f64(0.00581618),
-                                    t50,
-                                    T::mul_add(
-                                        T::from_f64(0.000036193132534599707),
-                                        t57,
-                                        T::mul_add(
-                                            T::from_f64(0.00025041333326721244),
-                                            t24,
-                                            T::mul_add(
-                                                T::from_f64(0.0002411074452672124),
-                                                t23,
-                                                T::mul_add(
-                                                    T::from_f64(0.000048226685267212334),
-                                                    qd[3],
-                                                    T::mul_add(
-                                                        T::from_f64(0.00047111058),
-                                                        t10,
-                                                        t181 + t309 + t297 - t214,
-                                                    ),
-                                                ),
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
+            let t319 = T::mul_add(t0, T::mul_add(-t3, t284, t2 * t273), t1 * t305);
             (
                 t256,
                 t257,
@@ -15707,246 +12520,255 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Kinova<T> {
             t334,
             t335,
             t336,
+            t337,
+            t338,
+            t339,
+            t340,
+            t341,
+            t342,
+            t343,
+            t344,
+            t345,
+            t346,
+            t347,
+            t348,
+            t349,
+            t350,
+            t351,
+            t352,
+            t353,
+            t354,
+            t355,
+            t356,
+            t357,
+            t358,
+            t359,
+            t360,
+            t361,
+            t362,
+            t363,
+            t364,
+            t365,
+            t366,
+            t367,
+            t368,
+            t369,
+            t370,
         ) = {
-            let t320 = T::mul_add(
-                T::from_f64(0.0006678530073000001),
-                t81,
-                T::mul_add(
-                    T::from_f64(0.000036193132534599707),
-                    t57,
-                    T::mul_add(
-                        T::from_f64(0.00020039418526721203),
-                        t35,
-                        T::mul_add(
-                            T::from_f64(0.000048226685267212334),
-                            qd[3],
-                            t181 - t214 - t309 - t297,
-                        ),
-                    ),
-                ),
-            );
-            let t321 = T::mul_add(
-                -t1,
-                T::mul_add(t3, t279, t2 * t291),
-                T::mul_add(
-                    t0,
-                    T::mul_add(
-                        -t2,
-                        t279,
-                        T::mul_add(t3, t291, T::from_f64(0.41) * (t246 - t122)),
-                    ),
-                    T::from_f64(0.0016)
-                        * (T::mul_add(t0, T::mul_add(-t3, t231, t2 * t263), t1 * t293)),
-                ),
-            );
+            let t320 = t236 - (t303 + t133);
+            let t321 = T::mul_add(T::from_f64(0.0114), t274, -(-t306));
             let t322 = T::mul_add(
-                t1,
-                T::mul_add(-t3, t261, t2 * t292),
-                -t0 * (T::mul_add(t2, t261, t3 * t292)),
+                -t1,
+                T::mul_add(-t3, t262, t2 * t287),
+                t0 * (T::mul_add(t2, t262, t3 * t287)),
             );
-            let t323 = t3 * t316;
-            let t324 = t2 * t316;
-            let t325 = T::mul_add(t3, t315, t311);
+            let t323 = T::mul_add(
+                T::from_f64(0.2073),
+                t254,
+                T::mul_add(-t4, t267, t5 * t303),
+            );
+            let t324 = T::mul_add(
+                T::from_f64(0.2073),
+                t255,
+                T::mul_add(-T::from_f64(0.0114), t214, T::mul_add(t5, t267, t4 * t303)),
+            );
+            let t325 = T::mul_add(
+                T::from_f64(0.41),
+                t257,
+                T::mul_add(t2, t281, -t3 * t304),
+            );
             let t326 = T::mul_add(
-                T::from_f64(0.0016),
-                t98,
+                -T::from_f64(0.00000792),
+                t16,
                 T::mul_add(
-                    qd[0],
-                    t0 * t202,
-                    T::mul_add(
-                        -qd[0],
-                        t1
-                            * (T::mul_add(
-                                -t2,
-                                t140,
-                                T::mul_add(
-                                    -t3,
-                                    t166,
-                                    T::mul_add(
-                                        T::from_f64(0.82),
-                                        t91,
-                                        T::from_f64(0.49530666549099994),
-                                    ),
-                                ),
-                            )),
-                        T::mul_add(
-                            T::from_f64(0.0005108400000000023),
-                            t20,
-                            T::mul_add(
-                                T::from_f64(0.00204435),
-                                qd[1],
-                                t323 + t274 + t275 - t313,
-                            ),
-                        ),
-                    ),
+                    -T::from_f64(0.0004455000000000014),
+                    t16,
+                    -T::from_f64(0.001022175) * qd[1],
                 ),
-            );
-            let t327 = T::mul_add(
-                t1,
-                T::mul_add(-t3, t289, t2 * t306),
-                T::mul_add(
-                    t0,
-                    T::mul_add(
-                        -t2,
-                        t289,
-                        T::mul_add(-t3, t306, T::from_f64(0.41) * (t217 - t244)),
-                    ),
-                    T::from_f64(0.0016)
-                        * (T::mul_add(t0, T::mul_add(t3, t85, t2 * t257), t1 * t290)),
-                ),
-            );
-            let t328 = T::mul_add(
-                t1,
-                T::mul_add(-t3, t283, t2 * t307),
-                -t0 * (T::mul_add(t2, t283, t3 * t307)),
-            );
-            let t329 = T::mul_add(
-                t3,
-                t317,
-                T::mul_add(
-                    -t2,
-                    t325,
-                    T::mul_add(
-                        T::from_f64(0.41),
-                        t242 - t270,
-                        T::mul_add(
-                            T::from_f64(0.0011857229999999999),
-                            t20,
-                            T::from_f64(0.025963017745499993) * qd[1],
-                        ),
-                    ),
-                ),
-            );
+            ) + T::mul_add(t3, t281, t2 * t304);
+            let t327 = T::mul_add(-t5, t285, -t4 * t313);
+            let t328 = T::mul_add(-t4, t285, t5 * t313);
+            let t329 = T::mul_add(-t1, T::mul_add(-t3, t266, t2 * t290), -t0 * t316);
             let t330 = T::mul_add(
-                t3,
-                T::mul_add(-t3, t285, t311),
-                T::mul_add(
-                    t2,
-                    T::mul_add(-t2, t315, t312),
-                    T::from_f64(0.00204435) * t19,
-                ),
+                t5,
+                T::mul_add(t5, t252, t268),
+                t4 * (T::mul_add(t4, t302, t269)),
             );
             let t331 = T::mul_add(
-                t1,
+                T::from_f64(0.027390150000000002),
+                t49,
                 T::mul_add(
-                    T::from_f64(0.0016),
-                    t99,
+                    -T::from_f64(0.00295372388354),
+                    t10,
                     T::mul_add(
-                        -qd[0],
-                        t0 * t203,
-                        T::mul_add(
-                            qd[0],
-                            t1 * t202,
-                            T::mul_add(
-                                T::from_f64(0.0005108399999999985),
-                                t19,
-                                t324 + t314 + t273 - t272,
-                            ),
-                        ),
+                        T::from_f64(0.00017717707399999988),
+                        t10,
+                        -T::from_f64(0.00023555529) * t24,
                     ),
                 ),
-                T::mul_add(
-                    -t0,
-                    t326,
-                    T::from_f64(0.0016)
-                        * (T::mul_add(
-                            -t0,
-                            T::mul_add(
-                                T::from_f64(2.0),
-                                t242 - t270,
-                                T::mul_add(
-                                    T::from_f64(0.005688320000000001),
-                                    t20,
-                                    T::mul_add(T::from_f64(0.20443499999999998), qd[1], t98),
-                                ),
-                            ),
-                            t1
-                                * (T::mul_add(
-                                    -T::from_f64(2.0),
-                                    t271 + t243,
-                                    T::mul_add(T::from_f64(0.005688320000000001), t19, t99),
-                                )),
-                        )),
-                ),
-            );
+            ) + t323;
             let t332 = T::mul_add(
-                -t1,
+                -T::from_f64(0.00290809),
+                t48,
                 T::mul_add(
-                    -T::from_f64(0.82),
-                    t239 + t216,
-                    T::mul_add(
-                        -T::from_f64(0.022459923),
-                        t34,
-                        T::mul_add(
-                            T::from_f64(0.166008065491),
-                            t19,
-                            t273 - t324 - t314 - t272,
-                        ),
-                    ),
+                    -T::from_f64(0.00275153723554),
+                    t23,
+                    T::from_f64(0.0112299615) * t15,
                 ),
-                t0
-                    * (T::mul_add(
-                        T::from_f64(0.00039600000000000046),
-                        t20,
-                        t313 + t274 + t275 - t323,
-                    )),
-            );
-            let t333 = T::mul_add(
-                -t1,
-                T::mul_add(t3, t304, t2 * t319),
-                T::mul_add(
-                    -t0,
-                    T::mul_add(
-                        t2,
-                        t304,
-                        T::mul_add(
-                            -t3,
-                            t319,
-                            T::from_f64(0.41) * (T::mul_add(-t66, t34, t44 * t35)),
-                        ),
-                    ),
-                    T::from_f64(0.0016)
-                        * (T::mul_add(t0, T::mul_add(-t3, t254, t2 * t227), t1 * t286)),
-                ),
-            );
+            ) + t324;
+            let t333 = T::mul_add(-t5, t297, t4 * t320);
             let t334 = T::mul_add(
-                t1,
-                T::mul_add(-t3, t305, t2 * t320),
-                -t0 * (T::mul_add(t2, t305, t3 * t320)),
+                T::from_f64(0.41),
+                t264,
+                -(T::mul_add(t2, t299, -t3 * t315)),
             );
             let t335 = T::mul_add(
-                t0,
-                T::mul_add(
-                    t2,
-                    t317,
-                    T::mul_add(
-                        t3,
-                        t325,
-                        T::mul_add(
-                            -T::from_f64(0.82),
-                            t271 + t243,
-                            T::from_f64(0.000327096) * t19,
-                        ),
-                    ),
-                ),
-                t1 * t329,
+                T::from_f64(2.0),
+                t270,
+                T::mul_add(-t4, t280, t5 * t317),
             );
             let t336 = T::mul_add(
-                t1,
-                T::mul_add(-t1, t330, t0 * t329),
+                -T::from_f64(0.0114),
+                t254,
+                T::mul_add(t5, t280, t4 * t317),
+            );
+            let t337 = t2 * t331;
+            let t338 = t3 * t331;
+            let t339 = t332 - t304;
+            let t340 = T::mul_add(t4, t297, t5 * t320)
+                + T::mul_add(T::from_f64(0.2073), t275, -T::from_f64(0.0114) * t69);
+            let t341 = T::mul_add(T::from_f64(2.0), t60, t335);
+            let t342 = T::mul_add(
+                -T::from_f64(0.00290809),
+                t49,
                 T::mul_add(
-                    t0,
-                    t335,
+                    T::from_f64(0.00295372388354),
+                    t24,
                     T::mul_add(
-                        T::from_f64(0.0032),
-                        t239 + t216,
-                        T::mul_add(
-                            T::from_f64(0.00008764848),
-                            t34,
-                            -T::from_f64(0.0007707488) * t19,
-                        ),
+                        T::from_f64(0.00023555529),
+                        t10,
+                        -T::from_f64(0.0029287143095399998) * t24,
                     ),
                 ),
+            ) + t336;
+            let t343 = T::mul_add(
+                T::from_f64(2.0),
+                t60,
+                T::mul_add(
+                    T::from_f64(0.00047111058),
+                    t23,
+                    -T::from_f64(0.0023846337999999996) * t15,
+                ),
+            )
+                + T::mul_add(
+                    T::from_f64(2.0),
+                    t270,
+                    T::mul_add(-T::from_f64(0.0228), t255, t330),
+                );
+            let t344 = T::mul_add(-t2, t309, t338);
+            let t345 = t304 + t332 + t164;
+            let t346 = T::mul_add(-t1, T::mul_add(t3, t299, t2 * t315), t0 * t334);
+            let t347 = t343 + t186;
+            let t348 = t342 + t281;
+            let t349 = T::mul_add(
+                t1,
+                T::mul_add(t3, t293, t2 * t328),
+                -t0 * (T::mul_add(-t2, t293, t3 * t328)),
+            );
+            let t350 = T::mul_add(t3, t341, -t337);
+            let t351 = t281 - (t342 + t200);
+            let t352 = T::mul_add(
+                T::from_f64(0.41),
+                t275,
+                T::mul_add(-t2, t321, -t3 * t340),
+            );
+            let t353 = T::mul_add(
+                -T::from_f64(0.41),
+                t257,
+                T::mul_add(-t3, t332, -t2 * t342),
+            );
+            let t354 = T::mul_add(
+                T::from_f64(0.026416437745499996),
+                t16,
+                T::mul_add(
+                    -T::from_f64(0.026359017745499994),
+                    t16,
+                    T::from_f64(0.001022175) * qd[1],
+                ),
+            ) + T::mul_add(-t2, t332, t3 * t342);
+            let t355 = T::mul_add(
+                T::from_f64(0.0023714459999999997),
+                t15,
+                T::mul_add(-T::from_f64(0.82), t283, t343),
+            ) + t259;
+            let t356 = T::mul_add(
+                t3,
+                T::mul_add(t3, t309, t337),
+                t2 * (T::mul_add(t2, t341, t338)),
+            );
+            let t357 = T::mul_add(-t1, T::mul_add(-t3, t321, t2 * t340), -t0 * t352);
+            let t358 = T::mul_add(
+                -T::from_f64(0.82),
+                t283,
+                T::mul_add(-t2, t344, t3 * t350),
+            );
+            let t359 = T::mul_add(
+                -T::from_f64(0.41),
+                -t282,
+                T::mul_add(-t3, t344, -t2 * t350),
+            );
+            let t360 = t326 - (t354 + T::mul_add(-T::from_f64(0.0016), t79, t271));
+            let t361 = T::mul_add(
+                T::from_f64(0.41),
+                T::mul_add(-t54, t23, t43 * t24),
+                T::mul_add(t2, t345, t3 * t351),
+            );
+            let t362 = T::mul_add(
+                -t1,
+                T::mul_add(t3, t339, t2 * t348),
+                t0 * (T::mul_add(-t2, t339, t3 * t348)),
+            );
+            let t363 = T::mul_add(
+                T::from_f64(0.000163548),
+                t16,
+                T::mul_add(
+                    T::from_f64(0.026408517745499994),
+                    qd[1],
+                    T::mul_add(
+                        T::from_f64(0.001022175),
+                        t16,
+                        -T::from_f64(0.0004455000000000014) * qd[1],
+                    ),
+                ),
+            ) + t359;
+            let t364 = T::mul_add(-T::from_f64(0.026416437745499996), t15, t325)
+                + T::mul_add(T::from_f64(0.02590559774549999), t15, t353)
+                + T::mul_add(T::from_f64(0.0016), t80, t258);
+            let t365 = T::mul_add(
+                -t1,
+                T::mul_add(T::from_f64(0.05232203549099999), t15, t353 - t325),
+                -t0 * (t354 + t326),
+            );
+            let t366 = T::mul_add(t1, T::mul_add(-t3, t345, t2 * t351), -t0 * t361);
+            let t367 = T::mul_add(
+                t0,
+                T::mul_add(T::from_f64(0.000327096), t15, t358),
+                t1 * t363,
+            );
+            let t368 = T::mul_add(
+                -t1,
+                T::mul_add(T::from_f64(0.00204435), t15, -t356),
+                t0 * t363,
+            );
+            let t369 = T::mul_add(
+                -T::from_f64(0.0016),
+                T::mul_add(t0, t311, t1 * t312),
+                T::mul_add(-t1, t364, t0 * t360),
+            );
+            let t370 = T::mul_add(
+                T::from_f64(2.0),
+                t318,
+                T::mul_add(-T::from_f64(0.2375), t310, T::mul_add(t1, t368, t0 * t367)),
             );
             (
                 t320,
@@ -15966,192 +12788,88 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Kinova<T> {
                 t334,
                 t335,
                 t336,
+                t337,
+                t338,
+                t339,
+                t340,
+                t341,
+                t342,
+                t343,
+                t344,
+                t345,
+                t346,
+                t347,
+                t348,
+                t349,
+                t350,
+                t351,
+                t352,
+                t353,
+                t354,
+                t355,
+                t356,
+                t357,
+                t358,
+                t359,
+                t360,
+                t361,
+                t362,
+                t363,
+                t364,
+                t365,
+                t366,
+                t367,
+                t368,
+                t369,
+                t370,
             )
         };
         [
-            [t336, t331, t333, t327, t321, t264],
             [
-                t332,
-                t318,
+                t370,
+                t369,
+                T::mul_add(T::from_f64(0.0016), t319, t366),
+                T::mul_add(-T::from_f64(0.0016), t314, t357),
+                T::mul_add(T::from_f64(0.0016), t308, t346),
+                T::mul_add(-T::from_f64(0.0016), t300, t329),
+            ],
+            [
+                t365,
+                t355,
+                T::mul_add(T::from_f64(0.41), t305, -t347),
                 T::mul_add(
-                    T::from_f64(0.41),
-                    t286,
-                    T::mul_add(
-                        T::from_f64(0.4146),
-                        t144 - t209,
-                        T::mul_add(
-                            -T::from_f64(0.1507602),
-                            t51,
-                            T::mul_add(
-                                -T::from_f64(0.00027689185682658004),
-                                t58,
-                                T::mul_add(
-                                    T::from_f64(0.00156528144),
-                                    t22,
-                                    T::mul_add(
-                                        -T::from_f64(0.00132406512),
-                                        t21,
-                                        t82 + t71 - t310 - t298 - t160 - t132,
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
+                    -T::from_f64(0.41),
+                    t298,
+                    T::mul_add(T::from_f64(0.2073), t274, -t333),
                 ),
                 T::mul_add(
                     T::from_f64(0.41),
-                    t290,
-                    T::mul_add(-T::from_f64(0.2073), t257, -t299 - t276),
+                    t289,
+                    T::mul_add(-T::from_f64(0.2073), t265, -t307),
                 ),
                 T::mul_add(
-                    T::from_f64(0.41),
-                    t293,
-                    T::mul_add(-T::from_f64(0.2073), t263, t262 - t278),
-                ),
-                T::mul_add(
-                    T::from_f64(0.41),
-                    t219,
-                    T::mul_add(-T::from_f64(0.2073), t184, t183 - t182),
+                    -T::from_f64(0.41),
+                    t278,
+                    T::mul_add(T::from_f64(0.2073), t245, -t277),
                 ),
             ],
             [
-                t334,
-                T::mul_add(
-                    T::from_f64(0.0016),
-                    T::mul_add(qd[0], t0 * t91, t110),
-                    T::mul_add(
-                        -qd[0],
-                        t0 * t167,
-                        T::mul_add(
-                            T::from_f64(0.4146),
-                            t144 - t209,
-                            T::mul_add(
-                                -T::from_f64(0.1507602),
-                                t51,
-                                T::mul_add(
-                                    -T::from_f64(0.00027689185682658004),
-                                    t58,
-                                    T::mul_add(
-                                        T::from_f64(0.00156528144),
-                                        t22,
-                                        T::mul_add(
-                                            -T::from_f64(0.00132406512),
-                                            t21,
-                                            -t310 - t298 - t193,
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-                T::mul_add(
-                    T::from_f64(0.4146),
-                    t209 - t144,
-                    T::mul_add(
-                        T::from_f64(0.1507602),
-                        t51,
-                        T::mul_add(
-                            T::from_f64(0.00027689185682658004),
-                            t58,
-                            T::mul_add(
-                                -T::from_f64(0.00156528144),
-                                t22,
-                                T::mul_add(
-                                    T::from_f64(0.00132406512),
-                                    t21,
-                                    t310 + t298 + t160 + t132 - t82 - t71,
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-                T::mul_add(T::from_f64(0.2073), t257, t299 + t276),
-                T::mul_add(T::from_f64(0.2073), t263, t278 - t262),
-                T::mul_add(T::from_f64(0.2073), t184, t182 - t183),
+                t362,
+                -t343 + t215,
+                t347,
+                T::mul_add(-T::from_f64(0.2073), t274, t333),
+                T::mul_add(T::from_f64(0.2073), t265, t307),
+                T::mul_add(-T::from_f64(0.2073), t245, t277),
             ],
-            [
-                t328,
-                t308,
-                T::mul_add(-t67, t61, T::mul_add(t92, t34, t131 - t300 - t277)),
-                T::mul_add(
-                    T::from_f64(0.0013357060146000001),
-                    t80,
-                    T::mul_add(
-                        -T::from_f64(0.00007238626506919941),
-                        t58,
-                        t266 + t237 + t111 + t84 + t100 - t101,
-                    ),
-                ),
-                t258,
-                -t146,
-            ],
-            [
-                t322,
-                t294,
-                T::mul_add(
-                    t37,
-                    t62,
-                    T::mul_add(
-                        t5,
-                        t38 * t61,
-                        T::mul_add(-t68, t34, T::mul_add(-t93, t35, -t280 - t247)),
-                    ),
-                ),
-                T::mul_add(t38, t80, T::mul_add(-t45, t58, t83 - t261)),
-                T::mul_add(
-                    T::from_f64(0.06500910264696372),
-                    t121,
-                    T::mul_add(
-                        T::from_f64(0.000010375000000000522),
-                        t79 - t95,
-                        T::mul_add(
-                            -T::from_f64(0.000000000000000000011248597539537108),
-                            t94 + t78,
-                            T::mul_add(
-                                T::from_f64(0.00006575368432434527),
-                                t76,
-                                t206 + t207 + t103 + t104 + t133,
-                            ),
-                        ),
-                    ),
-                ),
-                T::mul_add(T::from_f64(0.10375), t126, t123 + t124),
-            ],
-            [
-                t295,
-                t234,
-                T::mul_add(
-                    t6,
-                    t11 * t62,
-                    T::mul_add(
-                        t48,
-                        t61,
-                        T::mul_add(-t56, t34, T::mul_add(-t69, t35, t218 - t185)),
-                    ),
-                ),
-                T::mul_add(
-                    -t14,
-                    t81,
-                    T::mul_add(
-                        t7,
-                        t11 * t80,
-                        T::mul_add(t46, t58, T::mul_add(-t47, t57, t198)),
-                    ),
-                ),
-                T::mul_add(
-                    t11,
-                    t121,
-                    T::mul_add(T::from_f64(0.0007776443641723163), t76, t162 + t102),
-                ),
-                T::zero(),
-            ],
+            [t349, -t327 + t187, t327 + t159, t306, t276, t232],
+            [t322, -t288 + t136 + t81, t288 + t118, t262 + t103, t242, t204],
+            [t301, -t247 + t137 + t82, t247 + t120, t221 + t119, t191 + t128, t165],
         ]
     }
     /// Inverse dynamics: tau = M(q) qdd + b(q, qd) + G(q).
     ///
     /// Route: Newton-Euler.
-    /// Operations: 379 mul, 407 add, 0 div, 5 sin, 5 cos.
+    /// Operations: 352 mul, 268 add, 0 div, 5 sin, 5 cos.
     fn inverse_dynamics(&self, q: &[T; 6], qd: &[T; 6], qdd: &[T; 6]) -> [T; 6] {
         let ([s1, s2, s3, s4, s5], [c1, c2, c3, c4, c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
             q[1],
@@ -16246,94 +12964,138 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Kinova<T> {
             let t17 = qd[0] * qd[0] * t0 * t0;
             let t18 = qdd[0] * t0;
             let t19 = qdd[0] * t1;
-            let t20 = t5 * t12;
-            let t21 = T::mul_add(
+            let t20 = T::mul_add(
                 T::from_f64(0.00204435),
                 t13,
                 T::from_f64(0.05271803549099999) * qd[1],
             );
-            let t22 = T::mul_add(
+            let t21 = T::mul_add(
                 T::from_f64(0.0008910000000000028),
                 t13,
                 T::from_f64(0.00204435) * qd[1],
             );
-            let t23 = T::mul_add(-qd[0], t1 * t2, qd[0] * t0 * t3);
-            let t24 = T::mul_add(qd[0], t1 * t3, qd[0] * t0 * t2);
-            let t25 = t15 - t19;
-            let t26 = t14 + t18;
-            let t27 = T::mul_add(
-                T::from_f64(0.0016),
-                t19,
-                T::mul_add(T::from_f64(9.81), t0, T::from_f64(0.41) * (qdd[1] - t16)),
-            );
+            let t22 = T::mul_add(-qd[0], t1 * t2, qd[0] * t0 * t3);
+            let t23 = T::mul_add(qd[0], t1 * t3, qd[0] * t0 * t2);
+            let t24 = T::mul_add(T::from_f64(0.0016), t19, T::from_f64(9.81) * t0);
+            let t25 = T::mul_add(-T::from_f64(0.0016), t18, T::from_f64(9.81) * t1);
+            let t26 = t15 - t19;
+            let t27 = t14 + t18;
             let t28 = T::mul_add(
-                -T::from_f64(0.0016),
-                t18,
+                T::from_f64(0.054780300000000004),
+                t11,
+                T::from_f64(0.00581618) * t23,
+            );
+            let t29 = t22 * t23;
+            let t30 = t22 * t11;
+            let t31 = t22 * t22;
+            let t32 = T::mul_add(
+                T::from_f64(0.0058574286190799995),
+                t11,
+                T::from_f64(0.00047111058) * t23,
+            );
+            let t33 = T::mul_add(
+                T::from_f64(0.00047111058),
+                t11,
+                T::from_f64(0.00035435414799999976) * t23,
+            );
+            let t34 = T::mul_add(T::from_f64(0.2073), t11, T::from_f64(0.0114) * t23);
+            let t35 = qd[3] + t23;
+            let t36 = T::mul_add(T::from_f64(0.41), qdd[1] - t16, t24);
+            let t37 = T::from_f64(0.41) * (T::mul_add(qd[1], qd[1], t17)) + t25;
+            let t38 = T::mul_add(
+                T::from_f64(0.41),
+                t14 + t27,
+                T::from_f64(0.0016) * t10,
+            );
+            let t39 = T::mul_add(
+                T::from_f64(0.20443499999999998),
+                t17,
+                qd[1]
+                    * (T::mul_add(
+                        T::from_f64(0.0099),
+                        t13,
+                        T::from_f64(0.20443499999999998) * qd[1],
+                    )),
+            );
+            let t40 = T::mul_add(t5, t11, t4 * t22);
+            let t41 = T::mul_add(-t4, t11, t5 * t22);
+            let t42 = T::mul_add(-t11, t34, -T::from_f64(0.2073) * t31);
+            let t43 = t40 * t41;
+            let t44 = t35 * t41;
+            let t45 = T::mul_add(
+                T::from_f64(0.0013357060146000001),
+                t35,
+                T::from_f64(0.0250914799819) * t40,
+            );
+            let t46 = t41 * t41;
+            let t47 = T::mul_add(
+                T::from_f64(0.00007238626506919941),
+                t35,
+                T::from_f64(0.0017919207358628258) * t40,
+            );
+            let t48 = T::mul_add(
+                T::from_f64(0.00009645337053442467),
+                t35,
+                T::from_f64(0.00007238626506919941) * t40,
+            );
+            let t49 = t40 * t35;
+            let t50 = qd[4] + t40;
+            let t51 = T::mul_add(
+                -T::from_f64(0.05281703549099999),
+                t27,
+                T::mul_add(qd[1], t21, -qd[0] * t1 * t20)
+                    + T::mul_add(
+                        T::from_f64(0.0099),
+                        t25,
+                        -T::from_f64(0.000327096) * t10,
+                    ),
+            );
+            let t52 = T::mul_add(
+                -T::from_f64(0.0099),
+                t24,
+                T::mul_add(qd[0], t0 * t20, -T::from_f64(0.05281703549099999) * t15)
+                    + T::mul_add(
+                        T::from_f64(0.0008910000000000028),
+                        t26,
+                        -T::from_f64(0.00204435) * qdd[1],
+                    ),
+            );
+            let t53 = T::mul_add(
+                T::from_f64(0.20443499999999998),
+                t24,
+                T::mul_add(qd[0], t0 * t21, -T::from_f64(0.05281703549099999) * t16)
+                    + T::mul_add(
+                        -T::from_f64(0.00204435),
+                        t26,
+                        T::from_f64(0.05271803549099999) * qdd[1],
+                    ),
+            );
+            let t54 = T::mul_add(t2, t37, -t3 * t36);
+            let t55 = T::mul_add(t3, t37, t2 * t36);
+            let t56 = T::mul_add(qd[2], t22, -(T::mul_add(t3, t26, -t2 * t27)));
+            let t57 = T::mul_add(qd[2], t23, -(T::mul_add(t2, t26, t3 * t27)));
+            let t58 = T::mul_add(t6, t35, t7 * t41);
+            let t59 = T::mul_add(-t7, t35, t6 * t41);
+            let t60 = -t54;
+            let t61 = T::mul_add(
+                -T::from_f64(0.00581618),
+                t57,
                 T::mul_add(
-                    T::from_f64(0.41),
-                    T::mul_add(qd[1], qd[1], t17),
-                    T::from_f64(9.81) * t1,
+                    T::from_f64(0.6763),
+                    t55,
+                    T::mul_add(-T::from_f64(0.054780300000000004), t31, -t11 * t28),
                 ),
             );
-            let t29 = qd[2] * t23;
-            let t30 = T::mul_add(
-                T::from_f64(0.00581618),
-                t24,
-                T::from_f64(0.054780300000000004) * t11,
+            let t62 = T::mul_add(
+                -T::from_f64(0.054780300000000004),
+                t57,
+                T::mul_add(
+                    -T::from_f64(0.6763),
+                    t38,
+                    T::mul_add(t23, t28, T::from_f64(0.00581618) * t31),
+                ),
             );
-            let t31 = T::from_f64(0.00581618) * t23;
-            let t32 = T::from_f64(0.054780300000000004) * t23;
-            let t33 = T::from_f64(0.00590744776708) * t23;
-            let t34 = T::mul_add(
-                T::from_f64(0.00047111058),
-                t24,
-                T::from_f64(0.0058574286190799995) * t11,
-            );
-            let t35 = T::mul_add(
-                T::from_f64(0.00035435414799999976),
-                t24,
-                T::from_f64(0.00047111058) * t11,
-            );
-            let t36 = T::mul_add(T::from_f64(0.0114), t24, T::from_f64(0.2073) * t11);
-            let t37 = T::from_f64(0.0114) * t23;
-            let t38 = T::from_f64(0.2073) * t23;
-            let t39 = t24 + qd[3];
-            let t40 = t2 * t26;
-            let t41 = t3 * t25;
-            let t42 = t3 * t27;
-            let t43 = t2 * t28;
-            let t44 = t2 * t27;
-            let t45 = t3 * t28;
-            let t46 = t23 * t35;
-            let t47 = t24 * t33;
-            let t48 = T::mul_add(t5, t11, t4 * t23);
-            let t49 = t11 * t36;
-            let t50 = t23 * t38;
-            let t51 = T::mul_add(-t4, t11, t5 * t23);
-            let t52 = T::mul_add(-t2, t25, T::mul_add(-t3, t26, qd[2] * t24));
-            let t53 = qdd[3] + t29 + t40 - t41;
-            let t54 = qd[3] * t51;
-            let t55 = T::from_f64(0.0250914799819) * t51;
-            let t56 = T::from_f64(0.0013357060146000001) * t51;
-            let t57 = T::mul_add(
-                T::from_f64(0.0250914799819),
-                t48,
-                T::from_f64(0.0013357060146000001) * t39,
-            );
-            let t58 = T::mul_add(
-                T::from_f64(0.0017919207358628258),
-                t48,
-                T::from_f64(0.00007238626506919941) * t39,
-            );
-            let t59 = T::mul_add(
-                T::from_f64(0.00007238626506919941),
-                t48,
-                T::from_f64(0.00009645337053442467) * t39,
-            );
-            let t60 = T::from_f64(0.0017957741063972504) * t51;
-            let t61 = T::from_f64(0.10375) * t51;
-            let t62 = T::from_f64(0.10375) * t48;
-            let t63 = t48 + qd[4];
+            let t63 = T::mul_add(-T::from_f64(0.0114), t57, t42 + t55);
             (
                 t0,
                 t1,
@@ -16467,183 +13229,328 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Kinova<T> {
             t126,
             t127,
         ) = {
-            let t64 = t4 * t52;
-            let t65 = T::mul_add(
-                t11,
-                t37,
-                T::mul_add(
-                    -t24,
-                    t38,
-                    T::mul_add(
-                        T::from_f64(0.0114),
-                        t29 + t40 - t41,
-                        T::mul_add(T::from_f64(0.2073), t12, t43 - t42),
+            let t64 = T::mul_add(
+                -T::from_f64(0.2073),
+                t57,
+                T::mul_add(t23, t34, T::from_f64(0.0114) * t31)
+                    + T::mul_add(
+                        -T::from_f64(0.41),
+                        t14 + t27,
+                        -T::from_f64(0.0016) * t10,
                     ),
-                ),
             );
-            let t66 = T::mul_add(
-                T::from_f64(0.41),
-                t18,
-                T::mul_add(
-                    -t24,
-                    t36,
-                    T::mul_add(
-                        -t23,
-                        t37,
-                        T::mul_add(
-                            T::from_f64(0.2073),
-                            t52,
-                            T::mul_add(T::from_f64(0.82), t14, T::from_f64(0.0016) * t10),
-                        ),
-                    ),
-                ),
-            );
-            let t67 = t7 * t53;
-            let t68 = t51 * t55;
-            let t69 = t48 * t57;
-            let t70 = t51 * t58;
-            let t71 = t48 * t60;
-            let t72 = T::mul_add(t6, t39, t7 * t51);
-            let t73 = t39 * t62;
-            let t74 = T::mul_add(-t7, t39, t6 * t51);
-            let t75 = T::from_f64(0.10375) * t63;
-            let t76 = t5 * t65;
-            let t77 = t4 * t66;
-            let t78 = t4 * t65;
-            let t79 = t5 * t66;
-            let t80 = T::mul_add(t4, t12, T::mul_add(t5, t52, qd[3] * t48));
-            let t81 = qdd[4] + t54 + t20 - t64;
-            let t82 = qd[4] * t72;
-            let t83 = T::from_f64(0.0013224560195000002) * t72;
-            let t84 = T::from_f64(0.0230207699865) * t72;
-            let t85 = T::mul_add(
+            let t65 = qdd[3] + t56;
+            let t66 = t58 * t59;
+            let t67 = t58 * t50;
+            let t68 = T::mul_add(
                 -T::from_f64(0.0013224560195000002),
-                t74,
-                T::from_f64(0.0230207699865) * t63,
+                t59,
+                T::from_f64(0.0230207699865) * t50,
             );
-            let t86 = T::from_f64(0.0015805219734713843) * t72;
-            let t87 = T::mul_add(
+            let t69 = t58 * t58;
+            let t70 = T::mul_add(
                 -T::from_f64(0.00009637730005078133),
-                t74,
-                T::from_f64(0.00006575368432434527) * t63,
+                t59,
+                T::from_f64(0.00006575368432434527) * t50,
             );
-            let t88 = T::mul_add(
+            let t71 = T::mul_add(
                 -T::from_f64(0.00006575368432434527),
-                t74,
-                T::from_f64(0.0015767446734206029) * t63,
+                t59,
+                T::from_f64(0.0015767446734206029) * t50,
             );
-            let t89 = T::from_f64(0.10375) * t72;
-            let t90 = t63 * t75;
-            let t91 = t74 + qd[5];
-            let t92 = t6 * t80;
-            let t93 = T::mul_add(
-                t48,
-                t62,
+            let t72 = qd[5] + t59;
+            let t73 = T::mul_add(
+                -T::from_f64(0.00590744776708),
+                t57,
+                T::mul_add(-t11, t33, t23 * t32)
+                    + T::mul_add(
+                        T::from_f64(0.00581618),
+                        t55,
+                        -T::from_f64(0.054780300000000004) * t38,
+                    ),
+            );
+            let t74 = T::mul_add(
+                T::from_f64(0.00581618),
+                t60,
+                T::mul_add(t22, t32, -T::from_f64(0.00590744776708) * t30)
+                    + T::mul_add(
+                        -T::from_f64(0.00047111058),
+                        t12,
+                        -T::from_f64(0.00035435414799999976) * t56,
+                    ),
+            );
+            let t75 = T::mul_add(
+                T::from_f64(0.054780300000000004),
+                t60,
+                T::mul_add(-t22, t33, T::from_f64(0.00590744776708) * t29)
+                    + T::mul_add(
+                        -T::from_f64(0.0058574286190799995),
+                        t12,
+                        -T::from_f64(0.00047111058) * t56,
+                    ),
+            );
+            let t76 = T::mul_add(T::from_f64(0.0114), t30, -T::from_f64(0.2073) * t29)
+                + t54 + T::mul_add(T::from_f64(0.2073), t12, T::from_f64(0.0114) * t56);
+            let t77 = T::from_f64(0.10375) * (T::mul_add(t40, t40, t46))
+                + T::mul_add(T::from_f64(0.0114), t57, -t42 - t55);
+            let t78 = T::mul_add(-t9, t50, t8 * t58);
+            let t79 = T::mul_add(t8, t50, t9 * t58);
+            let t80 = T::mul_add(qd[3], t40, T::mul_add(t4, t12, t5 * t57));
+            let t81 = T::mul_add(qd[3], t41, T::mul_add(t5, t12, -t4 * t57));
+            let t82 = T::mul_add(
+                T::from_f64(0.00000000000000000010842021724855044),
+                t79,
+                T::from_f64(0.00010000000000000503) * t78,
+            );
+            let t83 = T::mul_add(
+                T::from_f64(0.0650091026469637),
+                t79,
+                T::from_f64(0.00010000000000000503) * t72,
+            );
+            let t84 = T::mul_add(
+                -T::from_f64(0.00000000000000000010842021724855044),
+                t72,
+                T::from_f64(0.0650091026469637) * t78,
+            );
+            let t85 = T::mul_add(
+                -T::from_f64(0.004894691391055498),
+                t79,
                 T::mul_add(
-                    t51,
-                    t61,
-                    T::mul_add(T::from_f64(0.0114), t52, t49 + t50 - t44 - t45),
+                    -T::from_f64(0.000014022756617410007),
+                    t72,
+                    T::from_f64(0.0000000000000006979729257032011) * t78,
                 ),
             );
-            let t94 = T::mul_add(
-                -t39,
-                t61,
-                T::mul_add(T::from_f64(0.10375), t54 + t20 - t64, t76 - t77),
+            let t86 = T::mul_add(
+                -T::from_f64(0.0000000000000006979729257032011),
+                t79,
+                T::mul_add(
+                    T::from_f64(0.000000000000000000006709516445275485),
+                    t72,
+                    T::from_f64(0.004705147001603182) * t78,
+                ),
             );
-            let t95 = t8 * t81;
-            let t96 = t9 * t81;
-            let t97 = t72 * t83;
-            let t98 = t74 * t85;
-            let t99 = t72 * t87;
-            let t100 = t74 * t86;
-            let t101 = T::mul_add(-t9, t63, t8 * t72);
-            let t102 = t72 * t89;
-            let t103 = T::mul_add(t8, t63, t9 * t72);
-            let t104 = t7 * t94;
-            let t105 = t6 * t93;
-            let t106 = t6 * t94;
-            let t107 = t7 * t93;
-            let t108 = T::mul_add(-t6, t53, T::mul_add(t7, t80, qd[4] * t74));
-            let t109 = qd[5] * t101;
-            let t110 = qd[5] * t103;
+            let t87 = T::mul_add(
+                T::from_f64(0.000014022756617410007),
+                t79,
+                T::mul_add(
+                    T::from_f64(0.0007776443641723163),
+                    t72,
+                    T::from_f64(0.000000000000000000006709516445275485) * t78,
+                ),
+            );
+            let t88 = T::mul_add(-t4, t64, -t5 * t76);
+            let t89 = T::mul_add(-t5, t64, t4 * t76);
+            let t90 = T::mul_add(
+                T::from_f64(0.0013357060146000001),
+                t80,
+                T::mul_add(
+                    -T::from_f64(0.463),
+                    t63,
+                    T::mul_add(t40, t45, T::from_f64(0.0250914799819) * t46),
+                ),
+            );
+            let t91 = qdd[4] + t81;
+            let t92 = -t88;
+            let t93 = T::mul_add(
+                T::from_f64(0.0250914799819),
+                t80,
+                T::mul_add(
+                    T::from_f64(0.463),
+                    t89,
+                    T::mul_add(-T::from_f64(0.0013357060146000001), t46, -t35 * t45),
+                ),
+            );
+            let t94 = T::mul_add(T::from_f64(0.10375), t44 - t81, t88);
+            let t95 = T::mul_add(T::from_f64(0.10375), t49 - t80, -t89);
+            let t96 = T::mul_add(
+                T::from_f64(0.0017957741063972504),
+                t80,
+                T::mul_add(-t35, t47, t40 * t48)
+                    + T::mul_add(
+                        T::from_f64(0.0250914799819),
+                        t89,
+                        -T::from_f64(0.0013357060146000001) * t63,
+                    ),
+            );
+            let t97 = T::mul_add(
+                T::from_f64(0.0250914799819),
+                t92,
+                T::mul_add(t41, t48, -T::from_f64(0.0017957741063972504) * t44)
+                    + T::mul_add(
+                        T::from_f64(0.0017919207358628258),
+                        t81,
+                        T::from_f64(0.00007238626506919941) * t65,
+                    ),
+            );
+            let t98 = T::mul_add(
+                T::from_f64(0.0013357060146000001),
+                t92,
+                T::mul_add(-t41, t47, T::from_f64(0.0017957741063972504) * t43)
+                    + T::mul_add(
+                        T::from_f64(0.00007238626506919941),
+                        t81,
+                        T::from_f64(0.00009645337053442467) * t65,
+                    ),
+            );
+            let t99 = T::mul_add(qd[4], t58, -(T::mul_add(t7, t65, t6 * t80)));
+            let t100 = T::mul_add(qd[4], t59, -(T::mul_add(t6, t65, -t7 * t80)));
+            let t101 = T::mul_add(t6, t77, -t7 * t94);
+            let t102 = T::mul_add(t7, t77, t6 * t94);
+            let t103 = T::mul_add(
+                -T::from_f64(0.0230207699865),
+                t100,
+                T::mul_add(
+                    -T::from_f64(0.463),
+                    t95,
+                    T::mul_add(-t59, t68, T::from_f64(0.0013224560195000002) * t69),
+                ),
+            );
+            let t104 = T::mul_add(
+                T::from_f64(0.10375),
+                T::mul_add(t50, t59, t100),
+                -(T::mul_add(T::from_f64(0.10375), t80 - t49, t89)),
+            );
+            let t105 = qdd[5] + t99;
+            let t106 = -t101;
+            let t107 = T::mul_add(
+                -T::from_f64(0.0013224560195000002),
+                t100,
+                T::mul_add(
+                    T::from_f64(0.463),
+                    t102,
+                    T::mul_add(-T::from_f64(0.0230207699865), t69, -t50 * t68),
+                ),
+            );
+            let t108 = -T::from_f64(0.10375) * (T::mul_add(t50, t50, t69)) + t102;
+            let t109 = T::mul_add(T::from_f64(0.10375), t66 + t91, -t101);
+            let t110 = T::mul_add(
+                -T::from_f64(0.0015805219734713843),
+                t100,
+                T::mul_add(-t50, t70, -t59 * t71)
+                    + T::mul_add(
+                        T::from_f64(0.0013224560195000002),
+                        t102,
+                        -T::from_f64(0.0230207699865) * t95,
+                    ),
+            );
             let t111 = T::mul_add(
-                -T::from_f64(0.0650091026469637),
-                t101,
-                T::from_f64(0.00000000000000000010842021724855044) * t91,
+                T::from_f64(0.0013224560195000002),
+                t106,
+                T::mul_add(-t58, t71, T::from_f64(0.0015805219734713843) * t67)
+                    + T::mul_add(
+                        -T::from_f64(0.00009637730005078133),
+                        t99,
+                        T::from_f64(0.00006575368432434527) * t91,
+                    ),
             );
             let t112 = T::mul_add(
-                T::from_f64(0.00010000000000000503),
-                t101,
-                T::from_f64(0.00000000000000000010842021724855044) * t103,
-            );
-            let t113 = T::mul_add(
-                T::from_f64(0.0650091026469637),
-                t103,
-                T::from_f64(0.00010000000000000503) * t91,
-            );
-            let t114 = T::mul_add(
-                T::from_f64(0.004705147001603182),
-                t101,
-                T::mul_add(
-                    -T::from_f64(0.0000000000000006979729257032011),
-                    t103,
-                    T::from_f64(0.000000000000000000006709516445275485) * t91,
-                ),
-            );
-            let t115 = T::mul_add(
-                T::from_f64(0.000000000000000000006709516445275485),
-                t101,
-                T::mul_add(
-                    T::from_f64(0.000014022756617410007),
-                    t103,
-                    T::from_f64(0.0007776443641723163) * t91,
-                ),
-            );
-            let t116 = T::mul_add(
-                -T::from_f64(0.0000000000000006979729257032011),
-                t101,
-                T::mul_add(
-                    T::from_f64(0.004894691391055498),
-                    t103,
-                    T::from_f64(0.000014022756617410007) * t91,
-                ),
-            );
-            let t117 = t9 * t108;
-            let t118 = t8 * t108;
-            let t119 = T::mul_add(
-                -t74,
-                t75,
-                T::mul_add(T::from_f64(0.10375), t80 - t108, t78 + t79 - t73),
-            );
-            let t120 = T::mul_add(
-                t74,
-                t89,
-                T::mul_add(T::from_f64(0.10375), t81, -t104 - t105),
-            );
-            let t121 = t103 * t114;
-            let t122 = t101 * t116;
-            let t123 = t9 * t120;
-            let t124 = t8 * t119;
-            let t125 = t8 * t120;
-            let t126 = t9 * t119;
-            let t127 = T::mul_add(
-                T::from_f64(1.03),
-                t123 - t124,
-                T::mul_add(
-                    t91,
-                    t113,
-                    T::mul_add(
-                        t101,
-                        t112,
-                        T::mul_add(
-                            T::from_f64(0.0650091026469637),
-                            t118 + t96 - t110,
-                            T::from_f64(0.00000000000000000010842021724855044)
-                                * (qdd[5] + t82 - t92 - t67),
-                        ),
+                T::from_f64(0.0230207699865),
+                t106,
+                T::mul_add(t58, t70, T::from_f64(0.0015805219734713843) * t66)
+                    + T::mul_add(
+                        -T::from_f64(0.00006575368432434527),
+                        t99,
+                        T::from_f64(0.0015767446734206029) * t91,
                     ),
-                ),
             );
+            let t113 = T::mul_add(qd[5], t78, T::mul_add(-t8, t91, t9 * t100));
+            let t114 = T::mul_add(qd[5], t79, T::mul_add(-t9, t91, -t8 * t100));
+            let t115 = T::mul_add(t8, t104, t9 * t109);
+            let t116 = T::mul_add(-t9, t104, t8 * t109);
+            let t117 = T::mul_add(
+                T::from_f64(1.03),
+                t115,
+                T::mul_add(t72, t83, t78 * t82)
+                    + T::mul_add(
+                        -T::from_f64(0.0650091026469637),
+                        t114,
+                        T::from_f64(0.00000000000000000010842021724855044) * t105,
+                    ),
+            );
+            let t118 = T::mul_add(
+                -T::from_f64(1.03),
+                t116,
+                T::mul_add(t79, t82, -t72 * t84)
+                    + T::mul_add(
+                        T::from_f64(0.0650091026469637),
+                        t113,
+                        -T::from_f64(0.00010000000000000503) * t105,
+                    ),
+            );
+            let t119 = T::mul_add(
+                T::from_f64(1.03),
+                t108,
+                -(T::mul_add(t78, t84, t79 * t83))
+                    - (T::mul_add(
+                        T::from_f64(0.00010000000000000503),
+                        t114,
+                        -T::from_f64(0.00000000000000000010842021724855044) * t113,
+                    )),
+            );
+            let t120 = T::mul_add(-t72, t86, t78 * t87)
+                + T::mul_add(
+                    T::from_f64(0.0000000000000006979729257032011),
+                    t114,
+                    T::mul_add(
+                        T::from_f64(0.004894691391055498),
+                        t113,
+                        -T::from_f64(0.000014022756617410007) * t105,
+                    ),
+                )
+                + T::mul_add(
+                    -T::from_f64(0.0650091026469637),
+                    t116,
+                    T::from_f64(0.00000000000000000010842021724855044) * t108,
+                );
+            let t121 = T::mul_add(t79, t87, t72 * t85)
+                + T::mul_add(
+                    T::from_f64(0.004705147001603182),
+                    t114,
+                    T::mul_add(
+                        T::from_f64(0.0000000000000006979729257032011),
+                        t113,
+                        T::from_f64(0.000000000000000000006709516445275485) * t105,
+                    ),
+                )
+                + T::mul_add(
+                    -T::from_f64(0.0650091026469637),
+                    t115,
+                    -T::from_f64(0.00010000000000000503) * t108,
+                );
+            let t122 = T::mul_add(-t78, t85, -t79 * t86)
+                + T::mul_add(
+                    T::from_f64(0.000000000000000000006709516445275485),
+                    t114,
+                    T::mul_add(
+                        -T::from_f64(0.000014022756617410007),
+                        t113,
+                        T::from_f64(0.0007776443641723163) * t105,
+                    ),
+                )
+                + T::mul_add(
+                    T::from_f64(0.00010000000000000503),
+                    t116,
+                    T::from_f64(0.00000000000000000010842021724855044) * t115,
+                );
+            let t123 = t107 + t119;
+            let t124 = T::mul_add(t8, t118, -t9 * t117);
+            let t125 = T::mul_add(-t9, t118, -t8 * t117);
+            let t126 = T::mul_add(
+                -T::from_f64(0.463),
+                t106,
+                T::mul_add(
+                    -T::from_f64(0.0013224560195000002),
+                    t67,
+                    -T::from_f64(0.0230207699865) * t66,
+                )
+                    + T::mul_add(
+                        T::from_f64(0.0013224560195000002),
+                        t99,
+                        -T::from_f64(0.0230207699865) * t91,
+                    ),
+            ) + t124;
+            let t127 = t103 + t125;
             (
                 t64,
                 t65,
@@ -16743,601 +13650,105 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Kinova<T> {
             t156,
             t157,
             t158,
-            t159,
-            t160,
-            t161,
-            t162,
-            t163,
-            t164,
         ) = {
-            let t128 = T::mul_add(
-                T::from_f64(0.0650091026469637),
-                t124 - t123,
-                T::mul_add(
-                    t103,
-                    t115,
-                    T::mul_add(
-                        -t91,
-                        t116,
-                        T::mul_add(
-                            T::from_f64(0.004705147001603182),
-                            t110 - t118 - t96,
-                            T::mul_add(
-                                T::from_f64(0.0000000000000006979729257032011),
-                                t109 + t117 - t95,
-                                T::mul_add(
-                                    T::from_f64(0.00010000000000000503),
-                                    t90 + t102 + t106 - t107,
-                                    T::from_f64(0.000000000000000000006709516445275485)
-                                        * (qdd[5] + t82 - t92 - t67),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
+            let t128 = t111 + -t122;
             let t129 = T::mul_add(
-                T::from_f64(0.0650091026469637),
-                t125 + t126,
-                T::mul_add(
-                    t91,
-                    t114,
-                    T::mul_add(
-                        -t101,
-                        t115,
-                        T::mul_add(
-                            T::from_f64(0.0000000000000006979729257032011),
-                            t118 + t96 - t110,
-                            T::mul_add(
-                                T::from_f64(0.004894691391055498),
-                                t95 - t109 - t117,
-                                T::mul_add(
-                                    T::from_f64(0.00000000000000000010842021724855044),
-                                    t90 + t102 + t106 - t107,
-                                    T::from_f64(0.000014022756617410007)
-                                        * (qdd[5] + t82 - t92 - t67),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
+                -T::from_f64(0.10375),
+                -t125,
+                T::mul_add(t8, t121, -t9 * t120),
             );
             let t130 = T::mul_add(
-                T::from_f64(1.03),
-                t125 + t126,
-                T::mul_add(
-                    -t103,
-                    t112,
-                    T::mul_add(
-                        -t91,
-                        t111,
-                        T::mul_add(
-                            T::from_f64(0.0650091026469637),
-                            t95 - t109 - t117,
-                            T::from_f64(0.00010000000000000503)
-                                * (qdd[5] + t82 - t92 - t67),
-                        ),
-                    ),
-                ),
-            );
-            let t131 = T::mul_add(
-                -T::from_f64(0.00010000000000000503),
-                t125 + t126,
-                T::mul_add(
-                    T::from_f64(0.00000000000000000010842021724855044),
-                    t124 - t123,
-                    T::mul_add(
-                        -T::from_f64(0.0013224560195000002),
-                        t104 + t105,
-                        T::mul_add(
-                            T::from_f64(0.000000000000000000006709516445275485),
-                            t118 + t96 - t110,
-                            T::mul_add(
-                                T::from_f64(0.000014022756617410007),
-                                t109 + t117 - t95,
-                                T::mul_add(
-                                    -t72,
-                                    t88,
-                                    T::mul_add(
-                                        t63,
-                                        t86,
-                                        T::mul_add(
-                                            T::from_f64(0.0008740216642230976),
-                                            t92 + t67 - t82,
-                                            T::mul_add(
-                                                -T::from_f64(0.0007776443641723163),
-                                                qdd[5],
-                                                T::mul_add(
-                                                    T::from_f64(0.00006575368432434527),
-                                                    t81,
-                                                    t121 - t122,
-                                                ),
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t132 = T::mul_add(
-                T::from_f64(1.493),
-                t106 - t107,
-                T::mul_add(
-                    T::from_f64(0.00010000000000000503),
-                    t110 - t118 - t96,
-                    T::mul_add(
-                        T::from_f64(0.00000000000000000010842021724855044),
-                        t95 - t109 - t117,
-                        T::mul_add(
-                            T::from_f64(1.03),
-                            t90 + t102,
-                            T::mul_add(
-                                -t101,
-                                t111,
-                                T::mul_add(
-                                    t103,
-                                    t113,
-                                    T::mul_add(
-                                        t72,
-                                        t84,
-                                        T::mul_add(
-                                            t63,
-                                            t85,
-                                            T::from_f64(0.0013224560195000002) * t108,
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t133 = t9 * t127;
-            let t134 = t8 * t130;
-            let t135 = t8 * t127;
-            let t136 = t9 * t130;
-            let t137 = t8 * t129;
-            let t138 = t9 * t128;
-            let t139 = t6 * t132;
-            let t140 = t7 * t132;
-            let t141 = t7 * t131;
-            let t142 = T::mul_add(
                 T::from_f64(0.10375),
-                t136 - t135,
-                T::mul_add(
-                    T::from_f64(0.0013224560195000002),
-                    t107 - t106,
-                    T::mul_add(
-                        t8,
-                        t128,
-                        T::mul_add(
-                            t9,
-                            t129,
-                            T::mul_add(
-                                -t63,
-                                t87,
-                                T::mul_add(
-                                    -t74,
-                                    t88,
-                                    T::mul_add(
-                                        -T::from_f64(0.0015805219734713843),
-                                        t108,
-                                        T::mul_add(
-                                            T::from_f64(0.0230207699865),
-                                            t78 + t79 - t73,
-                                            T::from_f64(0.0023884048860993747) * t80,
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
+                -t124,
+                T::mul_add(-t9, t121, -t8 * t120),
             );
-            let t143 = T::mul_add(
+            let t131 = t93 + t127;
+            let t132 = t110 + t129;
+            let t133 = t112 + t130;
+            let t134 = T::mul_add(t6, t123, -t7 * t126);
+            let t135 = T::mul_add(
                 -T::from_f64(0.463),
-                t104 + t105,
+                t92,
                 T::mul_add(
-                    t63,
-                    t83,
-                    T::mul_add(
-                        t74,
-                        t84,
-                        T::mul_add(
-                            T::from_f64(0.0013224560195000002),
-                            t92 + t67 - t82,
-                            T::mul_add(T::from_f64(0.0230207699865), t81, t133 + t134),
-                        ),
+                    T::from_f64(0.0250914799819),
+                    t44,
+                    -T::from_f64(0.0013357060146000001) * t43,
+                )
+                    + T::mul_add(
+                        -T::from_f64(0.0250914799819),
+                        t81,
+                        -T::from_f64(0.0013357060146000001) * t65,
                     ),
-                ),
-            );
-            let t144 = T::mul_add(
-                T::from_f64(0.926),
-                t78 + t79,
-                T::mul_add(
-                    -T::from_f64(0.0230207699865),
-                    t108,
-                    T::mul_add(
-                        -T::from_f64(0.463),
-                        t73,
-                        T::mul_add(
-                            -t51,
-                            t56,
-                            T::mul_add(
-                                -t39,
-                                t57,
-                                T::mul_add(
-                                    T::from_f64(0.07312772998190001),
-                                    t80,
-                                    t97 + t136 - t98 - t135,
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t145 = t7 * t143;
-            let t146 = t6 * t143;
-            let t147 = t6 * t142;
-            let t148 = t4 * t144;
-            let t149 = t5 * t144;
-            let t150 = T::mul_add(
-                T::from_f64(0.07312772998190001),
-                t78 + t79,
-                T::mul_add(
-                    T::from_f64(0.10375),
-                    t97 + t136 - t98 - t135,
-                    T::mul_add(
-                        -T::from_f64(0.0023884048860993747),
-                        t108,
-                        T::mul_add(
-                            -T::from_f64(0.04803625),
-                            t73,
-                            T::mul_add(
-                                t6,
-                                t131,
-                                T::mul_add(
-                                    -t7,
-                                    t142,
-                                    T::mul_add(
-                                        -t39,
-                                        t58,
-                                        T::mul_add(
-                                            t48,
-                                            t59,
-                                            T::mul_add(
-                                                T::from_f64(0.00677953504389725),
-                                                t80,
-                                                T::mul_add(
-                                                    T::from_f64(0.0013357060146000001),
-                                                    t49 + t50 - t44 - t45,
-                                                    T::from_f64(0.000015227048566440002) * t52,
-                                                ),
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t151 = T::mul_add(
+            ) + t134;
+            let t136 = t90 + T::mul_add(t7, t123, t6 * t126);
+            let t137 = T::mul_add(
                 T::from_f64(0.10375),
-                t133 + t134 + t139 - t145,
-                T::mul_add(
-                    -T::from_f64(0.0230207699865),
-                    t104 + t105,
-                    T::mul_add(
-                        T::from_f64(0.0250914799819),
-                        t76 - t77,
-                        T::mul_add(
-                            T::from_f64(0.00006575368432434527),
-                            t92 + t67 - t82,
-                            T::mul_add(
-                                t51,
-                                t59,
-                                T::mul_add(
-                                    -t39,
-                                    t60,
-                                    T::mul_add(
-                                        T::from_f64(0.0033686654092834286),
-                                        t54 + t20 - t64,
-                                        T::mul_add(
-                                            T::from_f64(0.0015767446734206029),
-                                            qdd[4],
-                                            T::mul_add(
-                                                T::from_f64(0.00007238626506919941),
-                                                t53,
-                                                t99 + t100 + t137 - t138,
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
+                t127,
+                T::mul_add(t6, t128, -t7 * t132),
             );
-            let t152 = T::mul_add(
-                T::from_f64(0.463),
-                t76 - t77,
+            let t138 = t97 + T::mul_add(T::from_f64(0.10375), -t134, t133);
+            let t139 = t98 + T::mul_add(t7, t128, t6 * t132);
+            let t140 = T::mul_add(t4, t131, -t5 * t135);
+            let t141 = T::mul_add(-t5, t131, -t4 * t135);
+            let t142 = t61 + -t136;
+            let t143 = t96 + t137;
+            let t144 = -t140;
+            let t145 = T::mul_add(
+                -T::from_f64(0.6763),
+                t60,
                 T::mul_add(
-                    -t39,
-                    t55,
-                    T::mul_add(
-                        t48,
-                        t56,
-                        T::mul_add(
-                            T::from_f64(0.0250914799819),
-                            t54 + t20 - t64,
-                            T::mul_add(
-                                T::from_f64(0.0013357060146000001),
-                                t53,
-                                t139 - t145,
-                            ),
-                        ),
+                    T::from_f64(0.00581618),
+                    t30,
+                    -T::from_f64(0.054780300000000004) * t29,
+                )
+                    + T::mul_add(
+                        T::from_f64(0.054780300000000004),
+                        t12,
+                        T::from_f64(0.00581618) * t56,
                     ),
-                ),
-            );
-            let t153 = T::mul_add(
-                -T::from_f64(1.1393),
-                t44 + t45,
-                T::mul_add(
-                    T::from_f64(0.0013357060146000001),
-                    t80,
-                    T::mul_add(
-                        T::from_f64(0.463),
-                        t49 + t50,
-                        T::mul_add(
-                            t23,
-                            t32,
-                            T::mul_add(
-                                t11,
-                                t30,
-                                T::mul_add(
-                                    T::from_f64(0.011094380000000001),
-                                    t52,
-                                    t68 + t69 - t146 - t140,
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t154 = t5 * t152;
-            let t155 = t4 * t152;
-            let t156 = t4 * t150;
-            let t157 = t5 * t151;
-            let t158 = t2 * t153;
-            let t159 = T::mul_add(
-                T::from_f64(0.6763),
-                t43 - t42,
-                T::mul_add(
-                    t11,
-                    t31,
-                    T::mul_add(
-                        -t24,
-                        t32,
-                        T::mul_add(
-                            T::from_f64(0.00581618),
-                            t29 + t40 - t41,
-                            T::mul_add(
-                                T::from_f64(0.054780300000000004),
-                                t12,
-                                t154 + t148,
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t160 = T::mul_add(
+            ) + t140;
+            let t146 = t74 + T::mul_add(T::from_f64(0.0114), t144, -t139);
+            let t147 = T::mul_add(t2, t142, -t3 * t145);
+            let t148 = T::mul_add(t4, t138, -t5 * t143)
+                + T::mul_add(-T::from_f64(0.2073), -t141, -T::from_f64(0.0114) * t136);
+            let t149 = T::mul_add(
                 T::from_f64(0.2073),
-                t149 - t155,
-                T::mul_add(
-                    -T::from_f64(0.011094380000000001),
-                    t44 + t45,
-                    T::mul_add(
-                        T::from_f64(0.022459923),
-                        t18,
-                        T::mul_add(
-                            T::from_f64(0.0114),
-                            t68 + t69 - t146 - t140,
-                            T::mul_add(
-                                T::from_f64(0.000015227048566440002),
-                                t80,
-                                T::mul_add(
-                                    T::from_f64(0.0052782),
-                                    t49 + t50,
-                                    T::mul_add(
-                                        -t4,
-                                        t151,
-                                        T::mul_add(
-                                            t5,
-                                            t150,
-                                            T::mul_add(
-                                                t11,
-                                                t35,
-                                                T::mul_add(
-                                                    -t24,
-                                                    t34,
-                                                    T::mul_add(
-                                                        T::from_f64(0.00596761924708),
-                                                        t52,
-                                                        T::mul_add(
-                                                            T::from_f64(0.044919846),
-                                                            t14,
-                                                            T::from_f64(0.00008764848) * t10,
-                                                        ),
-                                                    ),
-                                                ),
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
+                t144,
+                T::mul_add(-t5, t138, -t4 * t143),
             );
-            let t161 = T::mul_add(
-                T::from_f64(0.0114),
-                t154 + t148,
+            let t150 = T::mul_add(
+                T::from_f64(0.99),
+                t24,
                 T::mul_add(
-                    T::from_f64(0.0013357060146000001),
-                    t76 - t77,
-                    T::mul_add(
-                        T::from_f64(0.00581618),
-                        t43 - t42,
-                        T::mul_add(
-                            T::from_f64(0.00007238626506919941),
-                            t54 + t20 - t64,
-                            T::mul_add(
-                                -t23,
-                                t34,
-                                T::mul_add(
-                                    t11,
-                                    t33,
-                                    T::mul_add(
-                                        T::from_f64(0.00045080751853442445),
-                                        t29 + t40 - t41,
-                                        T::mul_add(
-                                            T::from_f64(0.00009645337053442467),
-                                            qdd[3],
-                                            T::mul_add(
-                                                T::from_f64(0.00047111058),
-                                                t12,
-                                                t71 + t147 + t141 - t70,
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
+                    -T::from_f64(0.20443499999999998),
+                    t16,
+                    T::from_f64(0.0099) * t15,
+                )
+                    + T::mul_add(
+                        -T::from_f64(0.0099),
+                        t26,
+                        T::from_f64(0.20443499999999998) * qdd[1],
                     ),
-                ),
+            ) + t147;
+            let t151 = T::mul_add(
+                -T::from_f64(0.0099),
+                t27,
+                T::mul_add(T::from_f64(0.99), t25, t39),
+            ) + T::mul_add(t3, t142, t2 * t145);
+            let t152 = t73 + t148;
+            let t153 = t75 + t149;
+            let t154 = T::mul_add(
+                T::from_f64(0.41),
+                t62 + t141,
+                T::mul_add(t2, t146, -t3 * t152),
             );
-            let t162 = t3 * t159;
-            let t163 = T::mul_add(
-                -T::from_f64(0.011484000000000001),
-                t18,
-                T::mul_add(
-                    T::from_f64(0.20443499999999998),
-                    t17,
-                    T::mul_add(
-                        -t3,
-                        t153,
-                        T::mul_add(
-                            t2,
-                            t159,
-                            T::mul_add(
-                                qd[1],
-                                T::mul_add(
-                                    T::from_f64(0.0099),
-                                    t13,
-                                    T::from_f64(0.20443499999999998) * qd[1],
-                                ),
-                                T::mul_add(
-                                    -T::from_f64(0.0099),
-                                    t14,
-                                    T::from_f64(9.7119) * t1,
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t164 = T::mul_add(
-                t1,
-                T::mul_add(
-                    T::from_f64(0.0009068400000000028),
-                    t19,
-                    T::mul_add(
-                        t3,
-                        t161,
-                        T::mul_add(
-                            t2,
-                            t160,
-                            T::mul_add(
-                                -qd[0],
-                                t0 * t21,
-                                T::mul_add(
-                                    T::from_f64(0.051926035490999986),
-                                    t15,
-                                    T::mul_add(
-                                        T::from_f64(0.09711900000000001),
-                                        t0,
-                                        T::from_f64(0.00204435) * qdd[1],
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-                T::mul_add(
-                    -t0,
-                    T::mul_add(
-                        -T::from_f64(0.16651890549099999),
-                        t18,
-                        T::mul_add(
-                            T::from_f64(0.41),
-                            T::mul_add(t24, t30, T::mul_add(t23, t31, t155 - t149)),
-                            T::mul_add(
-                                -T::from_f64(0.022459923),
-                                t52,
-                                T::mul_add(
-                                    -t2,
-                                    t161,
-                                    T::mul_add(
-                                        t3,
-                                        t160,
-                                        T::mul_add(
-                                            qd[1],
-                                            t22,
-                                            T::mul_add(
-                                                -qd[0],
-                                                t1 * t21,
-                                                T::mul_add(
-                                                    -T::from_f64(0.28018909549099996),
-                                                    t14,
-                                                    T::mul_add(
-                                                        -T::from_f64(0.0007707488),
-                                                        t10,
-                                                        T::from_f64(0.09711900000000001) * t1,
-                                                    ),
-                                                ),
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                    T::mul_add(
-                        T::from_f64(0.0016),
-                        T::mul_add(
-                            -t0,
-                            t163,
-                            t1
-                                * (T::mul_add(
-                                    T::from_f64(0.011484000000000001),
-                                    t19,
-                                    T::mul_add(
-                                        T::from_f64(9.7119),
-                                        t0,
-                                        T::mul_add(
-                                            T::from_f64(0.20443499999999998),
-                                            qdd[1] - t16,
-                                            -t162 - t158,
-                                        ),
-                                    ),
-                                )),
-                        ),
-                        T::from_f64(0.0006011508000000001) * qdd[0],
-                    ),
-                ),
+            let t155 = t52 + T::mul_add(t3, t146, t2 * t152);
+            let t156 = t53 + T::mul_add(-T::from_f64(0.41), -t147, -t153);
+            let t157 = T::mul_add(-t1, t155, -t0 * (t51 + t154));
+            let t158 = T::mul_add(
+                T::from_f64(0.0016),
+                T::mul_add(-t0, t151, t1 * t150),
+                t157,
             );
             (
                 t128,
@@ -17371,129 +13782,15 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Kinova<T> {
                 t156,
                 t157,
                 t158,
-                t159,
-                t160,
-                t161,
-                t162,
-                t163,
-                t164,
             )
         };
         [
-            t164,
-            T::mul_add(
-                -T::from_f64(0.41),
-                t162 + t158,
-                T::mul_add(
-                    T::from_f64(0.2073),
-                    t154 + t148,
-                    T::mul_add(
-                        T::from_f64(0.054780300000000004),
-                        t43 - t42,
-                        T::mul_add(
-                            T::from_f64(0.0023714459999999997),
-                            t19,
-                            T::mul_add(
-                                T::from_f64(0.00047111058),
-                                t29 + t40 - t41,
-                                T::mul_add(
-                                    qd[0],
-                                    t0 * t22,
-                                    T::mul_add(
-                                        -T::from_f64(0.05281703549099999),
-                                        t16,
-                                        T::mul_add(
-                                            -T::from_f64(0.00204435),
-                                            t15,
-                                            T::mul_add(
-                                                T::from_f64(2.00550735),
-                                                t0,
-                                                T::mul_add(
-                                                    -T::from_f64(0.0058574286190799995),
-                                                    qdd[2],
-                                                    T::mul_add(
-                                                        T::from_f64(0.05857546411007999),
-                                                        qdd[1],
-                                                        t46 + t156 + t157 - t47,
-                                                    ),
-                                                ),
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
-            T::mul_add(
-                -T::from_f64(0.2073),
-                t154 + t148,
-                T::mul_add(
-                    T::from_f64(0.054780300000000004),
-                    t42 - t43,
-                    T::mul_add(
-                        T::from_f64(0.00047111058),
-                        t41 - t29 - t40,
-                        T::mul_add(
-                            -T::from_f64(0.0058574286190799995),
-                            t12,
-                            t47 - t46 - t156 - t157,
-                        ),
-                    ),
-                ),
-            ),
-            T::mul_add(
-                T::from_f64(0.0013357060146000001),
-                t76 - t77,
-                T::mul_add(
-                    T::from_f64(0.00007238626506919941),
-                    t54 + t20 - t64,
-                    T::mul_add(
-                        T::from_f64(0.00009645337053442467),
-                        t53,
-                        t71 + t147 + t141 - t70,
-                    ),
-                ),
-            ),
-            T::mul_add(
-                T::from_f64(0.10375),
-                t133 + t134,
-                T::mul_add(
-                    -T::from_f64(0.0230207699865),
-                    t104 + t105,
-                    T::mul_add(
-                        T::from_f64(0.00006575368432434527),
-                        t92 + t67 - t82,
-                        T::mul_add(
-                            T::from_f64(0.0015767446734206029),
-                            t81,
-                            t99 + t100 + t137 - t138,
-                        ),
-                    ),
-                ),
-            ),
-            T::mul_add(
-                T::from_f64(0.00010000000000000503),
-                t125 + t126,
-                T::mul_add(
-                    T::from_f64(0.00000000000000000010842021724855044),
-                    t123 - t124,
-                    T::mul_add(
-                        T::from_f64(0.000000000000000000006709516445275485),
-                        t110 - t118 - t96,
-                        T::mul_add(
-                            T::from_f64(0.000014022756617410007),
-                            t95 - t109 - t117,
-                            T::mul_add(
-                                T::from_f64(0.0007776443641723163),
-                                qdd[5] + t82 - t92 - t67,
-                                t122 - t121,
-                            ),
-                        ),
-                    ),
-                ),
-            ),
+            T::mul_add(T::from_f64(0.0006011508000000001), qdd[0], t158),
+            t156,
+            t153,
+            t139,
+            t133,
+            t122,
         ]
     }
     /// Forward dynamics: qdd = M(q)^-1 (tau - b(q, qd) - G(q)).
@@ -17502,7 +13799,7 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Kinova<T> {
     /// model and finite inputs); `try_forward_dynamics` says which pivot failed.
     ///
     /// Route: M and b + G as in `mass_matrix` and `bias`, then an unrolled L^T D L solve without fill-in.
-    /// Operations: 709 mul, 623 add, 5 div, 5 sin, 5 cos.
+    /// Operations: 684 mul, 489 add, 5 div, 5 sin, 5 cos.
     fn forward_dynamics(&self, q: &[T; 6], qd: &[T; 6], tau: &[T; 6]) -> [T; 6] {
         match self.forward_dynamics_checked(q, qd, tau) {
             Ok((qdd, failures)) => ::eomgen_runtime::lane::nan_failed(qdd, &failures),
@@ -17512,7 +13809,7 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Kinova<T> {
     /// The kinetic energy T = qd^T M(q) qd / 2.
     ///
     /// Route: a sum over body velocities, O(N).
-    /// Operations: 156 mul, 92 add, 0 div, 5 sin, 5 cos.
+    /// Operations: 157 mul, 95 add, 0 div, 5 sin, 5 cos.
     fn kinetic_energy(&self, q: &[T; 6], qd: &[T; 6]) -> T {
         let ([s1, s2, s3, s4, s5], [c1, c2, c3, c4, c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
             q[1],
@@ -17533,270 +13830,247 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Kinova<T> {
         let t9 = c5;
         let t10 = qd[1] - qd[2];
         let t11 = qd[0] * t1;
-        let t12 = qd[0] * t0 * t3;
-        let t13 = qd[0] * t1 * t2;
+        let t12 = qd[0] * qd[0] * t0 * t0;
+        let t13 = qd[0] * t0 * t3;
         let t14 = qd[0] * t0 * t2;
-        let t15 = qd[0] * t1 * t3;
-        let t16 = t12 - t13;
-        let t17 = t14 + t15;
-        let t18 = T::mul_add(T::from_f64(0.0016), t11, T::from_f64(0.41) * qd[1]);
-        let t19 = t17 + qd[3];
-        let t20 = t3 * t18;
-        let t21 = t2 * t18;
-        let t22 = T::mul_add(-T::from_f64(0.2073), t16, T::from_f64(0.41) * qd[0] * t0);
-        let t23 = T::mul_add(t5, t10, t4 * t16);
-        let t24 = T::mul_add(-t4, t10, t5 * t16);
-        let t25 = T::mul_add(
+        let t15 = T::mul_add(-qd[0], t1 * t2, t13);
+        let t16 = T::mul_add(qd[0], t1 * t3, t14);
+        let t17 = T::mul_add(T::from_f64(0.0016), t11, T::from_f64(0.41) * qd[1]);
+        let t18 = qd[3] + t16;
+        let t19 = t3 * t17;
+        let t20 = t2 * t17;
+        let t21 = T::mul_add(-T::from_f64(0.2073), t15, T::from_f64(0.41) * qd[0] * t0);
+        let t22 = T::mul_add(t5, t10, t4 * t15);
+        let t23 = T::mul_add(-t4, t10, t5 * t15);
+        let t24 = T::mul_add(T::from_f64(0.0016), t13, -t20);
+        let t25 = T::mul_add(T::from_f64(0.0016), t14, t19);
+        let t26 = qd[4] + t22;
+        let t27 = T::mul_add(T::from_f64(0.2073), t10, T::from_f64(0.0114) * t16)
+            + T::mul_add(-T::from_f64(0.0016), t14, -t19);
+        let t28 = T::mul_add(
             T::from_f64(0.0114),
             t15,
+            T::mul_add(-T::from_f64(0.0016), t13, t20),
+        );
+        let t29 = T::mul_add(
+            t10,
             T::mul_add(
-                T::from_f64(0.0098),
-                t14,
-                T::mul_add(T::from_f64(0.2073), t10, -t20),
+                T::from_f64(0.0058574286190799995),
+                t10,
+                T::from_f64(0.00047111058) * t16,
+            ),
+            T::mul_add(
+                t16,
+                T::mul_add(
+                    T::from_f64(0.00047111058),
+                    t10,
+                    T::from_f64(0.00035435414799999976) * t16,
+                ),
+                T::from_f64(0.00590744776708) * t15 * t15,
             ),
         );
-        let t26 = T::mul_add(
-            -T::from_f64(0.0114),
-            t13,
-            T::mul_add(T::from_f64(0.0098), t12, t21),
-        );
-        let t27 = T::mul_add(T::from_f64(0.0016), t12, -t21);
-        let t28 = T::mul_add(T::from_f64(0.0016), t14, t20);
-        let t29 = t23 + qd[4];
-        let t30 = T::mul_add(t6, t19, t7 * t24);
-        let t31 = T::mul_add(-t7, t19, t6 * t24);
-        let t32 = T::mul_add(t5, t22, t4 * t25);
-        let t33 = T::mul_add(-t4, t22, t5 * t25);
-        let t34 = t31 + qd[5];
-        let t35 = T::mul_add(T::from_f64(0.10375), t23, t33);
-        let t36 = T::mul_add(T::from_f64(0.10375), t24, -t32);
-        let t37 = T::mul_add(T::from_f64(0.10375), t24 - t30, -t32);
-        let t38 = T::mul_add(-t9, t29, t8 * t30);
-        let t39 = T::mul_add(t8, t29, t9 * t30);
-        let t40 = T::mul_add(-t6, t26, t7 * t35);
-        let t41 = T::mul_add(t7, t26, t6 * t35);
-        let t42 = T::mul_add(T::from_f64(0.10375), t29, -t40);
-        let t43 = T::mul_add(t8, t37, t9 * t42);
-        let t44 = T::mul_add(-t9, t37, t8 * t42);
-        let t45 = T::mul_add(
-            T::from_f64(0.515),
-            T::mul_add(t44, t44, t43 * t43),
+        let t30 = T::mul_add(t6, t18, t7 * t23);
+        let t31 = T::mul_add(-t7, t18, t6 * t23);
+        let t32 = T::mul_add(
+            -T::from_f64(0.022459923),
+            qd[0] * t0 * t15,
             T::mul_add(
-                T::from_f64(0.7465),
-                t41 * t41,
+                -T::from_f64(0.00581618),
+                t15 * t24,
+                -(T::mul_add(
+                    T::from_f64(0.054780300000000004),
+                    t10,
+                    T::from_f64(0.00581618) * t16,
+                )) * t25,
+            ),
+        );
+        let t33 = qd[5] + t31;
+        let t34 = T::mul_add(t4, t21, -t5 * t27);
+        let t35 = T::mul_add(t5, t21, t4 * t27);
+        let t36 = T::mul_add(
+            t18,
+            T::mul_add(
+                T::from_f64(0.00009645337053442467),
+                t18,
+                T::from_f64(0.00007238626506919941) * t22,
+            ),
+            T::mul_add(
+                t22,
                 T::mul_add(
-                    T::from_f64(0.2315),
+                    T::from_f64(0.00007238626506919941),
+                    t18,
+                    T::from_f64(0.0017919207358628258) * t22,
+                ),
+                T::from_f64(0.0017957741063972504) * t23 * t23,
+            ),
+        );
+        let t37 = T::mul_add(-t9, t26, t8 * t30);
+        let t38 = T::mul_add(t8, t26, t9 * t30);
+        let t39 = T::mul_add(T::from_f64(0.10375), t22, -t34);
+        let t40 = T::mul_add(T::from_f64(0.10375), t23, -t35);
+        let t41 = -t34;
+        let t42 = T::mul_add(
+            T::from_f64(0.10375),
+            t30,
+            T::mul_add(-T::from_f64(0.10375), t23, t35),
+        );
+        let t43 = T::mul_add(
+            t26,
+            T::mul_add(
+                -T::from_f64(0.00006575368432434527),
+                t31,
+                T::from_f64(0.0015767446734206029) * t26,
+            ),
+            T::mul_add(
+                -t31,
+                T::mul_add(
+                    -T::from_f64(0.00009637730005078133),
+                    t31,
+                    T::from_f64(0.00006575368432434527) * t26,
+                ),
+                T::from_f64(0.0015805219734713843) * t30 * t30,
+            ),
+        );
+        let t44 = T::mul_add(-t6, t28, t7 * t39);
+        let t45 = T::mul_add(t7, t28, t6 * t39);
+        let t46 = T::mul_add(
+            T::from_f64(0.0013357060146000001),
+            t23 * t28,
+            T::mul_add(
+                -T::from_f64(0.0250914799819),
+                t23 * t35,
+                (T::mul_add(
+                    T::from_f64(0.0013357060146000001),
+                    t18,
+                    T::from_f64(0.0250914799819) * t22,
+                )) * t41,
+            ),
+        );
+        let t47 = T::mul_add(T::from_f64(0.10375), t26, -t44);
+        let t48 = t45 * t45;
+        let t49 = T::mul_add(
+            t33,
+            T::mul_add(
+                T::from_f64(0.000014022756617410007),
+                t38,
+                T::mul_add(
+                    T::from_f64(0.0007776443641723163),
+                    t33,
+                    T::from_f64(0.000000000000000000006709516445275485) * t37,
+                ),
+            ),
+            T::mul_add(
+                t37,
+                T::mul_add(
+                    -T::from_f64(0.0000000000000006979729257032011),
+                    t38,
                     T::mul_add(
-                        t36,
-                        t36,
+                        T::from_f64(0.000000000000000000006709516445275485),
+                        t33,
+                        T::from_f64(0.004705147001603182) * t37,
+                    ),
+                ),
+                -t38
+                    * (T::mul_add(
+                        -T::from_f64(0.004894691391055498),
+                        t38,
                         T::mul_add(
-                            t40,
-                            t40,
-                            T::mul_add(t26, t26, T::mul_add(t32, t32, t33 * t33)),
+                            -T::from_f64(0.000014022756617410007),
+                            t33,
+                            T::from_f64(0.0000000000000006979729257032011) * t37,
                         ),
+                    )),
+            ),
+        );
+        let t50 = T::mul_add(
+            -T::from_f64(0.0230207699865),
+            t30 * t40,
+            T::mul_add(
+                -T::from_f64(0.0013224560195000002),
+                t30 * t45,
+                -(T::mul_add(
+                    -T::from_f64(0.0013224560195000002),
+                    t31,
+                    T::from_f64(0.0230207699865) * t26,
+                )) * t44,
+            ),
+        );
+        let t51 = T::mul_add(-t8, t42, t9 * t47);
+        let t52 = T::mul_add(t9, t42, t8 * t47);
+        let t53 = T::mul_add(
+            T::mul_add(
+                T::from_f64(0.00000000000000000010842021724855044),
+                t38,
+                T::from_f64(0.00010000000000000503) * t37,
+            ),
+            t45,
+            T::mul_add(
+                T::mul_add(
+                    T::from_f64(0.0650091026469637),
+                    t38,
+                    T::from_f64(0.00010000000000000503) * t33,
+                ),
+                t52,
+                -(T::mul_add(
+                    -T::from_f64(0.00000000000000000010842021724855044),
+                    t33,
+                    T::from_f64(0.0650091026469637) * t37,
+                )) * t51,
+            ),
+        );
+        let t54 = T::mul_add(
+            T::from_f64(0.515),
+            T::mul_add(t52, t52, T::mul_add(t51, t51, t48)),
+            T::mul_add(
+                T::from_f64(0.2315),
+                T::mul_add(t28, t28, T::mul_add(t35, t35, t41 * t41))
+                    + T::mul_add(t40, t40, T::mul_add(t44, t44, t48)),
+                T::mul_add(
+                    T::from_f64(0.33815),
+                    T::mul_add(
+                        t24,
+                        t24,
+                        T::mul_add(t25, t25, T::from_f64(0.16809999999999997) * t12),
                     ),
                     T::mul_add(
-                        -T::from_f64(0.41),
-                        qd[0] * t0 * (T::from_f64(0.054780300000000004) * t16),
+                        T::from_f64(0.5),
                         T::mul_add(
+                            qd[1],
                             T::mul_add(
-                                T::from_f64(0.00010000000000000503),
-                                t38,
-                                T::from_f64(0.00000000000000000010842021724855044) * t39,
+                                T::from_f64(0.00204435),
+                                t11,
+                                T::from_f64(0.05271803549099999) * qd[1],
                             ),
-                            t41,
                             T::mul_add(
+                                qd[0],
+                                t1
+                                    * (T::mul_add(
+                                        T::from_f64(0.0008910000000000028),
+                                        t11,
+                                        T::from_f64(0.00204435) * qd[1],
+                                    )),
+                                t29 + t36 + t43 + t49,
+                            ),
+                        ),
+                        T::mul_add(
+                            T::from_f64(0.495),
+                            T::from_f64(0.00000256)
+                                * (T::mul_add(qd[0], qd[0] * t1 * t1, t12)),
+                            T::mul_add(
+                                T::from_f64(0.0016),
+                                qd[0] * t1
+                                    * (T::mul_add(
+                                        T::from_f64(0.0099),
+                                        t11,
+                                        T::from_f64(0.20443499999999998) * qd[1],
+                                    )),
                                 T::mul_add(
-                                    T::from_f64(0.0650091026469637),
-                                    t39,
-                                    T::from_f64(0.00010000000000000503) * t34,
-                                ),
-                                t44,
-                                T::mul_add(
+                                    T::from_f64(0.026424357745499994),
+                                    t12,
                                     T::mul_add(
-                                        -T::from_f64(0.0650091026469637),
-                                        t38,
-                                        T::from_f64(0.00000000000000000010842021724855044) * t34,
-                                    ),
-                                    t43,
-                                    T::mul_add(
-                                        -(T::from_f64(0.0230207699865) * t30),
-                                        t36,
-                                        T::mul_add(
-                                            -(T::from_f64(0.0013224560195000002) * t30),
-                                            t41,
-                                            T::mul_add(
-                                                -(T::mul_add(
-                                                    -T::from_f64(0.0013224560195000002),
-                                                    t31,
-                                                    T::from_f64(0.0230207699865) * t29,
-                                                )),
-                                                t40,
-                                                T::mul_add(
-                                                    T::from_f64(0.0013357060146000001) * t24,
-                                                    t26,
-                                                    T::mul_add(
-                                                        -(T::from_f64(0.0250914799819) * t24),
-                                                        t32,
-                                                        T::mul_add(
-                                                            T::mul_add(
-                                                                T::from_f64(0.0250914799819),
-                                                                t23,
-                                                                T::from_f64(0.0013357060146000001) * t19,
-                                                            ),
-                                                            t33,
-                                                            T::mul_add(
-                                                                -(T::from_f64(0.00581618) * t16),
-                                                                t27,
-                                                                T::mul_add(
-                                                                    -(T::mul_add(
-                                                                        T::from_f64(0.00581618),
-                                                                        t17,
-                                                                        T::from_f64(0.054780300000000004) * t10,
-                                                                    )),
-                                                                    t28,
-                                                                    T::mul_add(
-                                                                        T::from_f64(0.33815),
-                                                                        T::mul_add(t27, t27, t28 * t28),
-                                                                        T::mul_add(
-                                                                            T::from_f64(0.5),
-                                                                            T::mul_add(
-                                                                                t34,
-                                                                                T::mul_add(
-                                                                                    T::from_f64(0.000000000000000000006709516445275485),
-                                                                                    t38,
-                                                                                    T::mul_add(
-                                                                                        T::from_f64(0.000014022756617410007),
-                                                                                        t39,
-                                                                                        T::from_f64(0.0007776443641723163) * t34,
-                                                                                    ),
-                                                                                ),
-                                                                                T::mul_add(
-                                                                                    t38,
-                                                                                    T::mul_add(
-                                                                                        T::from_f64(0.004705147001603182),
-                                                                                        t38,
-                                                                                        T::mul_add(
-                                                                                            -T::from_f64(0.0000000000000006979729257032011),
-                                                                                            t39,
-                                                                                            T::from_f64(0.000000000000000000006709516445275485) * t34,
-                                                                                        ),
-                                                                                    ),
-                                                                                    T::mul_add(
-                                                                                        t39,
-                                                                                        T::mul_add(
-                                                                                            -T::from_f64(0.0000000000000006979729257032011),
-                                                                                            t38,
-                                                                                            T::mul_add(
-                                                                                                T::from_f64(0.004894691391055498),
-                                                                                                t39,
-                                                                                                T::from_f64(0.000014022756617410007) * t34,
-                                                                                            ),
-                                                                                        ),
-                                                                                        T::mul_add(
-                                                                                            t29,
-                                                                                            T::mul_add(
-                                                                                                -T::from_f64(0.00006575368432434527),
-                                                                                                t31,
-                                                                                                T::from_f64(0.0015767446734206029) * t29,
-                                                                                            ),
-                                                                                            T::mul_add(
-                                                                                                -t31,
-                                                                                                T::mul_add(
-                                                                                                    -T::from_f64(0.00009637730005078133),
-                                                                                                    t31,
-                                                                                                    T::from_f64(0.00006575368432434527) * t29,
-                                                                                                ),
-                                                                                                T::mul_add(
-                                                                                                    t30,
-                                                                                                    T::from_f64(0.0015805219734713843) * t30,
-                                                                                                    T::mul_add(
-                                                                                                        t19,
-                                                                                                        T::mul_add(
-                                                                                                            T::from_f64(0.00007238626506919941),
-                                                                                                            t23,
-                                                                                                            T::from_f64(0.00009645337053442467) * t19,
-                                                                                                        ),
-                                                                                                        T::mul_add(
-                                                                                                            t23,
-                                                                                                            T::mul_add(
-                                                                                                                T::from_f64(0.0017919207358628258),
-                                                                                                                t23,
-                                                                                                                T::from_f64(0.00007238626506919941) * t19,
-                                                                                                            ),
-                                                                                                            T::mul_add(
-                                                                                                                t24,
-                                                                                                                T::from_f64(0.0017957741063972504) * t24,
-                                                                                                                T::mul_add(
-                                                                                                                    t10,
-                                                                                                                    T::mul_add(
-                                                                                                                        T::from_f64(0.00047111058),
-                                                                                                                        t17,
-                                                                                                                        T::from_f64(0.0058574286190799995) * t10,
-                                                                                                                    ),
-                                                                                                                    T::mul_add(
-                                                                                                                        t17,
-                                                                                                                        T::mul_add(
-                                                                                                                            T::from_f64(0.00035435414799999976),
-                                                                                                                            t17,
-                                                                                                                            T::from_f64(0.00047111058) * t10,
-                                                                                                                        ),
-                                                                                                                        T::mul_add(
-                                                                                                                            t16,
-                                                                                                                            T::from_f64(0.00590744776708) * t16,
-                                                                                                                            T::mul_add(
-                                                                                                                                qd[1],
-                                                                                                                                T::mul_add(
-                                                                                                                                    T::from_f64(0.00204435),
-                                                                                                                                    t11,
-                                                                                                                                    T::from_f64(0.05271803549099999) * qd[1],
-                                                                                                                                ),
-                                                                                                                                qd[0] * t1
-                                                                                                                                    * (T::mul_add(
-                                                                                                                                        T::from_f64(0.0008910000000000028),
-                                                                                                                                        t11,
-                                                                                                                                        T::from_f64(0.00204435) * qd[1],
-                                                                                                                                    )),
-                                                                                                                            ),
-                                                                                                                        ),
-                                                                                                                    ),
-                                                                                                                ),
-                                                                                                            ),
-                                                                                                        ),
-                                                                                                    ),
-                                                                                                ),
-                                                                                            ),
-                                                                                        ),
-                                                                                    ),
-                                                                                ),
-                                                                            ),
-                                                                            T::mul_add(
-                                                                                T::from_f64(0.0000012672),
-                                                                                qd[0] * qd[0] * t1 * t1,
-                                                                                T::mul_add(
-                                                                                    T::from_f64(0.0016),
-                                                                                    qd[0] * t1
-                                                                                        * (T::mul_add(
-                                                                                            T::from_f64(0.0099),
-                                                                                            t11,
-                                                                                            T::from_f64(0.20443499999999998) * qd[1],
-                                                                                        )),
-                                                                                    T::mul_add(
-                                                                                        T::from_f64(0.08326863994549999),
-                                                                                        qd[0] * qd[0] * t0 * t0,
-                                                                                        T::from_f64(0.00030057540000000006) * qd[0] * qd[0],
-                                                                                    ),
-                                                                                ),
-                                                                            ),
-                                                                        ),
-                                                                    ),
-                                                                ),
-                                                            ),
-                                                        ),
-                                                    ),
-                                                ),
-                                            ),
-                                        ),
+                                        T::from_f64(0.00030057540000000006),
+                                        qd[0] * qd[0],
+                                        t32 + t46 + t50 + t53,
                                     ),
                                 ),
                             ),
@@ -17805,7 +14079,7 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Kinova<T> {
                 ),
             ),
         );
-        t45
+        t54
     }
     /// The gravitational potential energy V = -sum m g.c, zero with every centre of mass at the origin.
     ///

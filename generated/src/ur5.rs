@@ -229,91 +229,72 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
                 let t9 = c5;
                 let t10 = qd[0] * qd[0];
                 let t11 = qd[1] + qd[2];
-                let t12 = t2 * t4;
-                let t13 = t2 * t5;
-                let t14 = t7 * t7;
-                let t15 = t8 * t8;
-                let t16 = t9 * t9;
-                let t17 = t3 * t4;
-                let t18 = t3 * t5;
-                let t19 = t5 * t7 * t8 * t9;
-                let t20 = t4 * t7 * t8 * t9;
-                let t21 = T::mul_add(
+                let t12 = t2 * t5;
+                let t13 = t7 * t7;
+                let t14 = t8 * t8;
+                let t15 = t9 * t9;
+                let t16 = t3 * t5;
+                let t17 = t5 * t7 * t8 * t9;
+                let t18 = t4 * t7 * t8 * t9;
+                let t19 = T::mul_add(
                     T::from_f64(0.017784735),
                     t4,
                     -T::from_f64(1.598759275),
                 );
-                let t22 = qd[0] * qd[1] * t0;
-                let t23 = qd[0] * qd[0] * t0 * t1;
-                let t24 = qd[0] * qd[0] * t1 * t1;
-                let t25 = T::from_f64(0.56875) * t11;
-                let t26 = T::from_f64(0.19163081355599998) * t11;
-                let t27 = T::from_f64(0.39225) * t11;
-                let t28 = t11 + qd[3];
-                let t29 = T::mul_add(
+                let t20 = qd[0] * qd[1] * t0;
+                let t21 = qd[0] * qd[1] * t1;
+                let t22 = qd[0] * qd[0] * t0 * t1;
+                let t23 = qd[0] * qd[0] * t1 * t1;
+                let t24 = t11 * t11;
+                let t25 = qd[3] + t11;
+                let t26 = T::mul_add(
                     T::from_f64(0.033822),
-                    t16,
-                    T::mul_add(T::from_f64(0.0171364731454), t15, T::from_f64(0.21942)),
+                    t15,
+                    T::from_f64(0.0171364731454) * t14,
                 );
-                let t30 = T::mul_add(
-                    T::from_f64(0.0171364731454),
-                    t16,
-                    T::mul_add(T::from_f64(0.033822), t15, T::from_f64(0.11285608069875)),
-                );
-                let t31 = T::mul_add(
+                let t27 = T::mul_add(
                     T::from_f64(0.016685526854599998),
                     t6 * t8 * t9,
                     -T::from_f64(0.0016539803549999999),
                 );
-                let t32 = T::mul_add(
-                    T::from_f64(0.033822),
-                    t16,
-                    T::mul_add(
-                        T::from_f64(0.0171364731454),
-                        t15,
-                        T::from_f64(0.4510082781),
-                    ),
-                );
-                let t33 = t2 * t21;
-                let t34 = t3 * t21;
-                let t35 = T::mul_add(
+                let t28 = t3 * t19;
+                let t29 = T::from_f64(0.017784735) * (T::mul_add(t2, t4, -t16));
+                let t30 = T::from_f64(0.017784735) * (T::mul_add(t3, t4, t12));
+                let t31 = T::mul_add(
                     -T::from_f64(0.1197),
                     qd[0] * t0,
                     T::from_f64(0.425) * qd[1],
                 );
-                let t36 = T::mul_add(qd[0], t0 * t3, qd[0] * t1 * t2);
-                let t37 = T::mul_add(-qd[0], t0 * t2, qd[0] * t1 * t3);
-                let t38 = T::from_f64(0.111172755531) * t28;
-                let t39 = T::mul_add(-T::from_f64(0.425), t23, T::from_f64(9.81) * t1);
-                let t40 = t6 * t6 * t30;
-                let t41 = qd[0] * t0 * t35;
-                let t42 = T::from_f64(0.56875) * t37;
-                let t43 = T::from_f64(0.004095) * t36;
-                let t44 = T::from_f64(0.19163081355599998) * t37;
-                let t45 = T::from_f64(0.39225) * t37;
-                let t46 = t36 * t27;
-                let t47 = t3 * t39;
-                let t48 = t2 * t39;
-                let t49 = T::one() / t29;
-                let t50 = T::mul_add(
-                    t7,
-                    t7 * t30,
+                let t32 = T::mul_add(qd[0], t0 * t3, qd[0] * t1 * t2);
+                let t33 = T::mul_add(-qd[0], t0 * t2, qd[0] * t1 * t3);
+                let t34 = T::mul_add(
+                    T::from_f64(0.0171364731454),
+                    t15,
+                    T::from_f64(0.033822) * t14,
+                ) + T::from_f64(0.11285608069875);
+                let t35 = t26 + T::from_f64(0.21942);
+                let t36 = t26 + T::from_f64(0.4510082781);
+                let t37 = T::mul_add(-t2, t19, T::from_f64(0.017784735) * t16);
+                let t38 = T::mul_add(T::from_f64(0.017784735), t12, t28);
+                let t39 = t32 * t33;
+                let t40 = t11 * t32;
+                let t41 = t33 * t33;
+                let t42 = T::mul_add(
+                    -T::from_f64(82.33533000000001),
+                    t0,
+                    -T::from_f64(2.3500400000000004) * (T::mul_add(qd[1], qd[1], t23)),
+                );
+                let t43 = T::mul_add(
+                    T::from_f64(0.1197),
+                    t21,
                     T::mul_add(
-                        T::from_f64(0.12999255384415),
-                        t6 * t6,
-                        T::from_f64(0.123341033631),
+                        T::from_f64(9.81),
+                        t1,
+                        -(T::mul_add(T::from_f64(0.425), t22, T::from_f64(0.1197) * t21)),
                     ),
                 );
-                let t51 = T::mul_add(
-                    -t6,
-                    t7 * t30,
-                    T::from_f64(0.12999255384415) * t6 * t7,
-                );
-                let t52 = T::mul_add(-t5, t32, T::from_f64(0.016685526854599998) * t20);
-                let t53 = t1 * (T::mul_add(T::from_f64(0.017784735), t18, -t33));
-                let t54 = T::mul_add(-t5, t29, T::from_f64(0.016685526854599998) * t20);
-                let t55 = T::mul_add(t4, t29, T::from_f64(0.016685526854599998) * t19);
-                let t56 = T::mul_add(
+                let t44 = t1 * t37;
+                let t45 = T::mul_add(
                     -t0,
                     T::from_f64(0.0171364731454)
                         * (T::mul_add(-t3, t5 * t6, t2 * t4 * t6)),
@@ -321,29 +302,50 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
                         * (T::from_f64(0.0171364731454)
                             * (T::mul_add(t2, t5 * t6, t3 * t4 * t6))),
                 );
-                let t57 = T::mul_add(
+                let t46 = T::mul_add(-qd[0], t0 * t31, T::from_f64(0.1197) * t23);
+                let t47 = T::mul_add(
                     qd[2],
-                    t36,
+                    t32,
                     T::mul_add(qd[0], qd[1] * t1 * t2, qd[0] * qd[1] * t0 * t3),
                 );
-                let t58 = T::mul_add(
+                let t48 = T::mul_add(
                     -qd[2],
-                    t37,
+                    t33,
                     T::mul_add(-qd[0], qd[1] * t1 * t3, qd[0] * qd[1] * t0 * t2),
                 );
-                let t59 = t36 * t44;
-                let t60 = t37 * t43;
-                let t61 = T::mul_add(t5, t36, t4 * t37);
-                let t62 = T::mul_add(-t4, t36, t5 * t37);
-                let t63 = T::mul_add(
-                    qd[1],
-                    t35,
+                let t49 = T::mul_add(t5, t32, t4 * t33);
+                let t50 = T::mul_add(t4, t32, -t5 * t33);
+                let t51 = T::one() / t35;
+                let t52 = T::mul_add(t6, t6 * t34, T::from_f64(0.12999255384415) * t13);
+                let t53 = T::mul_add(
+                    -t6,
+                    t7 * t34,
+                    T::from_f64(0.12999255384415) * t6 * t7,
+                );
+                let t54 = T::mul_add(-t5, t36, T::from_f64(0.016685526854599998) * t18);
+                let t55 = t0
+                    * (T::mul_add(-T::from_f64(0.017784735), t12, -t28)
+                        + T::from_f64(4.4329225));
+                let t56 = T::mul_add(-t5, t35, T::from_f64(0.016685526854599998) * t18);
+                let t57 = T::mul_add(t4, t35, T::from_f64(0.016685526854599998) * t17);
+                let t58 = T::mul_add(
+                    T::from_f64(0.425),
+                    t20,
+                    T::mul_add(T::from_f64(0.13585), t10, -t46),
+                );
+                let t59 = -t50;
+                let t60 = qd[4] + t50;
+                let t61 = T::mul_add(
+                    T::from_f64(0.1197),
+                    t20,
                     T::mul_add(
-                        T::from_f64(0.425),
-                        t24,
-                        T::mul_add(T::from_f64(0.1197), t22, T::from_f64(9.81) * t0),
+                        T::from_f64(9.81),
+                        t0,
+                        -(T::mul_add(-qd[1], t31, -T::from_f64(0.425) * t23)),
                     ),
                 );
+                let t62 = t7 * t45;
+                let t63 = T::from_f64(58.355064750790525) * t45;
                 (
                     t0,
                     t1,
@@ -477,198 +479,223 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
                 t126,
                 t127,
             ) = {
-                let t64 = t6 * t6 * t8 * t8 * t9 * t9 * t49;
-                let t65 = T::from_f64(0.111172755531) * t61;
-                let t66 = T::from_f64(0.21942) * t62;
-                let t67 = T::from_f64(0.093) * t62;
-                let t68 = T::from_f64(0.093) * t61;
-                let t69 = qd[4] - t62;
-                let t70 = t2 * t63;
-                let t71 = t3 * t63;
-                let t72 = t7 * t56;
-                let t73 = T::from_f64(58.355064750790525) * t56;
-                let t74 = T::mul_add(
+                let t64 = t6 * t6 * t8 * t8 * t9 * t9 * t51;
+                let t65 = T::mul_add(
+                    t7,
+                    t7 * t34,
+                    T::from_f64(0.12999255384415) * t6 * t6,
+                ) + T::from_f64(0.123341033631);
+                let t66 = T::mul_add(
+                    -T::from_f64(0.0139521246075),
+                    t4,
+                    t52 + T::from_f64(0.51519389364975),
+                );
+                let t67 = T::mul_add(
+                    -T::from_f64(0.39225),
+                    t47 + t40,
+                    T::mul_add(
+                        -T::from_f64(0.425),
+                        t20,
+                        T::mul_add(-T::from_f64(0.13585), t10, t46),
+                    ),
+                );
+                let t68 = t25 * t59;
+                let t69 = T::mul_add(t6, t25, t7 * t49);
+                let t70 = T::mul_add(t7, t25, -t6 * t49);
+                let t71 = T::mul_add(
                     -T::from_f64(0.0002784068064155777),
                     t64,
                     T::mul_add(
-                        T::from_f64(0.11285608069875001),
-                        t14,
-                        t40 + T::from_f64(0.111172755531),
+                        -T::from_f64(0.0171364731454),
+                        t13,
+                        t52 + T::from_f64(0.111172755531),
                     ),
                 );
-                let t75 = T::mul_add(
+                let t72 = T::mul_add(
                     T::from_f64(0.0002784068064155777),
                     t64,
                     T::mul_add(
-                        -T::from_f64(0.11285608069875001),
-                        t14,
+                        T::from_f64(0.0171364731454),
+                        t13,
                         T::mul_add(
                             T::from_f64(0.00697606230375),
                             t4,
-                            -t40 - T::from_f64(0.111172755531),
+                            -t52 - T::from_f64(0.111172755531),
                         ),
                     ),
                 );
-                let t76 = T::mul_add(
-                    T::from_f64(0.0002784068064155777),
-                    t64,
-                    T::mul_add(
-                        -T::from_f64(0.11285608069875001),
-                        t14,
-                        T::mul_add(
-                            T::from_f64(0.007558512375),
-                            t13 + t17,
-                            T::mul_add(
-                                T::from_f64(0.00697606230375),
-                                t4,
-                                -t40 - T::from_f64(0.111172755531),
-                            ),
-                        ),
-                    ),
-                );
-                let t77 = T::mul_add(t5, t31, t4 * t51);
-                let t78 = T::mul_add(-t4, t31, t5 * t51);
-                let t79 = T::mul_add(-T::from_f64(0.016685526854599998), t19, t4 * t50);
-                let t80 = T::mul_add(qd[3], t61, T::mul_add(-t4, t58, t5 * t57));
-                let t81 = T::mul_add(-qd[3], t62, T::mul_add(t5, t58, t4 * t57));
-                let t82 = t62 * t65;
-                let t83 = t61 * t66;
-                let t84 = T::mul_add(t6, t28, t7 * t61);
-                let t85 = t28 * t67;
-                let t86 = T::mul_add(-t7, t28, t6 * t61);
-                let t87 = T::from_f64(0.21942) * t69;
-                let t88 = T::mul_add(t36, t45, t70 - t47);
-                let t89 = T::mul_add(t11, t27, T::mul_add(t37, t45, t48 + t71));
-                let t90 = T::one() / t74;
-                let t91 = t78 - T::from_f64(0.051322656825);
-                let t92 = t3 * t77;
-                let t93 = t2 * t77;
-                let t94 = t6 * t81;
-                let t95 = T::mul_add(
-                    t61,
-                    t68,
-                    T::mul_add(
-                        t62,
-                        t67,
-                        T::mul_add(
-                            T::from_f64(0.39225),
-                            t57,
-                            T::mul_add(
-                                -T::from_f64(0.1197),
-                                t24,
-                                T::mul_add(
-                                    T::from_f64(0.425),
-                                    t22,
-                                    T::mul_add(T::from_f64(0.13585), t10, t41 + t46),
-                                ),
-                            ),
-                        ),
-                    ),
-                );
-                let t96 = qd[4] * t84;
-                let t97 = T::from_f64(0.111172755531) * t84;
-                let t98 = T::from_f64(0.111172755531) * t86;
-                let t99 = T::from_f64(0.09465) * t84;
-                let t100 = T::from_f64(0.09465) * t86;
-                let t101 = qd[5] - t86;
-                let t102 = t4 * t88;
-                let t103 = t5 * t89;
-                let t104 = t5 * t88;
-                let t105 = t4 * t89;
-                let t106 = T::mul_add(
-                    t4,
-                    T::mul_add(t4, t32, T::from_f64(0.016685526854599998) * t19),
-                    T::mul_add(
-                        t5,
-                        T::mul_add(t5, t50, T::from_f64(0.016685526854599998) * t20),
-                        T::from_f64(0.004095),
-                    ),
-                );
-                let t107 = T::mul_add(
-                    t5,
-                    t52,
-                    T::mul_add(
-                        -t4,
-                        t79,
-                        T::mul_add(
-                            T::from_f64(0.0139521246075),
-                            t4,
-                            -T::from_f64(0.5956519516747499),
-                        ),
-                    ),
-                );
-                let t108 = T::mul_add(
-                    -t4,
-                    t52,
-                    T::mul_add(-t5, t79, T::from_f64(0.00697606230375) * t5),
-                );
-                let t109 = t3 * t91;
-                let t110 = T::mul_add(
-                    -t0,
-                    T::mul_add(-t3, t55, t2 * t54),
-                    t1 * (T::mul_add(t2, t55, t3 * t54)),
-                );
-                let t111 = t6 * t95;
-                let t112 = t7 * t95;
-                let t113 = T::mul_add(qd[4], t86, t7 * t81);
-                let t114 = t84 * t98;
-                let t115 = t86 * t97;
-                let t116 = T::mul_add(-t8, t69, t9 * t84);
-                let t117 = T::mul_add(t9, t69, t8 * t84);
-                let t118 = t69 * t100;
-                let t119 = T::from_f64(0.0171364731454) * t101;
-                let t120 = T::mul_add(
-                    -t28,
-                    t68,
-                    T::mul_add(T::from_f64(0.093), t80, t102 - t103),
-                );
-                let t121 = T::mul_add(
-                    -T::from_f64(0.0002784068064155777),
-                    t64,
-                    T::mul_add(
-                        -t90,
-                        t75 * t75,
-                        T::mul_add(
-                            T::from_f64(0.11285608069875001),
-                            t14,
-                            T::mul_add(
-                                -T::from_f64(0.0139521246075),
-                                t4,
-                                t40 + T::from_f64(0.70682470720575),
-                            ),
-                        ),
-                    ),
-                );
-                let t122 = T::mul_add(
+                let t73 = T::mul_add(t5, t27, t4 * t53);
+                let t74 = T::mul_add(-t4, t27, t5 * t53);
+                let t75 = T::mul_add(qd[3], t59, T::mul_add(-t5, t48, -t4 * t47));
+                let t76 = T::mul_add(qd[3], t49, T::mul_add(-t4, t48, t5 * t47));
+                let t77 = -t70;
+                let t78 = t69 * t60;
+                let t79 = T::mul_add(t2, t61, -t3 * t43);
+                let t80 = T::mul_add(-t3, t61, -t2 * t43);
+                let t81 = T::one() / t71;
+                let t82 = T::mul_add(
                     T::from_f64(0.0002784068064155777),
                     t64,
                     T::mul_add(
                         T::from_f64(0.425),
-                        t34,
+                        t30,
                         T::mul_add(
-                            t90,
-                            t75 * t76,
+                            T::from_f64(0.0171364731454),
+                            t13,
+                            -(T::mul_add(
+                                -T::from_f64(0.00697606230375),
+                                t4,
+                                t52 + T::from_f64(0.111172755531),
+                            )),
+                        ),
+                    ),
+                );
+                let t83 = T::mul_add(-T::from_f64(0.016685526854599998), t17, t4 * t65);
+                let t84 = t74 - T::from_f64(0.051322656825);
+                let t85 = t3 * t73;
+                let t86 = t2 * t73;
+                let t87 = t67 + -T::from_f64(0.093) * (T::mul_add(t49, t49, t59 * t59));
+                let t88 = t60 * t77;
+                let t89 = T::mul_add(-t8, t60, t9 * t69);
+                let t90 = T::mul_add(t9, t60, t8 * t69);
+                let t91 = -t79;
+                let t92 = T::mul_add(T::from_f64(0.39225), t39, t79);
+                let t93 = -T::from_f64(0.39225) * (t41 + t24) + t80;
+                let t94 = T::mul_add(
+                    -t0,
+                    T::mul_add(-t3, t57, t2 * t56),
+                    t1 * (T::mul_add(t2, t57, t3 * t56)),
+                );
+                let t95 = T::mul_add(-qd[4], t77, t7 * t75);
+                let t96 = T::mul_add(qd[4], t69, t6 * t75);
+                let t97 = T::mul_add(
+                    -T::from_f64(0.0002784068064155777),
+                    t64,
+                    T::mul_add(
+                        -t81,
+                        t72 * t72,
+                        T::mul_add(
+                            -T::from_f64(0.0171364731454),
+                            t13,
+                            t66 + T::from_f64(0.19163081355599998),
+                        ),
+                    ),
+                );
+                let t98 = T::mul_add(
+                    T::from_f64(0.0002784068064155777),
+                    t64,
+                    T::mul_add(
+                        T::from_f64(0.425),
+                        t38,
+                        T::mul_add(
+                            t81,
+                            t72 * t82,
                             T::mul_add(
-                                -T::from_f64(0.11285608069875001),
-                                t14,
-                                T::mul_add(
-                                    T::from_f64(0.007558512375),
-                                    t13,
-                                    T::mul_add(
-                                        T::from_f64(0.0139521246075),
-                                        t4,
-                                        -t40 - T::from_f64(0.70682470720575),
-                                    ),
-                                ),
+                                T::from_f64(0.0171364731454),
+                                t13,
+                                -t66 - T::from_f64(0.19163081355599998),
                             ),
                         ),
                     ),
                 );
-                let t123 = t2 * t108;
-                let t124 = t3 * t108;
-                let t125 = T::from_f64(0.0171364731454) * t116;
-                let t126 = T::from_f64(0.033822) * t117;
-                let t127 = t7 * t120;
+                let t99 = T::mul_add(
+                    t4,
+                    T::mul_add(t4, t36, T::from_f64(0.016685526854599998) * t17),
+                    t5 * (T::mul_add(t5, t65, T::from_f64(0.016685526854599998) * t18)),
+                );
+                let t100 = T::mul_add(t3, t84, -t86);
+                let t101 = T::mul_add(
+                    -T::from_f64(0.1197),
+                    t30,
+                    T::mul_add(t3, t74, -t86),
+                );
+                let t102 = T::mul_add(
+                    T::from_f64(0.1197),
+                    t29,
+                    -(T::mul_add(t2, t74, t85)),
+                );
+                let t103 = T::mul_add(
+                    -T::from_f64(0.016685526854599998),
+                    t89 * t90,
+                    -T::from_f64(0.0171364731454) * t96,
+                );
+                let t104 = T::mul_add(-t5, t93, -t4 * t92);
+                let t105 = T::mul_add(-t4, t93, t5 * t92);
+                let t106 = t6 * t8 * t9 * t94 * t51;
+                let t107 = T::one() / t97;
+                let t108 = T::mul_add(
+                    -T::from_f64(0.0139521246075),
+                    t4,
+                    T::mul_add(-t5, t54, t4 * t83) + T::from_f64(0.40402113811874996),
+                );
+                let t109 = t99 + T::from_f64(0.004095);
+                let t110 = T::mul_add(
+                    T::from_f64(0.00697606230375),
+                    t5,
+                    -(T::mul_add(t4, t54, t5 * t83)),
+                );
+                let t111 = T::mul_add(
+                    T::from_f64(0.1197),
+                    t37,
+                    T::mul_add(t2, t84, t85),
+                );
+                let t112 = T::mul_add(T::from_f64(0.093), t75 - t68, t105);
+                let t113 = T::mul_add(
+                    T::from_f64(0.093),
+                    T::mul_add(-t49, t25, t76),
+                    -t104,
+                );
+                let t114 = t103 - tau[5];
+                let t115 = t108 + T::from_f64(0.19163081355599998);
+                let t116 = t2 * t110;
+                let t117 = t3 * t110;
+                let t118 = t1 * t111;
+                let t119 = T::mul_add(-qd[5], t90, T::mul_add(-t8, t76, t9 * t95));
+                let t120 = T::mul_add(qd[5], t89, T::mul_add(t9, t76, t8 * t95));
+                let t121 = -T::from_f64(0.09465) * (T::mul_add(t77, t77, t69 * t69))
+                    + t112;
+                let t122 = T::mul_add(
+                    -T::from_f64(0.0002784068064155777),
+                    t64,
+                    T::mul_add(
+                        -t107,
+                        t98 * t98,
+                        T::mul_add(
+                            -t81,
+                            t82 * t82,
+                            T::mul_add(
+                                -T::from_f64(0.0171364731454),
+                                t13,
+                                T::mul_add(
+                                    -T::from_f64(0.85),
+                                    t38,
+                                    t66 + T::from_f64(1.0768558760559999),
+                                ) + T::from_f64(0.8849018759100001),
+                            ),
+                        ),
+                    ),
+                );
+                let t123 = t7 * t114;
+                let t124 = T::mul_add(-t2, t109, t117);
+                let t125 = T::mul_add(
+                    -t0,
+                    T::mul_add(
+                        -T::from_f64(0.1197),
+                        t38,
+                        t100 + T::from_f64(0.19371331275000003),
+                    ),
+                    -t118,
+                );
+                let t126 = T::mul_add(
+                    -t0,
+                    T::mul_add(-T::from_f64(0.1197), t38, t100),
+                    -t118,
+                );
+                let t127 = T::mul_add(
+                    T::from_f64(0.016685526854599998),
+                    t90 * (qd[5] + t70),
+                    T::from_f64(0.0171364731454) * t119,
+                );
                 (
                     t64,
                     t65,
@@ -802,597 +829,279 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
                 t190,
                 t191,
             ) = {
-                let t128 = t6 * t120;
-                let t129 = T::mul_add(
-                    t86,
-                    t100,
+                let t128 = T::mul_add(-t7, t113, t6 * t87);
+                let t129 = T::mul_add(t6, t113, t7 * t87);
+                let t130 = T::mul_add(
+                    T::from_f64(0.016685526854599998),
+                    t106,
                     T::mul_add(
-                        t84,
-                        t99,
-                        T::mul_add(T::from_f64(0.093), t81, t85 - t104 - t105),
+                        T::from_f64(0.13585),
+                        T::mul_add(t1, t29, t0 * t30),
+                        -(T::mul_add(-t0, t101, t1 * t102)) - t62,
                     ),
                 );
-                let t130 = t6 * t8 * t9 * t110 * t49;
-                let t131 = T::one() / t121;
-                let t132 = T::mul_add(t3, t107, t123);
-                let t133 = T::mul_add(-t2, t106, t124);
-                let t134 = t1
-                    * (T::mul_add(
-                        t2,
-                        t91,
-                        T::mul_add(
-                            -T::from_f64(0.1197),
-                            t33,
-                            T::mul_add(T::from_f64(0.0021288327795), t18, t92),
-                        ),
-                    ));
-                let t135 = t117 * t125;
-                let t136 = t116 * t126;
+                let t131 = T::one() / t122;
+                let t132 = T::mul_add(t3, t115, -t116);
+                let t133 = T::mul_add(T::from_f64(0.09465), t96 - t78, -t128);
+                let t134 = T::mul_add(T::from_f64(0.09465), t95 + t88, -t129);
+                let t135 = T::mul_add(
+                    -T::from_f64(0.1879),
+                    t134,
+                    T::from_f64(1.219) * t129,
+                );
+                let t136 = T::mul_add(
+                    -T::from_f64(0.016685526854599998),
+                    t106,
+                    T::mul_add(
+                        T::from_f64(0.13585),
+                        T::mul_add(-t0, t38, t44),
+                        T::mul_add(-t81, t72 * t130, t126 + t62),
+                    ),
+                );
                 let t137 = T::mul_add(
-                    t69,
-                    t99,
-                    T::mul_add(T::from_f64(0.09465), t94 - t96, -t111 - t127),
+                    t3,
+                    T::mul_add(t3, t109, t116),
+                    t2 * (T::mul_add(t2, t115, t117)),
                 );
                 let t138 = T::mul_add(
-                    -T::from_f64(0.1879),
-                    t118,
-                    T::mul_add(
-                        T::from_f64(1.4069),
-                        t128 - t112,
-                        T::from_f64(0.017784735) * t113,
-                    ),
+                    T::from_f64(0.21942),
+                    t76,
+                    T::mul_add(T::from_f64(0.033822), t9 * t120, -t8 * t127),
                 );
-                let t139 = T::mul_add(
-                    T::from_f64(0.016685526854599998),
-                    t130,
-                    T::mul_add(
-                        -t0,
-                        T::mul_add(
-                            -t3,
-                            t78,
-                            T::mul_add(T::from_f64(0.0021288327795), t13 + t17, t93),
-                        ),
-                        T::mul_add(
-                            -t1,
-                            T::mul_add(
-                                -t2,
-                                t78,
-                                T::mul_add(T::from_f64(0.0021288327795), t12 - t18, -t92),
-                            ),
-                            T::mul_add(
-                                T::from_f64(0.13585),
-                                T::mul_add(
-                                    t1,
-                                    T::from_f64(0.017784735) * (t12 - t18),
-                                    t0 * (T::from_f64(0.017784735) * (t13 + t17)),
-                                ),
-                                -t72,
-                            ),
-                        ),
-                    ),
-                );
-                let t140 = T::mul_add(
-                    t117,
-                    t119,
-                    T::mul_add(
-                        -t101,
-                        t126,
-                        T::from_f64(0.0171364731454)
-                            * (T::mul_add(qd[5], t117, T::mul_add(t8, t80, t9 * t113))),
-                    ),
-                );
+                let t139 = T::mul_add(t8, t121, t9 * t133);
+                let t140 = T::mul_add(-t9, t121, t8 * t133);
                 let t141 = T::mul_add(
-                    t101,
-                    t125,
-                    T::mul_add(
-                        -t116,
-                        t119,
-                        T::from_f64(0.033822)
-                            * (T::mul_add(-qd[5], t116, T::mul_add(-t9, t80, t8 * t113))),
-                    ),
+                    T::from_f64(0.017784735),
+                    t134,
+                    T::mul_add(T::from_f64(0.033822), t8 * t120, t9 * t127),
                 );
-                let t142 = t6 * t138;
-                let t143 = t7 * t138;
-                let t144 = T::mul_add(
-                    -T::from_f64(0.0002784068064155777),
-                    t64,
-                    T::mul_add(
-                        -T::from_f64(0.85),
-                        t34,
-                        T::mul_add(
-                            -t131,
-                            t122 * t122,
-                            T::mul_add(
-                                -t90,
-                                t76 * t76,
-                                T::mul_add(
-                                    T::from_f64(0.11285608069875001),
-                                    t14,
-                                    T::mul_add(
-                                        -T::from_f64(0.01511702475),
-                                        t13,
-                                        T::mul_add(
-                                            -T::from_f64(0.0139521246075),
-                                            t4,
-                                            t40 + T::from_f64(2.47695164561575),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
+                let t142 = T::mul_add(
+                    -T::from_f64(0.85),
+                    t38,
+                    T::mul_add(-t2, t124, t3 * t132) + T::from_f64(0.9241220958009998),
                 );
-                let t145 = T::mul_add(
-                    T::from_f64(0.0171364731454),
-                    t94 - t96,
-                    t135 - t136 - tau[5],
+                let t143 = T::mul_add(
+                    T::from_f64(0.425),
+                    t37,
+                    -(T::mul_add(-t3, t124, -t2 * t132)),
                 );
+                let t144 = t9 * t139;
+                let t145 = t8 * t140;
                 let t146 = T::mul_add(
-                    t3,
-                    T::mul_add(t3, t106, t123),
-                    T::mul_add(
-                        t2,
-                        T::mul_add(-t2, t107, t124),
-                        T::from_f64(0.054004433300999945),
-                    ),
-                );
+                    -T::from_f64(0.108247244469),
+                    t88,
+                    T::from_f64(0.111172755531) * t95,
+                ) + t141;
                 let t147 = T::mul_add(
-                    t3,
-                    t133,
-                    T::mul_add(
-                        -t2,
-                        t132,
-                        T::mul_add(
-                            -T::from_f64(0.425),
-                            t33,
-                            T::from_f64(0.007558512375) * t18,
-                        ),
-                    ),
-                );
-                let t148 = t8 * t140;
-                let t149 = t9 * t141;
-                let t150 = T::from_f64(0.1879) * (T::mul_add(t8, t129, t9 * t137));
-                let t151 = T::from_f64(0.1879) * (T::mul_add(-t9, t129, t8 * t137));
-                let t152 = T::mul_add(
                     -T::from_f64(0.016685526854599998),
-                    t130,
+                    t106,
                     T::mul_add(
-                        -t90,
-                        t75 * t139,
+                        T::from_f64(0.13585),
+                        t44 + t55,
                         T::mul_add(
-                            t0,
-                            T::mul_add(
-                                T::from_f64(0.1197),
-                                t34,
-                                T::mul_add(T::from_f64(0.0021288327795), t13, t93 - t109),
-                            ),
-                            T::mul_add(
-                                T::from_f64(0.13585),
-                                T::mul_add(
-                                    -t0,
-                                    T::mul_add(T::from_f64(0.017784735), t13, t34),
-                                    t53,
-                                ),
-                                t72 - t134,
-                            ),
+                            t136,
+                            t107 * t98,
+                            T::mul_add(-t81, t82 * t130, t125 + t62),
                         ),
                     ),
                 );
-                let t153 = T::one() / t144;
-                let t154 = t7 * t145;
-                let t155 = t9 * t150;
-                let t156 = t8 * t151;
-                let t157 = t8 * t150;
-                let t158 = t9 * t151;
+                let t148 = t138 - tau[4];
+                let t149 = t6 * t8 * t9 * t51 * t148;
+                let t150 = T::mul_add(
+                    -t0,
+                    t137 + T::from_f64(0.054004433300999945),
+                    t1 * t143,
+                );
+                let t151 = T::mul_add(
+                    T::from_f64(1.219),
+                    t128,
+                    -T::from_f64(0.1879) * (t144 + t145),
+                );
+                let t152 = T::mul_add(
+                    T::from_f64(1.219),
+                    t112,
+                    T::from_f64(0.1879) * (T::mul_add(-t9, t140, t8 * t139)),
+                );
+                let t153 = T::mul_add(
+                    -t1,
+                    t142 + T::from_f64(0.8849018759100001),
+                    t0 * t143,
+                );
+                let t154 = T::mul_add(
+                    -T::from_f64(0.108247244469),
+                    t78,
+                    -T::from_f64(0.111172755531) * t96,
+                )
+                    + T::mul_add(
+                        -T::from_f64(0.09465),
+                        T::from_f64(0.1879) * (t144 + t145),
+                        t103,
+                    );
+                let t155 = T::mul_add(T::from_f64(1.219), t105, t152);
+                let t156 = T::mul_add(-t6, t135, t7 * t151);
+                let t157 = T::mul_add(
+                    T::from_f64(1.219),
+                    t67,
+                    T::mul_add(t7, t135, t6 * t151),
+                );
+                let t158 = T::mul_add(T::from_f64(1.219), -t104, -t156);
                 let t159 = T::mul_add(
-                    t8,
-                    t141,
-                    T::mul_add(
-                        t9,
-                        t140,
-                        T::mul_add(
-                            -t69,
-                            t98,
-                            T::mul_add(
-                                t86,
-                                t87,
-                                T::mul_add(
-                                    T::from_f64(0.017784735),
-                                    t128 - t112 - t118,
-                                    T::from_f64(0.11285608069875) * t113,
-                                ),
-                            ),
-                        ),
-                    ),
+                    T::from_f64(0.093),
+                    t152,
+                    T::mul_add(-t6, t154, t7 * t146),
                 );
                 let t160 = T::mul_add(
-                    T::from_f64(0.21942),
-                    t80,
-                    t115 + t148 - t114 - t149 - tau[4],
+                    T::from_f64(0.108247244469),
+                    t49 * t59,
+                    T::mul_add(t7, t154, t6 * t146),
                 );
                 let t161 = T::mul_add(
-                    t1,
-                    T::mul_add(
-                        t2,
-                        t133,
-                        T::mul_add(
-                            t3,
-                            t132,
-                            T::mul_add(
-                                T::from_f64(0.85),
-                                t34,
-                                T::mul_add(
-                                    T::from_f64(0.01511702475),
-                                    t13,
-                                    -T::from_f64(1.809023971711),
-                                ),
-                            ),
-                        ),
-                    ),
-                    t0 * t147,
+                    T::from_f64(0.21942),
+                    t76,
+                    T::mul_add(-T::from_f64(0.093), t156, t138),
                 );
                 let t162 = T::mul_add(
-                    T::from_f64(0.09465),
-                    t155 + t156,
+                    -t147,
+                    t147 * t131,
                     T::mul_add(
-                        -t84,
-                        t87,
+                        -t136,
+                        t136 * t107,
                         T::mul_add(
-                            t69,
-                            t97,
+                            -t81,
+                            t130 * t130,
                             T::mul_add(
-                                T::from_f64(0.12830922867640002),
-                                t94 - t96,
-                                t135 - t136,
+                                -t94,
+                                t94 * t51,
+                                T::mul_add(
+                                    -t45,
+                                    t63,
+                                    T::mul_add(-t0, t150, -t1 * t153)
+                                        + T::from_f64(0.12816210104175002),
+                                ),
                             ),
                         ),
                     ),
                 );
-                let t163 = T::mul_add(T::from_f64(1.219), t111 + t127, -t155 - t156);
-                let t164 = t6 * t159;
-                let t165 = T::mul_add(
-                    -T::from_f64(2.438),
-                    t104 + t105,
-                    T::mul_add(
-                        T::from_f64(1.219),
-                        t85,
-                        T::mul_add(T::from_f64(0.11336700000000001), t81, t157 - t158),
-                    ),
-                );
+                let t163 = T::mul_add(
+                    -T::from_f64(0.108247244469),
+                    t68,
+                    T::from_f64(0.111172755531) * t75,
+                ) + t159;
+                let t164 = T::mul_add(t5, t155, t4 * t158);
+                let t165 = T::one() / t162;
                 let t166 = T::mul_add(
-                    -T::from_f64(0.016685526854599998),
-                    t130,
-                    T::mul_add(
-                        t152,
-                        t131 * t122,
-                        T::mul_add(
-                            -t90,
-                            t76 * t139,
-                            T::mul_add(
-                                t0,
-                                T::mul_add(
-                                    T::from_f64(0.1197),
-                                    t34,
-                                    T::mul_add(
-                                        T::from_f64(0.0021288327795),
-                                        t13,
-                                        t93 - t109 - T::from_f64(0.19371331275000003),
-                                    ),
-                                ),
-                                T::mul_add(
-                                    T::from_f64(0.13585),
-                                    T::mul_add(
-                                        -t0,
-                                        T::mul_add(
-                                            T::from_f64(0.017784735),
-                                            t13,
-                                            t34 - T::from_f64(4.4329225),
-                                        ),
-                                        t53,
-                                    ),
-                                    t72 - t134,
-                                ),
-                            ),
-                        ),
-                    ),
+                    -T::from_f64(2.275),
+                    t91,
+                    T::from_f64(0.56875) * t39,
+                ) + t164;
+                let t167 = T::mul_add(
+                    -T::from_f64(2.275),
+                    -t80,
+                    -T::from_f64(0.56875) * (t41 + t24),
+                ) + T::mul_add(-t4, t155, t5 * t158);
+                let t168 = T::mul_add(
+                    -T::from_f64(0.56875),
+                    t91,
+                    T::from_f64(0.187535813556) * t39,
+                ) + T::mul_add(T::from_f64(0.39225), t164, t160);
+                let t169 = T::mul_add(
+                    T::from_f64(0.016685526854599998),
+                    t149,
+                    tau[3] - t160 + t123,
                 );
-                let t167 = t6 * t8 * t9 * t49 * t160;
-                let t168 = t7 * t163;
-                let t169 = t6 * t163;
-                let t170 = t7 * t162;
-                let t171 = t5 * t165;
-                let t172 = T::mul_add(
-                    T::from_f64(0.093),
-                    t168 + t142,
-                    T::mul_add(
-                        -t28,
-                        t65,
-                        T::mul_add(
-                            t61,
-                            t38,
-                            T::mul_add(
-                                T::from_f64(0.43884),
-                                t80,
-                                t115 + t148 - t114 - t149,
-                            ),
-                        ),
-                    ),
+                let t170 = T::mul_add(
+                    -T::from_f64(0.39225),
+                    t157,
+                    T::mul_add(t5, t161, -t4 * t163),
                 );
-                let t173 = T::mul_add(
-                    T::from_f64(0.093),
-                    t157 - t158,
-                    T::mul_add(
-                        T::from_f64(0.11336700000000001),
-                        t85 - t104 - t105,
-                        T::mul_add(
-                            t6,
-                            t162,
-                            T::mul_add(
-                                t7,
-                                t159,
-                                T::mul_add(
-                                    -t62,
-                                    t38,
-                                    T::mul_add(t28, t66, T::from_f64(0.121715886531) * t81),
-                                ),
-                            ),
-                        ),
-                    ),
+                let t171 = T::mul_add(
+                    T::from_f64(0.004095),
+                    t48,
+                    T::mul_add(-t4, t161, -t5 * t163),
                 );
-                let t174 = T::mul_add(T::from_f64(1.219), t102 - t103, t168 + t142);
+                let t172 = T::mul_add(t2, t167, t3 * t166);
+                let t173 = T::mul_add(t3, t167, -t2 * t166);
+                let t174 = T::mul_add(
+                    T::from_f64(0.187535813556),
+                    t40,
+                    T::mul_add(
+                        T::from_f64(0.19163081355599998),
+                        t47,
+                        T::from_f64(0.56875) * t58,
+                    ),
+                ) + t170;
                 let t175 = T::mul_add(
-                    -t166,
-                    t166 * t153,
-                    T::mul_add(
-                        -t152,
-                        t152 * t131,
-                        T::mul_add(
-                            -t90,
-                            t139 * t139,
-                            T::mul_add(
-                                -t110,
-                                t110 * t49,
-                                T::mul_add(
-                                    -t56,
-                                    t73,
-                                    T::mul_add(
-                                        -t0,
-                                        T::mul_add(-t0, t146, t1 * t147),
-                                        T::mul_add(-t1, t161, T::from_f64(0.12816210104175002)),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
+                    T::from_f64(0.1197),
+                    -t173,
+                    -T::from_f64(0.425)
+                        * (T::mul_add(
+                            -T::from_f64(0.56875),
+                            t47 + t40,
+                            -T::from_f64(2.275) * t58,
+                        ) + t157),
                 );
-                let t176 = T::mul_add(
+                let t176 = t0
+                    * (T::mul_add(
+                        T::from_f64(2.3500400000000004),
+                        t22,
+                        -T::from_f64(82.33533000000001) * t1,
+                    ) + t172);
+                let t177 = T::mul_add(
                     T::from_f64(0.016685526854599998),
-                    t167,
-                    t82 + t164 + tau[3] + t154 - t83 - t170,
+                    t149,
+                    tau[2] - t168 + t123,
                 );
-                let t177 = t4 * t174;
-                let t178 = T::one() / t175;
-                let t179 = T::mul_add(
-                    T::from_f64(2.275),
-                    t70 - t47,
-                    T::mul_add(t36, t42, t177 - t171),
-                );
-                let t180 = T::mul_add(
-                    T::from_f64(0.39225),
-                    t169 - t143,
-                    T::mul_add(
-                        T::from_f64(0.47815275),
-                        t46,
-                        T::mul_add(
-                            t5,
-                            t172,
-                            T::mul_add(
-                                t4,
-                                t173,
-                                T::mul_add(
-                                    t36,
-                                    t26,
-                                    T::mul_add(
-                                        -t11,
-                                        t43,
-                                        T::mul_add(
-                                            T::from_f64(1.04690275),
-                                            t41,
-                                            T::mul_add(
-                                                T::from_f64(0.37918622974349997),
-                                                t57,
-                                                T::mul_add(
-                                                    -T::from_f64(0.125314259175),
-                                                    t24,
-                                                    T::mul_add(
-                                                        T::from_f64(0.44493366875),
-                                                        t22,
-                                                        T::from_f64(0.14222173858749998) * t10,
-                                                    ),
-                                                ),
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                );
-                let t181 = T::mul_add(
-                    -t4,
-                    t172,
-                    T::mul_add(
-                        t5,
-                        t173,
-                        T::mul_add(
-                            t11,
-                            t44,
-                            T::mul_add(-t37, t26, T::from_f64(0.004095) * t58),
-                        ),
-                    ),
-                );
+                let t178 = T::mul_add(-t1, t42 + t173, t176);
+                let t179 = tau[1]
+                    - (T::mul_add(
+                        T::from_f64(0.8697944759100001),
+                        t22,
+                        -T::from_f64(23.053892400000006) * t1,
+                    ) + T::mul_add(T::from_f64(0.425), t172, t168));
+                let t180 = T::mul_add(t81, t72 * t169, t177);
+                let t181 = T::mul_add(t2, t171, t3 * t174) + t175;
                 let t182 = T::mul_add(
-                    T::from_f64(2.275),
-                    t48 + t71,
-                    T::mul_add(
-                        -t4,
-                        t165,
-                        T::mul_add(-t5, t174, T::mul_add(t11, t25, t37 * t42)),
-                    ),
+                    T::from_f64(0.1197),
+                    t172,
+                    T::mul_add(t3, t171, -t2 * t174),
                 );
-                let t183 = T::mul_add(
-                    -T::from_f64(0.016685526854599998),
-                    t167,
-                    T::mul_add(
-                        T::from_f64(0.39225),
-                        t177 - t171,
-                        T::mul_add(
-                            T::from_f64(0.56875),
-                            t70 - t47,
-                            T::mul_add(
-                                -t90,
-                                t75 * t176,
-                                t59 + t83 + t170 - t60 - t82 - t164 - tau[2] - t154,
-                            ),
-                        ),
-                    ),
+                let t183 = t1
+                    * (T::mul_add(
+                        T::from_f64(1.7546963518200003),
+                        t20,
+                        T::from_f64(0.31925293400000004) * t10,
+                    ) + t181);
+                let t184 = T::mul_add(
+                    t81,
+                    t82 * t169,
+                    T::mul_add(T::from_f64(0.016685526854599998), t149, t179 + t123),
                 );
-                let t184 = t3 * t179;
-                let t185 = t2 * t182;
-                let t186 = t2 * t179;
-                let t187 = t3 * t182;
+                let t185 = T::mul_add(
+                    t0,
+                    T::mul_add(T::from_f64(0.0151074), t21, -t182),
+                    -t183,
+                );
+                let t186 = T::mul_add(t107, t98 * t180, t184);
+                let t187 = T::mul_add(
+                    -t63,
+                    t114,
+                    tau[0] - (T::mul_add(T::from_f64(0.13585), t178, t185)),
+                );
                 let t188 = T::mul_add(
-                    T::from_f64(0.016685526854599998),
-                    t167,
-                    T::mul_add(
-                        T::from_f64(0.425),
-                        t185 - t184,
-                        T::mul_add(
-                            T::from_f64(0.39225),
-                            t171 - t177,
-                            T::mul_add(
-                                T::from_f64(0.56875),
-                                t47 - t70,
-                                T::mul_add(
-                                    -t131,
-                                    t122 * t183,
-                                    T::mul_add(
-                                        t90,
-                                        t76 * t176,
-                                        T::mul_add(
-                                            -T::from_f64(0.8697944759100001),
-                                            t23,
-                                            T::mul_add(
-                                                T::from_f64(23.053892400000006),
-                                                t1,
-                                                t60 + t82 + t164 + tau[1] + t154 - t59 - t83 - t170,
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
+                    t81,
+                    t130 * t169,
+                    T::mul_add(t94, t51 * t148, t187),
                 );
                 let t189 = T::mul_add(
-                    -t166,
-                    t153 * t188,
-                    T::mul_add(
-                        t152,
-                        t131 * t183,
-                        T::mul_add(
-                            t90,
-                            t139 * t176,
-                            T::mul_add(
-                                t110,
-                                t49 * t160,
-                                T::mul_add(
-                                    -t73,
-                                    t145,
-                                    T::mul_add(
-                                        -t0,
-                                        T::mul_add(
-                                            -t3,
-                                            t181,
-                                            T::mul_add(
-                                                t2,
-                                                t180,
-                                                T::mul_add(
-                                                    T::from_f64(0.1197),
-                                                    t185 - t184,
-                                                    T::from_f64(0.0151074) * qd[0] * qd[1] * t1,
-                                                ),
-                                            ),
-                                        ),
-                                        T::mul_add(
-                                            t1,
-                                            T::mul_add(
-                                                t2,
-                                                t181,
-                                                T::mul_add(
-                                                    t3,
-                                                    t180,
-                                                    T::mul_add(
-                                                        T::from_f64(0.1197),
-                                                        t186 + t187,
-                                                        T::mul_add(
-                                                            T::from_f64(0.5180750000000001),
-                                                            t46,
-                                                            T::mul_add(
-                                                                T::from_f64(0.425),
-                                                                T::mul_add(t36, t25, t169 - t143),
-                                                                T::mul_add(
-                                                                    T::from_f64(1.4849499999999998),
-                                                                    t41,
-                                                                    T::mul_add(
-                                                                        T::from_f64(0.44493366875),
-                                                                        t57,
-                                                                        T::mul_add(
-                                                                            -T::from_f64(0.17774851500000002),
-                                                                            t24,
-                                                                            T::mul_add(
-                                                                                T::from_f64(2.38580010182),
-                                                                                t22,
-                                                                                T::from_f64(0.5209833915000001) * t10,
-                                                                            ),
-                                                                        ),
-                                                                    ),
-                                                                ),
-                                                            ),
-                                                        ),
-                                                    ),
-                                                ),
-                                            ),
-                                            T::mul_add(
-                                                T::from_f64(0.13585),
-                                                T::mul_add(
-                                                    -t1,
-                                                    T::mul_add(
-                                                        T::from_f64(2.3500400000000004),
-                                                        T::mul_add(qd[1], qd[1], t24),
-                                                        T::mul_add(T::from_f64(82.33533000000001), t0, t186 + t187),
-                                                    ),
-                                                    t0
-                                                        * (T::mul_add(
-                                                            -T::from_f64(2.3500400000000004),
-                                                            t23,
-                                                            T::mul_add(T::from_f64(82.33533000000001), t1, t185 - t184),
-                                                        )),
-                                                ),
-                                                tau[0],
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
+                    -t147,
+                    t131 * t186,
+                    T::mul_add(-t136, t107 * t180, t188),
                 );
-                let t190 = T::mul_add(-t166, t153 * t178 * t189, t153 * t188);
+                let t190 = T::mul_add(-t147, t131 * t165 * t189, t131 * t186);
                 let t191 = T::mul_add(
-                    -t152,
-                    t131 * t178 * t189,
-                    T::mul_add(t131, t122 * t190, -t131 * t183),
+                    -t136,
+                    t107 * t165 * t189,
+                    T::mul_add(t107, t98 * t190, t107 * t180),
                 );
                 (
                     t128,
@@ -1461,47 +1170,51 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
                     t191,
                 )
             };
-            let (t192, t193) = {
-                let t192 = -t191;
-                let t193 = T::mul_add(
-                    t90,
-                    t139 * t178 * t189,
-                    T::mul_add(t90, t76 * t190, T::mul_add(-t90, t75 * t192, t90 * t176)),
+            let (t192, t193, t194, t195, t196, t197) = {
+                let t192 = T::mul_add(
+                    t81,
+                    t82 * t190,
+                    T::mul_add(t81, t72 * t191, t81 * t169),
                 );
-                (t192, t193)
+                let t193 = T::mul_add(t81, t130 * t165 * t189, t192);
+                let t194 = T::mul_add(
+                    -T::from_f64(0.016685526854599998),
+                    t6 * t8 * t9 * t51 * t191,
+                    T::mul_add(
+                        -T::from_f64(0.016685526854599998),
+                        t6 * t8 * t9 * t51 * t193,
+                        -t51 * t148,
+                    ),
+                );
+                let t195 = T::mul_add(
+                    -t7,
+                    t191,
+                    T::mul_add(-t7, t193, -T::from_f64(58.355064750790525) * t114),
+                );
+                let t196 = T::mul_add(
+                    -t94,
+                    t51 * t165 * t189,
+                    T::mul_add(
+                        -T::from_f64(0.016685526854599998),
+                        t6 * t8 * t9 * t51 * t190,
+                        t194,
+                    ),
+                );
+                let t197 = T::mul_add(t63, t165 * t189, T::mul_add(-t7, t190, t195));
+                (t192, t193, t194, t195, t196, t197)
             };
             [
-                t178 * t189,
+                t165 * t189,
                 t190,
                 t191,
                 t193,
-                T::mul_add(
-                    T::from_f64(0.016685526854599998),
-                    T::mul_add(
-                        -t6,
-                        t8 * t9 * t49 * t190,
-                        T::mul_add(t6, t8 * t9 * t49 * t192, -t6 * t8 * t9 * t49 * t193),
-                    ),
-                    T::mul_add(-t110, t49 * t178 * t189, -t49 * t160),
-                ),
-                T::mul_add(
-                    T::from_f64(58.355064750790525),
-                    t136 + tau[5] - t135,
-                    T::mul_add(
-                        t73,
-                        t178 * t189,
-                        T::mul_add(
-                            -t7,
-                            t190,
-                            T::mul_add(t7, t192, T::mul_add(-t7, t193, t96 - t94)),
-                        ),
-                    ),
-                ),
-                t175,
-                t144,
-                t121,
-                t74,
-                t29,
+                t196,
+                t197,
+                t162,
+                t122,
+                t97,
+                t71,
+                t35,
                 T::from_f64(0.0171364731454),
             ]
         };
@@ -1516,7 +1229,7 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
     /// The generalized momentum p = M(q) qd = dT/dqd (a momentum observer's measurement).
     ///
     /// Route: Newton-Euler at rest without gravity, with qd as the accelerations, O(N).
-    /// Operations: 139 mul, 118 add, 0 div, 5 sin, 5 cos.
+    /// Operations: 135 mul, 88 add, 0 div, 5 sin, 5 cos.
     pub fn generalized_momentum(&self, q: &[T; 6], qd: &[T; 6]) -> [T; 6] {
         let ([s1, s2, s3, s4, s5], [c1, c2, c3, c4, c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
             q[1],
@@ -1601,112 +1314,117 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
             let t7 = c4;
             let t8 = s5;
             let t9 = c5;
-            let t10 = qd[1] + qd[2] + qd[3];
+            let t10 = qd[1] + qd[2];
             let t11 = qd[0] * t1;
             let t12 = qd[0] * t0;
             let t13 = qd[0] * t1 * t3;
             let t14 = qd[0] * t1 * t2;
-            let t15 = t7 * t10;
+            let t15 = qd[3] + t10;
             let t16 = T::mul_add(qd[0], t0 * t3, t14);
             let t17 = T::mul_add(-qd[0], t0 * t2, t13);
             let t18 = T::mul_add(
-                T::from_f64(0.016149999999999998),
+                T::from_f64(0.13585),
                 t12,
-                T::from_f64(0.425) * qd[1],
+                T::mul_add(-T::from_f64(0.1197), t12, T::from_f64(0.425) * qd[1]),
             );
-            let t19 = t5 * t17;
-            let t20 = t4 * t16;
-            let t21 = t3 * t18;
-            let t22 = t2 * t18;
-            let t23 = T::mul_add(T::from_f64(0.39225), t17, T::from_f64(0.425) * t11);
-            let t24 = T::mul_add(t5, t16, t4 * t17);
-            let t25 = qd[4] + t20 - t19;
-            let t26 = T::mul_add(
-                T::from_f64(0.016149999999999998),
-                t14,
-                T::mul_add(T::from_f64(0.39225), qd[1] + qd[2], t21),
+            let t19 = T::mul_add(T::from_f64(0.39225), t17, T::from_f64(0.425) * t11);
+            let t20 = T::mul_add(t5, t16, t4 * t17);
+            let t21 = T::mul_add(t4, t16, -t5 * t17);
+            let t22 = -t21;
+            let t23 = qd[4] + t21;
+            let t24 = T::mul_add(t3, t18, T::from_f64(0.016149999999999998) * t14);
+            let t25 = T::mul_add(-t2, t18, T::from_f64(0.016149999999999998) * t13);
+            let t26 = T::mul_add(t6, t15, t7 * t20);
+            let t27 = T::mul_add(t7, t15, -t6 * t20);
+            let t28 = T::mul_add(T::from_f64(0.39225), t10, t24);
+            let t29 = -t27;
+            let t30 = qd[5] + t27;
+            let t31 = T::mul_add(-t8, t23, t9 * t26);
+            let t32 = T::mul_add(t9, t23, t8 * t26);
+            let t33 = T::mul_add(t5, t25, -t4 * t28);
+            let t34 = T::mul_add(t4, t25, t5 * t28);
+            let t35 = T::mul_add(T::from_f64(0.093), t22, t33);
+            let t36 = T::mul_add(T::from_f64(0.093), t20, t34);
+            let t37 = T::mul_add(t6, t19, t7 * t35);
+            let t38 = T::mul_add(t7, t19, -t6 * t35);
+            let t39 = T::mul_add(
+                T::from_f64(0.21942),
+                t23,
+                T::mul_add(
+                    T::from_f64(0.033822),
+                    t9 * t32,
+                    -T::from_f64(0.0171364731454) * t8 * t31,
+                ),
             );
-            let t27 = T::mul_add(T::from_f64(0.016149999999999998), t13, -t22);
-            let t28 = t6 * t23;
-            let t29 = t7 * t23;
-            let t30 = t6 * t24;
-            let t31 = t4 * t26;
-            let t32 = t5 * t27;
-            let t33 = t5 * t26;
-            let t34 = t4 * t27;
-            let t35 = T::mul_add(t6, t10, t7 * t24);
-            let t36 = T::mul_add(T::from_f64(0.093), t19 - t20, t32 - t31);
-            let t37 = T::mul_add(T::from_f64(0.093), t24, t33 + t34);
-            let t38 = t7 * t36;
-            let t39 = t6 * t36;
-            let t40 = T::from_f64(0.0171364731454) * (T::mul_add(-t8, t25, t9 * t35));
-            let t41 = T::from_f64(0.033822) * (T::mul_add(t9, t25, t8 * t35));
-            let t42 = T::mul_add(T::from_f64(0.09465), t30 - t15, -t38 - t28);
-            let t43 = T::mul_add(
-                T::from_f64(1.4069),
-                t39 - t29,
-                T::from_f64(0.017784735) * t35,
-            );
-            let t44 = t8 * t40;
-            let t45 = t9 * t41;
-            let t46 = t6 * t43;
-            let t47 = t7 * t43;
-            let t48 = T::from_f64(0.1879) * (T::mul_add(-t9, t37, t8 * t42));
-            let t49 = T::from_f64(0.1879) * (T::mul_add(t8, t37, t9 * t42));
-            let t50 = T::mul_add(
-                t8,
+            let t40 = T::mul_add(T::from_f64(0.09465), t29, -t37);
+            let t41 = T::mul_add(T::from_f64(0.09465), t26, -t38);
+            let t42 = T::mul_add(
+                T::from_f64(0.017784735),
                 t41,
                 T::mul_add(
-                    t9,
-                    t40,
-                    T::mul_add(
-                        T::from_f64(0.017784735),
-                        t39 - t29,
-                        T::from_f64(0.11285608069875) * t35,
-                    ),
+                    T::from_f64(0.033822),
+                    t8 * t32,
+                    T::from_f64(0.0171364731454) * t9 * t31,
                 ),
             );
-            let t51 = t9 * t49;
-            let t52 = t8 * t48;
-            let t53 = t8 * t49;
-            let t54 = t9 * t48;
-            let t55 = t6 * t50;
-            let t56 = T::mul_add(T::from_f64(1.219), t38 + t28, -t51 - t52);
+            let t43 = T::mul_add(T::from_f64(1.219), -t38, T::from_f64(0.1879) * t41);
+            let t44 = T::mul_add(-t9, t36, t8 * t40);
+            let t45 = T::mul_add(t8, t36, t9 * t40);
+            let t46 = T::mul_add(T::from_f64(0.111172755531), t26, t42);
+            let t47 = t9 * t45;
+            let t48 = t8 * t44;
+            let t49 = T::mul_add(
+                T::from_f64(1.219),
+                t37,
+                -T::from_f64(0.1879) * (t47 + t48),
+            );
+            let t50 = T::mul_add(
+                T::from_f64(1.219),
+                t36,
+                T::from_f64(0.1879) * (T::mul_add(-t9, t44, t8 * t45)),
+            );
+            let t51 = T::mul_add(
+                T::from_f64(0.111172755531),
+                t29,
+                -(T::mul_add(
+                    -T::from_f64(0.09465),
+                    T::from_f64(0.1879) * (t47 + t48),
+                    T::from_f64(0.0171364731454) * t30,
+                )),
+            );
+            let t52 = T::mul_add(T::from_f64(1.219), t34, t50);
+            let t53 = T::mul_add(t6, t43, t7 * t49);
+            let t54 = T::mul_add(
+                T::from_f64(1.219),
+                t19,
+                T::mul_add(-t7, t43, t6 * t49),
+            );
+            let t55 = T::mul_add(T::from_f64(1.219), -t33, -t53);
+            let t56 = T::mul_add(T::from_f64(0.093), t50, T::mul_add(t6, t51, t7 * t46));
             let t57 = T::mul_add(
-                -T::from_f64(0.09465),
-                t51 + t52,
-                T::mul_add(
-                    T::from_f64(0.12830922867640002),
-                    t15 - t30,
-                    T::from_f64(0.0171364731454) * qd[5],
-                ),
+                T::from_f64(0.111172755531),
+                t15,
+                T::mul_add(-t7, t51, t6 * t46),
             );
             let t58 = T::mul_add(
-                T::from_f64(2.438),
-                t33 + t34,
-                T::mul_add(T::from_f64(0.11336700000000001), t24, t53 - t54),
+                T::from_f64(0.21942),
+                t22,
+                -(T::mul_add(-T::from_f64(0.093), t53, t39)),
             );
-            let t59 = t7 * t56;
-            let t60 = t6 * t56;
-            let t61 = t7 * t57;
-            let t62 = t5 * t58;
+            let t59 = T::mul_add(T::from_f64(0.111172755531), t20, t56);
+            let t60 = T::mul_add(t5, t52, t4 * t55);
+            let t61 = T::mul_add(T::from_f64(2.275), t24, T::from_f64(0.56875) * t10)
+                + t60;
+            let t62 = T::mul_add(
+                T::from_f64(2.275),
+                t25,
+                -(T::mul_add(-t4, t52, t5 * t55)),
+            );
             let t63 = T::mul_add(
-                -t6,
-                t57,
-                T::mul_add(
-                    t7,
-                    t50,
-                    T::mul_add(
-                        T::from_f64(0.093),
-                        t53 - t54,
-                        T::mul_add(
-                            T::from_f64(0.11336700000000001),
-                            t33 + t34,
-                            T::from_f64(0.121715886531) * t24,
-                        ),
-                    ),
-                ),
-            );
+                T::from_f64(0.56875),
+                t24,
+                T::from_f64(0.19163081355599998) * t10,
+            ) + T::mul_add(T::from_f64(0.39225), t60, t57);
             (
                 t0,
                 t1,
@@ -1774,191 +1492,79 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
                 t63,
             )
         };
-        let (t64, t65, t66, t67, t68, t69, t70, t71, t72, t73, t74, t75) = {
+        let (t64, t65, t66, t67, t68, t69, t70, t71, t72, t73, t74) = {
             let t64 = T::mul_add(
-                -T::from_f64(0.093),
-                t59 + t46,
-                T::mul_add(
-                    T::from_f64(0.43884),
-                    t20 - t19,
-                    T::mul_add(T::from_f64(0.21942), qd[4], t45 - t44),
-                ),
+                -T::from_f64(0.39225),
+                t54,
+                T::mul_add(-t5, t58, -t4 * t59),
             );
-            let t65 = T::mul_add(T::from_f64(1.219), t31 - t32, -t59 - t46);
-            let t66 = t4 * t65;
-            let t67 = T::mul_add(
-                T::from_f64(2.275),
-                t21,
-                T::mul_add(
-                    T::from_f64(0.036741249999999996),
-                    t14,
-                    T::mul_add(T::from_f64(0.56875), qd[1] + qd[2], t66 + t62),
-                ),
+            let t65 = T::mul_add(
+                T::from_f64(0.004095),
+                t16,
+                -(T::mul_add(t4, t58, -t5 * t59)),
             );
+            let t66 = T::mul_add(-t2, t62, t3 * t61);
+            let t67 = T::mul_add(-t3, t62, -t2 * t61);
             let t68 = T::mul_add(
-                -t5,
-                t64,
-                T::mul_add(
-                    t4,
-                    t63,
-                    T::mul_add(
-                        T::from_f64(0.39225),
-                        t60 - t47,
-                        T::mul_add(
-                            T::from_f64(0.37918622974349997),
-                            t17,
-                            T::from_f64(0.44493366875) * t11,
-                        ),
-                    ),
-                ),
-            );
+                -T::from_f64(0.19163081355599998),
+                t17,
+                -T::from_f64(0.24171874999999998) * t11,
+            ) + t64;
             let t69 = T::mul_add(
-                t4,
-                t64,
-                T::mul_add(t5, t63, T::from_f64(0.004095) * t16),
+                T::from_f64(0.1197),
+                -t67,
+                -T::from_f64(0.425)
+                    * (T::mul_add(
+                        T::from_f64(0.56875),
+                        t17,
+                        T::from_f64(0.9668749999999999) * t11,
+                    ) + t54),
             );
-            let t70 = T::mul_add(
-                t4,
-                t58,
-                T::mul_add(
-                    -t5,
-                    t65,
-                    T::mul_add(
-                        -T::from_f64(2.275),
-                        t22,
-                        T::from_f64(0.036741249999999996) * t13,
-                    ),
-                ),
+            let t70 = t0
+                * (T::mul_add(
+                    T::from_f64(1.14018905),
+                    t12,
+                    T::from_f64(2.3500400000000004) * qd[1],
+                ) + t66);
+            let t71 = T::mul_add(
+                t1,
+                T::mul_add(T::from_f64(1.14018905), t11, -t67),
+                t70,
             );
-            let t71 = t3 * t67;
-            let t72 = t2 * t70;
-            let t73 = t2 * t67;
-            let t74 = t3 * t70;
-            let t75 = T::mul_add(
+            let t72 = T::mul_add(-t2, t65, t3 * t68) + t69;
+            let t73 = T::mul_add(
+                T::from_f64(0.1197),
+                t66,
+                T::mul_add(-t3, t65, -t2 * t68),
+            );
+            let t74 = T::mul_add(
                 t0,
-                T::mul_add(
-                    t3,
-                    t69,
-                    T::mul_add(
-                        -t2,
-                        t68,
-                        T::mul_add(
-                            T::from_f64(0.1197),
-                            t72 - t71,
-                            T::from_f64(0.0151074) * t12,
-                        ),
-                    ),
-                ),
-                T::mul_add(
-                    t1,
-                    T::mul_add(
-                        t2,
-                        t69,
-                        T::mul_add(
-                            t3,
-                            t68,
-                            T::mul_add(
-                                -T::from_f64(0.1197),
-                                t73 + t74,
-                                T::mul_add(
-                                    T::from_f64(0.425),
-                                    t60 - t47,
-                                    T::mul_add(
-                                        T::from_f64(0.44493366875),
-                                        t17,
-                                        T::from_f64(1.51600562591) * t11,
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                    T::mul_add(
-                        T::from_f64(0.13585),
-                        T::mul_add(
-                            t1,
-                            T::mul_add(T::from_f64(1.14018905), t11, t73 + t74),
-                            t0
-                                * (T::mul_add(
-                                    T::from_f64(1.14018905),
-                                    t12,
-                                    T::mul_add(
-                                        T::from_f64(2.3500400000000004),
-                                        qd[1],
-                                        t71 - t72,
-                                    ),
-                                )),
-                        ),
-                        T::from_f64(0.00666) * qd[0],
-                    ),
-                ),
+                T::mul_add(T::from_f64(0.0151074), t12, -t73),
+                t1 * (T::mul_add(T::from_f64(0.8849018759100001), t11, -t72)),
             );
-            (t64, t65, t66, t67, t68, t69, t70, t71, t72, t73, t74, t75)
+            (t64, t65, t66, t67, t68, t69, t70, t71, t72, t73, t74)
         };
         [
-            t75,
             T::mul_add(
-                T::from_f64(0.425),
-                t71 - t72,
-                T::mul_add(
-                    T::from_f64(0.39225),
-                    t66 + t62,
-                    T::mul_add(
-                        T::from_f64(0.56875),
-                        t21,
-                        T::mul_add(
-                            T::from_f64(0.009185312499999999),
-                            t14,
-                            T::mul_add(
-                                T::from_f64(0.31925293400000004),
-                                t12,
-                                T::mul_add(
-                                    T::from_f64(0.111172755531),
-                                    qd[3],
-                                    T::mul_add(
-                                        T::from_f64(0.302803569087),
-                                        qd[2],
-                                        T::mul_add(
-                                            T::from_f64(1.1877054449970001),
-                                            qd[1],
-                                            t55 + t61,
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
+                T::from_f64(0.00666),
+                qd[0],
+                T::mul_add(T::from_f64(0.13585), t71, t74),
             ),
             T::mul_add(
-                T::from_f64(0.39225),
-                t66 + t62,
-                T::mul_add(
-                    T::from_f64(0.56875),
-                    t21,
-                    T::mul_add(
-                        T::from_f64(0.009185312499999999),
-                        t14,
-                        T::mul_add(
-                            T::from_f64(0.111172755531),
-                            qd[3],
-                            T::mul_add(
-                                T::from_f64(0.302803569087),
-                                qd[1] + qd[2],
-                                t55 + t61,
-                            ),
-                        ),
-                    ),
-                ),
-            ),
-            T::mul_add(T::from_f64(0.111172755531), t10, t55 + t61),
-            T::mul_add(T::from_f64(0.21942), t25, t45 - t44),
-            T::from_f64(0.0171364731454) * (qd[5] + t15 - t30),
+                T::from_f64(0.31925293400000004),
+                t12,
+                T::from_f64(0.8849018759100001) * qd[1],
+            ) + T::mul_add(T::from_f64(0.425), t66, t63),
+            t63,
+            t57,
+            t39,
+            T::from_f64(0.0171364731454) * t30,
         ]
     }
     /// Craig's centrifugal matrix C(q): `b = B(q) [qd qd] + C(q) [qd^2]`.
     ///
     /// Route: second velocity derivatives of the Newton-Euler bias.
-    /// Operations: 431 mul, 232 add, 0 div, 5 sin, 5 cos.
+    /// Operations: 388 mul, 175 add, 0 div, 5 sin, 5 cos.
     pub fn centrifugal(&self, q: &[T; 6]) -> [[T; 6]; 6] {
         let ([s1, s2, s3, s4, s5], [c1, c2, c3, c4, c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
             q[1],
@@ -2043,112 +1649,91 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
             let t7 = c4;
             let t8 = s5;
             let t9 = c5;
-            let t10 = t2 * t4;
-            let t11 = t2 * t5;
-            let t12 = t0 * t0;
-            let t13 = t1 * t1;
-            let t14 = t6 * t6;
-            let t15 = t7 * t7;
-            let t16 = t0 * t1;
-            let t17 = t6 * t7 * t8 * t9;
-            let t18 = t6 * t7 * t8 * t8;
-            let t19 = t6 * t6 * t8 * t9;
-            let t20 = t0 * t1 * t3;
-            let t21 = t1 * t1 * t2;
-            let t22 = t0 * t1 * t2;
-            let t23 = t1 * t1 * t3;
-            let t24 = T::mul_add(T::from_f64(0.85), t3, T::from_f64(0.7845));
-            let t25 = t5 * t6 * t6;
-            let t26 = t5 * t6 * t7;
-            let t27 = t6 * t6 * t7 * t8 * t9;
-            let t28 = T::mul_add(-t0, t2, t1 * t3);
-            let t29 = T::mul_add(t0, t3, t1 * t2);
-            let t30 = T::from_f64(0.016685526854599998) * t7 * t8 * t9;
-            let t31 = -T::from_f64(0.016685526854599998) * t19;
-            let t32 = t5 * t24;
-            let t33 = t4 * t24;
-            let t34 = T::mul_add(
-                -T::from_f64(0.1893),
-                t14 + t15,
-                T::from_f64(0.7845) * t4,
-            );
-            let t35 = T::mul_add(
-                T::from_f64(0.0333710537092),
-                t17,
+            let t10 = t1 * t1;
+            let t11 = t6 * t6;
+            let t12 = t7 * t7;
+            let t13 = t0 * t1;
+            let t14 = t6 * t7 * t8 * t9;
+            let t15 = t6 * t7 * t8 * t8;
+            let t16 = t6 * t6 * t8 * t9;
+            let t17 = t0 * t1 * t3;
+            let t18 = t1 * t1 * t2;
+            let t19 = t0 * t1 * t2;
+            let t20 = t1 * t1 * t3;
+            let t21 = T::mul_add(T::from_f64(0.85), t3, T::from_f64(0.7845));
+            let t22 = T::mul_add(-t0, t2, t1 * t3);
+            let t23 = T::mul_add(t0, t3, t1 * t2);
+            let t24 = T::from_f64(0.016685526854599998) * t7 * t8 * t9;
+            let t25 = -T::from_f64(0.016685526854599998) * t16;
+            let t26 = T::from_f64(0.2394) * (T::mul_add(t0, t0, t10));
+            let t27 = -T::from_f64(0.85) * (t17 + t18);
+            let t28 = -T::from_f64(0.1893) * (t11 + t12);
+            let t29 = T::mul_add(
+                T::from_f64(0.033371053709199995),
+                t14,
                 T::from_f64(0.0139521246075) * t5 * t6,
             );
-            let t36 = T::from_f64(0.1893) * (t14 + t15);
-            let t37 = -T::from_f64(0.0166855268546) * t18;
-            let t38 = T::from_f64(0.56875) * t28;
-            let t39 = T::from_f64(0.39225) * t28;
-            let t40 = T::mul_add(T::from_f64(0.85), t10, -t32);
+            let t30 = T::from_f64(0.1893) * (t11 + t12);
+            let t31 = -T::from_f64(0.016685526854599998) * t15;
+            let t32 = t22 * t23;
+            let t33 = t22 * t22;
+            let t34 = T::mul_add(t4, t21, T::from_f64(0.85) * t2 * t5);
+            let t35 = T::mul_add(-t5, t21, T::from_f64(0.85) * t2 * t4);
+            let t36 = T::mul_add(T::from_f64(0.7845), t4, t28);
+            let t37 = t8 * t8 * t30;
+            let t38 = t9 * t9 * t30;
+            let t39 = T::mul_add(t22, t4, t23 * t5);
+            let t40 = T::mul_add(-t22, t5, t23 * t4);
             let t41 = T::mul_add(
-                -T::from_f64(0.1893),
-                t14 + t15,
-                T::mul_add(T::from_f64(0.85), t11, t33),
+                T::from_f64(0.7845),
+                t32,
+                T::from_f64(0.85) * (t17 + t18),
             );
-            let t42 = t6 * t35;
-            let t43 = t8 * t8 * t36;
-            let t44 = t9 * t9 * t36;
-            let t45 = T::mul_add(t28, t4, t29 * t5);
-            let t46 = T::mul_add(-t28, t5, t29 * t4);
-            let t47 = t28 * (T::from_f64(0.004095) * t29);
-            let t48 = t29 * (T::from_f64(0.19163081355599998) * t28);
-            let t49 = t6 * t6 * t40;
-            let t50 = t6 * t7 * t40;
-            let t51 = T::mul_add(
-                -T::from_f64(0.1879),
-                t8 * t34,
-                T::from_f64(0.14740755) * t5 * t7 * t9,
+            let t42 = T::mul_add(
+                -T::from_f64(0.7845),
+                t33,
+                T::from_f64(0.85) * (t19 - t20),
             );
-            let t52 = T::mul_add(
-                T::from_f64(0.1879),
-                t9 * t34,
-                T::from_f64(0.14740755) * t5 * t7 * t8,
+            let t43 = t34 + t28;
+            let t44 = T::from_f64(0.1879) * (t37 + t38);
+            let t45 = T::mul_add(
+                t0,
+                T::from_f64(0.033371053709199995)
+                    * (T::mul_add(-t3, t5 * t6 * t8 * t9, t2 * t4 * t6 * t8 * t9)),
+                -t1
+                    * (T::from_f64(0.033371053709199995)
+                        * (T::mul_add(t2, t5 * t6 * t8 * t9, t3 * t4 * t6 * t8 * t9))),
             );
-            let t53 = T::from_f64(0.1879) * (t43 + t44);
-            let t54 = T::mul_add(
-                -T::from_f64(0.033371053709199995),
-                t6 * t6 * t6 * t8 * t9,
-                T::mul_add(
-                    -T::from_f64(0.0333710537092),
-                    t6 * t7 * t7 * t8 * t9,
-                    T::from_f64(0.0174747) * (t43 + t44),
-                ),
-            );
-            let t55 = T::from_f64(0.5)
-                * (T::mul_add(
-                    t0,
-                    T::from_f64(0.033371053709199995)
-                        * (T::mul_add(-t3, t5 * t6 * t8 * t9, t2 * t4 * t6 * t8 * t9)),
-                    -t1
-                        * (T::from_f64(0.033371053709199995)
-                            * (T::mul_add(
-                                t2,
-                                t5 * t6 * t8 * t9,
-                                t3 * t4 * t6 * t8 * t9,
-                            ))),
-                ));
-            let t56 = T::from_f64(0.21942) * t46;
-            let t57 = T::mul_add(
-                T::from_f64(2.0),
-                t29 * t39,
-                T::from_f64(0.85) * (t20 + t21),
-            );
-            let t58 = T::mul_add(
-                -T::from_f64(2.0),
-                t28 * t39,
-                T::from_f64(0.85) * (t22 - t23),
-            );
-            let t59 = t45 * t46 * t6;
-            let t60 = t45 * t46 * t7;
-            let t61 = T::from_f64(0.1879) * (T::mul_add(t8, t41, t7 * t9 * t40));
-            let t62 = T::from_f64(0.1879) * (T::mul_add(-t9, t41, t7 * t8 * t40));
-            let t63 = T::mul_add(
+            let t46 = t39 * t40 * t6;
+            let t47 = t39 * t40 * t7;
+            let t48 = T::mul_add(
                 -T::from_f64(0.017784735),
-                t6 * t40,
-                T::from_f64(0.0333710537092) * t17,
+                t6 * t35,
+                T::from_f64(0.033371053709199995) * t14,
             );
+            let t49 = T::mul_add(-t8, t36, T::from_f64(0.7845) * t5 * t7 * t9);
+            let t50 = T::mul_add(t9, t36, T::from_f64(0.7845) * t5 * t7 * t8);
+            let t51 = T::mul_add(
+                T::from_f64(0.093),
+                -T::from_f64(0.1879) * (t37 + t38),
+                T::from_f64(0.033371053709199995)
+                    * (T::mul_add(t6, t6 * t6 * t8 * t9, t6 * t7 * t7 * t8 * t9)),
+            );
+            let t52 = t5 * t44;
+            let t53 = T::mul_add(t40, t9, t39 * t7 * t8);
+            let t54 = T::mul_add(-t4, t42, t5 * t41);
+            let t55 = T::mul_add(t5, t42, t4 * t41);
+            let t56 = T::mul_add(t8, t43, t7 * t9 * t35);
+            let t57 = T::mul_add(-t9, t43, t7 * t8 * t35);
+            let t58 = T::mul_add(t2, t4 * t44, -t3 * t5 * t44);
+            let t59 = T::mul_add(-t3, t4 * t44, -t2 * t5 * t44);
+            let t60 = t39 * t6 * t8 * t53;
+            let t61 = t26 + -T::from_f64(0.186) * (T::mul_add(t39, t39, t40 * t40))
+                - T::from_f64(0.2717);
+            let t62 = t54
+                + -T::from_f64(0.1893)
+                    * (T::mul_add(t39, t39 * t6 * t6, t39 * t39 * t7 * t7));
+            let t63 = (T::mul_add(-t40, t8, t39 * t7 * t9)) * t53;
             (
                 t0,
                 t1,
@@ -2282,187 +1867,170 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
             t126,
             t127,
         ) = {
-            let t64 = t9 * t51;
-            let t65 = t8 * t52;
-            let t66 = t8 * t51;
-            let t67 = t9 * t52;
-            let t68 = t5 * t53;
-            let t69 = T::mul_add(-t46, t8, t45 * t7 * t9);
-            let t70 = T::mul_add(t46, t9, t45 * t7 * t8);
-            let t71 = t46 * (T::from_f64(0.111172755531) * t45);
-            let t72 = t45 * t56;
-            let t73 = t5 * t57;
-            let t74 = t4 * t58;
-            let t75 = t9 * t61;
-            let t76 = t8 * t62;
-            let t77 = t8 * t61;
-            let t78 = t9 * t62;
-            let t79 = t6 * t63;
-            let t80 = T::mul_add(T::from_f64(0.9563055), t5 * t7, t64 + t65);
-            let t81 = T::mul_add(
-                -T::from_f64(0.09465),
-                t64 + t65,
-                T::from_f64(0.033371053709199995) * t19,
-            );
-            let t82 = T::mul_add(T::from_f64(1.912611), t4, t67 - t66);
-            let t83 = T::mul_add(
-                -T::from_f64(0.0333710537092),
+            let t64 = T::from_f64(0.1879) * (T::mul_add(t8, t50, t9 * t49));
+            let t65 = T::from_f64(0.1879) * (T::mul_add(t9, t50, -t8 * t49));
+            let t66 = T::mul_add(
+                T::from_f64(0.033371053709199995),
                 t5 * t6 * t7 * t8 * t8,
-                t4 * t54,
+                t4 * t51,
             );
-            let t84 = T::mul_add(
-                T::from_f64(0.0333710537092),
+            let t67 = T::mul_add(
+                -T::from_f64(0.033371053709199995),
                 t4 * t6 * t7 * t8 * t8,
-                t5 * t54,
+                t5 * t51,
             );
-            let t85 = T::mul_add(-t2, t4 * t53, t3 * t5 * t53);
-            let t86 = T::mul_add(t3, t4 * t53, t2 * t5 * t53);
-            let t87 = T::from_f64(0.0171364731454) * t69;
-            let t88 = T::from_f64(0.033822) * t70;
-            let t89 = T::mul_add(t5, t58, t4 * t57);
-            let t90 = T::mul_add(
-                -T::from_f64(2.0),
-                T::mul_add(
-                    t45,
-                    T::from_f64(0.093) * t45,
-                    t46 * (T::from_f64(0.093) * t46),
-                ),
-                T::mul_add(T::from_f64(0.2394), t12 + t13, -T::from_f64(0.2717)),
+            let t68 = -T::from_f64(0.1879) * (T::mul_add(t8, t57, t9 * t56));
+            let t69 = T::mul_add(T::from_f64(0.9563055), t5 * t7, t64);
+            let t70 = T::mul_add(
+                -T::from_f64(0.09465),
+                t64,
+                T::from_f64(0.033371053709199995) * t16,
             );
-            let t91 = T::mul_add(
-                T::from_f64(0.1893),
-                T::mul_add(t45, t45 * t6 * t6, t45 * t45 * t7 * t7),
-                t74 - t73,
+            let t71 = T::mul_add(T::from_f64(1.912611), t4, t65);
+            let t72 = T::mul_add(t6, t61, -t7 * t55);
+            let t73 = T::mul_add(t7, t61, t6 * t55);
+            let t74 = T::mul_add(
+                T::from_f64(1.219),
+                t34,
+                T::from_f64(0.1879) * (T::mul_add(-t9, t57, t8 * t56)),
             );
-            let t92 = T::mul_add(T::from_f64(1.219), t7 * t40, t75 + t76);
-            let t93 = T::mul_add(
-                T::from_f64(0.09465),
-                t75 + t76,
-                T::from_f64(0.033371053709199995) * t19,
+            let t75 = T::mul_add(T::from_f64(1.219), t7 * t35, -t68);
+            let t76 = T::mul_add(
+                -T::from_f64(0.09465),
+                t68,
+                T::from_f64(0.033371053709199995) * t16,
             );
-            let t94 = T::mul_add(
-                T::from_f64(2.438),
-                t33,
-                T::mul_add(T::from_f64(2.0723000000000003), t11, t77 - t78),
-            );
-            let t95 = t7 * t80;
-            let t96 = t6 * t80;
-            let t97 = t7 * t81;
-            let t98 = t7 * t89;
-            let t99 = t6 * t90;
-            let t100 = t6 * t89;
-            let t101 = t7 * t90;
-            let t102 = t7 * t92;
-            let t103 = t6 * t92;
-            let t104 = t7 * t93;
-            let t105 = t5 * t94;
-            let t106 = T::mul_add(
-                T::from_f64(1.10371305),
-                t25,
-                T::mul_add(T::from_f64(0.9563055), t5, t95),
-            );
-            let t107 = T::mul_add(
-                t6,
-                t81,
-                T::mul_add(
-                    t7,
-                    t35,
-                    T::mul_add(
-                        T::from_f64(0.093),
-                        t67 - t66,
-                        T::from_f64(0.0889364115) * t4,
-                    ),
-                ),
-            );
-            let t108 = T::mul_add(
-                T::from_f64(0.10264531365),
-                t25,
-                T::mul_add(T::from_f64(0.093), t95, T::from_f64(0.0333710537092) * t18),
-            );
-            let t109 = T::mul_add(-T::from_f64(0.1893), t60, t98 - t99);
-            let t110 = T::mul_add(
-                -T::from_f64(0.0342729462908),
-                t45 * t6 * t70,
-                T::from_f64(2.0) * t45 * t6 * t88,
-            );
-            let t111 = T::mul_add(
-                -T::from_f64(2.0),
-                t45 * t6 * t87,
-                T::from_f64(0.0342729462908) * t45 * t6 * t69,
-            );
-            let t112 = T::mul_add(
-                -T::from_f64(0.03556947),
+            let t77 = T::mul_add(-t1, -t59, -t0 * (-t58));
+            let t78 = T::mul_add(T::from_f64(0.1893), t47, t72);
+            let t79 = T::mul_add(-T::from_f64(0.1893), t46, t73);
+            let t80 = T::mul_add(T::from_f64(1.219), t34, t74);
+            let t81 = T::mul_add(T::from_f64(1.10371305), t5 * t6 * t6, t7 * t69);
+            let t82 = T::mul_add(-T::from_f64(1.10371305), t5 * t6 * t7, t6 * t69);
+            let t83 = T::mul_add(-t7, t70, t6 * t29);
+            let t84 = T::mul_add(
+                T::from_f64(0.1197),
                 t59,
-                T::from_f64(1.4069) * (t100 + t101),
+                T::mul_add(-t2, t67, -t3 * t66),
             );
-            let t113 = T::mul_add(-t69, t88, t70 * t87);
+            let t85 = T::mul_add(
+                T::from_f64(0.1197),
+                t58,
+                T::mul_add(-t3, t67, t2 * t66),
+            );
+            let t86 = T::mul_add(-T::from_f64(0.1879), t79, T::from_f64(1.219) * (-t73));
+            let t87 = T::mul_add(-T::from_f64(1.4069), t6 * t6 * t35, -t7 * t75);
+            let t88 = T::mul_add(T::from_f64(1.4069), t6 * t7 * t35, -t6 * t75);
+            let t89 = T::mul_add(-t7, t76, t6 * t48);
+            let t90 = T::mul_add(
+                T::from_f64(0.093),
+                T::mul_add(T::from_f64(0.9563055), t4, t65),
+                T::mul_add(t6, t70, t7 * t29),
+            );
+            let t91 = T::mul_add(T::from_f64(0.9563055), t5, t81);
+            let t92 = T::mul_add(
+                T::from_f64(0.093),
+                t81,
+                T::from_f64(0.033371053709199995) * t15,
+            );
+            let t93 = T::mul_add(-t8, t62, t9 * t78);
+            let t94 = T::mul_add(t9, t62, t8 * t78);
+            let t95 = T::mul_add(
+                T::from_f64(0.216494488938),
+                t46,
+                -(T::mul_add(
+                    -T::from_f64(0.033371053709199995),
+                    t39 * t6 * t9 * t53,
+                    -T::from_f64(0.017784735) * t79,
+                )),
+            );
+            let t96 = T::mul_add(T::from_f64(0.093), t74, T::mul_add(t6, t76, t7 * t48));
+            let t97 = T::mul_add(T::from_f64(1.219), t35, -t87);
+            let t98 = T::mul_add(
+                T::from_f64(0.093),
+                t87,
+                T::from_f64(0.033371053709199995) * t15,
+            );
+            let t99 = T::mul_add(t5, t71, -t4 * t91);
+            let t100 = T::mul_add(-t4, t92, t5 * t90);
+            let t101 = T::mul_add(
+                T::from_f64(0.13585),
+                t77,
+                T::mul_add(-t0, t85, -t1 * t84),
+            );
+            let t102 = T::from_f64(0.1879) * (T::mul_add(t8, t94, t9 * t93));
+            let t103 = T::mul_add(t5, t80, t4 * t97);
+            let t104 = T::mul_add(-t4, t98, t5 * t96);
+            let t105 = T::mul_add(T::from_f64(0.39225), t99, t83);
+            let t106 = -t99;
+            let t107 = T::mul_add(-t4, t71, -t5 * t91) - T::from_f64(1.1375);
+            let t108 = T::mul_add(
+                T::from_f64(0.39225),
+                t82,
+                -(T::mul_add(-t5, t92, -t4 * t90)),
+            );
+            let t109 = T::mul_add(T::from_f64(1.219), t72, t102);
+            let t110 = T::mul_add(
+                T::from_f64(1.219),
+                t54,
+                T::from_f64(0.1879) * (T::mul_add(t9, t94, -t8 * t93)),
+            );
+            let t111 = T::mul_add(T::from_f64(1.9337499999999999), t2, t103);
+            let t112 = T::mul_add(
+                T::from_f64(1.9337499999999999),
+                t3,
+                T::from_f64(1.1375) - (T::mul_add(-t4, t80, t5 * t97)),
+            );
+            let t113 = T::mul_add(
+                T::from_f64(0.39225),
+                t88,
+                -(T::mul_add(-t5, t98, -t4 * t96)),
+            );
             let t114 = T::mul_add(
-                T::from_f64(1.4069),
-                t49,
-                T::mul_add(
-                    -T::from_f64(1.219),
-                    t32,
-                    T::mul_add(T::from_f64(1.0361500000000001), t10, t102),
-                ),
+                T::from_f64(0.216494488938),
+                t47,
+                -(T::mul_add(
+                    T::from_f64(0.09465),
+                    t102,
+                    -T::from_f64(0.033371053709199995) * t63,
+                )),
             );
-            let t115 = T::mul_add(
-                t6,
-                t93,
-                T::mul_add(
-                    t7,
-                    t63,
-                    T::mul_add(
-                        T::from_f64(0.093),
-                        t77 - t78,
-                        T::mul_add(
-                            T::from_f64(0.11336700000000001),
-                            t33,
-                            T::from_f64(0.09636195) * t11,
-                        ),
-                    ),
-                ),
-            );
+            let t115 = T::mul_add(T::from_f64(1.219), t54, t110);
             let t116 = T::mul_add(
-                -T::from_f64(0.1308417),
-                t49,
-                T::mul_add(-T::from_f64(0.093), t102, T::from_f64(0.0333710537092) * t18),
+                T::from_f64(0.48343749999999996),
+                t2,
+                T::mul_add(T::from_f64(0.39225), t103, t89),
             );
-            let t117 = t8 * t110;
-            let t118 = t9 * t111;
-            let t119 = t6 * t112;
-            let t120 = t7 * t112;
-            let t121 = t4 * t114;
-            let t122 = T::mul_add(-t5, t82, t4 * t106);
-            let t123 = T::mul_add(t4, t82, T::mul_add(t5, t106, T::from_f64(1.1375)));
+            let t117 = T::mul_add(t2, t107, -t3 * t106);
+            let t118 = T::mul_add(t3, t107, t2 * t106);
+            let t119 = T::mul_add(t6, t86, t7 * t109);
+            let t120 = T::mul_add(-t2, t112, t3 * t111);
+            let t121 = T::mul_add(-t3, t112, -t2 * t111);
+            let t122 = T::mul_add(
+                T::from_f64(0.1197),
+                t117,
+                T::mul_add(-t3, t100, t2 * t108),
+            );
+            let t123 = T::mul_add(
+                -T::from_f64(0.093),
+                t119,
+                T::from_f64(0.033371053709199995) * t60,
+            );
             let t124 = T::mul_add(
-                t5,
-                t108,
-                T::mul_add(
-                    t4,
-                    t107,
-                    T::mul_add(
-                        -T::from_f64(0.43293144386250004),
-                        t26,
-                        T::from_f64(0.39225) * t96,
-                    ),
-                ),
+                T::from_f64(1.219),
+                t26,
+                T::mul_add(-t7, t86, t6 * t109) - T::from_f64(0.3312023),
             );
-            let t125 = T::mul_add(-t4, t108, t5 * t107);
+            let t125 = T::mul_add(T::from_f64(1.219), t55, -t119);
             let t126 = T::mul_add(
-                T::from_f64(0.5),
-                T::mul_add(
-                    t0,
-                    T::mul_add(-t3, t84, T::mul_add(t2, t83, T::from_f64(0.1197) * t85)),
-                    t1
-                        * (T::mul_add(
-                            -t2,
-                            t84,
-                            T::mul_add(-t3, t83, T::from_f64(0.1197) * t86),
-                        )),
-                ),
-                -T::from_f64(0.067925) * (T::mul_add(t1, t86, t0 * t85)),
+                T::from_f64(0.1197),
+                t120,
+                T::mul_add(-t3, t104, t2 * t113),
             );
-            let t127 = T::from_f64(0.1879) * (T::mul_add(-t8, t91, t9 * t109));
+            let t127 = T::mul_add(
+                T::from_f64(0.093),
+                t110,
+                T::mul_add(t6, t114, -t7 * t95),
+            );
             (
                 t64,
                 t65,
@@ -2552,263 +2120,85 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
             t146,
             t147,
             t148,
-            t149,
-            t150,
-            t151,
-            t152,
-            t153,
-            t154,
-            t155,
-            t156,
-            t157,
-            t158,
-            t159,
-            t160,
-            t161,
-            t162,
-            t163,
-            t164,
-            t165,
         ) = {
-            let t128 = T::from_f64(0.1879) * (T::mul_add(t9, t91, t8 * t109));
-            let t129 = T::mul_add(
-                t8,
-                t111,
-                T::mul_add(
-                    t9,
-                    t110,
-                    T::mul_add(
-                        -T::from_f64(0.2257121613975),
-                        t59,
-                        T::mul_add(
-                            T::from_f64(2.0),
-                            t45 * t6 * t56,
-                            T::from_f64(0.017784735) * (t100 + t101),
-                        ),
-                    ),
-                ),
+            let t128 = T::mul_add(
+                -T::from_f64(0.216494488938),
+                t39 * t40,
+                T::mul_add(-t7, t114, -t6 * t95),
             );
-            let t130 = T::mul_add(T::from_f64(1.9337499999999999), t2, t121 + t105);
-            let t131 = T::mul_add(
-                -t5,
-                t116,
-                T::mul_add(
-                    -t4,
-                    t115,
-                    T::mul_add(
-                        -T::from_f64(0.551856525),
-                        t50,
-                        T::from_f64(0.39225) * t103,
-                    ),
-                ),
+            let t129 = T::mul_add(-t2, t100, -t3 * t108)
+                + T::mul_add(T::from_f64(0.1197), -t118, -T::from_f64(0.425) * t82);
+            let t130 = T::mul_add(-t1, t118, -t0 * (-t117));
+            let t131 = T::mul_add(t5, t115, t4 * t125);
+            let t132 = T::mul_add(-t2, t104, -t3 * t113)
+                + T::mul_add(T::from_f64(0.1197), -t121, -T::from_f64(0.425) * t88);
+            let t133 = T::mul_add(-t1, t121 - T::from_f64(4.700080000000001), t0 * t120);
+            let t134 = T::mul_add(T::from_f64(1.1375), t32, -T::from_f64(2.275) * t27)
+                + t131;
+            let t135 = T::mul_add(
+                -T::from_f64(1.1375),
+                t33,
+                -T::from_f64(2.275) * (T::from_f64(0.85) * (t20 - t19)),
+            ) + T::mul_add(-t4, t115, t5 * t125);
+            let t136 = T::mul_add(t4, t123, t5 * t127);
+            let t137 = T::mul_add(
+                -T::from_f64(0.39225),
+                t124,
+                T::mul_add(t5, t123, -t4 * t127),
             );
-            let t132 = T::mul_add(
-                t4,
-                t94,
-                T::mul_add(
-                    -t5,
-                    t114,
-                    T::mul_add(T::from_f64(1.9337499999999999), t3, T::from_f64(1.1375)),
-                ),
+            let t138 = T::mul_add(
+                T::from_f64(0.375071627112),
+                t32,
+                -T::from_f64(0.56875) * t27,
+            ) + T::mul_add(T::from_f64(0.39225), t131, t128);
+            let t139 = T::mul_add(
+                T::from_f64(0.13585),
+                t130,
+                T::mul_add(-t0, t122, -t1 * t129),
             );
-            let t133 = T::mul_add(-t4, t116, t5 * t115);
-            let t134 = t9 * t127;
-            let t135 = t8 * t128;
-            let t136 = t8 * t127;
-            let t137 = t9 * t128;
-            let t138 = t6 * t129;
-            let t139 = t2 * t130;
-            let t140 = t3 * t132;
-            let t141 = T::mul_add(t2, t123, t3 * t122);
-            let t142 = T::mul_add(-t3, t123, t2 * t122);
+            let t140 = T::mul_add(t2, t135, t3 * t134);
+            let t141 = T::mul_add(t3, t135, -t2 * t134);
+            let t142 = T::mul_add(
+                T::from_f64(0.56875),
+                t26,
+                -t137 - T::from_f64(0.154529375),
+            );
             let t143 = T::mul_add(
-                -T::from_f64(0.09465),
-                t134 + t135,
-                T::mul_add(
-                    T::from_f64(0.222345511062),
-                    t60,
-                    T::from_f64(2.0) * (T::mul_add(-t45, t7 * t56, t113)),
-                ),
+                T::from_f64(0.13585),
+                t133,
+                T::mul_add(-t0, t126, -t1 * t132),
             );
-            let t144 = T::mul_add(T::from_f64(1.219), t98 - t99, t134 + t135);
-            let t145 = T::mul_add(T::from_f64(2.438), t73 - t74, t136 - t137);
-            let t146 = T::mul_add(-t2, t132, t3 * t130);
-            let t147 = t7 * t144;
-            let t148 = t6 * t144;
-            let t149 = t7 * t143;
-            let t150 = t5 * t145;
-            let t151 = T::mul_add(T::from_f64(0.093), t147 + t119, t117 - t118);
-            let t152 = T::mul_add(T::from_f64(1.219), t89, t147 + t119);
-            let t153 = T::mul_add(
-                -t6,
-                t143,
-                T::mul_add(
-                    -t7,
-                    t129,
-                    T::mul_add(
-                        T::from_f64(0.093),
-                        t136 - t137,
-                        T::from_f64(0.11336700000000001) * (t73 - t74),
-                    ),
-                ),
-            );
-            let t154 = T::mul_add(
-                T::from_f64(0.5),
-                T::mul_add(
-                    t0,
-                    T::mul_add(
-                        t3,
-                        t125,
-                        T::mul_add(-t2, t124, T::from_f64(0.1197) * t141),
-                    ),
-                    t1
+            let t144 = T::mul_add(-t2, t136, -t3 * t142)
+                + T::mul_add(
+                    T::from_f64(0.1197),
+                    -t141,
+                    -T::from_f64(0.425)
                         * (T::mul_add(
-                            t2,
-                            t125,
-                            T::mul_add(
-                                t3,
-                                t124,
-                                T::mul_add(
-                                    T::from_f64(0.1197),
-                                    t142,
-                                    T::mul_add(
-                                        -T::from_f64(0.46907804625000005),
-                                        t26,
-                                        T::from_f64(0.425) * t96,
-                                    ),
-                                ),
-                            ),
+                            T::from_f64(2.275),
+                            t26,
+                            t124 - T::from_f64(0.6181175),
                         )),
-                ),
-                -T::from_f64(0.067925) * (T::mul_add(t1, t142, t0 * t141)),
+                );
+            let t145 = T::mul_add(
+                T::from_f64(0.1197),
+                t140,
+                T::mul_add(-t3, t136, t2 * t142),
             );
-            let t155 = t4 * t152;
-            let t156 = T::mul_add(
-                -T::from_f64(0.5),
-                T::mul_add(
-                    t0,
-                    T::mul_add(
-                        -t3,
-                        t133,
-                        T::mul_add(-t2, t131, T::from_f64(0.1197) * t146),
-                    ),
-                    t1
-                        * (T::mul_add(
-                            -t2,
-                            t133,
-                            T::mul_add(
-                                t3,
-                                t131,
-                                T::mul_add(
-                                    T::from_f64(0.1197),
-                                    t139 + t140,
-                                    T::mul_add(
-                                        -T::from_f64(0.5979325),
-                                        t50,
-                                        T::from_f64(0.425) * t103,
-                                    ),
-                                ),
-                            ),
-                        )),
-                ),
-                T::from_f64(0.067925)
-                    * (T::mul_add(
-                        t1,
-                        t139 + t140 + T::from_f64(4.700080000000001),
-                        t0 * t146,
-                    )),
+            let t146 = T::mul_add(
+                t1,
+                T::mul_add(T::from_f64(4.700080000000001), t10, -t141),
+                t0 * (T::mul_add(T::from_f64(4.700080000000001), t13, t140)),
             );
-            let t157 = T::mul_add(
-                T::from_f64(2.0),
-                t29 * t38,
-                T::mul_add(T::from_f64(1.9337499999999999), t20 + t21, t155 + t150),
-            );
-            let t158 = T::mul_add(
-                -t4,
+            let t147 = T::from_f64(0.5)
+                * (T::mul_add(
+                    T::from_f64(1.7395889518200003),
+                    t13,
+                    T::mul_add(T::from_f64(0.425), t140, t138),
+                ));
+            let t148 = T::mul_add(
+                -t0,
                 t145,
-                T::mul_add(
-                    t5,
-                    t152,
-                    T::mul_add(
-                        -T::from_f64(2.0),
-                        t28 * t38,
-                        T::from_f64(1.9337499999999999) * (t22 - t23),
-                    ),
-                ),
-            );
-            let t159 = T::mul_add(
-                -t5,
-                t151,
-                T::mul_add(
-                    t4,
-                    t153,
-                    T::mul_add(
-                        T::from_f64(0.39225),
-                        t120 - t148,
-                        T::mul_add(
-                            T::from_f64(0.25062851835),
-                            t13,
-                            T::mul_add(
-                                T::from_f64(0.25062851835000005),
-                                t12,
-                                -T::from_f64(0.28444347717499996),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t160 = T::mul_add(t4, t151, t5 * t153);
-            let t161 = t3 * t157;
-            let t162 = t2 * t158;
-            let t163 = t2 * t157;
-            let t164 = t3 * t158;
-            let t165 = T::mul_add(
-                T::from_f64(0.5),
-                T::mul_add(
-                    -t0,
-                    T::mul_add(
-                        -t3,
-                        t160,
-                        T::mul_add(t2, t159, T::from_f64(0.1197) * (t161 + t162)),
-                    ),
-                    t1
-                        * (T::mul_add(
-                            t2,
-                            t160,
-                            T::mul_add(
-                                t3,
-                                t159,
-                                T::mul_add(
-                                    T::from_f64(0.1197),
-                                    t164 - t163,
-                                    T::mul_add(
-                                        T::from_f64(0.425),
-                                        t120 - t148,
-                                        T::mul_add(
-                                            T::from_f64(0.35549703000000005),
-                                            t13,
-                                            T::mul_add(
-                                                T::from_f64(0.35549702999999994),
-                                                t12,
-                                                -T::from_f64(1.0419667830000001),
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        )),
-                ),
-                T::from_f64(0.067925)
-                    * (T::mul_add(
-                        t1,
-                        T::mul_add(T::from_f64(4.700080000000001), t13, t163 - t164),
-                        t0
-                            * (T::mul_add(
-                                T::from_f64(4.700080000000001),
-                                t16,
-                                t161 + t162,
-                            )),
-                    )),
+                -t1 * (t144 + T::from_f64(0.6385058680000001)),
             );
             (
                 t128,
@@ -2832,131 +2222,64 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
                 t146,
                 t147,
                 t148,
-                t149,
-                t150,
-                t151,
-                t152,
-                t153,
-                t154,
-                t155,
-                t156,
-                t157,
-                t158,
-                t159,
-                t160,
-                t161,
-                t162,
-                t163,
-                t164,
-                t165,
             )
         };
         [
-            [t165, t156, t154, t126, t55, T::zero()],
             [
-                T::mul_add(
-                    T::from_f64(0.2125),
-                    t161 + t162,
-                    T::mul_add(
-                        T::from_f64(0.196125),
-                        t155 + t150,
-                        T::mul_add(
-                            T::from_f64(0.5),
-                            t149 - t138,
-                            T::mul_add(
-                                T::from_f64(0.24171874999999998),
-                                t20 + t21,
-                                T::mul_add(
-                                    T::from_f64(0.8697944759100001),
-                                    t16,
-                                    t71 + t48 - t47 - t72,
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-                T::mul_add(
-                    T::from_f64(0.2125),
-                    t146,
-                    T::mul_add(
-                        T::from_f64(0.196125),
-                        t121 + t105,
-                        T::mul_add(
-                            T::from_f64(0.5),
-                            t79 - t104,
-                            T::from_f64(0.24171874999999998) * t2,
-                        ),
-                    ),
-                ),
-                T::mul_add(
-                    -T::from_f64(0.2125),
-                    t141,
-                    T::mul_add(
-                        -T::from_f64(0.196125),
-                        t122,
-                        T::from_f64(0.5) * (t42 - t97),
-                    ),
-                ),
-                T::mul_add(
-                    -T::from_f64(0.2125),
-                    t85,
-                    T::mul_add(
-                        -T::from_f64(0.196125),
-                        t68,
-                        T::from_f64(0.000000000000000003469446951953614) * t27,
-                    ),
-                ),
-                t30,
+                T::from_f64(0.5) * (T::mul_add(T::from_f64(0.13585), t146, t148)),
+                T::from_f64(0.5) * t143,
+                T::from_f64(0.5) * t139,
+                T::from_f64(0.5) * t101,
+                T::from_f64(0.5) * t45,
                 T::zero(),
             ],
             [
-                T::mul_add(
-                    T::from_f64(0.196125),
-                    t155 + t150,
-                    T::mul_add(
-                        T::from_f64(0.5),
-                        t149 - t138,
-                        T::mul_add(
-                            T::from_f64(0.24171874999999998),
-                            t20 + t21,
-                            t71 + t48 - t47 - t72,
-                        ),
-                    ),
-                ),
-                T::mul_add(
-                    T::from_f64(0.196125),
-                    t121 + t105,
-                    T::mul_add(
-                        T::from_f64(0.5),
-                        t79 - t104,
-                        T::from_f64(0.24171874999999998) * t2,
-                    ),
-                ),
-                T::mul_add(-T::from_f64(0.196125), t122, T::from_f64(0.5) * (t42 - t97)),
-                T::mul_add(
-                    -T::from_f64(0.196125),
-                    t68,
-                    T::from_f64(0.000000000000000003469446951953614) * t27,
-                ),
-                t30,
+                t147,
+                T::from_f64(0.5) * (T::mul_add(T::from_f64(0.425), t120, t116)),
+                T::from_f64(0.5) * (T::mul_add(T::from_f64(0.425), t117, t105)),
+                T::from_f64(0.5)
+                    * (T::mul_add(T::from_f64(0.425), t58, -T::from_f64(0.39225) * t52)),
+                t24,
                 T::zero(),
             ],
             [
-                T::mul_add(T::from_f64(0.5), t149 - t138, t71 - t72),
-                T::from_f64(0.5) * (t79 - t104),
-                T::from_f64(0.5) * (t42 - t97),
-                T::from_f64(0.000000000000000003469446951953614) * t27,
-                t30,
+                T::from_f64(0.5) * t138,
+                T::from_f64(0.5) * t116,
+                T::from_f64(0.5) * t105,
+                -T::from_f64(0.196125) * t52,
+                t24,
                 T::zero(),
             ],
-            [T::from_f64(0.5) * (t117 - t118), t37, t37, t37, T::zero(), T::zero()],
-            [t113, t31, t31, t31, T::from_f64(0.016685526854599998) * t8 * t9, T::zero()],
+            [
+                T::from_f64(0.5) * t128,
+                T::from_f64(0.5) * t89,
+                T::from_f64(0.5) * t83,
+                T::zero(),
+                t24,
+                T::zero(),
+            ],
+            [
+                T::from_f64(0.016685526854599998) * t60,
+                t31,
+                t31,
+                t31,
+                T::zero(),
+                T::zero(),
+            ],
+            [
+                -T::from_f64(0.016685526854599998) * t63,
+                t25,
+                t25,
+                t25,
+                T::from_f64(0.016685526854599998) * t8 * t9,
+                T::zero(),
+            ],
         ]
     }
     /// Craig's Coriolis matrix B(q), N x N(N-1)/2 = 6 x 15, columns for qd_j qd_k with j < k in the order (0,1), (0,2), ..., (1,2), ...
     ///
     /// Route: second velocity derivatives of the Newton-Euler bias.
-    /// Operations: 527 mul, 255 add, 0 div, 5 sin, 5 cos.
+    /// Operations: 475 mul, 211 add, 0 div, 5 sin, 5 cos.
     pub fn coriolis_pairs(&self, q: &[T; 6]) -> [[T; 15]; 6] {
         let ([s1, s2, s3, s4, s5], [c1, c2, c3, c4, c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
             q[1],
@@ -3047,118 +2370,99 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
             let t13 = t6 * t6 * t8 * t9;
             let t14 = t6 * t9 * t9;
             let t15 = t6 * t8 * t8;
-            let t16 = t5 * t6 * t6;
-            let t17 = t5 * t6 * t7;
-            let t18 = t6 * t6 * t7 * t8 * t9;
-            let t19 = T::mul_add(-t0, t2, t1 * t3);
-            let t20 = T::mul_add(t0, t3, t1 * t2);
-            let t21 = -T::from_f64(0.033371053709199995) * t13;
-            let t22 = T::mul_add(
-                T::from_f64(0.016685526854599998),
-                t15 - t14,
-                -T::from_f64(0.0171364731454) * t6,
-            );
-            let t23 = -T::from_f64(0.0333710537092) * t12;
-            let t24 = T::mul_add(
-                -T::from_f64(0.1893),
-                t10 + t11,
-                T::from_f64(0.7845) * t4,
-            );
-            let t25 = T::mul_add(
-                T::from_f64(0.0333710537092),
+            let t16 = T::mul_add(t0, t2, -t1 * t3);
+            let t17 = T::mul_add(t0, t3, t1 * t2);
+            let t18 = T::from_f64(0.033371053709199995) * t13;
+            let t19 = -T::from_f64(0.033371053709199995) * t13;
+            let t20 = -T::from_f64(0.033371053709199995) * t12;
+            let t21 = T::mul_add(
+                T::from_f64(0.033371053709199995),
                 t6 * t7 * t8 * t9,
                 T::from_f64(0.0139521246075) * t5 * t6,
             );
-            let t26 = T::from_f64(0.1893) * (t10 + t11);
-            let t27 = T::from_f64(0.000000000000000006938893903907228) * t18;
-            let t28 = -T::from_f64(0.000000000000000006938893903907228) * t7 * t8 * t9;
-            let t29 = T::mul_add(
-                T::from_f64(0.033822),
-                t7 * t8 * t8,
-                T::mul_add(
-                    T::from_f64(0.033822000000000005),
-                    t7 * t9 * t9,
-                    T::from_f64(0.21942000000000003) * t7,
-                ),
-            );
-            let t30 = T::mul_add(
-                T::from_f64(0.016685526854599998),
-                t14 - t15,
-                T::from_f64(0.23655647314540001) * t6,
-            );
-            let t31 = T::mul_add(
+            let t22 = T::from_f64(0.1893) * (t10 + t11);
+            let t23 = T::mul_add(
                 T::from_f64(0.0004509462908000028),
                 t15,
-                T::from_f64(0.033822000000000005) * t14,
+                T::from_f64(0.033822) * t14,
             );
-            let t32 = T::from_f64(0.0333710537092) * t13;
-            let t33 = T::mul_add(
+            let t24 = T::mul_add(
                 T::from_f64(0.0004509462908000028),
                 t9 * t9,
-                T::from_f64(0.033822000000000005) * t8 * t8,
+                T::from_f64(0.033822) * t8 * t8,
             );
-            let t34 = T::mul_add(T::from_f64(0.7845), t20, T::from_f64(0.85) * t0);
-            let t35 = T::from_f64(0.7845) * t20;
-            let t36 = t8 * t8 * t26;
-            let t37 = t9 * t9 * t26;
-            let t38 = T::mul_add(t19, t4, t20 * t5);
-            let t39 = T::mul_add(-t19, t5, t20 * t4);
-            let t40 = t6 * t34;
-            let t41 = t7 * t34;
-            let t42 = t6 * t35;
-            let t43 = t7 * t35;
-            let t44 = T::mul_add(
-                -T::from_f64(0.1879),
-                t8 * t24,
-                T::from_f64(0.14740755) * t5 * t7 * t9,
-            );
-            let t45 = T::mul_add(
-                T::from_f64(0.1879),
-                t9 * t24,
-                T::from_f64(0.14740755) * t5 * t7 * t8,
-            );
-            let t46 = T::from_f64(0.1879) * (t36 + t37);
-            let t47 = T::mul_add(
-                -T::from_f64(0.033371053709199995),
-                t6 * t6 * t6 * t8 * t9,
-                T::mul_add(
-                    -T::from_f64(0.0333710537092),
-                    t6 * t7 * t7 * t8 * t9,
-                    T::from_f64(0.0174747) * (t36 + t37),
-                ),
-            );
-            let t48 = T::mul_add(-t7, t30, t6 * t29);
-            let t49 = T::mul_add(t6, t30, t7 * t29);
-            let t50 = T::mul_add(
-                -t5,
-                t31,
-                T::from_f64(0.0333710537092) * t4 * t6 * t7 * t8 * t9,
-            );
-            let t51 = T::mul_add(
+            let t25 = -t16;
+            let t26 = T::mul_add(T::from_f64(0.7845), t17, T::from_f64(0.85) * t0);
+            let t27 = T::from_f64(0.7845) * t17;
+            let t28 = T::mul_add(
+                T::from_f64(0.7845),
                 t4,
-                t31,
-                T::from_f64(0.0333710537092) * t5 * t6 * t7 * t8 * t9,
+                -T::from_f64(0.1893) * (t10 + t11),
             );
-            let t52 = -t6 * t33;
-            let t53 = T::mul_add(
-                -T::from_f64(0.0333710537092),
+            let t29 = t8 * t8 * t22;
+            let t30 = t9 * t9 * t22;
+            let t31 = T::mul_add(
+                -T::from_f64(0.016685526854599998),
+                t14 - t15,
+                -T::from_f64(0.0171364731454) * t6,
+            );
+            let t32 = T::mul_add(
+                T::from_f64(0.21942),
+                t7,
+                T::from_f64(0.033822) * (T::mul_add(t7, t8 * t8, t7 * t9 * t9)),
+            );
+            let t33 = t6 * t26;
+            let t34 = t7 * t26;
+            let t35 = t6 * t27;
+            let t36 = t7 * t27;
+            let t37 = T::from_f64(0.1879) * (t29 + t30);
+            let t38 = T::mul_add(T::from_f64(0.21942), t6, -t31);
+            let t39 = T::mul_add(
+                -t5,
+                t23,
+                T::from_f64(0.033371053709199995) * t4 * t6 * t7 * t8 * t9,
+            );
+            let t40 = T::mul_add(
+                t4,
+                t23,
+                T::from_f64(0.033371053709199995) * t5 * t6 * t7 * t8 * t9,
+            );
+            let t41 = -t6 * t24;
+            let t42 = T::mul_add(
+                -T::from_f64(0.033371053709199995),
                 t5 * t8 * t9,
-                t4 * t7 * t33,
+                t4 * t7 * t24,
             );
-            let t54 = T::mul_add(
-                T::from_f64(0.0333710537092),
+            let t43 = T::mul_add(
+                T::from_f64(0.033371053709199995),
                 t4 * t8 * t9,
-                t5 * t7 * t33,
+                t5 * t7 * t24,
             );
-            let t55 = t38 * t7;
-            let t56 = T::from_f64(0.21942) * t39;
-            let t57 = t39 * t6;
-            let t58 = t39 * t6 * t7;
-            let t59 = t39 * t7;
-            let t60 = t39 * t6 * t9 * t9;
-            let t61 = t39 * t6 * t8 * t8;
-            let t62 = t39 * t7 * t7;
-            let t63 = t9 * t44;
+            let t44 = T::mul_add(t25, t4, t17 * t5);
+            let t45 = T::mul_add(-t25, t5, t17 * t4);
+            let t46 = T::mul_add(-t8, t28, T::from_f64(0.7845) * t5 * t7 * t9);
+            let t47 = T::mul_add(t9, t28, T::from_f64(0.7845) * t5 * t7 * t8);
+            let t48 = T::mul_add(
+                T::from_f64(0.093),
+                -T::from_f64(0.1879) * (t29 + t30),
+                T::from_f64(0.033371053709199995)
+                    * (T::mul_add(t6, t6 * t6 * t8 * t9, t6 * t7 * t7 * t8 * t9)),
+            );
+            let t49 = t5 * t37;
+            let t50 = t44 * t7;
+            let t51 = t45 * t6;
+            let t52 = t45 * t6 * t7;
+            let t53 = -T::from_f64(0.002925511062000008) * t45;
+            let t54 = t45 * t7;
+            let t55 = -T::from_f64(0.39225) * t49;
+            let t56 = T::mul_add(t2, t4 * t37, -t3 * t5 * t37);
+            let t57 = T::mul_add(-t3, t4 * t37, -t2 * t5 * t37);
+            let t58 = T::mul_add(-t7, t38, t6 * t32);
+            let t59 = T::mul_add(t6, t38, t7 * t32);
+            let t60 = T::mul_add(-t45, t8, t44 * t7 * t9);
+            let t61 = T::mul_add(t45, t9, t44 * t7 * t8);
+            let t62 = T::mul_add(-t44, t9, t45 * t7 * t8);
+            let t63 = T::mul_add(T::from_f64(0.1893), t51, -t33);
             (
                 t0,
                 t1,
@@ -3292,222 +2596,195 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
             t126,
             t127,
         ) = {
-            let t64 = t8 * t45;
-            let t65 = t8 * t44;
-            let t66 = t9 * t45;
-            let t67 = t5 * t46;
-            let t68 = T::mul_add(-t39, t8, t38 * t7 * t9);
-            let t69 = T::mul_add(t39, t9, t38 * t7 * t8);
-            let t70 = t7 * t56;
-            let t71 = t6 * t56;
-            let t72 = T::mul_add(T::from_f64(0.1893), t57, -t40);
-            let t73 = T::mul_add(
+            let t64 = T::mul_add(
                 -T::from_f64(1.4069),
-                t41,
-                T::from_f64(0.03556947) * t59,
+                t34,
+                T::from_f64(0.03556947) * t54,
             );
-            let t74 = T::mul_add(T::from_f64(0.1893), t57, -t42);
+            let t65 = T::mul_add(T::from_f64(0.1893), t51, -t35);
+            let t66 = T::mul_add(
+                -T::from_f64(1.4069),
+                t36,
+                T::from_f64(0.03556947) * t54,
+            );
+            let t67 = T::from_f64(0.03556947)
+                * (T::mul_add(t45, t6 * t8 * t8, t45 * t6 * t9 * t9));
+            let t68 = T::from_f64(0.1879) * (T::mul_add(t8, t47, t9 * t46));
+            let t69 = T::mul_add(
+                T::from_f64(0.033371053709199995),
+                t5 * t6 * t7 * t8 * t8,
+                t4 * t48,
+            );
+            let t70 = T::mul_add(
+                -T::from_f64(0.033371053709199995),
+                t4 * t6 * t7 * t8 * t8,
+                t5 * t48,
+            );
+            let t71 = T::mul_add(T::from_f64(0.425), t56, -T::from_f64(0.39225) * t49);
+            let t72 = t9 * t60;
+            let t73 = t8 * t61;
+            let t74 = t7 * t67;
             let t75 = T::mul_add(
-                -T::from_f64(1.4069),
-                t43,
-                T::from_f64(0.03556947) * t59,
+                T::from_f64(0.21942),
+                t44 * t6,
+                -(-T::from_f64(0.033822)
+                    * (T::mul_add(t44, t6 * t8 * t8, t44 * t6 * t9 * t9))),
             );
-            let t76 = T::from_f64(0.03556947) * (t60 + t61);
+            let t76 = T::mul_add(T::from_f64(0.9563055), t5 * t7, t68);
             let t77 = T::mul_add(
-                T::from_f64(0.033822),
-                t38 * t6 * t8 * t8,
-                T::mul_add(
-                    T::from_f64(0.033822000000000005),
-                    t38 * t6 * t9 * t9,
-                    T::from_f64(0.21942000000000003) * t38 * t6,
-                ),
+                T::from_f64(0.9563055),
+                t4,
+                T::from_f64(0.1879) * (T::mul_add(t9, t47, -t8 * t46)),
             );
-            let t78 = T::mul_add(T::from_f64(0.9563055), t5 * t7, t63 + t64);
-            let t79 = T::mul_add(
+            let t78 = T::mul_add(
                 -T::from_f64(0.09465),
-                t63 + t64,
+                t68,
                 T::from_f64(0.033371053709199995) * t13,
             );
-            let t80 = T::mul_add(T::from_f64(1.912611), t4, t66 - t65);
-            let t81 = T::mul_add(
-                -T::from_f64(0.0333710537092),
-                t5 * t6 * t7 * t8 * t8,
-                t4 * t47,
+            let t79 = T::mul_add(
+                -t0,
+                T::mul_add(-t3, t40, t2 * t39),
+                t1 * (T::mul_add(t2, t40, t3 * t39)),
             );
-            let t82 = T::mul_add(
-                -T::from_f64(0.39225),
-                t67,
-                T::from_f64(0.000000000000000006938893903907228) * t18,
+            let t80 = T::mul_add(
+                t0,
+                T::mul_add(-t3, t43, t2 * t42),
+                -t1 * (T::mul_add(t2, t43, t3 * t42)),
             );
-            let t83 = T::mul_add(
-                T::from_f64(0.0333710537092),
-                t4 * t6 * t7 * t8 * t8,
-                t5 * t47,
+            let t81 = T::from_f64(0.1879) * (T::mul_add(t8, t8 * t63, t9 * t9 * t63));
+            let t82 = T::from_f64(0.1879) * (T::mul_add(t8, t8 * t65, t9 * t9 * t65));
+            let t83 = T::mul_add(T::from_f64(0.03556947), t45 * t7 * t7, t6 * t67);
+            let t84 = T::mul_add(T::from_f64(0.03556947), t52, -t74);
+            let t85 = T::mul_add(
+                -T::from_f64(0.0004509462908000028),
+                t9 * t61,
+                T::from_f64(0.033822) * t8 * t60,
             );
-            let t84 = T::mul_add(-t2, t4 * t46, t3 * t5 * t46);
-            let t85 = T::mul_add(t3, t4 * t46, t2 * t5 * t46);
             let t86 = T::mul_add(
-                -t5,
-                t49,
-                T::from_f64(0.000000000000000006938893903907228) * t4 * t7 * t8 * t9,
+                T::from_f64(0.0004509462908000028),
+                t73,
+                T::from_f64(0.033822) * t72,
             );
-            let t87 = T::mul_add(
-                t4,
-                t49,
-                T::from_f64(0.000000000000000006938893903907228) * t5 * t7 * t8 * t9,
+            let t87 = T::mul_add(-t1, -t57, -t0 * (-t56));
+            let t88 = T::mul_add(T::from_f64(0.9563055), t4, t77);
+            let t89 = T::mul_add(
+                T::from_f64(0.016685526854599998),
+                T::mul_add(t7, t61, -t44 * t6 * t6 * t8),
+                T::from_f64(0.0171364731454) * (T::mul_add(-t44, t8, -t45 * t7 * t9)),
             );
-            let t88 = T::from_f64(0.0171364731454) * t68;
-            let t89 = T::from_f64(0.033822) * t69;
-            let t90 = t6 * t8 * t68;
-            let t91 = t6 * t9 * t69;
-            let t92 = t9 * t68;
-            let t93 = t8 * t69;
-            let t94 = t9 * t9 * t72;
-            let t95 = t8 * t8 * t72;
-            let t96 = t7 * t73;
-            let t97 = t9 * t9 * t74;
-            let t98 = t8 * t8 * t74;
-            let t99 = t7 * t75;
-            let t100 = t7 * t76;
-            let t101 = t6 * t76;
-            let t102 = T::from_f64(0.0004509462908000028) * t69;
-            let t103 = T::from_f64(0.033822000000000005) * t68;
-            let t104 = t7 * t78;
-            let t105 = t6 * t78;
+            let t90 = T::mul_add(
+                -T::from_f64(0.016685526854599998),
+                T::mul_add(t6, t9 * t61, t6 * t8 * t60),
+                T::from_f64(0.0171364731454) * t51,
+            );
+            let t91 = T::mul_add(T::from_f64(1.219), t33, -t81);
+            let t92 = T::mul_add(T::from_f64(1.219), t35, -t82);
+            let t93 = T::mul_add(
+                -T::from_f64(0.016685526854599998),
+                t72 - t73,
+                -T::from_f64(0.0171364731454) * t50,
+            );
+            let t94 = t6 * t85;
+            let t95 = T::mul_add(T::from_f64(1.10371305), t5 * t6 * t6, t7 * t76);
+            let t96 = T::mul_add(-T::from_f64(1.10371305), t5 * t6 * t7, t6 * t76);
+            let t97 = T::mul_add(-t7, t78, t6 * t21);
+            let t98 = T::mul_add(
+                T::from_f64(0.1197),
+                t57,
+                T::mul_add(-t2, t70, -t3 * t69),
+            );
+            let t99 = T::mul_add(
+                T::from_f64(0.1197),
+                t56,
+                T::mul_add(-t3, t70, t2 * t69),
+            );
+            let t100 = T::mul_add(
+                -t0,
+                T::mul_add(-t3, t5 * t59, t2 * t4 * t59),
+                t1 * (T::mul_add(t2, t5 * t59, t3 * t4 * t59)),
+            );
+            let t101 = T::mul_add(t2, t5 * t84, t3 * t4 * t84);
+            let t102 = T::mul_add(-t3, t5 * t84, t2 * t4 * t84);
+            let t103 = T::mul_add(T::from_f64(0.21942), t50, -t93);
+            let t104 = T::mul_add(-t5, t86, t4 * t7 * t85);
+            let t105 = T::mul_add(t4, t86, t5 * t7 * t85);
             let t106 = T::mul_add(
-                -T::from_f64(0.425),
-                t84,
-                T::mul_add(
-                    -T::from_f64(0.39225),
-                    t67,
-                    T::from_f64(0.000000000000000006938893903907228) * t18,
-                ),
+                T::from_f64(0.093),
+                t77,
+                T::mul_add(t6, t78, t7 * t21),
             );
-            let t107 = t6 * t8 * t88;
-            let t108 = t6 * t9 * t89;
-            let t109 = T::mul_add(
-                -T::from_f64(0.1879),
-                t94 + t95,
-                T::from_f64(1.219) * t40,
+            let t107 = T::mul_add(T::from_f64(0.9563055), t5, t95);
+            let t108 = T::mul_add(
+                T::from_f64(0.093),
+                t95,
+                T::from_f64(0.033371053709199995) * t12,
             );
+            let t109 = T::mul_add(-T::from_f64(0.033822), t8 * t62, t9 * t89);
             let t110 = T::mul_add(
-                -T::from_f64(0.1879),
-                t97 + t98,
-                T::from_f64(1.219) * t42,
+                T::from_f64(0.002925511062000008),
+                t51,
+                T::mul_add(T::from_f64(0.09465), t81, t90),
             );
-            let t111 = T::mul_add(T::from_f64(0.03556947), t58, -t100);
-            let t112 = t9 * t88;
-            let t113 = t8 * t89;
-            let t114 = T::mul_add(-t7, t79, t6 * t25);
+            let t111 = T::mul_add(-t6, t64, -t7 * t91);
+            let t112 = T::mul_add(
+                T::from_f64(0.002925511062000008),
+                t51,
+                T::mul_add(T::from_f64(0.09465), t82, t90),
+            );
+            let t113 = T::mul_add(-t6, t66, -t7 * t92);
+            let t114 = T::mul_add(
+                T::from_f64(0.002925511062000008),
+                t51,
+                T::mul_add(T::from_f64(0.09465), t67, t90),
+            );
             let t115 = T::mul_add(
-                T::from_f64(1.10371305),
-                t16,
-                T::mul_add(T::from_f64(0.9563055), t5, t104),
+                T::from_f64(0.21942),
+                t44,
+                T::mul_add(-t8, t89, -T::from_f64(0.033822) * t9 * t62),
             );
             let t116 = T::mul_add(
-                t6,
-                t79,
-                T::mul_add(
-                    t7,
-                    t25,
-                    T::mul_add(
-                        T::from_f64(0.093),
-                        t66 - t65,
-                        T::from_f64(0.0889364115) * t4,
-                    ),
-                ),
+                T::from_f64(1.219),
+                T::mul_add(-T::from_f64(0.7845), t17, -T::from_f64(0.85) * t0),
+                T::mul_add(t7, t64, -t6 * t91),
             );
-            let t117 = T::mul_add(
-                T::from_f64(0.10264531365),
-                t16,
-                T::mul_add(T::from_f64(0.093), t104, T::from_f64(0.0333710537092) * t12),
-            );
+            let t117 = -t111;
             let t118 = T::mul_add(
-                -t0,
-                T::mul_add(-t3, t51, t2 * t50),
-                t1 * (T::mul_add(t2, t51, t3 * t50)),
+                T::from_f64(1.219),
+                -T::from_f64(0.7845) * t17,
+                T::mul_add(t7, t66, -t6 * t92),
             );
-            let t119 = T::mul_add(
-                t0,
-                T::mul_add(-t3, t54, t2 * t53),
-                -t1 * (T::mul_add(t2, t54, t3 * t53)),
+            let t119 = -t113;
+            let t120 = T::mul_add(-t7, t103, -t6 * t75);
+            let t121 = T::mul_add(-t6, t103, t7 * t75);
+            let t122 = T::mul_add(-t4, t108, t5 * t106);
+            let t123 = T::mul_add(
+                T::from_f64(0.13585),
+                t87,
+                T::mul_add(-t0, t99, -t1 * t98),
             );
-            let t120 = T::mul_add(
-                -T::from_f64(0.033822),
-                t90,
-                T::mul_add(T::from_f64(0.0171364731454), t57 + t91, t107 - t108),
+            let t124 = T::mul_add(t5, t88, -t4 * t107);
+            let t125 = T::mul_add(
+                T::from_f64(0.002925511062000008),
+                t54,
+                -(T::mul_add(
+                    -T::from_f64(0.017784735),
+                    T::mul_add(T::from_f64(0.1893), t54, -t34),
+                    t109,
+                )),
             );
-            let t121 = T::mul_add(
-                T::from_f64(0.016685526854599998),
-                t38 * t6 * t6 * t8,
-                T::mul_add(
-                    -t7,
-                    t89,
-                    T::from_f64(0.0171364731454)
-                        * (T::mul_add(t7, t69, T::mul_add(t38, t8, t39 * t7 * t9))),
-                ),
-            );
-            let t122 = T::mul_add(
-                t7,
-                t88,
-                T::mul_add(
-                    -T::from_f64(0.0171364731454),
-                    t7 * t68,
-                    T::from_f64(0.033822) * (T::mul_add(-t38, t9, t39 * t7 * t8)),
-                ),
-            );
-            let t123 = t6 * t109;
-            let t124 = T::mul_add(
-                T::from_f64(0.017784735),
-                t94 + t95,
-                T::mul_add(
-                    T::from_f64(0.0171364731454),
-                    t91,
-                    T::mul_add(
-                        -T::from_f64(0.033822),
-                        t90,
-                        T::mul_add(
-                            T::from_f64(0.23948198420740002),
-                            t57,
-                            t107 - t71 - t108,
-                        ),
-                    ),
-                ),
-            );
-            let t125 = t6 * t110;
             let t126 = T::mul_add(
-                T::from_f64(0.017784735),
-                t97 + t98,
-                T::mul_add(
-                    T::from_f64(0.0171364731454),
-                    t91,
-                    T::mul_add(
-                        -T::from_f64(0.033822),
-                        t90,
-                        T::mul_add(
-                            T::from_f64(0.23948198420740002),
-                            t57,
-                            t107 - t71 - t108,
-                        ),
-                    ),
-                ),
+                T::from_f64(0.002925511062000008),
+                t54,
+                -(T::mul_add(
+                    -T::from_f64(0.017784735),
+                    T::mul_add(T::from_f64(0.1893), t54, -t36),
+                    t109,
+                )),
             );
             let t127 = T::mul_add(
-                T::from_f64(0.0033666503355),
-                t60 + t61,
-                T::mul_add(
-                    T::from_f64(0.0171364731454),
-                    t91,
-                    T::mul_add(
-                        -T::from_f64(0.033822),
-                        t90,
-                        T::mul_add(
-                            T::from_f64(0.23948198420740002),
-                            t57,
-                            t107 - t71 - t108,
-                        ),
-                    ),
-                ),
+                T::from_f64(0.002925511062000008),
+                t54,
+                -(T::mul_add(-T::from_f64(0.0033666503355), t54, t109)),
             );
             (
                 t64,
@@ -3625,322 +2902,161 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
             t173,
             t174,
             t175,
-            t176,
-            t177,
-            t178,
-            t179,
-            t180,
-            t181,
-            t182,
-            t183,
-            t184,
-            t185,
         ) = {
-            let t128 = t4 * t111;
-            let t129 = T::mul_add(
-                T::from_f64(0.0171364731454),
-                t93,
+            let t128 = T::mul_add(
+                T::from_f64(0.39225),
+                t96,
+                -(T::mul_add(-t5, t108, -t4 * t106)),
+            );
+            let t129 = T::mul_add(T::from_f64(0.39225), t124, t97);
+            let t130 = T::mul_add(-t4, t88, -t5 * t107) - T::from_f64(1.1375);
+            let t131 = -t124;
+            let t132 = T::mul_add(
+                T::from_f64(0.21942),
+                t44,
+                T::mul_add(-T::from_f64(0.093), t111, t115),
+            );
+            let t133 = T::mul_add(t2, t5 * t117, t3 * t4 * t117);
+            let t134 = T::mul_add(-t3, t5 * t117, t2 * t4 * t117);
+            let t135 = T::mul_add(
+                T::from_f64(0.21942),
+                t44,
+                T::mul_add(-T::from_f64(0.093), t113, t115),
+            );
+            let t136 = T::mul_add(t2, t5 * t119, t3 * t4 * t119);
+            let t137 = T::mul_add(-t3, t5 * t119, t2 * t4 * t119);
+            let t138 = T::mul_add(
+                T::from_f64(0.21942),
+                t44,
                 T::mul_add(
-                    T::from_f64(0.033822),
-                    t92,
-                    T::mul_add(T::from_f64(0.23655647314540001), t55, -t112 - t113),
+                    -T::from_f64(0.093),
+                    T::mul_add(-T::from_f64(0.03556947), t52, t74),
+                    t115,
                 ),
             );
-            let t130 = T::mul_add(t9, t103, t8 * t102);
-            let t131 = T::mul_add(-t8, t103, t9 * t102);
-            let t132 = t9 * t121;
-            let t133 = t8 * t122;
-            let t134 = t8 * t121;
-            let t135 = t9 * t122;
-            let t136 = T::mul_add(t6, t73, t7 * t109);
-            let t137 = T::mul_add(t6, t75, t7 * t110);
-            let t138 = T::mul_add(t2, t5 * t111, t3 * t4 * t111);
-            let t139 = T::mul_add(-t3, t5 * t111, t2 * t4 * t111);
-            let t140 = T::mul_add(-t5, t80, t4 * t115);
-            let t141 = T::mul_add(t4, t80, T::mul_add(t5, t115, T::from_f64(1.1375)));
-            let t142 = T::mul_add(
-                t5,
-                t117,
-                T::mul_add(
-                    t4,
-                    t116,
-                    T::mul_add(
-                        -T::from_f64(0.43293144386250004),
-                        t17,
-                        T::from_f64(0.39225) * t105,
-                    ),
-                ),
-            );
-            let t143 = T::mul_add(-t4, t117, t5 * t116);
-            let t144 = T::mul_add(
-                t0,
-                T::mul_add(-t3, t83, T::mul_add(t2, t81, T::from_f64(0.1197) * t84)),
-                T::mul_add(
-                    t1,
-                    T::mul_add(
-                        -t2,
-                        t83,
-                        T::mul_add(-t3, t81, T::from_f64(0.1197) * t85),
-                    ),
-                    -T::from_f64(0.13585) * (T::mul_add(t1, t85, t0 * t84)),
-                ),
-            );
-            let t145 = T::mul_add(
+            let t139 = T::mul_add(
                 -t0,
-                T::mul_add(t3, t86, t2 * t87),
-                t1 * (T::mul_add(-t2, t86, t3 * t87)),
+                T::mul_add(-t3, t105, t2 * t104),
+                t1 * (T::mul_add(t2, t105, t3 * t104)),
             );
-            let t146 = T::mul_add(T::from_f64(0.21942), t38, t134 - t135);
-            let t147 = T::mul_add(
-                -T::from_f64(0.017784735),
-                t41,
-                T::mul_add(T::from_f64(0.2257121613975), t59, t132 + t133 - t70),
+            let t140 = T::mul_add(t7, t110, -t6 * t125);
+            let t141 = T::mul_add(
+                T::from_f64(0.1197),
+                t134,
+                -T::from_f64(0.425)
+                    * (T::mul_add(
+                        -T::from_f64(1.1375),
+                        t17,
+                        -T::from_f64(1.9337499999999999) * t0,
+                    ) + t116),
             );
-            let t148 = T::mul_add(
-                T::from_f64(0.093),
-                t136,
-                T::mul_add(T::from_f64(0.43884), t38, t134 - t135),
-            );
-            let t149 = t4 * t136;
-            let t150 = T::mul_add(
-                -T::from_f64(0.017784735),
-                t43,
-                T::mul_add(T::from_f64(0.2257121613975), t59, t132 + t133 - t70),
-            );
-            let t151 = T::mul_add(
-                T::from_f64(0.093),
+            let t142 = T::mul_add(t7, t112, -t6 * t126);
+            let t143 = T::mul_add(
+                T::from_f64(0.1197),
                 t137,
-                T::mul_add(T::from_f64(0.43884), t38, t134 - t135),
+                -T::from_f64(0.425) * (-T::from_f64(1.1375) * t17 + t118),
             );
-            let t152 = t4 * t137;
-            let t153 = T::mul_add(T::from_f64(0.2257121613975), t59, t132 + t133 - t70);
+            let t144 = T::mul_add(t7, t114, -t6 * t127);
+            let t145 = T::mul_add(t2, t130, -t3 * t131);
+            let t146 = T::mul_add(t3, t130, t2 * t131);
+            let t147 = t53 + T::mul_add(-t6, t110, -t7 * t125);
+            let t148 = T::mul_add(T::from_f64(0.39225), t4 * t117, t140);
+            let t149 = t53 + T::mul_add(-t6, t112, -t7 * t126);
+            let t150 = T::mul_add(T::from_f64(0.39225), t4 * t119, t142);
+            let t151 = T::mul_add(T::from_f64(0.39225), t4 * t84, t144);
+            let t152 = T::mul_add(
+                t0,
+                T::mul_add(-t3, t5 * t121, t2 * t4 * t121),
+                -t1 * (T::mul_add(t2, t5 * t121, t3 * t4 * t121)),
+            );
+            let t153 = T::mul_add(
+                T::from_f64(0.1197),
+                t145,
+                T::mul_add(-t3, t122, t2 * t128),
+            );
             let t154 = T::mul_add(
-                -T::from_f64(0.093),
-                t100,
-                T::mul_add(
-                    T::from_f64(0.0033079607099999997),
-                    t58,
-                    T::mul_add(T::from_f64(0.43884), t38, t134 - t135),
-                ),
+                T::from_f64(0.002925511062000008),
+                t45,
+                -(T::mul_add(-t6, t114, -t7 * t127)),
             );
-            let t155 = T::mul_add(-t7, t129, -t6 * t77);
-            let t156 = T::mul_add(-t6, t129, t7 * t77);
-            let t157 = -t6 * t131;
-            let t158 = T::mul_add(t5, t130, t4 * t7 * t131);
-            let t159 = T::mul_add(-t4, t130, t5 * t7 * t131);
-            let t160 = T::mul_add(t2, t5 * t136, t3 * t4 * t136);
-            let t161 = T::mul_add(-t3, t5 * t136, t2 * t4 * t136);
-            let t162 = T::mul_add(-t3, t5 * t137, t2 * t4 * t137);
-            let t163 = T::mul_add(t2, t5 * t137, t3 * t4 * t137);
-            let t164 = T::mul_add(t2, t141, t3 * t140);
-            let t165 = T::mul_add(-t3, t141, t2 * t140);
-            let t166 = T::mul_add(t7, t124, -t6 * t147);
+            let t155 = T::mul_add(-t2, t122, -t3 * t128)
+                + T::mul_add(T::from_f64(0.1197), -t146, -T::from_f64(0.425) * t96);
+            let t156 = T::mul_add(-t1, t146, -t0 * (-t145));
+            let t157 = T::mul_add(-t5, t154, t4 * t138);
+            let t158 = T::mul_add(
+                -T::from_f64(0.39225),
+                t116,
+                T::mul_add(t5, t132, -t4 * t147),
+            );
+            let t159 = T::mul_add(
+                T::from_f64(0.004095),
+                t16,
+                T::mul_add(-t4, t132, -t5 * t147),
+            );
+            let t160 = T::mul_add(
+                -T::from_f64(0.39225),
+                t118,
+                T::mul_add(t5, t135, -t4 * t149),
+            );
+            let t161 = T::mul_add(
+                T::from_f64(0.004095),
+                t25,
+                -(T::mul_add(-t4, t135, -t5 * t149)),
+            );
+            let t162 = T::mul_add(
+                T::from_f64(0.39225),
+                t83,
+                -(T::mul_add(t4, t154, t5 * t138)),
+            );
+            let t163 = T::mul_add(
+                T::from_f64(0.379166627112),
+                t17,
+                T::from_f64(0.48343749999999996) * t0,
+            ) + t158;
+            let t164 = T::from_f64(0.379166627112) * t17 + t160;
+            let t165 = T::mul_add(
+                T::from_f64(0.13585),
+                t156,
+                T::mul_add(-t0, t153, -t1 * t155),
+            );
+            let t166 = T::mul_add(T::from_f64(0.1197), t102, -T::from_f64(0.425) * t83)
+                + T::mul_add(-t2, t157, -t3 * t162);
             let t167 = T::mul_add(
-                t6,
-                t124,
-                T::mul_add(t7, t147, T::from_f64(0.0029255110620000045) * t39),
+                T::from_f64(0.1197),
+                t101,
+                T::mul_add(-t3, t157, t2 * t162),
             );
-            let t168 = T::mul_add(t7, t126, -t6 * t150);
+            let t168 = T::mul_add(t2, t159, t3 * t163) + t141;
             let t169 = T::mul_add(
-                t6,
-                t126,
-                T::mul_add(t7, t150, T::from_f64(0.0029255110620000045) * t39),
+                T::from_f64(0.1197),
+                t133,
+                T::mul_add(t3, t159, -t2 * t163),
             );
-            let t170 = T::mul_add(t7, t127, -t6 * t153);
+            let t170 = T::mul_add(-t2, t161, t3 * t164) + t143;
             let t171 = T::mul_add(
-                t6,
-                t127,
-                T::mul_add(t7, t153, T::from_f64(0.0029255110620000045) * t39),
+                T::from_f64(0.1197),
+                t136,
+                T::mul_add(-t3, t161, -t2 * t164),
             );
             let t172 = T::mul_add(
-                T::from_f64(0.000000000000000006938893903907228),
-                t5 * t38 * t6 * t8 * t9,
-                t4 * t156,
+                T::from_f64(0.13585),
+                T::mul_add(t1, t102, t0 * t101),
+                T::mul_add(-t0, t167, -t1 * t166),
             );
             let t173 = T::mul_add(
-                -T::from_f64(0.000000000000000006938893903907228),
-                t4 * t38 * t6 * t8 * t9,
-                t5 * t156,
+                t0,
+                T::mul_add(T::from_f64(0.0151074), t1, -t169),
+                -t1 * (T::mul_add(T::from_f64(1.7546963518200003), t0, t168)),
             );
             let t174 = T::mul_add(
-                t5,
-                t148,
-                T::mul_add(
-                    t4,
-                    t167,
-                    T::mul_add(
-                        T::from_f64(0.39225),
-                        t123 - t96,
-                        T::mul_add(
-                            T::from_f64(0.7542774594869999),
-                            t20,
-                            T::from_f64(0.8898673375) * t0,
-                        ),
-                    ),
-                ),
+                T::from_f64(0.13585),
+                T::mul_add(t1, t137, t0 * t136),
+                T::mul_add(-t0, t171, -t1 * t170),
             );
             let t175 = T::mul_add(
-                t4,
-                t148,
-                T::mul_add(-t5, t167, T::from_f64(0.0040949999999999875) * t19),
-            );
-            let t176 = T::mul_add(
-                t5,
-                t151,
-                T::mul_add(
-                    t4,
-                    t169,
-                    T::mul_add(
-                        T::from_f64(0.39225),
-                        t125 - t99,
-                        T::from_f64(0.7542774594869999) * t20,
-                    ),
-                ),
-            );
-            let t177 = T::mul_add(
-                t4,
-                t151,
-                T::mul_add(-t5, t169, T::from_f64(0.0040949999999999875) * t19),
-            );
-            let t178 = T::mul_add(
-                -t5,
-                t154,
-                T::mul_add(
-                    -t4,
-                    t171,
-                    T::mul_add(
-                        T::from_f64(0.0139521246075),
-                        t62,
-                        T::from_f64(0.39225) * t101,
-                    ),
-                ),
-            );
-            let t179 = T::mul_add(-t4, t154, t5 * t171);
-            let t180 = T::mul_add(
-                t0,
-                T::mul_add(-t3, t159, t2 * t158),
-                -t1 * (T::mul_add(t2, t159, t3 * t158)),
-            );
-            let t181 = T::mul_add(
-                t0,
-                T::mul_add(t3, t143, T::mul_add(-t2, t142, T::from_f64(0.1197) * t164)),
-                T::mul_add(
-                    t1,
-                    T::mul_add(
-                        t2,
-                        t143,
-                        T::mul_add(
-                            t3,
-                            t142,
-                            T::mul_add(
-                                T::from_f64(0.1197),
-                                t165,
-                                T::mul_add(
-                                    -T::from_f64(0.46907804625000005),
-                                    t17,
-                                    T::from_f64(0.425) * t105,
-                                ),
-                            ),
-                        ),
-                    ),
-                    -T::from_f64(0.13585) * (T::mul_add(t1, t165, t0 * t164)),
-                ),
-            );
-            let t182 = T::mul_add(
-                t0,
-                T::mul_add(-t3, t173, t2 * t172),
-                -t1 * (T::mul_add(t2, t173, t3 * t172)),
-            );
-            let t183 = T::mul_add(
-                t0,
-                T::mul_add(
-                    t3,
-                    t175,
-                    T::mul_add(
-                        t2,
-                        t174,
-                        T::mul_add(
-                            -T::from_f64(0.1197),
-                            t160,
-                            T::from_f64(0.0151074) * t1,
-                        ),
-                    ),
-                ),
-                T::mul_add(
-                    -t1,
-                    T::mul_add(
-                        -t2,
-                        t175,
-                        T::mul_add(
-                            t3,
-                            t174,
-                            T::mul_add(
-                                T::from_f64(0.1197),
-                                t161,
-                                T::mul_add(
-                                    T::from_f64(0.425),
-                                    t123 - t96,
-                                    T::mul_add(
-                                        T::from_f64(0.8898673375000001),
-                                        t20,
-                                        T::from_f64(3.01690385182) * t0,
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                    T::from_f64(0.13585) * (T::mul_add(t1, t161, t0 * t160)),
-                ),
-            );
-            let t184 = T::mul_add(
-                -t0,
-                T::mul_add(-t3, t177, T::mul_add(-t2, t176, T::from_f64(0.1197) * t163)),
-                T::mul_add(
-                    -t1,
-                    T::mul_add(
-                        -t2,
-                        t177,
-                        T::mul_add(
-                            t3,
-                            t176,
-                            T::mul_add(
-                                T::from_f64(0.1197),
-                                t162,
-                                T::mul_add(
-                                    T::from_f64(0.425),
-                                    t125 - t99,
-                                    T::from_f64(0.8898673375000001) * t20,
-                                ),
-                            ),
-                        ),
-                    ),
-                    T::from_f64(0.13585) * (T::mul_add(t1, t162, t0 * t163)),
-                ),
-            );
-            let t185 = T::mul_add(
-                -t0,
-                T::mul_add(t3, t179, T::mul_add(t2, t178, T::from_f64(0.1197) * t138)),
-                T::mul_add(
-                    t1,
-                    T::mul_add(
-                        -t2,
-                        t179,
-                        T::mul_add(
-                            t3,
-                            t178,
-                            T::mul_add(
-                                -T::from_f64(0.1197),
-                                t139,
-                                T::mul_add(
-                                    T::from_f64(0.01511702475),
-                                    t62,
-                                    T::from_f64(0.425) * t101,
-                                ),
-                            ),
-                        ),
-                    ),
-                    T::from_f64(0.13585) * (T::mul_add(t1, t139, t0 * t138)),
-                ),
+                T::from_f64(0.13585),
+                T::mul_add(t1, t134, t0 * t133),
+                t173,
             );
             (
                 t128,
@@ -3991,138 +3107,108 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
                 t173,
                 t174,
                 t175,
-                t176,
-                t177,
-                t178,
-                t179,
-                t180,
-                t181,
-                t182,
-                t183,
-                t184,
-                t185,
             )
         };
         [
             [
-                t183,
-                t184,
-                t185,
-                t182,
-                t180,
-                t181,
+                t175,
+                t174,
+                t172,
+                t152,
+                t139,
+                t165,
+                t123,
+                t100,
+                t79,
+                t123,
+                t100,
+                t79,
+                t100,
+                t79,
+                t80,
+            ],
+            [
+                T::mul_add(T::from_f64(0.425), t133, t148),
+                T::mul_add(T::from_f64(0.425), t136, t150),
+                T::mul_add(T::from_f64(0.425), t101, t151),
+                t120,
+                t94,
+                T::mul_add(T::from_f64(0.425), t145, t129),
+                t71,
+                t58,
+                t18,
+                t71,
+                t58,
+                t18,
+                t58,
+                t18,
+                t41,
+            ],
+            [
+                t148,
+                t150,
+                t151,
+                t120,
+                t94,
+                t129,
+                t55,
+                t58,
+                t18,
+                t55,
+                t58,
+                t18,
+                t58,
+                t18,
+                t41,
+            ],
+            [
+                t140,
+                t142,
                 t144,
-                t145,
-                t118,
-                t144,
-                t145,
-                t118,
-                t145,
-                t118,
-                t119,
-            ],
-            [
-                T::mul_add(
-                    T::from_f64(0.425),
-                    t160,
-                    T::mul_add(T::from_f64(0.39225), t149, t166),
-                ),
-                T::mul_add(
-                    T::from_f64(0.425),
-                    t163,
-                    T::mul_add(T::from_f64(0.39225), t152, t168),
-                ),
-                T::mul_add(
-                    T::from_f64(0.425),
-                    t138,
-                    T::mul_add(T::from_f64(0.39225), t128, t170),
-                ),
-                t155,
-                t157,
-                T::mul_add(
-                    -T::from_f64(0.425),
-                    t164,
-                    T::mul_add(-T::from_f64(0.39225), t140, t114),
-                ),
-                t106,
-                t48,
-                t32,
-                t106,
-                t48,
-                t32,
-                t48,
-                t32,
-                t52,
-            ],
-            [
-                T::mul_add(T::from_f64(0.39225), t149, t166),
-                T::mul_add(T::from_f64(0.39225), t152, t168),
-                T::mul_add(T::from_f64(0.39225), t128, t170),
-                t155,
-                t157,
-                T::mul_add(-T::from_f64(0.39225), t140, t114),
-                t82,
-                t48,
-                t32,
-                t82,
-                t48,
-                t32,
-                t48,
-                t32,
-                t52,
-            ],
-            [
-                t166,
-                t168,
-                t170,
-                t155,
-                t157,
-                t114,
-                t27,
-                t48,
-                t32,
-                t27,
-                t48,
-                t32,
-                t48,
-                t32,
-                t52,
-            ],
-            [
-                t146,
-                t146,
-                t146,
-                T::from_f64(0.000000000000000006938893903907228) * t38 * t6 * t8 * t9,
-                t130,
-                t23,
-                t23,
-                t28,
-                t31,
-                t23,
-                t28,
-                t31,
-                t28,
-                t31,
-                -T::from_f64(0.0333710537092) * t8 * t9,
-            ],
-            [
                 t120,
-                t120,
-                t120,
-                T::mul_add(
-                    -T::from_f64(0.033822),
-                    t92,
-                    T::mul_add(-T::from_f64(0.0171364731454), t55 + t93, t112 + t113),
-                ),
+                t94,
+                t97,
                 T::zero(),
-                t21,
-                t21,
-                t22,
+                t58,
+                t18,
                 T::zero(),
-                t21,
-                t22,
+                t58,
+                t18,
+                t58,
+                t18,
+                t41,
+            ],
+            [
+                t115,
+                t115,
+                t115,
                 T::zero(),
-                t22,
+                t86,
+                t20,
+                t20,
+                T::zero(),
+                t23,
+                t20,
+                T::zero(),
+                t23,
+                T::zero(),
+                t23,
+                -T::from_f64(0.033371053709199995) * t8 * t9,
+            ],
+            [
+                t90,
+                t90,
+                t90,
+                t93,
+                T::zero(),
+                t19,
+                t19,
+                t31,
+                T::zero(),
+                t19,
+                t31,
+                T::zero(),
+                t31,
                 T::zero(),
                 T::zero(),
             ],
@@ -4808,7 +3894,7 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
     /// The joint-space mass matrix M(q), symmetric positive definite.
     ///
     /// Route: composite-rigid-body algorithm.
-    /// Operations: 149 mul, 104 add, 0 div, 5 sin, 5 cos.
+    /// Operations: 132 mul, 87 add, 0 div, 5 sin, 5 cos.
     fn mass_matrix(&self, q: &[T; 6]) -> [[T; 6]; 6] {
         let ([s1, s2, s3, s4, s5], [c1, c2, c3, c4, c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
             q[1],
@@ -4817,321 +3903,312 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
             q[4],
             q[5],
         ]);
-        let t0 = s1;
-        let t1 = c1;
-        let t2 = s2;
-        let t3 = c2;
-        let t4 = s3;
-        let t5 = c3;
-        let t6 = s4;
-        let t7 = c4;
-        let t8 = s5;
-        let t9 = c5;
-        let t10 = t2 * t4;
-        let t11 = t2 * t5;
-        let t12 = t7 * t7;
-        let t13 = T::from_f64(0.0171364731454) * t7;
-        let t14 = t6 * t8 * t9;
-        let t15 = t8 * t8;
-        let t16 = t9 * t9;
-        let t17 = t3 * t4;
-        let t18 = t3 * t5;
-        let t19 = t5 * t7 * t8 * t9;
-        let t20 = t4 * t7 * t8 * t9;
-        let t21 = T::mul_add(T::from_f64(0.017784735), t4, -T::from_f64(1.598759275));
-        let t22 = T::from_f64(0.016685526854599998) * t14;
-        let t23 = T::mul_add(
-            T::from_f64(0.033822),
-            t16,
-            T::mul_add(T::from_f64(0.0171364731454), t15, T::from_f64(0.21942)),
-        );
-        let t24 = T::mul_add(
-            T::from_f64(0.0171364731454),
-            t16,
-            T::mul_add(T::from_f64(0.033822), t15, T::from_f64(0.11285608069875)),
-        );
-        let t25 = T::mul_add(
-            T::from_f64(0.016685526854599998),
-            t14,
-            -T::from_f64(0.0016539803549999999),
-        );
-        let t26 = T::mul_add(
-            T::from_f64(0.033822),
-            t16,
-            T::mul_add(T::from_f64(0.0171364731454), t15, T::from_f64(0.4510082781)),
-        );
-        let t27 = t2 * t21;
-        let t28 = t3 * t21;
-        let t29 = t6 * t6 * t24;
-        let t30 = T::mul_add(
+        let (
+            t0,
+            t1,
+            t2,
+            t3,
+            t4,
+            t5,
+            t6,
             t7,
-            t7 * t24,
-            T::mul_add(
-                T::from_f64(0.12999255384415),
-                t6 * t6,
-                T::from_f64(0.123341033631),
-            ),
-        );
-        let t31 = T::mul_add(-t6, t7 * t24, T::from_f64(0.12999255384415) * t6 * t7);
-        let t32 = T::mul_add(-t5, t26, T::from_f64(0.016685526854599998) * t20);
-        let t33 = t1 * (T::mul_add(T::from_f64(0.017784735), t18, -t27));
-        let t34 = T::mul_add(
-            -T::from_f64(0.425),
-            t28,
-            T::mul_add(
-                T::from_f64(0.12999255384415),
-                t12,
-                T::mul_add(
-                    -T::from_f64(0.007558512375),
-                    t11,
-                    T::mul_add(
-                        -T::from_f64(0.0139521246075),
-                        t4,
-                        t29 + T::from_f64(0.70682470720575),
-                    ),
-                ),
-            ),
-        );
-        let t35 = T::mul_add(
-            T::from_f64(0.12999255384415),
+            t8,
+            t9,
+            t10,
+            t11,
             t12,
-            T::mul_add(
+            t13,
+            t14,
+            t15,
+            t16,
+            t17,
+            t18,
+            t19,
+            t20,
+            t21,
+            t22,
+            t23,
+            t24,
+            t25,
+            t26,
+            t27,
+            t28,
+            t29,
+            t30,
+            t31,
+            t32,
+            t33,
+            t34,
+            t35,
+            t36,
+            t37,
+            t38,
+            t39,
+            t40,
+            t41,
+            t42,
+            t43,
+            t44,
+            t45,
+            t46,
+            t47,
+            t48,
+            t49,
+            t50,
+            t51,
+            t52,
+            t53,
+            t54,
+            t55,
+            t56,
+            t57,
+            t58,
+            t59,
+            t60,
+            t61,
+            t62,
+            t63,
+        ) = {
+            let t0 = s1;
+            let t1 = c1;
+            let t2 = s2;
+            let t3 = c2;
+            let t4 = s3;
+            let t5 = c3;
+            let t6 = s4;
+            let t7 = c4;
+            let t8 = s5;
+            let t9 = c5;
+            let t10 = t2 * t5;
+            let t11 = T::from_f64(0.0171364731454) * t7;
+            let t12 = t6 * t8 * t9;
+            let t13 = t8 * t8;
+            let t14 = t9 * t9;
+            let t15 = t3 * t5;
+            let t16 = t5 * t7 * t8 * t9;
+            let t17 = t4 * t7 * t8 * t9;
+            let t18 = T::mul_add(
+                T::from_f64(0.017784735),
+                t4,
+                -T::from_f64(1.598759275),
+            );
+            let t19 = T::from_f64(0.016685526854599998) * t12;
+            let t20 = T::mul_add(
+                T::from_f64(0.033822),
+                t14,
+                T::from_f64(0.0171364731454) * t13,
+            );
+            let t21 = T::mul_add(
+                T::from_f64(0.016685526854599998),
+                t12,
+                -T::from_f64(0.0016539803549999999),
+            );
+            let t22 = t3 * t18;
+            let t23 = T::from_f64(0.017784735) * (T::mul_add(t2, t4, -t15));
+            let t24 = T::from_f64(0.017784735) * (T::mul_add(t3, t4, t10));
+            let t25 = T::mul_add(
+                T::from_f64(0.0171364731454),
+                t14,
+                T::from_f64(0.033822) * t13,
+            ) + T::from_f64(0.11285608069875);
+            let t26 = t20 + T::from_f64(0.21942);
+            let t27 = t20 + T::from_f64(0.4510082781);
+            let t28 = T::mul_add(-t2, t18, T::from_f64(0.017784735) * t15);
+            let t29 = T::mul_add(T::from_f64(0.017784735), t10, t22);
+            let t30 = t1 * t28;
+            let t31 = T::mul_add(
+                t0,
+                T::from_f64(0.0171364731454) * (T::mul_add(-t3, t5 * t6, t2 * t4 * t6)),
+                -t1
+                    * (T::from_f64(0.0171364731454)
+                        * (T::mul_add(t2, t5 * t6, t3 * t4 * t6))),
+            );
+            let t32 = T::mul_add(t6, t6 * t25, T::from_f64(0.12999255384415) * t7 * t7);
+            let t33 = T::mul_add(-t6, t7 * t25, T::from_f64(0.12999255384415) * t6 * t7);
+            let t34 = T::mul_add(-t5, t27, T::from_f64(0.016685526854599998) * t17);
+            let t35 = t0
+                * (T::mul_add(-T::from_f64(0.017784735), t10, -t22)
+                    + T::from_f64(4.4329225));
+            let t36 = T::mul_add(-t5, t26, T::from_f64(0.016685526854599998) * t17);
+            let t37 = T::mul_add(t4, t26, T::from_f64(0.016685526854599998) * t16);
+            let t38 = T::mul_add(t7, t7 * t25, T::from_f64(0.12999255384415) * t6 * t6)
+                + T::from_f64(0.123341033631);
+            let t39 = T::mul_add(
+                -T::from_f64(0.0139521246075),
+                t4,
+                t32 + T::from_f64(0.51519389364975),
+            );
+            let t40 = T::mul_add(
                 -T::from_f64(0.00697606230375),
                 t4,
-                t29 + T::from_f64(0.111172755531),
-            ),
-        );
-        let t36 = T::mul_add(
-            T::from_f64(0.12999255384415),
-            t12,
-            T::mul_add(
-                -T::from_f64(0.007558512375),
-                t11 + t17,
-                T::mul_add(
-                    -T::from_f64(0.00697606230375),
-                    t4,
-                    t29 + T::from_f64(0.111172755531),
-                ),
-            ),
-        );
-        let t37 = T::mul_add(-t5, t23, T::from_f64(0.016685526854599998) * t20);
-        let t38 = T::mul_add(t4, t23, T::from_f64(0.016685526854599998) * t19);
-        let t39 = T::mul_add(
-            t0,
-            T::from_f64(0.0171364731454) * (T::mul_add(-t3, t5 * t6, t2 * t4 * t6)),
-            -t1
-                * (T::from_f64(0.0171364731454)
-                    * (T::mul_add(t2, t5 * t6, t3 * t4 * t6))),
-        );
-        let t40 = T::mul_add(t5, t25, t4 * t31);
-        let t41 = T::mul_add(-t4, t25, t5 * t31);
-        let t42 = T::mul_add(-T::from_f64(0.016685526854599998), t19, t4 * t30);
-        let t43 = t41 - T::from_f64(0.051322656825);
-        let t44 = t3 * t40;
-        let t45 = t2 * t40;
-        let t46 = T::mul_add(
-            t4,
-            T::mul_add(t4, t26, T::from_f64(0.016685526854599998) * t19),
-            T::mul_add(
+                t32 + T::from_f64(0.111172755531),
+            );
+            let t41 = T::mul_add(t5, t21, t4 * t33);
+            let t42 = T::mul_add(-t4, t21, t5 * t33);
+            let t43 = T::mul_add(
+                -T::from_f64(0.425),
+                t29,
+                t39 + T::from_f64(0.19163081355599998),
+            );
+            let t44 = T::mul_add(-T::from_f64(0.425), t24, t40);
+            let t45 = T::mul_add(-T::from_f64(0.016685526854599998), t16, t4 * t38);
+            let t46 = t42 - T::from_f64(0.051322656825);
+            let t47 = t3 * t41;
+            let t48 = t2 * t41;
+            let t49 = T::mul_add(
+                -t0,
+                T::mul_add(-t3, t37, t2 * t36),
+                t1 * (T::mul_add(t2, t37, t3 * t36)),
+            );
+            let t50 = T::mul_add(
+                t4,
+                T::mul_add(t4, t27, T::from_f64(0.016685526854599998) * t16),
+                t5 * (T::mul_add(t5, t38, T::from_f64(0.016685526854599998) * t17)),
+            );
+            let t51 = T::mul_add(t3, t46, -t48);
+            let t52 = T::mul_add(-T::from_f64(0.1197), t24, T::mul_add(t3, t42, -t48));
+            let t53 = T::mul_add(T::from_f64(0.1197), t23, -(T::mul_add(t2, t42, t47)));
+            let t54 = T::mul_add(
+                -T::from_f64(0.0139521246075),
+                t4,
+                T::mul_add(-t5, t34, t4 * t45) + T::from_f64(0.40402113811874996),
+            );
+            let t55 = t50 + T::from_f64(0.004095);
+            let t56 = T::mul_add(
+                T::from_f64(0.00697606230375),
                 t5,
-                T::mul_add(t5, t30, T::from_f64(0.016685526854599998) * t20),
-                T::from_f64(0.004095),
-            ),
-        );
-        let t47 = T::mul_add(
-            t5,
-            t32,
-            T::mul_add(
-                -t4,
-                t42,
-                T::mul_add(
-                    T::from_f64(0.0139521246075),
-                    t4,
-                    -T::from_f64(0.5956519516747499),
-                ),
-            ),
-        );
-        let t48 = T::mul_add(
-            -t4,
-            t32,
-            T::mul_add(-t5, t42, T::from_f64(0.00697606230375) * t5),
-        );
-        let t49 = t3 * t43;
-        let t50 = T::mul_add(
-            -t0,
-            T::mul_add(-t3, t38, t2 * t37),
-            t1 * (T::mul_add(t2, t38, t3 * t37)),
-        );
-        let t51 = t2 * t48;
-        let t52 = t3 * t48;
-        let t53 = T::mul_add(t3, t47, t51);
-        let t54 = T::mul_add(-t2, t46, t52);
-        let t55 = t1
-            * (T::mul_add(
-                t2,
-                t43,
+                -(T::mul_add(t4, t34, t5 * t45)),
+            );
+            let t57 = T::mul_add(T::from_f64(0.1197), t28, T::mul_add(t2, t46, t47));
+            let t58 = t54 + T::from_f64(0.19163081355599998);
+            let t59 = t2 * t56;
+            let t60 = t3 * t56;
+            let t61 = t1 * t57;
+            let t62 = T::mul_add(-t2, t55, t60);
+            let t63 = T::mul_add(
+                -t0,
                 T::mul_add(
                     -T::from_f64(0.1197),
-                    t27,
-                    T::mul_add(T::from_f64(0.0021288327795), t18, t44),
+                    t29,
+                    t51 + T::from_f64(0.19371331275000003),
                 ),
-            ));
-        let t56 = T::mul_add(
-            t0,
-            T::mul_add(
-                -t3,
-                t41,
-                T::mul_add(T::from_f64(0.0021288327795), t11 + t17, t45),
-            ),
-            T::mul_add(
+                -t61,
+            );
+            (
+                t0,
                 t1,
-                T::mul_add(
-                    -t2,
-                    t41,
-                    T::mul_add(T::from_f64(0.0021288327795), t10 - t18, -t44),
-                ),
-                -T::from_f64(0.13585)
-                    * (T::mul_add(
-                        t1,
-                        T::from_f64(0.017784735) * (t10 - t18),
-                        t0 * (T::from_f64(0.017784735) * (t11 + t17)),
-                    )),
-            ),
-        );
-        let t57 = T::mul_add(
-            t0,
-            T::mul_add(
-                T::from_f64(0.1197),
-                t28,
-                T::mul_add(
-                    T::from_f64(0.0021288327795),
-                    t11,
-                    t45 - t49 - T::from_f64(0.19371331275000003),
-                ),
-            ),
-            T::mul_add(
-                T::from_f64(0.13585),
-                T::mul_add(
-                    -t0,
-                    T::mul_add(
-                        T::from_f64(0.017784735),
-                        t11,
-                        t28 - T::from_f64(4.4329225),
-                    ),
-                    t33,
-                ),
-                -t55,
-            ),
-        );
-        let t58 = T::mul_add(
-            t0,
-            T::mul_add(
-                T::from_f64(0.1197),
-                t28,
-                T::mul_add(T::from_f64(0.0021288327795), t11, t45 - t49),
-            ),
-            T::mul_add(
-                T::from_f64(0.13585),
-                T::mul_add(-t0, T::mul_add(T::from_f64(0.017784735), t11, t28), t33),
-                -t55,
-            ),
-        );
-        let t59 = T::mul_add(
-            t3,
-            T::mul_add(t3, t46, t51),
-            T::mul_add(t2, T::mul_add(-t2, t47, t52), T::from_f64(0.054004433300999945)),
-        );
-        let t60 = T::mul_add(
-            t3,
-            t54,
-            T::mul_add(
-                -t2,
-                t53,
-                T::mul_add(-T::from_f64(0.425), t27, T::from_f64(0.007558512375) * t18),
-            ),
-        );
-        let t61 = T::mul_add(
-            t1,
-            T::mul_add(
                 t2,
+                t3,
+                t4,
+                t5,
+                t6,
+                t7,
+                t8,
+                t9,
+                t10,
+                t11,
+                t12,
+                t13,
+                t14,
+                t15,
+                t16,
+                t17,
+                t18,
+                t19,
+                t20,
+                t21,
+                t22,
+                t23,
+                t24,
+                t25,
+                t26,
+                t27,
+                t28,
+                t29,
+                t30,
+                t31,
+                t32,
+                t33,
+                t34,
+                t35,
+                t36,
+                t37,
+                t38,
+                t39,
+                t40,
+                t41,
+                t42,
+                t43,
+                t44,
+                t45,
+                t46,
+                t47,
+                t48,
+                t49,
+                t50,
+                t51,
+                t52,
+                t53,
                 t54,
-                T::mul_add(
-                    t3,
-                    t53,
-                    T::mul_add(
-                        T::from_f64(0.85),
-                        t28,
-                        T::mul_add(
-                            T::from_f64(0.01511702475),
-                            t11,
-                            -T::from_f64(1.809023971711),
-                        ),
-                    ),
-                ),
-            ),
-            t0 * t60,
-        );
-        let t62 = T::mul_add(
-            -t0,
-            T::mul_add(-t0, t59, t1 * t60),
-            T::mul_add(-t1, t61, T::from_f64(0.12816210104175002)),
-        );
-        [
-            [t62, t57, t58, t56, t50, t39],
-            [
+                t55,
+                t56,
                 t57,
+                t58,
+                t59,
+                t60,
+                t61,
+                t62,
+                t63,
+            )
+        };
+        let (t64, t65, t66, t67, t68, t69, t70, t71, t72, t73, t74) = {
+            let t64 = T::mul_add(-t0, T::mul_add(-T::from_f64(0.1197), t29, t51), -t61);
+            let t65 = T::mul_add(
+                -T::from_f64(0.13585),
+                T::mul_add(t1, t23, t0 * t24),
+                T::mul_add(-t0, t52, t1 * t53),
+            );
+            let t66 = T::mul_add(t3, t58, -t59);
+            let t67 = T::mul_add(T::from_f64(0.13585), t30 + t35, t63);
+            let t68 = T::mul_add(T::from_f64(0.13585), T::mul_add(-t0, t29, t30), t64);
+            let t69 = T::mul_add(
+                t3,
+                T::mul_add(t3, t55, t59),
+                t2 * (T::mul_add(t2, t58, t60)),
+            );
+            let t70 = T::mul_add(
+                -T::from_f64(0.85),
+                t29,
+                T::mul_add(-t2, t62, t3 * t66) + T::from_f64(0.9241220958009998),
+            );
+            let t71 = T::mul_add(
+                T::from_f64(0.425),
+                t28,
+                -(T::mul_add(-t3, t62, -t2 * t66)),
+            );
+            let t72 = T::mul_add(-t0, t69 + T::from_f64(0.054004433300999945), t1 * t71);
+            let t73 = T::mul_add(-t1, t70 + T::from_f64(0.8849018759100001), t0 * t71);
+            let t74 = T::mul_add(-t0, t72, -t1 * t73) + T::from_f64(0.12816210104175002);
+            (t64, t65, t66, t67, t68, t69, t70, t71, t72, t73, t74)
+        };
+        [
+            [t74, t67, t68, t65, t49, t31],
+            [
+                t67,
                 T::mul_add(
                     -T::from_f64(0.85),
-                    t28,
-                    T::mul_add(
-                        T::from_f64(0.12999255384415),
-                        t12,
-                        T::mul_add(
-                            -T::from_f64(0.01511702475),
-                            t11,
-                            T::mul_add(
-                                -T::from_f64(0.0139521246075),
-                                t4,
-                                t29 + T::from_f64(2.47695164561575),
-                            ),
-                        ),
-                    ),
-                ),
-                t34,
-                t36,
-                t22,
-                t13,
+                    t29,
+                    t39 + T::from_f64(1.0768558760559999),
+                ) + T::from_f64(0.8849018759100001),
+                t43,
+                t44,
+                t19,
+                t11,
             ],
-            [
-                t58,
-                t34,
-                T::mul_add(
-                    T::from_f64(0.12999255384415),
-                    t12,
-                    T::mul_add(
-                        -T::from_f64(0.0139521246075),
-                        t4,
-                        t29 + T::from_f64(0.70682470720575),
-                    ),
-                ),
-                t35,
-                t22,
-                t13,
-            ],
-            [
-                t56,
-                t36,
-                t35,
-                T::mul_add(
-                    T::from_f64(0.12999255384415),
-                    t12,
-                    t29 + T::from_f64(0.111172755531),
-                ),
-                t22,
-                t13,
-            ],
-            [t50, t22, t22, t22, t23, T::zero()],
-            [t39, t13, t13, t13, T::zero(), T::from_f64(0.0171364731454)],
+            [t68, t43, t39 + T::from_f64(0.19163081355599998), t40, t19, t11],
+            [t65, t44, t40, t32 + T::from_f64(0.111172755531), t19, t11],
+            [t49, t19, t19, t19, t26, T::zero()],
+            [t31, t11, t11, t11, T::zero(), T::from_f64(0.0171364731454)],
         ]
     }
     /// The generalized gravity force G(q) = dV/dq.
@@ -5175,7 +4252,7 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
     /// The Coriolis and centrifugal effort b(q, qd) = C(q, qd) qd, without gravity.
     ///
     /// Route: Newton-Euler.
-    /// Operations: 253 mul, 176 add, 0 div, 5 sin, 5 cos.
+    /// Operations: 207 mul, 128 add, 0 div, 5 sin, 5 cos.
     fn bias(&self, q: &[T; 6], qd: &[T; 6]) -> [T; 6] {
         let ([s1, s2, s3, s4, s5], [c1, c2, c3, c4, c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
             q[1],
@@ -5263,97 +4340,97 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
             let t10 = qd[0] * qd[0];
             let t11 = qd[1] + qd[2];
             let t12 = qd[0] * qd[1] * t0;
-            let t13 = qd[0] * qd[0] * t0 * t1;
-            let t14 = qd[0] * qd[0] * t1 * t1;
-            let t15 = qd[0] * qd[0] * t0 * t1 * t3;
-            let t16 = qd[0] * qd[0] * t0 * t1 * t2;
-            let t17 = T::from_f64(0.56875) * t11;
-            let t18 = T::from_f64(0.19163081355599998) * t11;
-            let t19 = T::from_f64(0.39225) * t11;
-            let t20 = t11 + qd[3];
-            let t21 = T::mul_add(
+            let t13 = qd[0] * qd[1] * t1;
+            let t14 = qd[0] * qd[0] * t0 * t1;
+            let t15 = qd[0] * qd[0] * t1 * t1;
+            let t16 = t11 * t11;
+            let t17 = qd[3] + t11;
+            let t18 = T::mul_add(
                 -T::from_f64(0.1197),
                 qd[0] * t0,
                 T::from_f64(0.425) * qd[1],
             );
-            let t22 = T::mul_add(qd[0], t0 * t3, qd[0] * t1 * t2);
-            let t23 = T::mul_add(-qd[0], t0 * t2, qd[0] * t1 * t3);
-            let t24 = T::from_f64(0.111172755531) * t20;
-            let t25 = qd[0] * t0 * t21;
-            let t26 = T::from_f64(0.56875) * t23;
-            let t27 = T::from_f64(0.004095) * t22;
-            let t28 = T::from_f64(0.19163081355599998) * t23;
-            let t29 = T::from_f64(0.39225) * t23;
-            let t30 = t22 * t19;
-            let t31 = T::mul_add(
-                qd[1],
-                t21,
-                T::mul_add(T::from_f64(0.425), t14, T::from_f64(0.1197) * t12),
+            let t19 = T::mul_add(qd[0], t0 * t3, qd[0] * t1 * t2);
+            let t20 = T::mul_add(-qd[0], t0 * t2, qd[0] * t1 * t3);
+            let t21 = T::mul_add(
+                T::from_f64(0.1197),
+                t13,
+                -(T::mul_add(T::from_f64(0.425), t14, T::from_f64(0.1197) * t13)),
             );
-            let t32 = T::mul_add(
+            let t22 = t19 * t20;
+            let t23 = t11 * t19;
+            let t24 = t20 * t20;
+            let t25 = T::mul_add(-qd[0], t0 * t18, T::from_f64(0.1197) * t15);
+            let t26 = T::mul_add(
                 qd[2],
-                t22,
+                t19,
                 T::mul_add(qd[0], qd[1] * t1 * t2, qd[0] * qd[1] * t0 * t3),
             );
-            let t33 = T::mul_add(
+            let t27 = T::mul_add(
                 -qd[2],
-                t23,
+                t20,
                 T::mul_add(-qd[0], qd[1] * t1 * t3, qd[0] * qd[1] * t0 * t2),
             );
-            let t34 = t22 * t28;
-            let t35 = t23 * t27;
-            let t36 = T::mul_add(t5, t22, t4 * t23);
-            let t37 = T::mul_add(-t4, t22, t5 * t23);
-            let t38 = t2 * t31;
-            let t39 = t3 * t31;
-            let t40 = T::from_f64(0.111172755531) * t36;
-            let t41 = T::from_f64(0.21942) * t37;
-            let t42 = T::from_f64(0.093) * t37;
-            let t43 = T::from_f64(0.093) * t36;
-            let t44 = qd[4] - t37;
-            let t45 = T::mul_add(t22, t29, T::mul_add(T::from_f64(0.425), t15, t38));
-            let t46 = T::mul_add(
-                -t11,
-                t19,
-                T::mul_add(-t23, t29, T::mul_add(T::from_f64(0.425), t16, -t39)),
+            let t28 = T::mul_add(t5, t19, t4 * t20);
+            let t29 = T::mul_add(t4, t19, -t5 * t20);
+            let t30 = T::mul_add(
+                T::from_f64(0.425),
+                t12,
+                T::mul_add(T::from_f64(0.13585), t10, -t25),
             );
-            let t47 = T::mul_add(qd[3], t36, T::mul_add(-t4, t33, t5 * t32));
-            let t48 = T::mul_add(-qd[3], t37, T::mul_add(t5, t33, t4 * t32));
-            let t49 = T::mul_add(t6, t20, t7 * t36);
-            let t50 = t20 * t42;
-            let t51 = T::mul_add(-t7, t20, t6 * t36);
-            let t52 = T::from_f64(0.21942) * t44;
-            let t53 = t4 * t45;
-            let t54 = t5 * t46;
-            let t55 = t5 * t45;
-            let t56 = t4 * t46;
-            let t57 = t6 * t48;
-            let t58 = T::mul_add(
-                t36,
-                t43,
+            let t31 = T::mul_add(
+                T::from_f64(0.1197),
+                t12,
+                -(T::mul_add(-qd[1], t18, -T::from_f64(0.425) * t15)),
+            );
+            let t32 = -t29;
+            let t33 = qd[4] + t29;
+            let t34 = T::mul_add(
+                -T::from_f64(0.39225),
+                t26 + t23,
                 T::mul_add(
-                    t37,
-                    t42,
-                    T::mul_add(
-                        T::from_f64(0.39225),
-                        t32,
-                        T::mul_add(
-                            -T::from_f64(0.1197),
-                            t14,
-                            T::mul_add(
-                                T::from_f64(0.425),
-                                t12,
-                                T::mul_add(T::from_f64(0.13585), t10, t25 + t30),
-                            ),
-                        ),
-                    ),
+                    -T::from_f64(0.425),
+                    t12,
+                    T::mul_add(-T::from_f64(0.13585), t10, t25),
                 ),
             );
-            let t59 = qd[4] * t49;
-            let t60 = T::from_f64(0.111172755531) * t49;
-            let t61 = T::from_f64(0.111172755531) * t51;
-            let t62 = T::from_f64(0.09465) * t49;
-            let t63 = T::from_f64(0.09465) * t51;
+            let t35 = t17 * t32;
+            let t36 = T::mul_add(t6, t17, t7 * t28);
+            let t37 = T::mul_add(t7, t17, -t6 * t28);
+            let t38 = T::mul_add(t2, t31, -t3 * t21);
+            let t39 = T::mul_add(-t3, t31, -t2 * t21);
+            let t40 = T::mul_add(qd[3], t32, T::mul_add(-t5, t27, -t4 * t26));
+            let t41 = T::mul_add(qd[3], t28, T::mul_add(-t4, t27, t5 * t26));
+            let t42 = -t37;
+            let t43 = t36 * t33;
+            let t44 = -t38;
+            let t45 = T::mul_add(T::from_f64(0.39225), t22, t38);
+            let t46 = t39 + -T::from_f64(0.39225) * (t24 + t16);
+            let t47 = t34 + -T::from_f64(0.093) * (T::mul_add(t28, t28, t32 * t32));
+            let t48 = t33 * t42;
+            let t49 = T::mul_add(-t8, t33, t9 * t36);
+            let t50 = T::mul_add(t9, t33, t8 * t36);
+            let t51 = T::mul_add(-qd[4], t42, t7 * t40);
+            let t52 = T::mul_add(qd[4], t36, t6 * t40);
+            let t53 = T::mul_add(-t5, t46, -t4 * t45);
+            let t54 = T::mul_add(-t4, t46, t5 * t45);
+            let t55 = T::mul_add(
+                -T::from_f64(0.016685526854599998),
+                t49 * t50,
+                -T::from_f64(0.0171364731454) * t52,
+            );
+            let t56 = T::mul_add(T::from_f64(0.093), T::mul_add(t28, t17, -t41), t53);
+            let t57 = T::mul_add(T::from_f64(0.093), t40 - t35, t54);
+            let t58 = t57 + -T::from_f64(0.09465) * (T::mul_add(t42, t42, t36 * t36));
+            let t59 = T::mul_add(-qd[5], t50, T::mul_add(-t8, t41, t9 * t51));
+            let t60 = T::mul_add(qd[5], t49, T::mul_add(t9, t41, t8 * t51));
+            let t61 = T::mul_add(t6, t47, t7 * t56);
+            let t62 = T::mul_add(t7, t47, -t6 * t56);
+            let t63 = T::mul_add(
+                T::from_f64(0.016685526854599998),
+                t50 * (qd[5] + t37),
+                T::from_f64(0.0171364731454) * t59,
+            );
             (
                 t0,
                 t1,
@@ -5458,352 +4535,134 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
             t97,
             t98,
             t99,
-            t100,
-            t101,
-            t102,
-            t103,
-            t104,
-            t105,
-            t106,
-            t107,
-            t108,
-            t109,
-            t110,
-            t111,
-            t112,
-            t113,
-            t114,
-            t115,
-            t116,
         ) = {
-            let t64 = qd[5] - t51;
-            let t65 = T::mul_add(
-                -t20,
-                t43,
-                T::mul_add(T::from_f64(0.093), t47, t53 + t54),
+            let t64 = T::mul_add(T::from_f64(0.09465), t43 - t52, t61);
+            let t65 = T::mul_add(-T::from_f64(0.09465), t51 + t48, t62);
+            let t66 = T::mul_add(-T::from_f64(0.1879), t65, T::from_f64(1.219) * (-t62));
+            let t67 = T::mul_add(-t8, t58, t9 * t64);
+            let t68 = T::mul_add(t9, t58, t8 * t64);
+            let t69 = T::mul_add(
+                -T::from_f64(0.017784735),
+                t65,
+                T::mul_add(T::from_f64(0.033822), t8 * t60, t9 * t63),
             );
-            let t66 = t6 * t58;
-            let t67 = t7 * t58;
-            let t68 = T::mul_add(qd[4], t51, t7 * t48);
-            let t69 = t49 * t61;
-            let t70 = t51 * t60;
-            let t71 = T::mul_add(-t8, t44, t9 * t49);
-            let t72 = T::mul_add(t9, t44, t8 * t49);
-            let t73 = t44 * t63;
-            let t74 = T::from_f64(0.0171364731454) * t64;
-            let t75 = t7 * t65;
-            let t76 = t6 * t65;
-            let t77 = T::mul_add(
-                t51,
-                t63,
-                T::mul_add(
-                    t49,
-                    t62,
-                    T::mul_add(T::from_f64(0.093), t48, t56 + t50 - t55),
-                ),
+            let t70 = T::mul_add(
+                T::from_f64(0.21942),
+                t41,
+                T::mul_add(T::from_f64(0.033822), t9 * t60, -t8 * t63),
             );
-            let t78 = T::from_f64(0.0171364731454) * t71;
-            let t79 = T::from_f64(0.033822) * t72;
-            let t80 = T::mul_add(
-                t44,
-                t62,
-                T::mul_add(T::from_f64(0.09465), t57 - t59, -t75 - t66),
-            );
-            let t81 = t72 * t78;
-            let t82 = t71 * t79;
-            let t83 = T::mul_add(
-                -T::from_f64(0.1879),
-                t73,
-                T::mul_add(
-                    T::from_f64(1.4069),
-                    t76 - t67,
-                    T::from_f64(0.017784735) * t68,
-                ),
-            );
-            let t84 = T::mul_add(
-                t72,
-                t74,
-                T::mul_add(
-                    -t64,
-                    t79,
-                    T::from_f64(0.0171364731454)
-                        * (T::mul_add(qd[5], t72, T::mul_add(t8, t47, t9 * t68))),
-                ),
-            );
-            let t85 = T::mul_add(
-                t64,
-                t78,
-                T::mul_add(
-                    -t71,
-                    t74,
-                    T::from_f64(0.033822)
-                        * (T::mul_add(-qd[5], t71, T::mul_add(-t9, t47, t8 * t68))),
-                ),
-            );
-            let t86 = t6 * t83;
-            let t87 = t7 * t83;
-            let t88 = T::from_f64(0.1879) * (T::mul_add(t8, t77, t9 * t80));
-            let t89 = T::from_f64(0.1879) * (T::mul_add(-t9, t77, t8 * t80));
-            let t90 = t8 * t84;
-            let t91 = t9 * t85;
-            let t92 = t9 * t88;
-            let t93 = t8 * t89;
-            let t94 = t8 * t88;
-            let t95 = t9 * t89;
-            let t96 = T::mul_add(
-                t8,
-                t85,
-                T::mul_add(
-                    t9,
-                    t84,
-                    T::mul_add(
-                        -t44,
-                        t61,
-                        T::mul_add(
-                            t51,
-                            t52,
-                            T::mul_add(
-                                T::from_f64(0.017784735),
-                                t76 - t67 - t73,
-                                T::from_f64(0.11285608069875) * t68,
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t97 = T::mul_add(
-                T::from_f64(0.09465),
-                t92 + t93,
-                T::mul_add(
-                    -t49,
-                    t52,
-                    T::mul_add(
-                        t44,
-                        t60,
-                        T::mul_add(
-                            T::from_f64(0.12830922867640002),
-                            t57 - t59,
-                            t81 - t82,
-                        ),
-                    ),
-                ),
-            );
-            let t98 = T::mul_add(T::from_f64(1.219), t75 + t66, -t92 - t93);
-            let t99 = T::mul_add(
+            let t71 = T::mul_add(
+                -T::from_f64(0.108247244469),
+                t48,
+                T::from_f64(0.111172755531) * t51,
+            ) + t69;
+            let t72 = T::from_f64(0.1879) * (T::mul_add(t8, t68, t9 * t67));
+            let t73 = T::mul_add(T::from_f64(1.219), t61, t72);
+            let t74 = T::mul_add(
                 T::from_f64(1.219),
-                t50,
-                T::mul_add(
-                    T::from_f64(2.438),
-                    t56 - t55,
-                    T::mul_add(T::from_f64(0.11336700000000001), t48, t94 - t95),
-                ),
+                t57,
+                T::from_f64(0.1879) * (T::mul_add(t9, t68, -t8 * t67)),
             );
-            let t100 = t7 * t98;
-            let t101 = t6 * t98;
-            let t102 = t5 * t99;
-            let t103 = T::mul_add(
-                t7,
-                t97,
-                T::mul_add(-t6, t96, T::mul_add(t36, t41, -t37 * t40)),
+            let t75 = T::mul_add(
+                -T::from_f64(0.108247244469),
+                t43,
+                -T::from_f64(0.111172755531) * t52,
+            ) + T::mul_add(T::from_f64(0.09465), t72, t55);
+            let t76 = T::mul_add(T::from_f64(1.219), t54, t74);
+            let t77 = T::mul_add(t6, t66, t7 * t73);
+            let t78 = T::mul_add(
+                T::from_f64(1.219),
+                t34,
+                T::mul_add(-t7, t66, t6 * t73),
             );
-            let t104 = T::mul_add(
+            let t79 = T::mul_add(T::from_f64(1.219), -t53, -t77);
+            let t80 = T::mul_add(
                 T::from_f64(0.093),
-                t100 + t86,
-                T::mul_add(
-                    -t20,
-                    t40,
-                    T::mul_add(
-                        t36,
-                        t24,
-                        T::mul_add(T::from_f64(0.43884), t47, t70 + t90 - t69 - t91),
-                    ),
-                ),
+                t74,
+                T::mul_add(-t6, t75, t7 * t71),
             );
-            let t105 = T::mul_add(
-                T::from_f64(0.093),
-                t94 - t95,
-                T::mul_add(
-                    t6,
-                    t97,
-                    T::mul_add(
-                        t7,
-                        t96,
-                        T::mul_add(
-                            -t37,
-                            t24,
-                            T::mul_add(
-                                t20,
-                                t41,
-                                T::mul_add(
-                                    T::from_f64(0.11336700000000001),
-                                    t56 + t50 - t55,
-                                    T::from_f64(0.121715886531) * t48,
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
+            let t81 = T::mul_add(
+                T::from_f64(0.108247244469),
+                t28 * t32,
+                T::mul_add(t7, t75, t6 * t71),
             );
-            let t106 = T::mul_add(T::from_f64(1.219), t53 + t54, t100 + t86);
-            let t107 = t4 * t106;
-            let t108 = T::mul_add(
+            let t82 = T::mul_add(
+                T::from_f64(0.21942),
+                t41,
+                T::mul_add(-T::from_f64(0.093), t77, t70),
+            );
+            let t83 = T::mul_add(
+                -T::from_f64(0.108247244469),
+                t35,
+                T::from_f64(0.111172755531) * t40,
+            ) + t80;
+            let t84 = T::mul_add(t5, t76, t4 * t79);
+            let t85 = T::mul_add(T::from_f64(0.56875), t22, -T::from_f64(2.275) * t44)
+                + t84;
+            let t86 = T::mul_add(
+                -T::from_f64(2.275),
+                -t39,
+                -T::from_f64(0.56875) * (t24 + t16),
+            ) + T::mul_add(-t4, t76, t5 * t79);
+            let t87 = T::mul_add(
+                T::from_f64(0.187535813556),
                 t22,
-                t26,
-                T::mul_add(
-                    T::from_f64(2.275),
-                    t38,
-                    T::mul_add(T::from_f64(0.9668749999999999), t15, t107 - t102),
-                ),
+                -T::from_f64(0.56875) * t44,
+            ) + T::mul_add(T::from_f64(0.39225), t84, t81);
+            let t88 = T::mul_add(
+                -T::from_f64(0.39225),
+                t78,
+                T::mul_add(t5, t82, -t4 * t83),
             );
-            let t109 = T::mul_add(
-                t4,
-                t99,
-                T::mul_add(
-                    t5,
-                    t106,
-                    T::mul_add(
-                        -t11,
-                        t17,
-                        T::mul_add(
-                            -t23,
-                            t26,
-                            T::mul_add(
-                                -T::from_f64(2.275),
-                                t39,
-                                T::from_f64(0.9668749999999999) * t16,
-                            ),
-                        ),
-                    ),
-                ),
+            let t89 = T::mul_add(
+                T::from_f64(0.004095),
+                t27,
+                T::mul_add(-t4, t82, -t5 * t83),
             );
-            let t110 = T::mul_add(
-                T::from_f64(0.39225),
-                t101 - t87,
+            let t90 = T::mul_add(t2, t86, t3 * t85);
+            let t91 = T::mul_add(t3, t86, -t2 * t85);
+            let t92 = T::mul_add(
+                T::from_f64(0.187535813556),
+                t23,
                 T::mul_add(
-                    T::from_f64(0.47815275),
-                    t30,
-                    T::mul_add(
-                        t5,
-                        t104,
-                        T::mul_add(
-                            t4,
-                            t105,
-                            T::mul_add(
-                                t22,
-                                t18,
-                                T::mul_add(
-                                    -t11,
-                                    t27,
-                                    T::mul_add(
-                                        T::from_f64(1.04690275),
-                                        t25,
-                                        T::mul_add(
-                                            T::from_f64(0.37918622974349997),
-                                            t32,
-                                            T::mul_add(
-                                                -T::from_f64(0.125314259175),
-                                                t14,
-                                                T::mul_add(
-                                                    T::from_f64(0.44493366875),
-                                                    t12,
-                                                    T::from_f64(0.14222173858749998) * t10,
-                                                ),
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
+                    T::from_f64(0.19163081355599998),
+                    t26,
+                    T::from_f64(0.56875) * t30,
                 ),
+            ) + t88;
+            let t93 = -T::from_f64(2.3500400000000004) * (T::mul_add(qd[1], qd[1], t15))
+                + t91;
+            let t94 = T::mul_add(
+                T::from_f64(0.1197),
+                -t91,
+                -T::from_f64(0.425)
+                    * (T::mul_add(
+                        -T::from_f64(0.56875),
+                        t26 + t23,
+                        -T::from_f64(2.275) * t30,
+                    ) + t78),
             );
-            let t111 = T::mul_add(
-                -t4,
-                t104,
-                T::mul_add(
-                    t5,
-                    t105,
-                    T::mul_add(
-                        t11,
-                        t28,
-                        T::mul_add(-t23, t18, T::from_f64(0.004095) * t33),
-                    ),
-                ),
+            let t95 = T::mul_add(
+                -t1,
+                t93,
+                t0 * (T::mul_add(T::from_f64(2.3500400000000004), t14, t90)),
             );
-            let t112 = t3 * t108;
-            let t113 = t2 * t109;
-            let t114 = t2 * t108;
-            let t115 = t3 * t109;
-            let t116 = T::mul_add(
+            let t96 = T::mul_add(t2, t89, t3 * t92) + t94;
+            let t97 = T::mul_add(
+                T::from_f64(0.1197),
+                t90,
+                T::mul_add(t3, t89, -t2 * t92),
+            );
+            let t98 = t1
+                * (T::mul_add(
+                    T::from_f64(1.7546963518200003),
+                    t12,
+                    T::from_f64(0.31925293400000004) * t10,
+                ) + t96);
+            let t99 = T::mul_add(
                 t0,
-                T::mul_add(
-                    -t3,
-                    t111,
-                    T::mul_add(
-                        t2,
-                        t110,
-                        T::mul_add(
-                            -T::from_f64(0.1197),
-                            t112 + t113,
-                            T::from_f64(0.0151074) * qd[0] * qd[1] * t1,
-                        ),
-                    ),
-                ),
-                T::mul_add(
-                    -t1,
-                    T::mul_add(
-                        t2,
-                        t111,
-                        T::mul_add(
-                            t3,
-                            t110,
-                            T::mul_add(
-                                T::from_f64(0.1197),
-                                t114 - t115,
-                                T::mul_add(
-                                    T::from_f64(0.5180750000000001),
-                                    t30,
-                                    T::mul_add(
-                                        T::from_f64(0.425),
-                                        T::mul_add(t22, t17, t101 - t87),
-                                        T::mul_add(
-                                            T::from_f64(1.4849499999999998),
-                                            t25,
-                                            T::mul_add(
-                                                T::from_f64(0.44493366875),
-                                                t32,
-                                                T::mul_add(
-                                                    -T::from_f64(0.17774851500000002),
-                                                    t14,
-                                                    T::mul_add(
-                                                        T::from_f64(2.38580010182),
-                                                        t12,
-                                                        T::from_f64(0.5209833915000001) * t10,
-                                                    ),
-                                                ),
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                    T::from_f64(0.13585)
-                        * (T::mul_add(
-                            t1,
-                            T::mul_add(
-                                T::from_f64(2.3500400000000004),
-                                T::mul_add(qd[1], qd[1], t14),
-                                t114 - t115,
-                            ),
-                            t0
-                                * (T::mul_add(
-                                    T::from_f64(2.3500400000000004),
-                                    t13,
-                                    t112 + t113,
-                                )),
-                        )),
-                ),
+                T::mul_add(T::from_f64(0.0151074), t13, -t97),
+                -t98,
             );
             (
                 t64,
@@ -5842,66 +4701,25 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
                 t97,
                 t98,
                 t99,
-                t100,
-                t101,
-                t102,
-                t103,
-                t104,
-                t105,
-                t106,
-                t107,
-                t108,
-                t109,
-                t110,
-                t111,
-                t112,
-                t113,
-                t114,
-                t115,
-                t116,
             )
         };
         [
-            t116,
+            T::mul_add(T::from_f64(0.13585), t95, t99),
             T::mul_add(
-                T::from_f64(0.425),
-                t112 + t113,
-                T::mul_add(
-                    T::from_f64(0.39225),
-                    t107 - t102,
-                    T::mul_add(
-                        T::from_f64(0.56875),
-                        t38,
-                        T::mul_add(
-                            T::from_f64(0.24171874999999998),
-                            t15,
-                            T::mul_add(
-                                T::from_f64(0.8697944759100001),
-                                t13,
-                                t103 + t34 - t35,
-                            ),
-                        ),
-                    ),
-                ),
+                T::from_f64(0.8697944759100001),
+                t14,
+                T::mul_add(T::from_f64(0.425), t90, t87),
             ),
-            T::mul_add(
-                T::from_f64(0.39225),
-                t107 - t102,
-                T::mul_add(
-                    T::from_f64(0.56875),
-                    t38,
-                    T::mul_add(T::from_f64(0.24171874999999998), t15, t103 + t34 - t35),
-                ),
-            ),
-            t103,
-            T::mul_add(T::from_f64(0.21942), t47, t70 + t90 - t69 - t91),
-            T::mul_add(T::from_f64(0.0171364731454), t57 - t59, t81 - t82),
+            t87,
+            t81,
+            t70,
+            t55,
         ]
     }
     /// The Christoffel-form Coriolis matrix C(q, qd): C qd = b, dM/dt - 2C skew-symmetric.
     ///
     /// Route: Echeandia and Wensing's O(N^2) recursion on composite inertias and momenta.
-    /// Operations: 639 mul, 511 add, 0 div, 5 sin, 5 cos.
+    /// Operations: 603 mul, 388 add, 0 div, 5 sin, 5 cos.
     fn coriolis_matrix(&self, q: &[T; 6], qd: &[T; 6]) -> [[T; 6]; 6] {
         let ([s1, s2, s3, s4, s5], [c1, c2, c3, c4, c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
             q[1],
@@ -5986,96 +4804,91 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
             let t7 = c4;
             let t8 = s5;
             let t9 = c5;
-            let t10 = qd[1] + qd[2] + qd[3];
-            let t11 = t2 * t4;
-            let t12 = t2 * t5;
-            let t13 = t8 * t8;
-            let t14 = t9 * t9;
-            let t15 = t3 * t4;
-            let t16 = t3 * t5;
-            let t17 = t5 * t7 * t8 * t9;
-            let t18 = t4 * t7 * t8 * t9;
-            let t19 = T::mul_add(
+            let t10 = qd[1] + qd[2];
+            let t11 = t2 * t5;
+            let t12 = t8 * t8;
+            let t13 = t9 * t9;
+            let t14 = t3 * t5;
+            let t15 = t5 * t7 * t8 * t9;
+            let t16 = t4 * t7 * t8 * t9;
+            let t17 = T::mul_add(
                 T::from_f64(0.017784735),
                 t4,
                 -T::from_f64(1.598759275),
             );
-            let t20 = qd[0] * t1;
-            let t21 = qd[0] * t0;
-            let t22 = qd[0] * t1 * t3;
-            let t23 = qd[0] * t0 * t2;
-            let t24 = qd[0] * t1 * t2;
-            let t25 = qd[0] * t0 * t3;
-            let t26 = T::mul_add(
+            let t18 = qd[0] * t1;
+            let t19 = qd[0] * t0;
+            let t20 = qd[0] * t1 * t3;
+            let t21 = qd[0] * t1 * t2;
+            let t22 = qd[3] + t10;
+            let t23 = T::mul_add(
                 T::from_f64(0.033822),
-                t14,
-                T::mul_add(T::from_f64(0.0171364731454), t13, T::from_f64(0.21942)),
+                t13,
+                T::from_f64(0.0171364731454) * t12,
             );
-            let t27 = T::mul_add(
-                T::from_f64(0.0171364731454),
-                t14,
-                T::mul_add(T::from_f64(0.033822), t13, T::from_f64(0.11285608069875)),
-            );
-            let t28 = T::mul_add(
+            let t24 = T::mul_add(
                 T::from_f64(0.016685526854599998),
                 t6 * t8 * t9,
                 -T::from_f64(0.0016539803549999999),
             );
-            let t29 = T::mul_add(
-                T::from_f64(0.033822),
-                t14,
-                T::mul_add(T::from_f64(0.0171364731454), t13, T::from_f64(0.4510082781)),
+            let t25 = t3 * t17;
+            let t26 = T::from_f64(0.017784735) * (T::mul_add(t2, t4, -t14));
+            let t27 = T::from_f64(0.017784735) * (T::mul_add(t3, t4, t11));
+            let t28 = T::mul_add(qd[0], t0 * t3, t21);
+            let t29 = T::mul_add(-qd[0], t0 * t2, t20);
+            let t30 = T::mul_add(
+                T::from_f64(0.0171364731454),
+                t13,
+                T::from_f64(0.033822) * t12,
+            ) + T::from_f64(0.11285608069875);
+            let t31 = t23 + T::from_f64(0.21942);
+            let t32 = t23 + T::from_f64(0.4510082781);
+            let t33 = T::mul_add(-t2, t17, T::from_f64(0.017784735) * t14);
+            let t34 = T::mul_add(T::from_f64(0.017784735), t11, t25);
+            let t35 = t5 * t29;
+            let t36 = T::mul_add(
+                T::from_f64(0.13585),
+                t19,
+                T::mul_add(-T::from_f64(0.1197), t19, T::from_f64(0.425) * qd[1]),
             );
-            let t30 = t2 * t19;
-            let t31 = t3 * t19;
-            let t32 = t24 + t25;
-            let t33 = t22 - t23;
-            let t34 = T::mul_add(
-                T::from_f64(0.016149999999999998),
-                t21,
-                T::from_f64(0.425) * qd[1],
+            let t37 = T::mul_add(T::from_f64(0.39225), t29, T::from_f64(0.425) * t18);
+            let t38 = T::mul_add(t5, t28, t4 * t29);
+            let t39 = T::mul_add(t4, t28, -t35);
+            let t40 = qd[0] * t0 * t33;
+            let t41 = T::mul_add(
+                qd[0],
+                t1
+                    * (T::from_f64(0.0171364731454)
+                        * (T::mul_add(-t3, t5 * t6, t2 * t4 * t6))),
+                qd[0] * t0
+                    * (T::from_f64(0.0171364731454)
+                        * (T::mul_add(t2, t5 * t6, t3 * t4 * t6))),
             );
-            let t35 = t5 * t33;
-            let t36 = t3 * t34;
-            let t37 = t2 * t34;
-            let t38 = T::mul_add(T::from_f64(0.39225), t33, T::from_f64(0.425) * t20);
-            let t39 = T::mul_add(
-                t7,
-                t7 * t27,
-                T::mul_add(
-                    T::from_f64(0.12999255384415),
-                    t6 * t6,
-                    T::from_f64(0.123341033631),
-                ),
-            );
-            let t40 = T::mul_add(-t6, t7 * t27, T::from_f64(0.12999255384415) * t6 * t7);
-            let t41 = T::mul_add(-t5, t29, T::from_f64(0.016685526854599998) * t18);
-            let t42 = T::mul_add(-t5, t26, T::from_f64(0.016685526854599998) * t18);
-            let t43 = T::mul_add(t4, t26, T::from_f64(0.016685526854599998) * t17);
-            let t44 = T::mul_add(t5, t32, t4 * t33);
-            let t45 = T::mul_add(-t4, t32, t35);
-            let t46 = T::mul_add(
-                T::from_f64(0.016149999999999998),
-                t24,
-                T::mul_add(T::from_f64(0.39225), qd[1] + qd[2], t36),
-            );
-            let t47 = T::mul_add(T::from_f64(0.016149999999999998), t22, -t37);
-            let t48 = t6 * t38;
-            let t49 = t7 * t38;
-            let t50 = qd[0] * t0 * (T::mul_add(T::from_f64(0.017784735), t16, -t30));
-            let t51 = qd[4] - t45;
-            let t52 = t4 * t46;
-            let t53 = t5 * t47;
-            let t54 = t5 * t46;
-            let t55 = t4 * t47;
-            let t56 = t19 * t47;
-            let t57 = t5 * (T::mul_add(T::from_f64(0.016149999999999998), t24, t36));
-            let t58 = t40 * t45;
-            let t59 = t28 * t44;
-            let t60 = t7 * t8 * t9 * t45;
-            let t61 = T::mul_add(t5, t28, t4 * t40);
-            let t62 = T::mul_add(-t4, t28, t5 * t40);
-            let t63 = T::mul_add(-T::from_f64(0.016685526854599998), t17, t4 * t39);
+            let t42 = T::mul_add(-t6, t7 * t30, T::from_f64(0.12999255384415) * t6 * t7);
+            let t43 = T::mul_add(-t5, t32, T::from_f64(0.016685526854599998) * t16);
+            let t44 = T::mul_add(-t5, t31, T::from_f64(0.016685526854599998) * t16);
+            let t45 = T::mul_add(t4, t31, T::from_f64(0.016685526854599998) * t15);
+            let t46 = -t39;
+            let t47 = qd[4] + t39;
+            let t48 = T::mul_add(t3, t36, T::from_f64(0.016149999999999998) * t21);
+            let t49 = T::mul_add(-t2, t36, T::from_f64(0.016149999999999998) * t20);
+            let t50 = qd[0] * t1
+                * (T::mul_add(-T::from_f64(0.017784735), t11, -t25)
+                    + T::from_f64(4.4329225));
+            let t51 = T::mul_add(t7, t7 * t30, T::from_f64(0.12999255384415) * t6 * t6)
+                + T::from_f64(0.123341033631);
+            let t52 = T::mul_add(t6, t22, t7 * t38);
+            let t53 = T::mul_add(t7, t22, -t6 * t38);
+            let t54 = T::mul_add(T::from_f64(0.39225), t10, t48);
+            let t55 = t4 * t49;
+            let t56 = t5 * t48;
+            let t57 = t7 * t8 * t9 * t46;
+            let t58 = T::mul_add(t5, t24, t4 * t42);
+            let t59 = T::mul_add(-t4, t24, t5 * t42);
+            let t60 = -t53;
+            let t61 = qd[5] + t53;
+            let t62 = T::mul_add(-T::from_f64(0.016685526854599998), t15, t4 * t51);
+            let t63 = t59 - T::from_f64(0.051322656825);
             (
                 t0,
                 t1,
@@ -6209,124 +5022,158 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
             t126,
             t127,
         ) = {
-            let t64 = T::mul_add(t6, t10, t7 * t44);
-            let t65 = T::mul_add(-t7, t10, t6 * t44);
-            let t66 = t8 * t51;
-            let t67 = t9 * t51;
-            let t68 = T::mul_add(T::from_f64(0.093), t45, t53 - t52);
-            let t69 = T::mul_add(T::from_f64(0.093), t44, t54 + t55);
-            let t70 = t62 - T::from_f64(0.051322656825);
-            let t71 = t3 * t61;
-            let t72 = t2 * t61;
-            let t73 = t9 * t64;
-            let t74 = t8 * t64;
-            let t75 = t7 * t68;
-            let t76 = t6 * t68;
-            let t77 = T::from_f64(0.008342763427299999) * (qd[5] - t65);
-            let t78 = t61 * t32;
-            let t79 = t8 * t9 * t65;
-            let t80 = T::mul_add(
-                t4,
-                T::mul_add(t4, t29, T::from_f64(0.016685526854599998) * t17),
-                T::mul_add(
-                    t5,
-                    T::mul_add(t5, t39, T::from_f64(0.016685526854599998) * t18),
-                    T::from_f64(0.004095),
-                ),
-            );
+            let t64 = t3 * t58;
+            let t65 = t2 * t58;
+            let t66 = T::mul_add(-t8, t47, t9 * t52);
+            let t67 = T::mul_add(t9, t47, t8 * t52);
+            let t68 = T::mul_add(t5, t49, -t4 * t54);
+            let t69 = T::mul_add(t5, t54, t55);
+            let t70 = t8 * t9 * t61;
+            let t71 = t58 * t28;
+            let t72 = T::mul_add(T::from_f64(0.093), t46, t68);
+            let t73 = T::mul_add(T::from_f64(0.093), t38, t69);
+            let t74 = -t68;
+            let t75 = t8 * t66;
+            let t76 = t9 * t66;
+            let t77 = t8 * t67;
+            let t78 = t9 * t67;
+            let t79 = t6 * t8 * t66;
+            let t80 = t7 * t8 * t66;
             let t81 = T::mul_add(
-                t5,
-                t41,
-                T::mul_add(
-                    -t4,
-                    t63,
-                    T::mul_add(
-                        T::from_f64(0.0139521246075),
-                        t4,
-                        -T::from_f64(0.5956519516747499),
-                    ),
-                ),
+                -T::from_f64(0.017784735),
+                t69,
+                T::mul_add(t24, t38, -t42 * t46),
             );
             let t82 = T::mul_add(
-                -t4,
-                t41,
-                T::mul_add(-t5, t63, T::from_f64(0.00697606230375) * t5),
+                T::from_f64(0.1308417),
+                t69,
+                T::mul_add(t32, t38, T::from_f64(0.016685526854599998) * t57),
             );
-            let t83 = t3 * t70;
-            let t84 = T::mul_add(T::from_f64(0.09465), t65, -t75 - t48);
-            let t85 = T::from_f64(0.0085682365727) * (t73 - t66);
-            let t86 = T::from_f64(0.016911) * (t74 + t67);
-            let t87 = T::from_f64(0.008342763427299999) * (t73 - t66);
-            let t88 = t8 * t9 * t77;
-            let t89 = t8 * t8 * t77;
-            let t90 = t9 * t9 * t77;
+            let t83 = -T::from_f64(0.016685526854599998)
+                * (T::mul_add(t8, t9 * t60, t70));
+            let t84 = T::mul_add(
+                -qd[0],
+                t1 * (T::mul_add(-t3, t45, t2 * t44)),
+                -qd[0] * t0 * (T::mul_add(t2, t45, t3 * t44)),
+            );
+            let t85 = T::mul_add(
+                t4,
+                T::mul_add(t4, t32, T::from_f64(0.016685526854599998) * t15),
+                t5 * (T::mul_add(t5, t51, T::from_f64(0.016685526854599998) * t16)),
+            );
+            let t86 = T::mul_add(t3, t63, -t65);
+            let t87 = T::mul_add(-T::from_f64(0.1197), t27, T::mul_add(t3, t59, -t65));
+            let t88 = T::mul_add(T::from_f64(0.1197), t26, -(T::mul_add(t2, t59, t64)));
+            let t89 = T::mul_add(
+                -T::from_f64(0.1308417),
+                t74,
+                T::mul_add(
+                    T::from_f64(0.016685526854599998),
+                    t7 * t8 * t9 * t38,
+                    t51 * t46,
+                ),
+            );
+            let t90 = T::mul_add(-t59, t29, t71)
+                + -T::from_f64(0.017784735) * (t55 + t56);
             let t91 = T::mul_add(
-                T::from_f64(0.70345),
-                t76 - t49,
-                T::from_f64(0.0088923675) * t64,
+                -T::from_f64(0.0002254731454000014),
+                t78,
+                T::from_f64(0.016911000000000002) * t75,
             );
-            let t92 = t70 * t33;
-            let t93 = T::from_f64(0.016911000000000002) * (t73 - t66);
-            let t94 = T::from_f64(0.0002254731454000014) * (t73 - t66);
-            let t95 = T::from_f64(0.0002254731454000014) * (t74 + t67);
-            let t96 = t2 * t82;
-            let t97 = t3 * t82;
-            let t98 = t9 * t87;
-            let t99 = t9 * t85;
-            let t100 = t8 * t86;
-            let t101 = t8 * t85;
-            let t102 = t9 * t86;
-            let t103 = t6 * t91;
-            let t104 = t7 * t91;
-            let t105 = t6 * t8 * t87;
-            let t106 = t7 * t8 * t87;
-            let t107 = T::mul_add(
-                -T::from_f64(0.11827823657270001),
-                t65,
-                T::mul_add(T::from_f64(0.0085682365727), qd[5], t90 - t89),
+            let t92 = T::mul_add(
+                T::from_f64(0.0002254731454000014),
+                t77,
+                T::from_f64(0.016911000000000002) * t76,
             );
-            let t108 = T::mul_add(t3, t81, t96);
-            let t109 = T::mul_add(-t2, t80, t97);
-            let t110 = T::from_f64(0.09395) * (T::mul_add(t8, t69, t9 * t84));
-            let t111 = T::from_f64(0.09395) * (T::mul_add(-t9, t69, t8 * t84));
-            let t112 = T::mul_add(
+            let t93 = T::mul_add(
+                -T::from_f64(0.016911),
+                t78,
+                T::from_f64(0.0002254731454000014) * t75,
+            );
+            let t94 = T::mul_add(
+                T::from_f64(0.016911),
+                t77,
+                T::from_f64(0.0002254731454000014) * t76,
+            );
+            let t95 = T::mul_add(
+                -T::from_f64(0.0139521246075),
+                t4,
+                T::mul_add(-t5, t43, t4 * t62) + T::from_f64(0.40402113811874996),
+            );
+            let t96 = t85 + T::from_f64(0.004095);
+            let t97 = T::mul_add(
+                T::from_f64(0.00697606230375),
+                t5,
+                -(T::mul_add(t4, t43, t5 * t62)),
+            );
+            let t98 = T::mul_add(T::from_f64(0.1197), t33, T::mul_add(t2, t63, t64));
+            let t99 = T::mul_add(t6, t37, t7 * t72);
+            let t100 = T::mul_add(t7, t37, -t6 * t72);
+            let t101 = T::mul_add(-t63, t29, t71)
+                + T::mul_add(-T::from_f64(0.017784735), t56, -t17 * t49);
+            let t102 = t6 * t91;
+            let t103 = t6 * t93;
+            let t104 = t95 + T::from_f64(0.19163081355599998);
+            let t105 = t2 * t97;
+            let t106 = t3 * t97;
+            let t107 = T::mul_add(T::from_f64(0.09465), t60, -t99);
+            let t108 = T::mul_add(T::from_f64(0.09465), t52, -t100);
+            let t109 = -t100;
+            let t110 = qd[0] * t0 * t98;
+            let t111 = T::mul_add(-t5, t92, t4 * t7 * t91);
+            let t112 = T::mul_add(t4, t92, t5 * t7 * t91);
+            let t113 = T::mul_add(-t5, t94, t4 * t7 * t93);
+            let t114 = T::mul_add(t4, t94, t5 * t7 * t93);
+            let t115 = t103
+                + T::from_f64(0.0171364731454)
+                    * (T::mul_add(-t5, t6 * t29, t4 * t6 * t28));
+            let t116 = T::mul_add(-t2, t96, t106);
+            let t117 = T::mul_add(
+                -T::from_f64(0.008342763427299999),
+                t76,
+                T::from_f64(0.0088923675) * t108,
+            );
+            let t118 = T::mul_add(
+                -T::from_f64(0.6095),
+                t109,
+                -T::from_f64(0.09395) * t108,
+            );
+            let t119 = T::mul_add(
                 T::from_f64(0.0088923675),
-                t49 - t76,
-                T::mul_add(T::from_f64(0.053281959650625), t64, t98),
+                t108,
+                T::mul_add(
+                    T::from_f64(0.016911),
+                    t77,
+                    T::from_f64(0.0085682365727) * t76,
+                ),
             );
-            let t113 = qd[0] * t0
-                * (T::mul_add(
-                    t2,
-                    t70,
-                    T::mul_add(
+            let t120 = T::mul_add(
+                T::from_f64(0.6095),
+                t109,
+                T::from_f64(0.09395) * t108,
+            );
+            let t121 = T::mul_add(
+                -qd[0],
+                t1
+                    * (T::mul_add(
                         -T::from_f64(0.1197),
-                        t30,
-                        T::mul_add(T::from_f64(0.0021288327795), t16, t71),
-                    ),
-                ));
-            let t114 = T::mul_add(
-                T::from_f64(0.12684647314540004),
-                t64,
-                t98 - t99 - t100,
+                        t34,
+                        t86 + T::from_f64(0.19371331275000003),
+                    )),
+                t110,
             );
-            let t115 = T::mul_add(T::from_f64(0.10971), t64, t98 + t99 + t100);
-            let t116 = t6 * t107;
-            let t117 = T::mul_add(t9, t93, t8 * t95);
-            let t118 = T::mul_add(t9, t94, t100);
-            let t119 = T::mul_add(-t8, t93, t9 * t95);
-            let t120 = T::mul_add(-t8, t94, t102);
-            let t121 = t9 * t110;
-            let t122 = t8 * t111;
-            let t123 = t8 * t110;
-            let t124 = t9 * t111;
-            let t125 = t7 * t112;
-            let t126 = t7
-                * (T::mul_add(
-                    T::from_f64(0.0088923675),
-                    t76 - t49,
-                    T::mul_add(T::from_f64(0.056428040349375), t64, t99 + t100),
-                ));
-            let t127 = t7 * t115;
+            let t122 = T::mul_add(
+                -qd[0],
+                t1 * (T::mul_add(-T::from_f64(0.1197), t34, t86)),
+                t110,
+            );
+            let t123 = T::mul_add(-qd[0], t1 * t87, -qd[0] * t0 * t88)
+                + T::from_f64(0.13585)
+                    * (T::mul_add(qd[0], t0 * t26, -qd[0] * t1 * t27));
+            let t124 = T::mul_add(t3, t104, -t105);
+            let t125 = T::mul_add(-t9, t73, t8 * t107);
+            let t126 = T::mul_add(t8, t73, t9 * t107);
+            let t127 = T::mul_add(T::from_f64(0.0541236222345), t52, -t117);
             (
                 t64,
                 t65,
@@ -6460,255 +5307,196 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
             t190,
             t191,
         ) = {
-            let t128 = t6 * t120;
-            let t129 = T::mul_add(
-                t3,
-                T::mul_add(t3, t80, t96),
-                T::mul_add(
-                    t2,
-                    T::mul_add(-t2, t81, t97),
-                    T::from_f64(0.054004433300999945),
-                ),
+            let t128 = T::mul_add(
+                -T::from_f64(0.1308417),
+                t49,
+                T::mul_add(-t96, t29, -t97 * t28),
             );
+            let t129 = t122 + -T::from_f64(0.13585) * (T::mul_add(qd[0], t1 * t34, t40));
             let t130 = T::mul_add(
-                t3,
+                T::from_f64(0.017784735),
                 t109,
-                T::mul_add(
-                    -t2,
-                    t108,
-                    T::mul_add(
-                        -T::from_f64(0.425),
-                        t30,
-                        T::from_f64(0.007558512375) * t16,
-                    ),
-                ),
+                T::mul_add(T::from_f64(0.12852979831314998), t52, -t117 - t119),
             );
-            let t131 = T::mul_add(
-                T::from_f64(2.0),
-                t88,
-                T::from_f64(0.1893) * (t123 - t124),
-            );
-            let t132 = T::from_f64(0.1893) * (t123 - t124);
-            let t133 = T::mul_add(T::from_f64(0.6095), t75 + t48, -t121 - t122);
+            let t131 = T::mul_add(T::from_f64(0.10971), t52, t119 - t117);
+            let t132 = t9 * t126;
+            let t133 = t8 * t125;
             let t134 = T::mul_add(
-                -T::from_f64(0.09465),
-                t121 + t122,
-                T::mul_add(T::from_f64(0.0541236222345), t65, t89 - t90),
+                T::from_f64(0.1308417),
+                t48,
+                T::mul_add(t97, t29, t104 * t28),
             );
-            let t135 = T::mul_add(
-                T::from_f64(1.219),
-                t54 + t55,
-                T::mul_add(T::from_f64(0.056683500000000005), t44, t123 - t124),
-            );
+            let t135 = t118
+                - (T::mul_add(
+                    -T::from_f64(1.4069),
+                    t109,
+                    -T::from_f64(0.017784735) * t52,
+                ) - t118);
             let t136 = T::mul_add(
-                T::from_f64(2.0),
-                t124 - t123,
-                T::mul_add(
-                    T::from_f64(0.18789999999999996),
-                    t54 + t55,
-                    T::from_f64(0.017474700000000003) * t44,
-                ),
+                t3,
+                T::mul_add(t3, t96, t105),
+                t2 * (T::mul_add(t2, t104, t106)),
             );
-            let t137 = T::mul_add(
-                -T::from_f64(2.0),
-                t121 + t122,
+            let t137 = -T::from_f64(0.09395) * (t132 + t133);
+            let t138 = T::from_f64(0.09395) * (T::mul_add(-t9, t125, t8 * t126));
+            let t139 = T::from_f64(0.09395) * (t132 + t133);
+            let t140 = T::mul_add(
+                -t0,
+                T::mul_add(-t3, t112, t2 * t111),
+                t1 * (T::mul_add(t2, t112, t3 * t111)),
+            );
+            let t141 = T::mul_add(
+                -t0,
+                T::mul_add(-t3, t114, t2 * t113),
+                t1 * (T::mul_add(t2, t114, t3 * t113)),
+            );
+            let t142 = T::mul_add(
+                -T::from_f64(0.85),
+                t34,
+                T::mul_add(-t2, t116, t3 * t124) + T::from_f64(0.9241220958009998),
+            );
+            let t143 = T::mul_add(
+                T::from_f64(0.425),
+                t33,
+                -(T::mul_add(-t3, t116, -t2 * t124)),
+            );
+            let t144 = T::mul_add(
+                T::from_f64(0.016685526854599998),
+                t70,
+                T::from_f64(0.1893) * t138,
+            );
+            let t145 = T::mul_add(
+                T::from_f64(0.09465),
+                t139,
+                T::from_f64(0.008342763427299999)
+                    * (T::mul_add(t9, t9 * t61, -t8 * t8 * t61)),
+            );
+            let t146 = T::mul_add(T::from_f64(0.6095), t99, t137);
+            let t147 = T::mul_add(T::from_f64(0.6095), t73, t138);
+            let t148 = T::mul_add(
+                -T::from_f64(0.09465),
+                t139,
+                T::from_f64(0.0085682365727) * t61,
+            );
+            let t149 = T::mul_add(
+                T::from_f64(2.0),
+                t137,
                 T::mul_add(
                     -T::from_f64(0.18789999999999996),
-                    t75 + t48,
-                    T::from_f64(0.017784735) * t65,
+                    t99,
+                    T::from_f64(0.017784735) * t60,
                 ),
             );
-            let t138 = T::mul_add(
-                t27,
-                t65,
-                T::mul_add(
-                    -T::from_f64(0.1893),
-                    t121 + t122,
-                    T::mul_add(
-                        -T::from_f64(0.017784735),
-                        t75 + t48,
-                        T::mul_add(
-                            -T::from_f64(0.01003099210370001),
-                            t65,
-                            T::mul_add(T::from_f64(0.0085682365727), qd[5], t89 - t90),
-                        ),
-                    ),
-                ),
+            let t150 = T::mul_add(-T::from_f64(0.0541236222345), t60, t145);
+            let t151 = T::mul_add(-T::from_f64(0.0555863777655), t60, t148);
+            let t152 = T::mul_add(T::from_f64(0.0541236222345), t60, -t145);
+            let t153 = T::mul_add(
+                T::from_f64(0.1893),
+                t6 * t138,
+                T::from_f64(0.008342763427299999) * t80,
             );
-            let t139 = T::mul_add(t6, t115, t7 * t107);
-            let t140 = T::mul_add(
-                -qd[0],
-                t1 * (T::mul_add(-t3, t43, t2 * t42)),
-                T::mul_add(-qd[0], t0 * (T::mul_add(t2, t43, t3 * t42)), t116 - t127),
-            );
-            let t141 = -t6 * t119;
-            let t142 = T::mul_add(t5, t117, t4 * t7 * t119);
-            let t143 = T::mul_add(-t4, t117, t5 * t7 * t119);
-            let t144 = T::mul_add(t5, t118, t4 * t7 * t120);
-            let t145 = T::mul_add(-t4, t118, t5 * t7 * t120);
-            let t146 = T::mul_add(
-                qd[0],
-                t1
-                    * (T::from_f64(0.0171364731454)
-                        * (T::mul_add(-t3, t5 * t6, t2 * t4 * t6))),
-                T::mul_add(
-                    qd[0],
-                    t0
-                        * (T::from_f64(0.0171364731454)
-                            * (T::mul_add(t2, t5 * t6, t3 * t4 * t6))),
-                    -t128,
-                ),
-            );
-            let t147 = t7 * t133;
-            let t148 = t6 * t133;
-            let t149 = t6 * t134;
-            let t150 = t6
-                * (T::mul_add(
-                    -T::from_f64(0.09465),
-                    t121 + t122,
-                    T::mul_add(
-                        -T::from_f64(0.06415461433820001),
-                        t65,
-                        T::from_f64(0.0085682365727) * qd[5],
-                    ),
-                ));
-            let t151 = t5 * t135;
-            let t152 = t4 * t135;
-            let t153 = t7 * t137;
-            let t154 = t4 * t6 * t137;
-            let t155 = T::mul_add(t7, t131, t105);
-            let t156 = T::mul_add(t6, t132, t106);
-            let t157 = T::mul_add(
-                t6,
-                t112,
-                T::mul_add(-t7, t134, T::from_f64(0.0541236222345) * t10),
-            );
-            let t158 = T::mul_add(
-                T::from_f64(0.093),
-                t123 - t124,
-                T::mul_add(
-                    T::from_f64(0.056683500000000005),
-                    t54 + t55,
-                    T::mul_add(T::from_f64(0.0608579432655), t44, t126 - t150),
-                ),
-            );
-            let t159 = T::mul_add(
-                -T::from_f64(0.093),
-                t147 + t103,
-                T::mul_add(
-                    -T::from_f64(0.21942),
-                    t45,
-                    T::mul_add(T::from_f64(0.10971), qd[4], t102 - t101),
-                ),
-            );
-            let t160 = T::mul_add(T::from_f64(0.6095), t52 - t53, -t147 - t103);
-            let t161 = T::mul_add(
-                T::from_f64(0.093),
-                t123 - t124,
-                T::mul_add(
-                    T::from_f64(0.056683500000000005),
-                    t54 + t55,
-                    T::mul_add(T::from_f64(0.0593951877345), t44, t149 + t125),
-                ),
-            );
-            let t162 = T::mul_add(
-                T::from_f64(0.186),
-                t104 - t148,
-                T::from_f64(2.0) * t88,
-            );
-            let t163 = T::mul_add(
+            let t154 = T::mul_add(T::from_f64(0.6095), t69, t147);
+            let t155 = T::mul_add(
                 -T::from_f64(2.0),
-                t147 + t103,
+                t147,
                 T::mul_add(
                     T::from_f64(1.4068999999999998),
-                    t53 - t52,
-                    T::from_f64(0.1308417) * t45,
+                    t69,
+                    T::from_f64(0.1308417) * t38,
                 ),
             );
-            let t164 = T::mul_add(
-                T::from_f64(0.001462755531000004),
-                t44,
-                t126 - t149 - t125 - t150,
+            let t156 = T::mul_add(t6, t120, t7 * t146);
+            let t157 = T::mul_add(-t7, t120, t6 * t146);
+            let t158 = T::mul_add(T::from_f64(0.008342763427299999), t79, t7 * t144);
+            let t159 = T::mul_add(
+                -qd[0],
+                t1 * (t136 + T::from_f64(0.054004433300999945)),
+                -qd[0] * t0 * t143,
             );
-            let t165 = T::mul_add(
-                -T::from_f64(0.016685526854599998),
-                t60,
+            let t160 = t150 + T::mul_add(-t30, t60, T::from_f64(0.017784735) * t99);
+            let t161 = t150 + t151;
+            let t162 = T::mul_add(-t7, t149, t6 * t135);
+            let t163 = T::mul_add(t6, t149, t7 * t135);
+            let t164 = T::mul_add(-T::from_f64(0.6095), t74, t156);
+            let t165 = T::mul_add(T::from_f64(0.6095), t37, t157);
+            let t166 = T::mul_add(
+                t6,
+                T::mul_add(T::from_f64(0.0555863777655), t60, -t148),
+                t7 * (T::mul_add(T::from_f64(0.0555863777655), t52, t119)),
+            );
+            let t167 = T::mul_add(
+                -T::from_f64(0.093),
+                t156,
                 T::mul_add(
-                    -t29,
-                    t44,
+                    T::from_f64(0.10971),
+                    t47,
                     T::mul_add(
-                        T::from_f64(0.186),
-                        t123 - t124,
-                        T::mul_add(
-                            -T::from_f64(0.017474700000000003),
-                            t54 + t55,
-                            T::mul_add(
-                                T::from_f64(0.120253131),
-                                t44,
-                                t149 + t125 + t126 - t150,
-                            ),
-                        ),
+                        T::from_f64(0.016911),
+                        t78,
+                        -T::from_f64(0.0085682365727) * t75,
                     ),
                 ),
             );
-            let t166 = T::mul_add(-t7, t114, -t6 * t138);
-            let t167 = T::mul_add(-t6, t114, t7 * t138);
-            let t168 = T::mul_add(
+            let t168 = T::mul_add(T::from_f64(0.6095), t74, -t156);
+            let t169 = T::mul_add(
+                -T::from_f64(0.186),
+                t157,
+                T::from_f64(0.016685526854599998) * t70,
+            );
+            let t170 = T::mul_add(
+                qd[0],
+                t1 * t143,
+                qd[0] * t0 * (t142 + T::from_f64(0.8849018759100001)),
+            );
+            let t171 = t151 - t160;
+            let t172 = T::mul_add(T::from_f64(0.093), t163, t83);
+            let t173 = T::mul_add(-t7, t153, t6 * t158);
+            let t174 = T::mul_add(
+                -t7,
+                T::mul_add(
+                    -T::from_f64(0.1893),
+                    t7 * t138,
+                    T::from_f64(0.008342763427299999) * t79,
+                ),
+                -t6 * (T::mul_add(-t6, t144, T::from_f64(0.008342763427299999) * t80)),
+            );
+            let t175 = T::mul_add(
                 -T::from_f64(0.093),
-                t6 * t137,
-                T::mul_add(
-                    T::from_f64(0.016685526854599998),
-                    t79,
-                    T::from_f64(2.0) * t88,
-                ),
+                t147,
+                T::mul_add(-t7, t127, -t6 * t152),
             );
-            let t169 = T::mul_add(T::from_f64(2.0), t5 * t8 * t9 * t77, t4 * t139);
-            let t170 = T::mul_add(-T::from_f64(2.0), t4 * t8 * t9 * t77, t5 * t139);
-            let t171 = T::mul_add(t2, t5 * t6 * t137, t3 * t4 * t6 * t137);
-            let t172 = T::mul_add(-t3, t5 * t6 * t137, t2 * t4 * t6 * t137);
-            let t173 = t6 * t155;
-            let t174 = t7 * t156;
-            let t175 = t6 * (T::mul_add(-t6, t131, t106));
-            let t176 = t7 * (T::mul_add(-t7, t132, t105));
-            let t177 = t4 * t160;
-            let t178 = t5 * t160;
-            let t179 = t5 * t157;
-            let t180 = t4 * t157;
-            let t181 = t4 * t161;
-            let t182 = t4 * t158;
-            let t183 = t5 * t159;
-            let t184 = t5 * t158;
-            let t185 = t4 * t159;
-            let t186 = T::mul_add(
-                t6,
-                t156,
-                T::mul_add(t7, t155, T::from_f64(0.186) * (t148 - t104)),
+            let t176 = T::mul_add(
+                T::from_f64(0.0541236222345),
+                t22,
+                T::mul_add(t6, t127, -t7 * t152),
             );
-            let t187 = T::mul_add(T::from_f64(0.093), t147 + t103, t174 - t173);
-            let t188 = T::mul_add(t5, t162, t180);
-            let t189 = T::mul_add(
-                T::from_f64(1.1375),
-                t36,
-                T::mul_add(
-                    T::from_f64(0.018370624999999998),
-                    t24,
-                    T::mul_add(T::from_f64(0.284375), qd[1] + qd[2], t177 + t151),
-                ),
+            let t177 = T::mul_add(-T::from_f64(0.10971), t46, t167);
+            let t178 = T::mul_add(
+                T::from_f64(0.284375),
+                t29,
+                T::from_f64(0.48343749999999996) * t18,
+            ) + t165;
+            let t179 = T::mul_add(T::from_f64(0.10971), t46, -t167);
+            let t180 = T::mul_add(t6, t131, t7 * t161);
+            let t181 = T::mul_add(-t7, t131, t6 * t161);
+            let t182 = T::mul_add(t2, t5 * t163, t3 * t4 * t163);
+            let t183 = T::mul_add(-t3, t5 * t163, t2 * t4 * t163);
+            let t184 = T::mul_add(
+                T::from_f64(0.186),
+                t157,
+                T::mul_add(t6, t153, t7 * t158),
             );
-            let t190 = T::mul_add(
-                -T::from_f64(1.1375),
-                t37,
-                T::mul_add(T::from_f64(0.018370624999999998), t22, t152 - t178),
+            let t185 = T::mul_add(-T::from_f64(0.093), t156, t173);
+            let t186 = T::mul_add(-T::from_f64(0.0541236222345), t38, t175);
+            let t187 = T::mul_add(
+                T::from_f64(0.0555863777655),
+                t38,
+                T::mul_add(T::from_f64(0.093), t147, t166),
             );
-            let t191 = T::mul_add(
-                T::from_f64(0.39225),
-                t148 - t104,
-                T::mul_add(
-                    T::from_f64(0.18959311487174998),
-                    t33,
-                    T::mul_add(T::from_f64(0.222466834375), t20, t182 - t183),
-                ),
-            );
+            let t188 = T::mul_add(t5, t154, t4 * t168);
+            let t189 = T::mul_add(-t4, t154, t5 * t168);
+            let t190 = T::mul_add(T::from_f64(0.093), t156, -t173);
+            let t191 = t5 * t176;
             (
                 t128,
                 t129,
@@ -6839,586 +5627,166 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
             t251,
             t252,
             t253,
+            t254,
+            t255,
         ) = {
-            let t192 = T::mul_add(T::from_f64(0.0020475), t32, t184 + t185);
-            let t193 = T::mul_add(
-                T::from_f64(2.0),
-                t178 - t152,
-                T::mul_add(
-                    -T::from_f64(2.6258999999999997),
-                    t37,
-                    T::mul_add(
-                        -T::from_f64(0.1308417),
-                        t23,
-                        T::from_f64(0.173249985) * t22,
-                    ),
-                ),
-            );
-            let t194 = T::mul_add(
-                T::from_f64(2.0),
-                t177 + t151,
-                T::mul_add(
-                    -T::from_f64(2.6258999999999997),
-                    t36,
-                    T::mul_add(
-                        -T::from_f64(0.1308417),
-                        t25,
-                        T::mul_add(
-                            -T::from_f64(0.173249985),
-                            t24,
-                            T::from_f64(0.56875) * (qd[1] + qd[2]),
-                        ),
-                    ),
-                ),
-            );
-            let t195 = T::mul_add(
-                -T::from_f64(0.13585),
-                T::mul_add(
-                    qd[0],
-                    t1 * (T::mul_add(T::from_f64(0.017784735), t12, t31)),
-                    t50,
-                ),
-                T::mul_add(
-                    T::from_f64(0.7845),
-                    t178 - t152,
-                    T::mul_add(
-                        qd[0],
-                        t1
-                            * (T::mul_add(
-                                T::from_f64(0.1197),
-                                t31,
-                                T::mul_add(T::from_f64(0.0021288327795), t12, t72 - t83),
-                            )),
-                        T::mul_add(
-                            T::from_f64(0.56875),
-                            t37,
-                            T::mul_add(
-                                -T::from_f64(0.009185312499999999),
-                                t22,
-                                t113 - t175 - t176,
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t196 = T::mul_add(
-                T::from_f64(0.016685526854599998),
-                t7 * t8 * t9 * t44,
-                T::mul_add(
-                    -T::from_f64(0.186),
-                    t147 + t103,
-                    T::mul_add(
-                        t39,
-                        t45,
-                        T::mul_add(
-                            T::from_f64(0.1308417),
-                            t53 - t52,
-                            T::mul_add(
-                                -T::from_f64(0.21942),
-                                t45,
-                                T::mul_add(
-                                    T::from_f64(0.10971),
-                                    qd[4],
-                                    t102 + t173 - t101 - t174,
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t197 = T::mul_add(t5, t163, t4 * t136);
-            let t198 = T::mul_add(-t4, t163, t5 * t136);
-            let t199 = T::mul_add(
-                -T::from_f64(0.21942),
-                t45,
-                T::mul_add(T::from_f64(0.10971), qd[4], t102 + t174 - t101 - t173),
-            );
-            let t200 = T::mul_add(
-                T::from_f64(0.13585),
-                T::mul_add(
-                    qd[0],
-                    t0 * (T::from_f64(0.017784735) * (t11 - t16)),
-                    -qd[0] * t1 * (T::from_f64(0.017784735) * (t12 + t15)),
-                ),
-                T::mul_add(
-                    qd[0],
-                    t1
-                        * (T::mul_add(
-                            -t3,
-                            t62,
-                            T::mul_add(T::from_f64(0.0021288327795), t12 + t15, t72),
-                        )),
-                    T::mul_add(
-                        -qd[0],
-                        t0
-                            * (T::mul_add(
-                                -t2,
-                                t62,
-                                T::mul_add(T::from_f64(0.0021288327795), t11 - t16, -t71),
-                            )),
-                        -t175 - t176,
-                    ),
-                ),
-            );
-            let t201 = T::mul_add(t4, t168, t5 * t167);
-            let t202 = T::mul_add(
-                t5,
-                t168,
-                T::mul_add(-t4, t167, T::from_f64(0.39225) * t153),
-            );
+            let t192 = T::mul_add(T::from_f64(0.0541236222345), t38, -t175);
+            let t193 = t4 * t176;
+            let t194 = t174 + t81;
+            let t195 = t164
+                - (T::mul_add(-T::from_f64(2.6259), t74, T::from_f64(0.1308417) * t46)
+                    - t164);
+            let t196 = T::mul_add(-t7, t130, -t6 * t171);
+            let t197 = T::mul_add(-t6, t130, t7 * t171);
+            let t198 = t181
+                + T::mul_add(t31, t38, T::from_f64(0.016685526854599998) * t57);
+            let t199 = t181 + T::mul_add(t45, t29, -t44 * t28);
+            let t200 = T::mul_add(t5, t169, t193);
+            let t201 = T::mul_add(T::from_f64(1.1375), t48, T::from_f64(0.284375) * t10)
+                + t188;
+            let t202 = T::mul_add(T::from_f64(1.1375), t49, -t189);
             let t203 = T::mul_add(
-                t0,
-                T::mul_add(-t3, t143, t2 * t142),
-                -t1 * (T::mul_add(t2, t143, t3 * t142)),
-            );
-            let t204 = T::mul_add(
-                t0,
-                T::mul_add(-t3, t145, t2 * t144),
-                -t1 * (T::mul_add(t2, t145, t3 * t144)),
-            );
-            let t205 = t5 * t187;
-            let t206 = t3 * t189;
-            let t207 = t2 * t190;
-            let t208 = t2 * t189;
-            let t209 = t3 * t190;
-            let t210 = t3 * t191;
-            let t211 = t2 * t192;
-            let t212 = t2 * t191;
-            let t213 = t3 * t192;
-            let t214 = T::mul_add(-t5, t161, t4 * t187);
-            let t215 = T::mul_add(t4, t186, -t179);
-            let t216 = T::mul_add(
-                T::from_f64(0.39225),
-                t148 - t104,
+                T::from_f64(2.0),
+                t189,
                 T::mul_add(
-                    T::from_f64(0.18754561487174998),
-                    t33,
-                    T::mul_add(T::from_f64(0.222466834375), t20, -t205 - t181),
+                    T::from_f64(2.6258999999999997),
+                    t49,
+                    T::from_f64(0.1308417) * t29,
                 ),
             );
-            let t217 = T::mul_add(
-                -T::from_f64(0.13585),
-                T::mul_add(
-                    qd[0],
-                    t1
-                        * (T::mul_add(
-                            T::from_f64(0.017784735),
-                            t12,
-                            t31 - T::from_f64(4.4329225),
-                        )),
-                    t50,
-                ),
-                T::mul_add(
-                    -T::from_f64(0.85),
-                    t208 + t209,
-                    T::mul_add(
-                        T::from_f64(0.7845),
-                        t178 - t152,
-                        T::mul_add(
-                            qd[0],
-                            t1
-                                * (T::mul_add(
-                                    T::from_f64(0.1197),
-                                    t31,
-                                    T::mul_add(
-                                        T::from_f64(0.0021288327795),
-                                        t12,
-                                        t72 - t83 - T::from_f64(0.19371331275000003),
-                                    ),
-                                )),
-                            T::mul_add(
-                                T::from_f64(0.56875),
-                                t37,
-                                T::mul_add(
-                                    -T::from_f64(0.009185312499999999),
-                                    t22,
-                                    T::mul_add(
-                                        -T::from_f64(0.31925293400000004),
-                                        t20,
-                                        t113 - t175 - t176,
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
+            let t204 = t185 - t177;
+            let t205 = t186 + t187;
+            let t206 = T::mul_add(T::from_f64(0.39225), t4 * t163, t196);
+            let t207 = T::mul_add(
+                T::from_f64(0.016685526854599998),
+                t5 * t8 * t9 * t61,
+                t4 * t180,
             );
+            let t208 = T::mul_add(
+                -T::from_f64(0.016685526854599998),
+                t4 * t8 * t9 * t61,
+                t5 * t180,
+            );
+            let t209 = T::mul_add(-t5, t192, t4 * t190);
+            let t210 = T::mul_add(t4, t184, -t191);
+            let t211 = T::mul_add(
+                -T::from_f64(0.56875),
+                t49,
+                T::mul_add(T::from_f64(0.7845), t189, t174),
+            );
+            let t212 = T::mul_add(t4, t179, -t5 * t187);
+            let t213 = t177 + t185 + t89;
+            let t214 = t187 - (t186 + t82);
+            let t215 = T::mul_add(-t5, t195, t4 * t155);
+            let t216 = T::mul_add(t4, t195, t5 * t155);
+            let t217 = T::mul_add(-t4, t172, t5 * t197);
             let t218 = T::mul_add(
-                t80,
-                t33,
-                T::mul_add(
-                    t82,
-                    t32,
-                    T::mul_add(
-                        -T::from_f64(0.1308417),
-                        t37,
-                        T::mul_add(
-                            T::from_f64(0.0020475000000000076),
-                            t23,
-                            T::mul_add(
-                                T::from_f64(0.00006559345499998481),
-                                t22,
-                                t183 - t205 - t181 - t182,
-                            ),
-                        ),
-                    ),
-                ),
-            );
-            let t219 = T::mul_add(-t2, t194, t3 * t193);
-            let t220 = T::mul_add(t3, t194, t2 * t193);
-            let t221 = T::mul_add(
-                T::from_f64(0.7845),
-                t148 - t104,
-                T::mul_add(
-                    T::from_f64(0.37713872974349993),
-                    t33,
-                    T::mul_add(
-                        T::from_f64(0.44493366875),
-                        t20,
-                        t182 - t205 - t181 - t183,
-                    ),
-                ),
-            );
-            let t222 = T::mul_add(
-                -t5,
+                -T::from_f64(0.39225),
                 t165,
-                T::mul_add(-t4, t196, T::from_f64(0.00697606230375) * t45),
+                T::mul_add(t4, t192, t5 * t190),
             );
-            let t223 = T::mul_add(t5, t164, t4 * t199);
-            let t224 = T::mul_add(-t4, t164, t5 * t199);
-            let t225 = T::mul_add(-t4, t165, t5 * t196);
-            let t226 = T::mul_add(t2, t198, t3 * t197);
-            let t227 = T::mul_add(-t3, t198, t2 * t197);
-            let t228 = T::mul_add(
-                -t0,
-                T::mul_add(-t3, t170, t2 * t169),
-                t1 * (T::mul_add(t2, t170, t3 * t169)),
+            let t219 = T::mul_add(
+                -T::from_f64(0.39225),
+                t165,
+                T::mul_add(-t5, t179, -t4 * t187),
             );
-            let t229 = t3 * t214;
-            let t230 = t2 * t216;
-            let t231 = t2 * t214;
-            let t232 = t3 * t216;
-            let t233 = T::mul_add(
-                t82,
-                t33,
-                T::mul_add(
-                    -t81,
-                    t32,
-                    T::mul_add(
-                        T::from_f64(0.1308417),
-                        t36,
-                        T::mul_add(
-                            -T::from_f64(0.0020475),
-                            t25,
-                            T::mul_add(
-                                T::from_f64(0.00006559345499999999),
-                                t24,
-                                t214 - t184 - t185,
-                            ),
-                        ),
-                    ),
-                ),
+            let t220 = T::mul_add(-T::from_f64(0.0020475), t28, t212);
+            let t221 = T::mul_add(-t2, t202, t3 * t201);
+            let t222 = T::mul_add(-t3, t202, -t2 * t201);
+            let t223 = T::mul_add(T::from_f64(0.0020475), t28, -t212);
+            let t224 = t211 + t101;
+            let t225 = t201
+                - (T::mul_add(T::from_f64(4.9009), t48, T::from_f64(0.1308417) * t28)
+                    - t201);
+            let t226 = T::mul_add(T::from_f64(0.39225), t215, t194);
+            let t227 = T::mul_add(-t5, t205, t4 * t204);
+            let t228 = T::mul_add(t4, t205, t5 * t204);
+            let t229 = T::mul_add(
+                T::from_f64(0.39225),
+                t162,
+                T::mul_add(t5, t172, t4 * t197),
             );
-            let t234 = T::mul_add(T::from_f64(0.0020475), t32, t214 + t184 + t185);
-            let t235 = T::mul_add(
+            let t230 = T::mul_add(
                 t4,
-                T::mul_add(-t4, t162, t179),
-                t5 * (T::mul_add(t5, t186, t180)),
+                T::mul_add(-t4, t169, t191),
+                t5 * (T::mul_add(t5, t184, t193)),
             );
-            let t236 = T::mul_add(
-                t5,
+            let t231 = T::mul_add(
+                -T::from_f64(0.093767906778),
+                t29,
+                -T::from_f64(0.12085937499999999) * t18,
+            ) + t218;
+            let t232 = T::mul_add(
+                -T::from_f64(0.09581540677799999),
+                t29,
+                -T::from_f64(0.12085937499999999) * t18,
+            ) + t219;
+            let t233 = -t222;
+            let t234 = T::mul_add(
+                T::from_f64(0.570094525),
+                t19,
+                T::from_f64(1.1750200000000002) * qd[1],
+            ) + t221;
+            let t235 = t220 + t209 + t134;
+            let t236 = t209 - t220;
+            let t237 = T::mul_add(-t4, t214, t5 * t213);
+            let t238 = T::mul_add(t2, t216, t3 * t215);
+            let t239 = T::mul_add(-t3, t216, t2 * t215);
+            let t240 = T::mul_add(
+                T::from_f64(0.7845),
+                t189,
+                T::mul_add(-t5, t200, t4 * t210),
+            );
+            let t241 = T::mul_add(
+                -T::from_f64(0.39225),
                 t188,
-                T::mul_add(
-                    -t4,
-                    t215,
-                    T::mul_add(
-                        T::from_f64(0.7845),
-                        t152 - t178,
-                        T::mul_add(
-                            -T::from_f64(0.56875),
-                            t37,
-                            T::from_f64(0.009185312499999999) * t22,
-                        ),
-                    ),
-                ),
+                T::mul_add(t4, t200, t5 * t210),
             );
-            let t237 = T::mul_add(
-                -t4,
-                t188,
-                T::mul_add(
-                    -t5,
-                    t215,
-                    T::mul_add(
-                        T::from_f64(0.39225),
-                        t177 + t151,
-                        T::mul_add(
-                            T::from_f64(0.284375),
-                            t36,
-                            T::mul_add(
-                                T::from_f64(0.0045926562499999995),
-                                t24,
-                                T::from_f64(0.093767906778) * (qd[1] + qd[2]),
-                            ),
-                        ),
-                    ),
-                ),
+            let t242 = T::mul_add(
+                -T::from_f64(0.425),
+                t233,
+                -T::from_f64(0.1197) * t178,
             );
-            let t238 = T::mul_add(
-                -qd[0],
-                t1 * t130,
-                T::mul_add(
-                    qd[0],
-                    t0
-                        * (T::mul_add(
-                            t2,
-                            t109,
-                            T::mul_add(
-                                t3,
-                                t108,
-                                T::mul_add(
-                                    T::from_f64(0.85),
-                                    t31,
-                                    T::mul_add(
-                                        T::from_f64(0.01511702475),
-                                        t12,
-                                        -T::from_f64(1.809023971711),
-                                    ),
-                                ),
-                            ),
-                        )),
-                    T::mul_add(
-                        T::from_f64(0.2394),
-                        t207 - t206,
-                        T::mul_add(
-                            T::from_f64(0.06947359067549999),
-                            t21,
-                            t230 + t213 - t229 - t212,
-                        ),
-                    ),
-                ),
-            );
-            let t239 = T::mul_add(
-                -t0,
-                T::mul_add(t3, t201, T::mul_add(t2, t202, T::from_f64(0.1197) * t171)),
-                T::mul_add(
-                    t1,
-                    T::mul_add(
-                        -t2,
-                        t201,
-                        T::mul_add(
-                            t3,
-                            t202,
-                            T::mul_add(
-                                -T::from_f64(0.1197),
-                                t172,
-                                T::from_f64(0.425) * t153,
-                            ),
-                        ),
-                    ),
-                    T::from_f64(0.13585) * (T::mul_add(t1, t172, t0 * t171)),
-                ),
-            );
-            let t240 = t2 * t237;
-            let t241 = t3 * t237;
-            let t242 = T::mul_add(t3, t236, t240);
-            let t243 = T::mul_add(-t2, t235, t241);
-            let t244 = T::mul_add(
-                -t0,
-                T::mul_add(
-                    -qd[0],
-                    t1 * t129,
-                    T::mul_add(
-                        -qd[0],
-                        t0 * t130,
-                        T::mul_add(
-                            -T::from_f64(0.2394),
-                            t208 + t209,
-                            T::mul_add(
-                                T::from_f64(0.06947359067549996),
-                                t20,
-                                t210 + t211 - t231 - t232,
-                            ),
-                        ),
-                    ),
-                ),
-                T::mul_add(
-                    t1,
-                    t238,
-                    T::from_f64(0.13585)
-                        * (T::mul_add(
-                            t1,
-                            T::mul_add(
-                                T::from_f64(2.0),
-                                t206 - t207,
-                                T::mul_add(
-                                    -T::from_f64(0.20999123500000016),
-                                    t21,
-                                    T::from_f64(2.3500400000000004) * qd[1],
-                                ),
-                            ),
-                            t0
-                                * (T::mul_add(
-                                    -T::from_f64(2.0),
-                                    t208 + t209,
-                                    T::from_f64(0.20999123500000016) * t20,
-                                )),
-                        )),
-                ),
-            );
-            let t245 = T::mul_add(
-                t0,
-                T::mul_add(
-                    T::from_f64(0.85),
-                    t148 - t104,
-                    T::mul_add(
-                        T::from_f64(0.44493366875),
-                        t33,
-                        T::mul_add(
-                            T::from_f64(1.5084519259100002),
-                            t20,
-                            t231 + t232 + t210 + t211,
-                        ),
-                    ),
-                ),
-                -t1
-                    * (T::mul_add(
-                        T::from_f64(0.0075537),
-                        t21,
-                        t229 + t213 - t230 - t212,
-                    )),
-            );
+            let t243 = t231 + t232;
+            let t244 = T::mul_add(-t2, t225, t3 * t203);
+            let t245 = T::mul_add(t3, t225, t2 * t203);
             let t246 = T::mul_add(
-                -t0,
-                T::mul_add(-t3, t225, T::mul_add(-t2, t222, T::from_f64(0.1197) * t226)),
-                T::mul_add(
-                    -t1,
-                    T::mul_add(
-                        -t2,
-                        t225,
-                        T::mul_add(
-                            t3,
-                            t222,
-                            T::mul_add(
-                                T::from_f64(0.1197),
-                                t227,
-                                T::from_f64(0.007558512375) * t45,
-                            ),
-                        ),
-                    ),
-                    T::from_f64(0.13585) * (T::mul_add(t1, t227, t0 * t226)),
-                ),
+                T::from_f64(0.00697606230375),
+                t46,
+                T::mul_add(-t5, t214, -t4 * t213),
             );
             let t247 = T::mul_add(
-                t0,
-                T::mul_add(-t3, t224, t2 * t223),
-                -t1 * (T::mul_add(t2, t224, t3 * t223)),
+                -t0,
+                T::mul_add(-t3, t208, t2 * t207),
+                t1 * (T::mul_add(t2, t208, t3 * t207)),
             );
             let t248 = T::mul_add(
-                -t0,
-                T::mul_add(-t3, t218, T::mul_add(-t2, t233, T::from_f64(0.1197) * t219)),
-                T::mul_add(
-                    -t1,
-                    T::mul_add(
-                        -t2,
-                        t218,
-                        T::mul_add(
-                            t3,
-                            t233,
-                            T::mul_add(
-                                T::from_f64(0.1197),
-                                t220,
-                                T::mul_add(
-                                    -T::from_f64(0.425),
-                                    t19 * t32,
-                                    T::from_f64(0.007558512375) * t35,
-                                ),
-                            ),
-                        ),
-                    ),
-                    T::from_f64(0.13585) * (T::mul_add(t1, t220, t0 * t219)),
-                ),
-            );
-            let t249 = T::mul_add(
-                t0,
-                T::mul_add(t3, t221, t2 * t234),
-                -t1 * (T::mul_add(-t2, t221, t3 * t234)),
-            );
-            let t250 = T::mul_add(
-                t3,
-                t243,
-                T::mul_add(
-                    -t2,
-                    t242,
-                    T::mul_add(
-                        T::from_f64(0.425),
-                        t206 - t207,
-                        T::mul_add(
-                            T::from_f64(0.15962646700000002),
-                            t21,
-                            T::from_f64(0.43489723795500007) * qd[1],
-                        ),
-                    ),
-                ),
-            );
-            let t251 = T::mul_add(
-                -t3,
-                T::mul_add(t3, t235, t240),
-                T::mul_add(
-                    -t2,
-                    T::mul_add(-t2, t236, t241),
-                    T::mul_add(
-                        T::from_f64(0.2394),
-                        t148 - t104,
-                        T::mul_add(
-                            T::from_f64(0.12531425917500003),
-                            t33,
-                            T::from_f64(0.177748515) * t20,
-                        ),
-                    ),
-                ),
-            );
+                -T::from_f64(0.284375),
+                t48,
+                -T::from_f64(0.093767906778) * t10,
+            ) + t241;
+            let t249 = T::mul_add(T::from_f64(0.56875), t49, -t240);
+            let t250 = t0
+                * (T::mul_add(
+                    T::from_f64(0.7800857600000002),
+                    t18,
+                    t222 + T::mul_add(-T::from_f64(0.570094525), t18, t222),
+                ));
+            let t251 = t232 - (t231 + t128);
             let t252 = T::mul_add(
-                t1,
-                T::mul_add(
-                    t2,
-                    t243,
-                    T::mul_add(
-                        t3,
-                        t242,
-                        T::mul_add(
-                            T::from_f64(0.85),
-                            t208 + t209,
-                            T::mul_add(
-                                T::from_f64(0.2394),
-                                t148 - t104,
-                                T::mul_add(
-                                    T::from_f64(0.12531425917500003),
-                                    t33,
-                                    T::from_f64(0.49700144900000004) * t20,
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-                t0 * t250,
+                T::from_f64(0.1197),
+                t245,
+                T::from_f64(0.425)
+                    * (T::mul_add(-t17, t28, T::from_f64(0.017784735) * t35)),
             );
-            let t253 = T::mul_add(
-                -t0,
-                T::mul_add(t0, t251, t1 * t250),
-                T::mul_add(
-                    -t1,
-                    t252,
-                    T::mul_add(
-                        T::from_f64(0.2717),
-                        t148 - t104,
-                        T::mul_add(
-                            T::from_f64(0.1422217385875),
-                            t33,
-                            T::from_f64(0.5209833915000001) * t20,
-                        ),
-                    ),
-                ),
+            let t253 = T::mul_add(t2, t217, t3 * t229)
+                + T::mul_add(T::from_f64(0.1197), t183, T::from_f64(0.425) * t162);
+            let t254 = T::mul_add(
+                T::from_f64(0.1197),
+                t182,
+                T::mul_add(t3, t217, -t2 * t229),
             );
+            let t255 = t2 * t248;
             (
                 t192,
                 t193,
@@ -7482,128 +5850,225 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
                 t251,
                 t252,
                 t253,
+                t254,
+                t255,
+            )
+        };
+        let (
+            t256,
+            t257,
+            t258,
+            t259,
+            t260,
+            t261,
+            t262,
+            t263,
+            t264,
+            t265,
+            t266,
+            t267,
+            t268,
+            t269,
+            t270,
+            t271,
+            t272,
+            t273,
+            t274,
+            t275,
+            t276,
+            t277,
+            t278,
+            t279,
+            t280,
+            t281,
+            t282,
+            t283,
+            t284,
+            t285,
+            t286,
+            t287,
+        ) = {
+            let t256 = t3 * t248;
+            let t257 = T::mul_add(
+                T::from_f64(0.1197),
+                t221,
+                T::mul_add(t2, t231, t3 * t209),
+            );
+            let t258 = T::mul_add(
+                -T::from_f64(0.1197),
+                t233,
+                T::mul_add(-T::from_f64(0.425), t178, T::mul_add(t3, t231, -t2 * t209)),
+            );
+            let t259 = T::mul_add(-t2, t223, t3 * t232)
+                + T::mul_add(T::from_f64(0.1197), t233, -T::from_f64(0.425) * t178);
+            let t260 = T::mul_add(
+                T::from_f64(0.1197),
+                t221,
+                T::mul_add(-t3, t223, -t2 * t232),
+            );
+            let t261 = t1
+                * (t234 - (T::mul_add(T::from_f64(1.3501802850000002), t19, -t234)));
+            let t262 = T::mul_add(
+                -t0,
+                T::mul_add(-t3, t228, t2 * t227),
+                t1 * (T::mul_add(t2, t228, t3 * t227)),
+            );
+            let t263 = T::mul_add(t2, t230, t256);
+            let t264 = T::mul_add(t3, t249, -t255);
+            let t265 = T::mul_add(-T::from_f64(0.44245093795500007), t18, t259);
+            let t266 = T::mul_add(-T::from_f64(0.0075537), t19, t260);
+            let t267 = T::mul_add(
+                -T::from_f64(0.31925293400000004),
+                t18,
+                T::mul_add(
+                    T::from_f64(2.0),
+                    t242,
+                    T::mul_add(T::from_f64(0.2394), t178, t211),
+                ),
+            ) + t121 + T::from_f64(0.13585) * (t50 - t40);
+            let t268 = T::mul_add(-t2, t237, t3 * t246)
+                + T::mul_add(
+                    T::from_f64(0.1197),
+                    t239,
+                    T::from_f64(0.007558512375) * t46,
+                );
+            let t269 = T::mul_add(
+                T::from_f64(0.1197),
+                t238,
+                T::mul_add(-t3, t237, -t2 * t246),
+            );
+            let t270 = t266 + t257
+                + T::mul_add(-T::from_f64(0.061919890675499994), t19, t170);
+            let t271 = T::mul_add(-t2, t251, t3 * t235) + t252;
+            let t272 = T::mul_add(
+                T::from_f64(0.1197),
+                t244,
+                T::mul_add(-t3, t251, -t2 * t235),
+            );
+            let t273 = T::mul_add(
+                t0,
+                T::mul_add(-t3, t243, t2 * t236),
+                -t1 * (T::mul_add(t2, t243, t3 * t236)),
+            );
+            let t274 = T::mul_add(
+                T::from_f64(0.13585),
+                T::mul_add(t1, t183, t0 * t182),
+                T::mul_add(-t0, t254, -t1 * t253),
+            );
+            let t275 = T::mul_add(
+                -t3,
+                T::mul_add(-t3, t230, t255),
+                -t2 * (T::mul_add(t2, t249, t256)),
+            );
+            let t276 = t0
+                * (t265
+                    - (T::mul_add(-T::from_f64(0.37297734727950005), t18, t258 + t159)));
+            let t277 = t0
+                * (T::mul_add(-T::from_f64(0.43489723795500007), t18, t258) + t265);
+            let t278 = T::mul_add(
+                T::from_f64(2.0),
+                t242,
+                T::mul_add(t2, t263, -t3 * t264),
+            );
+            let t279 = T::mul_add(
+                -T::from_f64(0.425),
+                t221,
+                T::mul_add(t3, t263, t2 * t264),
+            );
+            let t280 = T::mul_add(-t1, t257 - t266, -t277);
+            let t281 = T::mul_add(
+                T::from_f64(0.13585),
+                T::mul_add(t1, t239, t0 * t238),
+                T::mul_add(-t0, t269, -t1 * t268),
+            );
+            let t282 = T::mul_add(
+                -T::from_f64(0.15962646700000002),
+                t19,
+                -T::from_f64(0.43489723795500007) * qd[1],
+            ) + t279;
+            let t283 = T::mul_add(
+                T::from_f64(0.13585),
+                t250 + t261,
+                T::mul_add(-t1, t270, t276),
+            );
+            let t284 = T::mul_add(
+                T::from_f64(0.13585),
+                T::mul_add(t1, t245, t0 * t244),
+                T::mul_add(-t0, t272, -t1 * t271),
+            );
+            let t285 = T::mul_add(
+                -t1,
+                T::mul_add(T::from_f64(0.31925293400000004), t18, -t278),
+                t0 * t282,
+            );
+            let t286 = T::mul_add(
+                t0,
+                T::mul_add(
+                    T::from_f64(2.0),
+                    t242,
+                    T::mul_add(T::from_f64(0.85), t233, t275),
+                ),
+                t1 * t282,
+            );
+            let t287 = T::mul_add(
+                T::from_f64(0.2717),
+                T::mul_add(T::from_f64(1.1750200000000002), t18, t178),
+                T::mul_add(t0, t286, t1 * t285),
+            );
+            (
+                t256,
+                t257,
+                t258,
+                t259,
+                t260,
+                t261,
+                t262,
+                t263,
+                t264,
+                t265,
+                t266,
+                t267,
+                t268,
+                t269,
+                t270,
+                t271,
+                t272,
+                t273,
+                t274,
+                t275,
+                t276,
+                t277,
+                t278,
+                t279,
+                t280,
+                t281,
+                t282,
+                t283,
+                t284,
+                t285,
+                t286,
+                t287,
             )
         };
         [
-            [t253, t244, t248, t246, t239, t203],
+            [t287, t283, t284, t281, t274, t140],
             [
-                t245,
-                t217,
-                T::mul_add(
-                    T::from_f64(0.425),
-                    t219,
-                    T::mul_add(
-                        -T::from_f64(0.017784735),
-                        t57,
-                        T::mul_add(
-                            T::from_f64(0.7845),
-                            t178 - t152,
-                            T::mul_add(
-                                T::from_f64(0.56875),
-                                t37,
-                                T::mul_add(
-                                    -T::from_f64(0.009185312499999999),
-                                    t22,
-                                    t78 - t175 - t176 - t92 - t56,
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-                T::mul_add(
-                    T::from_f64(0.425),
-                    t226,
-                    T::mul_add(
-                        T::from_f64(0.39225),
-                        t197,
-                        T::mul_add(
-                            -T::from_f64(0.017784735),
-                            t54 + t55,
-                            t59 - t175 - t176 - t58,
-                        ),
-                    ),
-                ),
-                T::mul_add(
-                    T::from_f64(0.425),
-                    t171,
-                    T::mul_add(T::from_f64(0.39225), t154, t166),
-                ),
+                t280,
+                t267,
+                T::mul_add(T::from_f64(0.425), t244, t224),
+                T::mul_add(T::from_f64(0.425), t238, t226),
+                T::mul_add(T::from_f64(0.425), t182, t206),
+                t102,
+            ],
+            [t273, t211 + t129, t224, t226, t206, t102],
+            [t262, t174 + t123, t174 + t90, t194, t196, t102],
+            [t247, t181 + t84, t199, t198, t83, t92],
+            [
                 t141,
-            ],
-            [
-                t249,
-                t195,
-                T::mul_add(
-                    -T::from_f64(0.017784735),
-                    t57,
-                    T::mul_add(
-                        T::from_f64(0.7845),
-                        t178 - t152,
-                        T::mul_add(
-                            T::from_f64(0.56875),
-                            t37,
-                            T::mul_add(
-                                -T::from_f64(0.009185312499999999),
-                                t22,
-                                t78 - t175 - t176 - t92 - t56,
-                            ),
-                        ),
-                    ),
-                ),
-                T::mul_add(
-                    T::from_f64(0.39225),
-                    t197,
-                    T::mul_add(
-                        -T::from_f64(0.017784735),
-                        t54 + t55,
-                        t59 - t175 - t176 - t58,
-                    ),
-                ),
-                T::mul_add(T::from_f64(0.39225), t154, t166),
-                t141,
-            ],
-            [
-                t247,
-                t200,
-                T::mul_add(
-                    -t62,
-                    t33,
-                    T::mul_add(-T::from_f64(0.017784735), t55 + t57, t78 - t175 - t176),
-                ),
-                T::mul_add(
-                    -T::from_f64(0.017784735),
-                    t54 + t55,
-                    t59 - t175 - t176 - t58,
-                ),
-                t166,
-                t141,
-            ],
-            [
-                t228,
-                t140,
-                T::mul_add(t43, t33, T::mul_add(-t42, t32, t116 - t127)),
-                T::mul_add(
-                    t26,
-                    t44,
-                    T::mul_add(T::from_f64(0.016685526854599998), t60, t116 - t127),
-                ),
-                T::mul_add(
-                    -T::from_f64(0.016685526854599998),
-                    t79,
-                    -T::from_f64(2.0) * t88,
-                ),
-                t117,
-            ],
-            [
-                t204,
-                t146,
-                T::mul_add(
-                    T::from_f64(0.0171364731454),
-                    T::mul_add(-t5, t6 * t33, t4 * t6 * t32),
-                    -t128,
-                ),
-                T::mul_add(-T::from_f64(0.0171364731454), t6 * t45, -t128),
-                T::mul_add(-T::from_f64(0.0171364731454), t64, t118),
+                t103 + t41,
+                t115,
+                T::mul_add(-T::from_f64(0.0171364731454), t6 * t46, t103),
+                T::mul_add(-T::from_f64(0.0171364731454), t52, t94),
                 T::zero(),
             ],
         ]
@@ -7611,7 +6076,7 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
     /// Inverse dynamics: tau = M(q) qdd + b(q, qd) + G(q).
     ///
     /// Route: Newton-Euler.
-    /// Operations: 260 mul, 223 add, 0 div, 5 sin, 5 cos.
+    /// Operations: 224 mul, 160 add, 0 div, 5 sin, 5 cos.
     fn inverse_dynamics(&self, q: &[T; 6], qd: &[T; 6], qdd: &[T; 6]) -> [T; 6] {
         let ([s1, s2, s3, s4, s5], [c1, c2, c3, c4, c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
             q[1],
@@ -7698,82 +6163,82 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
             let t9 = c5;
             let t10 = qd[0] * qd[0];
             let t11 = qd[1] + qd[2];
-            let t12 = qdd[1] + qdd[2] + qdd[3];
+            let t12 = qdd[1] + qdd[2];
             let t13 = qd[0] * qd[1] * t0;
-            let t14 = qd[0] * qd[0] * t0 * t1;
-            let t15 = qd[0] * qd[0] * t1 * t1;
-            let t16 = T::from_f64(0.56875) * t11;
-            let t17 = T::from_f64(0.19163081355599998) * t11;
-            let t18 = T::from_f64(0.39225) * t11;
-            let t19 = t11 + qd[3];
-            let t20 = qdd[0] * t1;
-            let t21 = qdd[0] * t0;
-            let t22 = t7 * t12;
-            let t23 = T::mul_add(
+            let t14 = qd[0] * qd[1] * t1;
+            let t15 = qd[0] * qd[0] * t0 * t1;
+            let t16 = qd[0] * qd[0] * t1 * t1;
+            let t17 = t11 * t11;
+            let t18 = qd[3] + t11;
+            let t19 = qdd[0] * t1;
+            let t20 = qdd[0] * t0;
+            let t21 = qdd[3] + t12;
+            let t22 = T::mul_add(
                 -T::from_f64(0.1197),
                 qd[0] * t0,
                 T::from_f64(0.425) * qd[1],
             );
-            let t24 = T::mul_add(qd[0], t0 * t3, qd[0] * t1 * t2);
-            let t25 = T::mul_add(-qd[0], t0 * t2, qd[0] * t1 * t3);
-            let t26 = T::from_f64(0.111172755531) * t19;
-            let t27 = t13 - t20;
-            let t28 = T::mul_add(qd[0], qd[1] * t1, t21);
-            let t29 = T::mul_add(
-                T::from_f64(0.016149999999999998),
-                t21,
-                T::mul_add(-T::from_f64(9.81), t1, T::from_f64(0.425) * (qdd[1] + t14)),
+            let t23 = T::mul_add(qd[0], t0 * t3, qd[0] * t1 * t2);
+            let t24 = T::mul_add(-qd[0], t0 * t2, qd[0] * t1 * t3);
+            let t25 = t13 - t19;
+            let t26 = T::mul_add(-T::from_f64(0.13585), t20, T::from_f64(9.81) * t1);
+            let t27 = t14 + t20;
+            let t28 = t23 * t24;
+            let t29 = t11 * t23;
+            let t30 = t24 * t24;
+            let t31 = T::mul_add(
+                -T::from_f64(8.393),
+                T::mul_add(T::from_f64(0.13585), t19, T::from_f64(9.81) * t0),
+                -T::from_f64(2.3500400000000004) * (T::mul_add(qd[1], qd[1], t16)),
             );
-            let t30 = qd[0] * t0 * t23;
-            let t31 = T::from_f64(0.56875) * t25;
-            let t32 = T::from_f64(0.004095) * t24;
-            let t33 = T::from_f64(0.19163081355599998) * t25;
-            let t34 = T::from_f64(0.39225) * t25;
-            let t35 = t24 * t18;
-            let t36 = t3 * t29;
-            let t37 = t2 * t29;
-            let t38 = t24 * t33;
-            let t39 = t25 * t32;
-            let t40 = T::mul_add(t5, t24, t4 * t25);
-            let t41 = T::mul_add(-t4, t24, t5 * t25);
-            let t42 = T::mul_add(
-                T::from_f64(0.016149999999999998),
-                t20,
-                T::mul_add(
-                    qd[1],
-                    t23,
-                    T::mul_add(
-                        T::from_f64(0.425),
-                        t15,
-                        T::mul_add(T::from_f64(0.1197), t13, T::from_f64(9.81) * t0),
-                    ),
-                ),
+            let t32 = T::mul_add(-qd[0], t0 * t22, T::from_f64(0.1197) * t16);
+            let t33 = T::mul_add(t5, t23, t4 * t24);
+            let t34 = T::mul_add(t4, t23, -t5 * t24);
+            let t35 = T::mul_add(T::from_f64(0.425), t15, T::from_f64(0.1197) * t14)
+                + T::mul_add(T::from_f64(0.13585), t20, -T::from_f64(9.81) * t1)
+                + T::mul_add(-T::from_f64(0.1197), t27, T::from_f64(0.425) * qdd[1]);
+            let t36 = -t34;
+            let t37 = qd[4] + t34;
+            let t38 = T::mul_add(
+                -T::from_f64(0.425),
+                t25,
+                T::mul_add(-T::from_f64(0.13585), t10, t32),
             );
-            let t43 = T::mul_add(t2, t28, T::mul_add(t3, t27, qd[2] * t24));
-            let t44 = T::mul_add(t3, t28, T::mul_add(-t2, t27, qd[2] * t25));
-            let t45 = qd[3] * t40;
-            let t46 = T::from_f64(0.111172755531) * t40;
-            let t47 = T::from_f64(0.21942) * t41;
-            let t48 = T::from_f64(0.093) * t41;
-            let t49 = T::from_f64(0.093) * t40;
-            let t50 = qd[4] - t41;
-            let t51 = t2 * t42;
-            let t52 = t3 * t42;
-            let t53 = t5 * t43;
-            let t54 = t4 * t44;
-            let t55 = t41 * t46;
-            let t56 = t40 * t47;
-            let t57 = T::mul_add(t6, t19, t7 * t40);
-            let t58 = t19 * t48;
-            let t59 = T::mul_add(-t7, t19, t6 * t40);
-            let t60 = T::from_f64(0.21942) * t50;
-            let t61 = T::mul_add(
-                t24,
-                t34,
-                T::mul_add(T::from_f64(0.39225), qdd[1] + qdd[2], t36 + t51),
+            let t39 = T::mul_add(
+                -T::from_f64(0.1197),
+                t25,
+                T::mul_add(-qd[1], t22, -T::from_f64(0.425) * t16)
+                    + T::mul_add(-T::from_f64(0.13585), t19, -T::from_f64(9.81) * t0),
             );
-            let t62 = T::mul_add(t11, t18, T::mul_add(t25, t34, t52 - t37));
-            let t63 = T::mul_add(t5, t44, T::mul_add(-t4, t43, qd[3] * t41));
+            let t40 = T::mul_add(
+                T::from_f64(0.425),
+                t25,
+                T::mul_add(T::from_f64(0.13585), t10, -t32),
+            );
+            let t41 = T::mul_add(qd[2], t23, T::mul_add(t2, t27, t3 * t25));
+            let t42 = T::mul_add(qd[2], t24, -(T::mul_add(-t3, t27, t2 * t25)));
+            let t43 = t18 * t36;
+            let t44 = T::mul_add(t6, t18, t7 * t33);
+            let t45 = T::mul_add(t7, t18, -t6 * t33);
+            let t46 = T::mul_add(T::from_f64(0.39225), t29 + t41, -t38);
+            let t47 = -t45;
+            let t48 = t44 * t37;
+            let t49 = T::mul_add(-t2, t39, t3 * t35);
+            let t50 = T::mul_add(t3, t39, t2 * t35);
+            let t51 = t37 * t47;
+            let t52 = T::mul_add(-t8, t37, t9 * t44);
+            let t53 = T::mul_add(t9, t37, t8 * t44);
+            let t54 = T::mul_add(T::from_f64(0.39225), t28 + t12, t49);
+            let t55 = -T::from_f64(0.39225) * (t30 + t17) + t50;
+            let t56 = T::mul_add(qd[3], t36, T::mul_add(t5, t42, -t4 * t41));
+            let t57 = T::mul_add(qd[3], t33, T::mul_add(t4, t42, t5 * t41));
+            let t58 = -T::from_f64(0.093) * (T::mul_add(t33, t33, t36 * t36))
+                + T::mul_add(-T::from_f64(0.39225), t29 + t41, t38);
+            let t59 = qdd[4] + t57;
+            let t60 = T::mul_add(-t5, t55, -t4 * t54);
+            let t61 = T::mul_add(-t4, t55, t5 * t54);
+            let t62 = T::mul_add(T::from_f64(0.093), T::mul_add(t33, t18, -t57), t60);
+            let t63 = T::mul_add(T::from_f64(0.093), t43 - t56, -t61);
             (
                 t0,
                 t1,
@@ -7888,295 +6353,153 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
             t107,
             t108,
             t109,
-            t110,
-            t111,
-            t112,
-            t113,
-            t114,
-            t115,
-            t116,
-            t117,
-            t118,
-            t119,
-            t120,
-            t121,
-            t122,
-            t123,
-            t124,
-            t125,
-            t126,
-            t127,
         ) = {
-            let t64 = qdd[4] + t45 + t53 + t54;
-            let t65 = qd[4] * t57;
-            let t66 = T::from_f64(0.111172755531) * t57;
-            let t67 = T::from_f64(0.111172755531) * t59;
-            let t68 = T::from_f64(0.09465) * t57;
-            let t69 = T::from_f64(0.09465) * t59;
-            let t70 = qd[5] - t59;
-            let t71 = t4 * t61;
-            let t72 = t5 * t62;
-            let t73 = t5 * t61;
-            let t74 = t4 * t62;
-            let t75 = t6 * t63;
-            let t76 = T::mul_add(
-                T::from_f64(0.39225),
-                t43,
-                T::mul_add(
-                    t40,
-                    t49,
-                    T::mul_add(
-                        t41,
-                        t48,
-                        T::mul_add(
-                            -T::from_f64(0.1197),
-                            t15,
-                            T::mul_add(
-                                T::from_f64(0.425),
-                                t27,
-                                T::mul_add(T::from_f64(0.13585), t10, t30 + t35),
-                            ),
-                        ),
-                    ),
-                ),
+            let t64 = T::mul_add(-qd[4], t44, T::mul_add(t7, t21, -t6 * t56));
+            let t65 = T::mul_add(qd[4], t47, -(T::mul_add(t6, t21, t7 * t56)));
+            let t66 = -t64;
+            let t67 = -T::from_f64(0.09465) * (T::mul_add(t47, t47, t44 * t44))
+                + T::mul_add(T::from_f64(0.093), t56 - t43, t61);
+            let t68 = T::mul_add(t6, t58, t7 * t62);
+            let t69 = T::mul_add(t7, t58, -t6 * t62);
+            let t70 = T::mul_add(
+                T::from_f64(0.0171364731454),
+                qdd[5] + t64,
+                -T::from_f64(0.016685526854599998) * t52 * t53,
             );
-            let t77 = t57 * t67;
-            let t78 = t59 * t66;
-            let t79 = T::mul_add(-t8, t50, t9 * t57);
-            let t80 = T::mul_add(t9, t50, t8 * t57);
-            let t81 = t50 * t69;
-            let t82 = T::from_f64(0.0171364731454) * t70;
-            let t83 = T::mul_add(
-                -t19,
-                t49,
-                T::mul_add(T::from_f64(0.093), t45 + t53 + t54, t71 - t72),
+            let t71 = T::mul_add(T::from_f64(0.09465), t48 - t66, t68);
+            let t72 = T::mul_add(T::from_f64(0.09465), t51 - t65, -t69);
+            let t73 = T::mul_add(qd[5], t52, T::mul_add(t9, t59, -t8 * t65));
+            let t74 = T::mul_add(qd[5], t53, -(T::mul_add(-t8, t59, -t9 * t65)));
+            let t75 = T::mul_add(
+                -T::from_f64(0.0171364731454),
+                t74,
+                T::from_f64(0.016685526854599998) * t53 * (qd[5] + t45),
             );
-            let t84 = t6 * t76;
-            let t85 = t7 * t76;
-            let t86 = T::mul_add(-t6, t12, T::mul_add(-t7, t63, qd[4] * t59));
-            let t87 = T::from_f64(0.0171364731454) * t79;
-            let t88 = T::from_f64(0.033822) * t80;
-            let t89 = t7 * t83;
-            let t90 = t6 * t83;
-            let t91 = T::mul_add(
-                -t59,
-                t69,
-                T::mul_add(
-                    -t57,
-                    t68,
-                    T::mul_add(T::from_f64(0.093), t63, t73 + t74 - t58),
-                ),
-            );
-            let t92 = t80 * t87;
-            let t93 = t79 * t88;
-            let t94 = T::mul_add(
-                -t50,
-                t68,
-                T::mul_add(T::from_f64(0.09465), t65 + t75 - t22, t89 + t84),
-            );
-            let t95 = T::mul_add(
-                T::from_f64(1.4069),
-                t90 - t85,
-                T::mul_add(-T::from_f64(0.1879), t81, T::from_f64(0.017784735) * t86),
-            );
-            let t96 = T::mul_add(
-                -t70,
-                t87,
-                T::mul_add(
-                    t79,
-                    t82,
-                    T::from_f64(0.033822)
-                        * (T::mul_add(t9, t64, T::mul_add(-t8, t86, qd[5] * t79))),
-                ),
-            );
-            let t97 = T::mul_add(
-                t80,
-                t82,
-                T::mul_add(
-                    -t70,
-                    t88,
-                    T::from_f64(0.0171364731454)
-                        * (T::mul_add(t8, t64, T::mul_add(t9, t86, qd[5] * t80))),
-                ),
-            );
-            let t98 = t6 * t95;
-            let t99 = t7 * t95;
-            let t100 = T::from_f64(0.1879) * (T::mul_add(t8, t91, t9 * t94));
-            let t101 = T::from_f64(0.1879) * (T::mul_add(-t9, t91, t8 * t94));
-            let t102 = t8 * t97;
-            let t103 = t9 * t96;
-            let t104 = t9 * t100;
-            let t105 = t8 * t101;
-            let t106 = t8 * t100;
-            let t107 = t9 * t101;
-            let t108 = T::mul_add(
+            let t76 = T::mul_add(T::from_f64(0.1879), t72, T::from_f64(1.219) * (-t69));
+            let t77 = T::mul_add(-t8, t67, t9 * t71);
+            let t78 = T::mul_add(t9, t67, t8 * t71);
+            let t79 = T::from_f64(0.1879) * (T::mul_add(t8, t78, t9 * t77));
+            let t80 = T::from_f64(0.1879) * (T::mul_add(t9, t78, -t8 * t77));
+            let t81 = T::mul_add(
                 T::from_f64(0.017784735),
-                t90 - t81 - t85,
-                T::mul_add(
-                    -t8,
-                    t96,
-                    T::mul_add(
-                        t9,
-                        t97,
-                        T::mul_add(
-                            -t50,
-                            t67,
-                            T::mul_add(t59, t60, T::from_f64(0.11285608069875) * t86),
-                        ),
-                    ),
-                ),
+                t72,
+                T::mul_add(T::from_f64(0.033822), t8 * t73, t9 * t75),
             );
-            let t109 = T::mul_add(
-                -T::from_f64(0.09465),
-                t104 + t105,
-                T::mul_add(
-                    -t57,
-                    t60,
-                    T::mul_add(
-                        t50,
-                        t66,
-                        T::mul_add(
-                            T::from_f64(0.12830922867640002),
-                            t22 - t65 - t75,
-                            T::mul_add(T::from_f64(0.0171364731454), qdd[5], t92 - t93),
-                        ),
-                    ),
-                ),
+            let t82 = T::mul_add(
+                T::from_f64(0.21942),
+                t59,
+                T::mul_add(T::from_f64(0.033822), t9 * t73, -t8 * t75),
             );
-            let t110 = T::mul_add(T::from_f64(1.219), t89 + t84, t104 + t105);
-            let t111 = t6 * t108;
-            let t112 = T::mul_add(
-                T::from_f64(2.438),
-                t73 + t74,
-                T::mul_add(
-                    -T::from_f64(1.219),
-                    t58,
-                    T::mul_add(T::from_f64(0.11336700000000001), t63, t106 - t107),
-                ),
+            let t83 = T::mul_add(T::from_f64(1.219), t68, t79);
+            let t84 = T::mul_add(
+                -T::from_f64(0.111172755531),
+                t65,
+                -T::from_f64(0.108247244469) * t51,
+            ) + t81;
+            let t85 = T::mul_add(
+                -T::from_f64(0.111172755531),
+                t66,
+                -T::from_f64(0.108247244469) * t48,
+            ) + T::mul_add(T::from_f64(0.09465), t79, t70);
+            let t86 = T::mul_add(
+                T::from_f64(1.219),
+                t61,
+                T::mul_add(-T::from_f64(1.219), t63, t80),
             );
-            let t113 = t7 * t110;
-            let t114 = t6 * t110;
-            let t115 = t7 * t109;
-            let t116 = t5 * t112;
-            let t117 = T::mul_add(
-                T::from_f64(0.093),
-                t106 - t107,
-                T::mul_add(
-                    T::from_f64(0.11336700000000001),
-                    t73 + t74 - t58,
-                    T::mul_add(
-                        -t6,
-                        t109,
-                        T::mul_add(
-                            -t7,
-                            t108,
-                            T::mul_add(
-                                t41,
-                                t26,
-                                T::mul_add(-t19, t47, T::from_f64(0.121715886531) * t63),
-                            ),
-                        ),
-                    ),
-                ),
+            let t87 = T::mul_add(t6, t76, t7 * t83);
+            let t88 = T::mul_add(-t7, t76, t6 * t83);
+            let t89 = T::mul_add(T::from_f64(1.219), -t60, -t87);
+            let t90 = T::mul_add(
+                -T::from_f64(0.093),
+                T::mul_add(T::from_f64(1.219), t63, -t80),
+                T::mul_add(-t6, t85, t7 * t84),
             );
-            let t118 = T::mul_add(
-                T::from_f64(0.093),
-                t113 + t98,
-                T::mul_add(
-                    -t19,
-                    t46,
-                    T::mul_add(
-                        t40,
-                        t26,
-                        T::mul_add(
-                            T::from_f64(0.43884),
-                            t45 + t53 + t54,
-                            T::mul_add(
-                                T::from_f64(0.21942),
-                                qdd[4],
-                                t78 + t102 + t103 - t77,
-                            ),
-                        ),
-                    ),
-                ),
+            let t91 = T::mul_add(
+                T::from_f64(0.111172755531),
+                t21,
+                T::from_f64(0.108247244469) * t33 * t36,
+            ) + T::mul_add(t7, t85, t6 * t84);
+            let t92 = T::mul_add(
+                T::from_f64(0.21942),
+                t57,
+                T::mul_add(-T::from_f64(0.093), t87, t82),
             );
-            let t119 = T::mul_add(T::from_f64(1.219), t71 - t72, t113 + t98);
-            let t120 = t4 * t119;
-            let t121 = T::mul_add(
+            let t93 = T::mul_add(
+                T::from_f64(0.111172755531),
+                t56,
+                -T::from_f64(0.108247244469) * t43,
+            ) + t90;
+            let t94 = T::mul_add(t5, t86, t4 * t89);
+            let t95 = T::mul_add(
                 T::from_f64(2.275),
-                t36 + t51,
-                T::mul_add(
-                    t24,
-                    t31,
-                    T::mul_add(T::from_f64(0.56875), qdd[1] + qdd[2], t120 + t116),
-                ),
-            );
-            let t122 = T::mul_add(
+                t49,
+                T::from_f64(0.56875) * (t28 + t12),
+            ) + t94;
+            let t96 = T::mul_add(
+                T::from_f64(2.275),
+                t50,
+                -T::from_f64(0.56875) * (t30 + t17),
+            ) + T::mul_add(-t4, t86, t5 * t89);
+            let t97 = T::mul_add(
+                T::from_f64(0.19163081355599998),
+                t12,
+                T::mul_add(T::from_f64(0.56875), t49, T::from_f64(0.187535813556) * t28),
+            ) + T::mul_add(T::from_f64(0.39225), t94, t91);
+            let t98 = T::mul_add(
                 T::from_f64(0.39225),
-                t114 - t99,
-                T::mul_add(
-                    T::from_f64(0.47815275),
-                    t35,
+                T::mul_add(T::from_f64(1.219), t46, -t88),
+                T::mul_add(t5, t92, -t4 * t93),
+            );
+            let t99 = T::mul_add(
+                T::from_f64(0.004095),
+                t42,
+                -(T::mul_add(-t4, t92, -t5 * t93)),
+            );
+            let t100 = T::mul_add(t2, t96, t3 * t95);
+            let t101 = T::mul_add(t3, t96, -t2 * t95);
+            let t102 = T::mul_add(
+                T::from_f64(0.19163081355599998),
+                t41,
+                T::mul_add(T::from_f64(0.56875), t40, T::from_f64(0.187535813556) * t29),
+            ) + t98;
+            let t103 = T::mul_add(
+                T::from_f64(0.1197),
+                -t101,
+                -T::from_f64(0.425)
+                    * (T::mul_add(
+                        -T::from_f64(2.275),
+                        t40,
+                        -T::from_f64(0.56875) * (t29 + t41),
+                    ) + T::mul_add(-T::from_f64(1.219), t46, t88)),
+            );
+            let t104 = t0
+                * (T::mul_add(
+                    -T::from_f64(8.393),
+                    t26,
+                    T::from_f64(2.3500400000000004) * (qdd[1] + t15),
+                ) + t100);
+            let t105 = T::mul_add(-t1, t31 + t101, t104);
+            let t106 = T::mul_add(-t2, t99, t3 * t102) + t103;
+            let t107 = T::mul_add(
+                T::from_f64(0.1197),
+                t100,
+                T::mul_add(-t3, t99, -t2 * t102),
+            );
+            let t108 = t1
+                * (T::mul_add(
+                    T::from_f64(0.8849018759100001),
+                    t25,
                     T::mul_add(
-                        t5,
-                        t118,
-                        T::mul_add(
-                            -t4,
-                            t117,
-                            T::mul_add(
-                                t24,
-                                t17,
-                                T::mul_add(
-                                    -t11,
-                                    t32,
-                                    T::mul_add(
-                                        T::from_f64(0.37918622974349997),
-                                        t43,
-                                        T::mul_add(
-                                            T::from_f64(1.04690275),
-                                            t30,
-                                            T::mul_add(
-                                                -T::from_f64(0.125314259175),
-                                                t15,
-                                                T::mul_add(
-                                                    T::from_f64(0.44493366875),
-                                                    t27,
-                                                    T::from_f64(0.14222173858749998) * t10,
-                                                ),
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
+                        T::from_f64(0.8697944759100001),
+                        t13,
+                        T::from_f64(0.31925293400000004) * t10,
                     ),
-                ),
+                ) + t106);
+            let t109 = T::mul_add(
+                t0,
+                T::mul_add(T::from_f64(0.0151074), t27, -t107),
+                -t108,
             );
-            let t123 = T::mul_add(
-                t4,
-                t118,
-                T::mul_add(
-                    t5,
-                    t117,
-                    T::mul_add(
-                        -t11,
-                        t33,
-                        T::mul_add(t25, t17, T::from_f64(0.004095) * t44),
-                    ),
-                ),
-            );
-            let t124 = T::mul_add(
-                T::from_f64(2.275),
-                t52 - t37,
-                T::mul_add(
-                    t4,
-                    t112,
-                    T::mul_add(-t5, t119, T::mul_add(t11, t16, t25 * t31)),
-                ),
-            );
-            let t125 = t3 * t121;
-            let t126 = t2 * t124;
-            let t127 = t2 * t121;
             (
                 t64,
                 t65,
@@ -8224,179 +6547,27 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
                 t107,
                 t108,
                 t109,
-                t110,
-                t111,
-                t112,
-                t113,
-                t114,
-                t115,
-                t116,
-                t117,
-                t118,
-                t119,
-                t120,
-                t121,
-                t122,
-                t123,
-                t124,
-                t125,
-                t126,
-                t127,
             )
         };
-        let (t128, t129) = {
-            let t128 = t3 * t124;
-            let t129 = T::mul_add(
-                t0,
-                T::mul_add(
-                    t3,
-                    t123,
-                    T::mul_add(
-                        t2,
-                        t122,
-                        T::mul_add(
-                            T::from_f64(0.1197),
-                            t126 - t125,
-                            T::from_f64(0.0151074) * t28,
-                        ),
-                    ),
-                ),
-                T::mul_add(
-                    -t1,
-                    T::mul_add(
-                        -t2,
-                        t123,
-                        T::mul_add(
-                            t3,
-                            t122,
-                            T::mul_add(
-                                T::from_f64(0.1197),
-                                t127 + t128,
-                                T::mul_add(
-                                    -T::from_f64(1.51600562591),
-                                    t20,
-                                    T::mul_add(
-                                        T::from_f64(0.5180750000000001),
-                                        t35,
-                                        T::mul_add(
-                                            T::from_f64(0.425),
-                                            T::mul_add(t24, t16, t114 - t99),
-                                            T::mul_add(
-                                                T::from_f64(0.44493366875),
-                                                t43,
-                                                T::mul_add(
-                                                    T::from_f64(1.4849499999999998),
-                                                    t30,
-                                                    T::mul_add(
-                                                        -T::from_f64(0.17774851500000002),
-                                                        t15,
-                                                        T::mul_add(
-                                                            T::from_f64(2.38580010182),
-                                                            t13,
-                                                            T::from_f64(0.5209833915000001) * t10,
-                                                        ),
-                                                    ),
-                                                ),
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                    T::mul_add(
-                        T::from_f64(0.13585),
-                        T::mul_add(
-                            t1,
-                            T::mul_add(
-                                T::from_f64(1.14018905),
-                                t20,
-                                T::mul_add(
-                                    T::from_f64(2.3500400000000004),
-                                    T::mul_add(qd[1], qd[1], t15),
-                                    T::mul_add(T::from_f64(82.33533000000001), t0, t127 + t128),
-                                ),
-                            ),
-                            t0
-                                * (T::mul_add(
-                                    T::from_f64(1.14018905),
-                                    t21,
-                                    T::mul_add(
-                                        -T::from_f64(82.33533000000001),
-                                        t1,
-                                        T::mul_add(
-                                            T::from_f64(2.3500400000000004),
-                                            qdd[1] + t14,
-                                            t125 - t126,
-                                        ),
-                                    ),
-                                )),
-                        ),
-                        T::from_f64(0.00666) * qdd[0],
-                    ),
-                ),
-            );
-            (t128, t129)
-        };
         [
-            t129,
             T::mul_add(
-                T::from_f64(0.425),
-                t125 - t126,
-                T::mul_add(
-                    T::from_f64(0.39225),
-                    t120 + t116,
-                    T::mul_add(
-                        T::from_f64(0.56875),
-                        t36 + t51,
-                        T::mul_add(
-                            T::from_f64(0.31925293400000004),
-                            t21,
-                            T::mul_add(
-                                T::from_f64(0.8697944759100001),
-                                t14,
-                                T::mul_add(
-                                    -T::from_f64(23.053892400000006),
-                                    t1,
-                                    T::mul_add(
-                                        T::from_f64(0.111172755531),
-                                        qdd[3],
-                                        T::mul_add(
-                                            T::from_f64(0.302803569087),
-                                            qdd[2],
-                                            T::mul_add(
-                                                T::from_f64(1.1877054449970001),
-                                                qdd[1],
-                                                t38 + t56 + t115 - t39 - t55 - t111,
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
+                T::from_f64(0.00666),
+                qdd[0],
+                T::mul_add(T::from_f64(0.13585), t105, t109),
             ),
             T::mul_add(
-                T::from_f64(0.39225),
-                t120 + t116,
+                -T::from_f64(2.3500400000000004),
+                t26,
                 T::mul_add(
-                    T::from_f64(0.56875),
-                    t36 + t51,
-                    T::mul_add(
-                        T::from_f64(0.111172755531),
-                        qdd[3],
-                        T::mul_add(
-                            T::from_f64(0.302803569087),
-                            qdd[1] + qdd[2],
-                            t38 + t56 + t115 - t39 - t55 - t111,
-                        ),
-                    ),
+                    T::from_f64(0.8697944759100001),
+                    t15,
+                    T::from_f64(0.8849018759100001) * qdd[1],
                 ),
-            ),
-            T::mul_add(T::from_f64(0.111172755531), t12, t56 + t115 - t55 - t111),
-            T::mul_add(T::from_f64(0.21942), t64, t78 + t102 + t103 - t77),
-            T::mul_add(T::from_f64(0.0171364731454), qdd[5] + t22 - t65 - t75, t92 - t93),
+            ) + T::mul_add(T::from_f64(0.425), t100, t97),
+            t97,
+            t91,
+            t82,
+            t70,
         ]
     }
     /// Forward dynamics: qdd = M(q)^-1 (tau - b(q, qd) - G(q)).
@@ -8405,7 +6576,7 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
     /// model and finite inputs); `try_forward_dynamics` says which pivot failed.
     ///
     /// Route: M and b + G as in `mass_matrix` and `bias`, then an unrolled L^T D L solve without fill-in.
-    /// Operations: 503 mul, 353 add, 5 div, 5 sin, 5 cos.
+    /// Operations: 461 mul, 287 add, 5 div, 5 sin, 5 cos.
     fn forward_dynamics(&self, q: &[T; 6], qd: &[T; 6], tau: &[T; 6]) -> [T; 6] {
         match self.forward_dynamics_checked(q, qd, tau) {
             Ok((qdd, failures)) => ::eomgen_runtime::lane::nan_failed(qdd, &failures),
@@ -8415,7 +6586,7 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
     /// The kinetic energy T = qd^T M(q) qd / 2.
     ///
     /// Route: a sum over body velocities, O(N).
-    /// Operations: 108 mul, 57 add, 0 div, 5 sin, 5 cos.
+    /// Operations: 105 mul, 60 add, 0 div, 5 sin, 5 cos.
     fn kinetic_energy(&self, q: &[T; 6], qd: &[T; 6]) -> T {
         let ([s1, s2, s3, s4, s5], [c1, c2, c3, c4, c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
             q[1],
@@ -8435,137 +6606,112 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
         let t8 = s5;
         let t9 = c5;
         let t10 = qd[1] + qd[2];
-        let t11 = qd[0] * t1 * t3;
-        let t12 = qd[0] * t1 * t2;
-        let t13 = t10 + qd[3];
-        let t14 = T::mul_add(qd[0], t0 * t3, t12);
-        let t15 = T::mul_add(-qd[0], t0 * t2, t11);
-        let t16 = T::mul_add(
-            T::from_f64(0.016149999999999998),
-            qd[0] * t0,
-            T::from_f64(0.425) * qd[1],
+        let t11 = qd[0] * t0;
+        let t12 = qd[0] * qd[0] * t1 * t1;
+        let t13 = qd[0] * t1 * t3;
+        let t14 = qd[0] * t1 * t2;
+        let t15 = qd[3] + t10;
+        let t16 = qd[0] * qd[0] * t0 * t0;
+        let t17 = T::mul_add(qd[0], t0 * t3, t14);
+        let t18 = T::mul_add(-qd[0], t0 * t2, t13);
+        let t19 = T::mul_add(
+            T::from_f64(0.13585),
+            t11,
+            T::mul_add(-T::from_f64(0.1197), t11, T::from_f64(0.425) * qd[1]),
         );
-        let t17 = t3 * t16;
-        let t18 = T::mul_add(T::from_f64(0.39225), t15, T::from_f64(0.425) * qd[0] * t1);
-        let t19 = T::mul_add(t5, t14, t4 * t15);
-        let t20 = T::mul_add(-t4, t14, t5 * t15);
-        let t21 = T::mul_add(T::from_f64(0.016149999999999998), t12, t17);
-        let t22 = T::mul_add(
-            T::from_f64(0.016149999999999998),
-            t12,
-            T::mul_add(T::from_f64(0.39225), t10, t17),
+        let t20 = T::mul_add(T::from_f64(0.39225), t18, T::from_f64(0.425) * qd[0] * t1);
+        let t21 = T::mul_add(t5, t17, t4 * t18);
+        let t22 = T::mul_add(t4, t17, -t5 * t18);
+        let t23 = -t22;
+        let t24 = qd[4] + t22;
+        let t25 = T::mul_add(t3, t19, T::from_f64(0.016149999999999998) * t14);
+        let t26 = T::mul_add(-t2, t19, T::from_f64(0.016149999999999998) * t13);
+        let t27 = T::mul_add(t6, t15, t7 * t21);
+        let t28 = T::mul_add(t7, t15, -t6 * t21);
+        let t29 = T::mul_add(T::from_f64(0.39225), t10, t25);
+        let t30 = -t28;
+        let t31 = T::mul_add(t5, t26, -t4 * t29);
+        let t32 = T::mul_add(t4, t26, t5 * t29);
+        let t33 = T::mul_add(T::from_f64(0.093), t23, t31);
+        let t34 = T::mul_add(T::from_f64(0.093), t21, t32);
+        let t35 = T::mul_add(
+            T::from_f64(0.033822),
+            {
+                let b = T::mul_add(t9, t24, t8 * t27);
+                b * b
+            },
+            T::from_f64(0.0171364731454)
+                * (T::mul_add(
+                    qd[5] + t28,
+                    qd[5] + t28,
+                    (T::mul_add(-t8, t24, t9 * t27)) * (T::mul_add(-t8, t24, t9 * t27)),
+                )),
         );
-        let t23 = T::mul_add(-t2, t16, T::from_f64(0.016149999999999998) * t11);
-        let t24 = qd[4] - t20;
-        let t25 = T::mul_add(t6, t13, t7 * t19);
-        let t26 = T::mul_add(-t7, t13, t6 * t19);
-        let t27 = T::mul_add(t4, t23, t5 * t22);
-        let t28 = T::mul_add(-t5, t23, t4 * t22);
-        let t29 = qd[5] - t26;
-        let t30 = T::mul_add(T::from_f64(0.093), t20, -t28);
-        let t31 = T::mul_add(T::from_f64(0.093), t19, t27);
-        let t32 = T::mul_add(-t8, t24, t9 * t25);
-        let t33 = T::mul_add(t9, t24, t8 * t25);
-        let t34 = T::mul_add(t6, t18, t7 * t30);
-        let t35 = T::mul_add(-t7, t18, t6 * t30);
-        let t36 = T::mul_add(T::from_f64(0.09465), t26, -t34);
-        let t37 = T::mul_add(
-            T::from_f64(0.09395),
+        let t36 = T::mul_add(t6, t20, t7 * t33);
+        let t37 = T::mul_add(t7, t20, -t6 * t33);
+        let t38 = T::mul_add(t32, t32, T::mul_add(t20, t20, (-t31) * (-t31)));
+        let t39 = T::mul_add(T::from_f64(0.09465), t30, -t36);
+        let t40 = T::mul_add(t34, t34, T::mul_add(-t37, -t37, t36 * t36));
+        let t41 = T::mul_add(
+            T::mul_add(-t9, t34, t8 * t39),
+            T::mul_add(-t9, t34, t8 * t39),
             T::mul_add(
-                T::mul_add(-t9, t31, t8 * t36),
-                T::mul_add(-t9, t31, t8 * t36),
-                T::mul_add(
-                    T::mul_add(T::from_f64(0.09465), t25, t35),
-                    T::mul_add(T::from_f64(0.09465), t25, t35),
-                    (T::mul_add(t8, t31, t9 * t36)) * (T::mul_add(t8, t31, t9 * t36)),
-                ),
+                T::mul_add(T::from_f64(0.09465), t27, -t37),
+                T::mul_add(T::from_f64(0.09465), t27, -t37),
+                (T::mul_add(t8, t34, t9 * t39)) * (T::mul_add(t8, t34, t9 * t39)),
             ),
+        );
+        let t42 = T::mul_add(
+            T::from_f64(0.09395),
+            t41,
             T::mul_add(
                 T::from_f64(0.6095),
+                t38 + t40,
                 T::mul_add(
-                    t31,
-                    t31,
+                    T::from_f64(1.1375),
                     T::mul_add(
-                        t35,
-                        t35,
-                        T::mul_add(
-                            t34,
-                            t34,
-                            T::mul_add(t27, t27, T::mul_add(t18, t18, t28 * t28)),
-                        ),
-                    ),
-                ),
-                T::mul_add(
-                    T::from_f64(0.5),
-                    T::mul_add(
-                        t33,
-                        T::from_f64(0.033822) * t33,
-                        T::mul_add(
-                            t29,
-                            T::from_f64(0.0171364731454) * t29,
-                            T::mul_add(
-                                t32,
-                                T::from_f64(0.0171364731454) * t32,
-                                T::mul_add(
-                                    t24,
-                                    T::from_f64(0.21942) * t24,
-                                    T::mul_add(
-                                        t26,
-                                        T::from_f64(0.111172755531) * t26,
-                                        T::mul_add(
-                                            t25,
-                                            T::from_f64(0.111172755531) * t25,
-                                            T::mul_add(
-                                                t20,
-                                                T::from_f64(0.21942) * t20,
-                                                T::mul_add(
-                                                    t13,
-                                                    T::from_f64(0.111172755531) * t13,
-                                                    T::mul_add(
-                                                        t19,
-                                                        T::from_f64(0.111172755531) * t19,
-                                                        T::mul_add(
-                                                            t14,
-                                                            T::from_f64(0.004095) * t14,
-                                                            T::mul_add(
-                                                                t10,
-                                                                T::from_f64(0.19163081355599998) * t10,
-                                                                t15 * (T::from_f64(0.19163081355599998) * t15),
-                                                            ),
-                                                        ),
-                                                    ),
-                                                ),
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
+                        t26,
+                        t26,
+                        T::mul_add(t25, t25, T::from_f64(0.18062499999999998) * t12),
                     ),
                     T::mul_add(
-                        T::from_f64(0.425),
-                        qd[0] * t1 * (T::from_f64(0.56875) * t15),
+                        T::from_f64(0.5),
                         T::mul_add(
-                            T::from_f64(0.56875) * t10,
-                            t21,
+                            T::from_f64(0.0151074),
+                            t16,
+                            T::from_f64(0.8849018759100001)
+                                * (T::mul_add(qd[1], qd[1], t12)),
+                        )
+                            + T::mul_add(
+                                T::from_f64(0.004095),
+                                t17 * t17,
+                                T::from_f64(0.19163081355599998)
+                                    * (T::mul_add(t10, t10, t18 * t18)),
+                            )
+                            + T::mul_add(
+                                T::from_f64(0.111172755531),
+                                T::mul_add(t15, t15, t21 * t21),
+                                T::from_f64(0.21942) * t23 * t23,
+                            )
+                            + T::mul_add(
+                                T::from_f64(0.21942),
+                                t24 * t24,
+                                T::from_f64(0.111172755531)
+                                    * (T::mul_add(t30, t30, t27 * t27)),
+                            ) + t35,
+                        T::mul_add(
+                            T::from_f64(4.1965),
+                            T::from_f64(0.0184552225) * (t12 + t16),
                             T::mul_add(
-                                T::from_f64(1.1375),
-                                T::mul_add(t23, t23, t21 * t21),
+                                T::from_f64(0.31925293400000004),
+                                qd[0] * qd[1] * t0,
                                 T::mul_add(
-                                    T::from_f64(0.08500104122125),
-                                    qd[0] * qd[0] * t0 * t0,
+                                    T::from_f64(0.00333),
+                                    qd[0] * qd[0],
                                     T::mul_add(
-                                        T::from_f64(0.72535921667625),
-                                        qd[0] * qd[0] * t1 * t1,
-                                        T::mul_add(
-                                            T::from_f64(0.31925293400000004),
-                                            qd[0] * qd[1] * t0,
-                                            T::mul_add(
-                                                T::from_f64(0.44245093795500007),
-                                                qd[1] * qd[1],
-                                                T::from_f64(0.00333) * qd[0] * qd[0],
-                                            ),
-                                        ),
+                                        T::from_f64(0.24171874999999998),
+                                        qd[0] * t1 * t18,
+                                        T::from_f64(0.56875) * t10 * t25,
                                     ),
                                 ),
                             ),
@@ -8574,7 +6720,7 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
                 ),
             ),
         );
-        t37
+        t42
     }
     /// The gravitational potential energy V = -sum m g.c, zero with every centre of mass at the origin.
     ///

@@ -317,8 +317,8 @@ pub mod robots {
     }
     /// A synthetic 24-joint serial chain with only forward and inverse dynamics: forward
     /// dynamics solves at run time (the tree `L^T D L` factorization, unrolled).
-    pub mod chain24 {
-        include!(concat!(env!("OUT_DIR"), "/chain24.rs"));
+    pub mod chain28 {
+        include!(concat!(env!("OUT_DIR"), "/chain28.rs"));
     }
     /// The reference robots with `Builder::derivatives`, inverse dynamics, its derivatives,
     /// forward-dynamics derivatives and `M^-1` (and what those call) only.

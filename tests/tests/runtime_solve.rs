@@ -2,20 +2,20 @@
 //! dynamics of its accelerations gives back the efforts, and failures are reported.
 
 use eomgen_runtime::FactorError;
-use eomgen_tests::robots::chain24::Chain24;
+use eomgen_tests::robots::chain28::Chain28;
 
-const N: usize = 24;
+const N: usize = 28;
 
 #[test]
 fn the_generated_code_takes_the_runtime_route() {
-    let source = include_str!(concat!(env!("OUT_DIR"), "/chain24.rs"));
+    let source = include_str!(concat!(env!("OUT_DIR"), "/chain28.rs"));
     assert!(source.contains("fn ltdl_factor_unrolled"));
     assert!(source.contains("Self::ltdl_substitute_unrolled(&m, &rhs)"));
 }
 
 #[test]
 fn inverse_dynamics_of_forward_dynamics_is_the_identity() {
-    let robot = Chain24::<f64>::default();
+    let robot = Chain28::<f64>::default();
     let mut worst: f64 = 0.0;
     for s in 0..8 {
         let q: [f64; N] = core::array::from_fn(|i| (0.37 * (i + s) as f64).sin());
@@ -33,7 +33,7 @@ fn inverse_dynamics_of_forward_dynamics_is_the_identity() {
 
 #[test]
 fn non_finite_input_is_reported() {
-    let robot = Chain24::<f64>::default();
+    let robot = Chain28::<f64>::default();
     let q = [0.1; N];
     let mut tau = [0.0; N];
     tau[3] = f64::NAN;

@@ -28,7 +28,9 @@ pub mod schedule;
 pub mod simplify;
 
 pub use eval::UnboundSymbol;
-pub use graph::{Graph, GraphFull, Id, Limits, Node, Num, Symbol, SymbolIndex, SymbolKind};
+pub use graph::{
+    Graph, GraphFull, Id, Limits, Node, Num, SumFlattening, Symbol, SymbolIndex, SymbolKind,
+};
 pub use print::{format_number, Style, Syntax};
 pub use schedule::{Expr, OpCount, Order, Program};
 pub use simplify::TooLarge;

@@ -6,7 +6,7 @@
 //! chains stay independent (RBDA, tables 6.3 and 6.4). `M` is positive definite exactly when
 //! every pivot `D_i` is positive. Each pivot is inverted once; everything else multiplies.
 
-use crate::cas::{Graph, Id};
+use crate::cas::{Graph, Id, SumFlattening};
 
 /// `M = L^T D L` over the coordinate tree `parent` (each coordinate after its parent): `L`
 /// unit lower triangular with `L_ij` nonzero only for `j` an ancestor of `i`.
@@ -23,6 +23,7 @@ impl Factors {
     /// Factorizes `m` (only its lower triangle's tree entries are read).
     pub(crate) fn new(g: &mut Graph, parent: &[Option<usize>], m: &[Vec<Id>]) -> Factors {
         let n = m.len();
+        let old = g.set_flattening(SumFlattening::Always);
         let ancestors: Vec<Vec<usize>> = (0..n).map(|k| ancestors(parent, k)).collect();
         let mut h: Vec<Vec<Id>> = m.to_vec();
         let mut inv_d = vec![g.one(); n];
@@ -37,6 +38,7 @@ impl Factors {
                 h[k][i] = a;
             }
         }
+        g.set_flattening(old);
         Factors {
             h,
             inv_d,
@@ -77,6 +79,7 @@ impl Factors {
     /// floating quadruped.
     pub(crate) fn inverse(&self, g: &mut Graph) -> Vec<Vec<Id>> {
         let n = self.h.len();
+        let old = g.set_flattening(SumFlattening::Always);
         // x[i][s]: X_{i, k} for the s-th of `i`'s coordinates (itself, then its ancestors).
         let mut x: Vec<Vec<Id>> = Vec::with_capacity(n);
         for i in 0..n {
@@ -120,6 +123,7 @@ impl Factors {
                 inv[j][i] = e;
             }
         }
+        g.set_flattening(old);
         inv
     }
 

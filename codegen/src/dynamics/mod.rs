@@ -33,7 +33,7 @@ pub mod rnea_derivatives;
 
 use std::time::{Duration, Instant};
 
-use crate::cas::{Graph, GraphFull, Id, Limits};
+use crate::cas::{Graph, GraphFull, Id, Limits, SumFlattening};
 use crate::kinematics::{const_v3, Params, WorldKinematics, M3, V3};
 use crate::model::Model;
 use lagrangian::{Closed, Friction};
@@ -303,6 +303,9 @@ impl Derivation {
             )?),
             false => None,
         };
+        // From here on a sum used by several others is computed once (see SumFlattening):
+        // the recursions reuse each body's sums in its children and in the backward pass.
+        g.set_flattening(SumFlattening::Shared);
         let lm = newton_euler::LocalModel::new(&mut g, model, &params, &c.joint_q);
         g.check()?;
         if closed.is_none() {
@@ -327,8 +330,11 @@ impl Derivation {
         let fast = fast::fast_forms(&mut g, model, closed.as_ref(), &rec, f, qd, parents)?;
         clock.lap("fast forms");
         let m = &joint_mass_matrix;
+        // The centre of mass sums every body's first moment: merged sums collect its terms.
+        let old = g.set_flattening(SumFlattening::Always);
         let centroidal = Centroidal::new(&mut g, model, &lm, &world, &c.joint_qd, m);
         let centroidal = centroidal.projected(&mut g, &map);
+        g.set_flattening(old);
         g.check()?;
         let forms = Forms::new(&mut g, closed, &rec, &centroidal, grav);
         let joint_transforms = (0..lm.bodies())
@@ -412,6 +418,19 @@ impl Derivation {
         model: &Model,
         flat_max_ops: usize,
     ) -> Result<(), GraphFull> {
+        // Shared sums, as for the recursive algorithms the derivatives differentiate.
+        let old = self.graph.set_flattening(SumFlattening::Shared);
+        let added = self.add_derivative_stages(model, flat_max_ops);
+        self.graph.set_flattening(old);
+        added
+    }
+
+    /// The stages of [`Derivation::add_derivatives_flat_up_to`].
+    fn add_derivative_stages(
+        &mut self,
+        model: &Model,
+        flat_max_ops: usize,
+    ) -> Result<(), GraphFull> {
         let derived = derivatives::derive(self, model);
         self.graph.check()?;
         let extra = quantities::derivatives(self, &derived, flat_max_ops);
@@ -474,6 +493,8 @@ impl Derivation {
 fn finish(mut d: Derivation, model: &Model, mut clock: Clock) -> Derivation {
     d.quantities = quantities::catalogue(model, &mut d);
     mpc::add(&mut d, model);
+    // Reports and later stages that do not choose for themselves see the graph's default.
+    d.graph.set_flattening(SumFlattening::Always);
     clock.lap("catalogue");
     d.timings = clock.laps;
     d
