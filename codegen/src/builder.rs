@@ -86,12 +86,12 @@ pub const DEFAULT_MAX_FUNCTION_OPS: usize = 8000;
 
 /// The default of [`Builder::max_derivative_function_ops`]. The derivatives' bodies are where
 /// the blocks cost run time: on talos_full_v2 (50 joints, floating, two soles, native CPU) its
-/// inverse-dynamics derivatives (about 60,000 operations) took 13.9 us in blocks of 8,000
-/// operations, 13.1 us at 16,000 and 11.6 us at 32,000, for a native build (`scripts/build-cost`)
-/// of 50 s and 2.0 GiB instead of 52 s and 1.6 GiB; g1_29dof's (49,267 operations) 8.9 and
-/// 8.1 us, a build of 35 s and 1.5 GiB instead of 27 s and 1.1 GiB. Whole (64,000), talos's
-/// build took 2.9 GiB, and g1's would come close to issue 30's 2 GB.
-pub const DEFAULT_MAX_DERIVATIVE_FUNCTION_OPS: usize = 32_000;
+/// inverse-dynamics derivatives (then about 60,000 operations) took 13.9 us in blocks of 8,000
+/// operations, 13.1 us at 16,000 and 11.6 us at 32,000. The memory of a build is that of its
+/// longest block: g1_29dof's inverse-dynamics derivatives (30,702 operations) whole took its
+/// native build (`scripts/build-cost`) to 1.9 GiB, in two blocks 1.2 GiB, for 8 % of that
+/// function's run time (5.3 -> 5.7 us).
+pub const DEFAULT_MAX_DERIVATIVE_FUNCTION_OPS: usize = 24_000;
 
 /// Type names the generated code cannot take: `T` is its generic parameter.
 const RESERVED_TYPE_NAMES: &[&str] = &["T"];
@@ -291,7 +291,7 @@ impl Builder {
     /// The budget of [`Builder::max_function_ops`] for the bodies of the derivatives
     /// [`Builder::derivatives`] adds (`inverse_dynamics_derivatives`, straight-line
     /// `forward_dynamics_derivatives` and `mass_matrix_inverse`, the contact and impulse
-    /// partials; default [`DEFAULT_MAX_DERIVATIVE_FUNCTION_OPS`], 32,000). There the blocks'
+    /// partials; default [`DEFAULT_MAX_DERIVATIVE_FUNCTION_OPS`], 24,000). There the blocks'
     /// boundaries cost run time (about a sixth of a humanoid's inverse-dynamics derivatives at
     /// 8,000 operations a block), so they get longer blocks than the dynamics, at some compile
     /// memory. Set it after `max_function_ops`, which sets both.
