@@ -6,8 +6,9 @@
 //! pass over the graph is a simple loop, never a recursion that could overflow the stack.
 //!
 //! Constructors simplify as they build (see [`Graph::sum`] and [`Graph::product`]): constants
-//! fold, nested sums and products flatten, like terms and like factors collect, and children are
-//! kept sorted by `Id`, so equal expressions built in different orders get the same `Id`.
+//! fold, nested sums (as [`SumFlattening`] says) and products flatten, like terms and like
+//! factors collect, and children are kept sorted by `Id`, so equal expressions built in
+//! different orders get the same `Id`.
 
 use std::collections::HashMap;
 use std::hash::{BuildHasher, Hash, Hasher};
@@ -428,21 +429,22 @@ impl Graph {
         }
     }
 
-    /// `constant + sum of coefficient * term`, simplified: constants fold, nested sums flatten,
-    /// like terms collect (`2x + 3x = 5x`), zero terms vanish.
+    /// `constant + sum of coefficient * term`, simplified: constants fold, nested sums flatten
+    /// (those [`Graph::flattening`] merges), like terms collect (`2x + 3x = 5x`), zero terms
+    /// vanish.
     pub fn sum(&mut self, constant: f64, terms: impl IntoIterator<Item = (Id, f64)>) -> Id {
-        let terms: Vec<(Id, f64)> = terms.into_iter().filter(|t| t.1 != 0.0).collect();
-        let merge = self.merged_inputs(constant, &terms);
         let mut c = constant;
         let mut flat: Vec<(Id, f64)> = Vec::new();
-        for (&(id, k), merge) in terms.iter().zip(merge) {
-            match &self.nodes[id.index()] {
-                Node::Const(v) => c += k * v.get(),
-                Node::Add(c2, ts) if merge => {
-                    c += k * c2.get();
-                    flat.extend(ts.iter().map(|&(t, kt)| (t, k * kt.get())));
-                }
-                _ => flat.push((id, k)),
+        let terms = terms.into_iter().filter(|t| t.1 != 0.0);
+        if self.flattening == SumFlattening::Always {
+            for (id, k) in terms {
+                self.push_term(&mut c, &mut flat, (id, k), true);
+            }
+        } else {
+            let terms: Vec<(Id, f64)> = terms.collect();
+            let merge = self.merged_inputs(constant, &terms);
+            for (&term, merge) in terms.iter().zip(merge) {
+                self.push_term(&mut c, &mut flat, term, merge);
             }
         }
         flat.sort_unstable_by_key(|t| t.0);
@@ -458,6 +460,19 @@ impl Graph {
             [] => self.constant(c),
             [(id, k)] if c == 0.0 && k.get() == 1.0 => *id,
             _ => self.intern(Node::Add(Num::new(c), merged.into_boxed_slice())),
+        }
+    }
+
+    /// Adds `k * id` to a sum being built: a constant to `c`, a small child sum's terms when
+    /// `merge` says so (and it is at most [`Limits::max_flatten`] terms), else the term.
+    fn push_term(&self, c: &mut f64, flat: &mut Vec<(Id, f64)>, (id, k): (Id, f64), merge: bool) {
+        match &self.nodes[id.index()] {
+            Node::Const(v) => *c += k * v.get(),
+            Node::Add(c2, ts) if merge && ts.len() <= self.limits.max_flatten => {
+                *c += k * c2.get();
+                flat.extend(ts.iter().map(|&(t, kt)| (t, k * kt.get())));
+            }
+            _ => flat.push((id, k)),
         }
     }
 
