@@ -315,7 +315,7 @@ pub mod robots {
     pub mod panda_mpc {
         include!(concat!(env!("OUT_DIR"), "/panda_mpc.rs"));
     }
-    /// A synthetic 24-joint serial chain with only forward and inverse dynamics: forward
+    /// A synthetic 28-joint serial chain with only forward and inverse dynamics: forward
     /// dynamics solves at run time (the tree `L^T D L` factorization, unrolled).
     pub mod chain28 {
         include!(concat!(env!("OUT_DIR"), "/chain28.rs"));
