@@ -327,9 +327,12 @@ fn inverse_dynamics(d: &Derivation, notes: &Notes) -> Quantity {
 }
 
 /// Forward dynamics unrolled into straight-line code when that is at most this many
-/// operations; beyond, `M` from `mass_matrix` and a sparse solve at run time (a 48-joint chain's
-/// unrolled solve and second copy of `M` were 49k lines of its 172k).
-pub const FORWARD_DYNAMICS_FLAT_MAX_OPS: usize = 20_000;
+/// operations (one block of the default `max_function_ops`); beyond, `M` from `mass_matrix`
+/// and the tree's factorization unrolled for the robot, at run time. A 48-joint chain's
+/// unrolled solve and second copy of `M` were 49k lines of its 172k, and g1_29dof's
+/// straight-line forward dynamics (15,963 operations, two blocks) took 2.49 us against
+/// 2.25 us composed (2.16 us as one block of 16,000, at a build's memory).
+pub const FORWARD_DYNAMICS_FLAT_MAX_OPS: usize = 8_000;
 
 fn forward_dynamics(d: &Derivation, notes: &Notes) -> Quantity {
     let unrolled: Vec<Id> = d
