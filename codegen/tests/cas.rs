@@ -143,6 +143,15 @@ fn eval(g: &Graph, e: &[Id], x: &[f64]) -> Vec<f64> {
     .unwrap()
 }
 
+/// `d t / d x_var` by central differences of the tree itself.
+fn central_difference(t: &Tree, x: &[f64], var: usize) -> f64 {
+    let h = 1e-5;
+    let (mut xp, mut xm) = (x.to_vec(), x.to_vec());
+    xp[var] += h;
+    xm[var] -= h;
+    (t.eval(&xp) - t.eval(&xm)) / (2.0 * h)
+}
+
 fn close(a: f64, b: f64, tol: f64) -> bool {
     (a - b).abs() <= tol * (1.0 + a.abs().max(b.abs()))
 }
@@ -160,17 +169,34 @@ proptest! {
         prop_assert!(close(got, want, 1e-9), "{} vs {}", got, want);
     }
 
+    /// Shared sums (kept whole unless their terms collect) change the expressions' shape, not
+    /// their value: the graph and its program evaluate like the tree, derivatives included.
+    #[test]
+    fn shared_sums_evaluate_like_the_tree(t in tree(), x in point(), var in 0..NVARS) {
+        let mut g = Graph::new();
+        g.set_flattening(SumFlattening::Shared);
+        let e = t.build(&mut g);
+        let v = g.q(var);
+        let de = g.diff(e, v);
+        let want = t.eval(&x);
+        prop_assume!(want.is_finite() && want.abs() < 1e8);
+        let got = eval(&g, &[e], &x)[0];
+        prop_assert!(close(got, want, 1e-9), "{} vs {}", got, want);
+        let p = Program::new(&g, &[e, de]);
+        let run = p.eval(|s| match s.kind { eomgen::cas::SymbolKind::Q(i) => x.get(i).copied(), _ => None }).unwrap();
+        prop_assert!(close(run[0], want, 1e-9), "program {} vs {}", run[0], want);
+        let fd = central_difference(&t, &x, var);
+        prop_assume!(fd.is_finite() && fd.abs() < 1e4);
+        prop_assert!(close(run[1], fd, 1e-4), "d/dq{}: {} vs {}", var, run[1], fd);
+    }
+
     #[test]
     fn derivative_matches_central_differences(t in tree(), x in point(), var in 0..NVARS) {
         let mut g = Graph::new();
         let e = t.build(&mut g);
         let v = g.q(var);
         let de = g.diff(e, v);
-        let h = 1e-5;
-        let (mut xp, mut xm) = (x.clone(), x.clone());
-        xp[var] += h;
-        xm[var] -= h;
-        let fd = (t.eval(&xp) - t.eval(&xm)) / (2.0 * h);
+        let fd = central_difference(&t, &x, var);
         prop_assume!(fd.is_finite() && fd.abs() < 1e4);
         let got = eval(&g, &[de], &x)[0];
         prop_assert!(close(got, fd, 1e-4), "d/dq{}: {} vs {}", var, got, fd);

@@ -476,9 +476,9 @@ impl Graph {
         }
     }
 
-    /// Which inputs of a sum are child sums to merge into it, by [`Graph::flattening`]. A
-    /// child sum of more than [`Limits::max_flatten`] terms stays one term: merging it into
-    /// every parent would make building quadratic in its size.
+    /// Which inputs of a sum are child sums to merge into it under
+    /// [`SumFlattening::Shared`]. A child sum of more than [`Limits::max_flatten`] terms stays
+    /// one term: merging it into every parent would make building quadratic in its size.
     fn merged_inputs(&self, constant: f64, terms: &[(Id, f64)]) -> Vec<bool> {
         let max = self.limits.max_flatten;
         let child = |id: Id| match &self.nodes[id.index()] {
@@ -487,10 +487,10 @@ impl Graph {
         };
         let mut merge: Vec<bool> = terms.iter().map(|t| child(t.0).is_some()).collect();
         let negation = constant == 0.0 && terms.len() == 1 && terms[0].1 == -1.0;
-        if self.flattening == SumFlattening::Always || negation {
+        if negation {
             return merge;
         }
-        // Shared: scaled terms merge; a sum of several terms only when it collects.
+        // Scaled terms merge; a sum of several terms only when it collects.
         let several = |id: Id| child(id).is_some_and(|ts| ts.len() > 1);
         if !terms.iter().any(|t| several(t.0)) {
             return merge;

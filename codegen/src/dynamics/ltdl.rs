@@ -23,6 +23,8 @@ impl Factors {
     /// Factorizes `m` (only its lower triangle's tree entries are read).
     pub(crate) fn new(g: &mut Graph, parent: &[Option<usize>], m: &[Vec<Id>]) -> Factors {
         let n = m.len();
+        // Merged sums: the updates of one entry by each descendant collect with `M`'s terms
+        // (shared sums gave the forward dynamics 1 to 3 % more operations, here and below).
         let old = g.set_flattening(SumFlattening::Always);
         let ancestors: Vec<Vec<usize>> = (0..n).map(|k| ancestors(parent, k)).collect();
         let mut h: Vec<Vec<Id>> = m.to_vec();
