@@ -585,6 +585,12 @@ impl<T: Lane, const N: usize> TreePasses<T, N> for Walked {
 /// read-modify-writes of the same row stall on store forwarding, and on a 50-DoF humanoid the
 /// push form took twice as long.
 ///
+/// A row's updates go from its last descendant to its first: the rows finished first come
+/// first, and the nearest rows, finished just before, last, so that the processor gathers the
+/// rest while those are still being computed (a floating base's six rows gather from every
+/// joint below them, one after another: in the other order each waited for the one below it;
+/// anymal's forward-dynamics derivatives 3.35 -> 3.18 us).
+///
 /// `SPARSE`: `x` is the identity, whatever it holds on entry (each row starts from its unit row,
 /// and is written whole), and row `k` keeps its support `k..ends[k]` through this pass, so only
 /// the chunks of columns there are gathered.
@@ -598,14 +604,15 @@ fn pull_from_subtrees<T: Lane, const N: usize, const C: usize, const SPARSE: boo
     // `ends[a]` may belong to other subtrees when the order is not depth first).
     let mut inside = [false; N];
     for a in (0..N).rev() {
-        let mut acc = if SPARSE { unit_row(a) } else { x[a] };
         for k in a + 1..ends[a] {
-            let below =
+            inside[k] =
                 parent[k].is_some_and(|p| p == a || (p > a && inside.get(p) == Some(&true)));
-            inside[k] = below;
-            if below && SPARSE {
+        }
+        let mut acc = if SPARSE { unit_row(a) } else { x[a] };
+        for k in (a + 1..ends[a]).rev().filter(|&k| inside[k]) {
+            if SPARSE {
                 sub_scaled_chunks(&mut acc, &x[k], m[k][a], k..ends[k]);
-            } else if below {
+            } else {
                 axpy(&mut acc, -m[k][a], &x[k]);
             }
         }
@@ -624,7 +631,7 @@ fn unit_row<T: Lane, const C: usize>(a: usize) -> [T; C] {
 
 /// `D^-1`, then `L^-1`: row `i` of `x` less `L[i][a]` times row `a` for every
 /// ancestor `a`, from the first row down, gathered in one accumulator per row (see
-/// [`pull_from_subtrees`]).
+/// [`pull_from_subtrees`]), the root's row first and the parent's (finished last) last.
 ///
 /// `UPPER`: only the columns from `i` on are needed in row `i` (a symmetric result, mirrored
 /// afterwards), so only the chunks of columns there are gathered; the columns before `i` in
@@ -639,15 +646,22 @@ fn pull_from_ancestors<T: Lane, const N: usize, const C: usize, const UPPER: boo
         // One division per row rather than per column.
         let inv = T::one() / m[i][i];
         acc.iter_mut().for_each(|v| *v *= inv);
+        // The ancestors, parent first (at most N: a cycle cannot loop).
+        let mut chain = [0; N];
+        let mut len = 0;
         let mut a = parent[i];
-        while let Some(row) = a.and_then(|aa| x.get(aa)) {
-            let aa = a.unwrap_or(0);
+        while let (Some(aa), Some(slot)) = (a, chain.get_mut(len)) {
+            *slot = aa;
+            len += 1;
+            a = parent.get(aa).copied().flatten();
+        }
+        for &aa in chain.iter().take(len).rev() {
+            let Some(row) = x.get(aa) else { continue };
             if UPPER {
                 sub_scaled_chunks(&mut acc, row, m[i][aa], i..C);
             } else {
                 axpy(&mut acc, -m[i][aa], row);
             }
-            a = parent.get(aa).copied().flatten();
         }
         x[i] = acc;
     }

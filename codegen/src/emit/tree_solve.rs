@@ -161,8 +161,8 @@ fn gather(target: usize, init: Option<TokenStream>, updates: &[Update]) -> Token
 }
 
 /// `L^-T` (from the leaves up): row `a` less `L[k][a]` times row `k` for each `k` of its
-/// subtree, in increasing order, over `span(k)`; `init(a)` its starting value (`None`: the row
-/// as it is). The runtime's
+/// subtree, last first (the nearest rows, finished last, are gathered last), over `span(k)`;
+/// `init(a)` its starting value (`None`: the row as it is). The runtime's
 /// `pull_from_subtrees`.
 fn from_subtrees(
     parents: &[Option<usize>],
@@ -174,6 +174,7 @@ fn from_subtrees(
         .rev()
         .map(|a| {
             let updates: Vec<Update> = (a + 1..ends[a])
+                .rev()
                 .filter(|&k| ancestors(parents, k).contains(&a))
                 .map(|k| Update {
                     row: k,
@@ -187,11 +188,15 @@ fn from_subtrees(
         .collect()
 }
 
-/// `D^-1`, then `L^-1` (from the root down): row `i` scaled by `1 / D[i]`, less `L[i][a]`
-/// times row `a` for each ancestor `a`, nearest first, over `span(i)`. The runtime's
+/// `D^-1`, then `L^-1` (from the root down): row `i` scaled by `one / D[i]` (`one` is `1`, or
+/// `-1` for the negated result: every operation's sign flips, the result is negated to the
+/// bit), less `L[i][a]`
+/// times row `a` for each ancestor `a`, the root first and the parent last, over `span(i)`.
+/// The runtime's
 /// `pull_from_ancestors`.
 fn from_ancestors(
     parents: &[Option<usize>],
+    one: &TokenStream,
     span: impl Fn(usize) -> Span,
 ) -> Vec<(usize, TokenStream)> {
     (0..parents.len())
@@ -199,6 +204,7 @@ fn from_ancestors(
             let il = usize_lit(i);
             let updates: Vec<Update> = ancestors(parents, i)
                 .into_iter()
+                .rev()
                 .map(|a| Update {
                     row: i,
                     col: a,
@@ -208,7 +214,7 @@ fn from_ancestors(
                 .collect();
             let init = quote! {{
                 let mut row = x[#il];
-                let inv = T::one() / m[#il][#il];
+                let inv = #one / m[#il][#il];
                 for v in row.iter_mut() {
                     *v *= inv;
                 }
@@ -221,16 +227,18 @@ fn from_ancestors(
 
 /// The rows `(updates, code)` as functions `name_0`, `name_1`, ... of at most
 /// [`PART_UPDATES`] updates each (a row with more is a function alone), with the signature
-/// `x` (the type of the matrix the rows update) and `generics`: the functions and the calls
-/// of them in order.
+/// `x` (the type of the matrix the rows update), `generics` and `extra` (more parameters, as
+/// `(names, types)`): the functions and the calls of them in order.
 fn in_parts(
     name: &str,
     generics: TokenStream,
     turbofish: TokenStream,
     x: TokenStream,
+    extra: (&[TokenStream], &[TokenStream]),
     n: &Literal,
     rows: Vec<(usize, TokenStream)>,
 ) -> (TokenStream, TokenStream) {
+    let (names, types) = extra;
     let mut parts: Vec<Vec<TokenStream>> = Vec::new();
     let mut size = 0;
     for (updates, code) in rows {
@@ -245,20 +253,21 @@ fn in_parts(
             }
         }
     }
-    let names: Vec<_> = (0..parts.len())
+    let args = quote!(m, x #(, #names)*);
+    let functions: Vec<_> = (0..parts.len())
         .map(|p| format_ident!("{}_{}", name, p))
         .collect();
-    let bodies = names.iter().zip(&parts).map(|(f, rows)| {
+    let bodies = functions.iter().zip(&parts).map(|(f, rows)| {
         quote! {
             #[inline(never)]
-            fn #f #generics(m: &[[T; #n]; #n], x: &mut #x) {
+            fn #f #generics(m: &[[T; #n]; #n], x: &mut #x #(, #names: #types)*) {
                 #(#rows)*
             }
         }
     });
     (
         quote!(#(#bodies)*),
-        quote!(#(Self::#names #turbofish(m, x);)*),
+        quote!(#(Self::#functions #turbofish(#args);)*),
     )
 }
 
@@ -280,9 +289,19 @@ pub(super) fn inverse_fn(parents: &[Option<usize>], n: &Literal) -> TokenStream 
         }})
     };
     let mut rows = from_subtrees(parents, unit, |k| Span::chunks(k, ends[k], size));
-    rows.extend(from_ancestors(parents, |i| Span::chunks(i, size, size)));
+    rows.extend(from_ancestors(parents, &quote!(T::one()), |i| {
+        Span::chunks(i, size, size)
+    }));
     let x = quote!([[T; #n]; #n]);
-    let (parts, calls) = in_parts("ltdl_inverse_part", quote!(), quote!(), x, n, rows);
+    let (parts, calls) = in_parts(
+        "ltdl_inverse_part",
+        quote!(),
+        quote!(),
+        x,
+        (&[], &[]),
+        n,
+        rows,
+    );
     quote! {
         #parts
         /// `M^-1` from the factors of `ltdl_factor_unrolled`, whatever `x` held
@@ -308,33 +327,48 @@ pub(super) fn lower_rows_fn(parents: &[Option<usize>], n: &Literal) -> TokenStre
     let rows = from_subtrees(parents, |_| None, |_| Span::All);
     let doc = "`x <- L^-T x` for the `C` columns of `x` with the factors of \
                `ltdl_factor_unrolled` (`eomgen_runtime::tree::ltdl_lower_rows` unrolled).";
-    columns_fn("ltdl_lower_rows", doc, n, rows)
+    columns_fn("ltdl_lower_rows", doc, n, (&[], &[]), rows)
 }
 
-/// `fn ltdl_upper_rows_unrolled::<C>(m, x)`: `x <- L^-1 D^-1 x` for the `C` columns of `x`, the
-/// second half of the substitution after `ltdl_lower_rows_unrolled` (the two together are
-/// `tree::ltdl_substitute_rows`, to the bit), the tree walks done here.
+/// `fn ltdl_upper_rows_unrolled::<C>(m, x, one)`: `x <- one L^-1 D^-1 x` for the `C` columns of
+/// `x`, the second half of the substitution after `ltdl_lower_rows_unrolled` (the two together
+/// are `tree::ltdl_substitute_rows`, to the bit, with `one` = 1; `one` = -1 negates the result,
+/// to the bit, for the cost of none), the tree walks done here.
 pub(super) fn upper_rows_fn(parents: &[Option<usize>], n: &Literal) -> TokenStream {
-    let rows = from_ancestors(parents, |_| Span::All);
-    let doc = "`x <- L^-1 D^-1 x` for the `C` columns of `x` with the factors of \
+    let rows = from_ancestors(parents, &quote!(one), |_| Span::All);
+    let doc = "`x <- one L^-1 D^-1 x` for the `C` columns of `x` with the factors of \
                `ltdl_factor_unrolled` (the second pass of \
-               `eomgen_runtime::tree::ltdl_substitute_rows` unrolled).";
-    columns_fn("ltdl_upper_rows", doc, n, rows)
+               `eomgen_runtime::tree::ltdl_substitute_rows` unrolled; `one` = -1 negates it).";
+    columns_fn(
+        "ltdl_upper_rows",
+        doc,
+        n,
+        (&[quote!(one)], &[quote!(T)]),
+        rows,
+    )
 }
 
-/// `fn NAME_unrolled::<C>(m, x)` documented by `doc`, calling the parts (`NAME_part_0`, ...)
-/// that hold `rows` over all `C` columns of `x`.
-fn columns_fn(name: &str, doc: &str, n: &Literal, rows: Vec<(usize, TokenStream)>) -> TokenStream {
+/// `fn NAME_unrolled::<C>(m, x, extra...)` documented by `doc`, calling the parts
+/// (`NAME_part_0`, ...) that hold `rows` over all `C` columns of `x`; `extra` are more
+/// parameters, as `(names, types)`, passed on to each part.
+fn columns_fn(
+    name: &str,
+    doc: &str,
+    n: &Literal,
+    extra: (&[TokenStream], &[TokenStream]),
+    rows: Vec<(usize, TokenStream)>,
+) -> TokenStream {
     let generics = quote!(<const C: usize>);
     let x = quote!([[T; C]; #n]);
     let part = format!("{name}_part");
-    let (parts, calls) = in_parts(&part, generics, quote!(::<C>), x, n, rows);
+    let (parts, calls) = in_parts(&part, generics, quote!(::<C>), x, extra, n, rows);
     let f = format_ident!("{}_unrolled", name);
+    let (names, types) = extra;
     quote! {
         #parts
         #[doc = #doc]
         #[inline(never)]
-        fn #f<const C: usize>(m: &[[T; #n]; #n], x: &mut [[T; C]; #n]) {
+        fn #f<const C: usize>(m: &[[T; #n]; #n], x: &mut [[T; C]; #n] #(, #names: #types)*) {
             #calls
         }
     }

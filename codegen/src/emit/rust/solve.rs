@@ -271,7 +271,7 @@ impl Emitter<'_> {
                 #[inline(always)]
                 fn substitute_rows<const C: usize>(m: &[[T; #n]; #n], _: &[Option<usize>; #n], x: &mut [[T; C]; #n]) {
                     Self::ltdl_lower_rows_unrolled::<C>(m, x);
-                    Self::ltdl_upper_rows_unrolled::<C>(m, x);
+                    Self::ltdl_upper_rows_unrolled::<C>(m, x, T::one());
                 }
                 #[inline(always)]
                 fn inverse_into(m: &[[T; #n]; #n], _: &[Option<usize>; #n], x: &mut [[T; #n]; #n]) {
@@ -340,12 +340,10 @@ impl Emitter<'_> {
                 }
                 let qdd = Self::ltdl_substitute_unrolled(&m, &rhs);
                 #id_derivatives
+                // -M^-1 d tau: the upper pass's `-1` negates, to the bit.
                 for x in [&mut *dq, &mut *dqd] {
                     Self::ltdl_lower_rows_unrolled::<#n>(&m, x);
-                    Self::ltdl_upper_rows_unrolled::<#n>(&m, x);
-                    for v in x.iter_mut().flatten() {
-                        *v = -*v;
-                    }
+                    Self::ltdl_upper_rows_unrolled::<#n>(&m, x, -T::one());
                 }
                 Self::ltdl_inverse_unrolled(&m, inverse);
                 for x in [dq, dqd, inverse] {
