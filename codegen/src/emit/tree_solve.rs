@@ -69,9 +69,11 @@ pub(super) fn substitute_fn(parents: &[Option<usize>], n: &Literal) -> TokenStre
             quote!(x[#jl] = (-m[#il][#jl]).mul_add(x[#il], x[#jl]);)
         })
     });
+    // Each row's ancestors root first and parent last: the parent's value is finished last,
+    // so the rest of the row's sum is gathered while it is computed.
     let down = (0..parents.len()).flat_map(|i| {
         let il = usize_lit(i);
-        ancestors(parents, i).into_iter().map(move |j| {
+        ancestors(parents, i).into_iter().rev().map(move |j| {
             let jl = usize_lit(j);
             quote!(x[#il] = (-m[#il][#jl]).mul_add(x[#jl], x[#il]);)
         })
