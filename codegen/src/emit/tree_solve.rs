@@ -97,7 +97,7 @@ pub(super) fn substitute_fn(parents: &[Option<usize>], n: &Literal) -> TokenStre
 /// Columns per chunk of the runtime's `tree` passes (`eomgen_runtime::tree::CHUNK`, which the
 /// library does not depend on; a unit test holds the two equal): the inverse below updates
 /// whole chunks as they do, so that its result is theirs to the bit.
-const CHUNK: usize = 8;
+const CHUNK: usize = 2;
 
 /// Row updates per generated function of the passes below: one function of 50 rows and 760
 /// updates (a 50-DoF humanoid's inverse) took a frame of 28 kB, most of it the compiler's
