@@ -190,12 +190,10 @@ fn from_subtrees(
         .collect()
 }
 
-/// `D^-1`, then `L^-1` (from the root down): row `i` scaled by `one / D[i]` (`one` is `1`, or
-/// `-1` for the negated result: every operation's sign flips, the result is negated to the
-/// bit), less `L[i][a]`
-/// times row `a` for each ancestor `a`, the root first and the parent last, over `span(i)`.
-/// The runtime's
-/// `pull_from_ancestors`.
+/// `D^-1`, then `L^-1` (from the root down): row `i` scaled by `one / D[i]`, less `L[i][a]`
+/// times row `a` for each ancestor `a`, the root first and the parent last, over `span(i)`. The
+/// runtime's `pull_from_ancestors` when `one` is `1`; `-1` flips every operation's sign, so the
+/// result is negated to the bit.
 fn from_ancestors(
     parents: &[Option<usize>],
     one: &TokenStream,
@@ -227,20 +225,29 @@ fn from_ancestors(
         .collect()
 }
 
+/// Parameters a pass's functions take besides `m` and `x` (`params`, such as `, one: T`) and
+/// the arguments that pass them on (`args`, such as `, one`); none by default.
+#[derive(Default)]
+struct Extra {
+    params: TokenStream,
+    args: TokenStream,
+}
+
 /// The rows `(updates, code)` as functions `name_0`, `name_1`, ... of at most
 /// [`PART_UPDATES`] updates each (a row with more is a function alone), with the signature
-/// `x` (the type of the matrix the rows update), `generics` and `extra` (more parameters, as
-/// `(names, types)`): the functions and the calls of them in order.
+/// `x` (the type of the matrix the rows update), `generics` and `extra` (more parameters and
+/// the arguments that pass them on, each list with its leading comma): the functions and the
+/// calls of them in order.
 fn in_parts(
     name: &str,
     generics: TokenStream,
     turbofish: TokenStream,
     x: TokenStream,
-    extra: (&[TokenStream], &[TokenStream]),
+    extra: &Extra,
     n: &Literal,
     rows: Vec<(usize, TokenStream)>,
 ) -> (TokenStream, TokenStream) {
-    let (names, types) = extra;
+    let Extra { params, args } = extra;
     let mut parts: Vec<Vec<TokenStream>> = Vec::new();
     let mut size = 0;
     for (updates, code) in rows {
@@ -255,21 +262,20 @@ fn in_parts(
             }
         }
     }
-    let args = quote!(m, x #(, #names)*);
     let functions: Vec<_> = (0..parts.len())
         .map(|p| format_ident!("{}_{}", name, p))
         .collect();
     let bodies = functions.iter().zip(&parts).map(|(f, rows)| {
         quote! {
             #[inline(never)]
-            fn #f #generics(m: &[[T; #n]; #n], x: &mut #x #(, #names: #types)*) {
+            fn #f #generics(m: &[[T; #n]; #n], x: &mut #x #params) {
                 #(#rows)*
             }
         }
     });
     (
         quote!(#(#bodies)*),
-        quote!(#(Self::#functions #turbofish(#args);)*),
+        quote!(#(Self::#functions #turbofish(m, x #args);)*),
     )
 }
 
@@ -295,15 +301,8 @@ pub(super) fn inverse_fn(parents: &[Option<usize>], n: &Literal) -> TokenStream 
         Span::chunks(i, size, size)
     }));
     let x = quote!([[T; #n]; #n]);
-    let (parts, calls) = in_parts(
-        "ltdl_inverse_part",
-        quote!(),
-        quote!(),
-        x,
-        (&[], &[]),
-        n,
-        rows,
-    );
+    let none = Extra::default();
+    let (parts, calls) = in_parts("ltdl_inverse_part", quote!(), quote!(), x, &none, n, rows);
     quote! {
         #parts
         /// `M^-1` from the factors of `ltdl_factor_unrolled`, whatever `x` held
@@ -329,7 +328,7 @@ pub(super) fn lower_rows_fn(parents: &[Option<usize>], n: &Literal) -> TokenStre
     let rows = from_subtrees(parents, |_| None, |_| Span::All);
     let doc = "`x <- L^-T x` for the `C` columns of `x` with the factors of \
                `ltdl_factor_unrolled` (`eomgen_runtime::tree::ltdl_lower_rows` unrolled).";
-    columns_fn("ltdl_lower_rows", doc, n, (&[], &[]), rows)
+    columns_fn("ltdl_lower_rows", doc, n, &Extra::default(), rows)
 }
 
 /// `fn ltdl_upper_rows_unrolled::<C>(m, x, one)`: `x <- one L^-1 D^-1 x` for the `C` columns of
@@ -341,23 +340,20 @@ pub(super) fn upper_rows_fn(parents: &[Option<usize>], n: &Literal) -> TokenStre
     let doc = "`x <- one L^-1 D^-1 x` for the `C` columns of `x` with the factors of \
                `ltdl_factor_unrolled` (the second pass of \
                `eomgen_runtime::tree::ltdl_substitute_rows` unrolled; `one` = -1 negates it).";
-    columns_fn(
-        "ltdl_upper_rows",
-        doc,
-        n,
-        (&[quote!(one)], &[quote!(T)]),
-        rows,
-    )
+    let one = Extra {
+        params: quote!(, one: T),
+        args: quote!(, one),
+    };
+    columns_fn("ltdl_upper_rows", doc, n, &one, rows)
 }
 
 /// `fn NAME_unrolled::<C>(m, x, extra...)` documented by `doc`, calling the parts
-/// (`NAME_part_0`, ...) that hold `rows` over all `C` columns of `x`; `extra` are more
-/// parameters, as `(names, types)`, passed on to each part.
+/// (`NAME_part_0`, ...) that hold `rows` over all `C` columns of `x`, passing `extra` on.
 fn columns_fn(
     name: &str,
     doc: &str,
     n: &Literal,
-    extra: (&[TokenStream], &[TokenStream]),
+    extra: &Extra,
     rows: Vec<(usize, TokenStream)>,
 ) -> TokenStream {
     let generics = quote!(<const C: usize>);
@@ -365,12 +361,12 @@ fn columns_fn(
     let part = format!("{name}_part");
     let (parts, calls) = in_parts(&part, generics, quote!(::<C>), x, extra, n, rows);
     let f = format_ident!("{}_unrolled", name);
-    let (names, types) = extra;
+    let params = &extra.params;
     quote! {
         #parts
         #[doc = #doc]
         #[inline(never)]
-        fn #f<const C: usize>(m: &[[T; #n]; #n], x: &mut [[T; C]; #n] #(, #names: #types)*) {
+        fn #f<const C: usize>(m: &[[T; #n]; #n], x: &mut [[T; C]; #n] #params) {
             #calls
         }
     }
