@@ -311,8 +311,10 @@ impl Builder {
     /// this many operations (default [`crate::dynamics::DERIVATIVES_FLAT_MAX_OPS`], 20,000), and
     /// `mass_matrix_inverse` up to a fifth of it
     /// ([`crate::dynamics::MASS_MATRIX_INVERSE_FLAT_DIVISOR`]); beyond, they are composed at run
-    /// time from `mass_matrix`, its factorization unrolled for the robot's tree and
-    /// `inverse_dynamics_derivatives`. Straight-line code is faster on small robots (an arm); the
+    /// time: `forward_dynamics_derivatives` from `forward_dynamics_partials` (`d tau` at the
+    /// forward dynamics' accelerations and `M`'s factors, one straight-line body) and the
+    /// passes of the factorization unrolled for the robot's tree, `mass_matrix_inverse` from
+    /// `mass_matrix`. Straight-line code is faster on small robots (an arm); the
     /// composed route compiles faster and is faster from a quadruped on. `0` always composes.
     ///
     /// ```
@@ -341,7 +343,8 @@ impl Builder {
     ///   `contact_forward_dynamics`, `contact_forward_dynamics_active`,
     ///   `contact_forward_dynamics_stabilized`, `impulse_dynamics`, `impulse_dynamics_active`;
     /// - with [`Builder::derivatives`]: `inverse_dynamics_derivatives`,
-    ///   `forward_dynamics_derivatives`, `mass_matrix_inverse`, and with contacts
+    ///   `forward_dynamics_derivatives`, `mass_matrix_inverse`, `forward_dynamics_partials`
+    ///   (where the forward-dynamics derivatives are composed at run time), and with contacts
     ///   `contact_dynamics_partials`, `contact_forward_dynamics_derivatives`,
     ///   `contact_forward_dynamics_derivatives_active`, `impulse_dynamics_partials`,
     ///   `impulse_dynamics_derivatives`, `impulse_dynamics_derivatives_active`;

@@ -71,7 +71,10 @@ fn forward_dynamics_derivatives_are_the_runtime_ones() {
             let e = normwise(&flat(&ours), &flat(&runtime));
             assert!(e < 1e-10, "seed {seed}: {what} {e:e}");
         }
-        assert_eq!(inverse, robot.mass_matrix_inverse(&q), "seed {seed}");
+        // `M^-1` from the symbolic factors of `forward_dynamics_partials`, against the one
+        // from `mass_matrix`'s factors at run time: the same to rounding.
+        let e = normwise(&flat(&inverse), &flat(&robot.mass_matrix_inverse(&q)));
+        assert!(e < TOLERANCE, "seed {seed}: M^-1 {e:e}");
     }
 }
 

@@ -125,11 +125,11 @@ pub enum Evaluation {
     /// Straight-line expressions that hold when every pivot of the unrolled `L^T D L`
     /// factorization of `M` is positive (checked at run time: NaN in every entry otherwise).
     Factored { outputs: Vec<Id>, pivots: Vec<Id> },
-    /// `(d qdd/dq, d qdd/dqd, M^-1)` at run time through one tree factorization of
-    /// `mass_matrix`: `qdd` from it and `inverse_dynamics(q, qd, 0)`, then `-M^-1` times
-    /// `inverse_dynamics_derivatives` at `(q, qd, qdd)` (`tree::ltdl_substitute_rows`), and
-    /// `M^-1` from the same factors, unrolled over the tree (`tree::ltdl_inverse_factored`'s
-    /// operations; `emit::tree_solve`).
+    /// `(d qdd/dq, d qdd/dqd, M^-1)` at run time from `forward_dynamics_partials` (`d tau/dq`
+    /// and `d tau/dqd` at `qdd = FD(q, qd, tau)`, and the tree `L^T D L` factors of `M`, one
+    /// straight-line body): `-M^-1` times both (`tree::ltdl_substitute_rows`), and `M^-1` from
+    /// the same factors, unrolled over the tree (`tree::ltdl_inverse_factored`'s operations;
+    /// `emit::tree_solve`).
     ForwardDynamicsDerivatives,
     /// The accelerations and contact forces with the contact points held, solved at run time:
     /// `M` from `mass_matrix`, `h = b + G + F` straight-line, `J_c` and its drift from
@@ -340,11 +340,7 @@ impl Quantity {
                 "contact_jacobian",
                 "impulse_dynamics_partials",
             ],
-            Evaluation::ForwardDynamicsDerivatives => &[
-                "mass_matrix",
-                "inverse_dynamics",
-                "inverse_dynamics_derivatives",
-            ],
+            Evaluation::ForwardDynamicsDerivatives => &["forward_dynamics_partials"],
             _ => &[],
         }
     }
@@ -356,8 +352,7 @@ pub fn names(quantities: &[Quantity]) -> Vec<&'static str> {
 }
 
 /// Keeps the quantities named in `wanted` and everything they need, transitively (a need of a
-/// need, such as the `mass_matrix` that a run-time `forward_dynamics` calls for
-/// `forward_dynamics_derivatives`), in catalogue order; `Err` with the first unknown name.
+/// need too), in catalogue order; `Err` with the first unknown name.
 /// A runtime trait is implemented only with all its methods: when the selection leaves some
 /// of a trait's out, the ones kept become inherent ([`Home::Inherent`]).
 pub fn select(quantities: Vec<Quantity>, wanted: &[String]) -> Result<Vec<Quantity>, String> {
@@ -426,10 +421,13 @@ mod tests {
                 Evaluation::Exprs(Vec::new()),
             ),
             quantity("mass_matrix_inverse", Evaluation::MassMatrixInverse),
+            quantity("forward_dynamics_partials", Evaluation::Exprs(Vec::new())),
             quantity(
                 "forward_dynamics_derivatives",
                 Evaluation::ForwardDynamicsDerivatives,
             ),
+            quantity("centrifugal", Evaluation::CraigColumns(Craig::Centrifugal)),
+            quantity("coriolis_matrix", Evaluation::Exprs(Vec::new())),
         ]
     }
 
@@ -440,17 +438,17 @@ mod tests {
 
     #[test]
     fn the_needs_are_selected() {
-        // `forward_dynamics_derivatives` calls `mass_matrix`, `inverse_dynamics` and
-        // `inverse_dynamics_derivatives`, earlier in the catalogue; not `forward_dynamics` or
+        // `forward_dynamics_derivatives` calls `forward_dynamics_partials` alone, which computes
+        // its own `M` and accelerations: not `mass_matrix`, `inverse_dynamics` or
         // `mass_matrix_inverse`.
         assert_eq!(
             selected(&["forward_dynamics_derivatives"]),
-            [
-                "mass_matrix",
-                "inverse_dynamics",
-                "inverse_dynamics_derivatives",
-                "forward_dynamics_derivatives",
-            ]
+            ["forward_dynamics_partials", "forward_dynamics_derivatives"]
+        );
+        // A need later in the catalogue than the quantity that calls it.
+        assert_eq!(
+            selected(&["centrifugal"]),
+            ["centrifugal", "coriolis_matrix"]
         );
         assert_eq!(
             selected(&["forward_dynamics"]),

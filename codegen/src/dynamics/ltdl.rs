@@ -48,6 +48,20 @@ impl Factors {
         }
     }
 
+    /// The factors where the run-time tree passes keep them (`tree::ltdl_factor`'s layout):
+    /// `D` on the diagonal, `L_ij` at `(i, j)` for `j` an ancestor of `i`, zero elsewhere.
+    pub(crate) fn in_place(&self, g: &Graph) -> Vec<Vec<Id>> {
+        let n = self.h.len();
+        let mut m = vec![vec![g.zero(); n]; n];
+        for (i, anc) in self.ancestors.iter().enumerate() {
+            m[i][i] = self.h[i][i];
+            for &j in anc {
+                m[i][j] = self.h[i][j];
+            }
+        }
+        m
+    }
+
     /// The pivots `D`.
     pub(crate) fn pivots(&self) -> Vec<Id> {
         (0..self.h.len()).map(|i| self.h[i][i]).collect()

@@ -535,8 +535,9 @@ fn link_jacobian(n: usize) -> Quantity {
 /// `forward_dynamics_derivatives` is straight-line code (sharing `M`, its factorization and the
 /// accelerations) up to this many operations by default, `mass_matrix_inverse` up to this
 /// divided by [`MASS_MATRIX_INVERSE_FLAT_DIVISOR`] ([`crate::Builder::derivatives_flat_max_ops`]);
-/// beyond, they are composed at run time from
-/// `mass_matrix`, `forward_dynamics` and `inverse_dynamics_derivatives`.
+/// beyond, they are composed at run time: the forward-dynamics derivatives from
+/// `forward_dynamics_partials` (still one straight-line body up to `-M^-1`) and the tree's
+/// passes, `M^-1` from `mass_matrix`.
 ///
 /// Since the composed route's inverse is unrolled over the tree too, it is the faster one from
 /// a quadruped's size on: anymal's forward-dynamics derivatives (36,088 operations flat) took
@@ -577,9 +578,13 @@ pub fn derivatives(d: &Derivation, x: &Derivatives, flat_max_ops: usize) -> Vec<
     };
     let (fd_route, fd_eval) = match factored(fd, flat_max_ops) {
         Some(e) => ("Route: qdd as in `forward_dynamics`, `inverse_dynamics_derivatives` at (q, qd, qdd), then -M^-1 times them by substitutions through the one unrolled factorization of M, all in one straight-line body.", e),
-        None => ("Route: one factorization of M (from `mass_matrix`, the tree L^T D L unrolled): qdd from it and `inverse_dynamics` at zero acceleration, `inverse_dynamics_derivatives` at (q, qd, qdd), then -M^-1 times them by substitutions of all columns at once (the passes of eomgen_runtime::tree::ltdl_substitute_rows, unrolled for this robot's tree), and M^-1 from the same factors, unrolled over the tree (eomgen_runtime::tree::ltdl_inverse_factored's operations).", Evaluation::ForwardDynamicsDerivatives),
+        None => ("Route: `forward_dynamics_partials` (d tau / d q and d tau / d qd at qdd = FD(q, qd, tau), and M's factors), then -M^-1 times them by substitutions of all columns at once (the passes of eomgen_runtime::tree::ltdl_substitute_rows, unrolled for this robot's tree), and M^-1 from the same factors, unrolled over the tree (eomgen_runtime::tree::ltdl_inverse_factored's operations).", Evaluation::ForwardDynamicsDerivatives),
     };
-    vec![
+    let mut partials = flat(&x.partials[0]);
+    partials.extend(flat(&x.partials[1]));
+    partials.extend(flat(&x.partials[2]));
+    let composed = matches!(fd_eval, Evaluation::ForwardDynamicsDerivatives);
+    let mut out = vec![
         Quantity {
             name: "inverse_dynamics_derivatives",
             inputs: &[Input::Q, Input::Qd, Input::Qdd],
@@ -616,5 +621,30 @@ pub fn derivatives(d: &Derivation, x: &Derivatives, flat_max_ops: usize) -> Vec<
             route: fd_route.into(),
             eval: fd_eval,
         },
-    ]
+    ];
+    if composed {
+        out.insert(2, forward_dynamics_partials(n, partials));
+    }
+    out
+}
+
+/// What the run-time route of `forward_dynamics_derivatives` solves, in one straight-line body
+/// that shares the kinematics, `M` and its factorization between the forward dynamics'
+/// accelerations and the inverse-dynamics derivatives there.
+fn forward_dynamics_partials(n: usize, outputs: Vec<Id>) -> Quantity {
+    Quantity {
+        name: "forward_dynamics_partials",
+        inputs: &[Input::Q, Input::Qd, Input::Tau],
+        shape: Shape::Matrices(3, n, n),
+        home: Home::Inherent,
+        doc: vec![
+            "What `forward_dynamics_derivatives` solves: (d tau / d q, d tau / d qd) at the".into(),
+            "accelerations qdd = FD(q, qd, tau), and the tree L^T D L factors of M(q) (D on the".into(),
+            "diagonal, L_ij below it where j is an ancestor of i, zero elsewhere: the layout of".into(),
+            "`eomgen_runtime::tree::ltdl_factor`). Valid when every pivot D_i is positive; then".into(),
+            "d qdd / dx = -M^-1 d tau / dx.".into(),
+        ],
+        route: "Route: qdd by the unrolled L^T D L solve of `forward_dynamics`, then Carpentier and Mansard's recursive derivatives of Newton-Euler there, one straight-line body.".into(),
+        eval: Evaluation::Exprs(outputs),
+    }
 }

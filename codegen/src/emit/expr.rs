@@ -47,6 +47,17 @@ pub(super) fn lit(v: f64) -> TokenStream {
     }
 }
 
+/// [`lit`] as the whole right-hand side of an assignment: a negative number without the
+/// parentheses it needs inside an expression (`unused_parens` would flag them there).
+pub(super) fn assigned_lit(v: f64) -> TokenStream {
+    if v < 0.0 && v.is_finite() {
+        let l = Literal::f64_unsuffixed(-v);
+        quote!(-T::from_f64(#l))
+    } else {
+        lit(v)
+    }
+}
+
 impl Ctx<'_> {
     fn input(&self, s: u32, trig: &mut BTreeSet<(usize, bool)>, sin: Option<bool>) -> TokenStream {
         let sym = &self.symbols[s as usize];

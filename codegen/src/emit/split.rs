@@ -197,7 +197,10 @@ pub(super) fn split_body(
         let mut read = BTreeSet::new();
         temps_read(e, &mut read);
         let b = read.iter().map(|&t| of_temp[t]).max().unwrap_or(0);
-        let ts = cx.expr(e, &mut blocks[b].trig).ts;
+        let ts = match e {
+            Expr::Const(c) => super::expr::assigned_lit(*c),
+            _ => cx.expr(e, &mut blocks[b].trig).ts,
+        };
         let place = output_place(shape, j, split.rows);
         blocks[b].code.push(quote!(#place = #ts;));
         blocks[b].reads.extend(earlier_temps(e, b, &of_temp));

@@ -13,7 +13,11 @@ use crate::emit::split::Split;
 /// The quantities whose callers have them write into the callers' own results
 /// (`{name}_fill`): the inverse-dynamics derivatives (the composed forward-dynamics
 /// derivatives', the contact derivatives') and the impulse partials (the impulse derivatives').
-const FILLED: [&str; 2] = ["inverse_dynamics_derivatives", "impulse_dynamics_partials"];
+const FILLED: [&str; 3] = [
+    "inverse_dynamics_derivatives",
+    "impulse_dynamics_partials",
+    "forward_dynamics_partials",
+];
 
 impl Emitter<'_> {
     pub(super) fn quantity_fn(&mut self, q: &Quantity) -> TokenStream {

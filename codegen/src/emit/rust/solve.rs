@@ -171,13 +171,13 @@ impl Emitter<'_> {
             TokenStream::new()
         };
         // What substitutes through M's unrolled factors: forward dynamics, and contact dynamics,
-        // impulse dynamics and the contact derivatives for their one `M^-1 b` each.
+        // impulse dynamics and the contact derivatives for their one `M^-1 b` each (the
+        // forward-dynamics derivatives take M's factors from `forward_dynamics_partials`).
         let solves = |e: &Evaluation| {
             matches!(
                 e,
                 E::ForwardDynamicsSolve { .. }
                     | E::ContactForwardDynamics { .. }
-                    | E::ForwardDynamicsDerivatives
                     | E::ImpulseDynamics
                     | E::ContactDynamicsDerivatives { .. }
                     | E::ActiveContacts(
@@ -308,38 +308,34 @@ impl Emitter<'_> {
         }
     }
 
-    /// `(d qdd/dq, d qdd/dqd, M^-1)` through one factorization of `M`: `qdd` solves
-    /// `M qdd = tau - h` with `h = inverse_dynamics(q, qd, 0)`, then `d tau/dq` and `d tau/dqd`
-    /// there from `inverse_dynamics_derivatives`, both solves at once per matrix (the two
-    /// passes of `tree::ltdl_substitute_rows`, unrolled for the tree: `ltdl_lower_rows_unrolled`
-    /// and `ltdl_upper_rows_unrolled`), and `M^-1` from the same factors. Everything is written
-    /// into the caller's storage (`eomgen_runtime::place`), the derivatives of tau by
-    /// `inverse_dynamics_derivatives_fill` where that function was split.
+    /// `(d qdd/dq, d qdd/dqd, M^-1)` from `forward_dynamics_partials`, which writes `d tau/dq`
+    /// and `d tau/dqd` at the forward dynamics' accelerations straight into the result and M's
+    /// tree factors into a local (`forward_dynamics_partials_fill`: the kinematics, `M` and
+    /// its factorization computed once for both); the pivots checked, then `-M^-1` times both
+    /// matrices, all columns at once (the two passes of `tree::ltdl_substitute_rows`, unrolled
+    /// for the tree: `ltdl_lower_rows_unrolled` and `ltdl_upper_rows_unrolled`), and `M^-1`
+    /// from the same factors. Everything is written into the caller's storage
+    /// (`eomgen_runtime::place`).
     pub(super) fn forward_dynamics_derivatives_fn(&mut self, q: &Quantity) -> TokenStream {
         let docs = Self::quantity_doc(q, None);
         let (n, nq) = (&self.n, &self.nq);
-        let id = self.call("inverse_dynamics");
-        let mass_matrix = self.call("mass_matrix");
-        let id_derivatives = self.id_derivatives_into(quote!(*dq), quote!(*dqd), quote!(qdd));
+        debug_assert!(self.split.contains("forward_dynamics_partials"));
+        let partials = crate::emit::split::fill_name("forward_dynamics_partials");
         let matrix = quote!([[T; #n]; #n]);
         self.blocks.push(quote! {
             #[inline(never)]
             fn forward_dynamics_derivatives_in_place<'b>(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n], slot: ::eomgen_runtime::place::Slot<'b, (#matrix, #matrix, #matrix)>) -> ::eomgen_runtime::place::Filled<'b> {
                 let ((dq, dqd, inverse), filled) = slot.fill();
-                let mut m = #mass_matrix(self, q);
+                let mut m = [[T::zero(); #n]; #n];
+                self.#partials(q, qd, tau, dq, dqd, &mut m);
                 let mut failures = ::core::default::Default::default();
-                if Self::ltdl_factor_unrolled(&mut m, &mut failures).is_err() {
+                let pivots: [T; #n] = ::core::array::from_fn(|i| m[i][i]);
+                if ::eomgen_runtime::lane::check_pivots(&pivots, &mut failures).is_err() {
                     for v in dq.iter_mut().chain(dqd.iter_mut()).chain(inverse.iter_mut()).flatten() {
                         *v = T::nan();
                     }
                     return filled;
                 }
-                let mut rhs = *tau;
-                for (r, h) in rhs.iter_mut().zip(#id(self, q, qd, &[T::zero(); #n])) {
-                    *r -= h;
-                }
-                let qdd = Self::ltdl_substitute_unrolled(&m, &rhs);
-                #id_derivatives
                 // -M^-1 d tau: the upper pass's `-1` negates, to the bit.
                 for x in [&mut *dq, &mut *dqd] {
                     Self::ltdl_lower_rows_unrolled::<#n>(&m, x);
