@@ -101,7 +101,9 @@ impl Plan {
                 m: exprs_of("mass_matrix")?,
                 h: tape(h)?,
             },
-            Evaluation::MassMatrixInverse => Plan::Inverse(exprs_of("mass_matrix")?),
+            Evaluation::MassMatrixInverse | Evaluation::FactoredInverse { .. } => {
+                Plan::Inverse(exprs_of("mass_matrix")?)
+            }
             Evaluation::CraigColumns(which) => Plan::Craig {
                 coriolis: exprs_of("coriolis_matrix")?,
                 which: *which,
