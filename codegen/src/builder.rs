@@ -313,9 +313,8 @@ impl Builder {
     /// ([`crate::dynamics::MASS_MATRIX_INVERSE_FLAT_DIVISOR`]); beyond, they are composed at run
     /// time: `forward_dynamics_derivatives` from `forward_dynamics_partials` (`d tau` at the
     /// forward dynamics' accelerations and `M`'s factors, one straight-line body) and the
-    /// passes of the factorization unrolled for the robot's tree, `mass_matrix_inverse` from `M`
-    /// and its factors in one body (up to [`crate::dynamics::FACTORED_INVERSE_MAX_OPS`]) or from
-    /// `mass_matrix` and the factorization unrolled at run time. Straight-line code is faster on small robots (an arm); the
+    /// passes of the factorization unrolled for the robot's tree, `mass_matrix_inverse` from
+    /// `mass_matrix`. Straight-line code is faster on small robots (an arm); the
     /// composed route compiles faster and is faster from a quadruped on. `0` always composes.
     ///
     /// ```

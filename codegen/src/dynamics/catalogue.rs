@@ -122,11 +122,6 @@ pub enum Evaluation {
     /// `L^-1 D^-1 L^-T` unrolled over the tree too (`tree::ltdl_inverse_factored`'s operations;
     /// `emit::tree_solve`).
     MassMatrixInverse,
-    /// `M^-1` from `factors`, the tree `L^T D L` factors of `M` as one straight-line body
-    /// (row-major, `tree::ltdl_factor`'s layout), then `L^-1 D^-1 L^-T` unrolled over the tree
-    /// as for [`Evaluation::MassMatrixInverse`]: the kinematics, `M` and its factorization in
-    /// one body.
-    FactoredInverse { factors: Vec<Id> },
     /// Straight-line expressions that hold when every pivot of the unrolled `L^T D L`
     /// factorization of `M` is positive (checked at run time: NaN in every entry otherwise).
     Factored { outputs: Vec<Id>, pivots: Vec<Id> },
@@ -301,7 +296,6 @@ impl Quantity {
             Evaluation::Factored { outputs, pivots } => {
                 outputs.iter().chain(pivots).copied().collect()
             }
-            Evaluation::FactoredInverse { factors } => factors.clone(),
             _ => Vec::new(),
         }
     }

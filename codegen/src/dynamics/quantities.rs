@@ -537,7 +537,7 @@ fn link_jacobian(n: usize) -> Quantity {
 /// divided by [`MASS_MATRIX_INVERSE_FLAT_DIVISOR`] ([`crate::Builder::derivatives_flat_max_ops`]);
 /// beyond, they are composed at run time: the forward-dynamics derivatives from
 /// `forward_dynamics_partials` (still one straight-line body up to `-M^-1`) and the tree's
-/// passes, `M^-1` from `M`'s factors ([`FACTORED_INVERSE_MAX_OPS`]).
+/// passes, `M^-1` from `mass_matrix`.
 ///
 /// Since the composed route's inverse is unrolled over the tree too, it is the faster one from
 /// a quadruped's size on: anymal's forward-dynamics derivatives (36,088 operations flat) took
@@ -552,15 +552,6 @@ pub const DERIVATIVES_FLAT_MAX_OPS: usize = 20_000;
 /// flat) took 787 ns flat against 698 ns composed, the panda's (1,390) 165 ns against 256 ns
 /// (27 November 2026, native).
 pub const MASS_MATRIX_INVERSE_FLAT_DIVISOR: usize = 5;
-
-/// A composed `mass_matrix_inverse` takes `M` and its tree factorization as one straight-line
-/// body up to this many operations (as `forward_dynamics` takes its whole solve, up to
-/// [`FORWARD_DYNAMICS_FLAT_MAX_OPS`]), then the unrolled inverse; beyond, `M` from
-/// `mass_matrix` and the factorization unrolled at run time. In one body the factorization
-/// overlaps with `M` (anymal, 2,260 operations: 595 -> 559 ns); a humanoid's symbolic
-/// factorization is slower than the run-time one (g1_29dof, 9,698 operations: 2.39 -> 2.43 us;
-/// talos_full_v2, 15,279: 4.14 -> 4.41 us; 28 November 2026, native, alternated).
-pub const FACTORED_INVERSE_MAX_OPS: usize = FORWARD_DYNAMICS_FLAT_MAX_OPS;
 
 /// The derivatives of the dynamics ([`Derivation::add_derivatives`]): inverse dynamics
 /// (straight-line), `M^-1` and forward dynamics (straight-line, or composed at run time when
@@ -583,14 +574,7 @@ pub fn derivatives(d: &Derivation, x: &Derivatives, flat_max_ops: usize) -> Vec<
     let minv_limit = flat_max_ops / MASS_MATRIX_INVERSE_FLAT_DIVISOR;
     let (minv_route, minv_eval) = match factored(minv, minv_limit) {
         Some(e) => ("Route: M as in `mass_matrix`, an unrolled L^T D L factorization without fill-in, one substitution per column.", e),
-        None => {
-            let factors = flat(&x.partials[2]);
-            if ops(&d.graph, &factors) <= FACTORED_INVERSE_MAX_OPS {
-                ("Route: M and its sparse L^T D L factorization over the joint tree in one straight-line body, then L^-1 D^-1 L^-T over the tree, unrolled for this robot (eomgen_runtime::tree::ltdl_inverse_factored's operations, in parts of at most 128 row updates).", Evaluation::FactoredInverse { factors })
-            } else {
-                ("Route: M from `mass_matrix`, the sparse L^T D L factorization over the joint tree, unrolled for this robot, then L^-1 D^-1 L^-T over the tree, unrolled too (eomgen_runtime::tree::ltdl_inverse_factored's operations, in parts of at most 128 row updates).", Evaluation::MassMatrixInverse)
-            }
-        }
+        None => ("Route: M from `mass_matrix`, the sparse L^T D L factorization over the joint tree, unrolled for this robot, then L^-1 D^-1 L^-T over the tree, unrolled too (eomgen_runtime::tree::ltdl_inverse_factored's operations, in parts of at most 128 row updates).", Evaluation::MassMatrixInverse),
     };
     let (fd_route, fd_eval) = match factored(fd, flat_max_ops) {
         Some(e) => ("Route: qdd as in `forward_dynamics`, `inverse_dynamics_derivatives` at (q, qd, qdd), then -M^-1 times them by substitutions through the one unrolled factorization of M, all in one straight-line body.", e),

@@ -101,9 +101,7 @@ impl Plan {
                 m: exprs_of("mass_matrix")?,
                 h: tape(h)?,
             },
-            Evaluation::MassMatrixInverse | Evaluation::FactoredInverse { .. } => {
-                Plan::Inverse(exprs_of("mass_matrix")?)
-            }
+            Evaluation::MassMatrixInverse => Plan::Inverse(exprs_of("mass_matrix")?),
             Evaluation::CraigColumns(which) => Plan::Craig {
                 coriolis: exprs_of("coriolis_matrix")?,
                 which: *which,

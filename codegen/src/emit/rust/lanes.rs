@@ -18,7 +18,6 @@ fn evaluation_on_lanes(q: &Quantity) -> bool {
             | Evaluation::ForwardDynamics { .. }
             | Evaluation::ForwardDynamicsSolve { .. }
             | Evaluation::MassMatrixInverse
-            | Evaluation::FactoredInverse { .. }
             | Evaluation::Factored { .. }
             | Evaluation::ForwardDynamicsDerivatives
             | Evaluation::Integrate

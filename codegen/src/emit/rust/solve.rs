@@ -131,7 +131,6 @@ impl Emitter<'_> {
                 matches!(
                     e,
                     E::MassMatrixInverse
-                        | E::FactoredInverse { .. }
                         | E::ForwardDynamicsDerivatives
                         | E::ContactForwardDynamics { .. }
                         | E::ContactDynamicsDerivatives { .. }
@@ -213,12 +212,8 @@ impl Emitter<'_> {
         // The KKT systems of the contact and impulse derivatives take every pass over many
         // columns from the robot's `TreePasses` (`tree_passes_impl`).
         let passes = self.any_eval(kkt_derivatives);
-        let inverts = |e: &Evaluation| {
-            matches!(
-                e,
-                E::MassMatrixInverse | E::FactoredInverse { .. } | E::ForwardDynamicsDerivatives
-            )
-        };
+        let inverts =
+            |e: &Evaluation| matches!(e, E::MassMatrixInverse | E::ForwardDynamicsDerivatives);
         let inverse = if passes || self.any_eval(inverts) {
             crate::emit::tree_solve::inverse_fn(&self.parents, n)
         } else {
@@ -309,36 +304,6 @@ impl Emitter<'_> {
             #docs
             pub fn mass_matrix_inverse(&self, q: &[T; #nq]) -> [[T; #n]; #n] {
                 ::eomgen_runtime::place::build(|slot| self.mass_matrix_inverse_in_place(q, slot))
-            }
-        }
-    }
-
-    /// `M^-1` from M's tree factors computed in one straight-line body (`factors`, row-major,
-    /// `tree::ltdl_factor`'s layout), the pivots checked, then the unrolled inverse.
-    pub(super) fn factored_inverse_fn(&mut self, q: &Quantity, factors: &[Id]) -> TokenStream {
-        let (factored, ops) = self.straight(q, factors, q.shape);
-        let docs = Self::quantity_doc(q, Some(ops));
-        let (n, nq) = (&self.n, &self.nq);
-        self.blocks.push(quote! {
-            #[inline(never)]
-            fn mass_matrix_inverse_into<'b>(&self, q: &[T; #nq], slot: ::eomgen_runtime::place::Slot<'b, [[T; #n]; #n]>) -> ::eomgen_runtime::place::Filled<'b> {
-                let (o, filled) = slot.fill();
-                let m: [[T; #n]; #n] = { #factored };
-                let pivots: [T; #n] = ::core::array::from_fn(|i| m[i][i]);
-                let mut failures = ::core::default::Default::default();
-                if ::eomgen_runtime::lane::check_pivots(&pivots, &mut failures).is_err() {
-                    o.iter_mut().flatten().for_each(|v| *v = T::nan());
-                    return filled;
-                }
-                Self::ltdl_inverse_unrolled(&m, o);
-                ::eomgen_runtime::lane::nan_failed_in::<T>(o.as_flattened_mut(), &failures);
-                filled
-            }
-        });
-        quote! {
-            #docs
-            pub fn mass_matrix_inverse(&self, q: &[T; #nq]) -> [[T; #n]; #n] {
-                ::eomgen_runtime::place::build(|slot| self.mass_matrix_inverse_into(q, slot))
             }
         }
     }
