@@ -312,9 +312,10 @@ impl Builder {
     /// `mass_matrix_inverse` up to a fifth of it
     /// ([`crate::dynamics::MASS_MATRIX_INVERSE_FLAT_DIVISOR`]); beyond, they are composed at run
     /// time: `forward_dynamics_derivatives` from `forward_dynamics_partials` (`d tau` at the
-    /// forward dynamics' accelerations and `M`'s factors, one straight-line body) and the
-    /// passes of the factorization unrolled for the robot's tree, `mass_matrix_inverse` from
-    /// `mass_matrix`. Straight-line code is faster on small robots (an arm); the
+    /// forward dynamics' accelerations and `M`'s factors, one straight-line body, up to
+    /// [`crate::dynamics::FORWARD_DYNAMICS_PARTIALS_MAX_OPS`]) or from `mass_matrix`,
+    /// `inverse_dynamics` and `inverse_dynamics_derivatives`, then the passes of the
+    /// factorization unrolled for the robot's tree; `mass_matrix_inverse` from `mass_matrix`. Straight-line code is faster on small robots (an arm); the
     /// composed route compiles faster and is faster from a quadruped on. `0` always composes.
     ///
     /// ```
@@ -344,7 +345,7 @@ impl Builder {
     ///   `contact_forward_dynamics_stabilized`, `impulse_dynamics`, `impulse_dynamics_active`;
     /// - with [`Builder::derivatives`]: `inverse_dynamics_derivatives`,
     ///   `forward_dynamics_derivatives`, `mass_matrix_inverse`, `forward_dynamics_partials`
-    ///   (where the forward-dynamics derivatives are composed at run time), and with contacts
+    ///   (where the forward-dynamics derivatives are composed from it), and with contacts
     ///   `contact_dynamics_partials`, `contact_forward_dynamics_derivatives`,
     ///   `contact_forward_dynamics_derivatives_active`, `impulse_dynamics_partials`,
     ///   `impulse_dynamics_derivatives`, `impulse_dynamics_derivatives_active`;

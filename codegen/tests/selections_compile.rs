@@ -86,7 +86,7 @@ fn derive(robot: &Robot) -> (eomgen::model::Model, Derivation) {
     assert!(
         matches!(
             eval("forward_dynamics_derivatives"),
-            Evaluation::ForwardDynamicsDerivatives
+            Evaluation::ForwardDynamicsDerivatives { .. }
         ),
         "{}: the forward-dynamics derivatives are straight-line despite derivatives_flat_max_ops(0)",
         robot.file

@@ -125,12 +125,13 @@ pub enum Evaluation {
     /// Straight-line expressions that hold when every pivot of the unrolled `L^T D L`
     /// factorization of `M` is positive (checked at run time: NaN in every entry otherwise).
     Factored { outputs: Vec<Id>, pivots: Vec<Id> },
-    /// `(d qdd/dq, d qdd/dqd, M^-1)` at run time from `forward_dynamics_partials` (`d tau/dq`
-    /// and `d tau/dqd` at `qdd = FD(q, qd, tau)`, and the tree `L^T D L` factors of `M`, one
-    /// straight-line body): `-M^-1` times both (`tree::ltdl_substitute_rows`), and `M^-1` from
-    /// the same factors, unrolled over the tree (`tree::ltdl_inverse_factored`'s operations;
-    /// `emit::tree_solve`).
-    ForwardDynamicsDerivatives,
+    /// `(d qdd/dq, d qdd/dqd, M^-1)` at run time: `d tau/dq` and `d tau/dqd` at
+    /// `qdd = FD(q, qd, tau)` and the tree `L^T D L` factors of `M`, either from
+    /// `forward_dynamics_partials` (`partials`: one straight-line body) or from `mass_matrix`
+    /// factorized at run time, `inverse_dynamics(q, qd, 0)` and `inverse_dynamics_derivatives`;
+    /// then `-M^-1` times both (`tree::ltdl_substitute_rows`), and `M^-1` from the same factors,
+    /// unrolled over the tree (`tree::ltdl_inverse_factored`'s operations; `emit::tree_solve`).
+    ForwardDynamicsDerivatives { partials: bool },
     /// The accelerations and contact forces with the contact points held, solved at run time:
     /// `M` from `mass_matrix`, `h = b + G + F` straight-line, `J_c` and its drift from
     /// `contact_jacobian` and `contact_drift` (`eomgen_runtime::contact::solve`).
@@ -340,7 +341,14 @@ impl Quantity {
                 "contact_jacobian",
                 "impulse_dynamics_partials",
             ],
-            Evaluation::ForwardDynamicsDerivatives => &["forward_dynamics_partials"],
+            Evaluation::ForwardDynamicsDerivatives { partials: true } => {
+                &["forward_dynamics_partials"]
+            }
+            Evaluation::ForwardDynamicsDerivatives { partials: false } => &[
+                "mass_matrix",
+                "inverse_dynamics",
+                "inverse_dynamics_derivatives",
+            ],
             _ => &[],
         }
     }
@@ -424,7 +432,11 @@ mod tests {
             quantity("forward_dynamics_partials", Evaluation::Exprs(Vec::new())),
             quantity(
                 "forward_dynamics_derivatives",
-                Evaluation::ForwardDynamicsDerivatives,
+                Evaluation::ForwardDynamicsDerivatives { partials: true },
+            ),
+            quantity(
+                "forward_dynamics_derivatives_composed",
+                Evaluation::ForwardDynamicsDerivatives { partials: false },
             ),
             quantity("centrifugal", Evaluation::CraigColumns(Craig::Centrifugal)),
             quantity("coriolis_matrix", Evaluation::Exprs(Vec::new())),
@@ -444,6 +456,17 @@ mod tests {
         assert_eq!(
             selected(&["forward_dynamics_derivatives"]),
             ["forward_dynamics_partials", "forward_dynamics_derivatives"]
+        );
+        // Composed from the run-time factorization: `mass_matrix`, `inverse_dynamics` and
+        // `inverse_dynamics_derivatives`, not `forward_dynamics` or `mass_matrix_inverse`.
+        assert_eq!(
+            selected(&["forward_dynamics_derivatives_composed"]),
+            [
+                "mass_matrix",
+                "inverse_dynamics",
+                "inverse_dynamics_derivatives",
+                "forward_dynamics_derivatives_composed",
+            ]
         );
         // A need later in the catalogue than the quantity that calls it.
         assert_eq!(

@@ -45,7 +45,9 @@ pub use fast::{Fast, Route, CLOSED_FORM_MAX_DEPTH, CRAIG_FLAT_MAX_ENTRIES};
 pub use identification::Identification;
 pub use lagrangian::pairs;
 pub use mpc::{FrameMotion, Manifold};
-pub use quantities::{DERIVATIVES_FLAT_MAX_OPS, MASS_MATRIX_INVERSE_FLAT_DIVISOR};
+pub use quantities::{
+    DERIVATIVES_FLAT_MAX_OPS, FORWARD_DYNAMICS_PARTIALS_MAX_OPS, MASS_MATRIX_INVERSE_FLAT_DIVISOR,
+};
 
 /// The pose of a body in its parent body's frame (the root's for a body whose parent is the
 /// root), as expressions in the body's joint coordinate: `p_parent = rotation p + translation`.

@@ -536,8 +536,9 @@ fn link_jacobian(n: usize) -> Quantity {
 /// accelerations) up to this many operations by default, `mass_matrix_inverse` up to this
 /// divided by [`MASS_MATRIX_INVERSE_FLAT_DIVISOR`] ([`crate::Builder::derivatives_flat_max_ops`]);
 /// beyond, they are composed at run time: the forward-dynamics derivatives from
-/// `forward_dynamics_partials` (still one straight-line body up to `-M^-1`) and the tree's
-/// passes, `M^-1` from `mass_matrix`.
+/// `forward_dynamics_partials` (still one straight-line body up to `-M^-1`,
+/// [`FORWARD_DYNAMICS_PARTIALS_MAX_OPS`]) or from `mass_matrix`, `forward_dynamics` and
+/// `inverse_dynamics_derivatives`, and the tree's passes; `M^-1` from `mass_matrix`.
 ///
 /// Since the composed route's inverse is unrolled over the tree too, it is the faster one from
 /// a quadruped's size on: anymal's forward-dynamics derivatives (36,088 operations flat) took
@@ -552,6 +553,17 @@ pub const DERIVATIVES_FLAT_MAX_OPS: usize = 20_000;
 /// flat) took 787 ns flat against 698 ns composed, the panda's (1,390) 165 ns against 256 ns
 /// (27 November 2026, native).
 pub const MASS_MATRIX_INVERSE_FLAT_DIVISOR: usize = 5;
+
+/// A composed `forward_dynamics_derivatives` takes `d tau` at the forward dynamics'
+/// accelerations and `M`'s factors from `forward_dynamics_partials`, one straight-line body,
+/// up to this many operations (one block of the default
+/// [`crate::Builder::max_derivative_function_ops`]): anymal's (12,196 operations) took 2,735 ns
+/// against 2,862 ns from `mass_matrix`, `inverse_dynamics` and `inverse_dynamics_derivatives`,
+/// each computing the kinematics again. Beyond, it takes those: the body holds a second copy of
+/// the inverse-dynamics derivatives, which on a humanoid cost more to build than they save
+/// (g1_29dof, 41,076 operations: 12.09 -> 12.25 us, native build 34 -> 41 s; talos_full_v2,
+/// 63,000: 22.9 -> 23.3 us, 48 -> 65 s and 1.8 -> 2.2 GiB; 28 November 2026).
+pub const FORWARD_DYNAMICS_PARTIALS_MAX_OPS: usize = 24_000;
 
 /// The derivatives of the dynamics ([`Derivation::add_derivatives`]): inverse dynamics
 /// (straight-line), `M^-1` and forward dynamics (straight-line, or composed at run time when
@@ -576,14 +588,18 @@ pub fn derivatives(d: &Derivation, x: &Derivatives, flat_max_ops: usize) -> Vec<
         Some(e) => ("Route: M as in `mass_matrix`, an unrolled L^T D L factorization without fill-in, one substitution per column.", e),
         None => ("Route: M from `mass_matrix`, the sparse L^T D L factorization over the joint tree, unrolled for this robot, then L^-1 D^-1 L^-T over the tree, unrolled too (eomgen_runtime::tree::ltdl_inverse_factored's operations, in parts of at most 128 row updates).", Evaluation::MassMatrixInverse),
     };
-    let (fd_route, fd_eval) = match factored(fd, flat_max_ops) {
-        Some(e) => ("Route: qdd as in `forward_dynamics`, `inverse_dynamics_derivatives` at (q, qd, qdd), then -M^-1 times them by substitutions through the one unrolled factorization of M, all in one straight-line body.", e),
-        None => ("Route: `forward_dynamics_partials` (d tau / d q and d tau / d qd at qdd = FD(q, qd, tau), and M's factors), then -M^-1 times them by substitutions of all columns at once (the passes of eomgen_runtime::tree::ltdl_substitute_rows, unrolled for this robot's tree), and M^-1 from the same factors, unrolled over the tree (eomgen_runtime::tree::ltdl_inverse_factored's operations).", Evaluation::ForwardDynamicsDerivatives),
-    };
     let mut partials = flat(&x.partials[0]);
     partials.extend(flat(&x.partials[1]));
     partials.extend(flat(&x.partials[2]));
-    let composed = matches!(fd_eval, Evaluation::ForwardDynamicsDerivatives);
+    let (fd_route, fd_eval) = match factored(fd, flat_max_ops) {
+        Some(e) => ("Route: qdd as in `forward_dynamics`, `inverse_dynamics_derivatives` at (q, qd, qdd), then -M^-1 times them by substitutions through the one unrolled factorization of M, all in one straight-line body.", e),
+        None if ops(&d.graph, &partials) <= FORWARD_DYNAMICS_PARTIALS_MAX_OPS => ("Route: `forward_dynamics_partials` (d tau / d q and d tau / d qd at qdd = FD(q, qd, tau), and M's factors), then -M^-1 times them by substitutions of all columns at once (the passes of eomgen_runtime::tree::ltdl_substitute_rows, unrolled for this robot's tree), and M^-1 from the same factors, unrolled over the tree (eomgen_runtime::tree::ltdl_inverse_factored's operations).", Evaluation::ForwardDynamicsDerivatives { partials: true }),
+        None => ("Route: one factorization of M (from `mass_matrix`, the tree L^T D L unrolled): qdd from it and `inverse_dynamics` at zero acceleration, `inverse_dynamics_derivatives` at (q, qd, qdd), then -M^-1 times them by substitutions of all columns at once (the passes of eomgen_runtime::tree::ltdl_substitute_rows, unrolled for this robot's tree), and M^-1 from the same factors, unrolled over the tree (eomgen_runtime::tree::ltdl_inverse_factored's operations).", Evaluation::ForwardDynamicsDerivatives { partials: false }),
+    };
+    let composed = matches!(
+        fd_eval,
+        Evaluation::ForwardDynamicsDerivatives { partials: true }
+    );
     let mut out = vec![
         Quantity {
             name: "inverse_dynamics_derivatives",

@@ -106,7 +106,7 @@ impl Plan {
                 coriolis: exprs_of("coriolis_matrix")?,
                 which: *which,
             },
-            Evaluation::ForwardDynamicsDerivatives => Plan::FdDerivatives {
+            Evaluation::ForwardDynamicsDerivatives { .. } => Plan::FdDerivatives {
                 m: exprs_of("mass_matrix")?,
                 id: exprs_of("inverse_dynamics")?,
                 dtau: exprs_of("inverse_dynamics_derivatives")?,

@@ -19,7 +19,7 @@ fn evaluation_on_lanes(q: &Quantity) -> bool {
             | Evaluation::ForwardDynamicsSolve { .. }
             | Evaluation::MassMatrixInverse
             | Evaluation::Factored { .. }
-            | Evaluation::ForwardDynamicsDerivatives
+            | Evaluation::ForwardDynamicsDerivatives { .. }
             | Evaluation::Integrate
     )
 }

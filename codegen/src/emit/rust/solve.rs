@@ -131,7 +131,7 @@ impl Emitter<'_> {
                 matches!(
                     e,
                     E::MassMatrixInverse
-                        | E::ForwardDynamicsDerivatives
+                        | E::ForwardDynamicsDerivatives { .. }
                         | E::ContactForwardDynamics { .. }
                         | E::ContactDynamicsDerivatives { .. }
                         | E::ImpulseDynamics
@@ -171,13 +171,15 @@ impl Emitter<'_> {
             TokenStream::new()
         };
         // What substitutes through M's unrolled factors: forward dynamics, and contact dynamics,
-        // impulse dynamics and the contact derivatives for their one `M^-1 b` each (the
-        // forward-dynamics derivatives take M's factors from `forward_dynamics_partials`).
+        // impulse dynamics, the contact derivatives for their one `M^-1 b` each, and the
+        // forward-dynamics derivatives that do not take M's factors from
+        // `forward_dynamics_partials`.
         let solves = |e: &Evaluation| {
             matches!(
                 e,
                 E::ForwardDynamicsSolve { .. }
                     | E::ContactForwardDynamics { .. }
+                    | E::ForwardDynamicsDerivatives { partials: false }
                     | E::ImpulseDynamics
                     | E::ContactDynamicsDerivatives { .. }
                     | E::ActiveContacts(
@@ -212,8 +214,12 @@ impl Emitter<'_> {
         // The KKT systems of the contact and impulse derivatives take every pass over many
         // columns from the robot's `TreePasses` (`tree_passes_impl`).
         let passes = self.any_eval(kkt_derivatives);
-        let inverts =
-            |e: &Evaluation| matches!(e, E::MassMatrixInverse | E::ForwardDynamicsDerivatives);
+        let inverts = |e: &Evaluation| {
+            matches!(
+                e,
+                E::MassMatrixInverse | E::ForwardDynamicsDerivatives { .. }
+            )
+        };
         let inverse = if passes || self.any_eval(inverts) {
             crate::emit::tree_solve::inverse_fn(&self.parents, n)
         } else {
@@ -233,7 +239,7 @@ impl Emitter<'_> {
             )
         };
         // `forward_dynamics_derivatives` solves for the 2 N columns of d tau/dq and d tau/dqd.
-        let fd_derivatives = |e: &Evaluation| matches!(e, E::ForwardDynamicsDerivatives);
+        let fd_derivatives = |e: &Evaluation| matches!(e, E::ForwardDynamicsDerivatives { .. });
         let columns = passes || self.any_eval(fd_derivatives);
         let lower_rows = if columns || self.any_eval(lowers) {
             crate::emit::tree_solve::lower_rows_fn(&self.parents, n)
@@ -316,7 +322,10 @@ impl Emitter<'_> {
     /// for the tree: `ltdl_lower_rows_unrolled` and `ltdl_upper_rows_unrolled`), and `M^-1`
     /// from the same factors. Everything is written into the caller's storage
     /// (`eomgen_runtime::place`).
-    pub(super) fn forward_dynamics_derivatives_fn(&mut self, q: &Quantity) -> TokenStream {
+    pub(super) fn forward_dynamics_derivatives_from_partials_fn(
+        &mut self,
+        q: &Quantity,
+    ) -> TokenStream {
         let docs = Self::quantity_doc(q, None);
         let (n, nq) = (&self.n, &self.nq);
         debug_assert!(self.split.contains("forward_dynamics_partials"));
@@ -336,6 +345,58 @@ impl Emitter<'_> {
                     }
                     return filled;
                 }
+                // -M^-1 d tau: the upper pass's `-1` negates, to the bit.
+                for x in [&mut *dq, &mut *dqd] {
+                    Self::ltdl_lower_rows_unrolled::<#n>(&m, x);
+                    Self::ltdl_upper_rows_unrolled::<#n>(&m, x, -T::one());
+                }
+                Self::ltdl_inverse_unrolled(&m, inverse);
+                for x in [dq, dqd, inverse] {
+                    ::eomgen_runtime::lane::nan_failed_in::<T>(x.as_flattened_mut(), &failures);
+                }
+                filled
+            }
+        });
+        quote! {
+            #docs
+            pub fn forward_dynamics_derivatives(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n]) -> (#matrix, #matrix, #matrix) {
+                ::eomgen_runtime::place::build(|slot| self.forward_dynamics_derivatives_in_place(q, qd, tau, slot))
+            }
+        }
+    }
+
+    /// `(d qdd/dq, d qdd/dqd, M^-1)` through one factorization of `M`: `qdd` solves
+    /// `M qdd = tau - h` with `h = inverse_dynamics(q, qd, 0)`, then `d tau/dq` and `d tau/dqd`
+    /// there from `inverse_dynamics_derivatives`, both solves at once per matrix (the two
+    /// passes of `tree::ltdl_substitute_rows`, unrolled for the tree: `ltdl_lower_rows_unrolled`
+    /// and `ltdl_upper_rows_unrolled`), and `M^-1` from the same factors. Everything is written
+    /// into the caller's storage (`eomgen_runtime::place`), the derivatives of tau by
+    /// `inverse_dynamics_derivatives_fill` where that function was split.
+    pub(super) fn forward_dynamics_derivatives_fn(&mut self, q: &Quantity) -> TokenStream {
+        let docs = Self::quantity_doc(q, None);
+        let (n, nq) = (&self.n, &self.nq);
+        let id = self.call("inverse_dynamics");
+        let mass_matrix = self.call("mass_matrix");
+        let id_derivatives = self.id_derivatives_into(quote!(*dq), quote!(*dqd), quote!(qdd));
+        let matrix = quote!([[T; #n]; #n]);
+        self.blocks.push(quote! {
+            #[inline(never)]
+            fn forward_dynamics_derivatives_in_place<'b>(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n], slot: ::eomgen_runtime::place::Slot<'b, (#matrix, #matrix, #matrix)>) -> ::eomgen_runtime::place::Filled<'b> {
+                let ((dq, dqd, inverse), filled) = slot.fill();
+                let mut m = #mass_matrix(self, q);
+                let mut failures = ::core::default::Default::default();
+                if Self::ltdl_factor_unrolled(&mut m, &mut failures).is_err() {
+                    for v in dq.iter_mut().chain(dqd.iter_mut()).chain(inverse.iter_mut()).flatten() {
+                        *v = T::nan();
+                    }
+                    return filled;
+                }
+                let mut rhs = *tau;
+                for (r, h) in rhs.iter_mut().zip(#id(self, q, qd, &[T::zero(); #n])) {
+                    *r -= h;
+                }
+                let qdd = Self::ltdl_substitute_unrolled(&m, &rhs);
+                #id_derivatives
                 // -M^-1 d tau: the upper pass's `-1` negates, to the bit.
                 for x in [&mut *dq, &mut *dqd] {
                     Self::ltdl_lower_rows_unrolled::<#n>(&m, x);
