@@ -30,11 +30,8 @@ impl Emitter<'_> {
             Evaluation::LinkPose => self.link_pose_fn(q),
             Evaluation::LinkJacobian => self.link_jacobian_fn(q),
             Evaluation::MassMatrixInverse => self.mass_matrix_inverse_fn(q),
-            Evaluation::ForwardDynamicsDerivatives { partials: true } => {
-                self.forward_dynamics_derivatives_from_partials_fn(q)
-            }
-            Evaluation::ForwardDynamicsDerivatives { partials: false } => {
-                self.forward_dynamics_derivatives_fn(q)
+            Evaluation::ForwardDynamicsDerivatives { partials } => {
+                self.forward_dynamics_derivatives_fn(q, *partials)
             }
             Evaluation::ContactForwardDynamics { h } => self.contact_forward_dynamics_fns(q, h),
             Evaluation::Integrate => self.integrate_fn(q),

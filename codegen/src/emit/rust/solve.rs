@@ -3,7 +3,7 @@
 //! constants and helpers those solves read (`PARENTS`, `CONTACT_ROWS`, the unrolled
 //! factorization).
 
-use proc_macro2::TokenStream;
+use proc_macro2::{Literal, TokenStream};
 use quote::quote;
 
 use super::{usize_lit, Emitter};
@@ -314,37 +314,38 @@ impl Emitter<'_> {
         }
     }
 
-    /// `(d qdd/dq, d qdd/dqd, M^-1)` from `forward_dynamics_partials`, which writes `d tau/dq`
-    /// and `d tau/dqd` at the forward dynamics' accelerations straight into the result and M's
-    /// tree factors into a local (`forward_dynamics_partials_fill`: the kinematics, `M` and
-    /// its factorization computed once for both); the pivots checked, then `-M^-1` times both
-    /// matrices, all columns at once (the two passes of `tree::ltdl_substitute_rows`, unrolled
-    /// for the tree: `ltdl_lower_rows_unrolled` and `ltdl_upper_rows_unrolled`), and `M^-1`
-    /// from the same factors. Everything is written into the caller's storage
-    /// (`eomgen_runtime::place`).
-    pub(super) fn forward_dynamics_derivatives_from_partials_fn(
+    /// `(d qdd/dq, d qdd/dqd, M^-1)` through one factorization of `M`: `d tau/dq`, `d tau/dqd`
+    /// at the forward dynamics' accelerations and `M`'s factors (from
+    /// `forward_dynamics_partials` with `partials`, else [`Emitter::fd_composed_parts`]), then
+    /// `-M^-1` times both matrices, all columns at once (the two passes of
+    /// `tree::ltdl_substitute_rows`, unrolled for the tree: `ltdl_lower_rows_unrolled` and
+    /// `ltdl_upper_rows_unrolled`), and `M^-1` from the same factors. Everything is written
+    /// into the caller's storage (`eomgen_runtime::place`): `d tau` by the `_fill` method of
+    /// the function that computes it.
+    pub(super) fn forward_dynamics_derivatives_fn(
         &mut self,
         q: &Quantity,
+        partials: bool,
     ) -> TokenStream {
         let docs = Self::quantity_doc(q, None);
         let (n, nq) = (&self.n, &self.nq);
-        debug_assert!(self.split.contains("forward_dynamics_partials"));
-        let partials = crate::emit::split::fill_name("forward_dynamics_partials");
+        let nan = quote! {
+            for v in dq.iter_mut().chain(dqd.iter_mut()).chain(inverse.iter_mut()).flatten() {
+                *v = T::nan();
+            }
+            return filled;
+        };
+        let parts = if partials {
+            Self::fd_partials_parts(n, &nan)
+        } else {
+            self.fd_composed_parts(&nan)
+        };
         let matrix = quote!([[T; #n]; #n]);
         self.blocks.push(quote! {
             #[inline(never)]
             fn forward_dynamics_derivatives_in_place<'b>(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n], slot: ::eomgen_runtime::place::Slot<'b, (#matrix, #matrix, #matrix)>) -> ::eomgen_runtime::place::Filled<'b> {
                 let ((dq, dqd, inverse), filled) = slot.fill();
-                let mut m = [[T::zero(); #n]; #n];
-                self.#partials(q, qd, tau, dq, dqd, &mut m);
-                let mut failures = ::core::default::Default::default();
-                let pivots: [T; #n] = ::core::array::from_fn(|i| m[i][i]);
-                if ::eomgen_runtime::lane::check_pivots(&pivots, &mut failures).is_err() {
-                    for v in dq.iter_mut().chain(dqd.iter_mut()).chain(inverse.iter_mut()).flatten() {
-                        *v = T::nan();
-                    }
-                    return filled;
-                }
+                #parts
                 // -M^-1 d tau: the upper pass's `-1` negates, to the bit.
                 for x in [&mut *dq, &mut *dqd] {
                     Self::ltdl_lower_rows_unrolled::<#n>(&m, x);
@@ -365,55 +366,43 @@ impl Emitter<'_> {
         }
     }
 
-    /// `(d qdd/dq, d qdd/dqd, M^-1)` through one factorization of `M`: `qdd` solves
-    /// `M qdd = tau - h` with `h = inverse_dynamics(q, qd, 0)`, then `d tau/dq` and `d tau/dqd`
-    /// there from `inverse_dynamics_derivatives`, both solves at once per matrix (the two
-    /// passes of `tree::ltdl_substitute_rows`, unrolled for the tree: `ltdl_lower_rows_unrolled`
-    /// and `ltdl_upper_rows_unrolled`), and `M^-1` from the same factors. Everything is written
-    /// into the caller's storage (`eomgen_runtime::place`), the derivatives of tau by
-    /// `inverse_dynamics_derivatives_fill` where that function was split.
-    pub(super) fn forward_dynamics_derivatives_fn(&mut self, q: &Quantity) -> TokenStream {
-        let docs = Self::quantity_doc(q, None);
-        let (n, nq) = (&self.n, &self.nq);
+    /// Statements leaving `M`'s factors in `m`, `d tau` in `*dq` and `*dqd`, and the lanes
+    /// whose pivots failed in `failures` (a scalar runs `nan` at a bad pivot): from
+    /// `forward_dynamics_partials`, one straight-line body, written into `dq`, `dqd` and `m`.
+    fn fd_partials_parts(n: &Literal, nan: &TokenStream) -> TokenStream {
+        let partials = crate::emit::split::fill_name("forward_dynamics_partials");
+        quote! {
+            let mut m = [[T::zero(); #n]; #n];
+            self.#partials(q, qd, tau, dq, dqd, &mut m);
+            let mut failures = ::core::default::Default::default();
+            let pivots: [T; #n] = ::core::array::from_fn(|i| m[i][i]);
+            if ::eomgen_runtime::lane::check_pivots(&pivots, &mut failures).is_err() {
+                #nan
+            }
+        }
+    }
+
+    /// [`Emitter::fd_partials_parts`]'s statements from other generated functions: `M` from
+    /// `mass_matrix` factorized by the unrolled tree `L^T D L`, `qdd` from it and
+    /// `inverse_dynamics(q, qd, 0)`, then `inverse_dynamics_derivatives` there (through its
+    /// `_fill` method).
+    fn fd_composed_parts(&self, nan: &TokenStream) -> TokenStream {
+        let n = &self.n;
         let id = self.call("inverse_dynamics");
         let mass_matrix = self.call("mass_matrix");
         let id_derivatives = self.id_derivatives_into(quote!(*dq), quote!(*dqd), quote!(qdd));
-        let matrix = quote!([[T; #n]; #n]);
-        self.blocks.push(quote! {
-            #[inline(never)]
-            fn forward_dynamics_derivatives_in_place<'b>(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n], slot: ::eomgen_runtime::place::Slot<'b, (#matrix, #matrix, #matrix)>) -> ::eomgen_runtime::place::Filled<'b> {
-                let ((dq, dqd, inverse), filled) = slot.fill();
-                let mut m = #mass_matrix(self, q);
-                let mut failures = ::core::default::Default::default();
-                if Self::ltdl_factor_unrolled(&mut m, &mut failures).is_err() {
-                    for v in dq.iter_mut().chain(dqd.iter_mut()).chain(inverse.iter_mut()).flatten() {
-                        *v = T::nan();
-                    }
-                    return filled;
-                }
-                let mut rhs = *tau;
-                for (r, h) in rhs.iter_mut().zip(#id(self, q, qd, &[T::zero(); #n])) {
-                    *r -= h;
-                }
-                let qdd = Self::ltdl_substitute_unrolled(&m, &rhs);
-                #id_derivatives
-                // -M^-1 d tau: the upper pass's `-1` negates, to the bit.
-                for x in [&mut *dq, &mut *dqd] {
-                    Self::ltdl_lower_rows_unrolled::<#n>(&m, x);
-                    Self::ltdl_upper_rows_unrolled::<#n>(&m, x, -T::one());
-                }
-                Self::ltdl_inverse_unrolled(&m, inverse);
-                for x in [dq, dqd, inverse] {
-                    ::eomgen_runtime::lane::nan_failed_in::<T>(x.as_flattened_mut(), &failures);
-                }
-                filled
-            }
-        });
         quote! {
-            #docs
-            pub fn forward_dynamics_derivatives(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n]) -> (#matrix, #matrix, #matrix) {
-                ::eomgen_runtime::place::build(|slot| self.forward_dynamics_derivatives_in_place(q, qd, tau, slot))
+            let mut m = #mass_matrix(self, q);
+            let mut failures = ::core::default::Default::default();
+            if Self::ltdl_factor_unrolled(&mut m, &mut failures).is_err() {
+                #nan
             }
+            let mut rhs = *tau;
+            for (r, h) in rhs.iter_mut().zip(#id(self, q, qd, &[T::zero(); #n])) {
+                *r -= h;
+            }
+            let qdd = Self::ltdl_substitute_unrolled(&m, &rhs);
+            #id_derivatives
         }
     }
 
