@@ -315,8 +315,9 @@ impl Builder {
     /// forward dynamics' accelerations and `M`'s factors, one straight-line body, up to
     /// [`crate::dynamics::FORWARD_DYNAMICS_PARTIALS_MAX_OPS`]) or from `mass_matrix`,
     /// `inverse_dynamics` and `inverse_dynamics_derivatives`, then the passes of the
-    /// factorization unrolled for the robot's tree; `mass_matrix_inverse` from `mass_matrix`. Straight-line code is faster on small robots (an arm); the
-    /// composed route compiles faster and is faster from a quadruped on. `0` always composes.
+    /// factorization unrolled for the robot's tree; `mass_matrix_inverse` from `mass_matrix`.
+    /// Straight-line code is faster on small robots (an arm); the composed route compiles
+    /// faster and is faster from a quadruped on. `0` always composes.
     ///
     /// ```
     /// let b = eomgen::Builder::new("robots/anymal.urdf").derivatives().derivatives_flat_max_ops(0);

@@ -93,3 +93,50 @@ fn forward_dynamics_derivatives_match_central_differences() {
         }
     }
 }
+
+/// `forward_dynamics_partials` against references it does not share code with: its factors
+/// rebuild `M = L^T D L` (L unit lower triangular on the tree, `D` on the diagonal) as
+/// `mass_matrix` gives it (checked against Pinocchio in `tests/floating.rs`), `L` has no entry
+/// off the tree, and its `d tau` is `inverse_dynamics_derivatives` at the accelerations of
+/// `forward_dynamics`.
+#[test]
+fn forward_dynamics_partials_rebuild_m_and_are_the_inverse_dynamics_derivatives() {
+    let robot = Robot::default();
+    for seed in 0..6 {
+        let (q, v, tau) = random_state::<{ NV + 1 }, NV>(seed);
+        let (dq, dv, factors) = robot.forward_dynamics_partials(&q, &v, &tau);
+        let ancestor = |i: usize, j: usize| {
+            let mut a = Robot::PARENTS[i];
+            while let Some(p) = a {
+                if p == j {
+                    return true;
+                }
+                a = Robot::PARENTS[p];
+            }
+            false
+        };
+        let l = |i: usize, j: usize| match i.cmp(&j) {
+            core::cmp::Ordering::Equal => 1.0,
+            core::cmp::Ordering::Greater => factors[i][j],
+            core::cmp::Ordering::Less => 0.0,
+        };
+        for (i, row) in factors.iter().enumerate() {
+            for (j, x) in row.iter().enumerate() {
+                if i != j && !ancestor(i, j) {
+                    assert_eq!(*x, 0.0, "seed {seed}: L[{i}][{j}] off the tree");
+                }
+            }
+        }
+        let rebuilt: [[f64; NV]; NV] = core::array::from_fn(|i| {
+            core::array::from_fn(|j| (0..NV).map(|k| l(k, i) * factors[k][k] * l(k, j)).sum())
+        });
+        let e = normwise(&flat(&rebuilt), &flat(&robot.mass_matrix(&q)));
+        assert!(e < 1e-13, "seed {seed}: L^T D L against M {e:e}");
+        let qdd = robot.forward_dynamics(&q, &v, &tau);
+        let (want_q, want_v) = robot.inverse_dynamics_derivatives(&q, &v, &qdd);
+        for (what, ours, want) in [("dq", dq, want_q), ("dv", dv, want_v)] {
+            let e = normwise(&flat(&ours), &flat(&want));
+            assert!(e < 1e-12, "seed {seed}: d tau / {what} {e:e}");
+        }
+    }
+}

@@ -29,11 +29,11 @@ pub struct Derivatives {
     /// The pivots of the factorization of `M`: every expression above is valid when all are
     /// positive.
     pub pivots: Vec<Id>,
-    /// `(d tau / d q, d tau / d qd)` at the forward dynamics' accelerations (the right-hand
-    /// sides of [`Derivatives::forward`], before `-M^-1`) and the factors of `M` in the run-time
-    /// passes' layout ([`Factors::in_place`]): what the run-time route of the forward-dynamics
-    /// derivatives solves.
-    pub partials: [Vec<Vec<Id>>; 3],
+    /// `(d tau / d q, d tau / d qd)` at the forward dynamics' accelerations: the right-hand
+    /// sides of [`Derivatives::forward`], before `-M^-1`.
+    pub at_forward: InverseDynamicsDerivatives,
+    /// The factors of `M` in the run-time passes' layout ([`Factors::in_place`]).
+    pub factors: Vec<Vec<Id>>,
 }
 
 /// Derives the three functions for `model` in `d`'s graph.
@@ -89,13 +89,13 @@ pub fn derive(d: &mut Derivation, model: &Model) -> Derivatives {
         dq: solve_columns(g, &factors, &rhs_q),
         dqd: solve_columns(g, &factors, &rhs_qd),
     };
-    let partials = [at_fd.dq, at_fd.dqd, factors.in_place(g)];
     Derivatives {
         inverse,
         mass_matrix_inverse,
         forward,
         pivots,
-        partials,
+        factors: factors.in_place(g),
+        at_forward: at_fd,
     }
 }
 

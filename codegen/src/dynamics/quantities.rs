@@ -537,7 +537,7 @@ fn link_jacobian(n: usize) -> Quantity {
 /// divided by [`MASS_MATRIX_INVERSE_FLAT_DIVISOR`] ([`crate::Builder::derivatives_flat_max_ops`]);
 /// beyond, they are composed at run time: the forward-dynamics derivatives from
 /// `forward_dynamics_partials` (still one straight-line body up to `-M^-1`,
-/// [`FORWARD_DYNAMICS_PARTIALS_MAX_OPS`]) or from `mass_matrix`, `forward_dynamics` and
+/// [`FORWARD_DYNAMICS_PARTIALS_MAX_OPS`]) or from `mass_matrix`, `inverse_dynamics` and
 /// `inverse_dynamics_derivatives`, and the tree's passes; `M^-1` from `mass_matrix`.
 ///
 /// Since the composed route's inverse is unrolled over the tree too, it is the faster one from
@@ -588,15 +588,15 @@ pub fn derivatives(d: &Derivation, x: &Derivatives, flat_max_ops: usize) -> Vec<
         Some(e) => ("Route: M as in `mass_matrix`, an unrolled L^T D L factorization without fill-in, one substitution per column.", e),
         None => ("Route: M from `mass_matrix`, the sparse L^T D L factorization over the joint tree, unrolled for this robot, then L^-1 D^-1 L^-T over the tree, unrolled too (eomgen_runtime::tree::ltdl_inverse_factored's operations, in parts of at most 128 row updates).", Evaluation::MassMatrixInverse),
     };
-    let mut partials = flat(&x.partials[0]);
-    partials.extend(flat(&x.partials[1]));
-    partials.extend(flat(&x.partials[2]));
+    let mut partials = flat(&x.at_forward.dq);
+    partials.extend(flat(&x.at_forward.dqd));
+    partials.extend(flat(&x.factors));
     let (fd_route, fd_eval) = match factored(fd, flat_max_ops) {
         Some(e) => ("Route: qdd as in `forward_dynamics`, `inverse_dynamics_derivatives` at (q, qd, qdd), then -M^-1 times them by substitutions through the one unrolled factorization of M, all in one straight-line body.", e),
         None if ops(&d.graph, &partials) <= FORWARD_DYNAMICS_PARTIALS_MAX_OPS => ("Route: `forward_dynamics_partials` (d tau / d q and d tau / d qd at qdd = FD(q, qd, tau), and M's factors), then -M^-1 times them by substitutions of all columns at once (the passes of eomgen_runtime::tree::ltdl_substitute_rows, unrolled for this robot's tree), and M^-1 from the same factors, unrolled over the tree (eomgen_runtime::tree::ltdl_inverse_factored's operations).", Evaluation::ForwardDynamicsDerivatives { partials: true }),
         None => ("Route: one factorization of M (from `mass_matrix`, the tree L^T D L unrolled): qdd from it and `inverse_dynamics` at zero acceleration, `inverse_dynamics_derivatives` at (q, qd, qdd), then -M^-1 times them by substitutions of all columns at once (the passes of eomgen_runtime::tree::ltdl_substitute_rows, unrolled for this robot's tree), and M^-1 from the same factors, unrolled over the tree (eomgen_runtime::tree::ltdl_inverse_factored's operations).", Evaluation::ForwardDynamicsDerivatives { partials: false }),
     };
-    let composed = matches!(
+    let from_partials = matches!(
         fd_eval,
         Evaluation::ForwardDynamicsDerivatives { partials: true }
     );
@@ -638,7 +638,7 @@ pub fn derivatives(d: &Derivation, x: &Derivatives, flat_max_ops: usize) -> Vec<
             eval: fd_eval,
         },
     ];
-    if composed {
+    if from_partials {
         out.insert(2, forward_dynamics_partials(n, partials));
     }
     out
