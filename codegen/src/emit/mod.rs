@@ -10,6 +10,7 @@ mod identification;
 pub mod names;
 mod rust;
 mod split;
+mod tree_factor;
 mod tree_solve;
 
 pub use rust::EmitOptions;

@@ -202,7 +202,7 @@ impl Emitter<'_> {
             )
         };
         let factor = if self.any_eval(|e| solves(e) || kkt(e)) {
-            crate::emit::tree_solve::factor_fn(&self.parents, n)
+            crate::emit::tree_factor::factor_fn(&self.parents, n)
         } else {
             TokenStream::new()
         };
