@@ -544,6 +544,24 @@ fn shared_sums_stay_one_term_unless_they_collect() {
 }
 
 #[test]
+fn a_product_kept_whole_is_computed_once_for_every_product_that_uses_it() {
+    let mut g = Graph::new();
+    let (a, b, c, d) = (g.q(0), g.q(1), g.q(2), g.q(3));
+    assert!(g.set_product_flattening(false));
+    let ab = g.mul(a, b);
+    // (a b) c and (a b) d: 3 multiplications, `a b` once.
+    let (x, y) = (g.mul(ab, c), g.mul(ab, d));
+    assert_eq!(Program::new(&g, &[x, y]).ops().mul, 3);
+    // Merged (the default), each is a product of three factors: 4 multiplications.
+    assert!(!g.set_product_flattening(true));
+    let (x, y) = (g.mul(ab, c), g.mul(ab, d));
+    assert_eq!(Program::new(&g, &[x, y]).ops().mul, 4);
+    // Either way, like factors and constants still collect within one product.
+    let aa = g.mul(a, a);
+    assert_eq!(g.node(aa), &Node::Mul(vec![(a, 2)].into_boxed_slice()));
+}
+
+#[test]
 fn a_scaled_copy_of_a_sum_reuses_the_sum() {
     let mut g = Graph::new();
     let (a, b, c, d) = (g.q(0), g.q(1), g.q(2), g.q(3));

@@ -2038,92 +2038,44 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                 let t288 = -T::from_f64(0.0384) * (T::mul_add(t31, t31, t114 * t114))
                     + t252;
                 let t289 = T::from_f64(60263.23947213258) * t214;
-                let t290 = T::from_f64(60263.23947213258) * t213;
-                let t291 = T::from_f64(60263.23947213258) * t211;
-                let t292 = T::mul_add(t25, t202, t258);
-                let t293 = T::mul_add(t24, t161, t259);
-                let t294 = T::mul_add(t18, t204, t260);
-                let t295 = T::mul_add(t17, t166, t261);
-                let t296 = T::mul_add(t12, t206, t262);
-                let t297 = T::mul_add(t11, t171, t263);
-                let t298 = T::mul_add(t5, t209, t265);
-                let t299 = T::mul_add(t4, t177, t266);
-                let t300 = T::mul_add(qd[3], t183, T::mul_add(-t6, t182, t7 * t181));
-                let t301 = T::mul_add(-qd[3], t184, T::mul_add(t7, t182, t6 * t181));
-                let t302 = T::mul_add(qd[7], t187, T::mul_add(-t13, t186, t14 * t185));
-                let t303 = T::mul_add(-qd[7], t188, T::mul_add(t14, t186, t13 * t185));
-                let t304 = T::mul_add(qd[11], t191, T::mul_add(-t19, t190, t20 * t189));
-                let t305 = T::mul_add(-qd[11], t192, T::mul_add(t20, t190, t19 * t189));
-                let t306 = T::mul_add(qd[15], t195, T::mul_add(-t26, t194, t27 * t193));
-                let t307 = T::mul_add(-qd[15], t196, T::mul_add(t27, t194, t26 * t193));
-                let t308 = T::mul_add(
-                    -t254,
-                    t254 * t197,
-                    T::mul_add(
-                        -t130,
-                        t153,
-                        T::mul_add(
-                            -T::from_f64(0.108),
-                            t119,
-                            T::mul_add(
-                                T::from_f64(0.000034449408),
-                                t27,
-                                T::from_f64(0.0002509942774427206),
-                            ),
-                        ) + T::from_f64(0.0000285700490570738),
-                    ),
-                );
-                let t309 = T::mul_add(-t214, t77, T::mul_add(t23, -t163, t22 * t162));
-                let t310 = T::mul_add(
-                    -t255,
-                    t255 * t198,
-                    T::mul_add(
-                        -t129,
-                        t155,
-                        T::mul_add(
-                            -T::from_f64(0.108),
-                            t121,
-                            T::mul_add(
-                                T::from_f64(0.000034449408),
-                                t20,
-                                T::from_f64(0.0002509942774427206),
-                            ),
-                        ) + T::from_f64(0.0000285700490570738),
-                    ),
-                );
-                let t311 = T::mul_add(-t213, t78, T::mul_add(t16, -t168, t15 * t167));
-                let t312 = T::from_f64(21844.852556112917) * t268;
-                let t313 = T::mul_add(
-                    -t257,
-                    t257 * t201,
-                    T::mul_add(
-                        -t127,
-                        t158,
-                        T::mul_add(
-                            -T::from_f64(0.108),
-                            t126,
-                            T::mul_add(
-                                T::from_f64(0.000034449408),
-                                t7,
-                                T::from_f64(0.0002509942774427206),
-                            ),
-                        ) + T::from_f64(0.0000285700490570738),
-                    ),
-                );
-                let t314 = T::mul_add(-t211, t80, T::mul_add(t3, -t179, t2 * t178));
-                let t315 = T::mul_add(
+                let t290 = t254 * t197;
+                let t291 = T::from_f64(60263.23947213258) * t213;
+                let t292 = t255 * t198;
+                let t293 = t200 * t256;
+                let t294 = T::from_f64(60263.23947213258) * t211;
+                let t295 = t257 * t201;
+                let t296 = T::mul_add(t25, t202, t258);
+                let t297 = T::mul_add(t24, t161, t259);
+                let t298 = T::mul_add(t18, t204, t260);
+                let t299 = T::mul_add(t17, t166, t261);
+                let t300 = T::mul_add(t12, t206, t262);
+                let t301 = T::mul_add(t11, t171, t263);
+                let t302 = T::mul_add(t5, t209, t265);
+                let t303 = T::mul_add(t4, t177, t266);
+                let t304 = T::mul_add(qd[3], t183, T::mul_add(-t6, t182, t7 * t181));
+                let t305 = T::mul_add(-qd[3], t184, T::mul_add(t7, t182, t6 * t181));
+                let t306 = T::mul_add(qd[7], t187, T::mul_add(-t13, t186, t14 * t185));
+                let t307 = T::mul_add(-qd[7], t188, T::mul_add(t14, t186, t13 * t185));
+                let t308 = T::mul_add(qd[11], t191, T::mul_add(-t19, t190, t20 * t189));
+                let t309 = T::mul_add(-qd[11], t192, T::mul_add(t20, t190, t19 * t189));
+                let t310 = T::mul_add(qd[15], t195, T::mul_add(-t26, t194, t27 * t193));
+                let t311 = T::mul_add(-qd[15], t196, T::mul_add(t27, t194, t26 * t193));
+                let t312 = T::mul_add(-t214, t77, T::mul_add(t23, -t163, t22 * t162));
+                let t313 = T::mul_add(-t213, t78, T::mul_add(t16, -t168, t15 * t167));
+                let t314 = T::from_f64(21844.852556112917) * t268;
+                let t315 = T::mul_add(-t211, t80, T::mul_add(t3, -t179, t2 * t178));
+                let t316 = T::mul_add(
                     -T::from_f64(0.00044856000000000003),
-                    T::mul_add(t70, t191, t304),
+                    T::mul_add(t70, t191, t308),
                     T::from_f64(0.0264) * t232,
                 );
-                let t316 = T::mul_add(-t6, t282, t7 * t281);
-                let t317 = T::mul_add(-t13, t284, t14 * t283);
-                let t318 = T::mul_add(
+                let t317 = T::mul_add(-t6, t282, t7 * t281);
+                let t318 = T::mul_add(-t13, t284, t14 * t283);
+                let t319 = T::mul_add(
                     -T::from_f64(0.0556),
                     t248,
-                    -T::from_f64(0.0007106399999999999) * (t302 + t225),
+                    -T::from_f64(0.0007106399999999999) * (t306 + t225),
                 );
-                let t319 = T::mul_add(-t19, t286, t20 * t285);
                 (
                     t256,
                     t257,
@@ -2257,10 +2209,45 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                 t382,
                 t383,
             ) = {
-                let t320 = T::mul_add(-t26, t288, t27 * t287);
-                let t321 = T::one() / t308;
-                let t322 = T::one() / t310;
-                let t323 = T::mul_add(
+                let t320 = T::mul_add(-t19, t286, t20 * t285);
+                let t321 = T::mul_add(-t26, t288, t27 * t287);
+                let t322 = T::mul_add(
+                    -t254,
+                    t290,
+                    T::mul_add(
+                        -t130,
+                        t153,
+                        T::mul_add(
+                            -T::from_f64(0.108),
+                            t119,
+                            T::mul_add(
+                                T::from_f64(0.000034449408),
+                                t27,
+                                T::from_f64(0.0002509942774427206),
+                            ),
+                        ) + T::from_f64(0.0000285700490570738),
+                    ),
+                );
+                let t323 = t197 * t312;
+                let t324 = T::mul_add(
+                    -t255,
+                    t292,
+                    T::mul_add(
+                        -t129,
+                        t155,
+                        T::mul_add(
+                            -T::from_f64(0.108),
+                            t121,
+                            T::mul_add(
+                                T::from_f64(0.000034449408),
+                                t20,
+                                T::from_f64(0.0002509942774427206),
+                            ),
+                        ) + T::from_f64(0.0000285700490570738),
+                    ),
+                );
+                let t325 = t198 * t313;
+                let t326 = T::mul_add(
                     -t268,
                     t79,
                     t267
@@ -2270,178 +2257,196 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                             -T::from_f64(0.005) * t123,
                         ),
                 );
-                let t324 = T::one() / t313;
-                let t325 = T::mul_add(
+                let t327 = T::mul_add(
+                    -t257,
+                    t295,
+                    T::mul_add(
+                        -t127,
+                        t158,
+                        T::mul_add(
+                            -T::from_f64(0.108),
+                            t126,
+                            T::mul_add(
+                                T::from_f64(0.000034449408),
+                                t7,
+                                T::from_f64(0.0002509942774427206),
+                            ),
+                        ) + T::from_f64(0.0000285700490570738),
+                    ),
+                );
+                let t328 = t201 * t315;
+                let t329 = T::mul_add(
                     -t25,
                     T::mul_add(-t25, t161, t258),
                     -t24 * (T::mul_add(-t24, t202, t259)),
                 );
-                let t326 = T::mul_add(
+                let t330 = T::mul_add(
                     -t18,
                     T::mul_add(-t18, t166, t260),
                     -t17 * (T::mul_add(-t17, t204, t261)),
                 );
-                let t327 = T::mul_add(
+                let t331 = T::mul_add(
                     -t12,
                     T::mul_add(-t12, t171, t262),
                     -t11 * (T::mul_add(-t11, t206, t263)),
                 );
-                let t328 = T::mul_add(
+                let t332 = T::mul_add(
                     -t5,
                     T::mul_add(-t5, t177, t265),
                     -t4 * (T::mul_add(-t4, t209, t266)),
                 );
-                let t329 = T::mul_add(
-                    T::from_f64(0.0000056692479999999995),
-                    t301,
-                    T::from_f64(0.0000012936) * t300,
-                ) + T::mul_add(-t61, t219, -t184 * t220);
-                let t330 = T::mul_add(
-                    T::from_f64(0.0000338903173333),
-                    t303,
-                    T::mul_add(
-                        T::from_f64(0.0000052283),
-                        t302,
-                        T::from_f64(0.000011283525) * t65,
-                    ),
-                ) + T::mul_add(-t137, t226, -t188 * t227);
-                let t331 = T::mul_add(
+                let t333 = T::mul_add(
                     T::from_f64(0.0000056692479999999995),
                     t305,
                     T::from_f64(0.0000012936) * t304,
-                ) + T::mul_add(-t70, t233, -t192 * t234);
-                let t332 = T::mul_add(
-                    T::from_f64(0.0000056692479999999995),
+                ) + T::mul_add(-t61, t219, -t184 * t220);
+                let t334 = T::mul_add(
+                    T::from_f64(0.0000338903173333),
                     t307,
-                    T::from_f64(0.0000012936) * t306,
+                    T::mul_add(
+                        T::from_f64(0.0000052283),
+                        t306,
+                        T::from_f64(0.000011283525) * t65,
+                    ),
+                ) + T::mul_add(-t137, t226, -t188 * t227);
+                let t335 = T::mul_add(
+                    T::from_f64(0.0000056692479999999995),
+                    t309,
+                    T::from_f64(0.0000012936) * t308,
+                ) + T::mul_add(-t70, t233, -t192 * t234);
+                let t336 = T::mul_add(
+                    T::from_f64(0.0000056692479999999995),
+                    t311,
+                    T::from_f64(0.0000012936) * t310,
                 ) + T::mul_add(-t75, t240, -t196 * t241);
-                let t333 = T::mul_add(
+                let t337 = T::mul_add(
                     T::from_f64(0.00044856000000000003),
                     t232,
                     -(T::mul_add(
                         T::from_f64(0.0000012936),
-                        t305,
-                        T::from_f64(0.0000176458) * t304,
+                        t309,
+                        T::from_f64(0.0000176458) * t308,
                     )) - (T::mul_add(t191, t234, t70 * t235)),
                 );
-                let t334 = T::mul_add(
+                let t338 = T::mul_add(
                     T::from_f64(0.0264),
-                    t316,
+                    t317,
                     T::from_f64(0.00044856000000000003) * t183 * t184,
                 );
-                let t335 = T::mul_add(
+                let t339 = T::mul_add(
                     T::from_f64(0.0264),
                     T::mul_add(t7, t282, t6 * t281),
                     -T::from_f64(0.00044856000000000003)
                         * (T::mul_add(t61, t61, t184 * t184)),
                 );
-                let t336 = T::mul_add(
+                let t340 = T::mul_add(
                     T::from_f64(0.00044856000000000003),
                     t245,
                     T::mul_add(
                         T::from_f64(0.0000012936),
-                        t301,
-                        T::from_f64(0.0000176458) * t300,
+                        t305,
+                        T::from_f64(0.0000176458) * t304,
                     ) + T::mul_add(t183, t220, t61 * t221),
                 );
-                let t337 = T::mul_add(
+                let t341 = T::mul_add(
                     T::from_f64(0.00044856000000000003),
-                    t316,
+                    t317,
                     T::mul_add(
                         T::from_f64(0.0000017622),
-                        t301,
-                        T::from_f64(0.000001255968) * t300,
+                        t305,
+                        T::from_f64(0.000001255968) * t304,
                     ) + T::mul_add(t184, t221, -t183 * t219),
                 );
-                let t338 = T::mul_add(
+                let t342 = T::mul_add(
                     T::from_f64(0.0556),
-                    t317,
+                    t318,
                     T::from_f64(0.0007106399999999999) * (T::mul_add(t187, t188, t65)),
                 );
-                let t339 = T::mul_add(
+                let t343 = T::mul_add(
                     T::from_f64(0.0556),
                     T::mul_add(t14, t284, t13 * t283),
                     -T::from_f64(0.0007106399999999999)
                         * (T::mul_add(t137, t137, t188 * t188)),
                 );
-                let t340 = T::mul_add(
+                let t344 = T::mul_add(
                     T::from_f64(0.0007106399999999999),
                     t248,
                     T::mul_add(
                         T::from_f64(0.0000052283),
-                        t303,
+                        t307,
                         T::mul_add(
                             T::from_f64(0.00006395038933329998),
-                            t302,
+                            t306,
                             T::from_f64(0.000008042076) * t65,
                         ),
                     ) + T::mul_add(t187, t227, t137 * t228),
                 );
-                let t341 = T::mul_add(
+                let t345 = T::mul_add(
                     T::from_f64(0.0007106399999999999),
-                    t317,
+                    t318,
                     T::mul_add(
                         T::from_f64(0.000011283525),
-                        t303,
+                        t307,
                         T::mul_add(
                             T::from_f64(0.000008042076),
-                            t302,
+                            t306,
                             T::from_f64(0.000045777374666699994) * t65,
                         ),
                     ) + T::mul_add(t188, t228, -t187 * t226),
                 );
-                let t342 = T::mul_add(
+                let t346 = T::mul_add(
                     T::from_f64(0.0264),
-                    t319,
+                    t320,
                     T::from_f64(0.00044856000000000003) * t191 * t192,
                 );
-                let t343 = T::mul_add(
+                let t347 = T::mul_add(
                     T::from_f64(0.0264),
                     T::mul_add(t20, t286, t19 * t285),
                     -T::from_f64(0.00044856000000000003)
                         * (T::mul_add(t70, t70, t192 * t192)),
-                );
-                let t344 = T::mul_add(
-                    T::from_f64(0.00044856000000000003),
-                    t319,
-                    T::mul_add(
-                        T::from_f64(0.0000017622),
-                        t305,
-                        T::from_f64(0.000001255968) * t304,
-                    ) + T::mul_add(t192, t235, -t191 * t233),
-                );
-                let t345 = T::mul_add(
-                    T::from_f64(0.0264),
-                    t320,
-                    T::from_f64(0.00044856000000000003) * t195 * t196,
-                );
-                let t346 = T::mul_add(
-                    T::from_f64(0.0264),
-                    T::mul_add(t27, t288, t26 * t287),
-                    -T::from_f64(0.00044856000000000003)
-                        * (T::mul_add(t75, t75, t196 * t196)),
-                );
-                let t347 = T::mul_add(
-                    T::from_f64(0.00044856000000000003),
-                    t253,
-                    T::mul_add(
-                        T::from_f64(0.0000012936),
-                        t307,
-                        T::from_f64(0.0000176458) * t306,
-                    ) + T::mul_add(t195, t241, t75 * t242),
                 );
                 let t348 = T::mul_add(
                     T::from_f64(0.00044856000000000003),
                     t320,
                     T::mul_add(
                         T::from_f64(0.0000017622),
-                        t307,
-                        T::from_f64(0.000001255968) * t306,
-                    ) + T::mul_add(t196, t242, -t195 * t240),
+                        t309,
+                        T::from_f64(0.000001255968) * t308,
+                    ) + T::mul_add(t192, t235, -t191 * t233),
                 );
                 let t349 = T::mul_add(
-                    -t254,
-                    t197 * t309,
+                    T::from_f64(0.0264),
+                    t321,
+                    T::from_f64(0.00044856000000000003) * t195 * t196,
+                );
+                let t350 = T::mul_add(
+                    T::from_f64(0.0264),
+                    T::mul_add(t27, t288, t26 * t287),
+                    -T::from_f64(0.00044856000000000003)
+                        * (T::mul_add(t75, t75, t196 * t196)),
+                );
+                let t351 = T::mul_add(
+                    T::from_f64(0.00044856000000000003),
+                    t253,
+                    T::mul_add(
+                        T::from_f64(0.0000012936),
+                        t311,
+                        T::from_f64(0.0000176458) * t310,
+                    ) + T::mul_add(t195, t241, t75 * t242),
+                );
+                let t352 = T::mul_add(
+                    T::from_f64(0.00044856000000000003),
+                    t321,
+                    T::mul_add(
+                        T::from_f64(0.0000017622),
+                        t311,
+                        T::from_f64(0.000001255968) * t310,
+                    ) + T::mul_add(t196, t242, -t195 * t240),
+                );
+                let t353 = T::one() / t322;
+                let t354 = T::mul_add(
+                    -t290,
+                    t312,
                     T::mul_add(
                         -t214,
                         t153,
@@ -2452,9 +2457,10 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                         ),
                     ),
                 );
-                let t350 = T::mul_add(
-                    -t255,
-                    t198 * t311,
+                let t355 = T::one() / t324;
+                let t356 = T::mul_add(
+                    -t292,
+                    t313,
                     T::mul_add(
                         -t213,
                         t155,
@@ -2465,9 +2471,11 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                         ),
                     ),
                 );
-                let t351 = T::mul_add(
-                    -t257,
-                    t201 * t314,
+                let t357 = t200 * t326;
+                let t358 = T::one() / t327;
+                let t359 = T::mul_add(
+                    -t295,
+                    t315,
                     T::mul_add(
                         -t211,
                         t158,
@@ -2478,121 +2486,81 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                         ),
                     ),
                 );
-                let t352 = T::mul_add(
+                let t360 = T::mul_add(
                     -T::from_f64(0.108),
                     t119,
-                    T::mul_add(t24, t293, t25 * t292)
+                    T::mul_add(t24, t297, t25 * t296)
                         + T::from_f64(0.00018050039999999997),
                 );
-                let t353 = T::mul_add(
+                let t361 = T::mul_add(
                     -T::from_f64(0.054),
                     T::mul_add(
                         t24,
                         t41,
                         T::from_f64(0.00044856000000000003) * t25 * t26,
                     ),
-                    T::mul_add(t25, t293, -t24 * t292),
+                    T::mul_add(t25, t297, -t24 * t296),
                 );
-                let t354 = T::mul_add(
+                let t362 = T::mul_add(
                     -T::from_f64(0.108),
                     t121,
-                    T::mul_add(t17, t295, t18 * t294)
+                    T::mul_add(t17, t299, t18 * t298)
                         + T::from_f64(0.00018050039999999997),
                 );
-                let t355 = T::mul_add(
+                let t363 = T::mul_add(
                     -T::from_f64(0.054),
                     T::mul_add(
                         t17,
                         t46,
                         T::from_f64(0.00044856000000000003) * t18 * t19,
                     ),
-                    T::mul_add(t18, t295, -t17 * t294),
+                    T::mul_add(t18, t299, -t17 * t298),
                 );
-                let t356 = T::mul_add(
+                let t364 = T::mul_add(
                     -T::from_f64(0.0354),
                     t124,
-                    T::mul_add(t11, t297, t12 * t296) + T::from_f64(0.000029323944),
+                    T::mul_add(t11, t301, t12 * t300) + T::from_f64(0.000029323944),
                 );
-                let t357 = T::mul_add(
+                let t365 = T::mul_add(
                     -T::from_f64(0.0177),
                     t123,
-                    T::mul_add(t12, t297, -t11 * t296),
+                    T::mul_add(t12, t301, -t11 * t300),
                 );
-                let t358 = T::mul_add(
+                let t366 = T::mul_add(
                     -T::from_f64(0.108),
                     t126,
-                    T::mul_add(t4, t299, t5 * t298) + T::from_f64(0.00018050039999999997),
+                    T::mul_add(t4, t303, t5 * t302) + T::from_f64(0.00018050039999999997),
                 );
-                let t359 = T::mul_add(
+                let t367 = T::mul_add(
                     -T::from_f64(0.054),
                     T::mul_add(t4, t56, T::from_f64(0.00044856000000000003) * t5 * t6),
-                    T::mul_add(t5, t299, -t4 * t298),
+                    T::mul_add(t5, t303, -t4 * t302),
                 );
-                let t360 = T::mul_add(
-                    -t200,
-                    t256 * t256,
-                    T::mul_add(-t128, t199, t327 + T::from_f64(0.00000434097290977866)),
+                let t368 = t353 * t354;
+                let t369 = t355 * t356;
+                let t370 = T::mul_add(
+                    -t256,
+                    t293,
+                    T::mul_add(-t128, t199, t331 + T::from_f64(0.00000434097290977866)),
                 );
-                let t361 = t348 - tau[15];
-                let t362 = t344 - tau[11];
-                let t363 = t341 - tau[7];
-                let t364 = t337 - tau[3];
-                let t365 = t353 + T::from_f64(0.0000042343545689576);
-                let t366 = t355 + T::from_f64(0.0000042343545689576);
-                let t367 = t359 + T::from_f64(0.0000042343545689576);
-                let t368 = T::mul_add(t26, t346, t27 * t345);
-                let t369 = T::mul_add(t19, t343, t20 * t342);
-                let t370 = T::mul_add(t13, t339, t14 * t338);
-                let t371 = t10
+                let t371 = t358 * t359;
+                let t372 = t352 - tau[15];
+                let t373 = t348 - tau[11];
+                let t374 = t345 - tau[7];
+                let t375 = t341 - tau[3];
+                let t376 = t361 + T::from_f64(0.0000042343545689576);
+                let t377 = t363 + T::from_f64(0.0000042343545689576);
+                let t378 = t367 + T::from_f64(0.0000042343545689576);
+                let t379 = T::mul_add(t26, t350, t27 * t349);
+                let t380 = T::mul_add(t19, t347, t20 * t346);
+                let t381 = T::mul_add(t13, t343, t14 * t342);
+                let t382 = t10
                     * (T::mul_add(
                         T::from_f64(0.0119),
                         t147,
-                        -(T::mul_add(-T::from_f64(0.038), t147, t318)),
+                        -(T::mul_add(-T::from_f64(0.038), t147, t319)),
                     ));
-                let t372 = T::mul_add(t6, t335, t7 * t334);
-                let t373 = T::one() / t360;
-                let t374 = T::mul_add(
-                    -T::from_f64(0.0384),
-                    t315,
-                    T::mul_add(t19, t331, -t20 * t333),
-                );
-                let t375 = t277 + T::mul_add(t20, t331, t19 * t333);
-                let t376 = T::mul_add(
-                    T::from_f64(0.0384),
-                    T::mul_add(
-                        T::from_f64(0.0264),
-                        t253,
-                        T::from_f64(0.00044856000000000003) * (t306 + t239),
-                    ),
-                    T::mul_add(t27, t347, t26 * t332),
-                );
-                let t377 = T::mul_add(
-                    T::from_f64(0.0355),
-                    t252,
-                    T::mul_add(t27, t346, -t26 * t345),
-                );
-                let t378 = t280 + T::mul_add(-t26, t347, t27 * t332);
-                let t379 = T::mul_add(
-                    T::from_f64(0.0355),
-                    -t250,
-                    -(T::mul_add(t20, t343, -t19 * t342)),
-                );
-                let t380 = T::mul_add(
-                    T::from_f64(0.0514),
-                    T::mul_add(
-                        T::from_f64(0.0556),
-                        t248,
-                        T::from_f64(0.0007106399999999999) * (t302 + t225),
-                    ),
-                    T::mul_add(t14, t340, t13 * t330),
-                );
-                let t381 = T::mul_add(T::from_f64(0.038), t246, t370);
-                let t382 = T::mul_add(
-                    T::from_f64(0.038),
-                    t247,
-                    T::mul_add(t14, t339, -t13 * t338),
-                );
-                let t383 = t274 + T::mul_add(-t13, t340, t14 * t330);
+                let t383 = T::mul_add(t6, t339, t7 * t338);
                 (
                     t320,
                     t321,
@@ -2726,106 +2694,150 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                 t446,
                 t447,
             ) = {
-                let t384 = T::mul_add(
+                let t384 = T::one() / t370;
+                let t385 = T::mul_add(
+                    -T::from_f64(0.0384),
+                    t316,
+                    T::mul_add(t19, t335, -t20 * t337),
+                );
+                let t386 = t277 + T::mul_add(t20, t335, t19 * t337);
+                let t387 = T::mul_add(
+                    T::from_f64(0.0384),
+                    T::mul_add(
+                        T::from_f64(0.0264),
+                        t253,
+                        T::from_f64(0.00044856000000000003) * (t310 + t239),
+                    ),
+                    T::mul_add(t27, t351, t26 * t336),
+                );
+                let t388 = T::mul_add(
+                    T::from_f64(0.0355),
+                    t252,
+                    T::mul_add(t27, t350, -t26 * t349),
+                );
+                let t389 = t280 + T::mul_add(-t26, t351, t27 * t336);
+                let t390 = T::mul_add(
+                    T::from_f64(0.0355),
+                    -t250,
+                    -(T::mul_add(t20, t347, -t19 * t346)),
+                );
+                let t391 = T::mul_add(
+                    T::from_f64(0.0514),
+                    T::mul_add(
+                        T::from_f64(0.0556),
+                        t248,
+                        T::from_f64(0.0007106399999999999) * (t306 + t225),
+                    ),
+                    T::mul_add(t14, t344, t13 * t334),
+                );
+                let t392 = T::mul_add(T::from_f64(0.038), t246, t381);
+                let t393 = T::mul_add(
+                    T::from_f64(0.038),
+                    t247,
+                    T::mul_add(t14, t343, -t13 * t342),
+                );
+                let t394 = t274 + T::mul_add(-t13, t344, t14 * t334);
+                let t395 = T::mul_add(
                     T::from_f64(0.0384),
                     T::mul_add(
                         T::from_f64(0.0264),
                         t245,
-                        T::from_f64(0.00044856000000000003) * (t300 + t218),
+                        T::from_f64(0.00044856000000000003) * (t304 + t218),
                     ),
-                    T::mul_add(t7, t336, t6 * t329),
+                    T::mul_add(t7, t340, t6 * t333),
                 );
-                let t385 = T::mul_add(
+                let t396 = T::mul_add(
                     T::from_f64(0.0355),
                     t244,
-                    T::mul_add(t7, t335, -t6 * t334),
+                    T::mul_add(t7, t339, -t6 * t338),
                 );
-                let t386 = t271 + T::mul_add(-t6, t336, t7 * t329);
-                let t387 = T::mul_add(
+                let t397 = t271 + T::mul_add(-t6, t340, t7 * t333);
+                let t398 = T::mul_add(
                     -t22,
-                    t352 + T::from_f64(0.0000808728875979549),
-                    t23 * t365,
+                    t360 + T::from_f64(0.0000808728875979549),
+                    t23 * t376,
                 );
-                let t388 = T::mul_add(
+                let t399 = T::mul_add(
                     -t23,
-                    t325 + T::from_f64(0.0000796647061621031),
-                    t22 * t365,
+                    t329 + T::from_f64(0.0000796647061621031),
+                    t22 * t376,
                 );
-                let t389 = T::mul_add(
+                let t400 = T::mul_add(
                     -t15,
-                    t354 + T::from_f64(0.0000808728875979549),
-                    t16 * t366,
+                    t362 + T::from_f64(0.0000808728875979549),
+                    t16 * t377,
                 );
-                let t390 = T::mul_add(
+                let t401 = T::mul_add(
                     -t16,
-                    t326 + T::from_f64(0.0000796647061621031),
-                    t15 * t366,
+                    t330 + T::from_f64(0.0000796647061621031),
+                    t15 * t377,
                 );
-                let t391 = T::mul_add(
+                let t402 = T::mul_add(
                     -t9,
                     t208,
-                    t10 * (t356 + T::from_f64(0.0000043875110939419)),
+                    t10 * (t364 + T::from_f64(0.0000043875110939419)),
                 );
-                let t392 = T::mul_add(
+                let t403 = T::mul_add(
                     -t9,
                     t173 + T::from_f64(0.00000118904291699917),
-                    t10 * (t357 + T::from_f64(0.00000135226331844583)),
+                    t10 * (t365 + T::from_f64(0.00000135226331844583)),
                 );
-                let t393 = T::mul_add(
-                    -t2,
-                    t358 + T::from_f64(0.0000808728875979549),
-                    t3 * t367,
-                );
-                let t394 = T::mul_add(
-                    -t3,
-                    t328 + T::from_f64(0.0000796647061621031),
-                    t2 * t367,
-                );
-                let t395 = t275 + t374;
-                let t396 = t278 + t376;
-                let t397 = t279 + T::mul_add(T::from_f64(0.0384), t368, t348);
-                let t398 = t276 + T::mul_add(T::from_f64(0.0384), t369, t344);
-                let t399 = t18 * (T::mul_add(T::from_f64(0.0355), -t249, -t369));
-                let t400 = t272 + t380;
-                let t401 = t273 + T::mul_add(T::from_f64(0.0514), t370, t341);
-                let t402 = t269 + t384;
-                let t403 = t270 + T::mul_add(T::from_f64(0.0384), t372, t337);
                 let t404 = T::mul_add(
+                    -t2,
+                    t366 + T::from_f64(0.0000808728875979549),
+                    t3 * t378,
+                );
+                let t405 = T::mul_add(
+                    -t3,
+                    t332 + T::from_f64(0.0000796647061621031),
+                    t2 * t378,
+                );
+                let t406 = t275 + t385;
+                let t407 = t278 + t387;
+                let t408 = t279 + T::mul_add(T::from_f64(0.0384), t379, t352);
+                let t409 = t276 + T::mul_add(T::from_f64(0.0384), t380, t348);
+                let t410 = t18 * (T::mul_add(T::from_f64(0.0355), -t249, -t380));
+                let t411 = t272 + t391;
+                let t412 = t273 + T::mul_add(T::from_f64(0.0514), t381, t345);
+                let t413 = t269 + t395;
+                let t414 = t270 + T::mul_add(T::from_f64(0.0384), t383, t341);
+                let t415 = T::mul_add(
                     t24,
-                    t377,
-                    t25 * (T::mul_add(T::from_f64(0.0355), t251, t368)),
+                    t388,
+                    t25 * (T::mul_add(T::from_f64(0.0355), t251, t379)),
                 );
-                let t405 = T::mul_add(t11, t382, t12 * t381);
-                let t406 = T::mul_add(
+                let t416 = T::mul_add(t11, t393, t12 * t392);
+                let t417 = T::mul_add(
                     t4,
-                    t385,
-                    t5 * (T::mul_add(T::from_f64(0.0355), t243, t372)),
+                    t396,
+                    t5 * (T::mul_add(T::from_f64(0.0355), t243, t383)),
                 );
-                let t407 = T::mul_add(
-                    -t200,
-                    t256 * t323,
-                    T::mul_add(-t268, t199, T::mul_add(T::from_f64(0.0399), t174, -t392)),
+                let t418 = T::mul_add(
+                    -t293,
+                    t326,
+                    T::mul_add(-t268, t199, T::mul_add(T::from_f64(0.0399), t174, -t403)),
                 );
-                let t408 = T::mul_add(-t9, T::mul_add(t10, t208, -t264), t10 * t391);
-                let t409 = T::mul_add(
+                let t419 = T::mul_add(-t9, T::mul_add(t10, t208, -t264), t10 * t402);
+                let t420 = T::mul_add(
                     -T::from_f64(0.054),
-                    T::mul_add(t17, t379, t399),
-                    t398,
+                    T::mul_add(t17, t390, t410),
+                    t409,
                 );
-                let t410 = T::mul_add(
+                let t421 = T::mul_add(
                     T::from_f64(0.0119),
                     T::mul_add(
                         T::from_f64(0.0399),
                         t28,
                         T::from_f64(0.8549978271231358) * t8,
                     ),
-                    -(T::mul_add(t12, t382, -t11 * t381)),
+                    -(T::mul_add(t12, t393, -t11 * t392)),
                 );
-                let t411 = T::mul_add(t77, t361, tau[14] - t397);
-                let t412 = T::mul_add(t78, t362, tau[10] - t398);
-                let t413 = T::mul_add(t79, t363, tau[6] - t401);
-                let t414 = T::mul_add(t80, t364, tau[2] - t403);
-                let t415 = T::mul_add(
+                let t422 = t418 * t384;
+                let t423 = T::mul_add(t77, t372, tau[14] - t408);
+                let t424 = T::mul_add(t78, t373, tau[10] - t409);
+                let t425 = T::mul_add(t79, t374, tau[6] - t412);
+                let t426 = T::mul_add(t80, t375, tau[2] - t414);
+                let t427 = T::mul_add(
                     T::from_f64(2.0),
                     T::mul_add(
                         T::from_f64(0.005),
@@ -2843,16 +2855,16 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                     T::mul_add(
                         T::from_f64(0.054),
                         t174,
-                        t408 + T::from_f64(0.00017059455499999996),
+                        t419 + T::from_f64(0.00017059455499999996),
                     ),
                 );
-                let t416 = T::mul_add(
+                let t428 = T::mul_add(
                     -T::from_f64(0.054),
-                    T::mul_add(T::from_f64(0.0038339999999999997), t68, t315),
-                    T::mul_add(t17, t375, t18 * t395),
+                    T::mul_add(T::from_f64(0.0038339999999999997), t68, t316),
+                    T::mul_add(t17, t386, t18 * t406),
                 );
-                let t417 = t231 + T::mul_add(t18, t375, -t17 * t395);
-                let t418 = T::mul_add(
+                let t429 = t231 + T::mul_add(t18, t386, -t17 * t406);
+                let t430 = T::mul_add(
                     -T::from_f64(0.054),
                     T::mul_add(
                         T::from_f64(0.0355),
@@ -2860,19 +2872,19 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                         T::mul_add(
                             -T::from_f64(0.0264),
                             t253,
-                            -T::from_f64(0.00044856000000000003) * (t306 + t239),
+                            -T::from_f64(0.00044856000000000003) * (t310 + t239),
                         ),
                     ),
-                    T::mul_add(t24, t378, t25 * t396),
+                    T::mul_add(t24, t389, t25 * t407),
                 );
-                let t419 = t238 + T::mul_add(t25, t378, -t24 * t396);
-                let t420 = T::mul_add(
+                let t431 = t238 + T::mul_add(t25, t389, -t24 * t407);
+                let t432 = T::mul_add(
                     T::from_f64(0.0177),
-                    T::mul_add(T::from_f64(0.038), t147, -t318),
-                    T::mul_add(t11, t383, t12 * t400),
+                    T::mul_add(T::from_f64(0.038), t147, -t319),
+                    T::mul_add(t11, t394, t12 * t411),
                 );
-                let t421 = t224 + T::mul_add(t12, t383, -t11 * t400);
-                let t422 = T::mul_add(
+                let t433 = t224 + T::mul_add(t12, t394, -t11 * t411);
+                let t434 = T::mul_add(
                     T::from_f64(0.054),
                     T::mul_add(
                         T::from_f64(0.0355),
@@ -2884,109 +2896,79 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                         -(T::mul_add(
                             -T::from_f64(0.0264),
                             t245,
-                            -T::from_f64(0.00044856000000000003) * (t300 + t218),
+                            -T::from_f64(0.00044856000000000003) * (t304 + t218),
                         )),
                     ),
-                    T::mul_add(t4, t386, t5 * t402),
+                    T::mul_add(t4, t397, t5 * t413),
                 );
-                let t423 = t217 + T::mul_add(t5, t386, -t4 * t402);
-                let t424 = T::mul_add(
-                    -t321,
-                    t349 * t349,
+                let t435 = t217 + T::mul_add(t5, t397, -t4 * t413);
+                let t436 = T::mul_add(
+                    -t354,
+                    t368,
                     T::mul_add(
-                        -t197,
-                        t309 * t309,
+                        -t312,
+                        t323,
                         T::mul_add(
                             -t214,
                             t289,
-                            T::mul_add(-t23, t388, -t22 * t387)
+                            T::mul_add(-t23, t399, -t22 * t398)
                                 + T::from_f64(0.00000101666658333),
                         ),
                     ),
                 );
-                let t425 = T::mul_add(
-                    -t322,
-                    t350 * t350,
+                let t437 = T::mul_add(
+                    -t356,
+                    t369,
                     T::mul_add(
-                        -t198,
-                        t311 * t311,
+                        -t313,
+                        t325,
                         T::mul_add(
                             -t213,
-                            t290,
-                            T::mul_add(-t16, t390, -t15 * t389)
+                            t291,
+                            T::mul_add(-t16, t401, -t15 * t400)
                                 + T::from_f64(0.00000101666658333),
                         ),
                     ),
                 );
-                let t426 = T::mul_add(
-                    -t324,
-                    t351 * t351,
+                let t438 = T::mul_add(
+                    -t359,
+                    t371,
                     T::mul_add(
-                        -t201,
-                        t314 * t314,
+                        -t315,
+                        t328,
                         T::mul_add(
                             -t211,
-                            t291,
-                            T::mul_add(-t3, t394, -t2 * t393)
+                            t294,
+                            T::mul_add(-t3, t405, -t2 * t404)
                                 + T::from_f64(0.00000101666658333),
                         ),
                     ),
                 );
-                let t427 = T::mul_add(
+                let t439 = T::mul_add(
                     t9,
-                    T::mul_add(T::from_f64(0.0119), t146, t405),
-                    -t371,
+                    T::mul_add(T::from_f64(0.0119), t146, t416),
+                    -t382,
                 );
-                let t428 = t9 * (t223 + T::mul_add(T::from_f64(0.0177), t405, t401));
-                let t429 = tau[1] - (t216 + T::mul_add(T::from_f64(0.054), t406, t403));
-                let t430 = tau[13] - (t237 + T::mul_add(T::from_f64(0.054), t404, t397));
-                let t431 = T::one() / t424;
-                let t432 = T::one() / t425;
-                let t433 = T::mul_add(
-                    -t407,
-                    t407 * t373,
+                let t440 = t9 * (t223 + T::mul_add(T::from_f64(0.0177), t416, t412));
+                let t441 = tau[1] - (t216 + T::mul_add(T::from_f64(0.054), t417, t414));
+                let t442 = tau[13] - (t237 + T::mul_add(T::from_f64(0.054), t415, t408));
+                let t443 = T::mul_add(
+                    -t418,
+                    t422,
                     T::mul_add(
-                        -t200,
-                        t323 * t323,
+                        -t326,
+                        t357,
                         T::mul_add(
                             -t268,
-                            t312,
-                            t415 + T::from_f64(0.0000196731938544998),
+                            t314,
+                            t427 + T::from_f64(0.0000196731938544998),
                         ),
                     ),
                 );
-                let t434 = T::one() / t426;
-                let t435 = T::one() / t433;
-                let t436 = T::mul_add(t155, t362, tau[9] - (t230 + t409));
-                let t437 = T::mul_add(t16, t417, -t15 * (t229 + t416));
-                let t438 = T::mul_add(t23, t419, -t22 * (t236 + t418));
-                let t439 = T::mul_add(t10, t222 + t420, -t428);
-                let t440 = T::mul_add(t3, t423, -t2 * (t215 + t422));
-                let t441 = T::mul_add(-t254, t197 * t411, T::mul_add(t153, t361, t430));
-                let t442 = T::mul_add(-t255, t198 * t412, t436);
-                let t443 = T::mul_add(
-                    t200,
-                    t256 * t413,
-                    T::mul_add(-t199, t363, tau[5] - t421),
-                );
-                let t444 = T::mul_add(-t257, t201 * t414, T::mul_add(t158, t364, t429));
-                let t445 = tau[4]
-                    - (-t439
-                        - (T::mul_add(
-                            -T::from_f64(0.0399),
-                            t427,
-                            -T::from_f64(0.005) * t410,
-                        )));
-                let t446 = T::mul_add(
-                    t197,
-                    t309 * t411,
-                    T::mul_add(-t289, t361, tau[12] - t438),
-                );
-                let t447 = T::mul_add(
-                    t198,
-                    t311 * t412,
-                    T::mul_add(-t290, t362, tau[8] - t437),
-                );
+                let t444 = T::mul_add(t155, t373, tau[9] - (t230 + t420));
+                let t445 = T::mul_add(t16, t429, -t15 * (t229 + t428));
+                let t446 = T::mul_add(t23, t431, -t22 * (t236 + t430));
+                let t447 = T::mul_add(t10, t222 + t432, -t440);
                 (
                     t384,
                     t385,
@@ -3073,60 +3055,78 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                 t463,
                 t464,
                 t465,
+                t466,
+                t467,
+                t468,
+                t469,
+                t470,
+                t471,
+                t472,
+                t473,
             ) = {
-                let t448 = T::mul_add(
-                    t201,
-                    t314 * t414,
-                    T::mul_add(-t291, t364, tau[0] - t440),
+                let t448 = T::mul_add(t3, t435, -t2 * (t215 + t434));
+                let t449 = T::mul_add(-t290, t423, T::mul_add(t153, t372, t442));
+                let t450 = T::mul_add(-t292, t424, t444);
+                let t451 = T::mul_add(
+                    t293,
+                    t425,
+                    T::mul_add(-t199, t374, tau[5] - t433),
                 );
-                let t449 = T::mul_add(t321, t349 * t441, t446);
-                let t450 = T::mul_add(t322, t350 * t442, t447);
-                let t451 = T::mul_add(t200, t323 * t413, T::mul_add(-t312, t363, t445));
-                let t452 = T::mul_add(t324, t351 * t444, t448);
-                let t453 = T::mul_add(-t407, t373 * t443, t451);
-                let t454 = T::mul_add(t324, t351 * t434 * t452, t324 * t444);
-                let t455 = T::mul_add(t322, t350 * t432 * t450, t322 * t442);
-                let t456 = T::mul_add(t321, t349 * t431 * t449, t321 * t441);
-                let t457 = T::mul_add(-t407, t373 * t435 * t453, t373 * t443);
-                let t458 = T::mul_add(
-                    t201,
-                    t314 * t434 * t452,
-                    T::mul_add(-t257, t201 * t454, t201 * t414),
+                let t452 = T::mul_add(-t295, t426, T::mul_add(t158, t375, t441));
+                let t453 = tau[4]
+                    - (-t447
+                        - (T::mul_add(
+                            -T::from_f64(0.0399),
+                            t439,
+                            -T::from_f64(0.005) * t421,
+                        )));
+                let t454 = T::mul_add(
+                    t323,
+                    t423,
+                    T::mul_add(-t289, t372, tau[12] - t446),
                 );
-                let t459 = T::mul_add(
-                    t198,
-                    t311 * t432 * t450,
-                    T::mul_add(-t255, t198 * t455, t198 * t412),
+                let t455 = T::mul_add(
+                    t325,
+                    t424,
+                    T::mul_add(-t291, t373, tau[8] - t445),
                 );
-                let t460 = T::mul_add(
-                    t197,
-                    t309 * t431 * t449,
-                    T::mul_add(-t254, t197 * t456, t197 * t411),
+                let t456 = T::mul_add(
+                    t328,
+                    t426,
+                    T::mul_add(-t294, t375, tau[0] - t448),
                 );
-                let t461 = T::mul_add(
-                    t200,
-                    t323 * t435 * t453,
-                    T::mul_add(t200, t256 * t457, t200 * t413),
-                );
-                let t462 = T::mul_add(
+                let t457 = T::mul_add(t357, t425, T::mul_add(-t314, t374, t453));
+                let t458 = (T::one() / t438) * (T::mul_add(t371, t452, t456));
+                let t459 = (T::one() / t437) * (T::mul_add(t369, t450, t455));
+                let t460 = (T::one() / t436) * (T::mul_add(t368, t449, t454));
+                let t461 = (T::one() / t443) * (T::mul_add(-t422, t451, t457));
+                let t462 = T::mul_add(t371, t458, t358 * t452);
+                let t463 = T::mul_add(t369, t459, t355 * t450);
+                let t464 = T::mul_add(t368, t460, t353 * t449);
+                let t465 = T::mul_add(-t422, t461, t384 * t451);
+                let t466 = T::mul_add(t328, t458, T::mul_add(-t295, t462, t201 * t426));
+                let t467 = T::mul_add(t325, t459, T::mul_add(-t292, t463, t198 * t424));
+                let t468 = T::mul_add(t323, t460, T::mul_add(-t290, t464, t197 * t423));
+                let t469 = T::mul_add(t357, t461, T::mul_add(t293, t465, t200 * t425));
+                let t470 = T::mul_add(
                     -t158,
-                    t454,
-                    T::mul_add(-t80, t458, -T::from_f64(60263.23947213258) * t364),
+                    t462,
+                    T::mul_add(-t80, t466, -T::from_f64(60263.23947213258) * t375),
                 );
-                let t463 = T::mul_add(
+                let t471 = T::mul_add(
                     -t155,
-                    t455,
-                    T::mul_add(-t78, t459, -T::from_f64(60263.23947213258) * t362),
+                    t463,
+                    T::mul_add(-t78, t467, -T::from_f64(60263.23947213258) * t373),
                 );
-                let t464 = T::mul_add(
+                let t472 = T::mul_add(
                     -t153,
-                    t456,
-                    T::mul_add(-t77, t460, -T::from_f64(60263.23947213258) * t361),
+                    t464,
+                    T::mul_add(-t77, t468, -T::from_f64(60263.23947213258) * t372),
                 );
-                let t465 = T::mul_add(
+                let t473 = T::mul_add(
                     t199,
-                    t457,
-                    T::mul_add(-t79, t461, -T::from_f64(21844.852556112917) * t363),
+                    t465,
+                    T::mul_add(-t79, t469, -T::from_f64(21844.852556112917) * t374),
                 );
                 (
                     t448,
@@ -3147,39 +3147,47 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                     t463,
                     t464,
                     t465,
+                    t466,
+                    t467,
+                    t468,
+                    t469,
+                    t470,
+                    t471,
+                    t472,
+                    t473,
                 )
             };
             [
-                t434 * t452,
-                t454,
                 t458,
-                T::mul_add(t291, t434 * t452, t462),
-                t435 * t453,
-                t457,
+                t462,
+                t466,
+                T::mul_add(t294, t458, t470),
                 t461,
-                T::mul_add(t312, t435 * t453, t465),
-                t432 * t450,
-                t455,
+                t465,
+                t469,
+                T::mul_add(t314, t461, t473),
                 t459,
-                T::mul_add(t290, t432 * t450, t463),
-                t431 * t449,
-                t456,
+                t463,
+                t467,
+                T::mul_add(t291, t459, t471),
                 t460,
-                T::mul_add(t289, t431 * t449, t464),
-                t426,
-                t313,
+                t464,
+                t468,
+                T::mul_add(t289, t460, t472),
+                t438,
+                t327,
                 t157,
                 T::from_f64(0.000016593864000000002),
-                t433,
-                t360,
+                t443,
+                t370,
                 t156,
                 T::from_f64(0.000045777374666699994),
-                t425,
-                t310,
+                t437,
+                t324,
                 t154,
                 T::from_f64(0.000016593864000000002),
-                t424,
-                t308,
+                t436,
+                t322,
                 t152,
                 T::from_f64(0.000016593864000000002),
             ]
@@ -19292,7 +19300,7 @@ for AllegroRightHand<T> {
     /// model and finite inputs); `try_forward_dynamics` says which pivot failed.
     ///
     /// Route: M and b + G as in `mass_matrix` and `bias`, then an unrolled L^T D L solve without fill-in.
-    /// Operations: 1181 mul, 783 add, 12 div, 15 sin, 15 cos.
+    /// Operations: 1141 mul, 783 add, 12 div, 15 sin, 15 cos.
     fn forward_dynamics(&self, q: &[T; 16], qd: &[T; 16], tau: &[T; 16]) -> [T; 16] {
         match self.forward_dynamics_checked(q, qd, tau) {
             Ok((qdd, failures)) => ::eomgen_runtime::lane::nan_failed(qdd, &failures),

@@ -144,9 +144,8 @@ impl<T: ::eomgen_runtime::Lane> DoublePendulum<T> {
                 t7,
                 T::mul_add(T::from_f64(0.2), t4, T::from_f64(0.00863622790870487)),
             );
-            let t12 = T::one() / t11;
-            let t13 = t10 - tau[1];
-            let t14 = T::mul_add(
+            let t12 = t10 - tau[1];
+            let t13 = T::mul_add(
                 -t2,
                 T::mul_add(T::from_f64(0.33238), t9, T::from_f64(0.0335304944) * t5),
                 t3
@@ -156,16 +155,16 @@ impl<T: ::eomgen_runtime::Lane> DoublePendulum<T> {
                         T::from_f64(0.0000000000643853298) * t5,
                     )),
             );
-            let t15 = tau[0]
+            let t14 = tau[0]
                 - (T::mul_add(
                     T::from_f64(0.00000569152735461),
                     t1,
                     -T::from_f64(0.0943357495716) * t0,
-                ) + T::mul_add(T::from_f64(0.1), t14, t10));
-            let t16 = T::mul_add(t7, t13, t15);
+                ) + T::mul_add(T::from_f64(0.1), t13, t10));
+            let t15 = (T::one() / t11) * (T::mul_add(t7, t12, t14));
             [
-                t12 * t16,
-                T::mul_add(-t7, t12 * t16, -T::from_f64(219.4013895236754) * t13),
+                t15,
+                T::mul_add(-t7, t15, -T::from_f64(219.4013895236754) * t12),
                 t11,
                 T::from_f64(0.004557856275072),
             ]
@@ -830,7 +829,7 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 2> for DoublePendu
     /// model and finite inputs); `try_forward_dynamics` says which pivot failed.
     ///
     /// Route: M and b + G as in `mass_matrix` and `bias`, then an unrolled L^T D L solve without fill-in.
-    /// Operations: 32 mul, 20 add, 1 div, 2 sin, 2 cos.
+    /// Operations: 31 mul, 20 add, 1 div, 2 sin, 2 cos.
     fn forward_dynamics(&self, q: &[T; 2], qd: &[T; 2], tau: &[T; 2]) -> [T; 2] {
         match self.forward_dynamics_checked(q, qd, tau) {
             Ok((qdd, failures)) => ::eomgen_runtime::lane::nan_failed(qdd, &failures),

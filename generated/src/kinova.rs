@@ -730,11 +730,7 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                 );
                 let t126 = T::from_f64(0.10375) * (T::mul_add(t63, t63, t80))
                     + T::mul_add(-T::from_f64(0.0114), t61, -t76 - t89);
-                let t127 = T::mul_add(
-                    t7,
-                    T::mul_add(T::from_f64(0.0008740216642230976), t7, t37),
-                    t6 * (T::mul_add(t6, t53, t39)),
-                );
+                let t127 = t90 * t105;
                 (
                     t64,
                     t65,
@@ -868,23 +864,28 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                 t190,
                 t191,
             ) = {
-                let t128 = -t110;
-                let t129 = t0 * t109;
-                let t130 = T::mul_add(t4, t56, -t93)
+                let t128 = T::mul_add(
+                    t7,
+                    T::mul_add(T::from_f64(0.0008740216642230976), t7, t37),
+                    t6 * (T::mul_add(t6, t53, t39)),
+                );
+                let t129 = -t110;
+                let t130 = t0 * t109;
+                let t131 = T::mul_add(t4, t56, -t93)
                     + T::mul_add(-T::from_f64(0.2073), t58, T::from_f64(0.0114) * t35);
-                let t131 = T::mul_add(t4, t41, t5 * t73)
+                let t132 = T::mul_add(t4, t41, t5 * t73)
                     + T::mul_add(
                         -T::from_f64(0.2073),
                         t42,
                         T::from_f64(0.0114) * t6 * t12,
                     );
-                let t132 = T::mul_add(T::from_f64(0.2073), t43, t114);
-                let t133 = T::mul_add(-T::from_f64(0.2073), t43, -t114);
-                let t134 = T::mul_add(-t9, t84, t8 * t99);
-                let t135 = T::mul_add(t8, t84, t9 * t99);
-                let t136 = T::mul_add(t5, t104, -t4 * t96);
-                let t137 = T::mul_add(-t4, t104, -t5 * t96);
-                let t138 = T::mul_add(
+                let t133 = T::mul_add(T::from_f64(0.2073), t43, t114);
+                let t134 = T::mul_add(-T::from_f64(0.2073), t43, -t114);
+                let t135 = T::mul_add(-t9, t84, t8 * t99);
+                let t136 = T::mul_add(t8, t84, t9 * t99);
+                let t137 = T::mul_add(t5, t104, -t4 * t96);
+                let t138 = T::mul_add(-t4, t104, -t5 * t96);
+                let t139 = T::mul_add(
                     -T::from_f64(0.463),
                     t103,
                     T::mul_add(
@@ -893,129 +894,129 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                         T::mul_add(t63, t79, T::from_f64(0.0250914799819) * t80),
                     ),
                 );
-                let t139 = T::mul_add(
+                let t140 = T::mul_add(
                     T::from_f64(266.5742973918923),
                     t43,
                     T::from_f64(1285.9348644085492) * t114,
                 );
-                let t140 = T::mul_add(
+                let t141 = T::mul_add(
                     -T::from_f64(0.2075),
                     t36,
                     T::mul_add(t6, t54, t7 * t91) + T::from_f64(0.0160707453125),
                 );
-                let t141 = T::mul_add(
+                let t142 = T::mul_add(
                     T::from_f64(0.10375),
                     t35,
                     T::mul_add(t7, t54, -t6 * t91),
                 );
-                let t142 = T::mul_add(
+                let t143 = T::mul_add(
                     T::from_f64(0.0114),
                     t94,
-                    t127 + T::from_f64(0.00009645337053442467),
+                    t128 + T::from_f64(0.00009645337053442467),
                 );
-                let t143 = T::mul_add(T::from_f64(0.41), t75, t133);
-                let t144 = T::mul_add(-qd[4], t100, T::mul_add(-t6, t62, t7 * t98));
-                let t145 = T::mul_add(-qd[4], t99, T::mul_add(-t7, t62, -t6 * t98));
-                let t146 = T::mul_add(
-                    T::from_f64(0.00000000000000000010842021724855044),
-                    t135,
-                    T::from_f64(0.00010000000000000503) * t134,
-                );
+                let t144 = T::mul_add(T::from_f64(0.41), t75, t134);
+                let t145 = T::mul_add(-qd[4], t100, T::mul_add(-t6, t62, t7 * t98));
+                let t146 = T::mul_add(-qd[4], t99, T::mul_add(-t7, t62, -t6 * t98));
                 let t147 = T::mul_add(
-                    T::from_f64(0.0650091026469637),
-                    t135,
-                    T::from_f64(0.00010000000000000503) * t122,
+                    T::from_f64(0.00000000000000000010842021724855044),
+                    t136,
+                    T::from_f64(0.00010000000000000503) * t135,
                 );
                 let t148 = T::mul_add(
-                    -T::from_f64(0.00000000000000000010842021724855044),
-                    t122,
-                    T::from_f64(0.0650091026469637) * t134,
+                    T::from_f64(0.0650091026469637),
+                    t136,
+                    T::from_f64(0.00010000000000000503) * t122,
                 );
                 let t149 = T::mul_add(
+                    -T::from_f64(0.00000000000000000010842021724855044),
+                    t122,
+                    T::from_f64(0.0650091026469637) * t135,
+                );
+                let t150 = T::mul_add(
                     -T::from_f64(0.004894691391055498),
-                    t135,
+                    t136,
                     T::mul_add(
                         -T::from_f64(0.000014022756617410007),
                         t122,
-                        T::from_f64(0.0000000000000006979729257032011) * t134,
-                    ),
-                );
-                let t150 = T::mul_add(
-                    -T::from_f64(0.0000000000000006979729257032011),
-                    t135,
-                    T::mul_add(
-                        T::from_f64(0.000000000000000000006709516445275485),
-                        t122,
-                        T::from_f64(0.004705147001603182) * t134,
+                        T::from_f64(0.0000000000000006979729257032011) * t135,
                     ),
                 );
                 let t151 = T::mul_add(
+                    -T::from_f64(0.0000000000000006979729257032011),
+                    t136,
+                    T::mul_add(
+                        T::from_f64(0.000000000000000000006709516445275485),
+                        t122,
+                        T::from_f64(0.004705147001603182) * t135,
+                    ),
+                );
+                let t152 = T::mul_add(
                     T::from_f64(0.000014022756617410007),
-                    t135,
+                    t136,
                     T::mul_add(
                         T::from_f64(0.0007776443641723163),
                         t122,
-                        T::from_f64(0.000000000000000000006709516445275485) * t134,
+                        T::from_f64(0.000000000000000000006709516445275485) * t135,
                     ),
                 );
-                let t152 = -t136;
                 let t153 = -t137;
-                let t154 = T::mul_add(T::from_f64(0.10375), t97 - t78, -t136);
-                let t155 = T::mul_add(T::from_f64(0.10375), t98 + t83, -t137);
-                let t156 = T::mul_add(
+                let t154 = -t138;
+                let t155 = T::mul_add(T::from_f64(0.10375), t97 - t78, -t137);
+                let t156 = T::mul_add(T::from_f64(0.10375), t98 + t83, -t138);
+                let t157 = T::mul_add(
                     T::from_f64(1285.9348644085492),
-                    t133,
+                    t134,
                     T::from_f64(527.2332944075051) * t75,
                 );
-                let t157 = T::mul_add(
-                    -t90,
-                    t105 * t105,
-                    T::mul_add(-t59, t66, t127 + T::from_f64(0.00009645337053442467)),
+                let t158 = T::mul_add(
+                    -t105,
+                    t127,
+                    T::mul_add(-t59, t66, t128 + T::from_f64(0.00009645337053442467)),
                 );
-                let t158 = t140 + T::from_f64(0.0017957741063972504);
-                let t159 = T::mul_add(
+                let t159 = t141 + T::from_f64(0.0017957741063972504);
+                let t160 = T::mul_add(
                     T::from_f64(2.0),
                     t108,
                     T::mul_add(
                         T::from_f64(0.4146),
                         t36,
-                        t127 - T::from_f64(0.07427329421996133),
+                        t128 - T::from_f64(0.07427329421996133),
                     ),
                 ) + T::from_f64(0.00035435414799999976);
-                let t160 = T::mul_add(t1, t110 - T::from_f64(1.2836779999999999), t129);
-                let t161 = T::mul_add(
+                let t161 = T::mul_add(t1, t110 - T::from_f64(1.2836779999999999), t130);
+                let t162 = T::mul_add(
                     -T::from_f64(0.463),
-                    t153,
+                    t154,
                     T::mul_add(
                         -T::from_f64(0.0250914799819),
                         t98,
                         T::mul_add(-T::from_f64(0.0013357060146000001), t80, -t51 * t79),
                     ),
                 );
-                let t162 = T::mul_add(
+                let t163 = T::mul_add(
                     T::from_f64(0.0250914799819),
-                    t152,
+                    t153,
                     T::mul_add(
                         T::from_f64(0.0017919207358628258),
                         t97,
                         -T::from_f64(0.00007238626506919941) * t62,
                     ) + T::mul_add(t64, t82, -T::from_f64(0.0017957741063972504) * t78),
                 );
-                let t163 = T::mul_add(
+                let t164 = T::mul_add(
                     T::from_f64(0.0013357060146000001),
-                    t152,
+                    t153,
                     T::mul_add(
                         T::from_f64(0.00007238626506919941),
                         t97,
                         -T::from_f64(0.00009645337053442467) * t62,
                     ) + T::mul_add(-t64, t81, T::from_f64(0.0017957741063972504) * t77),
                 );
-                let t164 = T::mul_add(
+                let t165 = T::mul_add(
                     -T::from_f64(0.463),
-                    t155,
+                    t156,
                     T::mul_add(
                         T::from_f64(0.0230207699865),
-                        t144,
+                        t145,
                         T::mul_add(
                             -t100,
                             t118,
@@ -1023,43 +1024,43 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                         ),
                     ),
                 );
-                let t165 = T::mul_add(
-                    T::from_f64(0.10375),
-                    T::mul_add(-t84, t100, t144),
-                    T::mul_add(-T::from_f64(0.10375), t98 + t83, t137),
-                );
                 let t166 = T::mul_add(
-                    -t132,
+                    T::from_f64(0.10375),
+                    T::mul_add(-t84, t100, t145),
+                    T::mul_add(-T::from_f64(0.10375), t98 + t83, t138),
+                );
+                let t167 = T::mul_add(
+                    -t133,
                     t32,
                     T::mul_add(T::from_f64(0.2073), t57, t111),
                 );
-                let t167 = T::one() / t157;
-                let t168 = T::mul_add(t4, t106, -t5 * t141);
-                let t169 = T::mul_add(-t5, t106, -t4 * t141);
-                let t170 = T::mul_add(
-                    T::from_f64(0.41),
-                    t58,
-                    -(T::mul_add(t2, t112, -t3 * t130)),
-                );
+                let t168 = T::one() / t158;
+                let t169 = T::mul_add(t4, t106, -t5 * t142);
+                let t170 = T::mul_add(-t5, t106, -t4 * t142);
                 let t171 = T::mul_add(
                     T::from_f64(0.41),
-                    t42,
-                    -(T::mul_add(t2, t74, -t3 * t131)),
+                    t58,
+                    -(T::mul_add(t2, t112, -t3 * t131)),
                 );
                 let t172 = T::mul_add(
+                    T::from_f64(0.41),
+                    t42,
+                    -(T::mul_add(t2, t74, -t3 * t132)),
+                );
+                let t173 = T::mul_add(
                     -T::from_f64(0.0017957741063972504),
                     t98,
                     T::mul_add(-t51, t81, t63 * t82)
                         + T::mul_add(
                             -T::from_f64(0.0250914799819),
-                            t153,
+                            t154,
                             -T::from_f64(0.0013357060146000001) * t103,
                         ),
                 );
-                let t173 = T::mul_add(t6, t126, t7 * t154);
-                let t174 = T::mul_add(t7, t126, -t6 * t154);
-                let t175 = T::mul_add(
-                    -t143,
+                let t174 = T::mul_add(t6, t126, t7 * t155);
+                let t175 = T::mul_add(t7, t126, -t6 * t155);
+                let t176 = T::mul_add(
+                    -t144,
                     t32,
                     T::mul_add(
                         T::from_f64(0.41),
@@ -1067,66 +1068,41 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                         T::mul_add(-T::from_f64(0.2073), t57, -t111),
                     ),
                 );
-                let t176 = T::mul_add(t5, t158, -t92);
-                let t177 = T::mul_add(-T::from_f64(0.2073), t71, t168);
-                let t178 = T::mul_add(qd[5], t134, T::mul_add(-t8, t97, -t9 * t144));
-                let t179 = T::mul_add(qd[5], t135, T::mul_add(-t9, t97, t8 * t144));
-                let t180 = -t174;
-                let t181 = T::mul_add(
+                let t177 = t167 * t90;
+                let t178 = T::mul_add(t5, t159, -t92);
+                let t179 = T::mul_add(-T::from_f64(0.2073), t71, t169);
+                let t180 = T::mul_add(qd[5], t135, T::mul_add(-t8, t97, -t9 * t145));
+                let t181 = T::mul_add(qd[5], t136, T::mul_add(-t9, t97, t8 * t145));
+                let t182 = -t175;
+                let t183 = T::mul_add(
                     -T::from_f64(0.0013224560195000002),
-                    t173,
+                    t174,
                     T::mul_add(
                         T::from_f64(0.00009637730005078133),
-                        t145,
+                        t146,
                         T::from_f64(0.00006575368432434527) * t97,
                     ) + T::mul_add(-t99, t121, T::from_f64(0.0015805219734713843) * t117),
                 );
-                let t182 = T::mul_add(
+                let t184 = T::mul_add(
                     -T::from_f64(0.0230207699865),
-                    t173,
+                    t174,
                     T::mul_add(
                         T::from_f64(0.00006575368432434527),
-                        t145,
+                        t146,
                         T::from_f64(0.0015767446734206029) * t97,
                     ) + T::mul_add(t99, t120, T::from_f64(0.0015805219734713843) * t116),
                 );
-                let t183 = -T::from_f64(0.10375) * (T::mul_add(t84, t84, t119)) + t174;
-                let t184 = T::mul_add(T::from_f64(0.10375), t97 + t116, -t173);
-                let t185 = T::mul_add(
+                let t185 = -T::from_f64(0.10375) * (T::mul_add(t84, t84, t119)) + t175;
+                let t186 = T::mul_add(T::from_f64(0.10375), t97 + t116, -t174);
+                let t187 = T::mul_add(
                     -T::from_f64(0.2073),
                     t94,
-                    T::mul_add(t166, t90 * t105, T::mul_add(t132, t66, t169)),
+                    T::mul_add(t167, t127, T::mul_add(t133, t66, t170)),
                 );
-                let t186 = T::mul_add(T::from_f64(0.2073), t71, -t168);
-                let t187 = T::mul_add(-t1, T::mul_add(t3, t112, t2 * t130), t0 * t170);
-                let t188 = T::mul_add(-t1, T::mul_add(t3, t74, t2 * t131), t0 * t171);
-                let t189 = T::mul_add(
-                    -T::from_f64(0.463),
-                    t180,
-                    T::mul_add(
-                        T::from_f64(0.0013224560195000002),
-                        t144,
-                        T::mul_add(-T::from_f64(0.0230207699865), t119, -t84 * t118),
-                    ),
-                );
-                let t190 = T::mul_add(
-                    -t175,
-                    t90 * t105,
-                    T::mul_add(
-                        -t143,
-                        t66,
-                        T::mul_add(
-                            T::from_f64(0.41),
-                            t3 * t94,
-                            -(T::mul_add(T::from_f64(0.2073), t94, -t169)),
-                        ),
-                    ),
-                );
-                let t191 = T::mul_add(
-                    t5,
-                    T::mul_add(t5, t69, t92),
-                    t4 * (T::mul_add(t4, t158, t93)),
-                );
+                let t188 = t176 * t90;
+                let t189 = T::mul_add(T::from_f64(0.2073), t71, -t169);
+                let t190 = T::mul_add(-t1, T::mul_add(t3, t112, t2 * t131), t0 * t171);
+                let t191 = T::mul_add(-t1, T::mul_add(t3, t74, t2 * t132), t0 * t172);
                 (
                     t128,
                     t129,
@@ -1261,179 +1237,209 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                 t255,
             ) = {
                 let t192 = T::mul_add(
+                    -T::from_f64(0.463),
+                    t182,
+                    T::mul_add(
+                        T::from_f64(0.0013224560195000002),
+                        t145,
+                        T::mul_add(-T::from_f64(0.0230207699865), t119, -t84 * t118),
+                    ),
+                );
+                let t193 = t187 * t168;
+                let t194 = T::mul_add(
+                    -t176,
+                    t127,
+                    T::mul_add(
+                        -t144,
+                        t66,
+                        T::mul_add(
+                            T::from_f64(0.41),
+                            t3 * t94,
+                            -(T::mul_add(T::from_f64(0.2073), t94, -t170)),
+                        ),
+                    ),
+                );
+                let t195 = T::mul_add(
+                    t5,
+                    T::mul_add(t5, t69, t92),
+                    t4 * (T::mul_add(t4, t159, t93)),
+                );
+                let t196 = T::mul_add(
                     T::from_f64(0.2073),
                     t94,
                     T::mul_add(
                         -T::from_f64(0.0114),
                         t36,
-                        -t169 + T::from_f64(0.0066743469417936616),
+                        -t170 + T::from_f64(0.0066743469417936616),
                     ),
                 ) + T::from_f64(0.00047111058);
-                let t193 = t2 * t186;
-                let t194 = t3 * t186;
-                let t195 = T::mul_add(T::from_f64(0.0016), t115, t188);
-                let t196 = T::mul_add(
+                let t197 = t2 * t189;
+                let t198 = t3 * t189;
+                let t199 = T::mul_add(T::from_f64(0.0016), t115, t191);
+                let t200 = T::mul_add(
                     T::from_f64(0.0015805219734713843),
-                    t144,
+                    t145,
                     T::mul_add(-t84, t120, -t100 * t121)
                         + T::mul_add(
                             -T::from_f64(0.0013224560195000002),
-                            t180,
-                            -T::from_f64(0.0230207699865) * t155,
+                            t182,
+                            -T::from_f64(0.0230207699865) * t156,
                         ),
                 );
-                let t197 = T::mul_add(-t8, t165, t9 * t184);
-                let t198 = T::mul_add(t9, t165, t8 * t184);
-                let t199 = T::mul_add(
+                let t201 = T::mul_add(-t8, t166, t9 * t186);
+                let t202 = T::mul_add(t9, t166, t8 * t186);
+                let t203 = T::mul_add(
                     T::from_f64(1.03),
-                    t183,
+                    t185,
                     -(T::mul_add(
                         T::from_f64(0.00010000000000000503),
-                        t179,
-                        -T::from_f64(0.00000000000000000010842021724855044) * t178,
-                    )) - (T::mul_add(t134, t148, t135 * t147)),
+                        t181,
+                        -T::from_f64(0.00000000000000000010842021724855044) * t180,
+                    )) - (T::mul_add(t135, t149, t136 * t148)),
                 );
-                let t200 = T::mul_add(
+                let t204 = T::mul_add(
                     T::from_f64(2.0574957830536786),
                     t115,
-                    T::from_f64(1285.9348644085492) * t188,
+                    T::from_f64(1285.9348644085492) * t191,
                 );
-                let t201 = T::mul_add(
+                let t205 = t168 * t194;
+                let t206 = T::mul_add(
                     T::from_f64(2.0),
                     t108,
-                    T::mul_add(-t4, t107, t5 * t176) + T::from_f64(0.08430995700000002),
+                    T::mul_add(-t4, t107, t5 * t178) + T::from_f64(0.08430995700000002),
                 );
-                let t202 = T::mul_add(
+                let t207 = T::mul_add(
                     -T::from_f64(0.0114),
                     t71,
-                    T::mul_add(t5, t107, t4 * t176),
+                    T::mul_add(t5, t107, t4 * t178),
                 );
-                let t203 = T::mul_add(
+                let t208 = T::mul_add(
                     T::from_f64(2.0),
                     t108,
                     T::mul_add(
                         -T::from_f64(0.0228),
                         t94,
-                        t191 + T::from_f64(0.08405575524000002),
+                        t195 + T::from_f64(0.08405575524000002),
                     ),
                 );
-                let t204 = T::mul_add(-t2, t159, t194);
-                let t205 = T::mul_add(
+                let t209 = T::mul_add(-t2, t160, t198);
+                let t210 = T::mul_add(
                     T::from_f64(0.41),
                     t71,
-                    -(T::mul_add(-t2, t142, -t3 * t177)),
+                    -(T::mul_add(-t2, t143, -t3 * t179)),
                 );
-                let t206 = T::mul_add(
+                let t211 = T::mul_add(
                     T::from_f64(1.03),
-                    t197,
+                    t201,
                     T::mul_add(
                         -T::from_f64(0.0650091026469637),
-                        t179,
-                        -T::from_f64(0.00000000000000000010842021724855044) * t145,
-                    ) + T::mul_add(t122, t147, t134 * t146),
+                        t181,
+                        -T::from_f64(0.00000000000000000010842021724855044) * t146,
+                    ) + T::mul_add(t122, t148, t135 * t147),
                 );
-                let t207 = T::mul_add(
+                let t212 = T::mul_add(
                     -T::from_f64(1.03),
-                    t198,
+                    t202,
                     T::mul_add(
                         T::from_f64(0.0650091026469637),
-                        t178,
-                        T::from_f64(0.00010000000000000503) * t145,
-                    ) + T::mul_add(t135, t146, -t122 * t148),
+                        t180,
+                        T::from_f64(0.00010000000000000503) * t146,
+                    ) + T::mul_add(t136, t147, -t122 * t149),
                 );
-                let t208 = t189 + t199;
-                let t209 = t201 + T::from_f64(0.00590744776708);
-                let t210 = T::mul_add(
+                let t213 = t192 + t203;
+                let t214 = t206 + T::from_f64(0.00590744776708);
+                let t215 = T::mul_add(
                     T::from_f64(0.0000000000000006979729257032011),
-                    t179,
+                    t181,
                     T::mul_add(
                         T::from_f64(0.004894691391055498),
-                        t178,
-                        T::from_f64(0.000014022756617410007) * t145,
+                        t180,
+                        T::from_f64(0.000014022756617410007) * t146,
                     ),
-                ) + T::mul_add(-t122, t150, t134 * t151)
+                ) + T::mul_add(-t122, t151, t135 * t152)
                     + T::mul_add(
                         -T::from_f64(0.0650091026469637),
-                        t198,
-                        T::from_f64(0.00000000000000000010842021724855044) * t183,
+                        t202,
+                        T::from_f64(0.00000000000000000010842021724855044) * t185,
                     );
-                let t211 = T::mul_add(
+                let t216 = T::mul_add(
                     T::from_f64(0.004705147001603182),
-                    t179,
+                    t181,
                     T::mul_add(
                         T::from_f64(0.0000000000000006979729257032011),
-                        t178,
-                        -T::from_f64(0.000000000000000000006709516445275485) * t145,
+                        t180,
+                        -T::from_f64(0.000000000000000000006709516445275485) * t146,
                     ),
-                ) + T::mul_add(t135, t151, t122 * t149)
+                ) + T::mul_add(t136, t152, t122 * t150)
                     + T::mul_add(
                         -T::from_f64(0.0650091026469637),
-                        t197,
-                        -T::from_f64(0.00010000000000000503) * t183,
+                        t201,
+                        -T::from_f64(0.00010000000000000503) * t185,
                     );
-                let t212 = T::mul_add(
+                let t217 = T::mul_add(
                     T::from_f64(0.000000000000000000006709516445275485),
-                    t179,
+                    t181,
                     T::mul_add(
                         -T::from_f64(0.000014022756617410007),
-                        t178,
-                        -T::from_f64(0.0007776443641723163) * t145,
+                        t180,
+                        -T::from_f64(0.0007776443641723163) * t146,
                     ),
-                ) + T::mul_add(-t134, t149, -t135 * t150)
+                ) + T::mul_add(-t135, t150, -t136 * t151)
                     + T::mul_add(
                         T::from_f64(0.00010000000000000503),
-                        t198,
-                        T::from_f64(0.00000000000000000010842021724855044) * t197,
+                        t202,
+                        T::from_f64(0.00000000000000000010842021724855044) * t201,
                     );
-                let t213 = T::mul_add(
+                let t218 = T::mul_add(
                     T::from_f64(0.0016),
                     t113,
-                    T::mul_add(-t195, t32, t187),
+                    T::mul_add(-t199, t32, t190),
                 );
-                let t214 = T::mul_add(
-                    -t185,
-                    t185 * t167,
+                let t219 = T::mul_add(
+                    -t187,
+                    t193,
                     T::mul_add(
-                        -t166,
-                        t166 * t90,
+                        -t167,
+                        t177,
                         T::mul_add(
-                            -t132,
-                            t139,
-                            t203 + T::from_f64(0.0058574286190799995),
+                            -t133,
+                            t140,
+                            t208 + T::from_f64(0.0058574286190799995),
                         ),
                     ),
                 );
-                let t215 = T::mul_add(
+                let t220 = T::mul_add(
                     T::from_f64(0.41),
-                    t128,
+                    t129,
                     T::mul_add(
-                        -t185,
-                        t167 * t190,
+                        -t193,
+                        t194,
                         T::mul_add(
-                            t166,
-                            t175 * t90,
+                            t176,
+                            t177,
                             T::mul_add(
-                                t143,
-                                t139,
-                                t203 + T::from_f64(0.0058574286190799995),
+                                t144,
+                                t140,
+                                t208 + T::from_f64(0.0058574286190799995),
                             ),
                         ),
                     ),
                 );
-                let t216 = T::mul_add(t3, t192, t2 * t202);
-                let t217 = T::mul_add(-t1, T::mul_add(-t3, t142, t2 * t177), t0 * t205);
-                let t218 = T::mul_add(t8, t207, -t9 * t206);
-                let t219 = T::mul_add(-t9, t207, -t8 * t206);
-                let t220 = T::one() / t214;
-                let t221 = t212 - tau[5];
-                let t222 = T::mul_add(t3, t209, -t193);
-                let t223 = t0 * (T::mul_add(-t2, t192, t3 * t202));
-                let t224 = T::mul_add(
+                let t221 = T::mul_add(t3, t196, t2 * t207);
+                let t222 = T::mul_add(-t1, T::mul_add(-t3, t143, t2 * t179), t0 * t210);
+                let t223 = T::mul_add(t8, t212, -t9 * t211);
+                let t224 = T::mul_add(-t9, t212, -t8 * t211);
+                let t225 = t218 * t90;
+                let t226 = T::one() / t219;
+                let t227 = t217 - tau[5];
+                let t228 = T::mul_add(t3, t214, -t197);
+                let t229 = t0 * (T::mul_add(-t2, t196, t3 * t207));
+                let t230 = T::mul_add(
                     T::from_f64(0.463),
-                    t173,
+                    t174,
                     T::mul_add(
                         -T::from_f64(0.0013224560195000002),
-                        t145,
+                        t146,
                         -T::from_f64(0.0230207699865) * t97,
                     )
                         + T::mul_add(
@@ -1441,94 +1447,95 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                             t117,
                             -T::from_f64(0.0230207699865) * t116,
                         ),
-                ) + t218;
-                let t225 = t164 + t219;
-                let t226 = t181 + -t212;
-                let t227 = T::mul_add(
-                    -t213,
-                    t90 * t105,
+                ) + t223;
+                let t231 = t165 + t224;
+                let t232 = t183 + -t217;
+                let t233 = T::mul_add(
+                    -t218,
+                    t127,
                     T::mul_add(
-                        -t195,
+                        -t199,
                         t66,
                         T::mul_add(
                             T::from_f64(0.0016),
                             T::mul_add(t0, t2 * t94, t1 * t3 * t94),
-                            -t217,
+                            -t222,
                         ),
                     ),
                 );
-                let t228 = T::mul_add(
+                let t234 = t226 * t220;
+                let t235 = T::mul_add(
                     -T::from_f64(0.10375),
-                    -t219,
-                    T::mul_add(t8, t211, -t9 * t210),
+                    -t224,
+                    T::mul_add(t8, t216, -t9 * t215),
                 );
-                let t229 = T::mul_add(
+                let t236 = T::mul_add(
                     T::from_f64(0.10375),
-                    -t218,
-                    T::mul_add(-t9, t211, -t8 * t210),
+                    -t223,
+                    T::mul_add(-t9, t216, -t8 * t215),
                 );
-                let t230 = t161 + t225;
-                let t231 = T::mul_add(
-                    -t220,
-                    t215 * t215,
+                let t237 = t162 + t231;
+                let t238 = t168 * t233;
+                let t239 = T::mul_add(
+                    t3,
+                    T::mul_add(t3, t160, t197),
+                    t2 * (T::mul_add(t2, t214, t198)),
+                );
+                let t240 = T::mul_add(
+                    -T::from_f64(0.41),
+                    t70,
+                    -t221 + T::from_f64(0.011526977800000001),
+                ) - T::from_f64(0.00204435);
+                let t241 = t200 + t235;
+                let t242 = t184 + t236;
+                let t243 = T::mul_add(t6, t213, -t7 * t230);
+                let t244 = T::mul_add(
+                    T::from_f64(0.0016),
+                    T::mul_add(-t1, t129, t130),
                     T::mul_add(
-                        -t167,
-                        t190 * t190,
+                        t193,
+                        t233,
                         T::mul_add(
-                            -t175,
-                            t175 * t90,
+                            -t218,
+                            t177,
+                            T::mul_add(-t199, t140, T::mul_add(-t1, t221, t229)),
+                        ),
+                    ),
+                );
+                let t245 = T::mul_add(
+                    -t220,
+                    t234,
+                    T::mul_add(
+                        -t194,
+                        t205,
+                        T::mul_add(
+                            -t176,
+                            t188,
                             T::mul_add(
-                                -t143,
-                                t156,
+                                -t144,
+                                t157,
                                 T::mul_add(
                                     T::from_f64(0.82),
-                                    t128,
-                                    t203 + T::from_f64(0.44834705861908),
+                                    t129,
+                                    t208 + T::from_f64(0.44834705861908),
                                 ) + T::from_f64(0.05271803549099999),
                             ),
                         ),
                     ),
                 );
-                let t232 = T::mul_add(
-                    t3,
-                    T::mul_add(t3, t159, t193),
-                    t2 * (T::mul_add(t2, t209, t194)),
-                );
-                let t233 = T::mul_add(
-                    -T::from_f64(0.41),
-                    t70,
-                    -t216 + T::from_f64(0.011526977800000001),
-                ) - T::from_f64(0.00204435);
-                let t234 = t196 + t228;
-                let t235 = t182 + t229;
-                let t236 = T::mul_add(t6, t208, -t7 * t224);
-                let t237 = T::mul_add(
-                    T::from_f64(0.0016),
-                    T::mul_add(-t1, t128, t129),
-                    T::mul_add(
-                        t185,
-                        t167 * t227,
-                        T::mul_add(
-                            -t166,
-                            t213 * t90,
-                            T::mul_add(-t195, t139, T::mul_add(-t1, t216, t223)),
-                        ),
-                    ),
-                );
-                let t238 = T::one() / t231;
-                let t239 = T::mul_add(
+                let t246 = T::mul_add(
                     T::from_f64(0.82),
-                    t128,
-                    T::mul_add(-t2, t204, t3 * t222) + T::from_f64(0.44248962999999997),
+                    t129,
+                    T::mul_add(-t2, t209, t3 * t228) + T::from_f64(0.44248962999999997),
                 );
-                let t240 = T::mul_add(
+                let t247 = T::mul_add(
                     T::from_f64(0.41),
                     t109,
-                    T::mul_add(-t3, t204, -t2 * t222),
+                    T::mul_add(-t3, t209, -t2 * t228),
                 );
-                let t241 = T::mul_add(
+                let t248 = T::mul_add(
                     -T::from_f64(0.463),
-                    t152,
+                    t153,
                     T::mul_add(
                         -T::from_f64(0.0250914799819),
                         t97,
@@ -1539,61 +1546,22 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                             t78,
                             -T::from_f64(0.0013357060146000001) * t77,
                         ),
-                ) + t236;
-                let t242 = t138 + T::mul_add(t7, t208, t6 * t224);
-                let t243 = T::mul_add(t32, t221, tau[4] - t235);
-                let t244 = T::mul_add(
+                ) + t243;
+                let t249 = t139 + T::mul_add(t7, t213, t6 * t230);
+                let t250 = t244 * t226;
+                let t251 = T::one() / t245;
+                let t252 = T::mul_add(t32, t227, tau[4] - t242);
+                let t253 = T::mul_add(
                     t1,
-                    t232 + T::from_f64(0.0008910000000000028),
-                    t0 * t240,
+                    t239 + T::from_f64(0.0008910000000000028),
+                    t0 * t247,
                 );
-                let t245 = T::mul_add(
+                let t254 = T::mul_add(
                     T::from_f64(0.10375),
-                    t225,
-                    T::mul_add(t6, t226, -t7 * t234),
+                    t231,
+                    T::mul_add(t6, t232, -t7 * t241),
                 );
-                let t246 = t162 + T::mul_add(T::from_f64(0.10375), -t236, t235);
-                let t247 = t163 + T::mul_add(t7, t226, t6 * t234);
-                let t248 = T::mul_add(t4, t230, -t5 * t241);
-                let t249 = T::mul_add(-t5, t230, -t4 * t241);
-                let t250 = t102 + -t242;
-                let t251 = T::mul_add(
-                    -T::from_f64(0.0016),
-                    t160,
-                    T::mul_add(
-                        t237,
-                        t220 * t215,
-                        T::mul_add(
-                            -t167,
-                            t190 * t227,
-                            T::mul_add(
-                                -t175,
-                                t213 * t90,
-                                T::mul_add(-t195, t156, T::mul_add(-t1, t233, -t223)),
-                            ),
-                        ),
-                    ),
-                );
-                let t252 = T::mul_add(
-                    t0,
-                    t239 + T::from_f64(0.05281703549099999),
-                    t1 * t240,
-                );
-                let t253 = t172 + t245;
-                let t254 = -t248;
-                let t255 = T::mul_add(
-                    -T::from_f64(0.6763),
-                    t101,
-                    T::mul_add(
-                        -T::from_f64(0.00581618),
-                        t62,
-                        T::mul_add(
-                            T::from_f64(0.00581618),
-                            t46,
-                            -T::from_f64(0.054780300000000004) * t45,
-                        ),
-                    ),
-                ) + t248;
+                let t255 = t163 + T::mul_add(T::from_f64(0.10375), -t243, t242);
                 (
                     t192,
                     t193,
@@ -1694,19 +1662,66 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                 t285,
                 t286,
                 t287,
+                t288,
+                t289,
+                t290,
+                t291,
+                t292,
+                t293,
+                t294,
+                t295,
+                t296,
             ) = {
-                let t256 = t124 + T::mul_add(T::from_f64(0.0114), t254, -t247);
-                let t257 = T::mul_add(t2, t250, -t3 * t255);
-                let t258 = T::mul_add(
-                    t90,
-                    t105 * t243,
-                    T::mul_add(-t66, t221, tau[3] - t247),
+                let t256 = t164 + T::mul_add(t7, t232, t6 * t241);
+                let t257 = T::mul_add(t4, t237, -t5 * t248);
+                let t258 = T::mul_add(-t5, t237, -t4 * t248);
+                let t259 = t102 + -t249;
+                let t260 = T::mul_add(
+                    -T::from_f64(0.0016),
+                    t161,
+                    T::mul_add(
+                        t244,
+                        t234,
+                        T::mul_add(
+                            -t233,
+                            t205,
+                            T::mul_add(
+                                -t218,
+                                t188,
+                                T::mul_add(-t199, t157, T::mul_add(-t1, t240, -t229)),
+                            ),
+                        ),
+                    ),
                 );
-                let t259 = T::mul_add(
+                let t261 = T::mul_add(
+                    t0,
+                    t246 + T::from_f64(0.05281703549099999),
+                    t1 * t247,
+                );
+                let t262 = t173 + t254;
+                let t263 = -t257;
+                let t264 = T::mul_add(
+                    -T::from_f64(0.6763),
+                    t101,
+                    T::mul_add(
+                        -T::from_f64(0.00581618),
+                        t62,
+                        T::mul_add(
+                            T::from_f64(0.00581618),
+                            t46,
+                            -T::from_f64(0.054780300000000004) * t45,
+                        ),
+                    ),
+                ) + t257;
+                let t265 = t260 * t251;
+                let t266 = t124 + T::mul_add(T::from_f64(0.0114), t263, -t256);
+                let t267 = T::mul_add(t2, t259, -t3 * t264);
+                let t268 = T::mul_add(t127, t252, T::mul_add(-t66, t227, tau[3] - t256));
+                let t269 = T::mul_add(
                     T::from_f64(2.0),
                     T::mul_add(
                         T::from_f64(0.11875),
-                        t160,
+                        t161,
                         T::mul_add(
                             T::from_f64(0.0016),
                             t70,
@@ -1715,23 +1730,23 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                     ),
                     T::mul_add(
                         -T::from_f64(0.2375),
-                        t160,
-                        T::mul_add(t1, t244, t0 * t252)
+                        t161,
+                        T::mul_add(t1, t253, t0 * t261)
                             + T::from_f64(0.000009273088000001482),
                     ),
                 );
-                let t260 = T::mul_add(t4, t246, -t5 * t253)
+                let t270 = T::mul_add(t4, t255, -t5 * t262)
                     + T::mul_add(
                         -T::from_f64(0.2073),
-                        -t249,
-                        -T::from_f64(0.0114) * t242,
+                        -t258,
+                        -T::from_f64(0.0114) * t249,
                     );
-                let t261 = T::mul_add(
+                let t271 = T::mul_add(
                     T::from_f64(0.2073),
-                    t254,
-                    T::mul_add(-t5, t246, -t4 * t253),
+                    t263,
+                    T::mul_add(-t5, t255, -t4 * t262),
                 );
-                let t262 = T::mul_add(
+                let t272 = T::mul_add(
                     -T::from_f64(0.0099),
                     t19,
                     T::mul_add(
@@ -1743,104 +1758,79 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                             T::from_f64(0.0099) * t19,
                         ),
                     ),
-                ) + t257;
-                let t263 = T::mul_add(
+                ) + t267;
+                let t273 = T::mul_add(
                     -T::from_f64(0.0099),
                     t18,
                     T::mul_add(T::from_f64(9.7119), t1, t60),
-                ) + T::mul_add(t3, t250, t2 * t255);
-                let t264 = t123 + t260;
-                let t265 = t125 + t261;
-                let t266 = T::mul_add(
-                    -t251,
-                    t251 * t238,
+                ) + T::mul_add(t3, t259, t2 * t264);
+                let t274 = t123 + t270;
+                let t275 = t125 + t271;
+                let t276 = T::mul_add(
+                    -t260,
+                    t265,
                     T::mul_add(
-                        -t237,
-                        t237 * t220,
+                        -t244,
+                        t250,
                         T::mul_add(
-                            -t167,
-                            t227 * t227,
+                            -t233,
+                            t238,
                             T::mul_add(
-                                -t213,
-                                t213 * t90,
+                                -t218,
+                                t225,
                                 T::mul_add(
-                                    -t195,
-                                    t200,
-                                    t259 + T::from_f64(0.0006011508000000001),
+                                    -t199,
+                                    t204,
+                                    t269 + T::from_f64(0.0006011508000000001),
                                 ),
                             ),
                         ),
                     ),
                 );
-                let t267 = T::one() / t266;
-                let t268 = T::mul_add(
-                    T::from_f64(0.41),
-                    t95 + t249,
-                    T::mul_add(t2, t256, -t3 * t264),
-                );
-                let t269 = t86 + T::mul_add(t3, t256, t2 * t264);
-                let t270 = t87 + T::mul_add(-T::from_f64(0.41), -t257, -t265);
-                let t271 = T::mul_add(
-                    -t166,
-                    t90 * t243,
-                    T::mul_add(t139, t221, tau[2] - t265),
-                );
-                let t272 = T::mul_add(-t185, t167 * t258, t271);
-                let t273 = T::mul_add(-t1, t269, -t0 * (t85 + t268));
-                let t274 = T::mul_add(
-                    -t175,
-                    t90 * t243,
-                    T::mul_add(t156, t221, tau[1] - t270),
-                );
-                let t275 = T::mul_add(
-                    T::from_f64(0.0016),
-                    T::mul_add(-t0, t263, t1 * t262),
-                    t273,
-                );
-                let t276 = T::mul_add(
-                    t220,
-                    t215 * t272,
-                    T::mul_add(t167, t190 * t258, t274),
-                );
                 let t277 = T::mul_add(
-                    -t213,
-                    t90 * t243,
-                    T::mul_add(t200, t221, tau[0] - t275),
+                    T::from_f64(0.41),
+                    t95 + t258,
+                    T::mul_add(t2, t266, -t3 * t274),
                 );
-                let t278 = T::mul_add(
-                    -t237,
-                    t220 * t272,
-                    T::mul_add(t167, t227 * t258, t277),
+                let t278 = t86 + T::mul_add(t3, t266, t2 * t274);
+                let t279 = t87 + T::mul_add(-T::from_f64(0.41), -t267, -t275);
+                let t280 = T::mul_add(
+                    -t177,
+                    t252,
+                    T::mul_add(t140, t227, tau[2] - t275),
                 );
-                let t279 = T::mul_add(-t251, t238 * t276, t278);
-                let t280 = T::mul_add(-t251, t238 * t267 * t279, t238 * t276);
-                let t281 = T::mul_add(
-                    -t237,
-                    t220 * t267 * t279,
-                    T::mul_add(t220, t215 * t280, t220 * t272),
+                let t281 = T::mul_add(-t193, t268, t280);
+                let t282 = T::mul_add(-t1, t278, -t0 * (t85 + t277));
+                let t283 = T::mul_add(
+                    -t188,
+                    t252,
+                    T::mul_add(t157, t227, tau[1] - t279),
                 );
-                let t282 = T::mul_add(
-                    t167,
-                    t190 * t280,
-                    T::mul_add(-t185, t167 * t281, t167 * t258),
-                );
-                let t283 = T::mul_add(t167, t227 * t267 * t279, t282);
                 let t284 = T::mul_add(
-                    -t166,
-                    t90 * t281,
-                    T::mul_add(t90, t105 * t283, t90 * t243),
+                    T::from_f64(0.0016),
+                    T::mul_add(-t0, t273, t1 * t272),
+                    t282,
                 );
-                let t285 = T::mul_add(
-                    -t213,
-                    t90 * t267 * t279,
-                    T::mul_add(-t175, t90 * t280, t284),
-                );
+                let t285 = T::mul_add(t234, t281, T::mul_add(t205, t268, t283));
                 let t286 = T::mul_add(
-                    t66,
-                    t283,
-                    T::mul_add(-t32, t285, -T::from_f64(1285.9348644085492) * t221),
+                    -t225,
+                    t252,
+                    T::mul_add(t204, t227, tau[0] - t284),
                 );
-                let t287 = T::mul_add(-t156, t280, T::mul_add(-t139, t281, t286));
+                let t287 = T::mul_add(-t250, t281, T::mul_add(t238, t268, t286));
+                let t288 = (T::one() / t276) * (T::mul_add(-t265, t285, t287));
+                let t289 = T::mul_add(-t265, t288, t251 * t285);
+                let t290 = T::mul_add(-t250, t288, T::mul_add(t234, t289, t226 * t281));
+                let t291 = T::mul_add(t205, t289, T::mul_add(-t193, t290, t168 * t268));
+                let t292 = T::mul_add(t238, t288, t291);
+                let t293 = T::mul_add(-t177, t290, T::mul_add(t127, t292, t90 * t252));
+                let t294 = T::mul_add(-t225, t288, T::mul_add(-t188, t289, t293));
+                let t295 = T::mul_add(
+                    t66,
+                    t292,
+                    T::mul_add(-t32, t294, -T::from_f64(1285.9348644085492) * t227),
+                );
+                let t296 = T::mul_add(-t157, t289, T::mul_add(-t140, t290, t295));
                 (
                     t256,
                     t257,
@@ -1874,19 +1864,28 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                     t285,
                     t286,
                     t287,
+                    t288,
+                    t289,
+                    t290,
+                    t291,
+                    t292,
+                    t293,
+                    t294,
+                    t295,
+                    t296,
                 )
             };
             [
-                t267 * t279,
-                t280,
-                t281,
-                t283,
-                t285,
-                T::mul_add(-t200, t267 * t279, t287),
-                t266,
-                t231,
-                t214,
-                t157,
+                t288,
+                t289,
+                t290,
+                t292,
+                t294,
+                T::mul_add(-t204, t288, t296),
+                t276,
+                t245,
+                t219,
+                t158,
                 t65,
                 T::from_f64(0.0007776443641723163),
             ]
@@ -13799,7 +13798,7 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Kinova<T> {
     /// model and finite inputs); `try_forward_dynamics` says which pivot failed.
     ///
     /// Route: M and b + G as in `mass_matrix` and `bias`, then an unrolled L^T D L solve without fill-in.
-    /// Operations: 684 mul, 489 add, 5 div, 5 sin, 5 cos.
+    /// Operations: 649 mul, 489 add, 5 div, 5 sin, 5 cos.
     fn forward_dynamics(&self, q: &[T; 6], qd: &[T; 6], tau: &[T; 6]) -> [T; 6] {
         match self.forward_dynamics_checked(q, qd, tau) {
             Ok((qdd, failures)) => ::eomgen_runtime::lane::nan_failed(qdd, &failures),

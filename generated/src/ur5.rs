@@ -231,70 +231,71 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
                 let t11 = qd[1] + qd[2];
                 let t12 = t2 * t5;
                 let t13 = t7 * t7;
-                let t14 = t8 * t8;
-                let t15 = t9 * t9;
-                let t16 = t3 * t5;
-                let t17 = t5 * t7 * t8 * t9;
-                let t18 = t4 * t7 * t8 * t9;
-                let t19 = T::mul_add(
+                let t14 = t6 * t8 * t9;
+                let t15 = t8 * t8;
+                let t16 = t9 * t9;
+                let t17 = t3 * t5;
+                let t18 = t5 * t7 * t8 * t9;
+                let t19 = t4 * t7 * t8 * t9;
+                let t20 = T::mul_add(
                     T::from_f64(0.017784735),
                     t4,
                     -T::from_f64(1.598759275),
                 );
-                let t20 = qd[0] * qd[1] * t0;
-                let t21 = qd[0] * qd[1] * t1;
-                let t22 = qd[0] * qd[0] * t0 * t1;
-                let t23 = qd[0] * qd[0] * t1 * t1;
-                let t24 = t11 * t11;
-                let t25 = qd[3] + t11;
-                let t26 = T::mul_add(
-                    T::from_f64(0.033822),
-                    t15,
-                    T::from_f64(0.0171364731454) * t14,
-                );
+                let t21 = qd[0] * qd[1] * t0;
+                let t22 = qd[0] * qd[1] * t1;
+                let t23 = qd[0] * qd[0] * t0 * t1;
+                let t24 = qd[0] * qd[0] * t1 * t1;
+                let t25 = t11 * t11;
+                let t26 = qd[3] + t11;
                 let t27 = T::mul_add(
+                    T::from_f64(0.033822),
+                    t16,
+                    T::from_f64(0.0171364731454) * t15,
+                );
+                let t28 = T::mul_add(
                     T::from_f64(0.016685526854599998),
-                    t6 * t8 * t9,
+                    t14,
                     -T::from_f64(0.0016539803549999999),
                 );
-                let t28 = t3 * t19;
-                let t29 = T::from_f64(0.017784735) * (T::mul_add(t2, t4, -t16));
-                let t30 = T::from_f64(0.017784735) * (T::mul_add(t3, t4, t12));
-                let t31 = T::mul_add(
+                let t29 = t3 * t20;
+                let t30 = T::from_f64(0.017784735) * (T::mul_add(t2, t4, -t17));
+                let t31 = T::from_f64(0.017784735) * (T::mul_add(t3, t4, t12));
+                let t32 = T::mul_add(
                     -T::from_f64(0.1197),
                     qd[0] * t0,
                     T::from_f64(0.425) * qd[1],
                 );
-                let t32 = T::mul_add(qd[0], t0 * t3, qd[0] * t1 * t2);
-                let t33 = T::mul_add(-qd[0], t0 * t2, qd[0] * t1 * t3);
-                let t34 = T::mul_add(
+                let t33 = T::mul_add(qd[0], t0 * t3, qd[0] * t1 * t2);
+                let t34 = T::mul_add(-qd[0], t0 * t2, qd[0] * t1 * t3);
+                let t35 = T::mul_add(
                     T::from_f64(0.0171364731454),
-                    t15,
-                    T::from_f64(0.033822) * t14,
+                    t16,
+                    T::from_f64(0.033822) * t15,
                 ) + T::from_f64(0.11285608069875);
-                let t35 = t26 + T::from_f64(0.21942);
-                let t36 = t26 + T::from_f64(0.4510082781);
-                let t37 = T::mul_add(-t2, t19, T::from_f64(0.017784735) * t16);
-                let t38 = T::mul_add(T::from_f64(0.017784735), t12, t28);
-                let t39 = t32 * t33;
-                let t40 = t11 * t32;
-                let t41 = t33 * t33;
-                let t42 = T::mul_add(
+                let t36 = t27 + T::from_f64(0.21942);
+                let t37 = t27 + T::from_f64(0.4510082781);
+                let t38 = T::mul_add(-t2, t20, T::from_f64(0.017784735) * t17);
+                let t39 = T::mul_add(T::from_f64(0.017784735), t12, t29);
+                let t40 = t33 * t34;
+                let t41 = t11 * t33;
+                let t42 = t34 * t34;
+                let t43 = T::mul_add(
                     -T::from_f64(82.33533000000001),
                     t0,
-                    -T::from_f64(2.3500400000000004) * (T::mul_add(qd[1], qd[1], t23)),
+                    -T::from_f64(2.3500400000000004) * (T::mul_add(qd[1], qd[1], t24)),
                 );
-                let t43 = T::mul_add(
+                let t44 = T::mul_add(
                     T::from_f64(0.1197),
-                    t21,
+                    t22,
                     T::mul_add(
                         T::from_f64(9.81),
                         t1,
-                        -(T::mul_add(T::from_f64(0.425), t22, T::from_f64(0.1197) * t21)),
+                        -(T::mul_add(T::from_f64(0.425), t23, T::from_f64(0.1197) * t22)),
                     ),
                 );
-                let t44 = t1 * t37;
-                let t45 = T::mul_add(
+                let t45 = t1 * t38;
+                let t46 = T::mul_add(
                     -t0,
                     T::from_f64(0.0171364731454)
                         * (T::mul_add(-t3, t5 * t6, t2 * t4 * t6)),
@@ -302,50 +303,49 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
                         * (T::from_f64(0.0171364731454)
                             * (T::mul_add(t2, t5 * t6, t3 * t4 * t6))),
                 );
-                let t46 = T::mul_add(-qd[0], t0 * t31, T::from_f64(0.1197) * t23);
-                let t47 = T::mul_add(
+                let t47 = T::mul_add(-qd[0], t0 * t32, T::from_f64(0.1197) * t24);
+                let t48 = T::mul_add(
                     qd[2],
-                    t32,
+                    t33,
                     T::mul_add(qd[0], qd[1] * t1 * t2, qd[0] * qd[1] * t0 * t3),
                 );
-                let t48 = T::mul_add(
+                let t49 = T::mul_add(
                     -qd[2],
-                    t33,
+                    t34,
                     T::mul_add(-qd[0], qd[1] * t1 * t3, qd[0] * qd[1] * t0 * t2),
                 );
-                let t49 = T::mul_add(t5, t32, t4 * t33);
-                let t50 = T::mul_add(t4, t32, -t5 * t33);
-                let t51 = T::one() / t35;
-                let t52 = T::mul_add(t6, t6 * t34, T::from_f64(0.12999255384415) * t13);
-                let t53 = T::mul_add(
+                let t50 = T::mul_add(t5, t33, t4 * t34);
+                let t51 = T::mul_add(t4, t33, -t5 * t34);
+                let t52 = T::one() / t36;
+                let t53 = T::mul_add(t6, t6 * t35, T::from_f64(0.12999255384415) * t13);
+                let t54 = T::mul_add(
                     -t6,
-                    t7 * t34,
+                    t7 * t35,
                     T::from_f64(0.12999255384415) * t6 * t7,
                 );
-                let t54 = T::mul_add(-t5, t36, T::from_f64(0.016685526854599998) * t18);
-                let t55 = t0
-                    * (T::mul_add(-T::from_f64(0.017784735), t12, -t28)
+                let t55 = T::mul_add(-t5, t37, T::from_f64(0.016685526854599998) * t19);
+                let t56 = t0
+                    * (T::mul_add(-T::from_f64(0.017784735), t12, -t29)
                         + T::from_f64(4.4329225));
-                let t56 = T::mul_add(-t5, t35, T::from_f64(0.016685526854599998) * t18);
-                let t57 = T::mul_add(t4, t35, T::from_f64(0.016685526854599998) * t17);
-                let t58 = T::mul_add(
+                let t57 = T::mul_add(-t5, t36, T::from_f64(0.016685526854599998) * t19);
+                let t58 = T::mul_add(t4, t36, T::from_f64(0.016685526854599998) * t18);
+                let t59 = T::mul_add(
                     T::from_f64(0.425),
-                    t20,
-                    T::mul_add(T::from_f64(0.13585), t10, -t46),
+                    t21,
+                    T::mul_add(T::from_f64(0.13585), t10, -t47),
                 );
-                let t59 = -t50;
-                let t60 = qd[4] + t50;
-                let t61 = T::mul_add(
+                let t60 = -t51;
+                let t61 = qd[4] + t51;
+                let t62 = T::mul_add(
                     T::from_f64(0.1197),
-                    t20,
+                    t21,
                     T::mul_add(
                         T::from_f64(9.81),
                         t0,
-                        -(T::mul_add(-qd[1], t31, -T::from_f64(0.425) * t23)),
+                        -(T::mul_add(-qd[1], t32, -T::from_f64(0.425) * t24)),
                     ),
                 );
-                let t62 = t7 * t45;
-                let t63 = T::from_f64(58.355064750790525) * t45;
+                let t63 = t7 * t46;
                 (
                     t0,
                     t1,
@@ -479,223 +479,187 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
                 t126,
                 t127,
             ) = {
-                let t64 = t6 * t6 * t8 * t8 * t9 * t9 * t51;
-                let t65 = T::mul_add(
+                let t64 = T::from_f64(58.355064750790525) * t46;
+                let t65 = t14 * t52;
+                let t66 = T::mul_add(
                     t7,
-                    t7 * t34,
+                    t7 * t35,
                     T::from_f64(0.12999255384415) * t6 * t6,
                 ) + T::from_f64(0.123341033631);
-                let t66 = T::mul_add(
+                let t67 = T::mul_add(
                     -T::from_f64(0.0139521246075),
                     t4,
-                    t52 + T::from_f64(0.51519389364975),
+                    t53 + T::from_f64(0.51519389364975),
                 );
-                let t67 = T::mul_add(
+                let t68 = T::mul_add(
                     -T::from_f64(0.39225),
-                    t47 + t40,
+                    t48 + t41,
                     T::mul_add(
                         -T::from_f64(0.425),
-                        t20,
-                        T::mul_add(-T::from_f64(0.13585), t10, t46),
+                        t21,
+                        T::mul_add(-T::from_f64(0.13585), t10, t47),
                     ),
                 );
-                let t68 = t25 * t59;
-                let t69 = T::mul_add(t6, t25, t7 * t49);
-                let t70 = T::mul_add(t7, t25, -t6 * t49);
-                let t71 = T::mul_add(
+                let t69 = t26 * t60;
+                let t70 = T::mul_add(t6, t26, t7 * t50);
+                let t71 = T::mul_add(t7, t26, -t6 * t50);
+                let t72 = t14 * t65;
+                let t73 = T::mul_add(t5, t28, t4 * t54);
+                let t74 = T::mul_add(-t4, t28, t5 * t54);
+                let t75 = T::mul_add(qd[3], t60, T::mul_add(-t5, t49, -t4 * t48));
+                let t76 = T::mul_add(qd[3], t50, T::mul_add(-t4, t49, t5 * t48));
+                let t77 = -t71;
+                let t78 = t70 * t61;
+                let t79 = T::mul_add(t2, t62, -t3 * t44);
+                let t80 = T::mul_add(-t3, t62, -t2 * t44);
+                let t81 = T::mul_add(
                     -T::from_f64(0.0002784068064155777),
-                    t64,
+                    t72,
                     T::mul_add(
                         -T::from_f64(0.0171364731454),
                         t13,
-                        t52 + T::from_f64(0.111172755531),
+                        t53 + T::from_f64(0.111172755531),
                     ),
                 );
-                let t72 = T::mul_add(
+                let t82 = T::mul_add(
                     T::from_f64(0.0002784068064155777),
-                    t64,
+                    t72,
                     T::mul_add(
                         T::from_f64(0.0171364731454),
                         t13,
                         T::mul_add(
                             T::from_f64(0.00697606230375),
                             t4,
-                            -t52 - T::from_f64(0.111172755531),
+                            -t53 - T::from_f64(0.111172755531),
                         ),
                     ),
                 );
-                let t73 = T::mul_add(t5, t27, t4 * t53);
-                let t74 = T::mul_add(-t4, t27, t5 * t53);
-                let t75 = T::mul_add(qd[3], t59, T::mul_add(-t5, t48, -t4 * t47));
-                let t76 = T::mul_add(qd[3], t49, T::mul_add(-t4, t48, t5 * t47));
-                let t77 = -t70;
-                let t78 = t69 * t60;
-                let t79 = T::mul_add(t2, t61, -t3 * t43);
-                let t80 = T::mul_add(-t3, t61, -t2 * t43);
-                let t81 = T::one() / t71;
-                let t82 = T::mul_add(
+                let t83 = T::mul_add(
                     T::from_f64(0.0002784068064155777),
-                    t64,
+                    t72,
                     T::mul_add(
                         T::from_f64(0.425),
-                        t30,
+                        t31,
                         T::mul_add(
                             T::from_f64(0.0171364731454),
                             t13,
                             -(T::mul_add(
                                 -T::from_f64(0.00697606230375),
                                 t4,
-                                t52 + T::from_f64(0.111172755531),
+                                t53 + T::from_f64(0.111172755531),
                             )),
                         ),
                     ),
                 );
-                let t83 = T::mul_add(-T::from_f64(0.016685526854599998), t17, t4 * t65);
-                let t84 = t74 - T::from_f64(0.051322656825);
-                let t85 = t3 * t73;
-                let t86 = t2 * t73;
-                let t87 = t67 + -T::from_f64(0.093) * (T::mul_add(t49, t49, t59 * t59));
-                let t88 = t60 * t77;
-                let t89 = T::mul_add(-t8, t60, t9 * t69);
-                let t90 = T::mul_add(t9, t60, t8 * t69);
-                let t91 = -t79;
-                let t92 = T::mul_add(T::from_f64(0.39225), t39, t79);
-                let t93 = -T::from_f64(0.39225) * (t41 + t24) + t80;
-                let t94 = T::mul_add(
+                let t84 = T::mul_add(-T::from_f64(0.016685526854599998), t18, t4 * t66);
+                let t85 = t74 - T::from_f64(0.051322656825);
+                let t86 = t3 * t73;
+                let t87 = t2 * t73;
+                let t88 = t68 + -T::from_f64(0.093) * (T::mul_add(t50, t50, t60 * t60));
+                let t89 = t61 * t77;
+                let t90 = T::mul_add(-t8, t61, t9 * t70);
+                let t91 = T::mul_add(t9, t61, t8 * t70);
+                let t92 = -t79;
+                let t93 = T::mul_add(T::from_f64(0.39225), t40, t79);
+                let t94 = -T::from_f64(0.39225) * (t42 + t25) + t80;
+                let t95 = T::one() / t81;
+                let t96 = T::mul_add(
                     -t0,
-                    T::mul_add(-t3, t57, t2 * t56),
-                    t1 * (T::mul_add(t2, t57, t3 * t56)),
+                    T::mul_add(-t3, t58, t2 * t57),
+                    t1 * (T::mul_add(t2, t58, t3 * t57)),
                 );
-                let t95 = T::mul_add(-qd[4], t77, t7 * t75);
-                let t96 = T::mul_add(qd[4], t69, t6 * t75);
-                let t97 = T::mul_add(
+                let t97 = T::mul_add(-qd[4], t77, t7 * t75);
+                let t98 = T::mul_add(qd[4], t70, t6 * t75);
+                let t99 = t95 * t82;
+                let t100 = t95 * t83;
+                let t101 = T::mul_add(
+                    t4,
+                    T::mul_add(t4, t37, T::from_f64(0.016685526854599998) * t18),
+                    t5 * (T::mul_add(t5, t66, T::from_f64(0.016685526854599998) * t19)),
+                );
+                let t102 = T::mul_add(t3, t85, -t87);
+                let t103 = T::mul_add(
+                    -T::from_f64(0.1197),
+                    t31,
+                    T::mul_add(t3, t74, -t87),
+                );
+                let t104 = T::mul_add(
+                    T::from_f64(0.1197),
+                    t30,
+                    -(T::mul_add(t2, t74, t86)),
+                );
+                let t105 = T::mul_add(
+                    -T::from_f64(0.016685526854599998),
+                    t90 * t91,
+                    -T::from_f64(0.0171364731454) * t98,
+                );
+                let t106 = T::mul_add(-t5, t94, -t4 * t93);
+                let t107 = T::mul_add(-t4, t94, t5 * t93);
+                let t108 = t96 * t65;
+                let t109 = t96 * t52;
+                let t110 = T::mul_add(
+                    -T::from_f64(0.0139521246075),
+                    t4,
+                    T::mul_add(-t5, t55, t4 * t84) + T::from_f64(0.40402113811874996),
+                );
+                let t111 = t101 + T::from_f64(0.004095);
+                let t112 = T::mul_add(
+                    T::from_f64(0.00697606230375),
+                    t5,
+                    -(T::mul_add(t4, t55, t5 * t84)),
+                );
+                let t113 = T::mul_add(
+                    T::from_f64(0.1197),
+                    t38,
+                    T::mul_add(t2, t85, t86),
+                );
+                let t114 = T::mul_add(T::from_f64(0.093), t75 - t69, t107);
+                let t115 = T::mul_add(
+                    T::from_f64(0.093),
+                    T::mul_add(-t50, t26, t76),
+                    -t106,
+                );
+                let t116 = T::mul_add(
                     -T::from_f64(0.0002784068064155777),
-                    t64,
+                    t72,
                     T::mul_add(
-                        -t81,
-                        t72 * t72,
+                        -t82,
+                        t99,
                         T::mul_add(
                             -T::from_f64(0.0171364731454),
                             t13,
-                            t66 + T::from_f64(0.19163081355599998),
+                            t67 + T::from_f64(0.19163081355599998),
                         ),
                     ),
                 );
-                let t98 = T::mul_add(
+                let t117 = T::mul_add(
                     T::from_f64(0.0002784068064155777),
-                    t64,
+                    t72,
                     T::mul_add(
                         T::from_f64(0.425),
-                        t38,
+                        t39,
                         T::mul_add(
-                            t81,
-                            t72 * t82,
+                            t99,
+                            t83,
                             T::mul_add(
                                 T::from_f64(0.0171364731454),
                                 t13,
-                                -t66 - T::from_f64(0.19163081355599998),
+                                -t67 - T::from_f64(0.19163081355599998),
                             ),
                         ),
                     ),
                 );
-                let t99 = T::mul_add(
-                    t4,
-                    T::mul_add(t4, t36, T::from_f64(0.016685526854599998) * t17),
-                    t5 * (T::mul_add(t5, t65, T::from_f64(0.016685526854599998) * t18)),
-                );
-                let t100 = T::mul_add(t3, t84, -t86);
-                let t101 = T::mul_add(
-                    -T::from_f64(0.1197),
-                    t30,
-                    T::mul_add(t3, t74, -t86),
-                );
-                let t102 = T::mul_add(
-                    T::from_f64(0.1197),
-                    t29,
-                    -(T::mul_add(t2, t74, t85)),
-                );
-                let t103 = T::mul_add(
-                    -T::from_f64(0.016685526854599998),
-                    t89 * t90,
-                    -T::from_f64(0.0171364731454) * t96,
-                );
-                let t104 = T::mul_add(-t5, t93, -t4 * t92);
-                let t105 = T::mul_add(-t4, t93, t5 * t92);
-                let t106 = t6 * t8 * t9 * t94 * t51;
-                let t107 = T::one() / t97;
-                let t108 = T::mul_add(
-                    -T::from_f64(0.0139521246075),
-                    t4,
-                    T::mul_add(-t5, t54, t4 * t83) + T::from_f64(0.40402113811874996),
-                );
-                let t109 = t99 + T::from_f64(0.004095);
-                let t110 = T::mul_add(
-                    T::from_f64(0.00697606230375),
-                    t5,
-                    -(T::mul_add(t4, t54, t5 * t83)),
-                );
-                let t111 = T::mul_add(
-                    T::from_f64(0.1197),
-                    t37,
-                    T::mul_add(t2, t84, t85),
-                );
-                let t112 = T::mul_add(T::from_f64(0.093), t75 - t68, t105);
-                let t113 = T::mul_add(
-                    T::from_f64(0.093),
-                    T::mul_add(-t49, t25, t76),
-                    -t104,
-                );
-                let t114 = t103 - tau[5];
-                let t115 = t108 + T::from_f64(0.19163081355599998);
-                let t116 = t2 * t110;
-                let t117 = t3 * t110;
-                let t118 = t1 * t111;
-                let t119 = T::mul_add(-qd[5], t90, T::mul_add(-t8, t76, t9 * t95));
-                let t120 = T::mul_add(qd[5], t89, T::mul_add(t9, t76, t8 * t95));
-                let t121 = -T::from_f64(0.09465) * (T::mul_add(t77, t77, t69 * t69))
-                    + t112;
-                let t122 = T::mul_add(
-                    -T::from_f64(0.0002784068064155777),
-                    t64,
-                    T::mul_add(
-                        -t107,
-                        t98 * t98,
-                        T::mul_add(
-                            -t81,
-                            t82 * t82,
-                            T::mul_add(
-                                -T::from_f64(0.0171364731454),
-                                t13,
-                                T::mul_add(
-                                    -T::from_f64(0.85),
-                                    t38,
-                                    t66 + T::from_f64(1.0768558760559999),
-                                ) + T::from_f64(0.8849018759100001),
-                            ),
-                        ),
-                    ),
-                );
-                let t123 = t7 * t114;
-                let t124 = T::mul_add(-t2, t109, t117);
-                let t125 = T::mul_add(
-                    -t0,
-                    T::mul_add(
-                        -T::from_f64(0.1197),
-                        t38,
-                        t100 + T::from_f64(0.19371331275000003),
-                    ),
-                    -t118,
-                );
-                let t126 = T::mul_add(
-                    -t0,
-                    T::mul_add(-T::from_f64(0.1197), t38, t100),
-                    -t118,
-                );
-                let t127 = T::mul_add(
-                    T::from_f64(0.016685526854599998),
-                    t90 * (qd[5] + t70),
-                    T::from_f64(0.0171364731454) * t119,
-                );
+                let t118 = t105 - tau[5];
+                let t119 = t110 + T::from_f64(0.19163081355599998);
+                let t120 = t2 * t112;
+                let t121 = t3 * t112;
+                let t122 = t1 * t113;
+                let t123 = T::mul_add(-qd[5], t91, T::mul_add(-t8, t76, t9 * t97));
+                let t124 = T::mul_add(qd[5], t90, T::mul_add(t9, t76, t8 * t97));
+                let t125 = -T::from_f64(0.09465) * (T::mul_add(t77, t77, t70 * t70))
+                    + t114;
+                let t126 = T::one() / t116;
+                let t127 = t7 * t118;
                 (
                     t64,
                     t65,
@@ -829,280 +793,288 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
                 t190,
                 t191,
             ) = {
-                let t128 = T::mul_add(-t7, t113, t6 * t87);
-                let t129 = T::mul_add(t6, t113, t7 * t87);
+                let t128 = T::mul_add(-t2, t111, t121);
+                let t129 = T::mul_add(
+                    -t0,
+                    T::mul_add(
+                        -T::from_f64(0.1197),
+                        t39,
+                        t102 + T::from_f64(0.19371331275000003),
+                    ),
+                    -t122,
+                );
                 let t130 = T::mul_add(
+                    -t0,
+                    T::mul_add(-T::from_f64(0.1197), t39, t102),
+                    -t122,
+                );
+                let t131 = T::mul_add(
                     T::from_f64(0.016685526854599998),
-                    t106,
+                    t91 * (qd[5] + t71),
+                    T::from_f64(0.0171364731454) * t123,
+                );
+                let t132 = T::mul_add(-t7, t115, t6 * t88);
+                let t133 = T::mul_add(t6, t115, t7 * t88);
+                let t134 = T::mul_add(
+                    T::from_f64(0.016685526854599998),
+                    t108,
                     T::mul_add(
                         T::from_f64(0.13585),
-                        T::mul_add(t1, t29, t0 * t30),
-                        -(T::mul_add(-t0, t101, t1 * t102)) - t62,
+                        T::mul_add(t1, t30, t0 * t31),
+                        -(T::mul_add(-t0, t103, t1 * t104)) - t63,
                     ),
                 );
-                let t131 = T::one() / t122;
-                let t132 = T::mul_add(t3, t115, -t116);
-                let t133 = T::mul_add(T::from_f64(0.09465), t96 - t78, -t128);
-                let t134 = T::mul_add(T::from_f64(0.09465), t95 + t88, -t129);
-                let t135 = T::mul_add(
+                let t135 = t126 * t117;
+                let t136 = T::mul_add(t3, t119, -t120);
+                let t137 = T::mul_add(T::from_f64(0.09465), t98 - t78, -t132);
+                let t138 = T::mul_add(T::from_f64(0.09465), t97 + t89, -t133);
+                let t139 = t95 * t134;
+                let t140 = T::mul_add(
                     -T::from_f64(0.1879),
-                    t134,
-                    T::from_f64(1.219) * t129,
+                    t138,
+                    T::from_f64(1.219) * t133,
                 );
-                let t136 = T::mul_add(
+                let t141 = T::mul_add(
                     -T::from_f64(0.016685526854599998),
-                    t106,
+                    t108,
                     T::mul_add(
                         T::from_f64(0.13585),
-                        T::mul_add(-t0, t38, t44),
-                        T::mul_add(-t81, t72 * t130, t126 + t62),
+                        T::mul_add(-t0, t39, t45),
+                        T::mul_add(-t99, t134, t130 + t63),
                     ),
-                );
-                let t137 = T::mul_add(
-                    t3,
-                    T::mul_add(t3, t109, t116),
-                    t2 * (T::mul_add(t2, t115, t117)),
-                );
-                let t138 = T::mul_add(
-                    T::from_f64(0.21942),
-                    t76,
-                    T::mul_add(T::from_f64(0.033822), t9 * t120, -t8 * t127),
-                );
-                let t139 = T::mul_add(t8, t121, t9 * t133);
-                let t140 = T::mul_add(-t9, t121, t8 * t133);
-                let t141 = T::mul_add(
-                    T::from_f64(0.017784735),
-                    t134,
-                    T::mul_add(T::from_f64(0.033822), t8 * t120, t9 * t127),
                 );
                 let t142 = T::mul_add(
-                    -T::from_f64(0.85),
-                    t38,
-                    T::mul_add(-t2, t124, t3 * t132) + T::from_f64(0.9241220958009998),
-                );
-                let t143 = T::mul_add(
-                    T::from_f64(0.425),
-                    t37,
-                    -(T::mul_add(-t3, t124, -t2 * t132)),
-                );
-                let t144 = t9 * t139;
-                let t145 = t8 * t140;
-                let t146 = T::mul_add(
-                    -T::from_f64(0.108247244469),
-                    t88,
-                    T::from_f64(0.111172755531) * t95,
-                ) + t141;
-                let t147 = T::mul_add(
-                    -T::from_f64(0.016685526854599998),
-                    t106,
+                    -T::from_f64(0.0002784068064155777),
+                    t72,
                     T::mul_add(
-                        T::from_f64(0.13585),
-                        t44 + t55,
+                        -t117,
+                        t135,
                         T::mul_add(
-                            t136,
-                            t107 * t98,
-                            T::mul_add(-t81, t82 * t130, t125 + t62),
+                            -t83,
+                            t100,
+                            T::mul_add(
+                                -T::from_f64(0.0171364731454),
+                                t13,
+                                T::mul_add(
+                                    -T::from_f64(0.85),
+                                    t39,
+                                    t67 + T::from_f64(1.0768558760559999),
+                                ) + T::from_f64(0.8849018759100001),
+                            ),
                         ),
                     ),
                 );
-                let t148 = t138 - tau[4];
-                let t149 = t6 * t8 * t9 * t51 * t148;
+                let t143 = T::mul_add(
+                    t3,
+                    T::mul_add(t3, t111, t120),
+                    t2 * (T::mul_add(t2, t119, t121)),
+                );
+                let t144 = T::mul_add(
+                    T::from_f64(0.21942),
+                    t76,
+                    T::mul_add(T::from_f64(0.033822), t9 * t124, -t8 * t131),
+                );
+                let t145 = T::mul_add(t8, t125, t9 * t137);
+                let t146 = T::mul_add(-t9, t125, t8 * t137);
+                let t147 = T::mul_add(
+                    T::from_f64(0.017784735),
+                    t138,
+                    T::mul_add(T::from_f64(0.033822), t8 * t124, t9 * t131),
+                );
+                let t148 = t141 * t126;
+                let t149 = T::one() / t142;
                 let t150 = T::mul_add(
-                    -t0,
-                    t137 + T::from_f64(0.054004433300999945),
-                    t1 * t143,
+                    -T::from_f64(0.85),
+                    t39,
+                    T::mul_add(-t2, t128, t3 * t136) + T::from_f64(0.9241220958009998),
                 );
                 let t151 = T::mul_add(
-                    T::from_f64(1.219),
-                    t128,
-                    -T::from_f64(0.1879) * (t144 + t145),
+                    T::from_f64(0.425),
+                    t38,
+                    -(T::mul_add(-t3, t128, -t2 * t136)),
                 );
-                let t152 = T::mul_add(
-                    T::from_f64(1.219),
-                    t112,
-                    T::from_f64(0.1879) * (T::mul_add(-t9, t140, t8 * t139)),
-                );
-                let t153 = T::mul_add(
-                    -t1,
-                    t142 + T::from_f64(0.8849018759100001),
-                    t0 * t143,
-                );
+                let t152 = t9 * t145;
+                let t153 = t8 * t146;
                 let t154 = T::mul_add(
                     -T::from_f64(0.108247244469),
+                    t89,
+                    T::from_f64(0.111172755531) * t97,
+                ) + t147;
+                let t155 = T::mul_add(
+                    -T::from_f64(0.016685526854599998),
+                    t108,
+                    T::mul_add(
+                        T::from_f64(0.13585),
+                        t45 + t56,
+                        T::mul_add(t141, t135, T::mul_add(-t134, t100, t129 + t63)),
+                    ),
+                );
+                let t156 = t144 - tau[4];
+                let t157 = t155 * t149;
+                let t158 = t65 * t156;
+                let t159 = T::mul_add(
+                    -t0,
+                    t143 + T::from_f64(0.054004433300999945),
+                    t1 * t151,
+                );
+                let t160 = T::mul_add(
+                    T::from_f64(1.219),
+                    t132,
+                    -T::from_f64(0.1879) * (t152 + t153),
+                );
+                let t161 = T::mul_add(
+                    T::from_f64(1.219),
+                    t114,
+                    T::from_f64(0.1879) * (T::mul_add(-t9, t146, t8 * t145)),
+                );
+                let t162 = T::mul_add(
+                    -t1,
+                    t150 + T::from_f64(0.8849018759100001),
+                    t0 * t151,
+                );
+                let t163 = T::mul_add(
+                    -T::from_f64(0.108247244469),
                     t78,
-                    -T::from_f64(0.111172755531) * t96,
+                    -T::from_f64(0.111172755531) * t98,
                 )
                     + T::mul_add(
                         -T::from_f64(0.09465),
-                        T::from_f64(0.1879) * (t144 + t145),
-                        t103,
+                        T::from_f64(0.1879) * (t152 + t153),
+                        t105,
                     );
-                let t155 = T::mul_add(T::from_f64(1.219), t105, t152);
-                let t156 = T::mul_add(-t6, t135, t7 * t151);
-                let t157 = T::mul_add(
+                let t164 = T::mul_add(T::from_f64(1.219), t107, t161);
+                let t165 = T::mul_add(-t6, t140, t7 * t160);
+                let t166 = T::mul_add(
                     T::from_f64(1.219),
-                    t67,
-                    T::mul_add(t7, t135, t6 * t151),
+                    t68,
+                    T::mul_add(t7, t140, t6 * t160),
                 );
-                let t158 = T::mul_add(T::from_f64(1.219), -t104, -t156);
-                let t159 = T::mul_add(
+                let t167 = T::mul_add(T::from_f64(1.219), -t106, -t165);
+                let t168 = T::mul_add(
                     T::from_f64(0.093),
-                    t152,
-                    T::mul_add(-t6, t154, t7 * t146),
+                    t161,
+                    T::mul_add(-t6, t163, t7 * t154),
                 );
-                let t160 = T::mul_add(
+                let t169 = T::mul_add(
                     T::from_f64(0.108247244469),
-                    t49 * t59,
-                    T::mul_add(t7, t154, t6 * t146),
+                    t50 * t60,
+                    T::mul_add(t7, t163, t6 * t154),
                 );
-                let t161 = T::mul_add(
+                let t170 = T::mul_add(
                     T::from_f64(0.21942),
                     t76,
-                    T::mul_add(-T::from_f64(0.093), t156, t138),
+                    T::mul_add(-T::from_f64(0.093), t165, t144),
                 );
-                let t162 = T::mul_add(
-                    -t147,
-                    t147 * t131,
+                let t171 = T::mul_add(
+                    -t155,
+                    t157,
                     T::mul_add(
-                        -t136,
-                        t136 * t107,
+                        -t141,
+                        t148,
                         T::mul_add(
-                            -t81,
-                            t130 * t130,
+                            -t134,
+                            t139,
                             T::mul_add(
-                                -t94,
-                                t94 * t51,
+                                -t96,
+                                t109,
                                 T::mul_add(
-                                    -t45,
-                                    t63,
-                                    T::mul_add(-t0, t150, -t1 * t153)
+                                    -t46,
+                                    t64,
+                                    T::mul_add(-t0, t159, -t1 * t162)
                                         + T::from_f64(0.12816210104175002),
                                 ),
                             ),
                         ),
                     ),
                 );
-                let t163 = T::mul_add(
+                let t172 = T::mul_add(
                     -T::from_f64(0.108247244469),
-                    t68,
+                    t69,
                     T::from_f64(0.111172755531) * t75,
-                ) + t159;
-                let t164 = T::mul_add(t5, t155, t4 * t158);
-                let t165 = T::one() / t162;
-                let t166 = T::mul_add(
+                ) + t168;
+                let t173 = T::mul_add(t5, t164, t4 * t167);
+                let t174 = T::mul_add(
                     -T::from_f64(2.275),
-                    t91,
-                    T::from_f64(0.56875) * t39,
-                ) + t164;
-                let t167 = T::mul_add(
+                    t92,
+                    T::from_f64(0.56875) * t40,
+                ) + t173;
+                let t175 = T::mul_add(
                     -T::from_f64(2.275),
                     -t80,
-                    -T::from_f64(0.56875) * (t41 + t24),
-                ) + T::mul_add(-t4, t155, t5 * t158);
-                let t168 = T::mul_add(
+                    -T::from_f64(0.56875) * (t42 + t25),
+                ) + T::mul_add(-t4, t164, t5 * t167);
+                let t176 = T::mul_add(
                     -T::from_f64(0.56875),
-                    t91,
-                    T::from_f64(0.187535813556) * t39,
-                ) + T::mul_add(T::from_f64(0.39225), t164, t160);
-                let t169 = T::mul_add(
+                    t92,
+                    T::from_f64(0.187535813556) * t40,
+                ) + T::mul_add(T::from_f64(0.39225), t173, t169);
+                let t177 = T::mul_add(
                     T::from_f64(0.016685526854599998),
-                    t149,
-                    tau[3] - t160 + t123,
+                    t158,
+                    tau[3] - t169 + t127,
                 );
-                let t170 = T::mul_add(
+                let t178 = T::mul_add(
                     -T::from_f64(0.39225),
-                    t157,
-                    T::mul_add(t5, t161, -t4 * t163),
+                    t166,
+                    T::mul_add(t5, t170, -t4 * t172),
                 );
-                let t171 = T::mul_add(
+                let t179 = T::mul_add(
                     T::from_f64(0.004095),
-                    t48,
-                    T::mul_add(-t4, t161, -t5 * t163),
+                    t49,
+                    T::mul_add(-t4, t170, -t5 * t172),
                 );
-                let t172 = T::mul_add(t2, t167, t3 * t166);
-                let t173 = T::mul_add(t3, t167, -t2 * t166);
-                let t174 = T::mul_add(
+                let t180 = T::mul_add(t2, t175, t3 * t174);
+                let t181 = T::mul_add(t3, t175, -t2 * t174);
+                let t182 = T::mul_add(
                     T::from_f64(0.187535813556),
-                    t40,
+                    t41,
                     T::mul_add(
                         T::from_f64(0.19163081355599998),
-                        t47,
-                        T::from_f64(0.56875) * t58,
+                        t48,
+                        T::from_f64(0.56875) * t59,
                     ),
-                ) + t170;
-                let t175 = T::mul_add(
+                ) + t178;
+                let t183 = T::mul_add(
                     T::from_f64(0.1197),
-                    -t173,
+                    -t181,
                     -T::from_f64(0.425)
                         * (T::mul_add(
                             -T::from_f64(0.56875),
-                            t47 + t40,
-                            -T::from_f64(2.275) * t58,
-                        ) + t157),
+                            t48 + t41,
+                            -T::from_f64(2.275) * t59,
+                        ) + t166),
                 );
-                let t176 = t0
+                let t184 = t0
                     * (T::mul_add(
                         T::from_f64(2.3500400000000004),
-                        t22,
+                        t23,
                         -T::from_f64(82.33533000000001) * t1,
-                    ) + t172);
-                let t177 = T::mul_add(
+                    ) + t180);
+                let t185 = T::mul_add(
                     T::from_f64(0.016685526854599998),
-                    t149,
-                    tau[2] - t168 + t123,
+                    t158,
+                    tau[2] - t176 + t127,
                 );
-                let t178 = T::mul_add(-t1, t42 + t173, t176);
-                let t179 = tau[1]
+                let t186 = T::mul_add(-t1, t43 + t181, t184);
+                let t187 = tau[1]
                     - (T::mul_add(
                         T::from_f64(0.8697944759100001),
-                        t22,
+                        t23,
                         -T::from_f64(23.053892400000006) * t1,
-                    ) + T::mul_add(T::from_f64(0.425), t172, t168));
-                let t180 = T::mul_add(t81, t72 * t169, t177);
-                let t181 = T::mul_add(t2, t171, t3 * t174) + t175;
-                let t182 = T::mul_add(
+                    ) + T::mul_add(T::from_f64(0.425), t180, t176));
+                let t188 = T::mul_add(t99, t177, t185);
+                let t189 = T::mul_add(t2, t179, t3 * t182) + t183;
+                let t190 = T::mul_add(
                     T::from_f64(0.1197),
-                    t172,
-                    T::mul_add(t3, t171, -t2 * t174),
+                    t180,
+                    T::mul_add(t3, t179, -t2 * t182),
                 );
-                let t183 = t1
+                let t191 = t1
                     * (T::mul_add(
                         T::from_f64(1.7546963518200003),
-                        t20,
+                        t21,
                         T::from_f64(0.31925293400000004) * t10,
-                    ) + t181);
-                let t184 = T::mul_add(
-                    t81,
-                    t82 * t169,
-                    T::mul_add(T::from_f64(0.016685526854599998), t149, t179 + t123),
-                );
-                let t185 = T::mul_add(
-                    t0,
-                    T::mul_add(T::from_f64(0.0151074), t21, -t182),
-                    -t183,
-                );
-                let t186 = T::mul_add(t107, t98 * t180, t184);
-                let t187 = T::mul_add(
-                    -t63,
-                    t114,
-                    tau[0] - (T::mul_add(T::from_f64(0.13585), t178, t185)),
-                );
-                let t188 = T::mul_add(
-                    t81,
-                    t130 * t169,
-                    T::mul_add(t94, t51 * t148, t187),
-                );
-                let t189 = T::mul_add(
-                    -t147,
-                    t131 * t186,
-                    T::mul_add(-t136, t107 * t180, t188),
-                );
-                let t190 = T::mul_add(-t147, t131 * t165 * t189, t131 * t186);
-                let t191 = T::mul_add(
-                    -t136,
-                    t107 * t165 * t189,
-                    T::mul_add(t107, t98 * t190, t107 * t180),
-                );
+                    ) + t189);
                 (
                     t128,
                     t129,
@@ -1170,51 +1142,96 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
                     t191,
                 )
             };
-            let (t192, t193, t194, t195, t196, t197) = {
-                let t192 = T::mul_add(
-                    t81,
-                    t82 * t190,
-                    T::mul_add(t81, t72 * t191, t81 * t169),
-                );
-                let t193 = T::mul_add(t81, t130 * t165 * t189, t192);
-                let t194 = T::mul_add(
-                    -T::from_f64(0.016685526854599998),
-                    t6 * t8 * t9 * t51 * t191,
-                    T::mul_add(
-                        -T::from_f64(0.016685526854599998),
-                        t6 * t8 * t9 * t51 * t193,
-                        -t51 * t148,
-                    ),
-                );
-                let t195 = T::mul_add(
-                    -t7,
-                    t191,
-                    T::mul_add(-t7, t193, -T::from_f64(58.355064750790525) * t114),
-                );
-                let t196 = T::mul_add(
-                    -t94,
-                    t51 * t165 * t189,
-                    T::mul_add(
-                        -T::from_f64(0.016685526854599998),
-                        t6 * t8 * t9 * t51 * t190,
-                        t194,
-                    ),
-                );
-                let t197 = T::mul_add(t63, t165 * t189, T::mul_add(-t7, t190, t195));
-                (t192, t193, t194, t195, t196, t197)
-            };
-            [
-                t165 * t189,
-                t190,
-                t191,
+            let (
+                t192,
                 t193,
+                t194,
+                t195,
                 t196,
                 t197,
-                t162,
-                t122,
-                t97,
-                t71,
-                t35,
+                t198,
+                t199,
+                t200,
+                t201,
+                t202,
+                t203,
+                t204,
+                t205,
+                t206,
+            ) = {
+                let t192 = T::mul_add(
+                    t100,
+                    t177,
+                    T::mul_add(T::from_f64(0.016685526854599998), t158, t187 + t127),
+                );
+                let t193 = T::mul_add(
+                    t0,
+                    T::mul_add(T::from_f64(0.0151074), t22, -t190),
+                    -t191,
+                );
+                let t194 = T::mul_add(t135, t188, t192);
+                let t195 = T::mul_add(
+                    -t64,
+                    t118,
+                    tau[0] - (T::mul_add(T::from_f64(0.13585), t186, t193)),
+                );
+                let t196 = T::mul_add(t139, t177, T::mul_add(t109, t156, t195));
+                let t197 = T::mul_add(-t157, t194, T::mul_add(-t148, t188, t196));
+                let t198 = (T::one() / t171) * t197;
+                let t199 = T::mul_add(-t157, t198, t149 * t194);
+                let t200 = T::mul_add(-t148, t198, T::mul_add(t135, t199, t126 * t188));
+                let t201 = T::mul_add(t100, t199, T::mul_add(t99, t200, t95 * t177));
+                let t202 = T::mul_add(t139, t198, t201);
+                let t203 = T::mul_add(
+                    -T::from_f64(0.016685526854599998),
+                    t65 * t200,
+                    T::mul_add(
+                        -T::from_f64(0.016685526854599998),
+                        t65 * t202,
+                        -t52 * t156,
+                    ),
+                );
+                let t204 = T::mul_add(
+                    -t7,
+                    t200,
+                    T::mul_add(-t7, t202, -T::from_f64(58.355064750790525) * t118),
+                );
+                let t205 = T::mul_add(
+                    -t109,
+                    t198,
+                    T::mul_add(-T::from_f64(0.016685526854599998), t65 * t199, t203),
+                );
+                let t206 = T::mul_add(t64, t198, T::mul_add(-t7, t199, t204));
+                (
+                    t192,
+                    t193,
+                    t194,
+                    t195,
+                    t196,
+                    t197,
+                    t198,
+                    t199,
+                    t200,
+                    t201,
+                    t202,
+                    t203,
+                    t204,
+                    t205,
+                    t206,
+                )
+            };
+            [
+                t198,
+                t199,
+                t200,
+                t202,
+                t205,
+                t206,
+                t171,
+                t142,
+                t116,
+                t81,
+                t36,
                 T::from_f64(0.0171364731454),
             ]
         };
@@ -6576,7 +6593,7 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
     /// model and finite inputs); `try_forward_dynamics` says which pivot failed.
     ///
     /// Route: M and b + G as in `mass_matrix` and `bias`, then an unrolled L^T D L solve without fill-in.
-    /// Operations: 461 mul, 287 add, 5 div, 5 sin, 5 cos.
+    /// Operations: 419 mul, 287 add, 5 div, 5 sin, 5 cos.
     fn forward_dynamics(&self, q: &[T; 6], qd: &[T; 6], tau: &[T; 6]) -> [T; 6] {
         match self.forward_dynamics_checked(q, qd, tau) {
             Ok((qdd, failures)) => ::eomgen_runtime::lane::nan_failed(qdd, &failures),

@@ -233,6 +233,8 @@ pub struct Graph {
     refused: usize,
     /// How sums built from now on treat child sums.
     flattening: SumFlattening,
+    /// Whether products built from now on merge the factors of child products.
+    flatten_products: bool,
 }
 
 impl Default for Graph {
@@ -271,6 +273,7 @@ impl Graph {
             limits,
             refused: 0,
             flattening: SumFlattening::Always,
+            flatten_products: true,
         };
         // 0 and 1 first, whatever the limit: they are the most common children, and a full
         // graph answers with 0.
@@ -517,6 +520,13 @@ impl Graph {
         std::mem::replace(&mut self.flattening, f)
     }
 
+    /// Sets whether products built from now on merge the factors of child products (`x (y z)`
+    /// as `x y z`, the default) or keep a child product as one factor, computed once however
+    /// many products use it; returns the previous setting.
+    pub fn set_product_flattening(&mut self, on: bool) -> bool {
+        std::mem::replace(&mut self.flatten_products, on)
+    }
+
     /// How sums treat child sums now.
     pub fn flattening(&self) -> SumFlattening {
         self.flattening
@@ -542,7 +552,7 @@ impl Graph {
             }
             match &self.nodes[id.index()] {
                 Node::Const(v) => coef *= v.get().powi(e),
-                Node::Mul(fs) if fs.len() <= self.limits.max_flatten => {
+                Node::Mul(fs) if self.flatten_products && fs.len() <= self.limits.max_flatten => {
                     work.extend(fs.iter().map(|&(f, fe)| (f, fe * e)))
                 }
                 // A scaled term k * t: pull k into the coefficient.
