@@ -309,7 +309,7 @@ impl Builder {
 
     /// With [`Builder::derivatives`]: `forward_dynamics_derivatives` is straight-line code up to
     /// this many operations (default [`crate::dynamics::DERIVATIVES_FLAT_MAX_OPS`], 20,000), and
-    /// `mass_matrix_inverse` up to a fifth of it
+    /// `mass_matrix_inverse` up to a tenth of it
     /// ([`crate::dynamics::MASS_MATRIX_INVERSE_FLAT_DIVISOR`]); beyond, they are composed at run
     /// time: `forward_dynamics_derivatives` from `forward_dynamics_partials` (`d tau` at the
     /// forward dynamics' accelerations and `M`'s factors, one straight-line body, up to

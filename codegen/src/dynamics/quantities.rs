@@ -547,12 +547,14 @@ fn link_jacobian(n: usize) -> Quantity {
 pub const DERIVATIVES_FLAT_MAX_OPS: usize = 20_000;
 
 /// `mass_matrix_inverse` alone is straight-line code up to the derivatives' limit divided by
-/// this (4,000 operations by default). Its flat form shares nothing with other outputs, where
+/// this (2,000 operations by default). Its flat form shares nothing with other outputs, where
 /// the forward-dynamics derivatives' shares `M`'s factorization and the accelerations, so the
 /// composed route (the tree's inverse unrolled) wins sooner: anymal's `M^-1` (5,569 operations
 /// flat) took 787 ns flat against 698 ns composed, the panda's (1,390) 165 ns against 256 ns
-/// (27 November 2026, native).
-pub const MASS_MATRIX_INVERSE_FLAT_DIVISOR: usize = 5;
+/// (27 November 2026, native). Once the symbolic factorization kept each entry of `L` whole,
+/// anymal's flat form fell to 3,976 operations, under the 4,000 of a divisor of 5, and took
+/// 698 ns against 543 ns composed with the factorization in locals (28 November 2026).
+pub const MASS_MATRIX_INVERSE_FLAT_DIVISOR: usize = 10;
 
 /// A composed `forward_dynamics_derivatives` takes `d tau` at the forward dynamics'
 /// accelerations and `M`'s factors from `forward_dynamics_partials`, one straight-line body,
