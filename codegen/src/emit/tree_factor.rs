@@ -18,7 +18,7 @@ use super::rust::usize_lit;
 use crate::dynamics::ltdl::ancestors;
 
 /// The most entries (`M_ij` for `j` equal to `i` or one of its ancestors) a tree's
-/// factorization keeps in locals: a quadruped has 117, a quadruped with an arm about 200,
+/// factorization keeps in locals: a quadruped has 117, b1-z1 (a quadruped with an arm) 187,
 /// g1_29dof 341, talos_full_v2 567.
 pub(crate) const LOCALS_MAX_ENTRIES: usize = 256;
 
