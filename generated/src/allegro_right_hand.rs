@@ -20328,6 +20328,6336 @@ for AllegroRightHand<T> {
     clippy::type_complexity,
     clippy::too_many_arguments
 )]
+impl<T: ::eomgen_runtime::lane::Pack> AllegroRightHand<T> {
+    fn mass_matrix_unpacked(
+        &self,
+        q: &[T; 16],
+        out: &mut [[[<T as ::eomgen_runtime::lane::Pack>::Scalar; 16]; 16]],
+    ) {
+        let (
+            [s1,
+            s2,
+            s3,
+            s5,
+            s6,
+            s7,
+            s9,
+            s10,
+            s11,
+            s13,
+            s14,
+            s15,
+            ],
+            [c1,
+            c2,
+            c3,
+            c5,
+            c6,
+            c7,
+            c9,
+            c10,
+            c11,
+            c13,
+            c14,
+            c15,
+            ],
+        ) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[1],
+            q[2],
+            q[3],
+            q[5],
+            q[6],
+            q[7],
+            q[9],
+            q[10],
+            q[11],
+            q[13],
+            q[14],
+            q[15],
+        ]);
+        let (
+            t0,
+            t1,
+            t2,
+            t3,
+            t4,
+            t5,
+            t6,
+            t7,
+            t8,
+            t9,
+            t10,
+            t11,
+            t12,
+            t13,
+            t14,
+            t15,
+            t16,
+            t17,
+            t18,
+            t19,
+            t20,
+            t21,
+            t22,
+            t23,
+            t24,
+            t25,
+            t26,
+            t27,
+            t28,
+            t29,
+            t30,
+            t31,
+            t32,
+            t33,
+            t34,
+            t35,
+            t36,
+            t37,
+            t38,
+            t39,
+            t40,
+            t41,
+            t42,
+            t43,
+            t44,
+            t45,
+            t46,
+            t47,
+            t48,
+            t49,
+            t50,
+            t51,
+            t52,
+            t53,
+            t54,
+            t55,
+            t56,
+            t57,
+            t58,
+            t59,
+            t60,
+            t61,
+            t62,
+            t63,
+        ) = {
+            let t0 = s1;
+            let t1 = c1;
+            let t2 = s2;
+            let t3 = c2;
+            let t4 = s3;
+            let t5 = c3;
+            let t6 = s5;
+            let t7 = c5;
+            let t8 = s6;
+            let t9 = c6;
+            let t10 = s7;
+            let t11 = c7;
+            let t12 = s9;
+            let t13 = c9;
+            let t14 = s10;
+            let t15 = c10;
+            let t16 = s11;
+            let t17 = c11;
+            let t18 = s13;
+            let t19 = c13;
+            let t20 = s14;
+            let t21 = c14;
+            let t22 = s15;
+            let t23 = c15;
+            let t24 = t2 * t4;
+            let t25 = t9 * t10;
+            let t26 = t8 * t10;
+            let t27 = t14 * t16;
+            let t28 = t20 * t22;
+            let t29 = T::mul_add(
+                T::from_f64(0.000017224704),
+                t5,
+                T::from_f64(0.000016593864000000002),
+            );
+            let t30 = T::mul_add(
+                T::from_f64(0.00003652689599999999),
+                t11,
+                T::from_f64(0.000045777374666699994),
+            );
+            let t31 = T::mul_add(
+                T::from_f64(0.000017224704),
+                t17,
+                T::from_f64(0.000016593864000000002),
+            );
+            let t32 = T::mul_add(
+                T::from_f64(0.000017224704),
+                t23,
+                T::from_f64(0.000016593864000000002),
+            );
+            let t33 = T::mul_add(
+                T::from_f64(0.0000176458),
+                t23,
+                T::from_f64(0.0000012936) * t22,
+            );
+            let t34 = T::mul_add(
+                T::from_f64(0.000001255968),
+                t23,
+                T::from_f64(0.0000017622) * t22,
+            );
+            let t35 = T::mul_add(
+                T::from_f64(0.0000012936),
+                t23,
+                T::from_f64(0.0000056692479999999995) * t22,
+            );
+            let t36 = T::mul_add(
+                -T::from_f64(0.0000017622),
+                t23,
+                T::from_f64(0.000001255968) * t22,
+            );
+            let t37 = T::mul_add(
+                T::from_f64(0.00044856000000000003),
+                t23,
+                T::from_f64(0.0010137599999999998),
+            );
+            let t38 = T::mul_add(
+                T::from_f64(0.0000176458),
+                t17,
+                T::from_f64(0.0000012936) * t16,
+            );
+            let t39 = T::mul_add(
+                T::from_f64(0.000001255968),
+                t17,
+                T::from_f64(0.0000017622) * t16,
+            );
+            let t40 = T::mul_add(
+                T::from_f64(0.0000012936),
+                t17,
+                T::from_f64(0.0000056692479999999995) * t16,
+            );
+            let t41 = T::mul_add(
+                -T::from_f64(0.0000017622),
+                t17,
+                T::from_f64(0.000001255968) * t16,
+            );
+            let t42 = T::mul_add(
+                T::from_f64(0.00044856000000000003),
+                t17,
+                T::from_f64(0.0010137599999999998),
+            );
+            let t43 = T::mul_add(
+                T::from_f64(0.00006395038933329998),
+                t11,
+                T::from_f64(0.0000052283) * t10,
+            );
+            let t44 = T::mul_add(
+                T::from_f64(0.000008042076),
+                t11,
+                T::from_f64(0.000011283525) * t10,
+            );
+            let t45 = T::mul_add(
+                T::from_f64(0.0000052283),
+                t11,
+                T::from_f64(0.0000338903173333) * t10,
+            );
+            let t46 = T::mul_add(
+                -T::from_f64(0.000011283525),
+                t11,
+                T::from_f64(0.000008042076) * t10,
+            );
+            let t47 = T::mul_add(
+                T::from_f64(0.0007106399999999999),
+                t11,
+                T::from_f64(0.00285784),
+            );
+            let t48 = T::mul_add(
+                T::from_f64(0.0000176458),
+                t5,
+                T::from_f64(0.0000012936) * t4,
+            );
+            let t49 = T::mul_add(
+                T::from_f64(0.000001255968),
+                t5,
+                T::from_f64(0.0000017622) * t4,
+            );
+            let t50 = T::mul_add(
+                T::from_f64(0.0000012936),
+                t5,
+                T::from_f64(0.0000056692479999999995) * t4,
+            );
+            let t51 = T::mul_add(
+                -T::from_f64(0.0000017622),
+                t5,
+                T::from_f64(0.000001255968) * t4,
+            );
+            let t52 = T::mul_add(
+                T::from_f64(0.00044856000000000003),
+                t5,
+                T::from_f64(0.0010137599999999998),
+            );
+            let t53 = t34 + T::from_f64(0.0000054115225794551);
+            let t54 = T::mul_add(
+                T::from_f64(0.0000017622),
+                t23,
+                -T::from_f64(0.000001255968) * t22,
+            ) + T::from_f64(0.00000793657186922407);
+            let t55 = t39 + T::from_f64(0.0000054115225794551);
+            let t56 = T::mul_add(
+                T::from_f64(0.0000017622),
+                t17,
+                -T::from_f64(0.000001255968) * t16,
+            ) + T::from_f64(0.00000793657186922407);
+            let t57 = t44 + T::from_f64(0.00000818299639785789);
+            let t58 = T::mul_add(
+                T::from_f64(0.000011283525),
+                t11,
+                -T::from_f64(0.000008042076) * t10,
+            ) + T::from_f64(0.000011844769255572);
+            let t59 = t9 * t47;
+            let t60 = t49 + T::from_f64(0.0000054115225794551);
+            let t61 = T::mul_add(
+                T::from_f64(0.0000017622),
+                t5,
+                -T::from_f64(0.000001255968) * t4,
+            ) + T::from_f64(0.00000793657186922407);
+            let t62 = T::from_f64(0.0007106399999999999) * (T::mul_add(-t9, t11, t26));
+            let t63 = T::mul_add(
+                -t23,
+                T::mul_add(
+                    -T::from_f64(0.0000056692479999999995),
+                    t23,
+                    T::from_f64(0.0000012936) * t22,
+                ),
+                t22
+                    * (T::mul_add(
+                        -T::from_f64(0.0000012936),
+                        t23,
+                        T::from_f64(0.0000176458) * t22,
+                    )),
+            );
+            (
+                t0,
+                t1,
+                t2,
+                t3,
+                t4,
+                t5,
+                t6,
+                t7,
+                t8,
+                t9,
+                t10,
+                t11,
+                t12,
+                t13,
+                t14,
+                t15,
+                t16,
+                t17,
+                t18,
+                t19,
+                t20,
+                t21,
+                t22,
+                t23,
+                t24,
+                t25,
+                t26,
+                t27,
+                t28,
+                t29,
+                t30,
+                t31,
+                t32,
+                t33,
+                t34,
+                t35,
+                t36,
+                t37,
+                t38,
+                t39,
+                t40,
+                t41,
+                t42,
+                t43,
+                t44,
+                t45,
+                t46,
+                t47,
+                t48,
+                t49,
+                t50,
+                t51,
+                t52,
+                t53,
+                t54,
+                t55,
+                t56,
+                t57,
+                t58,
+                t59,
+                t60,
+                t61,
+                t62,
+                t63,
+            )
+        };
+        let (
+            t64,
+            t65,
+            t66,
+            t67,
+            t68,
+            t69,
+            t70,
+            t71,
+            t72,
+            t73,
+            t74,
+            t75,
+            t76,
+            t77,
+            t78,
+            t79,
+            t80,
+            t81,
+            t82,
+            t83,
+            t84,
+            t85,
+            t86,
+            t87,
+            t88,
+            t89,
+            t90,
+            t91,
+            t92,
+            t93,
+            t94,
+            t95,
+            t96,
+            t97,
+            t98,
+            t99,
+            t100,
+            t101,
+            t102,
+            t103,
+            t104,
+            t105,
+            t106,
+            t107,
+            t108,
+            t109,
+            t110,
+            t111,
+            t112,
+            t113,
+            t114,
+            t115,
+            t116,
+            t117,
+            t118,
+            t119,
+            t120,
+            t121,
+            t122,
+            t123,
+            t124,
+            t125,
+            t126,
+            t127,
+        ) = {
+            let t64 = T::mul_add(-t21, t37, T::from_f64(0.00044856000000000003) * t28);
+            let t65 = T::mul_add(
+                -t17,
+                T::mul_add(
+                    -T::from_f64(0.0000056692479999999995),
+                    t17,
+                    T::from_f64(0.0000012936) * t16,
+                ),
+                t16
+                    * (T::mul_add(
+                        -T::from_f64(0.0000012936),
+                        t17,
+                        T::from_f64(0.0000176458) * t16,
+                    )),
+            );
+            let t66 = T::mul_add(-t15, t42, T::from_f64(0.00044856000000000003) * t27);
+            let t67 = T::mul_add(
+                -t11,
+                T::mul_add(
+                    -T::from_f64(0.0000338903173333),
+                    t11,
+                    T::from_f64(0.0000052283) * t10,
+                ),
+                t10
+                    * (T::mul_add(
+                        -T::from_f64(0.0000052283),
+                        t11,
+                        T::from_f64(0.00006395038933329998) * t10,
+                    )),
+            );
+            let t68 = T::mul_add(t8, t47, T::from_f64(0.0007106399999999999) * t25);
+            let t69 = T::mul_add(T::from_f64(0.0007106399999999999), t26, -t59);
+            let t70 = T::mul_add(
+                -t5,
+                T::mul_add(
+                    -T::from_f64(0.0000056692479999999995),
+                    t5,
+                    T::from_f64(0.0000012936) * t4,
+                ),
+                t4
+                    * (T::mul_add(
+                        -T::from_f64(0.0000012936),
+                        t5,
+                        T::from_f64(0.0000176458) * t4,
+                    )),
+            );
+            let t71 = T::mul_add(-t3, t52, T::from_f64(0.00044856000000000003) * t24);
+            let t72 = T::mul_add(
+                -T::from_f64(0.054),
+                T::from_f64(0.00044856000000000003) * (T::mul_add(-t3, t5, t24)),
+                T::mul_add(
+                    T::from_f64(0.000017224704),
+                    t5,
+                    T::from_f64(0.000016593864000000002),
+                ),
+            );
+            let t73 = T::mul_add(-t9, t46, -t8 * t44);
+            let t74 = T::mul_add(
+                -T::from_f64(0.054),
+                T::from_f64(0.00044856000000000003) * (T::mul_add(-t15, t17, t27)),
+                T::mul_add(
+                    T::from_f64(0.000017224704),
+                    t17,
+                    T::from_f64(0.000016593864000000002),
+                ),
+            );
+            let t75 = T::mul_add(
+                -T::from_f64(0.054),
+                T::from_f64(0.00044856000000000003) * (T::mul_add(-t21, t23, t28)),
+                T::mul_add(
+                    T::from_f64(0.000017224704),
+                    t23,
+                    T::from_f64(0.000016593864000000002),
+                ),
+            );
+            let t76 = T::mul_add(
+                T::from_f64(0.000034449408),
+                t23,
+                T::mul_add(t22, t35, t23 * t33) + T::from_f64(0.000038928383999999994),
+            );
+            let t77 = T::mul_add(
+                -T::from_f64(0.000017224704),
+                t22,
+                T::mul_add(t23, t35, -t22 * t33),
+            );
+            let t78 = t63 + T::from_f64(0.0000266287347075153);
+            let t79 = T::mul_add(t20, t54, t21 * t53);
+            let t80 = T::mul_add(t21, t54, -t20 * t53);
+            let t81 = T::mul_add(
+                T::from_f64(0.000034449408),
+                t17,
+                T::mul_add(t16, t40, t17 * t38) + T::from_f64(0.000038928383999999994),
+            );
+            let t82 = T::mul_add(
+                -T::from_f64(0.000017224704),
+                t16,
+                T::mul_add(t17, t40, -t16 * t38),
+            );
+            let t83 = t65 + T::from_f64(0.0000266287347075153);
+            let t84 = T::mul_add(t14, t56, t15 * t55);
+            let t85 = T::mul_add(t15, t56, -t14 * t55);
+            let t86 = T::mul_add(
+                T::from_f64(0.00007305379199999999),
+                t11,
+                T::mul_add(t10, t45, t11 * t43) + T::from_f64(0.000146892976),
+            );
+            let t87 = T::mul_add(
+                -T::from_f64(0.00003652689599999999),
+                t10,
+                T::mul_add(t11, t45, -t10 * t43),
+            );
+            let t88 = t67 + T::from_f64(0.0000431323573125218);
+            let t89 = T::mul_add(t8, t58, t9 * t57);
+            let t90 = T::mul_add(t9, t58, -t8 * t57);
+            let t91 = t7 * t68;
+            let t92 = T::mul_add(
+                T::from_f64(0.000034449408),
+                t5,
+                T::mul_add(t4, t50, t5 * t48) + T::from_f64(0.000038928383999999994),
+            );
+            let t93 = T::mul_add(
+                -T::from_f64(0.000017224704),
+                t4,
+                T::mul_add(t5, t50, -t4 * t48),
+            );
+            let t94 = t70 + T::from_f64(0.0000266287347075153);
+            let t95 = T::mul_add(t2, t61, t3 * t60);
+            let t96 = T::mul_add(t3, t61, -t2 * t60);
+            let t97 = T::mul_add(
+                -T::from_f64(0.054),
+                t71,
+                T::mul_add(
+                    T::from_f64(0.000034449408),
+                    t5,
+                    T::from_f64(0.0000704938774427206),
+                ),
+            );
+            let t98 = T::mul_add(
+                T::from_f64(0.0399),
+                t6 * t62,
+                -T::from_f64(0.005)
+                    * (T::from_f64(0.0007106399999999999) * (T::mul_add(t8, t11, t25))),
+            );
+            let t99 = T::mul_add(
+                -T::from_f64(0.054),
+                t66,
+                T::mul_add(
+                    T::from_f64(0.000034449408),
+                    t17,
+                    T::from_f64(0.0000704938774427206),
+                ),
+            );
+            let t100 = T::mul_add(
+                -T::from_f64(0.054),
+                t64,
+                T::mul_add(
+                    T::from_f64(0.000034449408),
+                    t23,
+                    T::from_f64(0.0000704938774427206),
+                ),
+            );
+            let t101 = t76 + T::from_f64(0.000027108908376807);
+            let t102 = t77 + T::from_f64(0.00000285079817622615);
+            let t103 = t81 + T::from_f64(0.000027108908376807);
+            let t104 = t82 + T::from_f64(0.00000285079817622615);
+            let t105 = t86 + T::from_f64(0.000043811817294825);
+            let t106 = t87 + T::from_f64(0.00000255404234759754);
+            let t107 = t89 + T::from_f64(0.000000795929506936549);
+            let t108 = t92 + T::from_f64(0.000027108908376807);
+            let t109 = t93 + T::from_f64(0.00000285079817622615);
+            let t110 = T::mul_add(
+                -t1,
+                T::mul_add(t3, t51, t2 * t49),
+                -t0 * (T::mul_add(-t2, t51, t3 * t49)),
+            );
+            let t111 = T::mul_add(
+                -t6,
+                T::mul_add(
+                    -T::from_f64(0.0177),
+                    t62,
+                    T::mul_add(
+                        T::from_f64(0.00003652689599999999),
+                        t11,
+                        T::from_f64(0.000045777374666699994),
+                    ),
+                ),
+                t7 * (T::mul_add(-t8, t46, t9 * t44)),
+            );
+            let t112 = T::mul_add(
+                -t13,
+                T::mul_add(t15, t41, t14 * t39),
+                -t12 * (T::mul_add(-t14, t41, t15 * t39)),
+            );
+            let t113 = T::mul_add(
+                -t19,
+                T::mul_add(t21, t36, t20 * t34),
+                -t18 * (T::mul_add(-t20, t36, t21 * t34)),
+            );
+            let t114 = t20 * t102;
+            let t115 = t21 * t102;
+            let t116 = t14 * t104;
+            let t117 = t15 * t104;
+            let t118 = t8 * t106;
+            let t119 = t9 * t106;
+            let t120 = t6
+                * (T::mul_add(
+                    -T::from_f64(0.0354),
+                    t69,
+                    T::mul_add(
+                        T::from_f64(0.00007305379199999999),
+                        t11,
+                        T::from_f64(0.00023860023952591028),
+                    ),
+                ) + T::from_f64(0.00000465422984297958));
+            let t121 = t2 * t109;
+            let t122 = t3 * t109;
+            let t123 = T::mul_add(
+                -t6,
+                T::mul_add(
+                    -T::from_f64(0.0177),
+                    t69,
+                    T::mul_add(
+                        T::from_f64(0.00007305379199999999),
+                        t11,
+                        T::from_f64(0.0002092762955259103),
+                    ),
+                ),
+                t7 * t89,
+            );
+            let t124 = -t111 - t98;
+            let t125 = T::mul_add(t21, t101, t114);
+            let t126 = T::mul_add(t20, t78, t115);
+            let t127 = T::mul_add(
+                t19,
+                t80 + T::from_f64(0.0000214347646011766),
+                -t18 * (t79 + T::from_f64(0.0000148386162019941)),
+            );
+            (
+                t64,
+                t65,
+                t66,
+                t67,
+                t68,
+                t69,
+                t70,
+                t71,
+                t72,
+                t73,
+                t74,
+                t75,
+                t76,
+                t77,
+                t78,
+                t79,
+                t80,
+                t81,
+                t82,
+                t83,
+                t84,
+                t85,
+                t86,
+                t87,
+                t88,
+                t89,
+                t90,
+                t91,
+                t92,
+                t93,
+                t94,
+                t95,
+                t96,
+                t97,
+                t98,
+                t99,
+                t100,
+                t101,
+                t102,
+                t103,
+                t104,
+                t105,
+                t106,
+                t107,
+                t108,
+                t109,
+                t110,
+                t111,
+                t112,
+                t113,
+                t114,
+                t115,
+                t116,
+                t117,
+                t118,
+                t119,
+                t120,
+                t121,
+                t122,
+                t123,
+                t124,
+                t125,
+                t126,
+                t127,
+            )
+        };
+        let (
+            t128,
+            t129,
+            t130,
+            t131,
+            t132,
+            t133,
+            t134,
+            t135,
+            t136,
+            t137,
+            t138,
+            t139,
+            t140,
+            t141,
+            t142,
+            t143,
+            t144,
+            t145,
+            t146,
+            t147,
+            t148,
+            t149,
+            t150,
+            t151,
+            t152,
+            t153,
+            t154,
+            t155,
+            t156,
+            t157,
+            t158,
+            t159,
+            t160,
+            t161,
+            t162,
+            t163,
+            t164,
+            t165,
+            t166,
+            t167,
+            t168,
+        ) = {
+            let t128 = T::mul_add(t15, t103, t116);
+            let t129 = T::mul_add(t14, t83, t117);
+            let t130 = T::mul_add(
+                t13,
+                t85 + T::from_f64(0.0000214347646011766),
+                -t12 * (t84 + T::from_f64(0.0000148386162019941)),
+            );
+            let t131 = T::mul_add(t9, t105, t118);
+            let t132 = T::mul_add(t8, t88, t119);
+            let t133 = T::mul_add(t3, t108, t121);
+            let t134 = T::mul_add(t2, t94, t122);
+            let t135 = T::mul_add(
+                t1,
+                t96 + T::from_f64(0.0000214347646011766),
+                -t0 * (t95 + T::from_f64(0.0000148386162019941)),
+            );
+            let t136 = T::mul_add(-t1, -t96, -t0 * t95);
+            let t137 = -t123
+                - (T::mul_add(T::from_f64(0.0399), t6 * t69, -T::from_f64(0.005) * t68));
+            let t138 = T::mul_add(-t13, -t85, -t12 * t84);
+            let t139 = T::mul_add(-t19, -t80, -t18 * t79);
+            let t140 = T::mul_add(
+                -t21,
+                T::mul_add(-t21, t78, t114),
+                -t20 * (T::mul_add(-t20, t101, t115)),
+            );
+            let t141 = T::mul_add(
+                -t15,
+                T::mul_add(-t15, t83, t116),
+                -t14 * (T::mul_add(-t14, t103, t117)),
+            );
+            let t142 = T::mul_add(
+                -t9,
+                T::mul_add(-t9, t88, t118),
+                -t8 * (T::mul_add(-t8, t105, t119)),
+            );
+            let t143 = T::mul_add(
+                -t3,
+                T::mul_add(-t3, t94, t121),
+                -t2 * (T::mul_add(-t2, t108, t122)),
+            );
+            let t144 = T::mul_add(
+                -T::from_f64(0.108),
+                t64,
+                T::mul_add(t20, t126, t21 * t125) + T::from_f64(0.00018050039999999997),
+            );
+            let t145 = T::mul_add(
+                -T::from_f64(0.054),
+                T::mul_add(t20, t37, T::from_f64(0.00044856000000000003) * t21 * t22),
+                T::mul_add(t21, t126, -t20 * t125),
+            );
+            let t146 = T::mul_add(
+                -T::from_f64(0.108),
+                t66,
+                T::mul_add(t14, t129, t15 * t128) + T::from_f64(0.00018050039999999997),
+            );
+            let t147 = T::mul_add(
+                -T::from_f64(0.054),
+                T::mul_add(t14, t42, T::from_f64(0.00044856000000000003) * t15 * t16),
+                T::mul_add(t15, t129, -t14 * t128),
+            );
+            let t148 = T::mul_add(
+                -T::from_f64(0.0354),
+                t69,
+                T::mul_add(t8, t132, t9 * t131) + T::from_f64(0.000029323944),
+            );
+            let t149 = T::mul_add(
+                -T::from_f64(0.0177),
+                t68,
+                T::mul_add(t9, t132, -t8 * t131),
+            );
+            let t150 = T::mul_add(
+                -T::from_f64(0.108),
+                t71,
+                T::mul_add(t2, t134, t3 * t133) + T::from_f64(0.00018050039999999997),
+            );
+            let t151 = T::mul_add(
+                -T::from_f64(0.054),
+                T::mul_add(t2, t52, T::from_f64(0.00044856000000000003) * t3 * t4),
+                T::mul_add(t3, t134, -t2 * t133),
+            );
+            let t152 = t145 + T::from_f64(0.0000042343545689576);
+            let t153 = t147 + T::from_f64(0.0000042343545689576);
+            let t154 = t151 + T::from_f64(0.0000042343545689576);
+            let t155 = T::mul_add(
+                -t18,
+                t144 + T::from_f64(0.0000808728875979549),
+                t19 * t152,
+            );
+            let t156 = T::mul_add(
+                -t19,
+                t140 + T::from_f64(0.0000796647061621031),
+                t18 * t152,
+            );
+            let t157 = T::mul_add(
+                -t12,
+                t146 + T::from_f64(0.0000808728875979549),
+                t13 * t153,
+            );
+            let t158 = T::mul_add(
+                -t13,
+                t141 + T::from_f64(0.0000796647061621031),
+                t12 * t153,
+            );
+            let t159 = T::mul_add(
+                -t6,
+                t107,
+                t7 * (t148 + T::from_f64(0.0000043875110939419)),
+            );
+            let t160 = T::mul_add(
+                -t6,
+                t90 + T::from_f64(0.00000118904291699917),
+                t7 * (t149 + T::from_f64(0.00000135226331844583)),
+            );
+            let t161 = T::mul_add(
+                -t0,
+                t150 + T::from_f64(0.0000808728875979549),
+                t1 * t154,
+            );
+            let t162 = T::mul_add(
+                -t1,
+                t143 + T::from_f64(0.0000796647061621031),
+                t0 * t154,
+            );
+            let t163 = T::mul_add(T::from_f64(0.0399), t91, -t160);
+            let t164 = T::mul_add(-t6, T::mul_add(t7, t107, -t120), t7 * t159);
+            let t165 = T::mul_add(-t19, t156, -t18 * t155)
+                + T::from_f64(0.00000101666658333);
+            let t166 = T::mul_add(-t13, t158, -t12 * t157)
+                + T::from_f64(0.00000101666658333);
+            let t167 = T::mul_add(
+                T::from_f64(2.0),
+                T::mul_add(
+                    T::from_f64(0.005),
+                    t6 * t68,
+                    T::mul_add(
+                        -T::from_f64(0.027),
+                        t91,
+                        T::mul_add(
+                            T::from_f64(0.0399),
+                            T::mul_add(-T::from_f64(0.0007106399999999999), t26, t59),
+                            T::from_f64(0.00006610312799999999),
+                        ),
+                    ),
+                ),
+                T::mul_add(
+                    T::from_f64(0.054),
+                    t91,
+                    t164 + T::from_f64(0.00017059455499999996),
+                ),
+            );
+            let t168 = T::mul_add(-t1, t162, -t0 * t161)
+                + T::from_f64(0.00000101666658333);
+            (
+                t128,
+                t129,
+                t130,
+                t131,
+                t132,
+                t133,
+                t134,
+                t135,
+                t136,
+                t137,
+                t138,
+                t139,
+                t140,
+                t141,
+                t142,
+                t143,
+                t144,
+                t145,
+                t146,
+                t147,
+                t148,
+                t149,
+                t150,
+                t151,
+                t152,
+                t153,
+                t154,
+                t155,
+                t156,
+                t157,
+                t158,
+                t159,
+                t160,
+                t161,
+                t162,
+                t163,
+                t164,
+                t165,
+                t166,
+                t167,
+                t168,
+            )
+        };
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[t168, t135, t136, t110, T::zero(), T::zero(), T::zero(), T::zero()],
+            out,
+            0,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            8,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                t135,
+                T::mul_add(
+                    -T::from_f64(0.108),
+                    t71,
+                    T::mul_add(
+                        T::from_f64(0.000034449408),
+                        t5,
+                        T::from_f64(0.0002509942774427206),
+                    ),
+                ) + T::from_f64(0.0000285700490570738),
+                t97,
+                t72,
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            16,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            24,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                t136,
+                t97,
+                T::mul_add(
+                    T::from_f64(0.000034449408),
+                    t5,
+                    T::from_f64(0.0000704938774427206),
+                ),
+                t29,
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            32,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            40,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                t110,
+                t72,
+                t29,
+                T::from_f64(0.000016593864000000002),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            48,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            56,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                t167 + T::from_f64(0.0000196731938544998),
+                t163,
+                t137,
+                t124,
+            ],
+            out,
+            64,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            72,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                t163,
+                t142 + T::from_f64(0.00000434097290977866),
+                t90,
+                t73,
+            ],
+            out,
+            80,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            88,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                t137,
+                t90,
+                T::mul_add(
+                    T::from_f64(0.00007305379199999999),
+                    t11,
+                    T::from_f64(0.0002092762955259103),
+                ),
+                t30,
+            ],
+            out,
+            96,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            104,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                t124,
+                t73,
+                t30,
+                T::from_f64(0.000045777374666699994),
+            ],
+            out,
+            112,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            120,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            128,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[t166, t130, t138, t112, T::zero(), T::zero(), T::zero(), T::zero()],
+            out,
+            136,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            144,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                t130,
+                T::mul_add(
+                    -T::from_f64(0.108),
+                    t66,
+                    T::mul_add(
+                        T::from_f64(0.000034449408),
+                        t17,
+                        T::from_f64(0.0002509942774427206),
+                    ),
+                ) + T::from_f64(0.0000285700490570738),
+                t99,
+                t74,
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            152,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            160,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                t138,
+                t99,
+                T::mul_add(
+                    T::from_f64(0.000034449408),
+                    t17,
+                    T::from_f64(0.0000704938774427206),
+                ),
+                t31,
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            168,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            176,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                t112,
+                t74,
+                t31,
+                T::from_f64(0.000016593864000000002),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            184,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            192,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[T::zero(), T::zero(), T::zero(), T::zero(), t165, t127, t139, t113],
+            out,
+            200,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            208,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                t127,
+                T::mul_add(
+                    -T::from_f64(0.108),
+                    t64,
+                    T::mul_add(
+                        T::from_f64(0.000034449408),
+                        t23,
+                        T::from_f64(0.0002509942774427206),
+                    ),
+                ) + T::from_f64(0.0000285700490570738),
+                t100,
+                t75,
+            ],
+            out,
+            216,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            224,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                t139,
+                t100,
+                T::mul_add(
+                    T::from_f64(0.000034449408),
+                    t23,
+                    T::from_f64(0.0000704938774427206),
+                ),
+                t32,
+            ],
+            out,
+            232,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            240,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                t113,
+                t75,
+                t32,
+                T::from_f64(0.000016593864000000002),
+            ],
+            out,
+            248,
+        );
+    }
+    fn coriolis_matrix_unpacked(
+        &self,
+        q: &[T; 16],
+        qd: &[T; 16],
+        out: &mut [[[<T as ::eomgen_runtime::lane::Pack>::Scalar; 16]; 16]],
+    ) {
+        let (
+            [s1,
+            s2,
+            s3,
+            s5,
+            s6,
+            s7,
+            s9,
+            s10,
+            s11,
+            s13,
+            s14,
+            s15,
+            ],
+            [c1,
+            c2,
+            c3,
+            c5,
+            c6,
+            c7,
+            c9,
+            c10,
+            c11,
+            c13,
+            c14,
+            c15,
+            ],
+        ) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[1],
+            q[2],
+            q[3],
+            q[5],
+            q[6],
+            q[7],
+            q[9],
+            q[10],
+            q[11],
+            q[13],
+            q[14],
+            q[15],
+        ]);
+        let (
+            t0,
+            t1,
+            t2,
+            t3,
+            t4,
+            t5,
+            t6,
+            t7,
+            t8,
+            t9,
+            t10,
+            t11,
+            t12,
+            t13,
+            t14,
+            t15,
+            t16,
+            t17,
+            t18,
+            t19,
+            t20,
+            t21,
+            t22,
+            t23,
+            t24,
+            t25,
+            t26,
+            t27,
+            t28,
+            t29,
+            t30,
+            t31,
+            t32,
+            t33,
+            t34,
+            t35,
+            t36,
+            t37,
+            t38,
+            t39,
+            t40,
+            t41,
+            t42,
+            t43,
+            t44,
+            t45,
+            t46,
+            t47,
+            t48,
+            t49,
+            t50,
+            t51,
+            t52,
+            t53,
+            t54,
+            t55,
+            t56,
+            t57,
+            t58,
+            t59,
+            t60,
+            t61,
+            t62,
+            t63,
+        ) = {
+            let t0 = s1;
+            let t1 = c1;
+            let t2 = s2;
+            let t3 = c2;
+            let t4 = s3;
+            let t5 = c3;
+            let t6 = s5;
+            let t7 = c5;
+            let t8 = s6;
+            let t9 = c6;
+            let t10 = s7;
+            let t11 = c7;
+            let t12 = s9;
+            let t13 = c9;
+            let t14 = s10;
+            let t15 = c10;
+            let t16 = s11;
+            let t17 = c11;
+            let t18 = s13;
+            let t19 = c13;
+            let t20 = s14;
+            let t21 = c14;
+            let t22 = s15;
+            let t23 = c15;
+            let t24 = t12 * t15;
+            let t25 = t12 * t14;
+            let t26 = t0 * t3;
+            let t27 = t0 * t2;
+            let t28 = T::mul_add(T::from_f64(0.0164), t1, T::from_f64(0.054));
+            let t29 = T::mul_add(T::from_f64(0.054), t3, T::from_f64(0.0384));
+            let t30 = t2 * t5;
+            let t31 = t2 * t4;
+            let t32 = T::mul_add(-T::from_f64(0.027), t7, T::from_f64(0.005) * t6);
+            let t33 = T::mul_add(T::from_f64(0.005), t7, T::from_f64(0.027) * t6);
+            let t34 = t7 * t9;
+            let t35 = t7 * t8;
+            let t36 = t8 * t11;
+            let t37 = t8 * t10;
+            let t38 = T::mul_add(T::from_f64(0.0177), t9, T::from_f64(0.0514));
+            let t39 = T::mul_add(T::from_f64(0.0164), t13, T::from_f64(0.054));
+            let t40 = T::mul_add(T::from_f64(0.054), t15, T::from_f64(0.0384));
+            let t41 = t14 * t17;
+            let t42 = t14 * t16;
+            let t43 = t18 * t21;
+            let t44 = t18 * t20;
+            let t45 = T::mul_add(T::from_f64(0.0164), t19, T::from_f64(0.054));
+            let t46 = T::mul_add(T::from_f64(0.054), t21, T::from_f64(0.0384));
+            let t47 = t20 * t23;
+            let t48 = t20 * t22;
+            let t49 = T::mul_add(
+                T::from_f64(0.0384),
+                t5,
+                T::from_f64(0.01699090909090909),
+            );
+            let t50 = T::mul_add(
+                -T::from_f64(0.00000255404234759754),
+                t9,
+                T::from_f64(0.000043811817294825) * t8,
+            );
+            let t51 = T::mul_add(
+                -T::from_f64(0.0000431323573125218),
+                t9,
+                T::from_f64(0.00000255404234759754) * t8,
+            );
+            let t52 = T::mul_add(
+                T::from_f64(0.0514),
+                t11,
+                T::from_f64(0.012781294964028776),
+            );
+            let t53 = T::mul_add(
+                T::from_f64(0.0384),
+                t17,
+                T::from_f64(0.01699090909090909),
+            );
+            let t54 = T::mul_add(
+                T::from_f64(0.0384),
+                t23,
+                T::from_f64(0.01699090909090909),
+            );
+            let t55 = t3 * t4;
+            let t56 = t6 * t9;
+            let t57 = t6 * t8;
+            let t58 = T::mul_add(
+                T::from_f64(0.000043811817294825),
+                t9,
+                T::from_f64(0.00000255404234759754) * t8,
+            );
+            let t59 = T::mul_add(
+                T::from_f64(0.00000255404234759754),
+                t9,
+                T::from_f64(0.0000431323573125218) * t8,
+            );
+            let t60 = t15 * t16;
+            let t61 = t21 * t22;
+            let t62 = T::mul_add(t13, t14, t24);
+            let t63 = T::mul_add(-t13, t15, t25);
+            (
+                t0,
+                t1,
+                t2,
+                t3,
+                t4,
+                t5,
+                t6,
+                t7,
+                t8,
+                t9,
+                t10,
+                t11,
+                t12,
+                t13,
+                t14,
+                t15,
+                t16,
+                t17,
+                t18,
+                t19,
+                t20,
+                t21,
+                t22,
+                t23,
+                t24,
+                t25,
+                t26,
+                t27,
+                t28,
+                t29,
+                t30,
+                t31,
+                t32,
+                t33,
+                t34,
+                t35,
+                t36,
+                t37,
+                t38,
+                t39,
+                t40,
+                t41,
+                t42,
+                t43,
+                t44,
+                t45,
+                t46,
+                t47,
+                t48,
+                t49,
+                t50,
+                t51,
+                t52,
+                t53,
+                t54,
+                t55,
+                t56,
+                t57,
+                t58,
+                t59,
+                t60,
+                t61,
+                t62,
+                t63,
+            )
+        };
+        let (
+            t64,
+            t65,
+            t66,
+            t67,
+            t68,
+            t69,
+            t70,
+            t71,
+            t72,
+            t73,
+            t74,
+            t75,
+            t76,
+            t77,
+            t78,
+            t79,
+            t80,
+            t81,
+            t82,
+            t83,
+            t84,
+            t85,
+            t86,
+            t87,
+            t88,
+            t89,
+            t90,
+            t91,
+            t92,
+            t93,
+            t94,
+            t95,
+            t96,
+            t97,
+            t98,
+            t99,
+            t100,
+            t101,
+            t102,
+            t103,
+            t104,
+            t105,
+            t106,
+            t107,
+            t108,
+            t109,
+            t110,
+            t111,
+            t112,
+            t113,
+            t114,
+            t115,
+            t116,
+            t117,
+            t118,
+            t119,
+            t120,
+            t121,
+            t122,
+            t123,
+            t124,
+            t125,
+            t126,
+            t127,
+        ) = {
+            let t64 = t3 * t28;
+            let t65 = T::mul_add(t1, t2, t26);
+            let t66 = T::mul_add(-t1, t3, t27);
+            let t67 = t4 * t29;
+            let t68 = t5 * t29;
+            let t69 = t8 * t32;
+            let t70 = t11 * t38;
+            let t71 = t15 * t39;
+            let t72 = t16 * t40;
+            let t73 = t17 * t40;
+            let t74 = t21 * t45;
+            let t75 = T::mul_add(t19, t20, t43);
+            let t76 = T::mul_add(-t19, t21, t44);
+            let t77 = t22 * t46;
+            let t78 = t23 * t46;
+            let t79 = T::mul_add(
+                -T::from_f64(0.00000255404234759754),
+                t35,
+                T::mul_add(
+                    -T::from_f64(0.000043811817294825),
+                    t34,
+                    T::from_f64(0.00000818299639785789) * t6,
+                ),
+            );
+            let t80 = T::mul_add(
+                -T::from_f64(0.0000431323573125218),
+                t35,
+                T::mul_add(
+                    -T::from_f64(0.00000255404234759754),
+                    t34,
+                    T::from_f64(0.000011844769255572) * t6,
+                ),
+            );
+            let t81 = T::mul_add(t7, t8 * t11, t7 * t9 * t10);
+            let t82 = T::mul_add(-t7, t8 * t10, t7 * t9 * t11);
+            let t83 = T::mul_add(-t9, t11, t37);
+            let t84 = T::mul_add(t9, t10, t36);
+            let t85 = T::from_f64(0.054) * (t30 + t55);
+            let t86 = T::from_f64(0.054) * (T::mul_add(-t3, t5, t31));
+            let t87 = T::mul_add(t6, t8 * t11, t6 * t9 * t10);
+            let t88 = T::mul_add(-t6, t8 * t10, t6 * t9 * t11);
+            let t89 = t7 * t8 * t50;
+            let t90 = t7 * t9 * t58;
+            let t91 = t6
+                * (T::mul_add(
+                    T::from_f64(0.00000818299639785789),
+                    t9,
+                    T::from_f64(0.000011844769255572) * t8,
+                ));
+            let t92 = t7 * t9 * t51;
+            let t93 = t7 * t8 * t59;
+            let t94 = T::from_f64(0.054) * (t41 + t60);
+            let t95 = T::from_f64(0.054) * (T::mul_add(-t15, t17, t42));
+            let t96 = T::from_f64(0.054) * (t47 + t61);
+            let t97 = T::from_f64(0.054) * (T::mul_add(-t21, t23, t48));
+            let t98 = T::mul_add(t2, t28, T::from_f64(0.0164) * t26);
+            let t99 = T::mul_add(T::from_f64(0.0164), t27, -t64 - T::from_f64(0.0384));
+            let t100 = T::mul_add(T::from_f64(0.0576), t9, t69);
+            let t101 = T::mul_add(T::from_f64(0.0576), t9, t69 + T::from_f64(0.0514));
+            let t102 = T::mul_add(-t9, t32, T::from_f64(0.0576) * t8);
+            let t103 = T::mul_add(t14, t39, T::from_f64(0.0164) * t24);
+            let t104 = T::mul_add(T::from_f64(0.0164), t25, -t71 - T::from_f64(0.0384));
+            let t105 = T::mul_add(t20, t45, T::from_f64(0.0164) * t43);
+            let t106 = T::mul_add(T::from_f64(0.0164), t44, -t74 - T::from_f64(0.0384));
+            let t107 = T::mul_add(T::from_f64(0.0164), t27, -t64);
+            let t108 = T::mul_add(
+                T::from_f64(0.054),
+                t31,
+                -t68 - T::from_f64(0.01699090909090909),
+            );
+            let t109 = T::mul_add(T::from_f64(0.054), t30, t67);
+            let t110 = t33 * t81;
+            let t111 = t33 * t82;
+            let t112 = T::mul_add(
+                -T::from_f64(0.0000052283),
+                t81,
+                T::mul_add(
+                    -T::from_f64(0.00005486748988006258),
+                    t82,
+                    T::from_f64(0.000008042076) * t6,
+                ),
+            );
+            let t113 = T::mul_add(
+                -T::from_f64(0.0000338903173333),
+                t81,
+                T::mul_add(
+                    -T::from_f64(0.0000052283),
+                    t82,
+                    T::from_f64(0.000011283525) * t6,
+                ),
+            );
+            let t114 = T::mul_add(
+                T::from_f64(0.0177),
+                t37,
+                -t70 - T::from_f64(0.012781294964028776),
+            );
+            let t115 = T::mul_add(t10, t38, T::from_f64(0.0177) * t36);
+            let t116 = T::mul_add(
+                T::from_f64(0.0000052283),
+                t83,
+                T::from_f64(0.00005486748988006258) * t84,
+            );
+            let t117 = T::mul_add(
+                T::from_f64(0.0000338903173333),
+                t83,
+                T::from_f64(0.0000052283) * t84,
+            );
+            let t118 = T::mul_add(T::from_f64(0.0164), t25, -t71);
+            let t119 = T::mul_add(
+                T::from_f64(0.054),
+                t42,
+                -t73 - T::from_f64(0.01699090909090909),
+            );
+            let t120 = T::mul_add(T::from_f64(0.054), t41, t72);
+            let t121 = T::mul_add(T::from_f64(0.0164), t44, -t74);
+            let t122 = T::mul_add(
+                T::from_f64(0.054),
+                t48,
+                -t78 - T::from_f64(0.01699090909090909),
+            );
+            let t123 = T::mul_add(T::from_f64(0.054), t47, t77);
+            let t124 = T::from_f64(0.0164) * t66;
+            let t125 = T::from_f64(0.0164) * t65;
+            let t126 = T::mul_add(T::from_f64(0.054), t31, -t68);
+            let t127 = T::mul_add(t8, t11 * t33, t9 * t10 * t33);
+            (
+                t64,
+                t65,
+                t66,
+                t67,
+                t68,
+                t69,
+                t70,
+                t71,
+                t72,
+                t73,
+                t74,
+                t75,
+                t76,
+                t77,
+                t78,
+                t79,
+                t80,
+                t81,
+                t82,
+                t83,
+                t84,
+                t85,
+                t86,
+                t87,
+                t88,
+                t89,
+                t90,
+                t91,
+                t92,
+                t93,
+                t94,
+                t95,
+                t96,
+                t97,
+                t98,
+                t99,
+                t100,
+                t101,
+                t102,
+                t103,
+                t104,
+                t105,
+                t106,
+                t107,
+                t108,
+                t109,
+                t110,
+                t111,
+                t112,
+                t113,
+                t114,
+                t115,
+                t116,
+                t117,
+                t118,
+                t119,
+                t120,
+                t121,
+                t122,
+                t123,
+                t124,
+                t125,
+                t126,
+                t127,
+            )
+        };
+        let (
+            t128,
+            t129,
+            t130,
+            t131,
+            t132,
+            t133,
+            t134,
+            t135,
+            t136,
+            t137,
+            t138,
+            t139,
+            t140,
+            t141,
+            t142,
+            t143,
+            t144,
+            t145,
+            t146,
+            t147,
+            t148,
+            t149,
+            t150,
+            t151,
+            t152,
+            t153,
+            t154,
+            t155,
+            t156,
+            t157,
+            t158,
+            t159,
+            t160,
+            t161,
+            t162,
+            t163,
+            t164,
+            t165,
+            t166,
+            t167,
+            t168,
+            t169,
+            t170,
+            t171,
+            t172,
+            t173,
+            t174,
+            t175,
+            t176,
+            t177,
+            t178,
+            t179,
+            t180,
+            t181,
+            t182,
+            t183,
+            t184,
+            t185,
+            t186,
+            t187,
+            t188,
+            t189,
+            t190,
+            t191,
+        ) = {
+            let t128 = T::mul_add(-t8, t10 * t33, t9 * t11 * t33);
+            let t129 = T::mul_add(
+                -T::from_f64(0.00005486748988006258),
+                t83,
+                T::from_f64(0.0000052283) * t84,
+            );
+            let t130 = T::mul_add(
+                -T::from_f64(0.0000052283),
+                t83,
+                T::from_f64(0.0000338903173333) * t84,
+            );
+            let t131 = T::from_f64(0.0164) * t63;
+            let t132 = T::from_f64(0.0164) * t62;
+            let t133 = T::mul_add(T::from_f64(0.054), t42, -t73);
+            let t134 = T::from_f64(0.0164) * t76;
+            let t135 = T::from_f64(0.0164) * t75;
+            let t136 = T::mul_add(T::from_f64(0.054), t48, -t78);
+            let t137 = T::mul_add(
+                -T::from_f64(0.00007785676799999999),
+                t4 * t5,
+                T::from_f64(0.0020275199999999997) * t4 * t49,
+            );
+            let t138 = T::mul_add(
+                -T::from_f64(0.000016084152),
+                t83,
+                T::from_f64(0.00002256705) * t84,
+            );
+            let t139 = T::mul_add(
+                -T::from_f64(0.000293785952),
+                t10 * t11,
+                T::from_f64(0.00571568) * t10 * t52,
+            );
+            let t140 = T::mul_add(
+                -T::from_f64(0.00007785676799999999),
+                t16 * t17,
+                T::from_f64(0.0020275199999999997) * t16 * t53,
+            );
+            let t141 = T::mul_add(
+                -T::from_f64(0.00007785676799999999),
+                t22 * t23,
+                T::from_f64(0.0020275199999999997) * t22 * t54,
+            );
+            let t142 = T::mul_add(-t63, t16, t62 * t17);
+            let t143 = T::mul_add(t63, t17, t62 * t16);
+            let t144 = t5 * t98;
+            let t145 = t4 * t98;
+            let t146 = t11 * t102;
+            let t147 = t10 * t102;
+            let t148 = t17 * t103;
+            let t149 = t16 * t103;
+            let t150 = t23 * t105;
+            let t151 = t22 * t105;
+            let t152 = T::mul_add(t5, t66, t4 * t65);
+            let t153 = T::mul_add(-t4, t66, t5 * t65);
+            let t154 = T::mul_add(t23, t76, t22 * t75);
+            let t155 = T::mul_add(-t22, t76, t23 * t75);
+            let t156 = t66
+                * (T::mul_add(
+                    T::from_f64(0.00000285079817622615),
+                    t66,
+                    T::from_f64(0.000027108908376807) * t65,
+                ));
+            let t157 = t65
+                * (T::mul_add(
+                    -T::from_f64(0.000027108908376807),
+                    t66,
+                    T::from_f64(0.00000285079817622615) * t65,
+                ));
+            let t158 = t65
+                * (T::mul_add(
+                    T::from_f64(0.0000266287347075153),
+                    t66,
+                    T::from_f64(0.00000285079817622615) * t65,
+                ));
+            let t159 = t66
+                * (T::mul_add(
+                    -T::from_f64(0.00000285079817622615),
+                    t66,
+                    T::from_f64(0.0000266287347075153) * t65,
+                ));
+            let t160 = t109 * t49;
+            let t161 = t4 * t108;
+            let t162 = t5 * t109;
+            let t163 = t4 * t126;
+            let t164 = t114 * t83;
+            let t165 = t81 * t112;
+            let t166 = t82
+                * (T::mul_add(
+                    -T::from_f64(0.00005486748988006258),
+                    t81,
+                    T::from_f64(0.0000052283) * t82,
+                ));
+            let t167 = t6
+                * (T::mul_add(
+                    -T::from_f64(0.000008042076),
+                    t81,
+                    T::from_f64(0.000011283525) * t82,
+                ));
+            let t168 = t82 * t113;
+            let t169 = t81
+                * (T::mul_add(
+                    -T::from_f64(0.0000052283),
+                    t81,
+                    T::from_f64(0.0000338903173333) * t82,
+                ));
+            let t170 = t81 * t116;
+            let t171 = t82 * t129;
+            let t172 = t6
+                * (T::mul_add(
+                    -T::from_f64(0.000008042076),
+                    t83,
+                    T::from_f64(0.000011283525) * t84,
+                ));
+            let t173 = t82 * t117;
+            let t174 = t81 * t130;
+            let t175 = t83 * t116;
+            let t176 = t84 * t129;
+            let t177 = t84 * t117;
+            let t178 = t83 * t130;
+            let t179 = t63
+                * (T::mul_add(
+                    T::from_f64(0.00000285079817622615),
+                    t63,
+                    T::from_f64(0.000027108908376807) * t62,
+                ));
+            let t180 = t62
+                * (T::mul_add(
+                    -T::from_f64(0.000027108908376807),
+                    t63,
+                    T::from_f64(0.00000285079817622615) * t62,
+                ));
+            let t181 = t62
+                * (T::mul_add(
+                    T::from_f64(0.0000266287347075153),
+                    t63,
+                    T::from_f64(0.00000285079817622615) * t62,
+                ));
+            let t182 = t63
+                * (T::mul_add(
+                    -T::from_f64(0.00000285079817622615),
+                    t63,
+                    T::from_f64(0.0000266287347075153) * t62,
+                ));
+            let t183 = t120 * t53;
+            let t184 = t16 * t119;
+            let t185 = t17 * t120;
+            let t186 = t16 * t133;
+            let t187 = t76
+                * (T::mul_add(
+                    T::from_f64(0.00000285079817622615),
+                    t76,
+                    T::from_f64(0.000027108908376807) * t75,
+                ));
+            let t188 = t75
+                * (T::mul_add(
+                    -T::from_f64(0.000027108908376807),
+                    t76,
+                    T::from_f64(0.00000285079817622615) * t75,
+                ));
+            let t189 = t75
+                * (T::mul_add(
+                    T::from_f64(0.0000266287347075153),
+                    t76,
+                    T::from_f64(0.00000285079817622615) * t75,
+                ));
+            let t190 = t76
+                * (T::mul_add(
+                    -T::from_f64(0.00000285079817622615),
+                    t76,
+                    T::from_f64(0.0000266287347075153) * t75,
+                ));
+            let t191 = t123 * t54;
+            (
+                t128,
+                t129,
+                t130,
+                t131,
+                t132,
+                t133,
+                t134,
+                t135,
+                t136,
+                t137,
+                t138,
+                t139,
+                t140,
+                t141,
+                t142,
+                t143,
+                t144,
+                t145,
+                t146,
+                t147,
+                t148,
+                t149,
+                t150,
+                t151,
+                t152,
+                t153,
+                t154,
+                t155,
+                t156,
+                t157,
+                t158,
+                t159,
+                t160,
+                t161,
+                t162,
+                t163,
+                t164,
+                t165,
+                t166,
+                t167,
+                t168,
+                t169,
+                t170,
+                t171,
+                t172,
+                t173,
+                t174,
+                t175,
+                t176,
+                t177,
+                t178,
+                t179,
+                t180,
+                t181,
+                t182,
+                t183,
+                t184,
+                t185,
+                t186,
+                t187,
+                t188,
+                t189,
+                t190,
+                t191,
+            )
+        };
+        let (
+            t192,
+            t193,
+            t194,
+            t195,
+            t196,
+            t197,
+            t198,
+            t199,
+            t200,
+            t201,
+            t202,
+            t203,
+            t204,
+            t205,
+            t206,
+            t207,
+            t208,
+            t209,
+            t210,
+            t211,
+            t212,
+            t213,
+            t214,
+            t215,
+            t216,
+            t217,
+            t218,
+            t219,
+            t220,
+            t221,
+            t222,
+            t223,
+            t224,
+            t225,
+            t226,
+            t227,
+            t228,
+            t229,
+            t230,
+            t231,
+            t232,
+            t233,
+            t234,
+            t235,
+            t236,
+            t237,
+            t238,
+            t239,
+            t240,
+            t241,
+            t242,
+            t243,
+            t244,
+            t245,
+            t246,
+            t247,
+            t248,
+            t249,
+            t250,
+            t251,
+            t252,
+            t253,
+            t254,
+            t255,
+        ) = {
+            let t192 = t22 * t122;
+            let t193 = t23 * t123;
+            let t194 = t22 * t136;
+            let t195 = qd[2] * t137;
+            let t196 = qd[7] * t138;
+            let t197 = qd[6] * t139;
+            let t198 = qd[10] * t140;
+            let t199 = qd[14] * t141;
+            let t200 = T::mul_add(t5, t99, t145);
+            let t201 = T::mul_add(-t4, t99, t144);
+            let t202 = T::mul_add(-t11, t101, t147);
+            let t203 = T::mul_add(t10, t101, t146);
+            let t204 = T::mul_add(-t114, t84, t83 * t115);
+            let t205 = T::mul_add(t17, t104, t149);
+            let t206 = T::mul_add(-t16, t104, t148);
+            let t207 = T::mul_add(t23, t106, t151);
+            let t208 = T::mul_add(-t22, t106, t150);
+            let t209 = T::from_f64(0.0528) * (T::mul_add(-t109, t86, t108 * t85));
+            let t210 = T::from_f64(0.0528) * (T::mul_add(-t109, t126, t108 * t109));
+            let t211 = T::mul_add(t10, t100, t146);
+            let t212 = T::mul_add(-t11, t100, t147);
+            let t213 = T::mul_add(
+                -t84,
+                T::from_f64(0.0177) * t84,
+                T::mul_add(-t83, T::from_f64(0.0177) * t83, T::mul_add(t115, t84, t164)),
+            );
+            let t214 = T::mul_add(
+                -t83,
+                T::mul_add(T::from_f64(0.0177), t37, -t70),
+                t164,
+            );
+            let t215 = T::from_f64(0.0528) * (T::mul_add(-t120, t95, t119 * t94));
+            let t216 = T::from_f64(0.0528) * (T::mul_add(-t120, t133, t119 * t120));
+            let t217 = T::from_f64(0.0528) * (T::mul_add(-t123, t97, t122 * t96));
+            let t218 = T::from_f64(0.0528) * (T::mul_add(-t123, t136, t122 * t123));
+            let t219 = T::mul_add(
+                -T::from_f64(0.000002511936),
+                t152,
+                T::mul_add(
+                    T::from_f64(0.0000035244),
+                    t153,
+                    T::mul_add(
+                        -T::from_f64(0.0000108230451589102),
+                        t66,
+                        T::from_f64(0.00001587314373844814) * t65,
+                    ),
+                ),
+            );
+            let t220 = T::mul_add(
+                -T::from_f64(0.000002511936),
+                t152,
+                T::from_f64(0.0000035244) * t153,
+            );
+            let t221 = T::mul_add(
+                T::from_f64(0.0010137599999999998),
+                t163 - t161 - t162,
+                T::mul_add(
+                    T::from_f64(0.0264),
+                    t160,
+                    T::from_f64(0.000024222240000000003) * (t30 + t55),
+                ),
+            );
+            let t222 = T::mul_add(
+                T::from_f64(0.0010137599999999998),
+                t161 + t162 - t163,
+                T::mul_add(
+                    -T::from_f64(0.0264),
+                    t160,
+                    T::from_f64(0.000024222240000000003) * (t30 + t55),
+                ),
+            );
+            let t223 = T::mul_add(
+                -T::from_f64(0.000002511936),
+                t143,
+                T::mul_add(
+                    T::from_f64(0.0000035244),
+                    t142,
+                    T::mul_add(
+                        -T::from_f64(0.0000108230451589102),
+                        t63,
+                        T::from_f64(0.00001587314373844814) * t62,
+                    ),
+                ),
+            );
+            let t224 = T::mul_add(
+                -T::from_f64(0.000002511936),
+                t143,
+                T::from_f64(0.0000035244) * t142,
+            );
+            let t225 = T::mul_add(
+                T::from_f64(0.0010137599999999998),
+                t186 - t184 - t185,
+                T::mul_add(
+                    T::from_f64(0.0264),
+                    t183,
+                    T::from_f64(0.000024222240000000003) * (t41 + t60),
+                ),
+            );
+            let t226 = T::mul_add(
+                T::from_f64(0.0010137599999999998),
+                t184 + t185 - t186,
+                T::mul_add(
+                    -T::from_f64(0.0264),
+                    t183,
+                    T::from_f64(0.000024222240000000003) * (t41 + t60),
+                ),
+            );
+            let t227 = T::mul_add(
+                -T::from_f64(0.000002511936),
+                t154,
+                T::mul_add(
+                    T::from_f64(0.0000035244),
+                    t155,
+                    T::mul_add(
+                        -T::from_f64(0.0000108230451589102),
+                        t76,
+                        T::from_f64(0.00001587314373844814) * t75,
+                    ),
+                ),
+            );
+            let t228 = T::mul_add(
+                -T::from_f64(0.000002511936),
+                t154,
+                T::from_f64(0.0000035244) * t155,
+            );
+            let t229 = T::mul_add(
+                T::from_f64(0.0010137599999999998),
+                t194 - t192 - t193,
+                T::mul_add(
+                    T::from_f64(0.0264),
+                    t191,
+                    T::from_f64(0.000024222240000000003) * (t47 + t61),
+                ),
+            );
+            let t230 = T::mul_add(
+                T::from_f64(0.0010137599999999998),
+                t192 + t193 - t194,
+                T::mul_add(
+                    -T::from_f64(0.0264),
+                    t191,
+                    T::from_f64(0.000024222240000000003) * (t47 + t61),
+                ),
+            );
+            let t231 = t200 - T::from_f64(0.01699090909090909);
+            let t232 = t202 - T::from_f64(0.012781294964028776);
+            let t233 = t205 - T::from_f64(0.01699090909090909);
+            let t234 = t207 - T::from_f64(0.01699090909090909);
+            let t235 = t201 * t153;
+            let t236 = t152
+                * (T::mul_add(
+                    T::from_f64(0.0000012936),
+                    t152,
+                    T::from_f64(0.000010024357818181817) * t153,
+                ));
+            let t237 = t153
+                * (T::mul_add(
+                    -T::from_f64(0.000010024357818181817),
+                    t152,
+                    T::from_f64(0.0000012936) * t153,
+                ));
+            let t238 = t153
+                * (T::mul_add(
+                    T::from_f64(0.0000056692479999999995),
+                    t152,
+                    T::from_f64(0.0000012936) * t153,
+                ));
+            let t239 = t152
+                * (T::mul_add(
+                    -T::from_f64(0.0000012936),
+                    t152,
+                    T::from_f64(0.0000056692479999999995) * t153,
+                ));
+            let t240 = t142 * t206;
+            let t241 = t143
+                * (T::mul_add(
+                    T::from_f64(0.0000012936),
+                    t143,
+                    T::from_f64(0.000010024357818181817) * t142,
+                ));
+            let t242 = t142
+                * (T::mul_add(
+                    -T::from_f64(0.000010024357818181817),
+                    t143,
+                    T::from_f64(0.0000012936) * t142,
+                ));
+            let t243 = t142
+                * (T::mul_add(
+                    T::from_f64(0.0000056692479999999995),
+                    t143,
+                    T::from_f64(0.0000012936) * t142,
+                ));
+            let t244 = t143
+                * (T::mul_add(
+                    -T::from_f64(0.0000012936),
+                    t143,
+                    T::from_f64(0.0000056692479999999995) * t142,
+                ));
+            let t245 = t208 * t155;
+            let t246 = t154
+                * (T::mul_add(
+                    T::from_f64(0.0000012936),
+                    t154,
+                    T::from_f64(0.000010024357818181817) * t155,
+                ));
+            let t247 = t155
+                * (T::mul_add(
+                    -T::from_f64(0.000010024357818181817),
+                    t154,
+                    T::from_f64(0.0000012936) * t155,
+                ));
+            let t248 = t155
+                * (T::mul_add(
+                    T::from_f64(0.0000056692479999999995),
+                    t154,
+                    T::from_f64(0.0000012936) * t155,
+                ));
+            let t249 = t154
+                * (T::mul_add(
+                    -T::from_f64(0.0000012936),
+                    t154,
+                    T::from_f64(0.0000056692479999999995) * t155,
+                ));
+            let t250 = qd[2] * t219;
+            let t251 = qd[3] * t220;
+            let t252 = qd[1] * t209;
+            let t253 = qd[1] * t210;
+            let t254 = qd[1] * t222;
+            let t255 = qd[10] * t223;
+            (
+                t192,
+                t193,
+                t194,
+                t195,
+                t196,
+                t197,
+                t198,
+                t199,
+                t200,
+                t201,
+                t202,
+                t203,
+                t204,
+                t205,
+                t206,
+                t207,
+                t208,
+                t209,
+                t210,
+                t211,
+                t212,
+                t213,
+                t214,
+                t215,
+                t216,
+                t217,
+                t218,
+                t219,
+                t220,
+                t221,
+                t222,
+                t223,
+                t224,
+                t225,
+                t226,
+                t227,
+                t228,
+                t229,
+                t230,
+                t231,
+                t232,
+                t233,
+                t234,
+                t235,
+                t236,
+                t237,
+                t238,
+                t239,
+                t240,
+                t241,
+                t242,
+                t243,
+                t244,
+                t245,
+                t246,
+                t247,
+                t248,
+                t249,
+                t250,
+                t251,
+                t252,
+                t253,
+                t254,
+                t255,
+            )
+        };
+        let (
+            t256,
+            t257,
+            t258,
+            t259,
+            t260,
+            t261,
+            t262,
+            t263,
+            t264,
+            t265,
+            t266,
+            t267,
+            t268,
+            t269,
+            t270,
+            t271,
+            t272,
+            t273,
+            t274,
+            t275,
+            t276,
+            t277,
+            t278,
+            t279,
+            t280,
+            t281,
+            t282,
+            t283,
+            t284,
+            t285,
+            t286,
+            t287,
+            t288,
+            t289,
+            t290,
+            t291,
+            t292,
+            t293,
+            t294,
+            t295,
+            t296,
+            t297,
+            t298,
+            t299,
+            t300,
+            t301,
+            t302,
+            t303,
+            t304,
+            t305,
+            t306,
+            t307,
+            t308,
+            t309,
+            t310,
+            t311,
+            t312,
+            t313,
+            t314,
+            t315,
+            t316,
+            t317,
+            t318,
+            t319,
+        ) = {
+            let t256 = qd[11] * t224;
+            let t257 = qd[9] * t215;
+            let t258 = qd[9] * t216;
+            let t259 = qd[9] * t226;
+            let t260 = qd[14] * t227;
+            let t261 = qd[15] * t228;
+            let t262 = qd[13] * t217;
+            let t263 = qd[13] * t218;
+            let t264 = qd[13] * t230;
+            let t265 = T::mul_add(-t6, t203, t111);
+            let t266 = t231 * t152;
+            let t267 = T::mul_add(
+                -t6,
+                t128,
+                T::mul_add(t7, t203, T::mul_add(t33, t88, t32 * t82)),
+            );
+            let t268 = t232 * t81;
+            let t269 = T::mul_add(-t6, t211, t111);
+            let t270 = T::mul_add(-t6, t212, t110);
+            let t271 = T::mul_add(
+                T::from_f64(0.1112),
+                t204 * t213,
+                T::mul_add(
+                    -t9,
+                    t59,
+                    T::mul_add(
+                        t8,
+                        t51,
+                        T::mul_add(
+                            t8,
+                            t58,
+                            T::mul_add(t9, t50, t176 + t177 + t178 - t175),
+                        ),
+                    ),
+                ),
+            );
+            let t272 = T::mul_add(-t6, t202, t110);
+            let t273 = t143 * t233;
+            let t274 = t234 * t154;
+            let t275 = T::from_f64(0.5)
+                * (T::mul_add(
+                    -qd[3],
+                    t221,
+                    T::mul_add(
+                        -qd[2],
+                        T::mul_add(
+                            T::from_f64(0.0020275199999999997),
+                            t4 * t86,
+                            T::from_f64(0.0528) * t49 * t85,
+                        ),
+                        t252,
+                    ),
+                ));
+            let t276 = T::from_f64(0.5)
+                * (T::mul_add(
+                    -qd[3],
+                    T::mul_add(
+                        T::from_f64(0.0008971200000000001),
+                        t67,
+                        T::from_f64(0.000048444480000000005) * t30,
+                    ),
+                    T::mul_add(-qd[2], t221, t253),
+                ));
+            let t277 = T::mul_add(
+                -T::from_f64(0.1112),
+                t204 * t214,
+                t175 - t176 - t177 - t178,
+            );
+            let t278 = T::from_f64(0.5)
+                * (T::mul_add(
+                    -qd[11],
+                    t225,
+                    T::mul_add(
+                        -qd[10],
+                        T::mul_add(
+                            T::from_f64(0.0020275199999999997),
+                            t16 * t95,
+                            T::from_f64(0.0528) * t53 * t94,
+                        ),
+                        t257,
+                    ),
+                ));
+            let t279 = T::from_f64(0.5)
+                * (T::mul_add(
+                    -qd[11],
+                    T::mul_add(
+                        T::from_f64(0.0008971200000000001),
+                        t72,
+                        T::from_f64(0.000048444480000000005) * t41,
+                    ),
+                    T::mul_add(-qd[10], t225, t258),
+                ));
+            let t280 = T::from_f64(0.5)
+                * (T::mul_add(
+                    -qd[15],
+                    t229,
+                    T::mul_add(
+                        -qd[14],
+                        T::mul_add(
+                            T::from_f64(0.0020275199999999997),
+                            t22 * t97,
+                            T::from_f64(0.0528) * t54 * t96,
+                        ),
+                        t262,
+                    ),
+                ));
+            let t281 = T::from_f64(0.5)
+                * (T::mul_add(
+                    -qd[15],
+                    T::mul_add(
+                        T::from_f64(0.0008971200000000001),
+                        t77,
+                        T::from_f64(0.000048444480000000005) * t47,
+                    ),
+                    T::mul_add(-qd[14], t229, t263),
+                ));
+            let t282 = T::mul_add(-t231, t153, t152 * t201);
+            let t283 = T::mul_add(-t232, t82, t81 * t203);
+            let t284 = T::mul_add(t6, t232, -t110);
+            let t285 = T::mul_add(-t142, t233, t143 * t206);
+            let t286 = T::mul_add(-t234, t155, t154 * t208);
+            let t287 = T::mul_add(
+                t153,
+                T::mul_add(-t5, t125, t4 * t124),
+                T::mul_add(-t152, T::mul_add(t4, t125, t5 * t124), t235 + t266),
+            );
+            let t288 = T::mul_add(
+                -t153,
+                T::mul_add(-t4, t107, t144),
+                T::mul_add(-t152, T::mul_add(t5, t107, t145), t235 + t266),
+            );
+            let t289 = T::mul_add(
+                t33,
+                t87,
+                T::mul_add(t32, t81, T::mul_add(-t6, t127, t7 * t232)),
+            );
+            let t290 = T::mul_add(
+                -t232,
+                t88,
+                T::mul_add(-t82, t127, T::mul_add(t81, t128, t203 * t87)),
+            );
+            let t291 = t10 * t267;
+            let t292 = T::mul_add(
+                -t82,
+                t211,
+                T::mul_add(-t81, t212, T::mul_add(t203, t82, t268)),
+            );
+            let t293 = T::mul_add(-t81, t202, t268);
+            let t294 = t52 * t265;
+            let t295 = t11 * t265;
+            let t296 = t10 * t272;
+            let t297 = T::mul_add(
+                t142,
+                T::mul_add(-t17, t132, t16 * t131),
+                T::mul_add(-t143, T::mul_add(t16, t132, t17 * t131), t240 + t273),
+            );
+            let t298 = T::mul_add(
+                -t142,
+                T::mul_add(-t16, t118, t148),
+                T::mul_add(-t143, T::mul_add(t17, t118, t149), t240 + t273),
+            );
+            let t299 = T::mul_add(
+                t155,
+                T::mul_add(-t23, t135, t22 * t134),
+                T::mul_add(-t154, T::mul_add(t22, t135, t23 * t134), t245 + t274),
+            );
+            let t300 = T::mul_add(
+                -t155,
+                T::mul_add(-t22, t121, t150),
+                T::mul_add(-t154, T::mul_add(t23, t121, t151), t245 + t274),
+            );
+            let t301 = qd[5] * t271;
+            let t302 = qd[5] * t277;
+            let t303 = t52 * t289;
+            let t304 = t204 * t292;
+            let t305 = t283 * t213;
+            let t306 = t204 * t293;
+            let t307 = t283 * t214;
+            let t308 = t10 * t284;
+            let t309 = T::mul_add(
+                T::from_f64(0.0528),
+                t282 * t287,
+                T::mul_add(
+                    T::from_f64(0.071),
+                    (T::mul_add(-t65, t107, t66 * t98))
+                        * (T::mul_add(
+                            -t65,
+                            t125,
+                            T::mul_add(t66, t107, T::mul_add(-t66, t124, t65 * t98)),
+                        )),
+                    T::mul_add(
+                        -t1,
+                        T::mul_add(
+                            T::from_f64(0.0000042343545689576),
+                            t1,
+                            T::from_f64(0.0000796647061621031) * t0,
+                        ),
+                        T::mul_add(
+                            t0,
+                            T::mul_add(
+                                -T::from_f64(0.0000796647061621031),
+                                t1,
+                                T::from_f64(0.0000042343545689576) * t0,
+                            ),
+                            T::mul_add(
+                                t0,
+                                T::mul_add(
+                                    T::from_f64(0.0000808728875979549),
+                                    t1,
+                                    T::from_f64(0.0000042343545689576) * t0,
+                                ),
+                                T::mul_add(
+                                    t1,
+                                    T::mul_add(
+                                        -T::from_f64(0.0000042343545689576),
+                                        t1,
+                                        T::from_f64(0.0000808728875979549) * t0,
+                                    ),
+                                    t157 + t158 + t159 + t237 + t238 + t239 - t156 - t236,
+                                ),
+                            ),
+                        ),
+                    ),
+                ),
+            );
+            let t310 = T::mul_add(
+                T::from_f64(0.1112),
+                T::mul_add(-t265, t267, T::mul_add(-t283, t290, t284 * t289)),
+                T::mul_add(
+                    T::from_f64(0.076),
+                    T::mul_add(
+                        -(T::mul_add(-t6, t102, t7 * t9 * t33)),
+                        T::mul_add(t7, t102, t7 * t9 * t32),
+                        T::mul_add(
+                            -(T::mul_add(t7, t9 * t100, t7 * t8 * t102)),
+                            T::mul_add(t6, t9 * t100, t6 * t8 * t102),
+                            (T::mul_add(t7, t8 * t33, t6 * t100))
+                                * (T::mul_add(-t7, t8 * t32, t7 * t100)),
+                        ),
+                    ),
+                    T::mul_add(
+                        -t81,
+                        T::mul_add(
+                            T::from_f64(0.0000338903173333),
+                            t87,
+                            T::mul_add(
+                                T::from_f64(0.0000052283),
+                                t88,
+                                T::from_f64(0.000011283525) * t7,
+                            ),
+                        ),
+                        T::mul_add(
+                            t113,
+                            t87,
+                            T::mul_add(
+                                t6,
+                                T::mul_add(
+                                    T::from_f64(0.000011283525),
+                                    t87,
+                                    T::mul_add(
+                                        T::from_f64(0.000008042076),
+                                        t88,
+                                        T::from_f64(0.000036694475213462586) * t7,
+                                    ),
+                                ),
+                                T::mul_add(
+                                    t7,
+                                    T::mul_add(
+                                        -T::from_f64(0.000011283525),
+                                        t81,
+                                        T::mul_add(
+                                            -T::from_f64(0.000008042076),
+                                            t82,
+                                            T::from_f64(0.000036694475213462586) * t6,
+                                        ),
+                                    ),
+                                    T::mul_add(
+                                        -t82,
+                                        T::mul_add(
+                                            T::from_f64(0.0000052283),
+                                            t87,
+                                            T::mul_add(
+                                                T::from_f64(0.00005486748988006258),
+                                                t88,
+                                                T::from_f64(0.000008042076) * t7,
+                                            ),
+                                        ),
+                                        T::mul_add(
+                                            t112,
+                                            t88,
+                                            T::mul_add(
+                                                -t7,
+                                                t8
+                                                    * (T::mul_add(
+                                                        T::from_f64(0.0000431323573125218),
+                                                        t57,
+                                                        T::mul_add(
+                                                            T::from_f64(0.00000255404234759754),
+                                                            t56,
+                                                            T::from_f64(0.000011844769255572) * t7,
+                                                        ),
+                                                    )),
+                                                T::mul_add(
+                                                    t6,
+                                                    t8 * t80,
+                                                    T::mul_add(
+                                                        t6,
+                                                        T::mul_add(
+                                                            T::from_f64(0.000011844769255572),
+                                                            t57,
+                                                            T::mul_add(
+                                                                T::from_f64(0.00000818299639785789),
+                                                                t56,
+                                                                T::from_f64(0.0000166059448592103) * t7,
+                                                            ),
+                                                        ),
+                                                        T::mul_add(
+                                                            t7,
+                                                            T::mul_add(
+                                                                -T::from_f64(0.000011844769255572),
+                                                                t35,
+                                                                T::mul_add(
+                                                                    -T::from_f64(0.00000818299639785789),
+                                                                    t34,
+                                                                    T::from_f64(0.0000166059448592103) * t6,
+                                                                ),
+                                                            ),
+                                                            T::mul_add(
+                                                                -t7,
+                                                                t9
+                                                                    * (T::mul_add(
+                                                                        T::from_f64(0.00000255404234759754),
+                                                                        t57,
+                                                                        T::mul_add(
+                                                                            T::from_f64(0.000043811817294825),
+                                                                            t56,
+                                                                            T::from_f64(0.00000818299639785789) * t7,
+                                                                        ),
+                                                                    )),
+                                                                T::mul_add(
+                                                                    t6,
+                                                                    t9 * t79,
+                                                                    T::mul_add(
+                                                                        t6,
+                                                                        T::mul_add(
+                                                                            T::from_f64(0.00000465422984297958),
+                                                                            t7,
+                                                                            T::from_f64(0.000000795929506936549) * t6,
+                                                                        ),
+                                                                        T::mul_add(
+                                                                            t7,
+                                                                            T::mul_add(
+                                                                                -T::from_f64(0.000000795929506936549),
+                                                                                t7,
+                                                                                T::from_f64(0.00000465422984297958) * t6,
+                                                                            ),
+                                                                            T::mul_add(
+                                                                                -t7,
+                                                                                T::mul_add(
+                                                                                    T::from_f64(0.000000795929506936549),
+                                                                                    t7,
+                                                                                    T::from_f64(0.0000043875110939419) * t6,
+                                                                                ),
+                                                                                t6
+                                                                                    * (T::mul_add(
+                                                                                        -T::from_f64(0.0000043875110939419),
+                                                                                        t7,
+                                                                                        T::from_f64(0.000000795929506936549) * t6,
+                                                                                    )),
+                                                                            ),
+                                                                        ),
+                                                                    ),
+                                                                ),
+                                                            ),
+                                                        ),
+                                                    ),
+                                                ),
+                                            ),
+                                        ),
+                                    ),
+                                ),
+                            ),
+                        ),
+                    ),
+                ),
+            );
+            let t311 = T::mul_add(
+                T::from_f64(0.1112),
+                T::mul_add(-t265, t270, T::mul_add(t283, t292, -t284 * t269)),
+                T::mul_add(
+                    t7,
+                    t8
+                        * (T::mul_add(
+                            -T::from_f64(0.00000255404234759754),
+                            t35,
+                            T::from_f64(0.0000431323573125218) * t34,
+                        )),
+                    T::mul_add(
+                        -t7,
+                        t9 * t80,
+                        T::mul_add(
+                            -t6,
+                            T::mul_add(
+                                -T::from_f64(0.00000818299639785789),
+                                t35,
+                                T::from_f64(0.000011844769255572) * t34,
+                            ),
+                            T::mul_add(
+                                t7,
+                                t9
+                                    * (T::mul_add(
+                                        -T::from_f64(0.000043811817294825),
+                                        t35,
+                                        T::from_f64(0.00000255404234759754) * t34,
+                                    )),
+                                T::mul_add(t7, t8 * t79, t165 + t166 + t169 - t167 - t168),
+                            ),
+                        ),
+                    ),
+                ),
+            );
+            let t312 = T::mul_add(
+                T::from_f64(0.1112),
+                T::mul_add(-t265, t272, T::mul_add(t283, t293, -t284 * t265)),
+                t165 + t166 + t169 - t167 - t168,
+            );
+            let t313 = T::mul_add(
+                T::from_f64(0.0528),
+                t285 * t297,
+                T::mul_add(
+                    T::from_f64(0.071),
+                    (T::mul_add(-t62, t118, t63 * t103))
+                        * (T::mul_add(
+                            -t62,
+                            t132,
+                            T::mul_add(t63, t118, T::mul_add(-t63, t131, t62 * t103)),
+                        )),
+                    T::mul_add(
+                        -t13,
+                        T::mul_add(
+                            T::from_f64(0.0000042343545689576),
+                            t13,
+                            T::from_f64(0.0000796647061621031) * t12,
+                        ),
+                        T::mul_add(
+                            t12,
+                            T::mul_add(
+                                -T::from_f64(0.0000796647061621031),
+                                t13,
+                                T::from_f64(0.0000042343545689576) * t12,
+                            ),
+                            T::mul_add(
+                                t12,
+                                T::mul_add(
+                                    T::from_f64(0.0000808728875979549),
+                                    t13,
+                                    T::from_f64(0.0000042343545689576) * t12,
+                                ),
+                                T::mul_add(
+                                    t13,
+                                    T::mul_add(
+                                        -T::from_f64(0.0000042343545689576),
+                                        t13,
+                                        T::from_f64(0.0000808728875979549) * t12,
+                                    ),
+                                    t180 + t181 + t182 + t242 + t243 + t244 - t179 - t241,
+                                ),
+                            ),
+                        ),
+                    ),
+                ),
+            );
+            let t314 = T::mul_add(
+                T::from_f64(0.0528),
+                t286 * t299,
+                T::mul_add(
+                    T::from_f64(0.071),
+                    (T::mul_add(-t75, t121, t76 * t105))
+                        * (T::mul_add(
+                            -t75,
+                            t135,
+                            T::mul_add(t76, t121, T::mul_add(-t76, t134, t75 * t105)),
+                        )),
+                    T::mul_add(
+                        -t19,
+                        T::mul_add(
+                            T::from_f64(0.0000042343545689576),
+                            t19,
+                            T::from_f64(0.0000796647061621031) * t18,
+                        ),
+                        T::mul_add(
+                            t18,
+                            T::mul_add(
+                                -T::from_f64(0.0000796647061621031),
+                                t19,
+                                T::from_f64(0.0000042343545689576) * t18,
+                            ),
+                            T::mul_add(
+                                t18,
+                                T::mul_add(
+                                    T::from_f64(0.0000808728875979549),
+                                    t19,
+                                    T::from_f64(0.0000042343545689576) * t18,
+                                ),
+                                T::mul_add(
+                                    t19,
+                                    T::mul_add(
+                                        -T::from_f64(0.0000042343545689576),
+                                        t19,
+                                        T::from_f64(0.0000808728875979549) * t18,
+                                    ),
+                                    t188 + t189 + t190 + t247 + t248 + t249 - t187 - t246,
+                                ),
+                            ),
+                        ),
+                    ),
+                ),
+            );
+            let t315 = T::mul_add(
+                -T::from_f64(0.0528),
+                t282 * t288,
+                t156 + t236 - t157 - t158 - t159 - t237 - t238 - t239,
+            );
+            let t316 = T::mul_add(
+                -T::from_f64(0.0528),
+                t282 * (T::mul_add(-t152, t200, t266)),
+                t236 - t237 - t238 - t239,
+            );
+            let t317 = T::mul_add(
+                -T::from_f64(0.1112),
+                t204 * t290,
+                T::mul_add(
+                    -T::from_f64(2.0),
+                    T::mul_add(
+                        t117,
+                        t87,
+                        T::mul_add(
+                            t7,
+                            T::mul_add(
+                                T::from_f64(0.000011283525),
+                                t83,
+                                T::from_f64(0.000008042076) * t84,
+                            ),
+                            T::mul_add(
+                                t116,
+                                t88,
+                                T::mul_add(
+                                    t6,
+                                    t8 * t51,
+                                    T::mul_add(
+                                        t7,
+                                        T::mul_add(
+                                            -T::from_f64(0.000011844769255572),
+                                            t9,
+                                            T::from_f64(0.00000818299639785789) * t8,
+                                        ),
+                                        t6 * t9 * t50,
+                                    ),
+                                ),
+                            ),
+                        ),
+                    ),
+                    T::mul_add(
+                        T::from_f64(0.00000237808583399834),
+                        t7,
+                        T::from_f64(0.00000270452663689166) * t6,
+                    ),
+                ),
+            );
+            let t318 = T::mul_add(
+                T::from_f64(0.00285784),
+                t291,
+                T::mul_add(
+                    T::from_f64(0.0556),
+                    t304 + t305 - t303,
+                    T::mul_add(
+                        T::from_f64(0.000011283525),
+                        t87,
+                        T::mul_add(
+                            T::from_f64(0.000008042076),
+                            t88,
+                            T::mul_add(
+                                T::from_f64(0.000011844769255572),
+                                t57,
+                                T::mul_add(
+                                    T::from_f64(0.00000818299639785789),
+                                    t56,
+                                    T::mul_add(
+                                        T::from_f64(0.00005330042007267289),
+                                        t7,
+                                        t90 + t92 + t93 + t171 + t173 + t174 - t89 - t91 - t170
+                                            - t172,
+                                    ),
+                                ),
+                            ),
+                        ),
+                    ),
+                ),
+            );
+            let t319 = T::mul_add(
+                T::from_f64(0.0556),
+                t306 + t307,
+                T::mul_add(
+                    -T::from_f64(0.0007106399999999999),
+                    t289,
+                    T::mul_add(
+                        T::from_f64(0.000011283525),
+                        t87,
+                        T::mul_add(
+                            T::from_f64(0.000008042076),
+                            t88,
+                            T::mul_add(
+                                T::from_f64(0.000036694475213462586),
+                                t7,
+                                t171 + t173 + t174 - t170 - t172,
+                            ),
+                        ),
+                    ),
+                ),
+            );
+            (
+                t256,
+                t257,
+                t258,
+                t259,
+                t260,
+                t261,
+                t262,
+                t263,
+                t264,
+                t265,
+                t266,
+                t267,
+                t268,
+                t269,
+                t270,
+                t271,
+                t272,
+                t273,
+                t274,
+                t275,
+                t276,
+                t277,
+                t278,
+                t279,
+                t280,
+                t281,
+                t282,
+                t283,
+                t284,
+                t285,
+                t286,
+                t287,
+                t288,
+                t289,
+                t290,
+                t291,
+                t292,
+                t293,
+                t294,
+                t295,
+                t296,
+                t297,
+                t298,
+                t299,
+                t300,
+                t301,
+                t302,
+                t303,
+                t304,
+                t305,
+                t306,
+                t307,
+                t308,
+                t309,
+                t310,
+                t311,
+                t312,
+                t313,
+                t314,
+                t315,
+                t316,
+                t317,
+                t318,
+                t319,
+            )
+        };
+        let (
+            t320,
+            t321,
+            t322,
+            t323,
+            t324,
+            t325,
+            t326,
+            t327,
+            t328,
+            t329,
+            t330,
+            t331,
+            t332,
+            t333,
+            t334,
+            t335,
+            t336,
+            t337,
+            t338,
+            t339,
+            t340,
+            t341,
+            t342,
+            t343,
+            t344,
+            t345,
+            t346,
+            t347,
+            t348,
+        ) = {
+            let t320 = T::mul_add(
+                -T::from_f64(0.0556),
+                t294,
+                T::mul_add(
+                    T::from_f64(0.00285784),
+                    t295 - t308 - t296,
+                    T::mul_add(
+                        -T::from_f64(0.0007106399999999999),
+                        t269,
+                        T::mul_add(
+                            -T::from_f64(0.000016084152),
+                            t81,
+                            T::from_f64(0.00002256705) * t82,
+                        ),
+                    ),
+                ),
+            );
+            let t321 = T::mul_add(
+                T::from_f64(0.00285784),
+                t291,
+                T::mul_add(
+                    -T::from_f64(0.0556),
+                    t303 + t304 + t305,
+                    T::mul_add(
+                        T::from_f64(0.000011283525),
+                        t87,
+                        T::mul_add(
+                            T::from_f64(0.000008042076),
+                            t88,
+                            T::mul_add(
+                                T::from_f64(0.000011844769255572),
+                                t57,
+                                T::mul_add(
+                                    T::from_f64(0.00000818299639785789),
+                                    t56,
+                                    T::mul_add(
+                                        T::from_f64(0.00005330042007267289),
+                                        t7,
+                                        t89 + t91 + t170 + t172 - t90 - t92 - t93 - t171 - t173
+                                            - t174,
+                                    ),
+                                ),
+                            ),
+                        ),
+                    ),
+                ),
+            );
+            let t322 = T::mul_add(
+                -T::from_f64(0.0556),
+                t306 + t307,
+                T::mul_add(
+                    -T::from_f64(0.0007106399999999999),
+                    t289,
+                    T::mul_add(
+                        T::from_f64(0.000011283525),
+                        t87,
+                        T::mul_add(
+                            T::from_f64(0.000008042076),
+                            t88,
+                            T::mul_add(
+                                T::from_f64(0.000036694475213462586),
+                                t7,
+                                t170 + t172 - t171 - t173 - t174,
+                            ),
+                        ),
+                    ),
+                ),
+            );
+            let t323 = T::mul_add(
+                -T::from_f64(0.0556),
+                t294,
+                T::mul_add(
+                    T::from_f64(0.00285784),
+                    t295 - t308 - t296,
+                    T::from_f64(0.0007106399999999999) * t269,
+                ),
+            );
+            let t324 = T::mul_add(
+                -T::from_f64(0.0528),
+                t285 * t298,
+                t179 + t241 - t180 - t181 - t182 - t242 - t243 - t244,
+            );
+            let t325 = T::mul_add(
+                -T::from_f64(0.0528),
+                t285 * (T::mul_add(-t143, t205, t273)),
+                t241 - t242 - t243 - t244,
+            );
+            let t326 = T::mul_add(
+                -T::from_f64(0.0528),
+                t286 * t300,
+                t187 + t246 - t188 - t189 - t190 - t247 - t248 - t249,
+            );
+            let t327 = T::mul_add(
+                -T::from_f64(0.0528),
+                t286 * (T::mul_add(-t154, t207, t274)),
+                t246 - t247 - t248 - t249,
+            );
+            let t328 = qd[0] * t309;
+            let t329 = qd[0] * t315;
+            let t330 = qd[0] * t316;
+            let t331 = qd[4] * t310;
+            let t332 = qd[4] * t311;
+            let t333 = qd[4] * t312;
+            let t334 = qd[4] * t321;
+            let t335 = qd[4] * t322;
+            let t336 = qd[4] * t323;
+            let t337 = qd[8] * t313;
+            let t338 = qd[8] * t324;
+            let t339 = qd[8] * t325;
+            let t340 = qd[12] * t314;
+            let t341 = qd[12] * t326;
+            let t342 = qd[12] * t327;
+            let t343 = T::from_f64(0.5)
+                * (T::mul_add(
+                    -qd[1],
+                    T::mul_add(
+                        -T::from_f64(0.000002511936),
+                        t152,
+                        T::mul_add(
+                            T::from_f64(0.0000035244),
+                            t153,
+                            T::mul_add(
+                                -T::from_f64(0.0000108230451589102),
+                                t66,
+                                T::mul_add(
+                                    T::from_f64(0.00001587314373844814),
+                                    t65,
+                                    T::mul_add(
+                                        T::from_f64(0.0000296772324039882),
+                                        t1,
+                                        T::from_f64(0.0000428695292023532) * t0,
+                                    ),
+                                ),
+                            ),
+                        ),
+                    ),
+                    t328 - t250 - t251,
+                ));
+            let t344 = T::from_f64(0.5)
+                * (T::mul_add(
+                    -qd[7],
+                    t320,
+                    T::mul_add(
+                        -qd[6],
+                        T::mul_add(
+                            -T::from_f64(0.00571568),
+                            t10 * t270,
+                            T::mul_add(
+                                -T::from_f64(0.1112),
+                                t52 * t269,
+                                T::mul_add(
+                                    -T::from_f64(0.000016084152),
+                                    t81,
+                                    T::mul_add(
+                                        T::from_f64(0.00002256705),
+                                        t82,
+                                        T::mul_add(
+                                            -T::from_f64(0.00001636599279571578),
+                                            t35,
+                                            T::from_f64(0.000023689538511144) * t34,
+                                        ),
+                                    ),
+                                ),
+                            ),
+                        ),
+                        T::mul_add(qd[5], t318, t332),
+                    ),
+                ));
+            let t345 = T::from_f64(0.5)
+                * (T::mul_add(
+                    -qd[7],
+                    T::mul_add(
+                        -T::from_f64(0.0014212799999999998),
+                        t265,
+                        T::mul_add(
+                            -T::from_f64(0.000016084152),
+                            t81,
+                            T::from_f64(0.00002256705) * t82,
+                        ),
+                    ),
+                    T::mul_add(-qd[6], t320, T::mul_add(qd[5], t319, t333)),
+                ));
+            let t346 = T::from_f64(0.5)
+                * (T::mul_add(
+                    -qd[6],
+                    T::mul_add(
+                        -T::from_f64(0.000016084152),
+                        t83,
+                        T::mul_add(
+                            T::from_f64(0.00002256705),
+                            t84,
+                            T::mul_add(
+                                T::from_f64(0.00001636599279571578),
+                                t9,
+                                T::from_f64(0.000023689538511144) * t8,
+                            ),
+                        ),
+                    ),
+                    t301 - t334 - t196,
+                ));
+            let t347 = T::from_f64(0.5)
+                * (T::mul_add(
+                    -qd[9],
+                    T::mul_add(
+                        -T::from_f64(0.000002511936),
+                        t143,
+                        T::mul_add(
+                            T::from_f64(0.0000035244),
+                            t142,
+                            T::mul_add(
+                                -T::from_f64(0.0000108230451589102),
+                                t63,
+                                T::mul_add(
+                                    T::from_f64(0.00001587314373844814),
+                                    t62,
+                                    T::mul_add(
+                                        T::from_f64(0.0000296772324039882),
+                                        t13,
+                                        T::from_f64(0.0000428695292023532) * t12,
+                                    ),
+                                ),
+                            ),
+                        ),
+                    ),
+                    t337 - t255 - t256,
+                ));
+            let t348 = T::from_f64(0.5)
+                * (T::mul_add(
+                    -qd[13],
+                    T::mul_add(
+                        -T::from_f64(0.000002511936),
+                        t154,
+                        T::mul_add(
+                            T::from_f64(0.0000035244),
+                            t155,
+                            T::mul_add(
+                                -T::from_f64(0.0000108230451589102),
+                                t76,
+                                T::mul_add(
+                                    T::from_f64(0.00001587314373844814),
+                                    t75,
+                                    T::mul_add(
+                                        T::from_f64(0.0000296772324039882),
+                                        t19,
+                                        T::from_f64(0.0000428695292023532) * t18,
+                                    ),
+                                ),
+                            ),
+                        ),
+                    ),
+                    t340 - t260 - t261,
+                ));
+            (
+                t320,
+                t321,
+                t322,
+                t323,
+                t324,
+                t325,
+                t326,
+                t327,
+                t328,
+                t329,
+                t330,
+                t331,
+                t332,
+                t333,
+                t334,
+                t335,
+                t336,
+                t337,
+                t338,
+                t339,
+                t340,
+                t341,
+                t342,
+                t343,
+                t344,
+                t345,
+                t346,
+                t347,
+                t348,
+            )
+        };
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::from_f64(0.5)
+                    * (T::mul_add(-qd[3], t316, T::mul_add(-qd[2], t315, qd[1] * t309))),
+                t343,
+                -T::from_f64(0.5) * (T::mul_add(qd[1], t219, t250 + t251 + t329)),
+                -T::from_f64(0.5)
+                    * (T::mul_add(qd[2], t220, T::mul_add(qd[1], t220, t251 + t330))),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            0,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            8,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                -T::from_f64(0.5) * t328,
+                T::from_f64(0.5) * (T::mul_add(qd[3], t210, qd[2] * t209)),
+                t275,
+                t276,
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            16,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            24,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::from_f64(0.5) * t329,
+                T::from_f64(0.5) * (T::mul_add(qd[3], t222, -t252)),
+                -T::from_f64(0.5) * qd[3] * t137,
+                T::mul_add(
+                    -T::from_f64(0.000017224704),
+                    qd[3] * t4,
+                    T::from_f64(0.5) * (t254 - t195),
+                ),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            32,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            40,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::from_f64(0.5) * t330,
+                -T::from_f64(0.5) * (T::mul_add(qd[2], t222, t253)),
+                T::from_f64(0.5) * (t195 - t254),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            48,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            56,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::from_f64(0.5)
+                    * (T::mul_add(qd[7], t312, T::mul_add(qd[6], t311, qd[5] * t310))),
+                T::from_f64(0.5)
+                    * (T::mul_add(
+                        qd[7],
+                        t319,
+                        T::mul_add(qd[6], t318, T::mul_add(qd[5], t317, t331)),
+                    )),
+                t344,
+                t345,
+            ],
+            out,
+            64,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            72,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                -T::from_f64(0.5)
+                    * (T::mul_add(qd[7], t322, T::mul_add(qd[6], t321, t331))),
+                T::from_f64(0.5) * (T::mul_add(-qd[7], t277, qd[6] * t271)),
+                t346,
+                -T::from_f64(0.5) * (T::mul_add(qd[6], t138, t196 + t335 + t302)),
+            ],
+            out,
+            80,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            88,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::from_f64(0.5)
+                    * (T::mul_add(-qd[7], t323, T::mul_add(qd[5], t321, -t332))),
+                T::from_f64(0.5) * (t334 - t301),
+                -T::from_f64(0.5) * qd[7] * t139,
+                T::mul_add(
+                    -T::from_f64(0.00003652689599999999),
+                    qd[7] * t10,
+                    -T::from_f64(0.5) * (t336 + t197),
+                ),
+            ],
+            out,
+            96,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            104,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::from_f64(0.5)
+                    * (T::mul_add(qd[6], t323, T::mul_add(qd[5], t322, -t333))),
+                T::from_f64(0.5) * (t335 + t302),
+                T::from_f64(0.5) * (t336 + t197),
+                T::zero(),
+            ],
+            out,
+            112,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            120,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            128,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::from_f64(0.5)
+                    * (T::mul_add(
+                        -qd[11],
+                        t325,
+                        T::mul_add(-qd[10], t324, qd[9] * t313),
+                    )),
+                t347,
+                -T::from_f64(0.5) * (T::mul_add(qd[9], t223, t255 + t256 + t338)),
+                -T::from_f64(0.5)
+                    * (T::mul_add(qd[10], t224, T::mul_add(qd[9], t224, t256 + t339))),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            136,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            144,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                -T::from_f64(0.5) * t337,
+                T::from_f64(0.5) * (T::mul_add(qd[11], t216, qd[10] * t215)),
+                t278,
+                t279,
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            152,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            160,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::from_f64(0.5) * t338,
+                T::from_f64(0.5) * (T::mul_add(qd[11], t226, -t257)),
+                -T::from_f64(0.5) * qd[11] * t140,
+                T::mul_add(
+                    -T::from_f64(0.000017224704),
+                    qd[11] * t16,
+                    T::from_f64(0.5) * (t259 - t198),
+                ),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            168,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            176,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::from_f64(0.5) * t339,
+                -T::from_f64(0.5) * (T::mul_add(qd[10], t226, t258)),
+                T::from_f64(0.5) * (t198 - t259),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            184,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            192,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::from_f64(0.5)
+                    * (T::mul_add(
+                        -qd[15],
+                        t327,
+                        T::mul_add(-qd[14], t326, qd[13] * t314),
+                    )),
+                t348,
+                -T::from_f64(0.5) * (T::mul_add(qd[13], t227, t260 + t261 + t341)),
+                -T::from_f64(0.5)
+                    * (T::mul_add(qd[14], t228, T::mul_add(qd[13], t228, t261 + t342))),
+            ],
+            out,
+            200,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            208,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                -T::from_f64(0.5) * t340,
+                T::from_f64(0.5) * (T::mul_add(qd[15], t218, qd[14] * t217)),
+                t280,
+                t281,
+            ],
+            out,
+            216,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            224,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::from_f64(0.5) * t341,
+                T::from_f64(0.5) * (T::mul_add(qd[15], t230, -t262)),
+                -T::from_f64(0.5) * qd[15] * t141,
+                T::mul_add(
+                    -T::from_f64(0.000017224704),
+                    qd[15] * t22,
+                    T::from_f64(0.5) * (t264 - t199),
+                ),
+            ],
+            out,
+            232,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            240,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::from_f64(0.5) * t342,
+                -T::from_f64(0.5) * (T::mul_add(qd[14], t230, t263)),
+                T::from_f64(0.5) * (t199 - t264),
+                T::zero(),
+            ],
+            out,
+            248,
+        );
+    }
+    fn centrifugal_unpacked(
+        &self,
+        q: &[T; 16],
+        out: &mut [[[<T as ::eomgen_runtime::lane::Pack>::Scalar; 16]; 16]],
+    ) {
+        let (
+            [s1,
+            s2,
+            s3,
+            s5,
+            s6,
+            s7,
+            s9,
+            s10,
+            s11,
+            s13,
+            s14,
+            s15,
+            ],
+            [c1,
+            c2,
+            c3,
+            c5,
+            c6,
+            c7,
+            c9,
+            c10,
+            c11,
+            c13,
+            c14,
+            c15,
+            ],
+        ) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[1],
+            q[2],
+            q[3],
+            q[5],
+            q[6],
+            q[7],
+            q[9],
+            q[10],
+            q[11],
+            q[13],
+            q[14],
+            q[15],
+        ]);
+        let (
+            t0,
+            t1,
+            t2,
+            t3,
+            t4,
+            t5,
+            t6,
+            t7,
+            t8,
+            t9,
+            t10,
+            t11,
+            t12,
+            t13,
+            t14,
+            t15,
+            t16,
+            t17,
+            t18,
+            t19,
+            t20,
+            t21,
+            t22,
+            t23,
+            t24,
+            t25,
+            t26,
+            t27,
+            t28,
+            t29,
+            t30,
+            t31,
+            t32,
+            t33,
+            t34,
+            t35,
+            t36,
+            t37,
+            t38,
+            t39,
+            t40,
+            t41,
+            t42,
+            t43,
+            t44,
+            t45,
+            t46,
+            t47,
+            t48,
+            t49,
+            t50,
+            t51,
+            t52,
+            t53,
+            t54,
+            t55,
+            t56,
+            t57,
+            t58,
+            t59,
+            t60,
+            t61,
+            t62,
+            t63,
+        ) = {
+            let t0 = s1;
+            let t1 = c1;
+            let t2 = s2;
+            let t3 = c2;
+            let t4 = s3;
+            let t5 = c3;
+            let t6 = s5;
+            let t7 = c5;
+            let t8 = s6;
+            let t9 = c6;
+            let t10 = s7;
+            let t11 = c7;
+            let t12 = s9;
+            let t13 = c9;
+            let t14 = s10;
+            let t15 = c10;
+            let t16 = s11;
+            let t17 = c11;
+            let t18 = s13;
+            let t19 = c13;
+            let t20 = s14;
+            let t21 = c14;
+            let t22 = s15;
+            let t23 = c15;
+            let t24 = t12 * t15;
+            let t25 = t12 * t14;
+            let t26 = t0 * t3;
+            let t27 = t0 * t2;
+            let t28 = T::mul_add(T::from_f64(0.0164), t1, T::from_f64(0.054));
+            let t29 = T::mul_add(T::from_f64(0.054), t3, T::from_f64(0.0384));
+            let t30 = t2 * t5;
+            let t31 = t2 * t4;
+            let t32 = T::mul_add(-T::from_f64(0.027), t7, T::from_f64(0.005) * t6);
+            let t33 = T::mul_add(T::from_f64(0.005), t7, T::from_f64(0.027) * t6);
+            let t34 = t7 * t9;
+            let t35 = t7 * t8;
+            let t36 = t8 * t11;
+            let t37 = t8 * t10;
+            let t38 = T::mul_add(T::from_f64(0.0177), t9, T::from_f64(0.0514));
+            let t39 = T::mul_add(T::from_f64(0.0164), t13, T::from_f64(0.054));
+            let t40 = T::mul_add(T::from_f64(0.054), t15, T::from_f64(0.0384));
+            let t41 = t14 * t17;
+            let t42 = t14 * t16;
+            let t43 = t18 * t21;
+            let t44 = t18 * t20;
+            let t45 = T::mul_add(T::from_f64(0.0164), t19, T::from_f64(0.054));
+            let t46 = T::mul_add(T::from_f64(0.054), t21, T::from_f64(0.0384));
+            let t47 = t20 * t23;
+            let t48 = t20 * t22;
+            let t49 = T::mul_add(
+                T::from_f64(0.0384),
+                t5,
+                T::from_f64(0.01699090909090909),
+            );
+            let t50 = T::mul_add(
+                -T::from_f64(0.00000255404234759754),
+                t9,
+                T::from_f64(0.000043811817294825) * t8,
+            );
+            let t51 = T::mul_add(
+                -T::from_f64(0.0000431323573125218),
+                t9,
+                T::from_f64(0.00000255404234759754) * t8,
+            );
+            let t52 = T::mul_add(
+                T::from_f64(0.0514),
+                t11,
+                T::from_f64(0.012781294964028776),
+            );
+            let t53 = T::mul_add(
+                T::from_f64(0.0384),
+                t17,
+                T::from_f64(0.01699090909090909),
+            );
+            let t54 = T::mul_add(
+                T::from_f64(0.0384),
+                t23,
+                T::from_f64(0.01699090909090909),
+            );
+            let t55 = t6 * t9;
+            let t56 = t6 * t8;
+            let t57 = T::mul_add(t13, t14, t24);
+            let t58 = T::mul_add(-t13, t15, t25);
+            let t59 = t3 * t28;
+            let t60 = T::mul_add(t1, t2, t26);
+            let t61 = T::mul_add(-t1, t3, t27);
+            let t62 = t4 * t29;
+            let t63 = t5 * t29;
+            (
+                t0,
+                t1,
+                t2,
+                t3,
+                t4,
+                t5,
+                t6,
+                t7,
+                t8,
+                t9,
+                t10,
+                t11,
+                t12,
+                t13,
+                t14,
+                t15,
+                t16,
+                t17,
+                t18,
+                t19,
+                t20,
+                t21,
+                t22,
+                t23,
+                t24,
+                t25,
+                t26,
+                t27,
+                t28,
+                t29,
+                t30,
+                t31,
+                t32,
+                t33,
+                t34,
+                t35,
+                t36,
+                t37,
+                t38,
+                t39,
+                t40,
+                t41,
+                t42,
+                t43,
+                t44,
+                t45,
+                t46,
+                t47,
+                t48,
+                t49,
+                t50,
+                t51,
+                t52,
+                t53,
+                t54,
+                t55,
+                t56,
+                t57,
+                t58,
+                t59,
+                t60,
+                t61,
+                t62,
+                t63,
+            )
+        };
+        let (
+            t64,
+            t65,
+            t66,
+            t67,
+            t68,
+            t69,
+            t70,
+            t71,
+            t72,
+            t73,
+            t74,
+            t75,
+            t76,
+            t77,
+            t78,
+            t79,
+            t80,
+            t81,
+            t82,
+            t83,
+            t84,
+            t85,
+            t86,
+            t87,
+            t88,
+            t89,
+            t90,
+            t91,
+            t92,
+            t93,
+            t94,
+            t95,
+            t96,
+            t97,
+            t98,
+            t99,
+            t100,
+            t101,
+            t102,
+            t103,
+            t104,
+            t105,
+            t106,
+            t107,
+            t108,
+            t109,
+            t110,
+            t111,
+            t112,
+            t113,
+            t114,
+            t115,
+            t116,
+            t117,
+            t118,
+            t119,
+            t120,
+            t121,
+            t122,
+            t123,
+            t124,
+            t125,
+            t126,
+            t127,
+        ) = {
+            let t64 = t8 * t32;
+            let t65 = t11 * t38;
+            let t66 = t15 * t39;
+            let t67 = t16 * t40;
+            let t68 = t17 * t40;
+            let t69 = t21 * t45;
+            let t70 = T::mul_add(t19, t20, t43);
+            let t71 = T::mul_add(-t19, t21, t44);
+            let t72 = t22 * t46;
+            let t73 = t23 * t46;
+            let t74 = T::mul_add(
+                -T::from_f64(0.00000255404234759754),
+                t35,
+                T::mul_add(
+                    -T::from_f64(0.000043811817294825),
+                    t34,
+                    T::from_f64(0.00000818299639785789) * t6,
+                ),
+            );
+            let t75 = T::mul_add(
+                -T::from_f64(0.0000431323573125218),
+                t35,
+                T::mul_add(
+                    -T::from_f64(0.00000255404234759754),
+                    t34,
+                    T::from_f64(0.000011844769255572) * t6,
+                ),
+            );
+            let t76 = T::mul_add(t7, t8 * t11, t7 * t9 * t10);
+            let t77 = T::mul_add(-t7, t8 * t10, t7 * t9 * t11);
+            let t78 = T::mul_add(-t9, t11, t37);
+            let t79 = T::mul_add(t9, t10, t36);
+            let t80 = T::from_f64(0.054) * (T::mul_add(t3, t4, t30));
+            let t81 = T::from_f64(0.054) * (T::mul_add(-t3, t5, t31));
+            let t82 = T::mul_add(t6, t8 * t11, t6 * t9 * t10);
+            let t83 = T::mul_add(-t6, t8 * t10, t6 * t9 * t11);
+            let t84 = T::from_f64(0.054) * (T::mul_add(t15, t16, t41));
+            let t85 = T::from_f64(0.054) * (T::mul_add(-t15, t17, t42));
+            let t86 = T::from_f64(0.054) * (T::mul_add(t21, t22, t47));
+            let t87 = T::from_f64(0.054) * (T::mul_add(-t21, t23, t48));
+            let t88 = T::mul_add(t2, t28, T::from_f64(0.0164) * t26);
+            let t89 = T::mul_add(T::from_f64(0.0164), t27, -t59 - T::from_f64(0.0384));
+            let t90 = T::mul_add(T::from_f64(0.0576), t9, t64);
+            let t91 = T::mul_add(T::from_f64(0.0576), t9, t64 + T::from_f64(0.0514));
+            let t92 = T::mul_add(-t9, t32, T::from_f64(0.0576) * t8);
+            let t93 = T::mul_add(t14, t39, T::from_f64(0.0164) * t24);
+            let t94 = T::mul_add(T::from_f64(0.0164), t25, -t66 - T::from_f64(0.0384));
+            let t95 = T::mul_add(t20, t45, T::from_f64(0.0164) * t43);
+            let t96 = T::mul_add(T::from_f64(0.0164), t44, -t69 - T::from_f64(0.0384));
+            let t97 = T::mul_add(T::from_f64(0.0164), t27, -t59);
+            let t98 = T::mul_add(
+                T::from_f64(0.054),
+                t31,
+                -t63 - T::from_f64(0.01699090909090909),
+            );
+            let t99 = T::mul_add(T::from_f64(0.054), t30, t62);
+            let t100 = t33 * t76;
+            let t101 = t33 * t77;
+            let t102 = T::mul_add(
+                -T::from_f64(0.0000052283),
+                t76,
+                T::mul_add(
+                    -T::from_f64(0.00005486748988006258),
+                    t77,
+                    T::from_f64(0.000008042076) * t6,
+                ),
+            );
+            let t103 = T::mul_add(
+                -T::from_f64(0.0000338903173333),
+                t76,
+                T::mul_add(
+                    -T::from_f64(0.0000052283),
+                    t77,
+                    T::from_f64(0.000011283525) * t6,
+                ),
+            );
+            let t104 = T::mul_add(
+                T::from_f64(0.0177),
+                t37,
+                -t65 - T::from_f64(0.012781294964028776),
+            );
+            let t105 = T::mul_add(t10, t38, T::from_f64(0.0177) * t36);
+            let t106 = T::mul_add(
+                T::from_f64(0.0000052283),
+                t78,
+                T::from_f64(0.00005486748988006258) * t79,
+            );
+            let t107 = T::mul_add(
+                T::from_f64(0.0000338903173333),
+                t78,
+                T::from_f64(0.0000052283) * t79,
+            );
+            let t108 = T::mul_add(T::from_f64(0.0164), t25, -t66);
+            let t109 = T::mul_add(
+                T::from_f64(0.054),
+                t42,
+                -t68 - T::from_f64(0.01699090909090909),
+            );
+            let t110 = T::mul_add(T::from_f64(0.054), t41, t67);
+            let t111 = T::mul_add(T::from_f64(0.0164), t44, -t69);
+            let t112 = T::mul_add(
+                T::from_f64(0.054),
+                t48,
+                -t73 - T::from_f64(0.01699090909090909),
+            );
+            let t113 = T::mul_add(T::from_f64(0.054), t47, t72);
+            let t114 = T::from_f64(0.0164) * t61;
+            let t115 = T::from_f64(0.0164) * t60;
+            let t116 = T::mul_add(t8, t11 * t33, t9 * t10 * t33);
+            let t117 = T::mul_add(-t8, t10 * t33, t9 * t11 * t33);
+            let t118 = T::from_f64(0.0164) * t58;
+            let t119 = T::from_f64(0.0164) * t57;
+            let t120 = T::from_f64(0.0164) * t71;
+            let t121 = T::from_f64(0.0164) * t70;
+            let t122 = T::mul_add(-t58, t16, t57 * t17);
+            let t123 = T::mul_add(t58, t17, t57 * t16);
+            let t124 = t5 * t88;
+            let t125 = t4 * t88;
+            let t126 = t11 * t92;
+            let t127 = t10 * t92;
+            (
+                t64,
+                t65,
+                t66,
+                t67,
+                t68,
+                t69,
+                t70,
+                t71,
+                t72,
+                t73,
+                t74,
+                t75,
+                t76,
+                t77,
+                t78,
+                t79,
+                t80,
+                t81,
+                t82,
+                t83,
+                t84,
+                t85,
+                t86,
+                t87,
+                t88,
+                t89,
+                t90,
+                t91,
+                t92,
+                t93,
+                t94,
+                t95,
+                t96,
+                t97,
+                t98,
+                t99,
+                t100,
+                t101,
+                t102,
+                t103,
+                t104,
+                t105,
+                t106,
+                t107,
+                t108,
+                t109,
+                t110,
+                t111,
+                t112,
+                t113,
+                t114,
+                t115,
+                t116,
+                t117,
+                t118,
+                t119,
+                t120,
+                t121,
+                t122,
+                t123,
+                t124,
+                t125,
+                t126,
+                t127,
+            )
+        };
+        let (
+            t128,
+            t129,
+            t130,
+            t131,
+            t132,
+            t133,
+            t134,
+            t135,
+            t136,
+            t137,
+            t138,
+            t139,
+            t140,
+            t141,
+            t142,
+            t143,
+            t144,
+            t145,
+            t146,
+            t147,
+            t148,
+            t149,
+            t150,
+            t151,
+            t152,
+            t153,
+            t154,
+            t155,
+            t156,
+            t157,
+            t158,
+            t159,
+            t160,
+            t161,
+            t162,
+            t163,
+            t164,
+            t165,
+            t166,
+            t167,
+            t168,
+            t169,
+            t170,
+            t171,
+            t172,
+            t173,
+            t174,
+            t175,
+            t176,
+            t177,
+            t178,
+            t179,
+            t180,
+            t181,
+            t182,
+            t183,
+            t184,
+            t185,
+            t186,
+            t187,
+            t188,
+            t189,
+            t190,
+            t191,
+        ) = {
+            let t128 = t17 * t93;
+            let t129 = t16 * t93;
+            let t130 = t23 * t95;
+            let t131 = t22 * t95;
+            let t132 = T::mul_add(t5, t61, t4 * t60);
+            let t133 = T::mul_add(-t4, t61, t5 * t60);
+            let t134 = T::mul_add(t23, t71, t22 * t70);
+            let t135 = T::mul_add(-t22, t71, t23 * t70);
+            let t136 = t61
+                * (T::mul_add(
+                    T::from_f64(0.00000285079817622615),
+                    t61,
+                    T::from_f64(0.000027108908376807) * t60,
+                ));
+            let t137 = t60
+                * (T::mul_add(
+                    -T::from_f64(0.000027108908376807),
+                    t61,
+                    T::from_f64(0.00000285079817622615) * t60,
+                ));
+            let t138 = t60
+                * (T::mul_add(
+                    T::from_f64(0.0000266287347075153),
+                    t61,
+                    T::from_f64(0.00000285079817622615) * t60,
+                ));
+            let t139 = t61
+                * (T::mul_add(
+                    -T::from_f64(0.00000285079817622615),
+                    t61,
+                    T::from_f64(0.0000266287347075153) * t60,
+                ));
+            let t140 = t104 * t78;
+            let t141 = t76 * t102;
+            let t142 = t77
+                * (T::mul_add(
+                    -T::from_f64(0.00005486748988006258),
+                    t76,
+                    T::from_f64(0.0000052283) * t77,
+                ));
+            let t143 = t6
+                * (T::mul_add(
+                    -T::from_f64(0.000008042076),
+                    t76,
+                    T::from_f64(0.000011283525) * t77,
+                ));
+            let t144 = t77 * t103;
+            let t145 = t76
+                * (T::mul_add(
+                    -T::from_f64(0.0000052283),
+                    t76,
+                    T::from_f64(0.0000338903173333) * t77,
+                ));
+            let t146 = t78 * t106;
+            let t147 = t79
+                * (T::mul_add(
+                    -T::from_f64(0.00005486748988006258),
+                    t78,
+                    T::from_f64(0.0000052283) * t79,
+                ));
+            let t148 = t79 * t107;
+            let t149 = t78
+                * (T::mul_add(
+                    -T::from_f64(0.0000052283),
+                    t78,
+                    T::from_f64(0.0000338903173333) * t79,
+                ));
+            let t150 = t58
+                * (T::mul_add(
+                    T::from_f64(0.00000285079817622615),
+                    t58,
+                    T::from_f64(0.000027108908376807) * t57,
+                ));
+            let t151 = t57
+                * (T::mul_add(
+                    -T::from_f64(0.000027108908376807),
+                    t58,
+                    T::from_f64(0.00000285079817622615) * t57,
+                ));
+            let t152 = t57
+                * (T::mul_add(
+                    T::from_f64(0.0000266287347075153),
+                    t58,
+                    T::from_f64(0.00000285079817622615) * t57,
+                ));
+            let t153 = t58
+                * (T::mul_add(
+                    -T::from_f64(0.00000285079817622615),
+                    t58,
+                    T::from_f64(0.0000266287347075153) * t57,
+                ));
+            let t154 = t71
+                * (T::mul_add(
+                    T::from_f64(0.00000285079817622615),
+                    t71,
+                    T::from_f64(0.000027108908376807) * t70,
+                ));
+            let t155 = t70
+                * (T::mul_add(
+                    -T::from_f64(0.000027108908376807),
+                    t71,
+                    T::from_f64(0.00000285079817622615) * t70,
+                ));
+            let t156 = t70
+                * (T::mul_add(
+                    T::from_f64(0.0000266287347075153),
+                    t71,
+                    T::from_f64(0.00000285079817622615) * t70,
+                ));
+            let t157 = t71
+                * (T::mul_add(
+                    -T::from_f64(0.00000285079817622615),
+                    t71,
+                    T::from_f64(0.0000266287347075153) * t70,
+                ));
+            let t158 = T::mul_add(t5, t89, t125);
+            let t159 = T::mul_add(-t4, t89, t124);
+            let t160 = T::mul_add(-t11, t91, t127);
+            let t161 = T::mul_add(t10, t91, t126);
+            let t162 = T::mul_add(-t104, t79, t78 * t105);
+            let t163 = T::mul_add(t17, t94, t129);
+            let t164 = T::mul_add(-t16, t94, t128);
+            let t165 = T::mul_add(t23, t96, t131);
+            let t166 = T::mul_add(-t22, t96, t130);
+            let t167 = T::mul_add(t10, t90, t126);
+            let t168 = T::mul_add(-t11, t90, t127);
+            let t169 = T::mul_add(
+                -t79,
+                T::from_f64(0.0177) * t79,
+                T::mul_add(-t78, T::from_f64(0.0177) * t78, T::mul_add(t105, t79, t140)),
+            );
+            let t170 = T::mul_add(
+                -t78,
+                T::mul_add(T::from_f64(0.0177), t37, -t65),
+                t140,
+            );
+            let t171 = T::from_f64(0.0264)
+                * (T::mul_add(
+                    t99,
+                    T::mul_add(T::from_f64(0.054), t31, -t63),
+                    -t98 * t99,
+                ));
+            let t172 = T::from_f64(0.0264)
+                * (T::mul_add(
+                    t110,
+                    T::mul_add(T::from_f64(0.054), t42, -t68),
+                    -t109 * t110,
+                ));
+            let t173 = T::from_f64(0.0264)
+                * (T::mul_add(
+                    t113,
+                    T::mul_add(T::from_f64(0.054), t48, -t73),
+                    -t112 * t113,
+                ));
+            let t174 = t158 - T::from_f64(0.01699090909090909);
+            let t175 = t160 - T::from_f64(0.012781294964028776);
+            let t176 = t163 - T::from_f64(0.01699090909090909);
+            let t177 = t165 - T::from_f64(0.01699090909090909);
+            let t178 = t159 * t133;
+            let t179 = t132
+                * (T::mul_add(
+                    T::from_f64(0.0000012936),
+                    t132,
+                    T::from_f64(0.000010024357818181817) * t133,
+                ));
+            let t180 = t133
+                * (T::mul_add(
+                    -T::from_f64(0.000010024357818181817),
+                    t132,
+                    T::from_f64(0.0000012936) * t133,
+                ));
+            let t181 = t133
+                * (T::mul_add(
+                    T::from_f64(0.0000056692479999999995),
+                    t132,
+                    T::from_f64(0.0000012936) * t133,
+                ));
+            let t182 = t132
+                * (T::mul_add(
+                    -T::from_f64(0.0000012936),
+                    t132,
+                    T::from_f64(0.0000056692479999999995) * t133,
+                ));
+            let t183 = t122 * t164;
+            let t184 = t123
+                * (T::mul_add(
+                    T::from_f64(0.0000012936),
+                    t123,
+                    T::from_f64(0.000010024357818181817) * t122,
+                ));
+            let t185 = t122
+                * (T::mul_add(
+                    -T::from_f64(0.000010024357818181817),
+                    t123,
+                    T::from_f64(0.0000012936) * t122,
+                ));
+            let t186 = t122
+                * (T::mul_add(
+                    T::from_f64(0.0000056692479999999995),
+                    t123,
+                    T::from_f64(0.0000012936) * t122,
+                ));
+            let t187 = t123
+                * (T::mul_add(
+                    -T::from_f64(0.0000012936),
+                    t123,
+                    T::from_f64(0.0000056692479999999995) * t122,
+                ));
+            let t188 = t166 * t135;
+            let t189 = t134
+                * (T::mul_add(
+                    T::from_f64(0.0000012936),
+                    t134,
+                    T::from_f64(0.000010024357818181817) * t135,
+                ));
+            let t190 = t135
+                * (T::mul_add(
+                    -T::from_f64(0.000010024357818181817),
+                    t134,
+                    T::from_f64(0.0000012936) * t135,
+                ));
+            let t191 = t135
+                * (T::mul_add(
+                    T::from_f64(0.0000056692479999999995),
+                    t134,
+                    T::from_f64(0.0000012936) * t135,
+                ));
+            (
+                t128,
+                t129,
+                t130,
+                t131,
+                t132,
+                t133,
+                t134,
+                t135,
+                t136,
+                t137,
+                t138,
+                t139,
+                t140,
+                t141,
+                t142,
+                t143,
+                t144,
+                t145,
+                t146,
+                t147,
+                t148,
+                t149,
+                t150,
+                t151,
+                t152,
+                t153,
+                t154,
+                t155,
+                t156,
+                t157,
+                t158,
+                t159,
+                t160,
+                t161,
+                t162,
+                t163,
+                t164,
+                t165,
+                t166,
+                t167,
+                t168,
+                t169,
+                t170,
+                t171,
+                t172,
+                t173,
+                t174,
+                t175,
+                t176,
+                t177,
+                t178,
+                t179,
+                t180,
+                t181,
+                t182,
+                t183,
+                t184,
+                t185,
+                t186,
+                t187,
+                t188,
+                t189,
+                t190,
+                t191,
+            )
+        };
+        let (
+            t192,
+            t193,
+            t194,
+            t195,
+            t196,
+            t197,
+            t198,
+            t199,
+            t200,
+            t201,
+            t202,
+            t203,
+            t204,
+            t205,
+            t206,
+            t207,
+            t208,
+            t209,
+            t210,
+            t211,
+            t212,
+            t213,
+            t214,
+            t215,
+            t216,
+            t217,
+            t218,
+            t219,
+            t220,
+            t221,
+            t222,
+        ) = {
+            let t192 = t134
+                * (T::mul_add(
+                    -T::from_f64(0.0000012936),
+                    t134,
+                    T::from_f64(0.0000056692479999999995) * t135,
+                ));
+            let t193 = T::mul_add(-t6, t161, t101);
+            let t194 = t174 * t132;
+            let t195 = t175 * t76;
+            let t196 = T::mul_add(-t6, t167, t101);
+            let t197 = T::mul_add(-t6, t168, t100);
+            let t198 = t123 * t176;
+            let t199 = t177 * t134;
+            let t200 = T::mul_add(
+                -T::from_f64(0.0556),
+                t162 * t169,
+                T::from_f64(0.5)
+                    * (T::mul_add(
+                        t9,
+                        T::mul_add(
+                            T::from_f64(0.00000255404234759754),
+                            t9,
+                            T::from_f64(0.0000431323573125218) * t8,
+                        ),
+                        T::mul_add(
+                            -t8,
+                            t51,
+                            T::mul_add(
+                                -t8,
+                                T::mul_add(
+                                    T::from_f64(0.000043811817294825),
+                                    t9,
+                                    T::from_f64(0.00000255404234759754) * t8,
+                                ),
+                                T::mul_add(-t9, t50, t146 - t147 - t148 - t149),
+                            ),
+                        ),
+                    )),
+            );
+            let t201 = T::mul_add(-t174, t133, t132 * t159);
+            let t202 = T::mul_add(-t175, t77, t76 * t161);
+            let t203 = T::mul_add(t6, t175, -t100);
+            let t204 = T::mul_add(-t122, t176, t123 * t164);
+            let t205 = T::mul_add(-t177, t135, t134 * t166);
+            let t206 = T::mul_add(
+                t133,
+                T::mul_add(-t5, t115, t4 * t114),
+                T::mul_add(-t132, T::mul_add(t4, t115, t5 * t114), t178 + t194),
+            );
+            let t207 = T::mul_add(
+                -t133,
+                T::mul_add(-t4, t97, t124),
+                T::mul_add(-t132, T::mul_add(t5, t97, t125), t178 + t194),
+            );
+            let t208 = T::mul_add(
+                -t175,
+                t83,
+                T::mul_add(-t77, t116, T::mul_add(t76, t117, t161 * t82)),
+            );
+            let t209 = T::mul_add(
+                t122,
+                T::mul_add(-t17, t119, t16 * t118),
+                T::mul_add(-t123, T::mul_add(t16, t119, t17 * t118), t183 + t198),
+            );
+            let t210 = T::mul_add(
+                -t122,
+                T::mul_add(-t16, t108, t128),
+                T::mul_add(-t123, T::mul_add(t17, t108, t129), t183 + t198),
+            );
+            let t211 = T::mul_add(
+                t135,
+                T::mul_add(-t23, t121, t22 * t120),
+                T::mul_add(-t134, T::mul_add(t22, t121, t23 * t120), t188 + t199),
+            );
+            let t212 = T::mul_add(
+                -t135,
+                T::mul_add(-t22, t111, t130),
+                T::mul_add(-t134, T::mul_add(t23, t111, t131), t188 + t199),
+            );
+            let t213 = T::mul_add(
+                -T::from_f64(0.0556),
+                t162 * t208,
+                T::mul_add(
+                    -t107,
+                    t82,
+                    T::mul_add(
+                        -t7,
+                        T::mul_add(
+                            T::from_f64(0.000011283525),
+                            t78,
+                            T::from_f64(0.000008042076) * t79,
+                        ),
+                        T::mul_add(
+                            -t106,
+                            t83,
+                            T::mul_add(
+                                -t6,
+                                t8 * t51,
+                                T::mul_add(
+                                    -t7,
+                                    T::mul_add(
+                                        -T::from_f64(0.000011844769255572),
+                                        t9,
+                                        T::from_f64(0.00000818299639785789) * t8,
+                                    ),
+                                    T::mul_add(
+                                        -t6,
+                                        t9 * t50,
+                                        T::mul_add(
+                                            T::from_f64(0.00000118904291699917),
+                                            t7,
+                                            T::from_f64(0.00000135226331844583) * t6,
+                                        ),
+                                    ),
+                                ),
+                            ),
+                        ),
+                    ),
+                ),
+            );
+            let t214 = T::mul_add(
+                -T::from_f64(0.0264),
+                t201 * t206,
+                T::mul_add(
+                    -T::from_f64(0.0355),
+                    (T::mul_add(-t60, t97, t61 * t88))
+                        * (T::mul_add(
+                            -t60,
+                            t115,
+                            T::mul_add(t61, t97, T::mul_add(-t61, t114, t60 * t88)),
+                        )),
+                    T::from_f64(0.5)
+                        * (T::mul_add(
+                            t1,
+                            T::mul_add(
+                                T::from_f64(0.0000042343545689576),
+                                t1,
+                                T::from_f64(0.0000796647061621031) * t0,
+                            ),
+                            T::mul_add(
+                                -t0,
+                                T::mul_add(
+                                    -T::from_f64(0.0000796647061621031),
+                                    t1,
+                                    T::from_f64(0.0000042343545689576) * t0,
+                                ),
+                                T::mul_add(
+                                    -t0,
+                                    T::mul_add(
+                                        T::from_f64(0.0000808728875979549),
+                                        t1,
+                                        T::from_f64(0.0000042343545689576) * t0,
+                                    ),
+                                    T::mul_add(
+                                        -t1,
+                                        T::mul_add(
+                                            -T::from_f64(0.0000042343545689576),
+                                            t1,
+                                            T::from_f64(0.0000808728875979549) * t0,
+                                        ),
+                                        t136 + t179 - t137 - t138 - t139 - t180 - t181 - t182,
+                                    ),
+                                ),
+                            ),
+                        )),
+                ),
+            );
+            let t215 = T::mul_add(
+                -T::from_f64(0.0264),
+                t201 * (T::mul_add(-t132, t158, t194)),
+                T::from_f64(0.5) * (t179 - t180 - t181 - t182),
+            );
+            let t216 = T::mul_add(
+                T::from_f64(0.0556),
+                T::mul_add(
+                    t193,
+                    T::mul_add(
+                        -t6,
+                        t117,
+                        T::mul_add(t7, t161, T::mul_add(t33, t83, t32 * t77)),
+                    ),
+                    T::mul_add(
+                        t202,
+                        t208,
+                        -t203
+                            * (T::mul_add(
+                                t33,
+                                t82,
+                                T::mul_add(t32, t76, T::mul_add(-t6, t116, t7 * t175)),
+                            )),
+                    ),
+                ),
+                T::mul_add(
+                    T::from_f64(0.038),
+                    T::mul_add(
+                        T::mul_add(-t6, t92, t7 * t9 * t33),
+                        T::mul_add(t7, t92, t7 * t9 * t32),
+                        T::mul_add(
+                            T::mul_add(t7, t9 * t90, t7 * t8 * t92),
+                            T::mul_add(t6, t9 * t90, t6 * t8 * t92),
+                            -(T::mul_add(t7, t8 * t33, t6 * t90))
+                                * (T::mul_add(-t7, t8 * t32, t7 * t90)),
+                        ),
+                    ),
+                    T::from_f64(0.5)
+                        * (T::mul_add(
+                            t76,
+                            T::mul_add(
+                                T::from_f64(0.0000338903173333),
+                                t82,
+                                T::mul_add(
+                                    T::from_f64(0.0000052283),
+                                    t83,
+                                    T::from_f64(0.000011283525) * t7,
+                                ),
+                            ),
+                            T::mul_add(
+                                -t103,
+                                t82,
+                                T::mul_add(
+                                    -t6,
+                                    T::mul_add(
+                                        T::from_f64(0.000011283525),
+                                        t82,
+                                        T::mul_add(
+                                            T::from_f64(0.000008042076),
+                                            t83,
+                                            T::from_f64(0.000036694475213462586) * t7,
+                                        ),
+                                    ),
+                                    T::mul_add(
+                                        -t7,
+                                        T::mul_add(
+                                            -T::from_f64(0.000011283525),
+                                            t76,
+                                            T::mul_add(
+                                                -T::from_f64(0.000008042076),
+                                                t77,
+                                                T::from_f64(0.000036694475213462586) * t6,
+                                            ),
+                                        ),
+                                        T::mul_add(
+                                            t77,
+                                            T::mul_add(
+                                                T::from_f64(0.0000052283),
+                                                t82,
+                                                T::mul_add(
+                                                    T::from_f64(0.00005486748988006258),
+                                                    t83,
+                                                    T::from_f64(0.000008042076) * t7,
+                                                ),
+                                            ),
+                                            T::mul_add(
+                                                -t102,
+                                                t83,
+                                                T::mul_add(
+                                                    t7,
+                                                    t8
+                                                        * (T::mul_add(
+                                                            T::from_f64(0.0000431323573125218),
+                                                            t56,
+                                                            T::mul_add(
+                                                                T::from_f64(0.00000255404234759754),
+                                                                t55,
+                                                                T::from_f64(0.000011844769255572) * t7,
+                                                            ),
+                                                        )),
+                                                    T::mul_add(
+                                                        -t6,
+                                                        t8 * t75,
+                                                        T::mul_add(
+                                                            -t6,
+                                                            T::mul_add(
+                                                                T::from_f64(0.000011844769255572),
+                                                                t56,
+                                                                T::mul_add(
+                                                                    T::from_f64(0.00000818299639785789),
+                                                                    t55,
+                                                                    T::from_f64(0.0000166059448592103) * t7,
+                                                                ),
+                                                            ),
+                                                            T::mul_add(
+                                                                -t7,
+                                                                T::mul_add(
+                                                                    -T::from_f64(0.000011844769255572),
+                                                                    t35,
+                                                                    T::mul_add(
+                                                                        -T::from_f64(0.00000818299639785789),
+                                                                        t34,
+                                                                        T::from_f64(0.0000166059448592103) * t6,
+                                                                    ),
+                                                                ),
+                                                                T::mul_add(
+                                                                    t7,
+                                                                    t9
+                                                                        * (T::mul_add(
+                                                                            T::from_f64(0.00000255404234759754),
+                                                                            t56,
+                                                                            T::mul_add(
+                                                                                T::from_f64(0.000043811817294825),
+                                                                                t55,
+                                                                                T::from_f64(0.00000818299639785789) * t7,
+                                                                            ),
+                                                                        )),
+                                                                    T::mul_add(
+                                                                        -t6,
+                                                                        t9 * t74,
+                                                                        T::mul_add(
+                                                                            -t6,
+                                                                            T::mul_add(
+                                                                                T::from_f64(0.00000465422984297958),
+                                                                                t7,
+                                                                                T::from_f64(0.000000795929506936549) * t6,
+                                                                            ),
+                                                                            T::mul_add(
+                                                                                -t7,
+                                                                                T::mul_add(
+                                                                                    -T::from_f64(0.000000795929506936549),
+                                                                                    t7,
+                                                                                    T::from_f64(0.00000465422984297958) * t6,
+                                                                                ),
+                                                                                T::mul_add(
+                                                                                    t7,
+                                                                                    T::mul_add(
+                                                                                        T::from_f64(0.000000795929506936549),
+                                                                                        t7,
+                                                                                        T::from_f64(0.0000043875110939419) * t6,
+                                                                                    ),
+                                                                                    -t6
+                                                                                        * (T::mul_add(
+                                                                                            -T::from_f64(0.0000043875110939419),
+                                                                                            t7,
+                                                                                            T::from_f64(0.000000795929506936549) * t6,
+                                                                                        )),
+                                                                                ),
+                                                                            ),
+                                                                        ),
+                                                                    ),
+                                                                ),
+                                                            ),
+                                                        ),
+                                                    ),
+                                                ),
+                                            ),
+                                        ),
+                                    ),
+                                ),
+                            ),
+                        )),
+                ),
+            );
+            let t217 = T::mul_add(
+                T::from_f64(0.0556),
+                T::mul_add(
+                    t193,
+                    t197,
+                    T::mul_add(
+                        -t202,
+                        T::mul_add(
+                            -t77,
+                            t167,
+                            T::mul_add(-t76, t168, T::mul_add(t161, t77, t195)),
+                        ),
+                        t203 * t196,
+                    ),
+                ),
+                T::from_f64(0.5)
+                    * (T::mul_add(
+                        -t7,
+                        t8
+                            * (T::mul_add(
+                                -T::from_f64(0.00000255404234759754),
+                                t35,
+                                T::from_f64(0.0000431323573125218) * t34,
+                            )),
+                        T::mul_add(
+                            t7,
+                            t9 * t75,
+                            T::mul_add(
+                                t6,
+                                T::mul_add(
+                                    -T::from_f64(0.00000818299639785789),
+                                    t35,
+                                    T::from_f64(0.000011844769255572) * t34,
+                                ),
+                                T::mul_add(
+                                    -t7,
+                                    t9
+                                        * (T::mul_add(
+                                            -T::from_f64(0.000043811817294825),
+                                            t35,
+                                            T::from_f64(0.00000255404234759754) * t34,
+                                        )),
+                                    T::mul_add(-t7, t8 * t74, t143 + t144 - t141 - t142 - t145),
+                                ),
+                            ),
+                        ),
+                    )),
+            );
+            let t218 = T::mul_add(
+                T::from_f64(0.0556),
+                T::mul_add(
+                    t193,
+                    T::mul_add(-t6, t160, t100),
+                    T::mul_add(-t202, T::mul_add(-t76, t160, t195), t203 * t193),
+                ),
+                T::from_f64(0.5) * (t143 + t144 - t141 - t142 - t145),
+            );
+            let t219 = T::mul_add(
+                -T::from_f64(0.0264),
+                t204 * t209,
+                T::mul_add(
+                    -T::from_f64(0.0355),
+                    (T::mul_add(-t57, t108, t58 * t93))
+                        * (T::mul_add(
+                            -t57,
+                            t119,
+                            T::mul_add(t58, t108, T::mul_add(-t58, t118, t57 * t93)),
+                        )),
+                    T::from_f64(0.5)
+                        * (T::mul_add(
+                            t13,
+                            T::mul_add(
+                                T::from_f64(0.0000042343545689576),
+                                t13,
+                                T::from_f64(0.0000796647061621031) * t12,
+                            ),
+                            T::mul_add(
+                                -t12,
+                                T::mul_add(
+                                    -T::from_f64(0.0000796647061621031),
+                                    t13,
+                                    T::from_f64(0.0000042343545689576) * t12,
+                                ),
+                                T::mul_add(
+                                    -t12,
+                                    T::mul_add(
+                                        T::from_f64(0.0000808728875979549),
+                                        t13,
+                                        T::from_f64(0.0000042343545689576) * t12,
+                                    ),
+                                    T::mul_add(
+                                        -t13,
+                                        T::mul_add(
+                                            -T::from_f64(0.0000042343545689576),
+                                            t13,
+                                            T::from_f64(0.0000808728875979549) * t12,
+                                        ),
+                                        t150 + t184 - t151 - t152 - t153 - t185 - t186 - t187,
+                                    ),
+                                ),
+                            ),
+                        )),
+                ),
+            );
+            let t220 = T::mul_add(
+                -T::from_f64(0.0264),
+                t204 * (T::mul_add(-t123, t163, t198)),
+                T::from_f64(0.5) * (t184 - t185 - t186 - t187),
+            );
+            let t221 = T::mul_add(
+                -T::from_f64(0.0264),
+                t205 * t211,
+                T::mul_add(
+                    -T::from_f64(0.0355),
+                    (T::mul_add(-t70, t111, t71 * t95))
+                        * (T::mul_add(
+                            -t70,
+                            t121,
+                            T::mul_add(t71, t111, T::mul_add(-t71, t120, t70 * t95)),
+                        )),
+                    T::from_f64(0.5)
+                        * (T::mul_add(
+                            t19,
+                            T::mul_add(
+                                T::from_f64(0.0000042343545689576),
+                                t19,
+                                T::from_f64(0.0000796647061621031) * t18,
+                            ),
+                            T::mul_add(
+                                -t18,
+                                T::mul_add(
+                                    -T::from_f64(0.0000796647061621031),
+                                    t19,
+                                    T::from_f64(0.0000042343545689576) * t18,
+                                ),
+                                T::mul_add(
+                                    -t18,
+                                    T::mul_add(
+                                        T::from_f64(0.0000808728875979549),
+                                        t19,
+                                        T::from_f64(0.0000042343545689576) * t18,
+                                    ),
+                                    T::mul_add(
+                                        -t19,
+                                        T::mul_add(
+                                            -T::from_f64(0.0000042343545689576),
+                                            t19,
+                                            T::from_f64(0.0000808728875979549) * t18,
+                                        ),
+                                        t154 + t189 - t155 - t156 - t157 - t190 - t191 - t192,
+                                    ),
+                                ),
+                            ),
+                        )),
+                ),
+            );
+            let t222 = T::mul_add(
+                -T::from_f64(0.0264),
+                t205 * (T::mul_add(-t134, t165, t199)),
+                T::from_f64(0.5) * (t189 - t190 - t191 - t192),
+            );
+            (
+                t192,
+                t193,
+                t194,
+                t195,
+                t196,
+                t197,
+                t198,
+                t199,
+                t200,
+                t201,
+                t202,
+                t203,
+                t204,
+                t205,
+                t206,
+                t207,
+                t208,
+                t209,
+                t210,
+                t211,
+                t212,
+                t213,
+                t214,
+                t215,
+                t216,
+                t217,
+                t218,
+                t219,
+                t220,
+                t221,
+                t222,
+            )
+        };
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::mul_add(
+                    T::from_f64(0.000001255968),
+                    t132,
+                    T::mul_add(
+                        -T::from_f64(0.0000017622),
+                        t133,
+                        T::mul_add(
+                            T::from_f64(0.0000054115225794551),
+                            t61,
+                            T::mul_add(
+                                -T::from_f64(0.00000793657186922407),
+                                t60,
+                                T::mul_add(
+                                    -T::from_f64(0.0000148386162019941),
+                                    t1,
+                                    -T::from_f64(0.0000214347646011766) * t0,
+                                ),
+                            ),
+                        ),
+                    ),
+                ),
+                T::mul_add(
+                    T::from_f64(0.000001255968),
+                    t132,
+                    T::mul_add(
+                        -T::from_f64(0.0000017622),
+                        t133,
+                        T::mul_add(
+                            T::from_f64(0.0000054115225794551),
+                            t61,
+                            -T::from_f64(0.00000793657186922407) * t60,
+                        ),
+                    ),
+                ),
+                T::mul_add(
+                    T::from_f64(0.000001255968),
+                    t132,
+                    -T::from_f64(0.0000017622) * t133,
+                ),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            0,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            8,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                t214,
+                T::zero(),
+                T::mul_add(
+                    -T::from_f64(0.0010137599999999998),
+                    t4 * t81,
+                    -T::from_f64(0.0264) * t49 * t80,
+                ),
+                T::mul_add(
+                    -T::from_f64(0.00044856000000000003),
+                    t62,
+                    -T::from_f64(0.000024222240000000003) * t30,
+                ),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            16,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            24,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::mul_add(
+                    -T::from_f64(0.0264),
+                    t201 * t207,
+                    T::from_f64(0.5)
+                        * (t136 + t179 - t137 - t138 - t139 - t180 - t181 - t182),
+                ),
+                T::from_f64(0.0264) * (T::mul_add(t99, t81, -t98 * t80)),
+                T::zero(),
+                -T::from_f64(0.000017224704) * t4,
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            32,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            40,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                t215,
+                t171,
+                T::mul_add(
+                    -T::from_f64(0.000038928383999999994),
+                    t4 * t5,
+                    T::from_f64(0.0010137599999999998) * t4 * t49,
+                ),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            48,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            56,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                t213,
+                T::mul_add(
+                    T::from_f64(0.00285784),
+                    t10 * t197,
+                    T::mul_add(
+                        T::from_f64(0.0556),
+                        t52 * t196,
+                        T::mul_add(
+                            T::from_f64(0.000008042076),
+                            t76,
+                            T::mul_add(
+                                -T::from_f64(0.000011283525),
+                                t77,
+                                T::mul_add(
+                                    T::from_f64(0.00000818299639785789),
+                                    t35,
+                                    -T::from_f64(0.000011844769255572) * t34,
+                                ),
+                            ),
+                        ),
+                    ),
+                ),
+                T::mul_add(
+                    T::from_f64(0.0007106399999999999),
+                    t193,
+                    T::mul_add(
+                        T::from_f64(0.000008042076),
+                        t76,
+                        -T::from_f64(0.000011283525) * t77,
+                    ),
+                ),
+            ],
+            out,
+            64,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            72,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                t216,
+                T::zero(),
+                T::mul_add(
+                    T::from_f64(0.000008042076),
+                    t78,
+                    T::mul_add(
+                        -T::from_f64(0.000011283525),
+                        t79,
+                        T::mul_add(
+                            -T::from_f64(0.00000818299639785789),
+                            t9,
+                            -T::from_f64(0.000011844769255572) * t8,
+                        ),
+                    ),
+                ),
+                T::mul_add(
+                    T::from_f64(0.000008042076),
+                    t78,
+                    -T::from_f64(0.000011283525) * t79,
+                ),
+            ],
+            out,
+            80,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            88,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                t217,
+                t200,
+                T::zero(),
+                -T::from_f64(0.00003652689599999999) * t10,
+            ],
+            out,
+            96,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            104,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                t218,
+                T::mul_add(
+                    -T::from_f64(0.0556),
+                    t162 * t170,
+                    T::from_f64(0.5) * (t146 - t147 - t148 - t149),
+                ),
+                T::mul_add(
+                    -T::from_f64(0.000146892976),
+                    t10 * t11,
+                    T::from_f64(0.00285784) * t10 * t52,
+                ),
+                T::zero(),
+            ],
+            out,
+            112,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            120,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            128,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::mul_add(
+                    T::from_f64(0.000001255968),
+                    t123,
+                    T::mul_add(
+                        -T::from_f64(0.0000017622),
+                        t122,
+                        T::mul_add(
+                            T::from_f64(0.0000054115225794551),
+                            t58,
+                            T::mul_add(
+                                -T::from_f64(0.00000793657186922407),
+                                t57,
+                                T::mul_add(
+                                    -T::from_f64(0.0000148386162019941),
+                                    t13,
+                                    -T::from_f64(0.0000214347646011766) * t12,
+                                ),
+                            ),
+                        ),
+                    ),
+                ),
+                T::mul_add(
+                    T::from_f64(0.000001255968),
+                    t123,
+                    T::mul_add(
+                        -T::from_f64(0.0000017622),
+                        t122,
+                        T::mul_add(
+                            T::from_f64(0.0000054115225794551),
+                            t58,
+                            -T::from_f64(0.00000793657186922407) * t57,
+                        ),
+                    ),
+                ),
+                T::mul_add(
+                    T::from_f64(0.000001255968),
+                    t123,
+                    -T::from_f64(0.0000017622) * t122,
+                ),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            136,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            144,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                t219,
+                T::zero(),
+                T::mul_add(
+                    -T::from_f64(0.0010137599999999998),
+                    t16 * t85,
+                    -T::from_f64(0.0264) * t53 * t84,
+                ),
+                T::mul_add(
+                    -T::from_f64(0.00044856000000000003),
+                    t67,
+                    -T::from_f64(0.000024222240000000003) * t41,
+                ),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            152,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            160,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::mul_add(
+                    -T::from_f64(0.0264),
+                    t204 * t210,
+                    T::from_f64(0.5)
+                        * (t150 + t184 - t151 - t152 - t153 - t185 - t186 - t187),
+                ),
+                T::from_f64(0.0264) * (T::mul_add(t110, t85, -t109 * t84)),
+                T::zero(),
+                -T::from_f64(0.000017224704) * t16,
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            168,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            176,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                t220,
+                t172,
+                T::mul_add(
+                    -T::from_f64(0.000038928383999999994),
+                    t16 * t17,
+                    T::from_f64(0.0010137599999999998) * t16 * t53,
+                ),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            184,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            192,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::mul_add(
+                    T::from_f64(0.000001255968),
+                    t134,
+                    T::mul_add(
+                        -T::from_f64(0.0000017622),
+                        t135,
+                        T::mul_add(
+                            T::from_f64(0.0000054115225794551),
+                            t71,
+                            T::mul_add(
+                                -T::from_f64(0.00000793657186922407),
+                                t70,
+                                T::mul_add(
+                                    -T::from_f64(0.0000148386162019941),
+                                    t19,
+                                    -T::from_f64(0.0000214347646011766) * t18,
+                                ),
+                            ),
+                        ),
+                    ),
+                ),
+                T::mul_add(
+                    T::from_f64(0.000001255968),
+                    t134,
+                    T::mul_add(
+                        -T::from_f64(0.0000017622),
+                        t135,
+                        T::mul_add(
+                            T::from_f64(0.0000054115225794551),
+                            t71,
+                            -T::from_f64(0.00000793657186922407) * t70,
+                        ),
+                    ),
+                ),
+                T::mul_add(
+                    T::from_f64(0.000001255968),
+                    t134,
+                    -T::from_f64(0.0000017622) * t135,
+                ),
+            ],
+            out,
+            200,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            208,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                t221,
+                T::zero(),
+                T::mul_add(
+                    -T::from_f64(0.0010137599999999998),
+                    t22 * t87,
+                    -T::from_f64(0.0264) * t54 * t86,
+                ),
+                T::mul_add(
+                    -T::from_f64(0.00044856000000000003),
+                    t72,
+                    -T::from_f64(0.000024222240000000003) * t47,
+                ),
+            ],
+            out,
+            216,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            224,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::mul_add(
+                    -T::from_f64(0.0264),
+                    t205 * t212,
+                    T::from_f64(0.5)
+                        * (t154 + t189 - t155 - t156 - t157 - t190 - t191 - t192),
+                ),
+                T::from_f64(0.0264) * (T::mul_add(t113, t87, -t112 * t86)),
+                T::zero(),
+                -T::from_f64(0.000017224704) * t22,
+            ],
+            out,
+            232,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            240,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                t222,
+                t173,
+                T::mul_add(
+                    -T::from_f64(0.000038928383999999994),
+                    t22 * t23,
+                    T::from_f64(0.0010137599999999998) * t22 * t54,
+                ),
+                T::zero(),
+            ],
+            out,
+            248,
+        );
+    }
+}
+#[allow(
+    unused_variables,
+    clippy::approx_constant,
+    clippy::excessive_precision,
+    clippy::unreadable_literal,
+    clippy::neg_multiply,
+    clippy::double_parens,
+    clippy::identity_op,
+    clippy::needless_range_loop,
+    clippy::let_and_return,
+    clippy::type_complexity,
+    clippy::too_many_arguments
+)]
 impl<T: ::eomgen_runtime::batch::Batch> AllegroRightHand<T> {
     /// This robot's parameters in every lane of `L` (a vector of states such as
     /// `wide::f64x4`, with `eomgen_runtime`'s `simd` feature): the robot whose
@@ -20351,13 +26681,11 @@ impl<T: ::eomgen_runtime::batch::Batch> AllegroRightHand<T> {
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
             out,
             &|start: usize, out: &mut [[[T; 16]; 16]]| {
-                let r = <AllegroRightHand<
-                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
-                > as ::eomgen_runtime::Dynamics<
-                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
-                    16,
-                >>::mass_matrix(&robot, &::eomgen_runtime::batch::gather(q, start));
-                ::eomgen_runtime::batch::scatter_matrix(&r, out);
+                robot
+                    .mass_matrix_unpacked(
+                        &::eomgen_runtime::batch::gather(q, start),
+                        out,
+                    );
             },
         );
         Ok(())
@@ -20426,17 +26754,12 @@ impl<T: ::eomgen_runtime::batch::Batch> AllegroRightHand<T> {
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
             out,
             &|start: usize, out: &mut [[[T; 16]; 16]]| {
-                let r = <AllegroRightHand<
-                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
-                > as ::eomgen_runtime::Dynamics<
-                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
-                    16,
-                >>::coriolis_matrix(
-                    &robot,
-                    &::eomgen_runtime::batch::gather(q, start),
-                    &::eomgen_runtime::batch::gather(qd, start),
-                );
-                ::eomgen_runtime::batch::scatter_matrix(&r, out);
+                robot
+                    .coriolis_matrix_unpacked(
+                        &::eomgen_runtime::batch::gather(q, start),
+                        &::eomgen_runtime::batch::gather(qd, start),
+                        out,
+                    );
             },
         );
         Ok(())
@@ -20595,10 +26918,11 @@ impl<T: ::eomgen_runtime::batch::Batch> AllegroRightHand<T> {
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
             out,
             &|start: usize, out: &mut [[[T; 16]; 16]]| {
-                let r = AllegroRightHand::<
-                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
-                >::centrifugal(&robot, &::eomgen_runtime::batch::gather(q, start));
-                ::eomgen_runtime::batch::scatter_matrix(&r, out);
+                robot
+                    .centrifugal_unpacked(
+                        &::eomgen_runtime::batch::gather(q, start),
+                        out,
+                    );
             },
         );
         Ok(())

@@ -905,6 +905,119 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 2> for DoublePendu
     clippy::type_complexity,
     clippy::too_many_arguments
 )]
+impl<T: ::eomgen_runtime::lane::Pack> DoublePendulum<T> {
+    fn mass_matrix_unpacked(
+        &self,
+        q: &[T; 2],
+        out: &mut [[[<T as ::eomgen_runtime::lane::Pack>::Scalar; 2]; 2]],
+    ) {
+        let ([s1], [c1]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([q[1]]);
+        let t0 = T::mul_add(
+            T::from_f64(0.0335304944),
+            c1,
+            T::from_f64(0.0000000000643853298) * s1,
+        );
+        let t1 = T::mul_add(T::from_f64(0.1), t0, T::from_f64(0.004557856275072));
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::mul_add(T::from_f64(0.2), t0, T::from_f64(0.00863622790870487)),
+                t1,
+                t1,
+                T::from_f64(0.004557856275072),
+            ],
+            out,
+            0,
+        );
+    }
+    fn coriolis_matrix_unpacked(
+        &self,
+        q: &[T; 2],
+        qd: &[T; 2],
+        out: &mut [[[<T as ::eomgen_runtime::lane::Pack>::Scalar; 2]; 2]],
+    ) {
+        let ([s1], [c1]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([q[1]]);
+        let t0 = s1;
+        let t1 = c1;
+        let t2 = T::from_f64(0.06647600000000001)
+            * (T::mul_add(
+                -t1,
+                T::mul_add(T::from_f64(0.1), t0, T::from_f64(0.00000000019371)),
+                t0 * (T::mul_add(T::from_f64(0.1), t1, T::from_f64(0.10088))),
+            ));
+        let t3 = qd[0] * t2;
+        let t4 = -T::from_f64(0.5)
+            * (T::mul_add(
+                qd[1],
+                T::mul_add(
+                    -T::from_f64(0.000000000012877065960000002),
+                    t1,
+                    T::from_f64(0.00670609888) * t0,
+                ),
+                t3,
+            ));
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[-T::from_f64(0.5) * qd[1] * t2, t4, T::from_f64(0.5) * t3, T::zero()],
+            out,
+            0,
+        );
+    }
+    fn centrifugal_unpacked(
+        &self,
+        q: &[T; 2],
+        out: &mut [[[<T as ::eomgen_runtime::lane::Pack>::Scalar; 2]; 2]],
+    ) {
+        let ([s1], [c1]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([q[1]]);
+        let t0 = s1;
+        let t1 = c1;
+        let t2 = T::from_f64(0.033238000000000004)
+            * (T::mul_add(
+                -t1,
+                T::mul_add(T::from_f64(0.1), t0, T::from_f64(0.00000000019371)),
+                t0 * (T::mul_add(T::from_f64(0.1), t1, T::from_f64(0.10088))),
+            ));
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::mul_add(
+                    T::from_f64(0.000000000006438532980000001),
+                    t1,
+                    -T::from_f64(0.00335304944) * t0,
+                ),
+                t2,
+                T::zero(),
+            ],
+            out,
+            0,
+        );
+    }
+    fn coriolis_pairs_unpacked(
+        &self,
+        q: &[T; 2],
+        out: &mut [[[<T as ::eomgen_runtime::lane::Pack>::Scalar; 1]; 2]],
+    ) {
+        let ([s1], [c1]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([q[1]]);
+        let t0 = T::from_f64(0.1)
+            * (T::mul_add(
+                T::from_f64(0.0000000001287706596),
+                c1,
+                -T::from_f64(0.0670609888) * s1,
+            ));
+        ::eomgen_runtime::lane::Pack::unpack_run(&[t0, T::zero()], out, 0);
+    }
+}
+#[allow(
+    unused_variables,
+    clippy::approx_constant,
+    clippy::excessive_precision,
+    clippy::unreadable_literal,
+    clippy::neg_multiply,
+    clippy::double_parens,
+    clippy::identity_op,
+    clippy::needless_range_loop,
+    clippy::let_and_return,
+    clippy::type_complexity,
+    clippy::too_many_arguments
+)]
 impl<T: ::eomgen_runtime::batch::Batch> DoublePendulum<T> {
     /// This robot's parameters in every lane of `L` (a vector of states such as
     /// `wide::f64x4`, with `eomgen_runtime`'s `simd` feature): the robot whose
@@ -928,13 +1041,11 @@ impl<T: ::eomgen_runtime::batch::Batch> DoublePendulum<T> {
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
             out,
             &|start: usize, out: &mut [[[T; 2]; 2]]| {
-                let r = <DoublePendulum<
-                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
-                > as ::eomgen_runtime::Dynamics<
-                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
-                    2,
-                >>::mass_matrix(&robot, &::eomgen_runtime::batch::gather(q, start));
-                ::eomgen_runtime::batch::scatter_matrix(&r, out);
+                robot
+                    .mass_matrix_unpacked(
+                        &::eomgen_runtime::batch::gather(q, start),
+                        out,
+                    );
             },
         );
         Ok(())
@@ -1003,17 +1114,12 @@ impl<T: ::eomgen_runtime::batch::Batch> DoublePendulum<T> {
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
             out,
             &|start: usize, out: &mut [[[T; 2]; 2]]| {
-                let r = <DoublePendulum<
-                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
-                > as ::eomgen_runtime::Dynamics<
-                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
-                    2,
-                >>::coriolis_matrix(
-                    &robot,
-                    &::eomgen_runtime::batch::gather(q, start),
-                    &::eomgen_runtime::batch::gather(qd, start),
-                );
-                ::eomgen_runtime::batch::scatter_matrix(&r, out);
+                robot
+                    .coriolis_matrix_unpacked(
+                        &::eomgen_runtime::batch::gather(q, start),
+                        &::eomgen_runtime::batch::gather(qd, start),
+                        out,
+                    );
             },
         );
         Ok(())
@@ -1172,10 +1278,11 @@ impl<T: ::eomgen_runtime::batch::Batch> DoublePendulum<T> {
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
             out,
             &|start: usize, out: &mut [[[T; 2]; 2]]| {
-                let r = DoublePendulum::<
-                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
-                >::centrifugal(&robot, &::eomgen_runtime::batch::gather(q, start));
-                ::eomgen_runtime::batch::scatter_matrix(&r, out);
+                robot
+                    .centrifugal_unpacked(
+                        &::eomgen_runtime::batch::gather(q, start),
+                        out,
+                    );
             },
         );
         Ok(())
@@ -1192,10 +1299,11 @@ impl<T: ::eomgen_runtime::batch::Batch> DoublePendulum<T> {
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
             out,
             &|start: usize, out: &mut [[[T; 1]; 2]]| {
-                let r = DoublePendulum::<
-                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
-                >::coriolis_pairs(&robot, &::eomgen_runtime::batch::gather(q, start));
-                ::eomgen_runtime::batch::scatter_matrix(&r, out);
+                robot
+                    .coriolis_pairs_unpacked(
+                        &::eomgen_runtime::batch::gather(q, start),
+                        out,
+                    );
             },
         );
         Ok(())

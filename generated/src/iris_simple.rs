@@ -1499,6 +1499,505 @@ for IrisSimple<T> {
     clippy::type_complexity,
     clippy::too_many_arguments
 )]
+impl<T: ::eomgen_runtime::lane::Pack> IrisSimple<T> {
+    fn mass_matrix_unpacked(
+        &self,
+        q: &[T; 7],
+        out: &mut [[[<T as ::eomgen_runtime::lane::Pack>::Scalar; 6]; 6]],
+    ) {
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::from_f64(1.5349999999999995),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::from_f64(0.00045999999999999996),
+                T::zero(),
+                T::zero(),
+                T::from_f64(1.5349999999999995),
+            ],
+            out,
+            0,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                (-T::from_f64(0.00045999999999999996)),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::from_f64(1.5349999999999995),
+                T::zero(),
+            ],
+            out,
+            8,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                (-T::from_f64(0.00045999999999999996)),
+                T::zero(),
+                T::from_f64(0.030033480000000005),
+                T::zero(),
+                (-T::from_f64(0.000000000000000000005082197683525802)),
+            ],
+            out,
+            16,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::from_f64(0.00045999999999999996),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::from_f64(0.030575996),
+                (-T::from_f64(0.000000000000000000006776263578034403)),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            24,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                (-T::from_f64(0.000000000000000000005082197683525802)),
+                (-T::from_f64(0.000000000000000000006776263578034403)),
+                T::from_f64(0.057553016000000005),
+            ],
+            out,
+            32,
+        );
+    }
+    fn coriolis_matrix_unpacked(
+        &self,
+        q: &[T; 7],
+        qd: &[T; 6],
+        out: &mut [[[<T as ::eomgen_runtime::lane::Pack>::Scalar; 6]; 6]],
+    ) {
+        let t0 = T::mul_add(
+            -T::from_f64(0.000000000000000000002541098841762901),
+            qd[5],
+            T::from_f64(0.015016740000000002) * qd[3],
+        );
+        let t1 = T::mul_add(
+            -T::from_f64(0.0000000000000000000033881317890172014),
+            qd[5],
+            T::from_f64(0.015287998) * qd[4],
+        );
+        let t2 = T::mul_add(
+            T::from_f64(0.00022999999999999998),
+            qd[4],
+            T::from_f64(0.7674999999999997) * qd[0],
+        );
+        let t3 = T::mul_add(
+            -T::from_f64(0.00022999999999999998),
+            qd[3],
+            T::from_f64(0.7674999999999997) * qd[1],
+        );
+        let t4 = T::mul_add(
+            T::from_f64(0.0000000000000000000033881317890172014),
+            qd[5],
+            T::from_f64(0.028776508000000003) * qd[4],
+        );
+        let t5 = T::mul_add(
+            -T::from_f64(0.000000000000000000002541098841762901),
+            qd[5],
+            -T::from_f64(0.028776508000000003) * qd[3],
+        );
+        let t6 = T::from_f64(0.00045999999999999996) * qd[5];
+        let t7 = -T::from_f64(0.00045999999999999996) * qd[5];
+        let t8 = T::mul_add(
+            -T::from_f64(0.00045999999999999996),
+            qd[3],
+            T::from_f64(1.5349999999999995) * qd[1],
+        ) - t3 - t3;
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                -T::from_f64(1.5349999999999995) * qd[5],
+                T::from_f64(1.5349999999999995) * qd[4],
+                t6,
+                T::zero(),
+                t8,
+                T::from_f64(1.5349999999999995) * qd[5],
+                T::zero(),
+            ],
+            out,
+            0,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                -T::from_f64(1.5349999999999995) * qd[3],
+                T::zero(),
+                t6,
+                T::zero(),
+                -T::from_f64(1.5349999999999995) * qd[4],
+                T::from_f64(1.5349999999999995) * qd[3],
+                T::zero(),
+                T::mul_add(
+                    -T::from_f64(0.00022999999999999998),
+                    qd[3],
+                    T::mul_add(-T::from_f64(0.7674999999999997), qd[1], t3),
+                ),
+            ],
+            out,
+            8,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::mul_add(T::from_f64(1.5349999999999995), qd[0], -t2) - t2,
+                T::zero(),
+                t7,
+                T::zero(),
+                T::mul_add(T::from_f64(0.00045999999999999996), qd[3], t3) - t3,
+                T::zero(),
+                T::mul_add(
+                    -T::from_f64(0.001528230000000002),
+                    qd[5],
+                    T::mul_add(
+                        -T::from_f64(0.000000000000000000006776263578034403),
+                        qd[4],
+                        -T::from_f64(0.000000000000000000005082197683525802) * qd[3],
+                    ),
+                ),
+                T::mul_add(
+                    T::from_f64(0.015016740000000002),
+                    qd[4],
+                    T::mul_add(T::from_f64(0.00022999999999999998), qd[0], t4),
+                ) - (T::mul_add(T::from_f64(0.00022999999999999998), qd[0], t1)),
+            ],
+            out,
+            16,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                t7,
+                T::mul_add(
+                    T::from_f64(0.00069),
+                    qd[4],
+                    T::mul_add(T::from_f64(0.7674999999999997), qd[0], -t2),
+                ),
+                T::mul_add(
+                    T::from_f64(0.030304738000000005),
+                    qd[5],
+                    T::mul_add(
+                        T::from_f64(0.0000000000000000000033881317890172014),
+                        qd[4],
+                        T::from_f64(0.000000000000000000002541098841762901) * qd[3],
+                    ),
+                )
+                    - (T::mul_add(
+                        T::from_f64(0.028776508000000003),
+                        qd[5],
+                        T::mul_add(
+                            -T::from_f64(0.0000000000000000000033881317890172014),
+                            qd[4],
+                            -T::from_f64(0.000000000000000000002541098841762901) * qd[3],
+                        ),
+                    )),
+                T::zero(),
+                T::mul_add(-T::from_f64(0.015287998), qd[3], t0 + t5),
+                T::zero(),
+                T::zero(),
+            ],
+            out,
+            24,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::mul_add(
+                    -T::from_f64(0.000000000000000000006776263578034403),
+                    qd[5],
+                    T::mul_add(-T::from_f64(0.07256975600000001), qd[4], t1 + t4),
+                ),
+                T::mul_add(
+                    T::from_f64(0.000000000000000000005082197683525802),
+                    qd[5],
+                    T::mul_add(
+                        T::from_f64(0.07284101400000001),
+                        qd[3],
+                        T::mul_add(-T::from_f64(0.00022999999999999998), qd[1], t5),
+                    ),
+                ) - (T::mul_add(-T::from_f64(0.00022999999999999998), qd[1], t0)),
+                T::zero(),
+            ],
+            out,
+            32,
+        );
+    }
+    fn center_of_mass_jacobian_unpacked(
+        &self,
+        q: &[T; 7],
+        out: &mut [[[<T as ::eomgen_runtime::lane::Pack>::Scalar; 6]; 3]],
+    ) {
+        let t0 = q[3] * q[3];
+        let t1 = q[4] * q[4];
+        let t2 = q[5] * q[5];
+        let t3 = q[3] * q[4];
+        let t4 = q[3] * q[5];
+        let t5 = q[4] * q[5];
+        let t6 = q[3] * q[6];
+        let t7 = q[4] * q[6];
+        let t8 = q[5] * q[6];
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::mul_add(
+                    -T::from_f64(1.9999999999999998),
+                    t1 + t2,
+                    T::from_f64(0.9999999999999999),
+                ),
+                T::from_f64(1.9999999999999998) * (t3 - t8),
+                T::from_f64(1.9999999999999998) * (t4 + t7),
+                T::from_f64(0.0005993485342019545) * (t8 - t3),
+                T::mul_add(
+                    -T::from_f64(0.0005993485342019545),
+                    t1 + t2,
+                    T::from_f64(0.00029967426710097723),
+                ),
+                T::zero(),
+                T::from_f64(1.9999999999999998) * (t3 + t8),
+                T::mul_add(
+                    -T::from_f64(1.9999999999999998),
+                    t0 + t2,
+                    T::from_f64(0.9999999999999999),
+                ),
+            ],
+            out,
+            0,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::from_f64(1.9999999999999998) * (t5 - t6),
+                T::mul_add(
+                    T::from_f64(0.0005993485342019545),
+                    t0 + t2,
+                    -T::from_f64(0.00029967426710097723),
+                ),
+                T::from_f64(0.0005993485342019545) * (t3 + t8),
+                T::zero(),
+                T::from_f64(1.9999999999999998) * (t4 - t7),
+                T::from_f64(1.9999999999999998) * (t5 + t6),
+                T::mul_add(
+                    -T::from_f64(1.9999999999999998),
+                    t0 + t1,
+                    T::from_f64(0.9999999999999999),
+                ),
+                -T::from_f64(0.0005993485342019545) * (t5 + t6),
+            ],
+            out,
+            8,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[T::from_f64(0.0005993485342019545) * (t4 - t7), T::zero()],
+            out,
+            16,
+        );
+    }
+    fn centroidal_map_unpacked(
+        &self,
+        q: &[T; 7],
+        out: &mut [[[<T as ::eomgen_runtime::lane::Pack>::Scalar; 6]; 6]],
+    ) {
+        let t0 = q[3] * q[3];
+        let t1 = q[4] * q[4];
+        let t2 = q[5] * q[5];
+        let t3 = q[3] * q[4];
+        let t4 = q[3] * q[5];
+        let t5 = q[4] * q[5];
+        let t6 = q[3] * q[6];
+        let t7 = q[4] * q[6];
+        let t8 = q[5] * q[6];
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::mul_add(
+                    -T::from_f64(3.069999999999999),
+                    t1 + t2,
+                    T::from_f64(1.5349999999999995),
+                ),
+                T::from_f64(3.069999999999999) * (t3 - t8),
+                T::from_f64(3.069999999999999) * (t4 + t7),
+                T::from_f64(0.0009199999999999999) * (t8 - t3),
+                T::mul_add(
+                    -T::from_f64(0.0009199999999999999),
+                    t1 + t2,
+                    T::from_f64(0.00045999999999999996),
+                ),
+                T::zero(),
+                T::from_f64(3.069999999999999) * (t3 + t8),
+                T::mul_add(
+                    -T::from_f64(3.069999999999999),
+                    t0 + t2,
+                    T::from_f64(1.5349999999999995),
+                ),
+            ],
+            out,
+            0,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::from_f64(3.069999999999999) * (t5 - t6),
+                T::mul_add(
+                    T::from_f64(0.0009199999999999999),
+                    t0 + t2,
+                    -T::from_f64(0.00045999999999999996),
+                ),
+                T::from_f64(0.0009199999999999999) * (t3 + t8),
+                T::zero(),
+                T::from_f64(3.069999999999999) * (t4 - t7),
+                T::from_f64(3.069999999999999) * (t5 + t6),
+                T::mul_add(
+                    -T::from_f64(3.069999999999999),
+                    t0 + t1,
+                    T::from_f64(1.5349999999999995),
+                ),
+                -T::from_f64(0.0009199999999999999) * (t5 + t6),
+            ],
+            out,
+            8,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::from_f64(0.0009199999999999999) * (t4 - t7),
+                T::zero(),
+                T::from_f64(0.00000000000000000010842021724855044) * (t3 - t8),
+                T::mul_add(
+                    T::from_f64(0.00000000000000000010842021724855044),
+                    t1 + t2,
+                    -T::from_f64(0.00000000000000000005421010862427522),
+                ),
+                T::zero(),
+                T::mul_add(
+                    -T::from_f64(0.000000000000000000010164395367051604),
+                    t4 + t7,
+                    T::mul_add(
+                        -T::from_f64(0.060066684299674274),
+                        t1 + t2,
+                        T::from_f64(0.030033342149837137),
+                    ),
+                ),
+                T::mul_add(
+                    -T::from_f64(0.000000000000000000013552527156068805),
+                    t4 + t7,
+                    T::from_f64(0.061151716299674266) * (t3 - t8),
+                ),
+                T::mul_add(
+                    T::from_f64(0.11510603200000001),
+                    t4 + t7,
+                    T::mul_add(
+                        T::from_f64(0.000000000000000000013552527156068805),
+                        t8 - t3,
+                        T::mul_add(
+                            T::from_f64(0.000000000000000000010164395367051604),
+                            t1 + t2,
+                            -T::from_f64(0.000000000000000000005082197683525802),
+                        ),
+                    ),
+                ),
+            ],
+            out,
+            16,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::mul_add(
+                    -T::from_f64(0.00000000000000000010842021724855044),
+                    t0 + t2,
+                    T::from_f64(0.00000000000000000005421010862427522),
+                ),
+                -T::from_f64(0.00000000000000000010842021724855044) * (t3 + t8),
+                T::zero(),
+                T::mul_add(
+                    T::from_f64(0.000000000000000000010164395367051604),
+                    t6 - t5,
+                    T::from_f64(0.060066684299674274) * (t3 + t8),
+                ),
+                T::mul_add(
+                    T::from_f64(0.000000000000000000013552527156068805),
+                    t6 - t5,
+                    T::mul_add(
+                        -T::from_f64(0.061151716299674266),
+                        t0 + t2,
+                        T::from_f64(0.030575858149837133),
+                    ),
+                ),
+                T::mul_add(
+                    T::from_f64(0.11510603200000001),
+                    t5 - t6,
+                    T::mul_add(
+                        -T::from_f64(0.000000000000000000010164395367051604),
+                        t3 + t8,
+                        T::mul_add(
+                            T::from_f64(0.000000000000000000013552527156068805),
+                            t0 + t2,
+                            -T::from_f64(0.000000000000000000006776263578034403),
+                        ),
+                    ),
+                ),
+                T::from_f64(0.00000000000000000010842021724855044) * (t5 + t6),
+                T::from_f64(0.00000000000000000010842021724855044) * (t7 - t4),
+            ],
+            out,
+            24,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::zero(),
+                T::mul_add(
+                    T::from_f64(0.060066684299674274),
+                    t4 - t7,
+                    T::mul_add(
+                        T::from_f64(0.000000000000000000010164395367051604),
+                        t0 + t1,
+                        -T::from_f64(0.000000000000000000005082197683525802),
+                    ),
+                ),
+                T::mul_add(
+                    T::from_f64(0.061151716299674266),
+                    t5 + t6,
+                    T::mul_add(
+                        T::from_f64(0.000000000000000000013552527156068805),
+                        t0 + t1,
+                        -T::from_f64(0.000000000000000000006776263578034403),
+                    ),
+                ),
+                T::mul_add(
+                    -T::from_f64(0.000000000000000000013552527156068805),
+                    t5 + t6,
+                    T::mul_add(
+                        T::from_f64(0.000000000000000000010164395367051604),
+                        t7 - t4,
+                        T::mul_add(
+                            -T::from_f64(0.11510603200000001),
+                            t0 + t1,
+                            T::from_f64(0.057553016000000005),
+                        ),
+                    ),
+                ),
+            ],
+            out,
+            32,
+        );
+    }
+}
+#[allow(
+    unused_variables,
+    clippy::approx_constant,
+    clippy::excessive_precision,
+    clippy::unreadable_literal,
+    clippy::neg_multiply,
+    clippy::double_parens,
+    clippy::identity_op,
+    clippy::needless_range_loop,
+    clippy::let_and_return,
+    clippy::type_complexity,
+    clippy::too_many_arguments
+)]
 impl<T: ::eomgen_runtime::batch::Batch> IrisSimple<T> {
     /// This robot's parameters in every lane of `L` (a vector of states such as
     /// `wide::f64x4`, with `eomgen_runtime`'s `simd` feature): the robot whose
@@ -1522,14 +2021,11 @@ impl<T: ::eomgen_runtime::batch::Batch> IrisSimple<T> {
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
             out,
             &|start: usize, out: &mut [[[T; 6]; 6]]| {
-                let r = <IrisSimple<
-                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
-                > as ::eomgen_runtime::FloatingDynamics<
-                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
-                    7,
-                    6,
-                >>::mass_matrix(&robot, &::eomgen_runtime::batch::gather(q, start));
-                ::eomgen_runtime::batch::scatter_matrix(&r, out);
+                robot
+                    .mass_matrix_unpacked(
+                        &::eomgen_runtime::batch::gather(q, start),
+                        out,
+                    );
             },
         );
         Ok(())
@@ -1600,14 +2096,12 @@ impl<T: ::eomgen_runtime::batch::Batch> IrisSimple<T> {
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
             out,
             &|start: usize, out: &mut [[[T; 6]; 6]]| {
-                let r = IrisSimple::<
-                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
-                >::coriolis_matrix(
-                    &robot,
-                    &::eomgen_runtime::batch::gather(q, start),
-                    &::eomgen_runtime::batch::gather(qd, start),
-                );
-                ::eomgen_runtime::batch::scatter_matrix(&r, out);
+                robot
+                    .coriolis_matrix_unpacked(
+                        &::eomgen_runtime::batch::gather(q, start),
+                        &::eomgen_runtime::batch::gather(qd, start),
+                        out,
+                    );
             },
         );
         Ok(())
@@ -1782,13 +2276,11 @@ impl<T: ::eomgen_runtime::batch::Batch> IrisSimple<T> {
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
             out,
             &|start: usize, out: &mut [[[T; 6]; 3]]| {
-                let r = IrisSimple::<
-                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
-                >::center_of_mass_jacobian(
-                    &robot,
-                    &::eomgen_runtime::batch::gather(q, start),
-                );
-                ::eomgen_runtime::batch::scatter_matrix(&r, out);
+                robot
+                    .center_of_mass_jacobian_unpacked(
+                        &::eomgen_runtime::batch::gather(q, start),
+                        out,
+                    );
             },
         );
         Ok(())
@@ -1805,10 +2297,11 @@ impl<T: ::eomgen_runtime::batch::Batch> IrisSimple<T> {
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
             out,
             &|start: usize, out: &mut [[[T; 6]; 6]]| {
-                let r = IrisSimple::<
-                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
-                >::centroidal_map(&robot, &::eomgen_runtime::batch::gather(q, start));
-                ::eomgen_runtime::batch::scatter_matrix(&r, out);
+                robot
+                    .centroidal_map_unpacked(
+                        &::eomgen_runtime::batch::gather(q, start),
+                        out,
+                    );
             },
         );
         Ok(())

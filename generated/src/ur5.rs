@@ -6783,6 +6783,445 @@ impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, 6> for Ur5<T> {
     clippy::type_complexity,
     clippy::too_many_arguments
 )]
+impl<T: ::eomgen_runtime::lane::Pack> Ur5<T> {
+    fn mass_matrix_unpacked(
+        &self,
+        q: &[T; 6],
+        out: &mut [[[<T as ::eomgen_runtime::lane::Pack>::Scalar; 6]; 6]],
+    ) {
+        let ([s1, s2, s3, s4, s5], [c1, c2, c3, c4, c5]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+        ]);
+        let (
+            t0,
+            t1,
+            t2,
+            t3,
+            t4,
+            t5,
+            t6,
+            t7,
+            t8,
+            t9,
+            t10,
+            t11,
+            t12,
+            t13,
+            t14,
+            t15,
+            t16,
+            t17,
+            t18,
+            t19,
+            t20,
+            t21,
+            t22,
+            t23,
+            t24,
+            t25,
+            t26,
+            t27,
+            t28,
+            t29,
+            t30,
+            t31,
+            t32,
+            t33,
+            t34,
+            t35,
+            t36,
+            t37,
+            t38,
+            t39,
+            t40,
+            t41,
+            t42,
+            t43,
+            t44,
+            t45,
+            t46,
+            t47,
+            t48,
+            t49,
+            t50,
+            t51,
+            t52,
+            t53,
+            t54,
+            t55,
+            t56,
+            t57,
+            t58,
+            t59,
+            t60,
+            t61,
+            t62,
+            t63,
+        ) = {
+            let t0 = s1;
+            let t1 = c1;
+            let t2 = s2;
+            let t3 = c2;
+            let t4 = s3;
+            let t5 = c3;
+            let t6 = s4;
+            let t7 = c4;
+            let t8 = s5;
+            let t9 = c5;
+            let t10 = t2 * t5;
+            let t11 = T::from_f64(0.0171364731454) * t7;
+            let t12 = t6 * t8 * t9;
+            let t13 = t8 * t8;
+            let t14 = t9 * t9;
+            let t15 = t3 * t5;
+            let t16 = t5 * t7 * t8 * t9;
+            let t17 = t4 * t7 * t8 * t9;
+            let t18 = T::mul_add(
+                T::from_f64(0.017784735),
+                t4,
+                -T::from_f64(1.598759275),
+            );
+            let t19 = T::from_f64(0.016685526854599998) * t12;
+            let t20 = T::mul_add(
+                T::from_f64(0.033822),
+                t14,
+                T::from_f64(0.0171364731454) * t13,
+            );
+            let t21 = T::mul_add(
+                T::from_f64(0.016685526854599998),
+                t12,
+                -T::from_f64(0.0016539803549999999),
+            );
+            let t22 = t3 * t18;
+            let t23 = T::from_f64(0.017784735) * (T::mul_add(t2, t4, -t15));
+            let t24 = T::from_f64(0.017784735) * (T::mul_add(t3, t4, t10));
+            let t25 = T::mul_add(
+                T::from_f64(0.0171364731454),
+                t14,
+                T::from_f64(0.033822) * t13,
+            ) + T::from_f64(0.11285608069875);
+            let t26 = t20 + T::from_f64(0.21942);
+            let t27 = t20 + T::from_f64(0.4510082781);
+            let t28 = T::mul_add(-t2, t18, T::from_f64(0.017784735) * t15);
+            let t29 = T::mul_add(T::from_f64(0.017784735), t10, t22);
+            let t30 = t1 * t28;
+            let t31 = T::mul_add(
+                t0,
+                T::from_f64(0.0171364731454) * (T::mul_add(-t3, t5 * t6, t2 * t4 * t6)),
+                -t1
+                    * (T::from_f64(0.0171364731454)
+                        * (T::mul_add(t2, t5 * t6, t3 * t4 * t6))),
+            );
+            let t32 = T::mul_add(t6, t6 * t25, T::from_f64(0.12999255384415) * t7 * t7);
+            let t33 = T::mul_add(-t6, t7 * t25, T::from_f64(0.12999255384415) * t6 * t7);
+            let t34 = T::mul_add(-t5, t27, T::from_f64(0.016685526854599998) * t17);
+            let t35 = t0
+                * (T::mul_add(-T::from_f64(0.017784735), t10, -t22)
+                    + T::from_f64(4.4329225));
+            let t36 = T::mul_add(-t5, t26, T::from_f64(0.016685526854599998) * t17);
+            let t37 = T::mul_add(t4, t26, T::from_f64(0.016685526854599998) * t16);
+            let t38 = T::mul_add(t7, t7 * t25, T::from_f64(0.12999255384415) * t6 * t6)
+                + T::from_f64(0.123341033631);
+            let t39 = T::mul_add(
+                -T::from_f64(0.0139521246075),
+                t4,
+                t32 + T::from_f64(0.51519389364975),
+            );
+            let t40 = T::mul_add(
+                -T::from_f64(0.00697606230375),
+                t4,
+                t32 + T::from_f64(0.111172755531),
+            );
+            let t41 = T::mul_add(t5, t21, t4 * t33);
+            let t42 = T::mul_add(-t4, t21, t5 * t33);
+            let t43 = T::mul_add(
+                -T::from_f64(0.425),
+                t29,
+                t39 + T::from_f64(0.19163081355599998),
+            );
+            let t44 = T::mul_add(-T::from_f64(0.425), t24, t40);
+            let t45 = T::mul_add(-T::from_f64(0.016685526854599998), t16, t4 * t38);
+            let t46 = t42 - T::from_f64(0.051322656825);
+            let t47 = t3 * t41;
+            let t48 = t2 * t41;
+            let t49 = T::mul_add(
+                -t0,
+                T::mul_add(-t3, t37, t2 * t36),
+                t1 * (T::mul_add(t2, t37, t3 * t36)),
+            );
+            let t50 = T::mul_add(
+                t4,
+                T::mul_add(t4, t27, T::from_f64(0.016685526854599998) * t16),
+                t5 * (T::mul_add(t5, t38, T::from_f64(0.016685526854599998) * t17)),
+            );
+            let t51 = T::mul_add(t3, t46, -t48);
+            let t52 = T::mul_add(-T::from_f64(0.1197), t24, T::mul_add(t3, t42, -t48));
+            let t53 = T::mul_add(T::from_f64(0.1197), t23, -(T::mul_add(t2, t42, t47)));
+            let t54 = T::mul_add(
+                -T::from_f64(0.0139521246075),
+                t4,
+                T::mul_add(-t5, t34, t4 * t45) + T::from_f64(0.40402113811874996),
+            );
+            let t55 = t50 + T::from_f64(0.004095);
+            let t56 = T::mul_add(
+                T::from_f64(0.00697606230375),
+                t5,
+                -(T::mul_add(t4, t34, t5 * t45)),
+            );
+            let t57 = T::mul_add(T::from_f64(0.1197), t28, T::mul_add(t2, t46, t47));
+            let t58 = t54 + T::from_f64(0.19163081355599998);
+            let t59 = t2 * t56;
+            let t60 = t3 * t56;
+            let t61 = t1 * t57;
+            let t62 = T::mul_add(-t2, t55, t60);
+            let t63 = T::mul_add(
+                -t0,
+                T::mul_add(
+                    -T::from_f64(0.1197),
+                    t29,
+                    t51 + T::from_f64(0.19371331275000003),
+                ),
+                -t61,
+            );
+            (
+                t0,
+                t1,
+                t2,
+                t3,
+                t4,
+                t5,
+                t6,
+                t7,
+                t8,
+                t9,
+                t10,
+                t11,
+                t12,
+                t13,
+                t14,
+                t15,
+                t16,
+                t17,
+                t18,
+                t19,
+                t20,
+                t21,
+                t22,
+                t23,
+                t24,
+                t25,
+                t26,
+                t27,
+                t28,
+                t29,
+                t30,
+                t31,
+                t32,
+                t33,
+                t34,
+                t35,
+                t36,
+                t37,
+                t38,
+                t39,
+                t40,
+                t41,
+                t42,
+                t43,
+                t44,
+                t45,
+                t46,
+                t47,
+                t48,
+                t49,
+                t50,
+                t51,
+                t52,
+                t53,
+                t54,
+                t55,
+                t56,
+                t57,
+                t58,
+                t59,
+                t60,
+                t61,
+                t62,
+                t63,
+            )
+        };
+        let (t64, t65, t66, t67, t68, t69, t70, t71, t72, t73, t74) = {
+            let t64 = T::mul_add(-t0, T::mul_add(-T::from_f64(0.1197), t29, t51), -t61);
+            let t65 = T::mul_add(
+                -T::from_f64(0.13585),
+                T::mul_add(t1, t23, t0 * t24),
+                T::mul_add(-t0, t52, t1 * t53),
+            );
+            let t66 = T::mul_add(t3, t58, -t59);
+            let t67 = T::mul_add(T::from_f64(0.13585), t30 + t35, t63);
+            let t68 = T::mul_add(T::from_f64(0.13585), T::mul_add(-t0, t29, t30), t64);
+            let t69 = T::mul_add(
+                t3,
+                T::mul_add(t3, t55, t59),
+                t2 * (T::mul_add(t2, t58, t60)),
+            );
+            let t70 = T::mul_add(
+                -T::from_f64(0.85),
+                t29,
+                T::mul_add(-t2, t62, t3 * t66) + T::from_f64(0.9241220958009998),
+            );
+            let t71 = T::mul_add(
+                T::from_f64(0.425),
+                t28,
+                -(T::mul_add(-t3, t62, -t2 * t66)),
+            );
+            let t72 = T::mul_add(-t0, t69 + T::from_f64(0.054004433300999945), t1 * t71);
+            let t73 = T::mul_add(-t1, t70 + T::from_f64(0.8849018759100001), t0 * t71);
+            let t74 = T::mul_add(-t0, t72, -t1 * t73) + T::from_f64(0.12816210104175002);
+            (t64, t65, t66, t67, t68, t69, t70, t71, t72, t73, t74)
+        };
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                t74,
+                t67,
+                t68,
+                t65,
+                t49,
+                t31,
+                t67,
+                T::mul_add(
+                    -T::from_f64(0.85),
+                    t29,
+                    t39 + T::from_f64(1.0768558760559999),
+                ) + T::from_f64(0.8849018759100001),
+            ],
+            out,
+            0,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[t43, t44, t19, t11, t68, t43, t39 + T::from_f64(0.19163081355599998), t40],
+            out,
+            8,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[t19, t11, t65, t44, t40, t32 + T::from_f64(0.111172755531), t19, t11],
+            out,
+            16,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[t49, t19, t19, t19, t26, T::zero(), t31, t11],
+            out,
+            24,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[t11, t11, T::zero(), T::from_f64(0.0171364731454)],
+            out,
+            32,
+        );
+    }
+    fn center_of_mass_jacobian_unpacked(
+        &self,
+        q: &[T; 6],
+        out: &mut [[[<T as ::eomgen_runtime::lane::Pack>::Scalar; 6]; 3]],
+    ) {
+        let ([s0, s1, s2, s3], [c0, c1, c2, c3]) = <T as ::eomgen_runtime::Lane>::sin_cos_many([
+            q[0],
+            q[1],
+            q[2],
+            q[3],
+        ]);
+        let t0 = s0;
+        let t1 = c0;
+        let t2 = s1;
+        let t3 = c1;
+        let t4 = s2;
+        let t5 = c2;
+        let t6 = s3;
+        let t7 = c3;
+        let t8 = T::mul_add(T::from_f64(0.017784735), t6, -T::from_f64(1.598759275));
+        let t9 = T::mul_add(t1, t3 * t4, t1 * t2 * t5);
+        let t10 = T::mul_add(t0, t3 * t4, t0 * t2 * t5);
+        let t11 = T::mul_add(-t2, t4, t3 * t5);
+        let t12 = (T::mul_add(-t1, t3 * t5, t1 * t2 * t4)) * t7;
+        let t13 = (T::mul_add(-t0, t3 * t5, t0 * t2 * t4)) * t7;
+        let t14 = (T::mul_add(t2, t5, t3 * t4)) * t7;
+        let t15 = T::mul_add(-t4, t8, T::from_f64(0.017784735) * t5 * t7);
+        let t16 = T::mul_add(
+            t5,
+            t8,
+            T::mul_add(T::from_f64(0.017784735), t4 * t7, -T::from_f64(4.4329225)),
+        );
+        let t17 = T::mul_add(t3, t16, t2 * t15);
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::mul_add(
+                    T::from_f64(0.058844644254703156),
+                    t0 * t17,
+                    -T::from_f64(0.07945087855053873) * t1,
+                ),
+                T::from_f64(0.058844644254703156)
+                    * (T::mul_add(-t1, t3 * t15, t1 * t2 * t16)),
+                T::mul_add(
+                    T::from_f64(0.058844644254703156),
+                    t9 * t8,
+                    T::from_f64(0.001046536404239168) * t12,
+                ),
+                T::from_f64(0.001046536404239168) * (T::mul_add(t9, t6, t12)),
+                T::zero(),
+                T::zero(),
+                T::mul_add(
+                    -T::from_f64(0.058844644254703156),
+                    t1 * t17,
+                    -T::from_f64(0.07945087855053873) * t0,
+                ),
+                T::from_f64(0.058844644254703156)
+                    * (T::mul_add(-t0, t3 * t15, t0 * t2 * t16)),
+            ],
+            out,
+            0,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(
+            &[
+                T::mul_add(
+                    T::from_f64(0.058844644254703156),
+                    t10 * t8,
+                    T::from_f64(0.001046536404239168) * t13,
+                ),
+                T::from_f64(0.001046536404239168) * (T::mul_add(t10, t6, t13)),
+                T::zero(),
+                T::zero(),
+                T::zero(),
+                T::from_f64(0.058844644254703156) * t17,
+                T::mul_add(
+                    T::from_f64(0.058844644254703156),
+                    t11 * t8,
+                    T::from_f64(0.001046536404239168) * t14,
+                ),
+                T::from_f64(0.001046536404239168) * (T::mul_add(t11, t6, t14)),
+            ],
+            out,
+            8,
+        );
+        ::eomgen_runtime::lane::Pack::unpack_run(&[T::zero(), T::zero()], out, 16);
+    }
+}
+#[allow(
+    unused_variables,
+    clippy::approx_constant,
+    clippy::excessive_precision,
+    clippy::unreadable_literal,
+    clippy::neg_multiply,
+    clippy::double_parens,
+    clippy::identity_op,
+    clippy::needless_range_loop,
+    clippy::let_and_return,
+    clippy::type_complexity,
+    clippy::too_many_arguments
+)]
 impl<T: ::eomgen_runtime::batch::Batch> Ur5<T> {
     /// This robot's parameters in every lane of `L` (a vector of states such as
     /// `wide::f64x4`, with `eomgen_runtime`'s `simd` feature): the robot whose
@@ -6804,13 +7243,11 @@ impl<T: ::eomgen_runtime::batch::Batch> Ur5<T> {
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
             out,
             &|start: usize, out: &mut [[[T; 6]; 6]]| {
-                let r = <Ur5<
-                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
-                > as ::eomgen_runtime::Dynamics<
-                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
-                    6,
-                >>::mass_matrix(&robot, &::eomgen_runtime::batch::gather(q, start));
-                ::eomgen_runtime::batch::scatter_matrix(&r, out);
+                robot
+                    .mass_matrix_unpacked(
+                        &::eomgen_runtime::batch::gather(q, start),
+                        out,
+                    );
             },
         );
         Ok(())
@@ -7108,13 +7545,11 @@ impl<T: ::eomgen_runtime::batch::Batch> Ur5<T> {
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
             out,
             &|start: usize, out: &mut [[[T; 6]; 3]]| {
-                let r = Ur5::<
-                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
-                >::center_of_mass_jacobian(
-                    &robot,
-                    &::eomgen_runtime::batch::gather(q, start),
-                );
-                ::eomgen_runtime::batch::scatter_matrix(&r, out);
+                robot
+                    .center_of_mass_jacobian_unpacked(
+                        &::eomgen_runtime::batch::gather(q, start),
+                        out,
+                    );
             },
         );
         Ok(())

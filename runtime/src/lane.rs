@@ -408,6 +408,28 @@ pub trait Pack: Lane {
     fn unpack(v: &[Self], states: &mut [Self::Scalar]) {
         unpack_each(v, states);
     }
+    /// The run `v` of the entries `at..at + v.len()` (row-major) of the `R x C` matrices of the
+    /// first `LANES` states of `states`: lane `l` of `v[j]` goes to entry `at + j` of
+    /// `states[l]` (entries past the matrix's end are dropped). A generated batch method
+    /// writes its result run by run as its last statements compute it, so that the result
+    /// never goes through an array of vectors; with `R`, `C` and `at` constants, no index is
+    /// checked at run time.
+    ///
+    /// ```
+    /// use eomgen_runtime::lane::Pack;
+    ///
+    /// let mut states = [[[0.0_f64; 2]; 2]];
+    /// f64::unpack_run(&[1.5, 2.5], &mut states, 1);
+    /// assert_eq!(states, [[[0.0, 1.5], [2.5, 0.0]]]);
+    /// ```
+    #[inline(always)]
+    fn unpack_run<const R: usize, const C: usize>(
+        v: &[Self],
+        states: &mut [[[Self::Scalar; C]; R]],
+        at: usize,
+    ) {
+        unpack_run_each(v, states, at);
+    }
 }
 
 /// [`Pack::pack`] lane by lane (what vectors without a transposition of their own use).
@@ -433,6 +455,22 @@ pub(crate) fn unpack_each<L: Pack>(v: &[L], states: &mut [L::Scalar]) {
     for (j, x) in v.iter().enumerate() {
         for (state, y) in states.chunks_exact_mut(n).zip(x.lanes().as_ref()) {
             if let Some(o) = state.get_mut(j) {
+                *o = *y;
+            }
+        }
+    }
+}
+
+/// [`Pack::unpack_run`] lane by lane.
+#[inline(always)]
+pub(crate) fn unpack_run_each<L: Pack, const R: usize, const C: usize>(
+    v: &[L],
+    states: &mut [[[L::Scalar; C]; R]],
+    at: usize,
+) {
+    for (j, x) in v.iter().enumerate() {
+        for (state, y) in states.iter_mut().zip(x.lanes().as_ref()) {
+            if let Some(o) = state.as_flattened_mut().get_mut(at + j) {
                 *o = *y;
             }
         }

@@ -160,6 +160,18 @@ fn derivatives_in_batches_fixed_and_floating() {
         .unwrap();
     let mut acc = vec![[0.0; 18]; STATES];
     robot.forward_dynamics_batch(&q, &v, &a, &mut acc).unwrap();
+    // Written run by run from the lanes' straight-line body (`mass_matrix_unpacked`).
+    let mut m = vec![z; STATES];
+    robot.mass_matrix_batch(&q, &mut m).unwrap();
+    for i in 0..STATES {
+        assert_close(
+            "floating mass_matrix",
+            i,
+            &m[i],
+            &robot.mass_matrix(&q[i]),
+            0.0,
+        );
+    }
     let mut next = vec![[0.0; 19]; STATES];
     robot.integrate_batch(&q, &v, 0.01, &mut next).unwrap();
     for i in 0..STATES {
@@ -338,6 +350,47 @@ fn pack_round_trip<L: Pack>(from: impl Fn(f64) -> L::Scalar) {
             }
         }
     }
+}
+
+/// `Pack::unpack_run` of `L` against lane-by-lane writing: runs of every length from 1 to 9
+/// (whole transposed blocks and the entries past them) at several offsets of a 3 x 5 matrix,
+/// runs reaching past its end (dropped), whole and partial vectors of states, NaN lanes next to
+/// finite ones, bit for bit; nothing else of the states is written.
+fn unpack_run_writes_its_entries<L: Pack>(from: impl Fn(f64) -> L::Scalar) {
+    let mut numbers = Numbers(9);
+    for len in 1..=9 {
+        for at in [0, 1, 4, 7, 13] {
+            for count in 0..=L::LANES {
+                let full = run_of_states(len, L::LANES, &mut numbers);
+                let v: Vec<L> = (0..len)
+                    .map(|j| L::gather(|l| from(full[l * len + j])))
+                    .collect();
+                let mut states = vec![[[from(-2.0); 5]; 3]; count + 1];
+                L::unpack_run(&v, &mut states[..count], at);
+                for (l, state) in states.iter().enumerate() {
+                    for (k, got) in state.as_flattened().iter().enumerate() {
+                        let want = match k.checked_sub(at) {
+                            Some(j) if j < len && l < count => from(full[l * len + j]),
+                            _ => from(-2.0),
+                        };
+                        assert_eq!(
+                            got.to_f64().to_bits(),
+                            want.to_f64().to_bits(),
+                            "run of {len} at {at}, {count} states: state {l}, entry {k}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn unpack_run_transposes_whole_and_partial_vectors() {
+    unpack_run_writes_its_entries::<f64x4>(|x| x);
+    unpack_run_writes_its_entries::<f32x8>(|x| x as f32);
+    unpack_run_writes_its_entries::<wide::f64x2>(|x| x);
+    unpack_run_writes_its_entries::<f64>(|x| x);
 }
 
 #[test]

@@ -49,6 +49,18 @@ pub(super) fn body(
         let (code, blocks) = split_body(cx, &program, shape, split);
         return Body { code, ops, blocks };
     }
+    let (lets, outs) = statements(cx, &program);
+    let result = shaped(&outs, shape);
+    Body {
+        code: quote!(#lets #result),
+        ops,
+        blocks: Vec::new(),
+    }
+}
+
+/// A program's statements (the sines and cosines, then the temporaries) and its outputs'
+/// expressions.
+fn statements(cx: &Ctx<'_>, program: &Program) -> (TokenStream, Vec<TokenStream>) {
     let mut trig = BTreeSet::new();
     let defs: Vec<(Ident, TokenStream)> = program
         .temps
@@ -63,12 +75,47 @@ pub(super) fn body(
         .map(|e| cx.expr(e, &mut trig).ts)
         .collect();
     let pre = trig_lets(&trig);
-    let result = shaped(&outs, shape);
-    Body {
-        code: quote!(#(#pre)* #(#temps)* #result),
-        ops,
-        blocks: Vec::new(),
-    }
+    (quote!(#(#pre)* #(#temps)*), outs)
+}
+
+/// Entries per `Pack::unpack_run` of [`unpacked_body`]: a whole number of vectors of four and
+/// of eight lanes.
+const RUN: usize = 8;
+
+/// [`body`]'s program for a vector of states (`T: Pack`), ending in the writing of its result
+/// run by run into one slice of states per matrix of `shape`, `out` or `out_0`, `out_1`, ...
+/// (`&mut [[[T::Scalar; C]; R]]`, one matrix per state), by `Pack::unpack_run` on the
+/// outputs' expressions: the result never goes through an array of vectors. The same
+/// operations as [`body`], so the same bits per lane. (Each run written as soon as its
+/// temporaries were computed, instead of at the end, was no faster.)
+pub(super) fn unpacked_body(g: &Graph, cx: &Ctx<'_>, outputs: &[Id], shape: Shape) -> TokenStream {
+    let program = Program::ordered(g, outputs, Order::Levels);
+    let program = if program.ops().total() > DEPTH_ORDER_MIN_OPS {
+        Program::ordered(g, outputs, Order::Depth)
+    } else {
+        program
+    };
+    let (lets, outs) = statements(cx, &program);
+    let (k, size) = match shape {
+        Shape::Matrices(k, r, c) => (k, r * c),
+        _ => (1, outs.len()),
+    };
+    let runs = outs
+        .chunks(size.max(1))
+        .take(k)
+        .enumerate()
+        .flat_map(|(m, entries)| {
+            let out = if k == 1 {
+                format_ident!("out")
+            } else {
+                format_ident!("out_{}", m)
+            };
+            entries.chunks(RUN).enumerate().map(move |(r, run)| {
+                let at = Literal::usize_unsuffixed(r * RUN);
+                quote!(::eomgen_runtime::lane::Pack::unpack_run(&[#(#run),*], #out, #at);)
+            })
+        });
+    quote!(#lets #(#runs)*)
 }
 
 /// Temporaries go in chunks: `let (t0, .., t63) = { let t0 = ..; ..; (t0, .., t63) };`.

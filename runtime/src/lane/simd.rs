@@ -10,14 +10,14 @@
 //! at once, bit for bit again; single sines and cosines, and the `f32` vectors', are `wide`'s
 //! polynomial approximations, which differ from `libm`'s in the last bits.
 
-use super::{pack_each, scalar_check, unpack_each, Lane, LaneError, Pack};
+use super::{pack_each, scalar_check, unpack_each, unpack_run_each, Lane, LaneError, Pack};
 use crate::FactorError;
 use wide::{f32x4, f32x8, f64x2, f64x4};
 
 mod transpose;
 
 macro_rules! impl_lane {
-    ($v:ident, $s:ident, $n:literal, $pack:path, $unpack:path, $many:path) => {
+    ($v:ident, $s:ident, $n:literal, $pack:path, $unpack:path, $run:path, $many:path) => {
         impl Lane for $v {
             const LANES: usize = $n;
             type Mask = $v;
@@ -158,26 +158,52 @@ macro_rules! impl_lane {
             fn unpack(v: &[Self], states: &mut [$s]) {
                 $unpack(v, states);
             }
+            #[inline(always)]
+            fn unpack_run<const R: usize, const C: usize>(
+                v: &[Self],
+                states: &mut [[[$s; C]; R]],
+                at: usize,
+            ) {
+                $run(v, states, at);
+            }
         }
     };
 }
 
-impl_lane!(f64x2, f64, 2, pack_each, unpack_each, sin_cos_flat);
+impl_lane!(
+    f64x2,
+    f64,
+    2,
+    pack_each,
+    unpack_each,
+    unpack_run_each,
+    sin_cos_flat
+);
 impl_lane!(
     f64x4,
     f64,
     4,
     transpose::pack_f64x4,
     transpose::unpack_f64x4,
+    transpose::unpack_run_f64x4,
     sin_cos_flat
 );
-impl_lane!(f32x4, f32, 4, pack_each, unpack_each, sin_cos_wide);
+impl_lane!(
+    f32x4,
+    f32,
+    4,
+    pack_each,
+    unpack_each,
+    unpack_run_each,
+    sin_cos_wide
+);
 impl_lane!(
     f32x8,
     f32,
     8,
     transpose::pack_f32x8,
     transpose::unpack_f32x8,
+    transpose::unpack_run_f32x8,
     sin_cos_wide
 );
 

@@ -7,8 +7,17 @@ use quote::{format_ident, quote};
 use super::items::Fields;
 use super::traits::Trait;
 use super::{allow_lints, usize_lit, Emitter};
+use crate::cas::OpCount;
 use crate::dynamics::{Evaluation, Input, Quantity, Shape};
 use crate::emit::body::shape_type;
+
+/// The most operations per entry of its result for which a quantity's batch method writes the
+/// states' results from its own copy of the straight-line body ([`Emitter::unpacks`]): an
+/// 18 x 18 mass matrix of `f64x4` is 10 kB, which the lanes' method wrote and the unpacking
+/// read back (anymal, 1,010 operations for 324 entries: 9.0 -> 10.3 million states per
+/// second in `f64x4`, 17.5 -> 23 in `f32x8`); a Coriolis matrix (the panda's: 2,606
+/// operations for 81 entries) would add 2,600 lines to the file for little.
+const UNPACKED_MAX_OPS_PER_ENTRY: usize = 8;
 
 /// The lane type of a batch method: the widest vector of `T`.
 fn lanes() -> TokenStream {
@@ -73,7 +82,22 @@ impl Emitter<'_> {
             .iter()
             .filter(|q| self.lanes.contains(q.name))
             .map(|q| self.batch_fn(q));
+        let unpacked: Vec<TokenStream> = self
+            .quantities
+            .iter()
+            .filter(|q| self.unpacks(q))
+            .map(|q| self.unpacked_fn(q))
+            .collect();
+        let unpacked = (!unpacked.is_empty()).then(|| {
+            quote! {
+                #allow
+                impl<T: ::eomgen_runtime::lane::Pack> #ty<T> {
+                    #(#unpacked)*
+                }
+            }
+        });
         quote! {
+            #unpacked
             #allow
             impl<T: ::eomgen_runtime::batch::Batch> #ty<T> {
                 /// This robot's parameters in every lane of `L` (a vector of states such as
@@ -86,6 +110,52 @@ impl Emitter<'_> {
                     }
                 }
                 #(#methods)*
+            }
+        }
+    }
+
+    /// Whether `q`'s batch method computes each vector of states by `{name}_unpacked`, which
+    /// writes the states' results straight from the straight-line body
+    /// ([`crate::emit::body::unpacked_body`]) instead of through the lanes' result: matrices
+    /// from one body that is not split, outside the derivatives, of at most `N x N` entries
+    /// and [`UNPACKED_MAX_OPS_PER_ENTRY`] operations per entry. The body is a second copy of
+    /// the quantity's, which each user's crate parses and checks: it pays where the result is
+    /// large for its arithmetic (a mass matrix), not for a Coriolis matrix or Craig's `B(q)`.
+    fn unpacks(&self, q: &Quantity) -> bool {
+        let entries = q.shape.len();
+        let nv = self.model.nv();
+        let small = |ops: OpCount| {
+            entries <= nv * nv && ops.total() <= UNPACKED_MAX_OPS_PER_ENTRY * entries
+        };
+        self.lanes.contains(q.name)
+            && matches!(q.eval, Evaluation::Exprs(_))
+            && matches!(q.shape, Shape::Matrix(..) | Shape::Matrices(..))
+            && !self.split.contains(q.name)
+            && !self.derivatives.contains(q.name)
+            && self
+                .counts
+                .iter()
+                .any(|(name, ops)| name == q.name && small(*ops))
+    }
+
+    /// `fn {name}_unpacked(&self, inputs..., out...)` for `T: Pack`: `q`'s straight-line body
+    /// on one vector of states, writing each state's result into `out` (row-major, one state
+    /// after another; one slice per matrix of a tuple).
+    fn unpacked_fn(&self, q: &Quantity) -> TokenStream {
+        let Evaluation::Exprs(ids) = &q.eval else {
+            return TokenStream::new();
+        };
+        let f = format_ident!("{}_unpacked", q.name);
+        let params = self.args(q.inputs);
+        let outs = outputs(q.shape).names;
+        let (r, c) = match q.shape {
+            Shape::Matrix(r, c) | Shape::Matrices(_, r, c) => (usize_lit(r), usize_lit(c)),
+            _ => return TokenStream::new(),
+        };
+        let body = crate::emit::body::unpacked_body(self.graph, &self.cx, ids, q.shape);
+        quote! {
+            fn #f(&self, #(#params,)* #(#outs: &mut [[[<T as ::eomgen_runtime::lane::Pack>::Scalar; #c]; #r]]),*) {
+                #body
             }
         }
     }
@@ -160,6 +230,17 @@ impl Emitter<'_> {
             q.name, first
         );
         let l = lanes();
+        let evaluate = if self.unpacks(q) {
+            let f = format_ident!("{}_unpacked", q.name);
+            quote! {
+                robot.#f(#(#call_args,)* #(#outs),*);
+            }
+        } else {
+            quote! {
+                let r = #path(&robot, #(#call_args),*);
+                #(#scatters)*
+            }
+        };
         quote! {
             #[doc = #doc]
             pub fn #f(&self, #(#inputs: &[[T; #input_types]],)* #dt #(#outs: &mut [#out_types]),*) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
@@ -167,8 +248,7 @@ impl Emitter<'_> {
                 let robot = self.in_lanes::<#l>();
                 #dt_lanes
                 ::eomgen_runtime::batch::run(<#l as ::eomgen_runtime::Lane>::LANES, #passed, &|start: usize, #pattern| {
-                    let r = #path(&robot, #(#call_args),*);
-                    #(#scatters)*
+                    #evaluate
                 });
                 Ok(())
             }

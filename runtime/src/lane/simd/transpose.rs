@@ -112,6 +112,57 @@ fn unpack_blocks<V: Copy, S: Copy, const W: usize>(
     }
 }
 
+/// Unpacks the run `v` of entries `at..at + v.len()` of the `R x C` matrices of the first
+/// `W` states of `states`: `W` entries at a time by `transpose`, the rest by `lanes`
+/// ([`Pack::unpack_run`](super::Pack::unpack_run)). A whole vector of states, the usual case,
+/// goes through an array of `W` states, whose stores need no test of how many states there
+/// are (such tests were a sixth of anymal's `f64x4` mass matrix batch); fewer states, lane by
+/// lane.
+#[inline(always)]
+fn unpack_run_blocks<V: Copy, S: Copy, const W: usize, const R: usize, const C: usize>(
+    (v, states, at): (&[V], &mut [[[S; C]; R]], usize),
+    transpose: impl Fn(&[V; W]) -> [[S; W]; W],
+    lanes: impl Fn(V) -> [S; W],
+) {
+    let Some(Ok(states)) = states.get_mut(..W).map(<&mut [[[S; C]; R]; W]>::try_from) else {
+        return unpack_run_lanes(v, states, at, lanes);
+    };
+    // The entries past the matrix's end are dropped.
+    let v = v.get(..(R * C).saturating_sub(at)).unwrap_or(v);
+    let blocks = v.chunks_exact(W);
+    let rest = blocks.remainder();
+    for (k, block) in blocks.enumerate() {
+        let Ok(block) = <&[V; W]>::try_from(block) else {
+            continue;
+        };
+        let from = at + k * W;
+        for (state, row) in states.iter_mut().zip(transpose(block)) {
+            let run = state.as_flattened_mut().get_mut(from..from + W);
+            if let Some(Ok(run)) = run.map(<&mut [S; W]>::try_from) {
+                *run = row;
+            }
+        }
+    }
+    unpack_run_lanes(rest, states, at + v.len() - rest.len(), lanes);
+}
+
+/// The run `v` at `at` of each state of `states` lane by lane (up to `W` states).
+#[inline(always)]
+fn unpack_run_lanes<V: Copy, S: Copy, const W: usize, const R: usize, const C: usize>(
+    v: &[V],
+    states: &mut [[[S; C]; R]],
+    at: usize,
+    lanes: impl Fn(V) -> [S; W],
+) {
+    for (j, x) in v.iter().enumerate() {
+        for (state, y) in states.iter_mut().zip(lanes(*x)) {
+            if let Some(o) = state.as_flattened_mut().get_mut(at + j) {
+                *o = y;
+            }
+        }
+    }
+}
+
 /// The 4 x 4 transposition: lane `l` of vector `i` to lane `i` of vector `l` (4 unpacks, 4
 /// lane permutations).
 #[cfg(target_feature = "avx")]
@@ -156,6 +207,20 @@ pub(super) fn unpack_f64x4(v: &[f64x4], states: &mut [f64]) {
     );
 }
 
+/// [`Pack::unpack_run`](super::Pack::unpack_run) of `f64x4`.
+#[inline(always)]
+pub(super) fn unpack_run_f64x4<const R: usize, const C: usize>(
+    v: &[f64x4],
+    states: &mut [[[f64; C]; R]],
+    at: usize,
+) {
+    unpack_run_blocks(
+        (v, states, at),
+        |b| transpose4(b).map(f64x4::to_array),
+        f64x4::to_array,
+    );
+}
+
 /// [`Pack::pack`](super::Pack::pack) of `f32x8` (`wide`'s transposition: shuffles on AVX,
 /// lane by lane elsewhere).
 #[inline(always)]
@@ -174,6 +239,20 @@ pub(super) fn unpack_f32x8(v: &[f32x8], states: &mut [f32]) {
     unpack_blocks(
         v,
         states,
+        |b| f32x8::transpose(*b).map(f32x8::to_array),
+        f32x8::to_array,
+    );
+}
+
+/// [`Pack::unpack_run`](super::Pack::unpack_run) of `f32x8`.
+#[inline(always)]
+pub(super) fn unpack_run_f32x8<const R: usize, const C: usize>(
+    v: &[f32x8],
+    states: &mut [[[f32; C]; R]],
+    at: usize,
+) {
+    unpack_run_blocks(
+        (v, states, at),
         |b| f32x8::transpose(*b).map(f32x8::to_array),
         f32x8::to_array,
     );
