@@ -192,10 +192,16 @@ pub(crate) fn contact_space<T: Real, const N: usize, const K: usize>(
     // W^T D^-1 W as N rank-one updates, one per coordinate: the K x K sums are independent
     // chains the processor overlaps (gathered row by row, each row was a chain of N dependent
     // multiply-adds, and they were a sixth of a quadruped's contact dynamics).
+    // A coordinate's row of `W` is zero in the contact rows outside its subtree (a leg joint
+    // moves its own foot only): those rows of the update are skipped. (A non-finite entry
+    // still reaches `lambda`: through its own row, onto the diagonal.)
     let mut lambda = [[T::zero(); K]; K];
     for (i, wi) in w.iter().enumerate() {
         let d = T::one() / m[i][i];
         for (lr, wir) in lambda.iter_mut().zip(wi) {
+            if *wir == T::zero() {
+                continue;
+            }
             let s = *wir * d;
             for (l, x) in lr.iter_mut().zip(wi) {
                 *l = s.mul_add(*x, *l);
