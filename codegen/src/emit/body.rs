@@ -40,11 +40,7 @@ pub(super) fn body(
     let program = Program::ordered(g, outputs, Order::Levels);
     let ops = program.ops();
     let over = split.filter(|s| s.filled || ops.total() > s.budget);
-    let program = if ops.total() > DEPTH_ORDER_MIN_OPS || over.is_some() {
-        Program::ordered(g, outputs, Order::Depth)
-    } else {
-        program
-    };
+    let program = scheduled(g, outputs, program, over.is_some());
     if let Some(split) = over {
         let (code, blocks) = split_body(cx, &program, shape, split);
         return Body { code, ops, blocks };
@@ -55,6 +51,15 @@ pub(super) fn body(
         code: quote!(#lets #result),
         ops,
         blocks: Vec::new(),
+    }
+}
+
+/// `program` (in level order), or the same outputs depth first when it is large or `split`.
+fn scheduled(g: &Graph, outputs: &[Id], program: Program, split: bool) -> Program {
+    if split || program.ops().total() > DEPTH_ORDER_MIN_OPS {
+        Program::ordered(g, outputs, Order::Depth)
+    } else {
+        program
     }
 }
 
@@ -90,11 +95,7 @@ const RUN: usize = 8;
 /// temporaries were computed, instead of at the end, was no faster.)
 pub(super) fn unpacked_body(g: &Graph, cx: &Ctx<'_>, outputs: &[Id], shape: Shape) -> TokenStream {
     let program = Program::ordered(g, outputs, Order::Levels);
-    let program = if program.ops().total() > DEPTH_ORDER_MIN_OPS {
-        Program::ordered(g, outputs, Order::Depth)
-    } else {
-        program
-    };
+    let program = scheduled(g, outputs, program, false);
     let (lets, outs) = statements(cx, &program);
     let (k, size) = match shape {
         Shape::Matrices(k, r, c) => (k, r * c),

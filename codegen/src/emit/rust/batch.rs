@@ -123,10 +123,9 @@ impl Emitter<'_> {
     /// large for its arithmetic (a mass matrix), not for a Coriolis matrix or Craig's `B(q)`.
     fn unpacks(&self, q: &Quantity) -> bool {
         let entries = q.shape.len();
-        let nv = self.model.nv();
-        let small = |ops: OpCount| {
-            entries <= nv * nv && ops.total() <= UNPACKED_MAX_OPS_PER_ENTRY * entries
-        };
+        let n = self.parents.len();
+        let small =
+            |ops: OpCount| entries <= n * n && ops.total() <= UNPACKED_MAX_OPS_PER_ENTRY * entries;
         self.lanes.contains(q.name)
             && matches!(q.eval, Evaluation::Exprs(_))
             && matches!(q.shape, Shape::Matrix(..) | Shape::Matrices(..))
