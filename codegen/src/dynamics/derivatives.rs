@@ -10,7 +10,9 @@
 use super::lagrangian::Friction;
 use super::ltdl::Factors;
 use super::newton_euler::JointTree;
-use super::rnea_derivatives::{inverse_dynamics_derivatives, InverseDynamicsDerivatives};
+use super::rnea_derivatives::{
+    add_friction_rates, gravity_efforts, rigid_derivatives, InverseDynamicsDerivatives,
+};
 use super::Derivation;
 use crate::cas::{Graph, Id};
 use crate::kinematics::const_v3;
@@ -57,27 +59,42 @@ pub fn derive(d: &mut Derivation, model: &Model) -> Derivatives {
     } else {
         Friction::new(g, model, &params, &map, &joint_qd).joint
     };
-    let id = |g: &mut Graph, qdd: &[Id]| {
+    // The rigid bodies' derivatives (in the coordinates), then the friction's.
+    let rigid = |g: &mut Graph, qdd: &[Id]| {
         let joint_qdd = map.rates(g, qdd);
-        let r = inverse_dynamics_derivatives(g, &lm, grav, &joint_qd, &joint_qdd, &joint_friction);
+        let r = rigid_derivatives(g, &lm, grav, &joint_qd, &joint_qdd);
         if !map.is_coupled() {
             return r;
         }
         let dq = map.project_matrix(g, &r.dq, false);
-        let mut dqd = map.project_matrix(g, &r.dqd, false);
-        for (i, row) in dqd.iter_mut().enumerate() {
+        let dqd = map.project_matrix(g, &r.dqd, false);
+        InverseDynamicsDerivatives { dq, dqd }
+    };
+    let with_friction = |g: &mut Graph, mut r: InverseDynamicsDerivatives| {
+        if !map.is_coupled() {
+            add_friction_rates(g, &mut r.dqd, &joint_friction, &joint_qd);
+            return r;
+        }
+        for (i, row) in r.dqd.iter_mut().enumerate() {
             for (j, x) in row.iter_mut().enumerate() {
                 let df = g.diff(d.friction[i], d.qd[j]);
                 *x = g.add(*x, df);
             }
         }
-        InverseDynamicsDerivatives { dq, dqd }
+        r
     };
-    let inverse = id(g, &d.qdd);
+    let inverse = rigid(g, &d.qdd);
+    let rates = inverse.dqd.clone();
+    let inverse = with_friction(g, inverse);
     let factors = Factors::new(g, &parents, m);
     let mass_matrix_inverse = factors.inverse(g);
     let pivots = factors.pivots();
-    let at_fd = id(g, &d.fast.forward_dynamics);
+    let joint_gravity = gravity_efforts(g, &lm, grav);
+    let gravity = map.project(g, &joint_gravity);
+    let rhs = forward_rhs(g, &d.fast.tau_in, &rates, &d.qd, &gravity, &d.friction);
+    let qdd = factors.solve(g, &rhs);
+    let at_fd = rigid(g, &qdd);
+    let at_fd = with_friction(g, at_fd);
     let neg = |g: &mut Graph, a: &[Vec<Id>]| -> Vec<Vec<Id>> {
         a.iter()
             .map(|row| row.iter().map(|&x| g.neg(x)).collect())
@@ -97,6 +114,34 @@ pub fn derive(d: &mut Derivation, model: &Model) -> Derivatives {
         factors: factors.in_place(g),
         at_forward: at_fd,
     }
+}
+
+/// The right-hand side of forward dynamics, `tau - b - G - F`, from what the recursion
+/// computes anyway: `b = 1/2 (d b / d qd) qd` (`b` is quadratic in the rates; `rates` is the
+/// rigid bodies' `d tau / d qd`) and `G` from its composite inertias, instead of a second
+/// Newton-Euler pass for `b + G`: the panda's forward-dynamics derivatives 8,999 -> 8,447
+/// operations, anymal's `forward_dynamics_partials` 11,726 -> 10,736.
+fn forward_rhs(
+    g: &mut Graph,
+    tau: &[Id],
+    rates: &[Vec<Id>],
+    qd: &[Id],
+    gravity: &[Id],
+    friction: &[Id],
+) -> Vec<Id> {
+    (0..tau.len())
+        .map(|i| {
+            let products: Vec<(Id, f64)> = rates[i]
+                .iter()
+                .zip(qd)
+                .map(|(&c, &v)| (g.mul(c, v), -0.5))
+                .collect();
+            let minus_b = g.sum(0.0, products);
+            let h = g.add(gravity[i], friction[i]);
+            let rest = g.sub(tau[i], h);
+            g.add(rest, minus_b)
+        })
+        .collect()
 }
 
 /// `M^-1 B` column by column through the tree `L^T D L` factors of `M`.

@@ -594,7 +594,7 @@ pub fn derivatives(d: &Derivation, x: &Derivatives, flat_max_ops: usize) -> Vec<
     partials.extend(flat(&x.at_forward.dqd));
     partials.extend(flat(&x.factors));
     let (fd_route, fd_eval) = match factored(fd, flat_max_ops) {
-        Some(e) => ("Route: qdd as in `forward_dynamics`, `inverse_dynamics_derivatives` at (q, qd, qdd), then -M^-1 times them by substitutions through the one unrolled factorization of M, all in one straight-line body.", e),
+        Some(e) => ("Route: qdd from the factorization of M, with b = 1/2 (d tau / d qd) qd and G from the recursion's composite inertias, `inverse_dynamics_derivatives` at (q, qd, qdd), then -M^-1 times them by substitutions through the one unrolled factorization of M, all in one straight-line body.", e),
         None if ops(&d.graph, &partials) <= FORWARD_DYNAMICS_PARTIALS_MAX_OPS => ("Route: `forward_dynamics_partials` (d tau / d q and d tau / d qd at qdd = FD(q, qd, tau), and M's factors), then -M^-1 times them by substitutions of all columns at once (the passes of eomgen_runtime::tree::ltdl_substitute_rows, unrolled for this robot's tree), and M^-1 from the same factors, unrolled over the tree (eomgen_runtime::tree::ltdl_inverse_factored's operations).", Evaluation::ForwardDynamicsDerivatives { partials: true }),
         None => ("Route: one factorization of M (from `mass_matrix`, the tree L^T D L unrolled): qdd from it and `inverse_dynamics` at zero acceleration, `inverse_dynamics_derivatives` at (q, qd, qdd), then -M^-1 times them by substitutions of all columns at once (the passes of eomgen_runtime::tree::ltdl_substitute_rows, unrolled for this robot's tree), and M^-1 from the same factors, unrolled over the tree (eomgen_runtime::tree::ltdl_inverse_factored's operations).", Evaluation::ForwardDynamicsDerivatives { partials: false }),
     };
@@ -662,7 +662,7 @@ fn forward_dynamics_partials(n: usize, outputs: Vec<Id>) -> Quantity {
             "`eomgen_runtime::tree::ltdl_factor`). Valid when every pivot D_i is positive; then".into(),
             "d qdd / dx = -M^-1 d tau / dx.".into(),
         ],
-        route: "Route: qdd by the unrolled L^T D L solve of `forward_dynamics`, then Carpentier and Mansard's recursive derivatives of Newton-Euler there, one straight-line body.".into(),
+        route: "Route: qdd by an unrolled L^T D L solve (b = 1/2 (d tau / d qd) qd and G from the recursion's composite inertias, no second Newton-Euler pass), then Carpentier and Mansard's recursive derivatives of Newton-Euler there, one straight-line body.".into(),
         eval: Evaluation::Exprs(outputs),
     }
 }

@@ -214,6 +214,33 @@ pub fn inverse_dynamics_derivatives(
     qdd: &[Id],
     friction: &[Id],
 ) -> InverseDynamicsDerivatives {
+    let mut r = rigid_derivatives(g, lm, gravity, qd, qdd);
+    add_friction_rates(g, &mut r.dqd, friction, qd);
+    r
+}
+
+/// Adds the joint friction's `dF_x / dqd_x` to the diagonal of `d tau / d qd`.
+pub fn add_friction_rates(g: &mut Graph, dqd: &mut [Vec<Id>], friction: &[Id], qd: &[Id]) {
+    for x in 0..dqd.len() {
+        // No friction, nothing to differentiate (and `qd[x]` need not be a symbol then).
+        let df = match g.as_const(friction[x]) {
+            Some(_) => g.zero(),
+            None => g.diff(friction[x], qd[x]),
+        };
+        dqd[x][x] = g.add(dqd[x][x], df);
+    }
+}
+
+/// [`inverse_dynamics_derivatives`] of the rigid bodies alone (no friction): `d tau / d qd`
+/// is then `d b / d qd`, and since the bias `b` is quadratic in the rates,
+/// `b = 1/2 (d b / d qd) qd`.
+pub fn rigid_derivatives(
+    g: &mut Graph,
+    lm: &LocalModel,
+    gravity: V3,
+    qd: &[Id],
+    qdd: &[Id],
+) -> InverseDynamicsDerivatives {
     let n = qd.len();
     let p = pass(g, lm, gravity, qd, qdd);
     let comp = composites(g, lm);
@@ -229,12 +256,6 @@ pub fn inverse_dynamics_derivatives(
                 dq[y][x] = spatial_dot(g, sk, &v.own);
                 dqd[y][x] = spatial_dot(g, sk, &v.c);
             }
-            // No friction, nothing to differentiate (and `qd[x]` need not be a symbol then).
-            let df = match g.as_const(friction[x]) {
-                Some(_) => g.zero(),
-                None => g.diff(friction[x], qd[x]),
-            };
-            dqd[x][x] = g.add(dqd[x][x], df);
             // The ancestors' columns, carried up one body at a time.
             let mut b = j;
             while let Some(i) = lm.parent[b] {
@@ -257,6 +278,29 @@ pub fn inverse_dynamics_derivatives(
         }
     }
     InverseDynamicsDerivatives { dq, dqd }
+}
+
+/// The gravity efforts `G(q)` over the joint tree's velocity columns, from the composite
+/// inertias: gravity as an upward acceleration `a_g` of the base, carried to each body (a
+/// rotation only), gives `G_i = S_i . (I^C_i a_g)`. The same composites as the recursion's, so
+/// this costs one rotated vector and one product per body.
+pub fn gravity_efforts(g: &mut Graph, lm: &LocalModel, gravity: V3) -> Vec<Id> {
+    let base = ([g.zero(); 3], gravity.map(|x| g.neg(x)));
+    let comp = composites(g, lm);
+    let mut acc: Vec<Spatial> = Vec::with_capacity(lm.bodies());
+    let mut out = vec![g.zero(); lm.nv()];
+    for i in 0..lm.bodies() {
+        let a = match lm.parent[i] {
+            Some(p) => motion_to_child(g, lm, i, &acc[p]),
+            None => motion_to_child(g, lm, i, &base),
+        };
+        let f = inertia_times(g, Some(comp.mass[i]), &comp.h[i], &comp.j[i], &a);
+        for (k, s) in lm.subspace[i].iter().enumerate() {
+            out[lm.column[i] + k] = spatial_dot(g, s, &f);
+        }
+        acc.push(a);
+    }
+    out
 }
 
 /// `k s` for a number `k`.
@@ -302,6 +346,63 @@ mod tests {
         for (k, (a, b)) in w.iter().zip(&o).enumerate() {
             assert!((a - b).abs() < 1e-9 * (1.0 + a.abs()), "{k}: {a} vs {b}");
         }
+    }
+
+    /// What forward dynamics' derivatives take from the recursion instead of a second
+    /// Newton-Euler pass: `G` from the composites and `b = 1/2 (d b / d qd) qd`, equal to the
+    /// fast forms' gravity and bias at a state.
+    fn check_gravity_and_bias(builder: crate::Builder) {
+        let model = builder.model().unwrap();
+        let mut d = Derivation::new(&model);
+        let g = &mut d.graph;
+        let params = Params::new(g, &model);
+        let lm = LocalModel::new(g, &model, &params, &d.q);
+        let grav = const_v3(g, &model.gravity);
+        let r = rigid_derivatives(g, &lm, grav, &d.qd, &d.qdd);
+        let gravity = gravity_efforts(g, &lm, grav);
+        let bias: Vec<Id> = r
+            .dqd
+            .iter()
+            .map(|row| {
+                let terms: Vec<(Id, f64)> = row
+                    .iter()
+                    .zip(&d.qd)
+                    .map(|(&c, &v)| (g.mul(c, v), 0.5))
+                    .collect();
+                g.sum(0.0, terms)
+            })
+            .collect();
+        let want: Vec<Id> = d
+            .fast
+            .gravity
+            .1
+            .iter()
+            .chain(&d.fast.bias.1)
+            .copied()
+            .collect();
+        let got: Vec<Id> = gravity.iter().chain(&bias).copied().collect();
+        let value = |s: &crate::cas::Symbol| {
+            let k: f64 = s.name.bytes().map(f64::from).sum();
+            Some((k * 0.29).cos())
+        };
+        let w = Program::new(g, &want).eval(value).unwrap();
+        let o = Program::new(g, &got).eval(value).unwrap();
+        assert!(
+            w.iter().any(|x| x.abs() > 1e-3),
+            "a state with gravity and bias"
+        );
+        for (k, (a, b)) in w.iter().zip(&o).enumerate() {
+            assert!((a - b).abs() < 1e-9 * (1.0 + a.abs()), "{k}: {a} vs {b}");
+        }
+    }
+
+    #[test]
+    fn gravity_and_bias_from_the_recursion() {
+        let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/");
+        check_gravity_and_bias(crate::Builder::new(format!("{root}robots/panda.urdf")));
+        check_gravity_and_bias(
+            crate::Builder::new(format!("{root}robots/floating/anymal.urdf")).floating_base(),
+        );
     }
 
     #[test]
