@@ -88,6 +88,146 @@ pub fn build<R: Zeroed>(fill: impl for<'b> FnOnce(Slot<'b, R>) -> Filled<'b>) ->
     unsafe { value.assume_init() }
 }
 
+/// The storage of a result of `K` matrices of `R x C` entries, to be written entry by entry
+/// in order, without zeros first ([`Outputs::entries`]): what a function that writes every
+/// entry of its result, row by row through each matrix in turn, takes instead of a zeroed
+/// [`Slot`]. Made by [`Slot::outputs`] (the caller's uninitialized storage) or [`refill`]
+/// (matrices already initialized).
+///
+/// ```
+/// use eomgen_runtime::place::{build, Filled, Outputs, Slot};
+///
+/// #[inline(never)]
+/// fn counting<'b>(out: Outputs<'b, f64, 2, 1, 2>) -> Filled<'b> {
+///     let mut e = out.entries();
+///     for k in 0..3 {
+///         e.put(k as f64 + 1.0);
+///     }
+///     e.finish() // the entry not written is zero
+/// }
+///
+/// let (a, b) = build(|slot: Slot<'_, ([[f64; 2]; 1], [[f64; 2]; 1])>| counting(slot.outputs()));
+/// assert_eq!((a, b), ([[1.0, 2.0]], [[3.0, 0.0]]));
+/// ```
+pub struct Outputs<'b, T, const K: usize, const R: usize, const C: usize> {
+    /// The first entry of each matrix.
+    parts: [*mut T; K],
+    brand: Brand<'b>,
+}
+
+/// The entries of [`Outputs`] being written, the next one at `next` (counted through all
+/// matrices).
+pub struct Entries<'b, T, const K: usize, const R: usize, const C: usize> {
+    parts: [*mut T; K],
+    next: usize,
+    brand: Brand<'b>,
+}
+
+impl<'b, T: Lane, const K: usize, const R: usize, const C: usize> Outputs<'b, T, K, R, C> {
+    /// Starts at the first entry. Called in the function that writes the entries (inlined), the
+    /// position of every entry is known to the compiler: each [`Entries::put`] is one store.
+    #[inline(always)]
+    pub fn entries(self) -> Entries<'b, T, K, R, C> {
+        Entries {
+            parts: self.parts,
+            next: 0,
+            brand: self.brand,
+        }
+    }
+}
+
+impl<'b, T: Lane, const K: usize, const R: usize, const C: usize> Entries<'b, T, K, R, C> {
+    /// Writes the next entry (row by row, matrix after matrix); past the last, nothing.
+    #[inline(always)]
+    pub fn put(&mut self, x: T) {
+        let len = R * C;
+        if len == 0 || self.next >= K * len {
+            return;
+        }
+        let (k, i) = (self.next / len, self.next % len);
+        // SAFETY: `parts[k]` is the first of the `R * C` consecutive `T`s of matrix `k`
+        // (arrays have no padding), in storage borrowed mutably for `'b` (`Slot::outputs`,
+        // `refill`); `i < R * C`. Writing a value never de-initializes anything.
+        unsafe { self.parts[k].add(i).write(x) };
+        self.next += 1;
+    }
+
+    /// Zeros over the entries not written yet, and the proof that the storage is filled.
+    #[inline(always)]
+    pub fn finish(mut self) -> Filled<'b> {
+        while self.next < K * R * C {
+            self.put(T::zero());
+        }
+        Filled { brand: self.brand }
+    }
+}
+
+impl<'b, T: Lane, const R: usize, const C: usize> Slot<'b, [[T; C]; R]> {
+    /// The storage as [`Outputs`] of one matrix, to be written entry by entry.
+    #[inline(always)]
+    pub fn outputs(self) -> Outputs<'b, T, 1, R, C> {
+        Outputs {
+            parts: [self.value.as_mut_ptr().cast::<T>()],
+            brand: self.brand,
+        }
+    }
+}
+
+impl<'b, T: Lane, const R: usize, const C: usize> Slot<'b, ([[T; C]; R], [[T; C]; R])> {
+    /// The storage as [`Outputs`] of two matrices, the first written first.
+    #[inline(always)]
+    pub fn outputs(self) -> Outputs<'b, T, 2, R, C> {
+        let p = self.value.as_mut_ptr();
+        // SAFETY (both): fields of the tuple `p` points to, borrowed mutably for `'b`.
+        let parts = unsafe {
+            [
+                addr_of_mut!((*p).0).cast::<T>(),
+                addr_of_mut!((*p).1).cast::<T>(),
+            ]
+        };
+        Outputs {
+            parts,
+            brand: self.brand,
+        }
+    }
+}
+
+impl<'b, T: Lane, const R: usize, const C: usize>
+    Slot<'b, ([[T; C]; R], [[T; C]; R], [[T; C]; R])>
+{
+    /// The storage as [`Outputs`] of three matrices, in order.
+    #[inline(always)]
+    pub fn outputs(self) -> Outputs<'b, T, 3, R, C> {
+        let p = self.value.as_mut_ptr();
+        // SAFETY (all): fields of the tuple `p` points to, borrowed mutably for `'b`.
+        let parts = unsafe {
+            [
+                addr_of_mut!((*p).0).cast::<T>(),
+                addr_of_mut!((*p).1).cast::<T>(),
+                addr_of_mut!((*p).2).cast::<T>(),
+            ]
+        };
+        Outputs {
+            parts,
+            brand: self.brand,
+        }
+    }
+}
+
+/// Lends `K` matrices that hold values already (fields of a larger result, say) to `fill` as
+/// [`Outputs`], which writes them entry by entry as it would write a [`Slot`]'s storage.
+#[inline(always)]
+pub fn refill<T: Lane, const K: usize, const R: usize, const C: usize>(
+    matrices: [&mut [[T; C]; R]; K],
+    fill: impl for<'b> FnOnce(Outputs<'b, T, K, R, C>) -> Filled<'b>,
+) {
+    let parts = matrices.map(|m| m.as_mut_ptr().cast::<T>());
+    let _filled = fill(Outputs {
+        parts,
+        brand: PhantomData,
+    });
+}
+
 mod sealed {
     pub trait Sealed {}
 }
@@ -220,6 +360,53 @@ mod tests {
         let (v, m) = build(pair);
         assert_eq!(v, [0.0, 2.0]);
         assert_eq!(m, [[0.0, 0.0], [0.0, 0.0], [5.0, 0.0]]);
+    }
+
+    #[inline(never)]
+    fn numbered<'b>(out: Outputs<'b, f32, 2, 2, 3>, count: usize) -> Filled<'b> {
+        let mut e = out.entries();
+        for k in 0..count {
+            e.put(k as f32 + 1.0);
+        }
+        e.finish()
+    }
+
+    #[test]
+    fn outputs_are_written_in_order_and_the_rest_is_zero() {
+        type Pair = ([[f32; 3]; 2], [[f32; 3]; 2]);
+        for count in [0, 5, 12, 20] {
+            let (a, b) = build(|slot: Slot<'_, Pair>| numbered(slot.outputs(), count));
+            let flat = a.iter().chain(&b).flatten();
+            for (k, &x) in flat.enumerate() {
+                let want = if k < count { k as f32 + 1.0 } else { 0.0 };
+                assert_eq!(x, want, "entry {k} of {count} put");
+            }
+        }
+    }
+
+    #[test]
+    fn refill_writes_matrices_that_hold_values() {
+        let (mut a, mut b) = ([[9.0f32; 3]; 2], [[9.0f32; 3]; 2]);
+        refill([&mut a, &mut b], |out| numbered(out, 7));
+        assert_eq!(a, [[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]]);
+        assert_eq!(b, [[7.0, 0.0, 0.0], [0.0, 0.0, 0.0]]);
+        let mut m = [[0.5f64; 2]; 1];
+        refill([&mut m], |out| {
+            let mut e = out.entries();
+            e.put(1.5);
+            e.finish()
+        });
+        assert_eq!(m, [[1.5, 0.0]]);
+        type Three = ([[f64; 1]; 1], [[f64; 1]; 1], [[f64; 1]; 1]);
+        let t = build(|slot: Slot<'_, Three>| {
+            let mut e = slot.outputs().entries();
+            e.put(1.0);
+            e.put(2.0);
+            e.put(3.0);
+            e.put(4.0); // past the end: nothing
+            e.finish()
+        });
+        assert_eq!(t, ([[1.0]], [[2.0]], [[3.0]]));
     }
 
     type Triple = ([f64; 1], [f64; 2], [[f64; 1]; 1]);
