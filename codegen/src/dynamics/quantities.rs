@@ -567,6 +567,15 @@ pub const MASS_MATRIX_INVERSE_FLAT_DIVISOR: usize = 10;
 /// 63,000: 22.9 -> 23.3 us, 48 -> 65 s and 1.8 -> 2.2 GiB; 28 November 2026).
 pub const FORWARD_DYNAMICS_PARTIALS_MAX_OPS: usize = 24_000;
 
+/// The straight-line forward-dynamics derivatives' substitutions and `M^-1` (their operations
+/// beyond `forward_dynamics_partials`) up to this many operations; beyond, the columns are
+/// solved by the unrolled passes over the tree, which run across the columns in vector
+/// registers, from `forward_dynamics_partials`. Measured both ways (native, alternated,
+/// 28 November 2026; operations of that share, then the composed route's time over the
+/// straight-line one): the UR5 834, 1.23; the Kinova 860, 0.94; the allegro hand 1,046, 1.17;
+/// the xArm 7 1,389, 1.01; the panda 2,666, 0.93 (1,168 -> 1,083 ns).
+pub const FORWARD_DYNAMICS_FLAT_SOLVES_MAX_OPS: usize = 2_000;
+
 /// The derivatives of the dynamics ([`Derivation::add_derivatives`]): inverse dynamics
 /// (straight-line), `M^-1` and forward dynamics (straight-line, or composed at run time when
 /// that is large).
@@ -593,9 +602,17 @@ pub fn derivatives(d: &Derivation, x: &Derivatives, flat_max_ops: usize) -> Vec<
     let mut partials = flat(&x.at_forward.dq);
     partials.extend(flat(&x.at_forward.dqd));
     partials.extend(flat(&x.factors));
-    let (fd_route, fd_eval) = match factored(fd, flat_max_ops) {
+    // The straight-line route's share beyond the partials: its substitutions and `M^-1`.
+    let partials_ops = ops(&d.graph, &partials);
+    let solves_ops = ops(&d.graph, &fd).saturating_sub(partials_ops);
+    let fd_limit = if solves_ops > FORWARD_DYNAMICS_FLAT_SOLVES_MAX_OPS {
+        0
+    } else {
+        flat_max_ops
+    };
+    let (fd_route, fd_eval) = match factored(fd, fd_limit) {
         Some(e) => ("Route: qdd from the factorization of M, with b = 1/2 (d tau / d qd) qd and G from the recursion's composite inertias, `inverse_dynamics_derivatives` at (q, qd, qdd), then -M^-1 times them by substitutions through the one unrolled factorization of M, all in one straight-line body.", e),
-        None if ops(&d.graph, &partials) <= FORWARD_DYNAMICS_PARTIALS_MAX_OPS => ("Route: `forward_dynamics_partials` (d tau / d q and d tau / d qd at qdd = FD(q, qd, tau), and M's factors), then -M^-1 times them by substitutions of all columns at once (the passes of eomgen_runtime::tree::ltdl_substitute_rows, unrolled for this robot's tree), and M^-1 from the same factors, unrolled over the tree (eomgen_runtime::tree::ltdl_inverse_factored's operations).", Evaluation::ForwardDynamicsDerivatives { partials: true }),
+        None if partials_ops <= FORWARD_DYNAMICS_PARTIALS_MAX_OPS => ("Route: `forward_dynamics_partials` (d tau / d q and d tau / d qd at qdd = FD(q, qd, tau), and M's factors), then -M^-1 times them by substitutions of all columns at once (the passes of eomgen_runtime::tree::ltdl_substitute_rows, unrolled for this robot's tree), and M^-1 from the same factors, unrolled over the tree (eomgen_runtime::tree::ltdl_inverse_factored's operations).", Evaluation::ForwardDynamicsDerivatives { partials: true }),
         None => ("Route: one factorization of M (from `mass_matrix`, the tree L^T D L unrolled): qdd from it and `inverse_dynamics` at zero acceleration, `inverse_dynamics_derivatives` at (q, qd, qdd), then -M^-1 times them by substitutions of all columns at once (the passes of eomgen_runtime::tree::ltdl_substitute_rows, unrolled for this robot's tree), and M^-1 from the same factors, unrolled over the tree (eomgen_runtime::tree::ltdl_inverse_factored's operations).", Evaluation::ForwardDynamicsDerivatives { partials: false }),
     };
     let from_partials = matches!(
