@@ -176,7 +176,12 @@ impl Plan {
                 let rhs: Vec<f64> = (0..n).map(|i| x.values[at + i] - h[i]).collect();
                 let qdd = f.solve(&rhs);
                 let dtau = dtau.run(&x.with_accelerations(&qdd));
-                let mut out: Vec<f64> = f.solve_matrix(&dtau, n).iter().map(|v| -v).collect();
+                // `d tau / d q`, then `d tau / d qd`: each n x n, solved in turn.
+                let mut out: Vec<f64> = dtau
+                    .chunks(n * n)
+                    .flat_map(|b| f.solve_matrix(b, n))
+                    .map(|v| -v)
+                    .collect();
                 out.extend(f.inverse());
                 Ok(out)
             }
