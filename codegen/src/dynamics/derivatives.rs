@@ -11,7 +11,8 @@ use super::lagrangian::Friction;
 use super::ltdl::Factors;
 use super::newton_euler::JointTree;
 use super::rnea_derivatives::{
-    add_friction_rates, gravity_efforts, rigid_derivatives, InverseDynamicsDerivatives,
+    add_friction_rates, bias_from_rates, gravity_efforts, rigid_derivatives,
+    InverseDynamicsDerivatives,
 };
 use super::Derivation;
 use crate::cas::{Graph, Id};
@@ -129,17 +130,12 @@ fn forward_rhs(
     gravity: &[Id],
     friction: &[Id],
 ) -> Vec<Id> {
+    let bias = bias_from_rates(g, rates, qd);
     (0..tau.len())
         .map(|i| {
-            let products: Vec<(Id, f64)> = rates[i]
-                .iter()
-                .zip(qd)
-                .map(|(&c, &v)| (g.mul(c, v), -0.5))
-                .collect();
-            let minus_b = g.sum(0.0, products);
             let h = g.add(gravity[i], friction[i]);
             let rest = g.sub(tau[i], h);
-            g.add(rest, minus_b)
+            g.sub(rest, bias[i])
         })
         .collect()
 }

@@ -587,30 +587,28 @@ pub fn derivatives(d: &Derivation, x: &Derivatives, flat_max_ops: usize) -> Vec<
     let mut fd = flat(&x.forward.dq);
     fd.extend(flat(&x.forward.dqd));
     fd.extend(&minv);
-    let factored = |outputs: Vec<Id>, limit: usize| {
+    // Straight-line when the body's operations (the pivots' included) `fit`.
+    let factored = |outputs: Vec<Id>, fits: &dyn Fn(usize) -> bool| {
         let all: Vec<Id> = outputs.iter().chain(&x.pivots).copied().collect();
-        (ops(&d.graph, &all) <= limit).then(|| Evaluation::Factored {
+        fits(ops(&d.graph, &all)).then(|| Evaluation::Factored {
             outputs,
             pivots: x.pivots.clone(),
         })
     };
     let minv_limit = flat_max_ops / MASS_MATRIX_INVERSE_FLAT_DIVISOR;
-    let (minv_route, minv_eval) = match factored(minv, minv_limit) {
+    let (minv_route, minv_eval) = match factored(minv, &|n| n <= minv_limit) {
         Some(e) => ("Route: M as in `mass_matrix`, an unrolled L^T D L factorization without fill-in, one substitution per column.", e),
         None => ("Route: M from `mass_matrix`, the sparse L^T D L factorization over the joint tree, unrolled for this robot, then L^-1 D^-1 L^-T over the tree, unrolled too (eomgen_runtime::tree::ltdl_inverse_factored's operations, in parts of at most 128 row updates).", Evaluation::MassMatrixInverse),
     };
     let mut partials = flat(&x.at_forward.dq);
     partials.extend(flat(&x.at_forward.dqd));
     partials.extend(flat(&x.factors));
-    // The straight-line route's share beyond the partials: its substitutions and `M^-1`.
+    // Within the limit, and the share beyond the partials (substitutions and `M^-1`) too.
     let partials_ops = ops(&d.graph, &partials);
-    let solves_ops = ops(&d.graph, &fd).saturating_sub(partials_ops);
-    let fd_limit = if solves_ops > FORWARD_DYNAMICS_FLAT_SOLVES_MAX_OPS {
-        0
-    } else {
-        flat_max_ops
+    let fd_fits = |n: usize| {
+        n <= flat_max_ops && n.saturating_sub(partials_ops) <= FORWARD_DYNAMICS_FLAT_SOLVES_MAX_OPS
     };
-    let (fd_route, fd_eval) = match factored(fd, fd_limit) {
+    let (fd_route, fd_eval) = match factored(fd, &fd_fits) {
         Some(e) => ("Route: qdd from the factorization of M, with b = 1/2 (d tau / d qd) qd and G from the recursion's composite inertias, `inverse_dynamics_derivatives` at (q, qd, qdd), then -M^-1 times them by substitutions through the one unrolled factorization of M, all in one straight-line body.", e),
         None if partials_ops <= FORWARD_DYNAMICS_PARTIALS_MAX_OPS => ("Route: `forward_dynamics_partials` (d tau / d q and d tau / d qd at qdd = FD(q, qd, tau), and M's factors), then -M^-1 times them by substitutions of all columns at once (the passes of eomgen_runtime::tree::ltdl_substitute_rows, unrolled for this robot's tree), and M^-1 from the same factors, unrolled over the tree (eomgen_runtime::tree::ltdl_inverse_factored's operations).", Evaluation::ForwardDynamicsDerivatives { partials: true }),
         None => ("Route: one factorization of M (from `mass_matrix`, the tree L^T D L unrolled): qdd from it and `inverse_dynamics` at zero acceleration, `inverse_dynamics_derivatives` at (q, qd, qdd), then -M^-1 times them by substitutions of all columns at once (the passes of eomgen_runtime::tree::ltdl_substitute_rows, unrolled for this robot's tree), and M^-1 from the same factors, unrolled over the tree (eomgen_runtime::tree::ltdl_inverse_factored's operations).", Evaluation::ForwardDynamicsDerivatives { partials: false }),

@@ -303,6 +303,23 @@ pub fn gravity_efforts(g: &mut Graph, lm: &LocalModel, gravity: V3) -> Vec<Id> {
     out
 }
 
+/// The bias `b(q, qd) = 1/2 (d b / d qd) qd` from the rigid bodies' `d tau / d qd` (`rates`,
+/// [`rigid_derivatives`]): `b` is quadratic in the rates (Euler's theorem on homogeneous
+/// functions), so no Newton-Euler pass at zero acceleration is needed for it.
+pub fn bias_from_rates(g: &mut Graph, rates: &[Vec<Id>], qd: &[Id]) -> Vec<Id> {
+    rates
+        .iter()
+        .map(|row| {
+            let terms: Vec<(Id, f64)> = row
+                .iter()
+                .zip(qd)
+                .map(|(&c, &v)| (g.mul(c, v), 0.5))
+                .collect();
+            g.sum(0.0, terms)
+        })
+        .collect()
+}
+
 /// `k s` for a number `k`.
 fn spatial_scale_const(g: &mut Graph, s: &Spatial, k: f64) -> Spatial {
     (s.0.map(|x| g.scale(x, k)), s.1.map(|x| g.scale(x, k)))
@@ -360,18 +377,7 @@ mod tests {
         let grav = const_v3(g, &model.gravity);
         let r = rigid_derivatives(g, &lm, grav, &d.qd, &d.qdd);
         let gravity = gravity_efforts(g, &lm, grav);
-        let bias: Vec<Id> = r
-            .dqd
-            .iter()
-            .map(|row| {
-                let terms: Vec<(Id, f64)> = row
-                    .iter()
-                    .zip(&d.qd)
-                    .map(|(&c, &v)| (g.mul(c, v), 0.5))
-                    .collect();
-                g.sum(0.0, terms)
-            })
-            .collect();
+        let bias = bias_from_rates(g, &r.dqd, &d.qd);
         let want: Vec<Id> = d
             .fast
             .gravity

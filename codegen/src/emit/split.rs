@@ -523,15 +523,15 @@ fn block_fn(
         Out::Params(outs) => outs,
         Out::InOrder(outputs) => {
             return quote! {
-            #[inline(never)]
-            fn #name<'b>(&self, #(#params,)* w: &mut [T; #width], out: #outputs) -> ::eomgen_runtime::place::Filled<'b> {
-                #(#reads)*
-                #(#trig)*
-                #(#code)*
-                #(#writes)*
-                e.finish()
-            }
-            }
+                #[inline(never)]
+                fn #name<'b>(&self, #(#params,)* w: &mut [T; #width], out: #outputs) -> ::eomgen_runtime::place::Filled<'b> {
+                    #(#reads)*
+                    #(#trig)*
+                    #(#code)*
+                    #(#writes)*
+                    e.finish()
+                }
+            };
         }
     };
     quote! {
