@@ -67,6 +67,8 @@ pub struct Builder {
     /// Straight-line `M^-1` and forward-dynamics derivatives up to this many operations
     /// ([`Builder::derivatives_flat_max_ops`]).
     derivatives_flat_max_ops: usize,
+    /// ([`Builder::contact_forward_dynamics_flat_max_ops`]).
+    contact_flat_max_ops: usize,
 }
 
 /// Robots with more joints than this are refused unless [`Builder::max_dof`] raises the limit:
@@ -125,6 +127,7 @@ impl Builder {
             max_function_ops: DEFAULT_MAX_FUNCTION_OPS,
             max_derivative_function_ops: DEFAULT_MAX_DERIVATIVE_FUNCTION_OPS,
             derivatives_flat_max_ops: crate::dynamics::DERIVATIVES_FLAT_MAX_OPS,
+            contact_flat_max_ops: crate::dynamics::CONTACT_FORWARD_DYNAMICS_FLAT_MAX_OPS,
         }
     }
 
@@ -324,6 +327,25 @@ impl Builder {
     /// ```
     pub fn derivatives_flat_max_ops(mut self, limit: usize) -> Builder {
         self.derivatives_flat_max_ops = limit;
+        self
+    }
+
+    /// `contact_forward_dynamics` is one straight-line program up to this many operations
+    /// (default [`crate::dynamics::CONTACT_FORWARD_DYNAMICS_FLAT_MAX_OPS`], 32,000: every
+    /// robot measured, from a quadruped to a 50-joint humanoid with 6D soles, where it was a
+    /// fifth faster than the run-time route); beyond, `mass_matrix`, `contact_jacobian` and
+    /// `contact_drift` are called and the contact problem is solved at run time
+    /// (`eomgen_runtime::contact::solve_factored_active_by`, the route of the `_active`
+    /// variants). `0` always solves at run time: less generated code for a very large robot.
+    ///
+    /// ```
+    /// let b = eomgen::Builder::new("robots/anymal.urdf")
+    ///     .floating_base()
+    ///     .contact_points(&["LF_FOOT", "RF_FOOT"])
+    ///     .contact_forward_dynamics_flat_max_ops(0);
+    /// ```
+    pub fn contact_forward_dynamics_flat_max_ops(mut self, limit: usize) -> Builder {
+        self.contact_flat_max_ops = limit;
         self
     }
 
@@ -676,6 +698,10 @@ impl Builder {
             }));
         }
         let mut d = Derivation::try_new(model, limits).map_err(full)?;
+        if self.contact_flat_max_ops != crate::dynamics::CONTACT_FORWARD_DYNAMICS_FLAT_MAX_OPS {
+            d.set_contact_forward_dynamics_flat_max_ops(model, self.contact_flat_max_ops)
+                .map_err(full)?;
+        }
         if self.derivatives {
             d.add_derivatives_flat_up_to(model, self.derivatives_flat_max_ops)
                 .map_err(full)?;

@@ -7,7 +7,8 @@
 
 use crate::contact::{contact_space, transpose_times};
 use crate::kkt::{
-    axpy, dot, finite_rows, finite_solution, scaled, ContactKkt, ImpulseDynamicsDerivatives,
+    axpy, dot, finite_rows, finite_solution, scaled, times_columns, ContactKkt,
+    ImpulseDynamicsDerivatives,
 };
 use crate::tree::{ltdl_lower_rows, TreePasses, Walked};
 use crate::{FactorError, Real};
@@ -66,13 +67,15 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
         e: T,
         d: &mut ImpulseDynamicsDerivatives<T, N, K>,
     ) -> Result<(), FactorError> {
-        self.solve_signed_columns_in_place::<P, N>(&mut d.dv_dq, &mut d.dimpulse_dq, -T::one());
+        let inverse = self.lambda_inverse();
+        let (dv_dq, dp_dq) = (&mut d.dv_dq, &mut d.dimpulse_dq);
+        self.solve_signed_columns_in_place::<P, N>(Some(&inverse), dv_dq, dp_dq, -T::one());
         // dp/dv = -(1 + e) Lambda^-1 J, the factor applied to J's rows as they are copied.
         let k = -(T::one() + e);
         for (p, j) in d.dimpulse_dv.iter_mut().zip(self.jacobian()) {
             *p = scaled(j, k);
         }
-        self.lambda_solve_columns(&mut d.dimpulse_dv);
+        times_columns(&inverse, &mut d.dimpulse_dv);
         // I + Y dp/dv, each row gathered in a local accumulator. The identity's one is added
         // to the row once written: set in the accumulator at a varying index, it kept the
         // accumulator in memory, whose wide reloads of narrow stores could not be forwarded.

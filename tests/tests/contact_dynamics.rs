@@ -268,6 +268,26 @@ fn anymal_non_finite_state_is_reported() {
     assert!(r.contact_forward_dynamics_derivatives(&q, &v, &tau).da_dq[0][0].is_nan());
     assert!(r.impulse_dynamics(&q, &v, 0.0).1[0].is_nan());
     assert!(r.impulse_dynamics_derivatives(&q, &v, 0.0).dimpulse_dv[0][0].is_nan());
+    assert!(r.try_contact_forward_dynamics(&q, &v, &tau).is_err());
+    assert!(r.contact_forward_dynamics(&q, &v, &tau).1[0].is_nan());
+}
+
+/// A non-finite effort leaves `M` and `J M^-1 J^T` whole: the straight-line contact forward
+/// dynamics and the run-time route (the `_active` variant, every contact on) report the same
+/// first non-finite acceleration.
+#[test]
+fn anymal_non_finite_effort_is_reported_as_the_run_time_route_does() {
+    let r = AnymalMpc::<f64>::default();
+    let (q, v, mut tau) = state(4);
+    for (i, bad) in [(17, f64::NAN), (9, f64::INFINITY)] {
+        tau[i] = bad;
+        let flat = r.try_contact_forward_dynamics(&q, &v, &tau).unwrap_err();
+        let solved = r
+            .try_contact_forward_dynamics_active(&q, &v, &tau, &[true; 4])
+            .unwrap_err();
+        assert_eq!(flat, solved);
+        assert!(matches!(flat, eomgen_runtime::FactorError::NonFinite { .. }));
+    }
 }
 
 /// Contact points at a position in a link frame (`Builder::contact_point_at`): at the origin

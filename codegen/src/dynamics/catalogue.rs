@@ -136,6 +136,10 @@ pub enum Evaluation {
     /// `M` from `mass_matrix`, `h = b + G + F` straight-line, `J_c` and its drift from
     /// `contact_jacobian` and `contact_drift` (`eomgen_runtime::contact::solve`).
     ContactForwardDynamics { h: Vec<Id> },
+    /// The accelerations (`N`) and contact forces (`K`) with the contacts held, as one
+    /// straight-line program that holds when its pivots (`M`'s, then `J_c M^-1 J_c^T`'s) are
+    /// positive (`contact_flat`).
+    ContactForwardDynamicsFlat { outputs: Vec<Id>, pivots: Vec<Id> },
     /// A floating base's `q (+) v dt` (`eomgen_runtime::free_flyer::integrate`).
     Integrate,
     /// A link frame's velocity, acceleration or Jacobian time variation, walked along its
@@ -294,7 +298,8 @@ impl Quantity {
                 | ActiveContacts::Stabilized { h }
                 | ActiveContacts::Derivatives { h },
             ) => h.clone(),
-            Evaluation::Factored { outputs, pivots } => {
+            Evaluation::Factored { outputs, pivots }
+            | Evaluation::ContactForwardDynamicsFlat { outputs, pivots } => {
                 outputs.iter().chain(pivots).copied().collect()
             }
             _ => Vec::new(),
@@ -306,7 +311,8 @@ impl Quantity {
         Program::new(g, &self.exprs()).ops()
     }
 
-    /// Quantities whose generated code this one calls.
+    /// Quantities whose generated code this one calls (or, for a straight-line contact
+    /// forward dynamics, brings with it).
     pub fn needs(&self) -> &'static [&'static str] {
         use ActiveContacts as A;
         match self.eval {
@@ -318,6 +324,9 @@ impl Quantity {
             | Evaluation::ActiveContacts(A::Dynamics { .. }) => {
                 &["mass_matrix", "contact_jacobian", "contact_drift"]
             }
+            // Calls neither, but brings them as the run-time route does: with them the
+            // `Contacts` trait is complete, as a selection of it alone has always had.
+            Evaluation::ContactForwardDynamicsFlat { .. } => &["contact_jacobian", "contact_drift"],
             Evaluation::ActiveContacts(A::Stabilized { .. }) => &[
                 "mass_matrix",
                 "contact_jacobian",

@@ -10,9 +10,11 @@
 use super::catalogue::{Evaluation, Home, Input, Quantity, Shape};
 use super::newton_euler::{self, LocalModel, Terms};
 use super::{flat, Derivation};
-use crate::cas::{Graph, Id};
+use crate::cas::{Graph, Id, Program};
+use crate::kinematics::joint::free_flyer_placement;
 use crate::kinematics::{cross, mat_vec, vec_add, vec_scale, vec_sub, WorldKinematics, M3, V3};
 use crate::model::{Model, Transform};
+use std::collections::HashMap;
 
 /// World rotation and origin of every body of the local model (the floating base first when
 /// there is one).
@@ -277,7 +279,7 @@ pub(super) fn quantity(
 
 /// The catalogue's centre of mass quantities (every robot), the centroidal map and `integrate`
 /// (floating bases) and the contact quantities (robots with contact points).
-pub(super) fn quantities(model: &Model, d: &Derivation) -> Vec<Quantity> {
+pub(super) fn quantities(model: &Model, d: &mut Derivation) -> Vec<Quantity> {
     let mut out = center_of_mass_quantities(model, d);
     if !d.centroidal.contact_drift.is_empty() {
         out.extend(contact_quantities(model, d));
@@ -369,7 +371,9 @@ fn contact_order(model: &Model) -> String {
 }
 
 /// `contact_jacobian`, `contact_drift` and `contact_forward_dynamics` (robots with contacts).
-fn contact_quantities(model: &Model, d: &Derivation) -> [Quantity; 3] {
+fn contact_quantities(model: &Model, d: &mut Derivation) -> [Quantity; 3] {
+    let (route, forward) =
+        contact_forward_dynamics(model, d, CONTACT_FORWARD_DYNAMICS_FLAT_MAX_OPS);
     let (nv, c) = (d.dof, &d.centroidal);
     let k3 = c.contact_drift.len();
     let order = contact_order(model);
@@ -401,12 +405,78 @@ fn contact_quantities(model: &Model, d: &Derivation) -> [Quantity; 3] {
                 "NaN in every entry when M(q) is not positive definite or J_c is rank-deficient;",
                 "`try_contact_forward_dynamics` says why.",
             ],
+            route,
+            forward,
+        ),
+    ]
+}
+
+/// The largest straight-line contact forward dynamics generated (operations, with its
+/// pivots); beyond, `M`, `J_c` and the drift come from their own functions and the contact
+/// system is solved at run time (`eomgen_runtime::contact::solve_factored_active_by`).
+/// Straight-line was faster on every robot measured (native, alternated, run-time route ->
+/// straight-line): anymal (8,635 operations) 1,645 -> 1,305 ns, b1-z1 (a quadruped with an
+/// arm, 10,878) 2,167 -> 1,620 ns, g1_29dof (two 6D soles, 21,352) 3,796 -> 3,071 ns,
+/// talos_full_v2 (two 6D soles, 27,735) 5,119 -> 4,138 ns.
+pub const CONTACT_FORWARD_DYNAMICS_FLAT_MAX_OPS: usize = 32_000;
+
+/// `contact_forward_dynamics`'s route and evaluation: straight-line up to `flat_max_ops`
+/// operations (by default [`CONTACT_FORWARD_DYNAMICS_FLAT_MAX_OPS`]), else solved at run time.
+pub(super) fn contact_forward_dynamics(
+    model: &Model,
+    d: &mut Derivation,
+    flat_max_ops: usize,
+) -> (&'static str, Evaluation) {
+    let c = &d.centroidal;
+    let (mut j, mut drift) = (c.contact_jacobian.clone(), c.contact_drift.clone());
+    let axes = if model.is_floating() {
+        // In base axes: the base's quaternion (x, y, z, w) at the identity.
+        let g = &mut d.graph;
+        let (zero, one) = (g.zero(), g.one());
+        let map: HashMap<Id, Id> = [
+            (d.q[3], zero),
+            (d.q[4], zero),
+            (d.q[5], zero),
+            (d.q[6], one),
+        ]
+        .into_iter()
+        .collect();
+        let k = drift.len();
+        let all: Vec<Id> = j.iter().flatten().chain(&drift).copied().collect();
+        let based = g.substitute(&all, &map);
+        let n = d.dof;
+        j = based[..k * n].chunks(n).map(<[Id]>::to_vec).collect();
+        drift = based[k * n..].to_vec();
+        Some(free_flyer_placement(g, &d.q[..7]).rotation)
+    } else {
+        None
+    };
+    let flat = super::contact_flat::contact_forward_dynamics(
+        &mut d.graph,
+        &d.coordinate_parents,
+        &d.fast.mass_matrix.1,
+        &d.fast.bias_gravity_friction,
+        (&j, &drift),
+        axes.as_ref(),
+    );
+    let all: Vec<Id> = flat.outputs.iter().chain(&flat.pivots).copied().collect();
+    let ops = Program::new(&d.graph, &all).ops().total();
+    if ops <= flat_max_ops {
+        (
+            "one straight-line program: M and b + G as in `mass_matrix` and `bias`, J_c and its drift (in the floating base's axes, the forces turned into the world's at the end), the unrolled L^T D L of M, W = L^-T J_c^T, J_c M^-1 J_c^T = W^T D^-1 W and its L^T D L, without the zeros of J_c",
+            Evaluation::ContactForwardDynamicsFlat {
+                outputs: flat.outputs,
+                pivots: flat.pivots,
+            },
+        )
+    } else {
+        (
             "M from `mass_matrix`, b + G by Newton-Euler, J_c and its drift, then the unrolled L^T D L of M, a Cholesky factorization of J_c M^-1 J_c^T and one more substitution (eomgen_runtime::contact::solve_factored_active_by, with the first half of the substitution unrolled too)",
             Evaluation::ContactForwardDynamics {
                 h: d.fast.bias_gravity_friction.clone(),
             },
-        ),
-    ]
+        )
+    }
 }
 
 /// `integrate`: the floating base's SE(3) exponential, or each floating joint's.

@@ -76,17 +76,37 @@ impl Factors {
         (0..self.h.len()).map(|i| self.h[i][i]).collect()
     }
 
+    /// `1 / D`.
+    pub(crate) fn inverse_pivots(&self) -> &[Id] {
+        &self.inv_d
+    }
+
     /// `M^-1 rhs`: `L^-T`, `D^-1`, `L^-1`.
     pub(crate) fn solve(&self, g: &mut Graph, rhs: &[Id]) -> Vec<Id> {
-        let n = self.h.len();
+        let x = self.lower(g, rhs);
+        self.upper(g, &x)
+    }
+
+    /// `L^-T rhs`: the first half of [`Factors::solve`], each coordinate's value passed up to
+    /// its ancestors from the leaves.
+    pub(crate) fn lower(&self, g: &mut Graph, rhs: &[Id]) -> Vec<Id> {
         let old_products = g.set_product_flattening(false);
         let mut x = rhs.to_vec();
-        for i in (0..n).rev() {
+        for i in (0..self.h.len()).rev() {
             for &j in &self.ancestors[i] {
                 let p = g.mul(self.h[i][j], x[i]);
                 x[j] = g.sub(x[j], p);
             }
         }
+        g.set_product_flattening(old_products);
+        x
+    }
+
+    /// `L^-1 D^-1 x`: the second half of [`Factors::solve`], from the root down.
+    pub(crate) fn upper(&self, g: &mut Graph, x: &[Id]) -> Vec<Id> {
+        let n = self.h.len();
+        let old_products = g.set_product_flattening(false);
+        let mut x = x.to_vec();
         for i in 0..n {
             x[i] = g.mul(x[i], self.inv_d[i]);
             for &j in &self.ancestors[i] {

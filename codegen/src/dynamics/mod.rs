@@ -18,6 +18,7 @@ pub mod base_parameters;
 pub mod catalogue;
 mod centroidal;
 mod contact_derivatives;
+mod contact_flat;
 pub mod coupling;
 mod derivatives;
 mod fast;
@@ -39,7 +40,7 @@ use crate::model::Model;
 use lagrangian::{Closed, Friction};
 
 pub use catalogue::{ActiveContacts, Craig, Evaluation, Home, Input, Quantity, Shape};
-pub use centroidal::Centroidal;
+pub use centroidal::{Centroidal, CONTACT_FORWARD_DYNAMICS_FLAT_MAX_OPS};
 pub use coupling::CoordinateMap;
 pub use fast::{Fast, Route, CLOSED_FORM_MAX_DEPTH, CRAIG_FLAT_MAX_ENTRIES};
 pub use identification::Identification;
@@ -410,6 +411,30 @@ impl Derivation {
     /// Fails when the graph fills.
     pub fn add_derivatives(&mut self, model: &Model) -> Result<(), GraphFull> {
         self.add_derivatives_flat_up_to(model, quantities::DERIVATIVES_FLAT_MAX_OPS)
+    }
+
+    /// Generates `contact_forward_dynamics` as one straight-line program only up to
+    /// `flat_max_ops` operations, solving it at run time beyond
+    /// ([`crate::Builder::contact_forward_dynamics_flat_max_ops`]; the catalogue's default is
+    /// [`CONTACT_FORWARD_DYNAMICS_FLAT_MAX_OPS`]). Nothing changes without
+    /// contacts. Fails when the graph fills.
+    pub fn set_contact_forward_dynamics_flat_max_ops(
+        &mut self,
+        model: &Model,
+        flat_max_ops: usize,
+    ) -> Result<(), GraphFull> {
+        let Some(at) = self
+            .quantities
+            .iter()
+            .position(|q| q.name == "contact_forward_dynamics")
+        else {
+            return Ok(());
+        };
+        let (route, eval) = centroidal::contact_forward_dynamics(model, self, flat_max_ops);
+        self.graph.check()?;
+        let q = &mut self.quantities[at];
+        (q.route, q.eval) = (format!("Route: {route}."), eval);
+        Ok(())
     }
 
     /// [`Derivation::add_derivatives`] with `M^-1` and the forward-dynamics derivatives

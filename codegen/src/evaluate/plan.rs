@@ -90,7 +90,8 @@ impl Plan {
             | Evaluation::ForwardDynamics {
                 accelerations: outputs,
                 pivots,
-            } => {
+            }
+            | Evaluation::ContactForwardDynamicsFlat { outputs, pivots } => {
                 let all: Vec<Id> = outputs.iter().chain(pivots).copied().collect();
                 Plan::Checked {
                     tape: tape(&all)?,

@@ -233,19 +233,19 @@ impl Emitter<'_> {
                     *r -= h;
                 }
                 let drift = #drift(self, q, qd);
-                let (a, f, stash) = self.#solve(q, &rhs, &drift #arg, d)?;
+                let mut stash = <#stash>::new(&Self::PARENTS, &#rows);
+                let (a, f) = self.#solve(q, &rhs, &drift, d, &mut stash)?;
                 #id_derivatives
                 self.#stage(q, qd, &a, &f, d)?;
                 stash.contact_dynamics_derivatives_in_place_by::<Self>(d)
             }
 
-            /// The accelerations and forces, with the KKT system set up in `d`.
+            /// The accelerations and forces, with the KKT system set up in `d` and `stash`.
             #[inline(never)]
-            fn #solve(&self, q: &[T; #nq], rhs: &[T; #n], drift: &[T; #k] #param, d: &mut #ty) -> ::core::result::Result<([T; #n], [T; #k], #stash), #err> {
-                let stash = ::eomgen_runtime::ContactKkt::set_up_in_factored_by::<Self>(d, #fill, &Self::PARENTS, &#rows)?;
+            fn #solve(&self, q: &[T; #nq], rhs: &[T; #n], drift: &[T; #k], d: &mut #ty, stash: &mut #stash) -> ::core::result::Result<([T; #n], [T; #k]), #err> {
+                ::eomgen_runtime::ContactKkt::set_up_in_stash_by::<Self>(d, stash, #fill)?;
                 let substitute = |b: &[T; #n]| Self::ltdl_substitute_unrolled(&d.da_dtau, b);
-                let (a, f) = stash.solve_with(d, rhs, &drift.map(|x| -x), substitute)?;
-                Ok((a, f, stash))
+                stash.solve_with(d, rhs, &drift.map(|x| -x), substitute)
             }
 
             /// The partials added to `d` in a frame of their own.

@@ -33,7 +33,8 @@ impl Emitter<'_> {
             Evaluation::ForwardDynamicsDerivatives { partials } => {
                 self.forward_dynamics_derivatives_fn(q, *partials)
             }
-            Evaluation::ContactForwardDynamics { h } => self.contact_forward_dynamics_fns(q, h),
+            Evaluation::ContactForwardDynamics { .. }
+            | Evaluation::ContactForwardDynamicsFlat { .. } => self.contact_forward_dynamics_fns(q),
             Evaluation::Integrate => self.integrate_fn(q),
             Evaluation::FrameMotion(m) => self.frame_motion_fn(q, *m),
             Evaluation::Manifold(m) => self.manifold_fn(q, *m),

@@ -439,13 +439,17 @@ impl Emitter<'_> {
     }
 
     /// `try_contact_forward_dynamics` and `contact_forward_dynamics` (NaN on failure).
-    pub(super) fn contact_forward_dynamics_fns(&mut self, q: &Quantity, h: &[Id]) -> TokenStream {
-        let (hb, ops) = self.straight(q, h, Shape::Vector(h.len()));
+    pub(super) fn contact_forward_dynamics_fns(&mut self, q: &Quantity) -> TokenStream {
+        let (body, ops) = match &q.eval {
+            Evaluation::ContactForwardDynamics { h } => self.contact_runtime_body(q, h),
+            Evaluation::ContactForwardDynamicsFlat { outputs, pivots } => {
+                self.contact_flat_body(q, outputs, pivots)
+            }
+            _ => unreachable!("contact_forward_dynamics_fns on another evaluation"),
+        };
         let docs = Self::quantity_doc(q, Some(ops));
         let (n, nq) = (&self.n, &self.nq);
-        let k3 = usize_lit(q.shape.len() - h.len());
-        let free = self.free_accelerations(&hb);
-        let (j, drift) = (self.call("contact_jacobian"), self.call("contact_drift"));
+        let k3 = usize_lit(q.shape.len() - self.parents.len());
         let try_vis = self.vis("try_contact_forward_dynamics");
         let try_cfd = self.path("try_contact_forward_dynamics");
         let try_fn = quote! {
@@ -453,10 +457,7 @@ impl Emitter<'_> {
             /// do not exist: a pivot of M(q) (`pivot` < N) or of `J_c M^-1 J_c^T` (`pivot` - N,
             /// a rank-deficient contact Jacobian) that is not positive, or non-finite input.
             #try_vis fn try_contact_forward_dynamics(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n]) -> ::core::result::Result<([T; #n], [T; #k3]), ::eomgen_runtime::FactorError> {
-                #free
-                let substitute = |b: &[T; #n]| Self::ltdl_substitute_unrolled(&m, b);
-                let lower = |w: &mut [[T; #k3]; #n]| Self::ltdl_lower_rows_unrolled(&m, w);
-                ::eomgen_runtime::contact::solve_factored_active_by(&m, &free, &#j(self, q), &#drift(self, q, qd), &[true; #k3], substitute, lower)
+                #body
             }
         };
         let inherent_try = if self.trait_of("try_contact_forward_dynamics").is_some() {
@@ -476,6 +477,59 @@ impl Emitter<'_> {
                 }
             }
         }
+    }
+}
+
+impl Emitter<'_> {
+    /// The body of a `try_contact_forward_dynamics` solved at run time: `M` factorized by the
+    /// unrolled tree `L^T D L`, `h` straight-line, `J_c` and its drift from their functions,
+    /// then `eomgen_runtime::contact::solve_factored_active_by`.
+    fn contact_runtime_body(&mut self, q: &Quantity, h: &[Id]) -> (TokenStream, OpCount) {
+        let (hb, ops) = self.straight(q, h, Shape::Vector(h.len()));
+        let n = &self.n;
+        let k3 = usize_lit(q.shape.len() - h.len());
+        let free = self.free_accelerations(&hb);
+        let (j, drift) = (self.call("contact_jacobian"), self.call("contact_drift"));
+        let body = quote! {
+            #free
+            let substitute = |b: &[T; #n]| Self::ltdl_substitute_unrolled(&m, b);
+            let lower = |w: &mut [[T; #k3]; #n]| Self::ltdl_lower_rows_unrolled(&m, w);
+            ::eomgen_runtime::contact::solve_factored_active_by(&m, &free, &#j(self, q), &#drift(self, q, qd), &[true; #k3], substitute, lower)
+        };
+        (body, ops)
+    }
+
+    /// The body of a straight-line `try_contact_forward_dynamics`: the accelerations, forces
+    /// and pivots of one program, the pivots checked, then every result (as the run-time
+    /// route: a non-finite acceleration `i` is `NonFinite { pivot: i }`, a force `k`
+    /// `NonFinite { pivot: N + k }`).
+    fn contact_flat_body(
+        &mut self,
+        q: &Quantity,
+        outputs: &[Id],
+        pivots: &[Id],
+    ) -> (TokenStream, OpCount) {
+        let all: Vec<Id> = outputs.iter().chain(pivots).copied().collect();
+        let (b, ops) = self.straight(q, &all, Shape::Vector(all.len()));
+        let len = usize_lit(all.len());
+        let at = |range: core::ops::Range<usize>| -> Vec<TokenStream> {
+            range
+                .map(|i| {
+                    let i = usize_lit(i);
+                    quote!(o[#i])
+                })
+                .collect()
+        };
+        let n = self.parents.len();
+        let k = outputs.len() - n;
+        let (a, f, piv) = (at(0..n), at(n..n + k), at(n + k..all.len()));
+        let body = quote! {
+            let o: [T; #len] = { #b };
+            ::eomgen_runtime::lane::check_pivots(&[#(#piv),*], &mut ())?;
+            ::eomgen_runtime::lane::check_finite(&[#(#a,)* #(#f),*], &mut ())?;
+            Ok(([#(#a),*], [#(#f),*]))
+        };
+        (body, ops)
     }
 }
 

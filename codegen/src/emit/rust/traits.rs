@@ -30,7 +30,11 @@ impl Emitter<'_> {
             None => (name, false),
         };
         let q = self.quantities.iter().find(|q| q.name == quantity)?;
-        let solved = matches!(q.eval, Evaluation::ContactForwardDynamics { .. });
+        let solved = matches!(
+            q.eval,
+            Evaluation::ContactForwardDynamics { .. }
+                | Evaluation::ContactForwardDynamicsFlat { .. }
+        );
         if solved != try_ {
             return None;
         }

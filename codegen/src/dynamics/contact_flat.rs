@@ -1,0 +1,160 @@
+//! Contact forward dynamics as one straight-line program: the accelerations and contact forces
+//! of `M a + h = tau + J^T f`, `J a + drift = 0`, with both factorizations on the CAS.
+//!
+//! The route is the run-time one (`eomgen_runtime::contact::solve_factored_active_by`) written
+//! out for the robot: `M = L^T D L` over the joint tree, `W = L^-T J^T`, the contact-space
+//! matrix `Lambda = W^T D^-1 W` (`J M^-1 J^T`), `f = -Lambda^-1 (drift + J M^-1 (tau - h))`
+//! and `a = M^-1 (tau - h + J^T f)`, where `J M^-1 x = W^T D^-1 (L^-T x)` and
+//! `a = L^-1 D^-1 (L^-T (tau - h) + W f)`: half a substitution is shared and the accelerations
+//! without contacts are never formed. Written out, the zeros of `J` and `W` (a leg joint moves
+//! its own foot only) are not multiplied, and the kinematics that `M`, `h`, `J` and the drift
+//! share are computed once.
+//!
+//! `Lambda` is factorized as `L^T D L` too (no square roots), eliminating its rows first to
+//! last as the run-time Cholesky factorization does, so that its pivots fail in the same
+//! order: `D_k` is the square of the Cholesky factor's `k`-th diagonal entry.
+
+use super::ltdl::Factors;
+use crate::cas::{Graph, Id};
+use crate::kinematics::{mat_vec, M3};
+
+/// The straight-line contact forward dynamics.
+pub(crate) struct FlatContact {
+    /// The accelerations (`N`), then the contact forces (`K`).
+    pub outputs: Vec<Id>,
+    /// The pivots of `M`'s factorization (`N`), then those of `Lambda`'s (`K`): all positive
+    /// exactly when `M` is positive definite and `J` has full row rank.
+    pub pivots: Vec<Id>,
+}
+
+/// Contact forward dynamics from `M` (over the coordinate tree `parents`), `h = b + G + F`,
+/// the contact Jacobian `j` (`K` rows of `N`) and its drift `Jdot qd` (`K`), both in the axes
+/// that `axes` turns into the world's (each three rows; the identity when `None`).
+///
+/// In a floating base's axes, `J` and the drift do not depend on the base's orientation: the
+/// base's columns of `J` are `(I, -[p]x)` and nothing is turned into the world. `J M^-1 J^T`
+/// turns as `R Lambda R^T` and the right-hand side as `R b`, so the forces are `R` times
+/// those solved in base axes and `J^T f` is the same either way.
+pub(crate) fn contact_forward_dynamics(
+    g: &mut Graph,
+    parents: &[Option<usize>],
+    m: &[Vec<Id>],
+    h: &[Id],
+    (j, drift): (&[Vec<Id>], &[Id]),
+    axes: Option<&M3>,
+) -> FlatContact {
+    let n = m.len();
+    let old_products = g.set_product_flattening(false);
+    let factors = Factors::new(g, parents, m);
+    let rhs: Vec<Id> = (0..n)
+        .map(|i| {
+            let tau = g.tau(i);
+            g.sub(tau, h[i])
+        })
+        .collect();
+    // `J M^-1 x = W^T D^-1 L^-T x` and `a = M^-1 (tau - h + J^T f) = L^-1 D^-1 (L^-T (tau - h)
+    // + W f)`: one substitution's second half, and the accelerations without contacts never
+    // formed.
+    let lowered = factors.lower(g, &rhs);
+    let w: Vec<Vec<Id>> = j.iter().map(|row| factors.lower(g, row)).collect();
+    let scaled: Vec<Vec<Id>> = w
+        .iter()
+        .map(|row| {
+            let inv_d = factors.inverse_pivots();
+            row.iter().zip(inv_d).map(|(&x, &d)| g.mul(x, d)).collect()
+        })
+        .collect();
+    let lambda = gram(g, &scaled, &w);
+    let b: Vec<Id> = scaled
+        .iter()
+        .zip(drift)
+        .map(|(row, &d)| {
+            let jf = g.dot(row, &lowered);
+            let s = g.add(d, jf);
+            g.neg(s)
+        })
+        .collect();
+    let (f, lambda_pivots) = solve_dense(g, &lambda, &b);
+    let x: Vec<Id> = (0..n)
+        .map(|i| {
+            let terms = w.iter().zip(&f).map(|(wr, &fr)| g.mul(wr[i], fr));
+            let terms: Vec<Id> = core::iter::once(lowered[i]).chain(terms).collect();
+            g.add_all(terms)
+        })
+        .collect();
+    let a = factors.upper(g, &x);
+    let f = match axes {
+        Some(r) => f
+            .chunks(3)
+            .flat_map(|v| mat_vec(g, r, &[v[0], v[1], v[2]]))
+            .collect(),
+        None => f,
+    };
+    g.set_product_flattening(old_products);
+    FlatContact {
+        outputs: a.into_iter().chain(f).collect(),
+        pivots: factors.pivots().into_iter().chain(lambda_pivots).collect(),
+    }
+}
+
+/// `W^T D^-1 W` from the rows of `W^T` (`w`) and of `W^T D^-1` (`scaled`), symmetric (each
+/// entry below the diagonal is the node above it).
+fn gram(g: &mut Graph, scaled: &[Vec<Id>], w: &[Vec<Id>]) -> Vec<Vec<Id>> {
+    let k = w.len();
+    let mut out = vec![vec![g.zero(); k]; k];
+    for r in 0..k {
+        for c in 0..=r {
+            out[r][c] = g.dot(&scaled[r], &w[c]);
+            out[c][r] = out[r][c];
+        }
+    }
+    out
+}
+
+/// `A^-1 b` for a symmetric positive definite `A` by its dense `L^T D L` factorization,
+/// eliminating row 0 first, and the pivots in that order.
+fn solve_dense(g: &mut Graph, a: &[Vec<Id>], b: &[Id]) -> (Vec<Id>, Vec<Id>) {
+    let k = a.len();
+    // [`Factors`] eliminates the last coordinate first: reversed, row 0 goes first, and a
+    // chain makes every earlier coordinate an ancestor (a dense factorization).
+    let rev = |i: usize| k - 1 - i;
+    let reversed: Vec<Vec<Id>> = (0..k)
+        .map(|r| (0..k).map(|c| a[rev(r)][rev(c)]).collect())
+        .collect();
+    let chain: Vec<Option<usize>> = (0..k).map(|i| i.checked_sub(1)).collect();
+    let factors = Factors::new(g, &chain, &reversed);
+    let rb: Vec<Id> = (0..k).map(|r| b[rev(r)]).collect();
+    let x = factors.solve(g, &rb);
+    let pivots = factors.pivots();
+    (
+        (0..k).map(|r| x[rev(r)]).collect(),
+        (0..k).map(|r| pivots[rev(r)]).collect(),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cas::Program;
+
+    #[test]
+    fn the_dense_solve_inverts_and_reports_pivots_in_cholesky_order() {
+        let values = [[4.0, 1.0, 0.5], [1.0, 3.0, 0.2], [0.5, 0.2, 2.0]];
+        let mut g = Graph::new();
+        let a: Vec<Vec<Id>> = values
+            .iter()
+            .map(|row| row.iter().map(|&v| g.constant(v)).collect())
+            .collect();
+        let b: Vec<Id> = [1.0, -2.0, 0.5].iter().map(|&v| g.constant(v)).collect();
+        let (x, pivots) = solve_dense(&mut g, &a, &b);
+        let all: Vec<Id> = x.iter().chain(&pivots).copied().collect();
+        let v = Program::new(&g, &all).eval(|_| None).unwrap();
+        for (i, row) in values.iter().enumerate() {
+            let ax: f64 = row.iter().zip(&v).map(|(a, x)| a * x).sum();
+            assert!((ax - [1.0, -2.0, 0.5][i]).abs() < 1e-14, "row {i}: {ax}");
+        }
+        // Cholesky's first pivot is A_00, its second A_11 - A_10^2 / A_00.
+        assert_eq!(v[3], 4.0);
+        assert!((v[4] - (3.0 - 1.0 / 4.0)).abs() < 1e-15);
+    }
+}
