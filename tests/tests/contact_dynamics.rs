@@ -286,7 +286,10 @@ fn anymal_non_finite_effort_is_reported_as_the_run_time_route_does() {
             .try_contact_forward_dynamics_active(&q, &v, &tau, &[true; 4])
             .unwrap_err();
         assert_eq!(flat, solved);
-        assert!(matches!(flat, eomgen_runtime::FactorError::NonFinite { .. }));
+        assert!(matches!(
+            flat,
+            eomgen_runtime::FactorError::NonFinite { .. }
+        ));
     }
 }
 

@@ -411,6 +411,51 @@ fn contact_quantities(model: &Model, d: &mut Derivation) -> [Quantity; 3] {
     ]
 }
 
+/// A floating base's contact Jacobian and drift in the base's axes, and the base's rotation
+/// `R` that turns them into the world's (`J_c = R J_b`, `drift = R drift_b`, each three rows:
+/// a point's, or a 6D frame's linear or angular part); `None` without a floating base. They
+/// are the world's expressions with the base's quaternion (x, y, z, w) at the identity: the
+/// contacts move with the base, so nothing else in them depends on its orientation (nor on
+/// its position), and the base's columns of `J_b` are `(I, -[p]x)`.
+pub(super) fn contacts_in_base_axes(
+    model: &Model,
+    d: &mut Derivation,
+) -> Option<(Vec<Vec<Id>>, Vec<Id>, M3)> {
+    if !model.is_floating() {
+        return None;
+    }
+    let c = &d.centroidal;
+    let (n, k) = (d.dof, c.contact_drift.len());
+    let all: Vec<Id> = c
+        .contact_jacobian
+        .iter()
+        .flatten()
+        .chain(&c.contact_drift)
+        .copied()
+        .collect();
+    let g = &mut d.graph;
+    let (zero, one) = (g.zero(), g.one());
+    let at_identity: HashMap<Id, Id> = [
+        (d.q[3], zero),
+        (d.q[4], zero),
+        (d.q[5], zero),
+        (d.q[6], one),
+    ]
+    .into_iter()
+    .collect();
+    let based = g.substitute(&all, &at_identity);
+    let j = based[..k * n].chunks(n).map(<[Id]>::to_vec).collect();
+    let drift = based[k * n..].to_vec();
+    Some((j, drift, free_flyer_placement(g, &d.q[..7]).rotation))
+}
+
+/// `r` times each three entries of `v` (a vector of contact rows turned between axes).
+pub(super) fn turn_rows(g: &mut Graph, r: &M3, v: &[Id]) -> Vec<Id> {
+    v.chunks(3)
+        .flat_map(|x| mat_vec(g, r, &[x[0], x[1], x[2]]))
+        .collect()
+}
+
 /// The largest straight-line contact forward dynamics generated (operations, with its
 /// pivots); beyond, `M`, `J_c` and the drift come from their own functions and the contact
 /// system is solved at run time (`eomgen_runtime::contact::solve_factored_active_by`).
@@ -427,29 +472,12 @@ pub(super) fn contact_forward_dynamics(
     d: &mut Derivation,
     flat_max_ops: usize,
 ) -> (&'static str, Evaluation) {
-    let c = &d.centroidal;
-    let (mut j, mut drift) = (c.contact_jacobian.clone(), c.contact_drift.clone());
-    let axes = if model.is_floating() {
-        // In base axes: the base's quaternion (x, y, z, w) at the identity.
-        let g = &mut d.graph;
-        let (zero, one) = (g.zero(), g.one());
-        let map: HashMap<Id, Id> = [
-            (d.q[3], zero),
-            (d.q[4], zero),
-            (d.q[5], zero),
-            (d.q[6], one),
-        ]
-        .into_iter()
-        .collect();
-        let k = drift.len();
-        let all: Vec<Id> = j.iter().flatten().chain(&drift).copied().collect();
-        let based = g.substitute(&all, &map);
-        let n = d.dof;
-        j = based[..k * n].chunks(n).map(<[Id]>::to_vec).collect();
-        drift = based[k * n..].to_vec();
-        Some(free_flyer_placement(g, &d.q[..7]).rotation)
-    } else {
-        None
+    let (j, drift, axes) = match contacts_in_base_axes(model, d) {
+        Some((j, drift, r)) => (j, drift, Some(r)),
+        None => {
+            let c = &d.centroidal;
+            (c.contact_jacobian.clone(), c.contact_drift.clone(), None)
+        }
     };
     let flat = super::contact_flat::contact_forward_dynamics(
         &mut d.graph,

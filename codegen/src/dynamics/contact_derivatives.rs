@@ -89,29 +89,72 @@ fn mass_times_derivative(g: &mut Graph, model: &Model, q: &[Id], x: &[Id]) -> Ve
     }
 }
 
+/// `-J^T f` (one entry per column of `J`).
+fn minus_transpose_times(g: &mut Graph, jac: &[Vec<Id>], f: &[Id]) -> Vec<Id> {
+    let n = jac.first().map_or(0, Vec::len);
+    (0..n)
+        .map(|c| {
+            let column: Vec<Id> = jac.iter().map(|row| row[c]).collect();
+            let jf = g.dot(&column, f);
+            g.neg(jf)
+        })
+        .collect()
+}
+
+/// `J a + drift` and `J v` for the accelerations and velocities `(a, v)`.
+fn contact_rows(
+    g: &mut Graph,
+    jac: &[Vec<Id>],
+    drift: &[Id],
+    (a, v): (&[Id], &[Id]),
+) -> (Vec<Id>, Vec<Id>) {
+    let acc = jac
+        .iter()
+        .zip(drift)
+        .map(|(row, &dr)| {
+            let ja = g.dot(row, a);
+            g.add(ja, dr)
+        })
+        .collect();
+    let vel = jac.iter().map(|row| g.dot(row, v)).collect();
+    (acc, vel)
+}
+
 /// Derives the partials for `model`'s contacts in `d`'s graph.
 pub fn derive(d: &mut Derivation, model: &Model) -> ContactPartials {
     let n = d.dof;
-    let jac = d.centroidal.contact_jacobian.clone();
-    let drift = d.centroidal.contact_drift.clone();
-    let k = drift.len();
+    let based = super::centroidal::contacts_in_base_axes(model, d);
     let (q, qd, qdd) = (d.q.clone(), d.qd.clone(), d.qdd.clone());
+    let roots = match based {
+        Some((jac, drift, r)) => {
+            // In the base's axes: `J_c^T f = J_b^T (R^T f)`, `J_c a + drift = R (J_b a +
+            // drift_b)`, `J_c v = R J_b v`. Differentiated, the base's rotation is one factor
+            // where each entry of `J_c` carried it (a third of anymal's partials).
+            let g = &mut d.graph;
+            let rt = core::array::from_fn(|i| core::array::from_fn(|j| r[j][i]));
+            let f: Vec<Id> = (0..drift.len()).map(|i| g.force(i)).collect();
+            let fb = super::centroidal::turn_rows(g, &rt, &f);
+            let (acc, vel) = contact_rows(g, &jac, &drift, (&qdd, &qd));
+            let mut roots = minus_transpose_times(g, &jac, &fb);
+            roots.extend(super::centroidal::turn_rows(g, &r, &acc));
+            roots.extend(super::centroidal::turn_rows(g, &r, &vel));
+            (roots, super::centroidal::turn_rows(g, &r, &drift))
+        }
+        None => {
+            let (jac, drift) = (&d.centroidal.contact_jacobian, &d.centroidal.contact_drift);
+            let (jac, drift) = (jac.clone(), drift.clone());
+            let g = &mut d.graph;
+            let f: Vec<Id> = (0..drift.len()).map(|i| g.force(i)).collect();
+            let (acc, vel) = contact_rows(g, &jac, &drift, (&qdd, &qd));
+            let mut roots = minus_transpose_times(g, &jac, &f);
+            roots.extend(acc);
+            roots.extend(vel);
+            (roots, drift)
+        }
+    };
+    let (roots, drift) = roots;
+    let k = drift.len();
     let g = &mut d.graph;
-    let f: Vec<Id> = (0..k).map(|i| g.force(i)).collect();
-    let mut roots: Vec<Id> = (0..n)
-        .map(|c| {
-            let column: Vec<Id> = (0..k).map(|r| jac[r][c]).collect();
-            let jf = g.dot(&column, &f);
-            g.neg(jf)
-        })
-        .collect();
-    for r in 0..k {
-        let ja = g.dot(&jac[r], &qdd);
-        roots.push(g.add(ja, drift[r]));
-    }
-    for row in &jac {
-        roots.push(g.dot(row, &qd));
-    }
     let zero = g.zero();
     let mut contact = vec![vec![zero; n]; n + 2 * k];
     let mut impulse = vec![vec![zero; n]; n + k];

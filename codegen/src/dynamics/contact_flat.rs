@@ -16,7 +16,7 @@
 
 use super::ltdl::Factors;
 use crate::cas::{Graph, Id};
-use crate::kinematics::{mat_vec, M3};
+use crate::kinematics::M3;
 
 /// The straight-line contact forward dynamics.
 pub(crate) struct FlatContact {
@@ -84,10 +84,7 @@ pub(crate) fn contact_forward_dynamics(
         .collect();
     let a = factors.upper(g, &x);
     let f = match axes {
-        Some(r) => f
-            .chunks(3)
-            .flat_map(|v| mat_vec(g, r, &[v[0], v[1], v[2]]))
-            .collect(),
+        Some(r) => super::centroidal::turn_rows(g, r, &f),
         None => f,
     };
     g.set_product_flattening(old_products);
