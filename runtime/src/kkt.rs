@@ -269,9 +269,12 @@ impl<T: Real, const N: usize, const K: usize> Parts<'_, T, N, K> {
             }
             // Each row gathered in a local accumulator (kept in registers), not updated in
             // memory once per term: that form was vectorized across rows, with gathers.
+            // The zeros of `J` (a contact's row is zero outside its chain) are skipped.
             let mut acc = scaled(fk, sign);
             for (jki, xi) in jk.iter().zip(x.iter()) {
-                axpy(&mut acc, -sign * *jki, xi);
+                if *jki != T::zero() {
+                    axpy(&mut acc, -sign * *jki, xi);
+                }
             }
             *fk = acc;
         }
