@@ -330,13 +330,15 @@ impl Builder {
         self
     }
 
-    /// `contact_forward_dynamics` is one straight-line program up to this many operations
-    /// (default [`crate::dynamics::CONTACT_FORWARD_DYNAMICS_FLAT_MAX_OPS`], 32,000: every
-    /// robot measured, from a quadruped to a 50-joint humanoid with 6D soles, where it was a
-    /// fifth faster than the run-time route); beyond, `mass_matrix`, `contact_jacobian` and
-    /// `contact_drift` are called and the contact problem is solved at run time
-    /// (`eomgen_runtime::contact::solve_factored_active_by`, the route of the `_active`
-    /// variants). `0` always solves at run time: less generated code for a very large robot.
+    /// `contact_forward_dynamics` and `impulse_dynamics` are each one straight-line program up
+    /// to this many operations (default
+    /// [`crate::dynamics::CONTACT_FORWARD_DYNAMICS_FLAT_MAX_OPS`], 32,000: every robot
+    /// measured, from a quadruped to a 50-joint humanoid with 6D soles, where contact forward
+    /// dynamics was a fifth faster than the run-time route); beyond, `mass_matrix`,
+    /// `contact_jacobian` (and `contact_drift`) are called and the contact problem is solved
+    /// at run time (`eomgen_runtime::contact::solve_factored_active_by`,
+    /// `impulse::solve_factored_active_by`: the route of the `_active` variants). `0` always
+    /// solves at run time: less generated code for a very large robot.
     ///
     /// ```
     /// let b = eomgen::Builder::new("robots/anymal.urdf")

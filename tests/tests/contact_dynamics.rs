@@ -293,6 +293,26 @@ fn anymal_non_finite_effort_is_reported_as_the_run_time_route_does() {
     }
 }
 
+/// A non-finite velocity leaves `M` and `J M^-1 J^T` whole: the straight-line impulse dynamics
+/// and the run-time route (`_active`, every contact on) report the same first non-finite
+/// result, and agree on finite ones at every restitution.
+#[test]
+fn anymal_impulse_dynamics_agrees_with_the_run_time_route() {
+    let r = AnymalMpc::<f64>::default();
+    let (q, mut v, _) = state(5);
+    for e in [0.0, 0.3, 1.0] {
+        let (after, p) = r.impulse_dynamics(&q, &v, e);
+        let (after_a, p_a) = r.impulse_dynamics_active(&q, &v, e, &[true; 4]);
+        assert!(normwise(&after, &after_a) < 1e-12 && normwise(&p, &p_a) < 1e-12);
+    }
+    v[12] = f64::NAN;
+    let flat = r.try_impulse_dynamics(&q, &v, 0.5).unwrap_err();
+    let solved = r
+        .try_impulse_dynamics_active(&q, &v, 0.5, &[true; 4])
+        .unwrap_err();
+    assert_eq!(flat, solved);
+}
+
 /// Contact points at a position in a link frame (`Builder::contact_point_at`): at the origin
 /// they are the link's point contact; elsewhere the point moves with the link (`v_p = v_o +
 /// omega x r`), and the drift is the time derivative of `J v` along the motion.

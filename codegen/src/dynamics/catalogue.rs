@@ -155,6 +155,10 @@ pub enum Evaluation {
     /// The velocity after an impact and the contact impulses, solved at run time
     /// (`eomgen_runtime::ContactKkt::impulse` from `mass_matrix` and `contact_jacobian`).
     ImpulseDynamics,
+    /// `ImpulseDynamics` at restitution zero as one straight-line program (`contact_flat`):
+    /// the velocity change (`N`) and impulses (`K`), which the restitution scales, and the
+    /// pivots (`M`'s, then `J_c M^-1 J_c^T`'s).
+    ImpulseDynamicsFlat { outputs: Vec<Id>, pivots: Vec<Id> },
     /// The derivatives of `ImpulseDynamics`, from `impulse_dynamics_partials`.
     ImpulseDynamicsDerivatives,
     /// Contact or impulse dynamics (or their derivatives) with a set of active contacts given
@@ -299,7 +303,8 @@ impl Quantity {
                 | ActiveContacts::Derivatives { h },
             ) => h.clone(),
             Evaluation::Factored { outputs, pivots }
-            | Evaluation::ContactForwardDynamicsFlat { outputs, pivots } => {
+            | Evaluation::ContactForwardDynamicsFlat { outputs, pivots }
+            | Evaluation::ImpulseDynamicsFlat { outputs, pivots } => {
                 outputs.iter().chain(pivots).copied().collect()
             }
             _ => Vec::new(),
@@ -327,6 +332,7 @@ impl Quantity {
             // Calls neither, but brings them as the run-time route does: with them the
             // `Contacts` trait is complete, as a selection of it alone has always had.
             Evaluation::ContactForwardDynamicsFlat { .. } => &["contact_jacobian", "contact_drift"],
+            Evaluation::ImpulseDynamicsFlat { .. } => &["mass_matrix", "contact_jacobian"],
             Evaluation::ActiveContacts(A::Stabilized { .. }) => &[
                 "mass_matrix",
                 "contact_jacobian",

@@ -185,9 +185,14 @@ pub fn derive(d: &mut Derivation, model: &Model) -> ContactPartials {
 const PARTIAL_INPUTS: &[Input] = &[Input::Q, Input::Qd, Input::Qdd, Input::Forces];
 
 /// `impulse_dynamics` (robots with contacts), in the catalogue after the contact quantities.
-pub(super) fn impulse_dynamics(d: &Derivation) -> Option<Quantity> {
+pub(super) fn impulse_dynamics(model: &Model, d: &mut Derivation) -> Option<Quantity> {
     let (n, k) = (d.dof, d.centroidal.contact_drift.len());
-    (k > 0).then(|| quantity(
+    if k == 0 {
+        return None;
+    }
+    let max_ops = super::CONTACT_FORWARD_DYNAMICS_FLAT_MAX_OPS;
+    let (route, eval) = impulse_dynamics_route(model, d, max_ops);
+    Some(quantity(
         "impulse_dynamics",
         &[Input::Q, Input::Qd],
         Shape::Vector(n + k),
@@ -199,9 +204,46 @@ pub(super) fn impulse_dynamics(d: &Derivation) -> Option<Quantity> {
             "NaN in every entry when M(q) is not positive definite or J_c is rank-deficient;",
             "`try_impulse_dynamics` says why.",
         ],
-        "M from `mass_matrix`, J_c from `contact_jacobian`, then the unrolled L^T D L of M, a Cholesky factorization of J_c M^-1 J_c^T and one more substitution (eomgen_runtime::impulse::solve_factored_active_by, with the first half of the substitution unrolled too)",
-        Evaluation::ImpulseDynamics,
+        route,
+        eval,
     ))
+}
+
+/// `impulse_dynamics`'s route and evaluation: one straight-line program at restitution zero
+/// (`contact_flat::impulse_dynamics`, scaled by `1 + e` at run time) up to `flat_max_ops`
+/// operations, else solved at run time.
+pub(super) fn impulse_dynamics_route(
+    model: &Model,
+    d: &mut Derivation,
+    flat_max_ops: usize,
+) -> (&'static str, Evaluation) {
+    let (j, axes) = match super::centroidal::contacts_in_base_axes(model, d) {
+        Some((j, _, r)) => (j, Some(r)),
+        None => (d.centroidal.contact_jacobian.clone(), None),
+    };
+    let flat = super::contact_flat::impulse_dynamics(
+        &mut d.graph,
+        &d.coordinate_parents,
+        &d.fast.mass_matrix.1,
+        &j,
+        &d.qd,
+        axes.as_ref(),
+    );
+    let all: Vec<Id> = flat.outputs.iter().chain(&flat.pivots).copied().collect();
+    if crate::cas::Program::new(&d.graph, &all).ops().total() <= flat_max_ops {
+        (
+            "one straight-line program at restitution zero, scaled by 1 + e: M as in `mass_matrix`, J_c (in the floating base's axes, the impulses turned into the world's at the end), the unrolled L^T D L of M, W = L^-T J_c^T, J_c M^-1 J_c^T = W^T D^-1 W and its L^T D L, without the zeros of J_c",
+            Evaluation::ImpulseDynamicsFlat {
+                outputs: flat.outputs,
+                pivots: flat.pivots,
+            },
+        )
+    } else {
+        (
+            "M from `mass_matrix`, J_c from `contact_jacobian`, then the unrolled L^T D L of M, a Cholesky factorization of J_c M^-1 J_c^T and one more substitution (eomgen_runtime::impulse::solve_factored_active_by, with the first half of the substitution unrolled too)",
+            Evaluation::ImpulseDynamics,
+        )
+    }
 }
 
 /// The derivative entries of robots with contacts ([`Derivation::add_derivatives`]).

@@ -45,7 +45,7 @@ pub(crate) fn contact_forward_dynamics(
 ) -> FlatContact {
     let n = m.len();
     let old_products = g.set_product_flattening(false);
-    let factors = Factors::new(g, parents, m);
+    let space = Space::new(g, parents, m, j);
     let rhs: Vec<Id> = (0..n)
         .map(|i| {
             let tau = g.tau(i);
@@ -55,17 +55,9 @@ pub(crate) fn contact_forward_dynamics(
     // `J M^-1 x = W^T D^-1 L^-T x` and `a = M^-1 (tau - h + J^T f) = L^-1 D^-1 (L^-T (tau - h)
     // + W f)`: one substitution's second half, and the accelerations without contacts never
     // formed.
-    let lowered = factors.lower(g, &rhs);
-    let w: Vec<Vec<Id>> = j.iter().map(|row| factors.lower(g, row)).collect();
-    let scaled: Vec<Vec<Id>> = w
-        .iter()
-        .map(|row| {
-            let inv_d = factors.inverse_pivots();
-            row.iter().zip(inv_d).map(|(&x, &d)| g.mul(x, d)).collect()
-        })
-        .collect();
-    let lambda = gram(g, &scaled, &w);
-    let b: Vec<Id> = scaled
+    let lowered = space.factors.lower(g, &rhs);
+    let b: Vec<Id> = space
+        .scaled
         .iter()
         .zip(drift)
         .map(|(row, &d)| {
@@ -74,15 +66,8 @@ pub(crate) fn contact_forward_dynamics(
             g.neg(s)
         })
         .collect();
-    let (f, lambda_pivots) = solve_dense(g, &lambda, &b);
-    let x: Vec<Id> = (0..n)
-        .map(|i| {
-            let terms = w.iter().zip(&f).map(|(wr, &fr)| g.mul(wr[i], fr));
-            let terms: Vec<Id> = core::iter::once(lowered[i]).chain(terms).collect();
-            g.add_all(terms)
-        })
-        .collect();
-    let a = factors.upper(g, &x);
+    let (f, lambda_pivots) = solve_dense(g, &space.lambda, &b);
+    let a = space.upper_plus_w(g, Some(&lowered), &f);
     let f = match axes {
         Some(r) => super::centroidal::turn_rows(g, r, &f),
         None => f,
@@ -90,7 +75,95 @@ pub(crate) fn contact_forward_dynamics(
     g.set_product_flattening(old_products);
     FlatContact {
         outputs: a.into_iter().chain(f).collect(),
-        pivots: factors.pivots().into_iter().chain(lambda_pivots).collect(),
+        pivots: space
+            .factors
+            .pivots()
+            .into_iter()
+            .chain(lambda_pivots)
+            .collect(),
+    }
+}
+
+/// Impulse dynamics at restitution zero, whose results `(dv, p)` the restitution `e` scales:
+/// `p = -(1 + e) Lambda^-1 J v` and `v_after = v + M^-1 J^T p`, so generated code takes
+/// `(1 + e) p0` and `v + (1 + e) dv0` from `p0 = -Lambda^-1 J v` and `dv0 = L^-1 D^-1 W p0`.
+/// `J` is in the axes `axes` turns into the world's, as for [`contact_forward_dynamics`];
+/// `v` are the velocity symbols.
+pub(crate) fn impulse_dynamics(
+    g: &mut Graph,
+    parents: &[Option<usize>],
+    m: &[Vec<Id>],
+    j: &[Vec<Id>],
+    v: &[Id],
+    axes: Option<&M3>,
+) -> FlatContact {
+    let old_products = g.set_product_flattening(false);
+    let space = Space::new(g, parents, m, j);
+    let b: Vec<Id> = j
+        .iter()
+        .map(|row| {
+            let jv = g.dot(row, v);
+            g.neg(jv)
+        })
+        .collect();
+    let (p, lambda_pivots) = solve_dense(g, &space.lambda, &b);
+    let dv = space.upper_plus_w(g, None, &p);
+    let p = match axes {
+        Some(r) => super::centroidal::turn_rows(g, r, &p),
+        None => p,
+    };
+    g.set_product_flattening(old_products);
+    FlatContact {
+        outputs: dv.into_iter().chain(p).collect(),
+        pivots: space
+            .factors
+            .pivots()
+            .into_iter()
+            .chain(lambda_pivots)
+            .collect(),
+    }
+}
+
+/// The contact space of `M` and `J`: `M`'s factors, `W = L^-T J^T` (by rows of `W^T`),
+/// `W^T D^-1` and `Lambda = J M^-1 J^T = W^T D^-1 W`.
+struct Space {
+    factors: Factors,
+    w: Vec<Vec<Id>>,
+    scaled: Vec<Vec<Id>>,
+    lambda: Vec<Vec<Id>>,
+}
+
+impl Space {
+    fn new(g: &mut Graph, parents: &[Option<usize>], m: &[Vec<Id>], j: &[Vec<Id>]) -> Space {
+        let factors = Factors::new(g, parents, m);
+        let w: Vec<Vec<Id>> = j.iter().map(|row| factors.lower(g, row)).collect();
+        let scaled: Vec<Vec<Id>> = w
+            .iter()
+            .map(|row| {
+                let inv_d = factors.inverse_pivots();
+                row.iter().zip(inv_d).map(|(&x, &d)| g.mul(x, d)).collect()
+            })
+            .collect();
+        let lambda = gram(g, &scaled, &w);
+        Space {
+            factors,
+            w,
+            scaled,
+            lambda,
+        }
+    }
+
+    /// `L^-1 D^-1 (x + W f)` (`x` zero when `None`): `M^-1 (y + J^T f)` for `x = L^-T y`.
+    fn upper_plus_w(&self, g: &mut Graph, x: Option<&[Id]>, f: &[Id]) -> Vec<Id> {
+        let n = self.factors.pivots().len();
+        let sum: Vec<Id> = (0..n)
+            .map(|i| {
+                let terms = self.w.iter().zip(f).map(|(wr, &fr)| g.mul(wr[i], fr));
+                let terms: Vec<Id> = x.map(|x| x[i]).into_iter().chain(terms).collect();
+                g.add_all(terms)
+            })
+            .collect();
+        self.factors.upper(g, &sum)
     }
 }
 

@@ -413,8 +413,8 @@ impl Derivation {
         self.add_derivatives_flat_up_to(model, quantities::DERIVATIVES_FLAT_MAX_OPS)
     }
 
-    /// Generates `contact_forward_dynamics` as one straight-line program only up to
-    /// `flat_max_ops` operations, solving it at run time beyond
+    /// Generates `contact_forward_dynamics` and `impulse_dynamics` as straight-line programs
+    /// only up to `flat_max_ops` operations each, solving them at run time beyond
     /// ([`crate::Builder::contact_forward_dynamics_flat_max_ops`]; the catalogue's default is
     /// [`CONTACT_FORWARD_DYNAMICS_FLAT_MAX_OPS`]). Nothing changes without
     /// contacts. Fails when the graph fills.
@@ -423,17 +423,20 @@ impl Derivation {
         model: &Model,
         flat_max_ops: usize,
     ) -> Result<(), GraphFull> {
-        let Some(at) = self
-            .quantities
-            .iter()
-            .position(|q| q.name == "contact_forward_dynamics")
-        else {
-            return Ok(());
-        };
-        let (route, eval) = centroidal::contact_forward_dynamics(model, self, flat_max_ops);
-        self.graph.check()?;
-        let q = &mut self.quantities[at];
-        (q.route, q.eval) = (format!("Route: {route}."), eval);
+        for name in ["contact_forward_dynamics", "impulse_dynamics"] {
+            let Some(at) = self.quantities.iter().position(|q| q.name == name) else {
+                continue;
+            };
+            let (route, eval) = match name {
+                "impulse_dynamics" => {
+                    contact_derivatives::impulse_dynamics_route(model, self, flat_max_ops)
+                }
+                _ => centroidal::contact_forward_dynamics(model, self, flat_max_ops),
+            };
+            self.graph.check()?;
+            let q = &mut self.quantities[at];
+            (q.route, q.eval) = (format!("Route: {route}."), eval);
+        }
         Ok(())
     }
 

@@ -166,7 +166,7 @@ pub fn catalogue(model: &Model, d: &mut Derivation) -> Vec<Quantity> {
     out.push(link_pose());
     out.push(link_jacobian(d.dof));
     out.extend(centroidal::quantities(model, d));
-    out.extend(super::contact_derivatives::impulse_dynamics(d));
+    out.extend(super::contact_derivatives::impulse_dynamics(model, d));
     out.extend(super::active_contacts::quantities(d));
     if !model.velocities_are_rates() {
         // Not the `Dynamics` trait (whose arrays are all N long): a floating base's methods go

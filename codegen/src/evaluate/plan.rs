@@ -124,7 +124,9 @@ impl Plan {
             | Evaluation::Integrate => {
                 return not("it takes a link or a time step besides the state")
             }
-            Evaluation::ImpulseDynamics | Evaluation::ImpulseDynamicsDerivatives => {
+            Evaluation::ImpulseDynamics
+            | Evaluation::ImpulseDynamicsFlat { .. }
+            | Evaluation::ImpulseDynamicsDerivatives => {
                 return not("it takes a restitution besides the state")
             }
             Evaluation::ActiveContacts(_) => {

@@ -357,6 +357,55 @@ impl Emitter<'_> {
         }
     }
 
+    /// `try_impulse_dynamics` and `impulse_dynamics` from one straight-line program at
+    /// restitution zero (`Evaluation::ImpulseDynamicsFlat`), scaled by `1 + e`.
+    pub(super) fn impulse_flat_fns(
+        &mut self,
+        q: &Quantity,
+        outputs: &[Id],
+        pivots: &[Id],
+    ) -> TokenStream {
+        let all: Vec<Id> = outputs.iter().chain(pivots).copied().collect();
+        let (b, ops) = self.straight(q, &all, Shape::Vector(all.len()));
+        let docs = Self::quantity_doc(q, Some(ops));
+        let (n, nq, k) = (self.n.clone(), self.nq.clone(), self.k.clone());
+        let len = usize_lit(all.len());
+        let at = |range: core::ops::Range<usize>| -> Vec<TokenStream> {
+            range
+                .map(|i| {
+                    let i = usize_lit(i);
+                    quote!(o[#i])
+                })
+                .collect()
+        };
+        let (dof, rows) = (self.parents.len(), outputs.len() - self.parents.len());
+        let (dv, p, piv) = (at(0..dof), at(dof..dof + rows), at(dof + rows..all.len()));
+        quote! {
+            /// The velocity after the impact and the impulses of `impulse_dynamics`, or why
+            /// they do not exist: a pivot of M(q) (`pivot` < N) or of `J_c M^-1 J_c^T`
+            /// (`pivot` - N, a rank-deficient contact Jacobian) that is not positive, or a
+            /// non-finite result.
+            pub fn try_impulse_dynamics(&self, q: &[T; #nq], qd: &[T; #n], restitution: T) -> ::core::result::Result<([T; #n], [T; #k]), ::eomgen_runtime::FactorError> {
+                let o: [T; #len] = { #b };
+                ::eomgen_runtime::lane::check_pivots(&[#(#piv),*], &mut ())?;
+                let s = T::one() + restitution;
+                let jump = [#(s * #dv,)* #(s * #p),*];
+                ::eomgen_runtime::lane::check_finite(&jump, &mut ())?;
+                let after: [T; #n] = ::core::array::from_fn(|i| qd[i] + jump[i]);
+                let p: [T; #k] = ::core::array::from_fn(|i| jump[#n + i]);
+                Ok((after, p))
+            }
+
+            #docs
+            pub fn impulse_dynamics(&self, q: &[T; #nq], qd: &[T; #n], restitution: T) -> ([T; #n], [T; #k]) {
+                match self.try_impulse_dynamics(q, qd, restitution) {
+                    Ok(x) => x,
+                    Err(_) => ([T::nan(); #n], [T::nan(); #k]),
+                }
+            }
+        }
+    }
+
     /// `try_impulse_dynamics_derivatives` and `impulse_dynamics_derivatives` (NaN on
     /// failure), or their `_active` variants.
     pub(super) fn impulse_dynamics_derivatives_fns(

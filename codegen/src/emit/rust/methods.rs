@@ -42,6 +42,9 @@ impl Emitter<'_> {
                 self.contact_dynamics_derivatives_fns(q, h, false)
             }
             Evaluation::ImpulseDynamics => self.impulse_dynamics_fns(q, false),
+            Evaluation::ImpulseDynamicsFlat { outputs, pivots } => {
+                self.impulse_flat_fns(q, outputs, pivots)
+            }
             Evaluation::ImpulseDynamicsDerivatives => {
                 self.impulse_dynamics_derivatives_fns(q, false)
             }
