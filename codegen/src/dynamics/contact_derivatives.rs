@@ -10,6 +10,9 @@
 //! (`contact_dynamics_partials`) by differentiating the contact Jacobian and drift along each
 //! tangent direction of `q` ([`Graph::derivative_along_many`]), with the contact forces as
 //! symbols ([`Graph::force`]). They involve only the contacts' chains, so they are small.
+//! With a floating base they are taken in the base's axes (`J^T f = J_b^T (R^T f)`,
+//! `J a + drift = R (J_b a + drift_b)`, `centroidal::contacts_in_base_axes`), where the
+//! base's rotation is one factor instead of a part of every entry of `J`.
 //!
 //! Impulse dynamics solves `M (v+ - v) - J^T p = 0`, `J (v+ + e v) = 0`; its `q`-partials
 //! (`impulse_dynamics_partials`) are `d(M x)/dq` (Newton-Euler's derivatives at zero velocity
