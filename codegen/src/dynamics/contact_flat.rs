@@ -1,5 +1,6 @@
-//! Contact forward dynamics as one straight-line program: the accelerations and contact forces
-//! of `M a + h = tau + J^T f`, `J a + drift = 0`, with both factorizations on the CAS.
+//! Contact forward dynamics and impulse dynamics as straight-line programs: the accelerations
+//! and contact forces of `M a + h = tau + J^T f`, `J a + drift = 0`, and the velocity change
+//! and impulses of `M dv = J^T p`, `J (v + dv) = -e J v`, with both factorizations on the CAS.
 //!
 //! The route is the run-time one (`eomgen_runtime::contact::solve_factored_active_by`) written
 //! out for the robot: `M = L^T D L` over the joint tree, `W = L^-T J^T`, the contact-space
@@ -18,9 +19,10 @@ use super::ltdl::Factors;
 use crate::cas::{Graph, Id};
 use crate::kinematics::M3;
 
-/// The straight-line contact forward dynamics.
+/// A straight-line contact or impulse dynamics.
 pub(crate) struct FlatContact {
-    /// The accelerations (`N`), then the contact forces (`K`).
+    /// The accelerations (or velocity changes, `N`), then the contact forces (or impulses,
+    /// `K`).
     pub outputs: Vec<Id>,
     /// The pivots of `M`'s factorization (`N`), then those of `Lambda`'s (`K`): all positive
     /// exactly when `M` is positive definite and `J` has full row rank.
