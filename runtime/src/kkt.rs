@@ -1034,6 +1034,26 @@ mod tests {
         d.add_partials(&partials).unwrap();
         stash.contact_dynamics_derivatives_in_place(&mut d).unwrap();
         assert_eq!(d, want);
+        // Independently of either route, the `tau` block solves `[M -J^T; J 0] [X; F] = [I;
+        // 0]`, and the `q` block `[M -J^T; J 0] [X; F] = -[did_dq + P_top; P_middle]`.
+        for c in 0..3 {
+            for i in 0..3 {
+                let mx: f64 = (0..3).map(|k| m[i][k] * d.da_dtau[k][c]).sum();
+                let jf: f64 = (0..2).map(|k| j[k][i] * d.df_dtau[k][c]).sum();
+                let want = if i == c { 1.0 } else { 0.0 };
+                assert!((mx - jf - want).abs() < 1e-14, "tau ({i}, {c})");
+                let mx: f64 = (0..3).map(|k| m[i][k] * d.da_dq[k][c]).sum();
+                let jf: f64 = (0..2).map(|k| j[k][i] * d.df_dq[k][c]).sum();
+                let rhs = -(did_dq[i][c] + partials[i][c]);
+                assert!((mx - jf - rhs).abs() < 1e-13, "q ({i}, {c})");
+            }
+            for r in 0..2 {
+                let ja: f64 = (0..3).map(|k| j[r][k] * d.da_dtau[k][c]).sum();
+                assert!(ja.abs() < 1e-14, "tau row {r}, column {c}");
+                let ja: f64 = (0..3).map(|k| j[r][k] * d.da_dq[k][c]).sum();
+                assert!((ja + partials[3 + r][c]).abs() < 1e-13, "q row {r}");
+            }
+        }
     }
 
     #[test]

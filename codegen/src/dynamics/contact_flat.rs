@@ -70,20 +70,9 @@ pub(crate) fn contact_forward_dynamics(
         .collect();
     let (f, lambda_pivots) = solve_dense(g, &space.lambda, &b);
     let a = space.upper_plus_w(g, Some(&lowered), &f);
-    let f = match axes {
-        Some(r) => super::centroidal::turn_rows(g, r, &f),
-        None => f,
-    };
+    let flat = space.finish(g, a, (f, lambda_pivots), axes);
     g.set_product_flattening(old_products);
-    FlatContact {
-        outputs: a.into_iter().chain(f).collect(),
-        pivots: space
-            .factors
-            .pivots()
-            .into_iter()
-            .chain(lambda_pivots)
-            .collect(),
-    }
+    flat
 }
 
 /// Impulse dynamics at restitution zero, whose results `(dv, p)` the restitution `e` scales:
@@ -110,20 +99,9 @@ pub(crate) fn impulse_dynamics(
         .collect();
     let (p, lambda_pivots) = solve_dense(g, &space.lambda, &b);
     let dv = space.upper_plus_w(g, None, &p);
-    let p = match axes {
-        Some(r) => super::centroidal::turn_rows(g, r, &p),
-        None => p,
-    };
+    let flat = space.finish(g, dv, (p, lambda_pivots), axes);
     g.set_product_flattening(old_products);
-    FlatContact {
-        outputs: dv.into_iter().chain(p).collect(),
-        pivots: space
-            .factors
-            .pivots()
-            .into_iter()
-            .chain(lambda_pivots)
-            .collect(),
-    }
+    flat
 }
 
 /// The contact space of `M` and `J`: `M`'s factors, `W = L^-T J^T` (by rows of `W^T`),
@@ -152,6 +130,26 @@ impl Space {
             w,
             scaled,
             lambda,
+        }
+    }
+
+    /// The program's results: `n` values per coordinate, then the contact rows `f` turned
+    /// into the world's axes by `axes`; the pivots of `M`'s factorization, then `lambda`'s.
+    fn finish(
+        &self,
+        g: &mut Graph,
+        n: Vec<Id>,
+        (f, lambda_pivots): (Vec<Id>, Vec<Id>),
+        axes: Option<&M3>,
+    ) -> FlatContact {
+        let f = match axes {
+            Some(r) => super::centroidal::turn_rows(g, r, &f),
+            None => f,
+        };
+        let pivots = self.factors.pivots().into_iter().chain(lambda_pivots);
+        FlatContact {
+            outputs: n.into_iter().chain(f).collect(),
+            pivots: pivots.collect(),
         }
     }
 

@@ -365,29 +365,21 @@ impl Emitter<'_> {
         outputs: &[Id],
         pivots: &[Id],
     ) -> TokenStream {
-        let all: Vec<Id> = outputs.iter().chain(pivots).copied().collect();
-        let (b, ops) = self.straight(q, &all, Shape::Vector(all.len()));
+        let super::solve::FlatProgram {
+            program,
+            first: dv,
+            rows: p,
+            ops,
+        } = self.flat_program(q, outputs, pivots);
         let docs = Self::quantity_doc(q, Some(ops));
         let (n, nq, k) = (self.n.clone(), self.nq.clone(), self.k.clone());
-        let len = usize_lit(all.len());
-        let at = |range: core::ops::Range<usize>| -> Vec<TokenStream> {
-            range
-                .map(|i| {
-                    let i = usize_lit(i);
-                    quote!(o[#i])
-                })
-                .collect()
-        };
-        let (dof, rows) = (self.parents.len(), outputs.len() - self.parents.len());
-        let (dv, p, piv) = (at(0..dof), at(dof..dof + rows), at(dof + rows..all.len()));
         quote! {
             /// The velocity after the impact and the impulses of `impulse_dynamics`, or why
             /// they do not exist: a pivot of M(q) (`pivot` < N) or of `J_c M^-1 J_c^T`
             /// (`pivot` - N, a rank-deficient contact Jacobian) that is not positive, or a
             /// non-finite result.
             pub fn try_impulse_dynamics(&self, q: &[T; #nq], qd: &[T; #n], restitution: T) -> ::core::result::Result<([T; #n], [T; #k]), ::eomgen_runtime::FactorError> {
-                let o: [T; #len] = { #b };
-                ::eomgen_runtime::lane::check_pivots(&[#(#piv),*], &mut ())?;
+                #program
                 let s = T::one() + restitution;
                 let jump = [#(s * #dv,)* #(s * #p),*];
                 ::eomgen_runtime::lane::check_finite(&jump, &mut ())?;

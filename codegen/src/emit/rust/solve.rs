@@ -509,6 +509,29 @@ impl Emitter<'_> {
         outputs: &[Id],
         pivots: &[Id],
     ) -> (TokenStream, OpCount) {
+        let FlatProgram {
+            program,
+            first: a,
+            rows: f,
+            ops,
+        } = self.flat_program(q, outputs, pivots);
+        let body = quote! {
+            #program
+            ::eomgen_runtime::lane::check_finite(&[#(#a,)* #(#f),*], &mut ())?;
+            Ok(([#(#a),*], [#(#f),*]))
+        };
+        (body, ops)
+    }
+
+    /// The straight-line program of a contact or impulse dynamics (`contact_flat`): `let o`
+    /// holding its results then its pivots, the pivots checked (a scalar's first failure
+    /// returned), and the entries of `o` that hold each result.
+    pub(super) fn flat_program(
+        &mut self,
+        q: &Quantity,
+        outputs: &[Id],
+        pivots: &[Id],
+    ) -> FlatProgram {
         let all: Vec<Id> = outputs.iter().chain(pivots).copied().collect();
         let (b, ops) = self.straight(q, &all, Shape::Vector(all.len()));
         let len = usize_lit(all.len());
@@ -520,17 +543,29 @@ impl Emitter<'_> {
                 })
                 .collect()
         };
-        let n = self.parents.len();
-        let k = outputs.len() - n;
-        let (a, f, piv) = (at(0..n), at(n..n + k), at(n + k..all.len()));
-        let body = quote! {
-            let o: [T; #len] = { #b };
-            ::eomgen_runtime::lane::check_pivots(&[#(#piv),*], &mut ())?;
-            ::eomgen_runtime::lane::check_finite(&[#(#a,)* #(#f),*], &mut ())?;
-            Ok(([#(#a),*], [#(#f),*]))
-        };
-        (body, ops)
+        let (n, k) = (self.parents.len(), outputs.len() - self.parents.len());
+        let piv = at(n + k..all.len());
+        FlatProgram {
+            program: quote! {
+                let o: [T; #len] = { #b };
+                ::eomgen_runtime::lane::check_pivots(&[#(#piv),*], &mut ())?;
+            },
+            first: at(0..n),
+            rows: at(n..n + k),
+            ops,
+        }
     }
+}
+
+/// A straight-line contact or impulse dynamics ([`Emitter::flat_program`]).
+pub(super) struct FlatProgram {
+    /// `let o = ...;` and its pivots checked.
+    pub program: TokenStream,
+    /// The entries of `o` per velocity coordinate (accelerations, or velocity changes).
+    pub first: Vec<TokenStream>,
+    /// The entries per contact row (forces, or impulses).
+    pub rows: Vec<TokenStream>,
+    pub ops: OpCount,
 }
 
 /// The evaluations whose KKT systems take the robot's `TreePasses`.
