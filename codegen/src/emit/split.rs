@@ -44,6 +44,10 @@ pub(super) struct Split<'a> {
     /// as separate matrices (`o0`, `o1`, ...), so that a caller can have them written into
     /// different places; empty: the whole matrix (`o`).
     pub rows: &'a [usize],
+    /// How many of the first [`Split::rows`] groups `{name}_fill` adds onto the matrices it is
+    /// given (`+=`, the zero outputs skipped) instead of setting them: the contact partials'
+    /// rows in `q`, added onto the inverse-dynamics derivatives where they lie.
+    pub adds: usize,
     /// Another generated function has this one fill its result's storage (`{name}_fill`): the
     /// body is written in blocks even under the budget (one block then), so that the method
     /// exists and the result is not built in a local and copied.
@@ -206,10 +210,14 @@ pub(super) fn split_body(
             Expr::Const(c) => super::expr::assigned_lit(*c),
             _ => cx.expr(e, &mut blocks[b].trig).ts,
         };
+        let place = output_place(shape, j, split.rows);
         if seq.is_some() {
             blocks[b].code.push(quote!(e.put(#ts);));
+        } else if row_group(shape, j, split.rows).is_some_and(|(g, _)| g < split.adds) {
+            if !matches!(e, Expr::Const(c) if *c == 0.0) {
+                blocks[b].code.push(quote!(#place += #ts;));
+            }
         } else {
-            let place = output_place(shape, j, split.rows);
             blocks[b].code.push(quote!(#place = #ts;));
         }
         blocks[b].reads.extend(earlier_temps(e, b, &of_temp));
@@ -545,18 +553,30 @@ fn block_fn(
     }
 }
 
+/// The row group of [`Split::rows`] that output `j` of a [`Shape::Matrix`] result falls in,
+/// and its row in that group; `None` without groups.
+fn row_group(shape: Shape, j: usize, rows: &[usize]) -> Option<(usize, usize)> {
+    let Shape::Matrix(_, c) = shape else {
+        return None;
+    };
+    if rows.is_empty() || c == 0 {
+        return None;
+    }
+    let (mut i, mut g) = (j / c, 0);
+    while g + 1 < rows.len() && i >= rows[g] {
+        i -= rows[g];
+        g += 1;
+    }
+    Some((g, i))
+}
+
 /// Where flat output `j` of a result of `shape` goes in `o`.
 fn output_place(shape: Shape, j: usize, rows: &[usize]) -> TokenStream {
     let lit = Literal::usize_unsuffixed;
     match shape {
         Shape::Matrix(_, c) if !rows.is_empty() => {
-            let (mut i, col) = (j / c, lit(j % c));
-            let mut g = 0;
-            while g + 1 < rows.len() && i >= rows[g] {
-                i -= rows[g];
-                g += 1;
-            }
-            let (o, i) = (format_ident!("o{}", g), lit(i));
+            let (g, i) = row_group(shape, j, rows).unwrap_or((0, j / c));
+            let (o, i, col) = (format_ident!("o{}", g), lit(i), lit(j % c));
             quote!(#o[#i][#col])
         }
         Shape::Scalar => quote!(*o),

@@ -216,7 +216,11 @@ impl Emitter<'_> {
         let (fill, rows) = self.kkt_inputs(active);
         let drift = self.call("contact_drift");
         let id_derivatives = self.id_derivatives_into(quote!(d.da_dq), quote!(d.da_dv), quote!(a));
-        let partials = self.call("contact_dynamics_partials");
+        // The partials' blocks add their rows in `q` onto `d.da_dq` (the inverse-dynamics
+        // derivatives) and write their contact rows straight into `d` (a body that its callers
+        // fill is always written in blocks: `methods.rs`, `FILLED`).
+        debug_assert!(self.split.contains("contact_dynamics_partials"));
+        let partials = crate::emit::split::fill_name("contact_dynamics_partials");
         let ty = quote!(::eomgen_runtime::ContactDynamicsDerivatives<T, #n, #k>);
         let [into, solve, stage] =
             ["into", "solve", "partials"].map(|s| format_ident!("{}_{}", name, s));
@@ -251,7 +255,8 @@ impl Emitter<'_> {
             /// The partials added to `d` in a frame of their own.
             #[inline(never)]
             fn #stage(&self, q: &[T; #nq], qd: &[T; #n], a: &[T; #n], f: &[T; #k], d: &mut #ty) -> ::core::result::Result<(), #err> {
-                d.add_partials(&#partials(self, q, qd, a, f))
+                self.#partials(q, qd, a, f, &mut d.da_dq, &mut d.df_dq, &mut d.df_dv);
+                Ok(())
             }
         });
         let (with_err, without) = self.fill_in_place(

@@ -12,11 +12,13 @@ use crate::emit::split::Split;
 
 /// The quantities whose callers have them write into the callers' own results
 /// (`{name}_fill`): the inverse-dynamics derivatives (the composed forward-dynamics
-/// derivatives', the contact derivatives') and the impulse partials (the impulse derivatives').
-const FILLED: [&str; 3] = [
+/// derivatives', the contact derivatives') and the impulse and contact partials (the impulse
+/// and contact derivatives').
+const FILLED: [&str; 4] = [
     "inverse_dynamics_derivatives",
     "impulse_dynamics_partials",
     "forward_dynamics_partials",
+    "contact_dynamics_partials",
 ];
 
 impl Emitter<'_> {
@@ -109,6 +111,7 @@ impl Emitter<'_> {
         let rows = Self::row_groups(q.name, shape);
         let mut split = self.split(q.name, &params, &args);
         split.rows = &rows;
+        split.adds = Self::added_groups(q.name, &rows);
         let b = body(self.graph, &self.cx, outputs, shape, Some(&split));
         self.counts.push((q.name.to_string(), b.ops));
         if !b.blocks.is_empty() {
@@ -135,6 +138,7 @@ impl Emitter<'_> {
                 self.budget
             },
             rows: &[],
+            adds: 0,
             filled: self.filled_by_another(name),
         }
     }
@@ -149,12 +153,24 @@ impl Emitter<'_> {
 
     /// The row groups a split body of `name` fills separately ([`Split::rows`]): the impulse
     /// partials' `N` rows in `q` and `K` contact rows, which `impulse_dynamics_derivatives`
-    /// has written straight into two matrices of its result.
+    /// has written straight into two matrices of its result; the contact partials' `N` rows in
+    /// `q` and two groups of `K` contact rows, which `contact_forward_dynamics_derivatives`
+    /// adds onto its inverse-dynamics derivatives and writes into two matrices of its result
+    /// (built in a local, copied and added, they were a tenth of anymal's derivatives).
     pub(super) fn row_groups(name: &str, shape: Shape) -> Vec<usize> {
         match (name, shape) {
             ("impulse_dynamics_partials", Shape::Matrix(r, c)) if r > c => vec![c, r - c],
+            ("contact_dynamics_partials", Shape::Matrix(r, c)) if r > c && (r - c) % 2 == 0 => {
+                vec![c, (r - c) / 2, (r - c) / 2]
+            }
             _ => Vec::new(),
         }
+    }
+
+    /// How many of the first `rows` groups of `name`'s `{name}_fill` add onto their matrices
+    /// ([`Split::adds`]): the contact partials' rows in `q`.
+    fn added_groups(name: &str, rows: &[usize]) -> usize {
+        usize::from(name == "contact_dynamics_partials" && !rows.is_empty())
     }
 
     pub(super) fn exprs_fn(&mut self, q: &Quantity, ids: &[Id]) -> TokenStream {
