@@ -260,7 +260,7 @@ fn drive(
 ) -> (TokenStream, Vec<TokenStream>) {
     let (args, params) = (split.args, split.params);
     let (outs, out_params) = out_params(shape, split.rows);
-    let work = work_array(width);
+    let mut work = work_array(width);
     let first = block_name(split.name, 0);
     // One block writing the entries in order ([`sequential`]) is lent the matrices.
     let calls = if in_order {
@@ -268,7 +268,11 @@ fn drive(
             quote!(::eomgen_runtime::place::refill([#(#outs),*], |out| self.#first(#(#args,)* &mut w, out));),
         ]
     } else {
-        (0..count)
+        let starts = starts_work(0, width, &Out::Params(Vec::new()));
+        if starts {
+            work = quote!(let mut w = self.#first(#(#args,)* #(#outs),*););
+        }
+        (usize::from(starts)..count)
             .map(|b| {
                 let f = block_name(split.name, b);
                 quote!(self.#f(#(#args,)* &mut w, #(#outs),*);)
@@ -520,12 +524,32 @@ fn block_fn(
         Value::Temp(_) => None,
     }));
     let trig = trig_lets(&computed);
+    let block_writes = writes;
     let writes = writes.iter().map(|v| {
         let (name, s) = (v.ident(), slot(v));
         quote!(w[#s] = #name;)
     });
     let code = &block.code;
     let (name, params) = (block_name(split.name, b), split.params);
+    if starts_work(b, width, out) {
+        // The first block's values for later blocks, where the work array starts.
+        debug_assert!(block.reads.is_empty());
+        let at: BTreeMap<usize, Ident> =
+            block_writes.iter().map(|v| (slots[v], v.ident())).collect();
+        let entries = (0..width).map(|s| match at.get(&s) {
+            Some(name) => quote!(#name),
+            None => quote!(T::zero()),
+        });
+        let (outs, width) = (out_decls(out), Literal::usize_unsuffixed(width));
+        return quote! {
+            #[inline(never)]
+            fn #name(&self, #(#params,)* #(#outs),*) -> [T; #width] {
+                #(#trig)*
+                #(#code)*
+                [#(#entries),*]
+            }
+        };
+    }
     let width = Literal::usize_unsuffixed(width);
     let outs = match out {
         Out::Params(outs) => outs,
@@ -550,6 +574,22 @@ fn block_fn(
             #(#code)*
             #(#writes)*
         }
+    }
+}
+
+/// Whether block `b` returns the work array (of `width` values) instead of writing into one:
+/// the first of several blocks that write their outputs by index. The work array then starts
+/// as that block's values, not as zeros overwritten (anymal's contact forward dynamics zeroed
+/// 323 values, 2 % of its time).
+fn starts_work(b: usize, width: usize, out: &Out) -> bool {
+    b == 0 && width > 0 && matches!(out, Out::Params(_))
+}
+
+/// The parameters for the result that blocks writing by index take (`o`, or `o0`, `o1`, ...).
+fn out_decls(out: &Out) -> &[TokenStream] {
+    match out {
+        Out::Params(outs) => outs,
+        Out::InOrder(_) => &[],
     }
 }
 
