@@ -268,7 +268,7 @@ fn drive(
             quote!(::eomgen_runtime::place::refill([#(#outs),*], |out| self.#first(#(#args,)* &mut w, out));),
         ]
     } else {
-        let starts = starts_work(0, width, &Out::Params(Vec::new()));
+        let starts = starts_work(0, width, in_order);
         if starts {
             work = quote!(let mut w = self.#first(#(#args,)* #(#outs),*););
         }
@@ -531,24 +531,13 @@ fn block_fn(
     });
     let code = &block.code;
     let (name, params) = (block_name(split.name, b), split.params);
-    if starts_work(b, width, out) {
-        // The first block's values for later blocks, where the work array starts.
-        debug_assert!(block.reads.is_empty());
-        let at: BTreeMap<usize, Ident> =
-            block_writes.iter().map(|v| (slots[v], v.ident())).collect();
-        let entries = (0..width).map(|s| match at.get(&s) {
-            Some(name) => quote!(#name),
-            None => quote!(T::zero()),
-        });
-        let (outs, width) = (out_decls(out), Literal::usize_unsuffixed(width));
-        return quote! {
-            #[inline(never)]
-            fn #name(&self, #(#params,)* #(#outs),*) -> [T; #width] {
-                #(#trig)*
-                #(#code)*
-                [#(#entries),*]
-            }
-        };
+    if let Out::Params(outs) = out {
+        if starts_work(b, width, false) {
+            debug_assert!(block.reads.is_empty());
+            let at = block_writes.iter().map(|v| (slots[v], v.ident())).collect();
+            let body = quote!(#(#trig)* #(#code)*);
+            return first_block_fn(&name, params, outs, body, (width, &at));
+        }
     }
     let width = Literal::usize_unsuffixed(width);
     let outs = match out {
@@ -578,18 +567,33 @@ fn block_fn(
 }
 
 /// Whether block `b` returns the work array (of `width` values) instead of writing into one:
-/// the first of several blocks that write their outputs by index. The work array then starts
-/// as that block's values, not as zeros overwritten (anymal's contact forward dynamics zeroed
-/// 323 values, 2 % of its time).
-fn starts_work(b: usize, width: usize, out: &Out) -> bool {
-    b == 0 && width > 0 && matches!(out, Out::Params(_))
+/// the first of several blocks, unless one block writes the entries in order. The work array
+/// then starts as that block's values, not as zeros overwritten (anymal's contact forward
+/// dynamics zeroed 323 values, 2 % of its time).
+fn starts_work(b: usize, width: usize, in_order: bool) -> bool {
+    b == 0 && width > 0 && !in_order
 }
 
-/// The parameters for the result that blocks writing by index take (`o`, or `o0`, `o1`, ...).
-fn out_decls(out: &Out) -> &[TokenStream] {
-    match out {
-        Out::Params(outs) => outs,
-        Out::InOrder(_) => &[],
+/// The first block `name` of [`starts_work`]: `body` (its temporaries and outputs, written into
+/// `outs`), then the work array of `width` values, each slot its value of `at` or zero.
+fn first_block_fn(
+    name: &Ident,
+    params: &[TokenStream],
+    outs: &[TokenStream],
+    body: TokenStream,
+    (width, at): (usize, &BTreeMap<usize, Ident>),
+) -> TokenStream {
+    let entries = (0..width).map(|s| match at.get(&s) {
+        Some(name) => quote!(#name),
+        None => quote!(T::zero()),
+    });
+    let width = Literal::usize_unsuffixed(width);
+    quote! {
+        #[inline(never)]
+        fn #name(&self, #(#params,)* #(#outs),*) -> [T; #width] {
+            #body
+            [#(#entries),*]
+        }
     }
 }
 
