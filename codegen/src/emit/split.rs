@@ -10,7 +10,7 @@
 //!
 //! - a block reads what it needs of earlier blocks from a work array `w` at its start, computes
 //!   its temporaries, writes the outputs it completes straight into the result `o`, and at its
-//!   end writes into `w` the values later blocks read;
+//!   end writes into `w` the values later blocks read (the first block returns `w` instead);
 //! - a slot of `w` is reused once the last block reading its value has run, so that `w` holds
 //!   about as many values as cross one cut at a time;
 //! - each joint angle's sine and cosine are computed once, in the first block that uses them,
