@@ -524,7 +524,7 @@ impl Emitter<'_> {
     }
 
     /// The straight-line program of a contact or impulse dynamics (`contact_flat`): `let o`
-    /// holding its results then its pivots, the pivots checked (a scalar's first failure
+    /// holding its pivots then its results, the pivots checked (a scalar's first failure
     /// returned), and the entries of `o` that hold each result.
     pub(super) fn flat_program(
         &mut self,
@@ -532,7 +532,10 @@ impl Emitter<'_> {
         outputs: &[Id],
         pivots: &[Id],
     ) -> FlatProgram {
-        let all: Vec<Id> = outputs.iter().chain(pivots).copied().collect();
+        // The pivots first: scheduled depth first from them, the factorizations come before
+        // the right-hand sides (`h`, the drift), whose values are then not live across them
+        // (anymal's contact forward dynamics 2 % faster, alternated).
+        let all: Vec<Id> = pivots.iter().chain(outputs).copied().collect();
         let (b, ops) = self.straight(q, &all, Shape::Vector(all.len()));
         let len = usize_lit(all.len());
         let at = |range: core::ops::Range<usize>| -> Vec<TokenStream> {
@@ -543,15 +546,19 @@ impl Emitter<'_> {
                 })
                 .collect()
         };
-        let (n, k) = (self.parents.len(), outputs.len() - self.parents.len());
-        let piv = at(n + k..all.len());
+        let (n, k, p) = (
+            self.parents.len(),
+            outputs.len() - self.parents.len(),
+            pivots.len(),
+        );
+        let piv = at(0..p);
         FlatProgram {
             program: quote! {
                 let o: [T; #len] = { #b };
                 ::eomgen_runtime::lane::check_pivots(&[#(#piv),*], &mut ())?;
             },
-            first: at(0..n),
-            rows: at(n..n + k),
+            first: at(p..p + n),
+            rows: at(p + n..p + n + k),
             ops,
         }
     }
