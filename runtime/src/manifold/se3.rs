@@ -8,7 +8,7 @@
 //! rotation of `M0^-1 M1` is scaled by `2 / |q|^2` instead.
 
 use super::atan::atan2_quadrant;
-use crate::free_flyer::{quat_mul, rotation, rotation_scaled};
+use crate::free_flyer::{quat_mul, rotation};
 use crate::tree::cross;
 use crate::Real;
 
@@ -170,21 +170,24 @@ pub(super) fn integrate_jacobians<T: Real>(v: &[T]) -> (M6<T>, M6<T>) {
 /// each): `-Jlog6(M) Ad(M)^-1` and `Jlog6(M)`, `M = M0^-1 M1`, `Jlog6` the inverse of the
 /// right Jacobian, `[[J, -J Q J], [0, J]]` with `J = Jr3^-1 = I + phi^/2 + c phi^2` and
 /// `Q = R^T D`. With `P = J R^T`, the first is `[[-P, P t^ + J Q J R^T], [0, -P]]`.
+///
+/// `P` is the inverse of the left Jacobian (`Jl = R Jr`), `I - phi^/2 + c phi^2`, so that
+/// `J Q = P D` and `J Q J R^T = (P D) P`: the relative rotation `R` is never formed.
 pub(super) fn difference_jacobians<T: Real>(q0: &[T], q1: &[T]) -> (M6<T>, M6<T>) {
     let rel = Relative::new(q0, q1);
     let two_n2 = T::from_f64(2.0) / rel.n2;
-    let rt = transpose(&rotation_scaled(&rel.quat, two_n2));
     let (s, w) = (rel.s, rel.quat[3]);
     let k = coefficients(rel.t2, rel.theta, two_n2 * s * w, two_n2 * s * s);
     let h = hat(&rel.phi);
     let h2 = hat_squared(&rel.phi, rel.t2);
-    let j = combine(&h, &h2, T::from_f64(0.5), rel.c);
-    let q = mat_mul(&rt, &dv_dphi(&rel.rho, &rel.phi, &k));
-    let jqj = mat_mul(&mat_mul(&j, &q), &j);
-    let p = mat_mul(&j, &rt);
-    let pt = mat_mul(&p, &hat(&rel.t));
-    let jqjr = mat_mul(&jqj, &rt);
-    let d0_top = each(|i, c| pt[i][c] + jqjr[i][c]);
+    let half = T::from_f64(0.5);
+    let j = combine(&h, &h2, half, rel.c);
+    let p = combine(&h, &h2, -half, rel.c);
+    let jq = mat_mul(&p, &dv_dphi(&rel.rho, &rel.phi, &k));
+    let jqj = mat_mul(&jq, &j);
+    let pt = times_hat(&p, &rel.t);
+    let jqp = mat_mul(&jq, &p);
+    let d0_top = each(|i, c| pt[i][c] + jqp[i][c]);
     let minus_p = negated(&p);
     (
         blocks(&minus_p, &d0_top, &minus_p),
@@ -211,7 +214,7 @@ fn dv_dphi<T: Real>(rho: &[T; 3], phi: &[T; 3], k: &Coefficients<T>) -> M3<T> {
 /// `Ad((R, t))^-1 = [[R^T, -R^T t^], [0, R^T]]` on [linear; angular] vectors.
 fn inverse_action<T: Real>(r: &M3<T>, t: &[T; 3]) -> M6<T> {
     let rt = transpose(r);
-    let top = negated(&mat_mul(&rt, &hat(t)));
+    let top = negated(&times_hat(&rt, t));
     blocks(&rt, &top, &rt)
 }
 
@@ -272,6 +275,13 @@ fn transpose<T: Real>(m: &M3<T>) -> M3<T> {
 
 fn mat_mul<T: Real>(a: &M3<T>, b: &M3<T>) -> M3<T> {
     each(|i, j| a[i][0] * b[0][j] + a[i][1] * b[1][j] + a[i][2] * b[2][j])
+}
+
+/// `m t^`: each row of `m` crossed with `t` (`x^T t^ = (x cross t)^T`), without the products
+/// by the zeros of `t^`.
+fn times_hat<T: Real>(m: &M3<T>, t: &[T; 3]) -> M3<T> {
+    let rows = [cross(&m[0], t), cross(&m[1], t), cross(&m[2], t)];
+    each(|i, j| rows[i][j])
 }
 
 fn mat_vec<T: Real>(m: &M3<T>, v: &[T; 3]) -> [T; 3] {
