@@ -4,11 +4,13 @@
 //!
 //! Every function of the rotation angle `theta` comes from the sine and cosine of its half:
 //! the relative quaternion holds them already (scaled by its norm, which cancels), and
-//! `dIntegrate` takes one `sin_cos` of `theta / 2`. Nothing normalizes a quaternion: the
-//! rotation of `M0^-1 M1` is scaled by `2 / |q|^2` instead.
+//! `dIntegrate` takes one `sin_cos` of `theta / 2`. Nothing normalizes a quaternion: the sine
+//! and cosine of `M0^-1 M1`'s angle are scaled by `2 / |q|^2` instead. No rotation matrix is
+//! formed where an identity spares it: `R^T v` from the quaternion, `J R^T` as the inverse of
+//! the left Jacobian, `R^T t` as `Jr rho`.
 
 use super::atan::atan2_quadrant;
-use crate::free_flyer::{quat_mul, rotation};
+use crate::free_flyer::quat_mul;
 use crate::tree::cross;
 use crate::Real;
 
@@ -70,9 +72,8 @@ impl<T: Real> Relative<T> {
         } else {
             T::one() / t2 - w / (f(2.0) * theta * s)
         };
-        let r0 = rotation(&a);
         let dp = [q1[0] - q0[0], q1[1] - q0[1], q1[2] - q0[2]];
-        let t = mat_vec(&transpose(&r0), &dp);
+        let t = unrotated(&a, &dp);
         let pt = cross(&phi, &t);
         let ppt = cross(&phi, &pt);
         let half = f(0.5);
@@ -90,6 +91,16 @@ impl<T: Real> Relative<T> {
             t,
         }
     }
+}
+
+/// `R^T v` for the rotation `R` of the unit quaternion `q` (x, y, z, w):
+/// `v - 2 w (u x v) + 2 u x (u x v)`, `u = (x, y, z)`, without forming `R`.
+fn unrotated<T: Real>(q: &[T; 4], v: &[T; 3]) -> [T; 3] {
+    let u = [q[0], q[1], q[2]];
+    let uv = cross(&u, v);
+    let uuv = cross(&u, &uv);
+    let (w2, two) = (T::from_f64(2.0) * q[3], T::from_f64(2.0));
+    [0, 1, 2].map(|i| v[i] - w2 * uv[i] + two * uuv[i])
 }
 
 /// The functions of a rotation vector's angle `theta` that the Jacobians use.
@@ -159,11 +170,13 @@ pub(super) fn integrate_jacobians<T: Real>(v: &[T]) -> (M6<T>, M6<T>) {
     let k = coefficients(t2, theta, f(2.0) * sh * ch, f(2.0) * sh * sh);
     let h = hat(&phi);
     let h2 = hat_squared(&phi, t2);
-    let r = combine(&h, &h2, k.sinc, k.a);
-    let t = mat_vec(&combine(&h, &h2, k.a, k.b), &rho);
+    // R^T = I - sinc phi^ + a phi^2, and the inverse action's corner -R^T t^ = -(R^T t)^ R^T
+    // with R^T t = R^T Jl rho = Jr rho (Jl = R Jr): t itself is never formed.
+    let rt = combine(&h, &h2, -k.sinc, k.a);
     let jr = combine(&h, &h2, -k.a, k.b);
-    let q = mat_mul(&transpose(&r), &dv_dphi(&rho, &phi, &k));
-    (inverse_action(&r, &t), blocks(&jr, &q, &jr))
+    let top = negated(&hat_times(&mat_vec(&jr, &rho), &rt));
+    let q = mat_mul(&rt, &dv_dphi(&rho, &phi, &k));
+    (blocks(&rt, &top, &rt), blocks(&jr, &q, &jr))
 }
 
 /// A free flyer's blocks of `dDifference` from its coordinates in `q0` and `q1` (7 entries
@@ -209,13 +222,6 @@ fn dv_dphi<T: Real>(rho: &[T; 3], phi: &[T; 3], k: &Coefficients<T>) -> M3<T> {
         let sym = id + phi[i] * rho[j] - two * rho[i] * phi[j];
         -k.a * rh[i][j] + (k.da * pr[i] + k.db * ppr[i]) * phi[j] + k.b * sym
     })
-}
-
-/// `Ad((R, t))^-1 = [[R^T, -R^T t^], [0, R^T]]` on [linear; angular] vectors.
-fn inverse_action<T: Real>(r: &M3<T>, t: &[T; 3]) -> M6<T> {
-    let rt = transpose(r);
-    let top = negated(&times_hat(&rt, t));
-    blocks(&rt, &top, &rt)
 }
 
 /// `[[a, b], [0, c]]`.
@@ -269,10 +275,6 @@ fn negated<T: Real>(m: &M3<T>) -> M3<T> {
     each(|i, j| -m[i][j])
 }
 
-fn transpose<T: Real>(m: &M3<T>) -> M3<T> {
-    each(|i, j| m[j][i])
-}
-
 fn mat_mul<T: Real>(a: &M3<T>, b: &M3<T>) -> M3<T> {
     each(|i, j| a[i][0] * b[0][j] + a[i][1] * b[1][j] + a[i][2] * b[2][j])
 }
@@ -282,6 +284,13 @@ fn mat_mul<T: Real>(a: &M3<T>, b: &M3<T>) -> M3<T> {
 fn times_hat<T: Real>(m: &M3<T>, t: &[T; 3]) -> M3<T> {
     let rows = [cross(&m[0], t), cross(&m[1], t), cross(&m[2], t)];
     each(|i, j| rows[i][j])
+}
+
+/// `u^ m`: each column of `m` crossed by `u`.
+fn hat_times<T: Real>(u: &[T; 3], m: &M3<T>) -> M3<T> {
+    let column = |j: usize| cross(u, &[m[0][j], m[1][j], m[2][j]]);
+    let cols = [column(0), column(1), column(2)];
+    each(|i, j| cols[j][i])
 }
 
 fn mat_vec<T: Real>(m: &M3<T>, v: &[T; 3]) -> [T; 3] {
