@@ -10,7 +10,7 @@
 use super::catalogue::{Evaluation, Home, Input, Quantity, Shape};
 use super::newton_euler::{self, LocalModel, Terms};
 use super::{flat, Derivation};
-use crate::cas::{Graph, Id, Program};
+use crate::cas::{Graph, Id};
 use crate::kinematics::joint::free_flyer_placement;
 use crate::kinematics::{cross, mat_vec, vec_add, vec_scale, vec_sub, WorldKinematics, M3, V3};
 use crate::model::{Model, Transform};
@@ -449,8 +449,28 @@ pub(super) fn contacts_in_base_axes(
     Some((j, drift, free_flyer_placement(g, &d.q[..7]).rotation))
 }
 
-/// `r` times each three entries of `v` (a vector of contact rows turned between axes).
-pub(super) fn turn_rows(g: &mut Graph, r: &M3, v: &[Id]) -> Vec<Id> {
+/// The contact Jacobian and drift in the axes they are solved in, and the rotation that turns
+/// those axes into the world's: a floating base's ([`contacts_in_base_axes`]), or the world's
+/// own (`None`).
+pub(super) fn contacts_in_solving_axes(
+    model: &Model,
+    d: &mut Derivation,
+) -> (Vec<Vec<Id>>, Vec<Id>, Option<M3>) {
+    match contacts_in_base_axes(model, d) {
+        Some((j, drift, r)) => (j, drift, Some(r)),
+        None => {
+            let c = &d.centroidal;
+            (c.contact_jacobian.clone(), c.contact_drift.clone(), None)
+        }
+    }
+}
+
+/// `r` times each three entries of `v` (a vector of contact rows turned between axes); `v`
+/// itself when `r` is `None` (the axes are the world's).
+pub(super) fn turn_rows(g: &mut Graph, r: Option<&M3>, v: &[Id]) -> Vec<Id> {
+    let Some(r) = r else {
+        return v.to_vec();
+    };
     v.chunks(3)
         .flat_map(|x| mat_vec(g, r, &[x[0], x[1], x[2]]))
         .collect()
@@ -472,13 +492,16 @@ pub(super) fn contact_forward_dynamics(
     d: &mut Derivation,
     flat_max_ops: usize,
 ) -> (&'static str, Evaluation) {
-    let (j, drift, axes) = match contacts_in_base_axes(model, d) {
-        Some((j, drift, r)) => (j, drift, Some(r)),
-        None => {
-            let c = &d.centroidal;
-            (c.contact_jacobian.clone(), c.contact_drift.clone(), None)
-        }
-    };
+    let run_time = (
+        "M from `mass_matrix`, b + G by Newton-Euler, J_c and its drift, then the unrolled L^T D L of M, a Cholesky factorization of J_c M^-1 J_c^T and one more substitution (eomgen_runtime::contact::solve_factored_active_by, with the first half of the substitution unrolled too)",
+        Evaluation::ContactForwardDynamics {
+            h: d.fast.bias_gravity_friction.clone(),
+        },
+    );
+    if flat_max_ops == 0 {
+        return run_time;
+    }
+    let (j, drift, axes) = contacts_in_solving_axes(model, d);
     let flat = super::contact_flat::contact_forward_dynamics(
         &mut d.graph,
         &d.coordinate_parents,
@@ -487,9 +510,7 @@ pub(super) fn contact_forward_dynamics(
         (&j, &drift),
         axes.as_ref(),
     );
-    let all: Vec<Id> = flat.outputs.iter().chain(&flat.pivots).copied().collect();
-    let ops = Program::new(&d.graph, &all).ops().total();
-    if ops <= flat_max_ops {
+    if flat.fits(&d.graph, flat_max_ops) {
         (
             "one straight-line program: M and b + G as in `mass_matrix` and `bias`, J_c and its drift (in the floating base's axes, the forces turned into the world's at the end), the unrolled L^T D L of M, W = L^-T J_c^T, J_c M^-1 J_c^T = W^T D^-1 W and its L^T D L, without the zeros of J_c",
             Evaluation::ContactForwardDynamicsFlat {
@@ -498,12 +519,7 @@ pub(super) fn contact_forward_dynamics(
             },
         )
     } else {
-        (
-            "M from `mass_matrix`, b + G by Newton-Euler, J_c and its drift, then the unrolled L^T D L of M, a Cholesky factorization of J_c M^-1 J_c^T and one more substitution (eomgen_runtime::contact::solve_factored_active_by, with the first half of the substitution unrolled too)",
-            Evaluation::ContactForwardDynamics {
-                h: d.fast.bias_gravity_friction.clone(),
-            },
-        )
+        run_time
     }
 }
 

@@ -19,12 +19,12 @@
 //! and gravity, `x = v+ - v`) plus `d(-J^T p)/dq`, and `d(J w)/dq` (`w = v+ + e v`).
 
 use super::catalogue::{Evaluation, Input, Quantity, Shape};
-use super::centroidal::quantity;
+use super::centroidal::{quantity, turn_rows};
 use super::newton_euler::JointTree;
 use super::rnea_derivatives::inverse_dynamics_derivatives;
 use super::{flat, Derivation};
 use crate::cas::{Graph, Id};
-use crate::kinematics::joint;
+use crate::kinematics::{joint, M3};
 use crate::model::Model;
 
 /// The partial derivatives of the contact and impulse problems, as stacked matrices (rows
@@ -126,38 +126,21 @@ fn contact_rows(
 /// Derives the partials for `model`'s contacts in `d`'s graph.
 pub fn derive(d: &mut Derivation, model: &Model) -> ContactPartials {
     let n = d.dof;
-    let based = super::centroidal::contacts_in_base_axes(model, d);
+    let (jac, drift, r) = super::centroidal::contacts_in_solving_axes(model, d);
     let (q, qd, qdd) = (d.q.clone(), d.qd.clone(), d.qdd.clone());
-    let roots = match based {
-        Some((jac, drift, r)) => {
-            // In the base's axes: `J_c^T f = J_b^T (R^T f)`, `J_c a + drift = R (J_b a +
-            // drift_b)`, `J_c v = R J_b v`. Differentiated, the base's rotation is one factor
-            // where each entry of `J_c` carried it (a third of anymal's partials).
-            let g = &mut d.graph;
-            let rt = core::array::from_fn(|i| core::array::from_fn(|j| r[j][i]));
-            let f: Vec<Id> = (0..drift.len()).map(|i| g.force(i)).collect();
-            let fb = super::centroidal::turn_rows(g, &rt, &f);
-            let (acc, vel) = contact_rows(g, &jac, &drift, (&qdd, &qd));
-            let mut roots = minus_transpose_times(g, &jac, &fb);
-            roots.extend(super::centroidal::turn_rows(g, &r, &acc));
-            roots.extend(super::centroidal::turn_rows(g, &r, &vel));
-            (roots, super::centroidal::turn_rows(g, &r, &drift))
-        }
-        None => {
-            let (jac, drift) = (&d.centroidal.contact_jacobian, &d.centroidal.contact_drift);
-            let (jac, drift) = (jac.clone(), drift.clone());
-            let g = &mut d.graph;
-            let f: Vec<Id> = (0..drift.len()).map(|i| g.force(i)).collect();
-            let (acc, vel) = contact_rows(g, &jac, &drift, (&qdd, &qd));
-            let mut roots = minus_transpose_times(g, &jac, &f);
-            roots.extend(acc);
-            roots.extend(vel);
-            (roots, drift)
-        }
-    };
-    let (roots, drift) = roots;
-    let k = drift.len();
+    // In a floating base's axes: `J_c^T f = J_b^T (R^T f)`, `J_c a + drift = R (J_b a +
+    // drift_b)`, `J_c v = R J_b v`. Differentiated, the base's rotation is one factor where
+    // each entry of `J_c` carried it (a third of anymal's partials).
     let g = &mut d.graph;
+    let rt: Option<M3> = r.map(|r| core::array::from_fn(|i| core::array::from_fn(|j| r[j][i])));
+    let f: Vec<Id> = (0..drift.len()).map(|i| g.force(i)).collect();
+    let fb = turn_rows(g, rt.as_ref(), &f);
+    let (acc, vel) = contact_rows(g, &jac, &drift, (&qdd, &qd));
+    let mut roots = minus_transpose_times(g, &jac, &fb);
+    roots.extend(turn_rows(g, r.as_ref(), &acc));
+    roots.extend(turn_rows(g, r.as_ref(), &vel));
+    let drift = turn_rows(g, r.as_ref(), &drift);
+    let k = drift.len();
     let zero = g.zero();
     let mut contact = vec![vec![zero; n]; n + 2 * k];
     let mut impulse = vec![vec![zero; n]; n + k];
@@ -220,10 +203,14 @@ pub(super) fn impulse_dynamics_route(
     d: &mut Derivation,
     flat_max_ops: usize,
 ) -> (&'static str, Evaluation) {
-    let (j, axes) = match super::centroidal::contacts_in_base_axes(model, d) {
-        Some((j, _, r)) => (j, Some(r)),
-        None => (d.centroidal.contact_jacobian.clone(), None),
-    };
+    let run_time = (
+        "M from `mass_matrix`, J_c from `contact_jacobian`, then the unrolled L^T D L of M, a Cholesky factorization of J_c M^-1 J_c^T and one more substitution (eomgen_runtime::impulse::solve_factored_active_by, with the first half of the substitution unrolled too)",
+        Evaluation::ImpulseDynamics,
+    );
+    if flat_max_ops == 0 {
+        return run_time;
+    }
+    let (j, _, axes) = super::centroidal::contacts_in_solving_axes(model, d);
     let flat = super::contact_flat::impulse_dynamics(
         &mut d.graph,
         &d.coordinate_parents,
@@ -232,8 +219,7 @@ pub(super) fn impulse_dynamics_route(
         &d.qd,
         axes.as_ref(),
     );
-    let all: Vec<Id> = flat.outputs.iter().chain(&flat.pivots).copied().collect();
-    if crate::cas::Program::new(&d.graph, &all).ops().total() <= flat_max_ops {
+    if flat.fits(&d.graph, flat_max_ops) {
         (
             "one straight-line program at restitution zero, scaled by 1 + e: M as in `mass_matrix`, J_c (in the floating base's axes, the impulses turned into the world's at the end), the unrolled L^T D L of M, W = L^-T J_c^T, J_c M^-1 J_c^T = W^T D^-1 W and its L^T D L, without the zeros of J_c",
             Evaluation::ImpulseDynamicsFlat {
@@ -242,10 +228,7 @@ pub(super) fn impulse_dynamics_route(
             },
         )
     } else {
-        (
-            "M from `mass_matrix`, J_c from `contact_jacobian`, then the unrolled L^T D L of M, a Cholesky factorization of J_c M^-1 J_c^T and one more substitution (eomgen_runtime::impulse::solve_factored_active_by, with the first half of the substitution unrolled too)",
-            Evaluation::ImpulseDynamics,
-        )
+        run_time
     }
 }
 

@@ -16,7 +16,7 @@
 //! order: `D_k` is the square of the Cholesky factor's `k`-th diagonal entry.
 
 use super::ltdl::Factors;
-use crate::cas::{Graph, Id};
+use crate::cas::{Graph, Id, Program};
 use crate::kinematics::M3;
 
 /// A straight-line contact or impulse dynamics.
@@ -27,6 +27,14 @@ pub(crate) struct FlatContact {
     /// The pivots of `M`'s factorization (`N`), then those of `Lambda`'s (`K`): all positive
     /// exactly when `M` is positive definite and `J` has full row rank.
     pub pivots: Vec<Id>,
+}
+
+impl FlatContact {
+    /// Whether the program (its outputs and pivots) holds at most `max_ops` operations.
+    pub(crate) fn fits(&self, g: &Graph, max_ops: usize) -> bool {
+        let all: Vec<Id> = self.outputs.iter().chain(&self.pivots).copied().collect();
+        Program::new(g, &all).ops().total() <= max_ops
+    }
 }
 
 /// Contact forward dynamics from `M` (over the coordinate tree `parents`), `h = b + G + F`,
@@ -142,10 +150,7 @@ impl Space {
         (f, lambda_pivots): (Vec<Id>, Vec<Id>),
         axes: Option<&M3>,
     ) -> FlatContact {
-        let f = match axes {
-            Some(r) => super::centroidal::turn_rows(g, r, &f),
-            None => f,
-        };
+        let f = super::centroidal::turn_rows(g, axes, &f);
         let pivots = self.factors.pivots().into_iter().chain(lambda_pivots);
         FlatContact {
             outputs: n.into_iter().chain(f).collect(),
@@ -205,7 +210,6 @@ fn solve_dense(g: &mut Graph, a: &[Vec<Id>], b: &[Id]) -> (Vec<Id>, Vec<Id>) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::cas::Program;
 
     #[test]
     fn the_dense_solve_inverts_and_reports_pivots_in_cholesky_order() {
