@@ -7,7 +7,7 @@
 
 use crate::contact::{contact_space, transpose_times};
 use crate::kkt::{
-    axpy, dot, finite_rows, finite_solution, scaled, times_columns, ContactKkt,
+    column_support, combination_into, dot, finite_rows, finite_solution, ContactKkt,
     ImpulseDynamicsDerivatives,
 };
 use crate::tree::{ltdl_lower_rows, TreePasses, Walked};
@@ -70,21 +70,19 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
         let inverse = self.lambda_inverse();
         let (dv_dq, dp_dq) = (&mut d.dv_dq, &mut d.dimpulse_dq);
         self.solve_signed_columns_in_place::<P, N>(Some(&inverse), dv_dq, dp_dq, -T::one());
-        // dp/dv = -(1 + e) Lambda^-1 J, the factor applied to J's rows as they are copied.
+        // dp/dv = -(1 + e) Lambda^-1 J and I + Y dp/dv, on the columns where J is not zero
+        // (dp/dv is zero elsewhere, and those columns of dv+/dv the identity's).
+        let cols = column_support(self.jacobian());
         let k = -(T::one() + e);
-        for (p, j) in d.dimpulse_dv.iter_mut().zip(self.jacobian()) {
-            *p = scaled(j, k);
+        for (p, row) in d.dimpulse_dv.iter_mut().zip(&inverse) {
+            combination_into(p, |m| k * row[m], self.jacobian(), cols.clone());
         }
-        times_columns(&inverse, &mut d.dimpulse_dv);
-        // I + Y dp/dv, each row gathered in a local accumulator. The identity's one is added
-        // to the row once written: set in the accumulator at a varying index, it kept the
-        // accumulator in memory, whose wide reloads of narrow stores could not be forwarded.
+        // Each row gathered in a local accumulator; the identity's one is added to the row
+        // once written: set in the accumulator at a varying index, it kept the accumulator in
+        // memory, whose wide reloads of narrow stores could not be forwarded.
         for (i, row) in d.dv_dv.iter_mut().enumerate() {
-            let mut acc = [T::zero(); N];
-            for (yk, pk) in self.inverse_inertia_rows().iter().zip(&d.dimpulse_dv) {
-                axpy(&mut acc, yk[i], pk);
-            }
-            *row = acc;
+            let y = self.inverse_inertia_rows();
+            combination_into(row, |k| y[k][i], &d.dimpulse_dv, cols.clone());
             row[i] += T::one();
         }
         finite_rows(&d.dv_dq, 0)?;

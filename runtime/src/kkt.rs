@@ -16,7 +16,7 @@
 //! ([`ContactKkt::solve_columns`]), row by row so that the inner loops run over contiguous
 //! columns. Everything lives in fixed-size arrays on the stack.
 
-pub(crate) use crate::linalg::{axpy, scaled};
+pub(crate) use crate::linalg::{axpy, combination_into, scaled};
 use crate::linalg::{Cholesky, FactorError};
 use crate::tree::{ltdl_factor, ltdl_substitute, TreePasses, Walked};
 use crate::Real;
@@ -830,6 +830,19 @@ pub(crate) fn shift<const N: usize>(e: FactorError) -> FactorError {
     }
 }
 
+/// The columns `lo..hi` outside which every row of `j` is zero (an empty range for a zero
+/// `j`). A contact Jacobian is zero in the columns of the joints that move no contact (a
+/// humanoid's arms and waist for its soles: 17 of its 35 columns), and the products with it
+/// skip them. Found from the ends inwards, so a typical Jacobian costs a few compares.
+pub(crate) fn column_support<T: Real, const N: usize, const K: usize>(
+    j: &[[T; N]; K],
+) -> core::ops::Range<usize> {
+    let nonzero = |c: &usize| j.iter().any(|row| row[*c] != T::zero());
+    let lo = (0..N).find(nonzero).unwrap_or(N);
+    let hi = (lo..N).rev().find(nonzero).map_or(lo, |c| c + 1);
+    lo..hi
+}
+
 pub(crate) fn dot<T: Real, const N: usize>(a: &[T; N], b: &[T; N]) -> T {
     // Eight partial sums, one per lane of a vector: one long chain of dependent additions was
     // a twentieth of a humanoid's impulse dynamics (twelve of them, 35 terms each).
@@ -1122,5 +1135,129 @@ mod tests {
             singular.unwrap_err(),
             FactorError::NotPositiveDefinite { pivot: 2 }
         );
+    }
+
+    /// `N x N` symmetric positive definite, a chain's (parent `i - 1`), by a fixed recipe.
+    fn chain_inertia<const N: usize>() -> [[f64; N]; N] {
+        core::array::from_fn(|i| {
+            core::array::from_fn(|j| {
+                let d = i.abs_diff(j) as f64;
+                if i == j {
+                    N as f64 + 1.0 + 0.1 * i as f64
+                } else {
+                    0.5 / (1.0 + d) * if (i + j) % 3 == 0 { -1.0 } else { 1.0 }
+                }
+            })
+        })
+    }
+
+    /// The inverse by Gauss-Jordan elimination (no pivoting: for positive definite `a`).
+    #[allow(clippy::needless_range_loop)]
+    fn inverse<const N: usize>(a: &[[f64; N]; N]) -> [[f64; N]; N] {
+        let (mut a, mut x) = (*a, [[0.0; N]; N]);
+        (0..N).for_each(|i| x[i][i] = 1.0);
+        for c in 0..N {
+            let p = a[c][c];
+            for k in 0..N {
+                a[c][k] /= p;
+                x[c][k] /= p;
+            }
+            for r in (0..N).filter(|r| *r != c) {
+                let f = a[r][c];
+                for k in 0..N {
+                    a[r][k] -= f * a[c][k];
+                    x[r][k] -= f * x[c][k];
+                }
+            }
+        }
+        x
+    }
+
+    #[test]
+    fn the_column_support_is_the_span_of_the_nonzero_columns() {
+        let z = 0.0;
+        assert_eq!(column_support(&[[z, 1.0, z, z], [z, z, -2.0, z]]), 1..3);
+        assert_eq!(column_support(&[[f64::NAN, z, z, z]]), 0..1);
+        assert_eq!(column_support(&[[z, z, z, -0.0]]), 4..4);
+        assert_eq!(column_support(&[[z; 4]; 0]), 4..4);
+        assert_eq!(column_support(&[[z, z, z, 5.0]]), 3..4);
+    }
+
+    #[test]
+    fn a_combination_on_the_support_equals_the_whole_one() {
+        // Rows zero outside columns `lo..hi`; every window position, the last moved back.
+        for (lo, hi) in [(0, 11), (2, 6), (9, 11), (3, 4), (5, 5)] {
+            let x: [[f64; 11]; 3] = core::array::from_fn(|k| {
+                core::array::from_fn(|c| {
+                    if (lo..hi).contains(&c) {
+                        (k * 11 + c) as f64 * 0.37 - 2.0
+                    } else {
+                        0.0
+                    }
+                })
+            });
+            let a = |k: usize| 1.5 - k as f64;
+            let mut whole = [0.0; 11];
+            for (k, xk) in x.iter().enumerate() {
+                axpy(&mut whole, a(k), xk);
+            }
+            let mut part = [f64::NAN; 11];
+            combination_into(&mut part, a, &x, lo..hi);
+            assert_eq!(part, whole, "columns {lo}..{hi}");
+        }
+        // Fewer columns than a window: all of them.
+        let mut small = [f64::NAN; 3];
+        combination_into(
+            &mut small,
+            |k| k as f64 + 1.0,
+            &[[1.0, 0.0, 2.0], [0.5, 0.0, 0.0]],
+            0..0,
+        );
+        assert_eq!(small, [2.0, 0.0, 2.0]);
+    }
+
+    #[test]
+    #[allow(clippy::needless_range_loop)] // the formulas' indices, as written
+    fn impulse_derivatives_in_v_equal_the_dense_formulas() {
+        // 11 coordinates, the contact rows zero outside columns 2..7 (a limb's).
+        const N: usize = 11;
+        let m = chain_inertia::<N>();
+        let parent: [Option<usize>; N] = core::array::from_fn(|i| i.checked_sub(1));
+        let j: [[f64; N]; 2] = core::array::from_fn(|k| {
+            core::array::from_fn(|c| match c {
+                2..=6 => (c as f64 - 3.5 * k as f64).sin() + 0.2,
+                _ => 0.0,
+            })
+        });
+        let kkt = ContactKkt::new(m, &parent, j).unwrap();
+        let e = 0.3;
+        let d = kkt.impulse_derivatives(e, &[[0.0; N]; N + 2]).unwrap();
+        // dp/dv = -(1 + e) (J M^-1 J^T)^-1 J, dv+/dv = I + M^-1 J^T dp/dv, densely.
+        let mi = inverse(&m);
+        let y: [[f64; N]; 2] = core::array::from_fn(|k| {
+            core::array::from_fn(|c| (0..N).map(|i| mi[c][i] * j[k][i]).sum())
+        });
+        let lambda: [[f64; 2]; 2] = core::array::from_fn(|a| {
+            core::array::from_fn(|b| (0..N).map(|i| j[a][i] * y[b][i]).sum())
+        });
+        let li = inverse(&lambda);
+        for r in 0..2 {
+            for c in 0..N {
+                let dp: f64 = -(1.0 + e) * (0..2).map(|k| li[r][k] * j[k][c]).sum::<f64>();
+                assert!((d.dimpulse_dv[r][c] - dp).abs() < 1e-12, "dp/dv[{r}][{c}]");
+            }
+        }
+        for i in 0..N {
+            for c in 0..N {
+                let id = if i == c { 1.0 } else { 0.0 };
+                let dv = id + (0..2).map(|k| y[k][i] * d.dimpulse_dv[k][c]).sum::<f64>();
+                assert!((d.dv_dv[i][c] - dv).abs() < 1e-12, "dv+/dv[{i}][{c}]");
+            }
+        }
+        // Outside the contact's columns: dp/dv zero, dv+/dv the identity's columns.
+        for c in [0, 1, 7, 10] {
+            assert!((0..2).all(|r| d.dimpulse_dv[r][c] == 0.0));
+            assert!((0..N).all(|i| d.dv_dv[i][c] == if i == c { 1.0 } else { 0.0 }));
+        }
     }
 }

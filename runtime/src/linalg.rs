@@ -19,6 +19,45 @@ pub(crate) fn axpy<T: Lane, const C: usize>(y: &mut [T; C], a: T, x: &[T; C]) {
     }
 }
 
+/// Columns per window of [`combination_into`]: one 512-bit register of `f64`.
+const WINDOW: usize = 8;
+
+/// `out = sum_k a(k) x[k]` over the rows `x[k]`, computed in the columns `cols` only (zero in
+/// the others, where the caller knows every row is zero): windows of [`WINDOW`] columns, each
+/// gathered in a local accumulator over all `k` and stored into `out`, the last window moved
+/// back inside the row (its columns computed twice, the same way). With `N < WINDOW`, every
+/// column. `out` is written in place: a local row copied out afterwards was read back by
+/// loads that straddled the windows' stores, which the processor cannot forward.
+#[inline(always)]
+pub(crate) fn combination_into<T: Lane, const N: usize, const K: usize>(
+    out: &mut [T; N],
+    a: impl Fn(usize) -> T,
+    x: &[[T; N]; K],
+    cols: core::ops::Range<usize>,
+) {
+    *out = [T::zero(); N];
+    if N < WINDOW {
+        for (k, xk) in x.iter().enumerate() {
+            axpy(out, a(k), xk);
+        }
+        return;
+    }
+    let mut s = cols.start;
+    while s < cols.end {
+        let at = s.min(N - WINDOW);
+        let mut acc = [T::zero(); WINDOW];
+        for (k, xk) in x.iter().enumerate() {
+            if let Some(Ok(w)) = xk.get(at..at + WINDOW).map(<&[T; WINDOW]>::try_from) {
+                axpy(&mut acc, a(k), w);
+            }
+        }
+        if let Some(o) = out.get_mut(at..at + WINDOW) {
+            o.copy_from_slice(&acc);
+        }
+        s = at + WINDOW;
+    }
+}
+
 /// `a x`, by a loop the compiler vectorizes in place: `x.map(|v| a * v)` on a long array was
 /// left a call of `array::try_map` writing to memory, whose result, read back by wider loads,
 /// stalled on store forwarding (a tenth of a humanoid's contact derivatives).
