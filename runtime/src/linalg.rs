@@ -383,28 +383,28 @@ impl<T: Real, const N: usize> Cholesky<T, N> {
     /// assert_eq!(c.inverse(), [[0.3125, -0.125], [-0.125, 0.25]]);
     /// ```
     pub fn inverse(&self) -> [[T; N]; N] {
-        // X = L^-1 row by row: X_i = (e_i - sum over k < i of L_ik X_k) / L_ii.
+        // X = L^-1 row by row: X_i = (e_i - sum over k < i of L_ik X_k) / L_ii. `e_i` is
+        // built whole: a one stored at index `i` and read back by wide loads stalled on store
+        // forwarding.
         let mut x = [[T::zero(); N]; N];
         for i in 0..N {
             let (done, rest) = x.split_at_mut(i);
-            let mut row = [T::zero(); N];
-            row[i] = T::one();
+            let mut row: [T; N] =
+                core::array::from_fn(|c| if c == i { T::one() } else { T::zero() });
             for (lik, xk) in self.l[i].iter().zip(done.iter()) {
                 axpy(&mut row, -*lik, xk);
             }
             rest[0] = scaled(&row, self.diag_inv[i]);
         }
         // (X^T X)_rc = sum over k of X_kr X_kc, zero for k < r: row r from the rows k >= r.
+        // Entry (c, r) is the same sum: the same products in the same order, after exact
+        // zeros (X_kr = 0 for k < r), so the result is symmetric to the bit without the lower
+        // triangle copied over the upper (whose narrow stores the callers' wide loads of the
+        // rows then stalled on).
         let mut inv = [[T::zero(); N]; N];
         for (r, out) in inv.iter_mut().enumerate() {
             for xk in &x[r..] {
                 axpy(out, xk[r], xk);
-            }
-        }
-        for r in 1..N {
-            let (above, below) = inv.split_at_mut(r);
-            for (c, row) in above.iter().enumerate() {
-                below[0][c] = row[r];
             }
         }
         inv
@@ -451,5 +451,30 @@ pub fn solve_spd_or_nan<T: Lane, const N: usize>(m: &[[T; N]; N], b: &[T; N]) ->
             crate::lane::nan_failed(x, &failures)
         }
         Err(_) => [T::nan(); N],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_cholesky_inverse_is_symmetric_to_the_bit_and_inverts() {
+        const N: usize = 12;
+        let m: [[f64; N]; N] = core::array::from_fn(|i| {
+            core::array::from_fn(|j| match i == j {
+                true => 6.0 + i as f64,
+                false => ((i + j) * 7 % 11) as f64 / 11.0 - 0.5,
+            })
+        });
+        let inv = Cholesky::new(m).unwrap().inverse();
+        for (r, row) in inv.iter().enumerate() {
+            for (c, x) in row.iter().enumerate() {
+                assert_eq!(x.to_bits(), inv[c][r].to_bits(), "({r}, {c})");
+                let p: f64 = (0..N).map(|k| m[r][k] * inv[k][c]).sum();
+                let id = if r == c { 1.0 } else { 0.0 };
+                assert!((p - id).abs() < 1e-14, "(M M^-1)[{r}][{c}] = {p}");
+            }
+        }
     }
 }
