@@ -8655,6 +8655,24 @@ impl<T: ::eomgen_runtime::Real> Kinova<T> {
     ) -> ([[T; 6]; 6], [[T; 6]; 6]) {
         ::eomgen_runtime::manifold::vector_integrate_jacobians()
     }
+    /// `integrate_jacobians` written into `a` and `b`, their diagonal blocks only (a free flyer's
+    /// 6 x 6 blocks and each other coordinate's entry), as Pinocchio's `dIntegrate` and
+    /// `dDifference` write each joint's block of the matrix they are given. The entries
+    /// off those blocks are zero in the Jacobians and are left as they are: `a` and `b`
+    /// must hold zeros there (zeroed once, or written by an earlier call). The values are
+    /// `integrate_jacobians`'s to the bit, without writing its `2 NV^2` entries.
+    pub fn integrate_jacobians_into(
+        &self,
+        q: &[T; 6],
+        v: &[T; 6],
+        a: &mut [[T; 6]; 6],
+        b: &mut [[T; 6]; 6],
+    ) {
+        {
+            let _ = (q, v);
+            ::eomgen_runtime::manifold::vector_integrate_jacobians_into(a, b)
+        }
+    }
     /// The Jacobians of `difference(q0, q1)` in `q0` and in `q1`, both perturbed in their tangent
     /// spaces (Pinocchio's `dDifference`, ARG0 and ARG1); element `[i][j]` = d out_i / d in_j.
     ///
@@ -8667,6 +8685,24 @@ impl<T: ::eomgen_runtime::Real> Kinova<T> {
         q1: &[T; 6],
     ) -> ([[T; 6]; 6], [[T; 6]; 6]) {
         ::eomgen_runtime::manifold::vector_difference_jacobians()
+    }
+    /// `difference_jacobians` written into `a` and `b`, their diagonal blocks only (a free flyer's
+    /// 6 x 6 blocks and each other coordinate's entry), as Pinocchio's `dIntegrate` and
+    /// `dDifference` write each joint's block of the matrix they are given. The entries
+    /// off those blocks are zero in the Jacobians and are left as they are: `a` and `b`
+    /// must hold zeros there (zeroed once, or written by an earlier call). The values are
+    /// `difference_jacobians`'s to the bit, without writing its `2 NV^2` entries.
+    pub fn difference_jacobians_into(
+        &self,
+        q0: &[T; 6],
+        q1: &[T; 6],
+        a: &mut [[T; 6]; 6],
+        b: &mut [[T; 6]; 6],
+    ) {
+        {
+            let _ = (q0, q1);
+            ::eomgen_runtime::manifold::vector_difference_jacobians_into(a, b)
+        }
     }
     /// Each joint's axis (in the frame of the body it moves) and motion.
     const TREE_JOINTS: [::eomgen_runtime::tree::TreeJoint; 6] = [

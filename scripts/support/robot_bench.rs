@@ -152,6 +152,13 @@ fn bench_link() -> RobotLink {
     })
 }
 
+thread_local! {
+    /// The matrices the manifold's `_into` forms write into, kept from call to call as a
+    /// caller's (and pinbench's, for `dIntegrate` and `dDifference`) are.
+    static JACOBIANS: std::cell::RefCell<[[[f64; NV]; NV]; 2]> =
+        const { std::cell::RefCell::new([[[0.0; NV]; NV]; 2]) };
+}
+
 /// The MPC kit's frame kinematics and manifold, with a floating base the centroidal rate, with
 /// contacts the impulse dynamics: against pinbench's lines of the same algorithms.
 fn mpc_kit() -> Vec<Bench> {
@@ -185,6 +192,26 @@ fn mpc_kit() -> Vec<Bench> {
             "difference_jacobians",
             |r, s| kept(r.difference_jacobians(&s.q, &s.q1)).0[0][0],
             matrices::<2, NV, NV>(),
+        ),
+        (
+            "integrate_jacobians_into",
+            |r, s| {
+                JACOBIANS.with_borrow_mut(|[a, b]| {
+                    r.integrate_jacobians_into(&s.q, &s.v, a, b);
+                    a[0][0]
+                })
+            },
+            0, // written into the caller's matrices
+        ),
+        (
+            "difference_jacobians_into",
+            |r, s| {
+                JACOBIANS.with_borrow_mut(|[a, b]| {
+                    r.difference_jacobians_into(&s.q, &s.q1, a, b);
+                    a[0][0]
+                })
+            },
+            0,
         ),
     ];
     #[cfg(floating)]

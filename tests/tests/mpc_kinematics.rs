@@ -48,6 +48,12 @@ trait Kit<const NQ: usize, const NV: usize> {
         q0: &[f64; NQ],
         q1: &[f64; NQ],
     ) -> ([[f64; NV]; NV], [[f64; NV]; NV]);
+    /// `integrate_jacobians_into` and `difference_jacobians_into`, into `m` in that order.
+    fn jacobians_into(
+        &self,
+        states: (&[f64; NQ], &[f64; NV], &[f64; NQ]),
+        m: &mut [[[f64; NV]; NV]; 4],
+    );
 }
 
 macro_rules! kit {
@@ -98,6 +104,15 @@ macro_rules! kit {
                 q1: &[f64; $nq],
             ) -> ([[f64; $nv]; $nv], [[f64; $nv]; $nv]) {
                 $ty::difference_jacobians(self, q0, q1)
+            }
+            fn jacobians_into(
+                &self,
+                (q, v, q1): (&[f64; $nq], &[f64; $nv], &[f64; $nq]),
+                m: &mut [[[f64; $nv]; $nv]; 4],
+            ) {
+                let [a, b, c, d] = m;
+                $ty::integrate_jacobians_into(self, q, v, a, b);
+                $ty::difference_jacobians_into(self, q, q1, c, d);
             }
         }
     };
@@ -247,6 +262,8 @@ fn column<const N: usize>(m: &[[f64; N]; N], j: usize) -> Vec<f64> {
 /// differences of both in the tangent spaces against their Jacobians.
 fn manifold_checks<R: Kit<NQ, NV>, const NQ: usize, const NV: usize>(r: &R, doc: &Value) -> Worst {
     let mut worst = Worst::default();
+    // The `_into` forms write into matrices zeroed once and then holding the previous state's.
+    let mut into = [[[0.0; NV]; NV]; 4];
     for (q, v, _, q1) in states::<R, NQ, NV>(doc) {
         // A displacement of moderate size (the samples' velocities reach 10 rad/s).
         let small = v.map(|x| 0.1 * x);
@@ -258,6 +275,8 @@ fn manifold_checks<R: Kit<NQ, NV>, const NQ: usize, const NV: usize>(r: &R, doc:
         let end = r.integrate(&q, &small);
         let (dq, dv) = r.integrate_jacobians(&q, &small);
         let (d0, d1) = r.difference_jacobians(&q, &q1);
+        r.jacobians_into((&q, &small, &q1), &mut into);
+        assert_eq!(into, [dq, dv, d0, d1], "the _into forms");
         let base = r.difference(&q, &q1);
         for j in 0..NV {
             let fd = central(|h| {

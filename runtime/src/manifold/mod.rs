@@ -9,7 +9,13 @@
 //! d in_j, block diagonal with the base's 6 x 6 block and the joints' identity.
 
 mod atan;
+mod into;
 mod se3;
+
+pub use into::{
+    difference_jacobians_blocks_into, difference_jacobians_into, integrate_jacobians_blocks_into,
+    integrate_jacobians_into, vector_difference_jacobians_into, vector_integrate_jacobians_into,
+};
 
 use crate::place::{self, Filled, Slot};
 use crate::Real;

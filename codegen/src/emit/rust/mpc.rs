@@ -2,7 +2,7 @@
 //! (`eomgen_runtime::frame`) and the configuration manifold (`eomgen_runtime::manifold`).
 
 use proc_macro2::TokenStream;
-use quote::quote;
+use quote::{format_ident, quote};
 
 use super::{usize_lit, Emitter};
 use crate::dynamics::{FrameMotion, Manifold, Quantity};
@@ -69,52 +69,86 @@ impl Emitter<'_> {
         }
     }
 
-    /// `difference`, `integrate_jacobians` or `difference_jacobians` from the runtime's
-    /// kernels: a floating base's, floating joints' below the root (`_blocks`), or a vector
-    /// space's.
+    /// `difference`, `integrate_jacobians` or `difference_jacobians` (with its `_into` form,
+    /// which writes the Jacobians' diagonal blocks into the caller's matrices) from the
+    /// runtime's kernels: a floating base's, floating joints' below the root (`_blocks`), or a
+    /// vector space's.
     pub(super) fn manifold_fn(&mut self, q: &Quantity, which: Manifold) -> TokenStream {
         let docs = Self::quantity_doc(q, None);
         let (n, nq) = (&self.n, &self.nq);
-        let m = quote!(::eomgen_runtime::manifold);
         let jacobians = quote!(([[T; #n]; #n], [[T; #n]; #n]));
-        let free = self.free_blocks();
-        let (floating, blocks, fixed) = match which {
-            Manifold::Difference => (
-                quote!(#m::difference(q0, q1)),
-                quote!(#m::difference_blocks(q0, q1, #free)),
-                quote!(#m::vector_difference(q0, q1)),
-            ),
-            Manifold::IntegrateJacobians => (
-                quote!(#m::integrate_jacobians(q, v)),
-                quote!(#m::integrate_jacobians_blocks(q, v, #free)),
-                quote!(#m::vector_integrate_jacobians()),
-            ),
-            Manifold::DifferenceJacobians => (
-                quote!(#m::difference_jacobians(q0, q1)),
-                quote!(#m::difference_jacobians_blocks(q0, q1, #free)),
-                quote!(#m::vector_difference_jacobians()),
-            ),
+        let (body, into) = self.manifold_bodies(which);
+        let into_doc = |name: &str| {
+            super::doc(&[
+                format!("`{name}` written into `a` and `b`, their diagonal blocks only (a free flyer's"),
+                "6 x 6 blocks and each other coordinate's entry), as Pinocchio's `dIntegrate` and".into(),
+                "`dDifference` write each joint's block of the matrix they are given. The entries".into(),
+                "off those blocks are zero in the Jacobians and are left as they are: `a` and `b`".into(),
+                "must hold zeros there (zeroed once, or written by an earlier call). The values are".into(),
+                format!("`{name}`'s to the bit, without writing its `2 NV^2` entries."),
+            ])
         };
-        let body = if self.floating {
-            floating
-        } else if !self.model.floating_joints().is_empty() {
-            blocks
-        } else {
-            fixed
-        };
+        let mat = quote!(&mut [[T; #n]; #n]);
         match which {
             Manifold::Difference => quote! {
                 #docs
                 pub fn difference(&self, q0: &[T; #nq], q1: &[T; #nq]) -> [T; #n] { #body }
             },
-            Manifold::IntegrateJacobians => quote! {
-                #docs
-                pub fn integrate_jacobians(&self, q: &[T; #nq], v: &[T; #n]) -> #jacobians { #body }
-            },
-            Manifold::DifferenceJacobians => quote! {
-                #docs
-                pub fn difference_jacobians(&self, q0: &[T; #nq], q1: &[T; #nq]) -> #jacobians { #body }
-            },
+            Manifold::IntegrateJacobians => {
+                let doc = into_doc("integrate_jacobians");
+                quote! {
+                    #docs
+                    pub fn integrate_jacobians(&self, q: &[T; #nq], v: &[T; #n]) -> #jacobians { #body }
+                    #doc
+                    pub fn integrate_jacobians_into(&self, q: &[T; #nq], v: &[T; #n], a: #mat, b: #mat) { #into }
+                }
+            }
+            Manifold::DifferenceJacobians => {
+                let doc = into_doc("difference_jacobians");
+                quote! {
+                    #docs
+                    pub fn difference_jacobians(&self, q0: &[T; #nq], q1: &[T; #nq]) -> #jacobians { #body }
+                    #doc
+                    pub fn difference_jacobians_into(&self, q0: &[T; #nq], q1: &[T; #nq], a: #mat, b: #mat) { #into }
+                }
+            }
+        }
+    }
+
+    /// The bodies of `which` and of its `_into` form (none for `difference`): the runtime's
+    /// floating base, floating joints below the root (`NAME_blocks`), or vector space
+    /// (`vector_NAME`) kernels.
+    fn manifold_bodies(&self, which: Manifold) -> (TokenStream, TokenStream) {
+        let m = quote!(::eomgen_runtime::manifold);
+        let free = self.free_blocks();
+        let (name, args) = match which {
+            Manifold::Difference => ("difference", quote!(q0, q1)),
+            Manifold::IntegrateJacobians => ("integrate_jacobians", quote!(q, v)),
+            Manifold::DifferenceJacobians => ("difference_jacobians", quote!(q0, q1)),
+        };
+        let f = |prefix: &str, suffix: &str| format_ident!("{prefix}{name}{suffix}");
+        let (plain, blocks, vector) = (f("", ""), f("", "_blocks"), f("vector_", ""));
+        let (body, into) = if self.floating {
+            let into = f("", "_into");
+            (quote!(#m::#plain(#args)), quote!(#m::#into(#args, a, b)))
+        } else if !self.model.floating_joints().is_empty() {
+            let into = f("", "_blocks_into");
+            (
+                quote!(#m::#blocks(#args, #free)),
+                quote!(#m::#into(#args, #free, a, b)),
+            )
+        } else {
+            // A vector space's Jacobians are constant: their kernels take no state.
+            let into = f("vector_", "_into");
+            let body = match which {
+                Manifold::Difference => quote!(#m::#vector(#args)),
+                _ => quote!(#m::#vector()),
+            };
+            (body, quote!({ let _ = (#args); #m::#into(a, b) }))
+        };
+        match which {
+            Manifold::Difference => (body, TokenStream::new()),
+            _ => (body, into),
         }
     }
 }
