@@ -80,8 +80,8 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
         // Each row gathered in a local accumulator; the identity's one is added to the row
         // once written: set in the accumulator at a varying index, it kept the accumulator in
         // memory, whose wide reloads of narrow stores could not be forwarded.
+        let y = self.inverse_inertia_rows();
         for (i, row) in d.dv_dv.iter_mut().enumerate() {
-            let y = self.inverse_inertia_rows();
             combination_into(row, |k| y[k][i], &d.dimpulse_dv, cols.clone());
             row[i] += T::one();
         }

@@ -136,10 +136,7 @@ fn diagonal<T: Real, const N: usize>(x: &mut [[T; N]; N], y: &mut [[T; N]; N], a
 
 #[cfg(test)]
 mod tests {
-    use super::super::{
-        difference_jacobians, difference_jacobians_blocks, integrate_jacobians,
-        integrate_jacobians_blocks,
-    };
+    use super::super::{difference_jacobians, integrate_jacobians, integrate_jacobians_blocks};
     use super::*;
 
     /// A revolute joint, a free flyer below it, then two joints (the flyer's blocks at
@@ -153,15 +150,36 @@ mod tests {
         (q0, q1, v)
     }
 
+    /// `a I` and `b I`, with the 6 x 6 blocks `x` and `y` from row and column 1 (the flyer of
+    /// [`FREE`]).
+    fn expected(a: f64, b: f64, (x, y): ([[f64; 6]; 6], [[f64; 6]; 6])) -> [[[f64; 9]; 9]; 2] {
+        let unit =
+            |s: f64| core::array::from_fn(|i| core::array::from_fn(|j| s * f64::from(i == j)));
+        let mut m: [[[f64; 9]; 9]; 2] = [unit(a), unit(b)];
+        for i in 0..6 {
+            m[0][1 + i][1..7].copy_from_slice(&x[i]);
+            m[1][1 + i][1..7].copy_from_slice(&y[i]);
+        }
+        m
+    }
+
     #[test]
     fn written_into_zeros_they_equal_the_whole_jacobians() {
         let (q0, q1, v) = states();
+        // The flyer below the root: the identity around the root flyer's blocks, the
+        // latter from the dense root forms on the flyer's own coordinates.
+        let (f0, f1): ([f64; 7], [f64; 7]) = (
+            core::array::from_fn(|i| q0[i + 1]),
+            core::array::from_fn(|i| q1[i + 1]),
+        );
+        let fv: [f64; 6] = core::array::from_fn(|i| v[i + 1]);
         let (mut a, mut b) = ([[0.0; 9]; 9], [[0.0; 9]; 9]);
         integrate_jacobians_blocks_into(&q0, &v, &FREE, &mut a, &mut b);
-        assert_eq!((a, b), integrate_jacobians_blocks(&q0, &v, &FREE));
+        assert_eq!([a, b], expected(1.0, 1.0, integrate_jacobians(&f0, &fv)));
         difference_jacobians_blocks_into(&q0, &q1, &FREE, &mut a, &mut b);
-        assert_eq!((a, b), difference_jacobians_blocks(&q0, &q1, &FREE));
-        // A root free flyer (the first 7 positions and 6 velocities), and a fixed base.
+        assert_eq!([a, b], expected(-1.0, 1.0, difference_jacobians(&f0, &f1)));
+        // A root free flyer (the first 7 positions and 6 velocities) and a joint, and a fixed
+        // base.
         let (r0, r1): ([f64; 8], [f64; 8]) = (
             core::array::from_fn(|i| q0[i + 1]),
             core::array::from_fn(|i| q1[i + 1]),

@@ -137,15 +137,8 @@ pub fn integrate_jacobians_blocks<T: Real, const NQ: usize, const NV: usize>(
     v: &[T; NV],
     free: &[(usize, usize)],
 ) -> ([[T; NV]; NV], [[T; NV]; NV]) {
-    let _ = q;
-    let (mut dq, mut dv) = identities_with(T::one(), T::one(), None);
-    walk_blocks::<NQ, NV>(free, |block| {
-        if let Block::Flyer(_, b) = block {
-            let (bq, bv) = se3::integrate_jacobians(&v[b..b + 6]);
-            put_block(&mut dq, b, &bq);
-            put_block(&mut dv, b, &bv);
-        }
-    });
+    let (mut dq, mut dv) = ([[T::zero(); NV]; NV], [[T::zero(); NV]; NV]);
+    integrate_jacobians_blocks_into(q, v, free, &mut dq, &mut dv);
     (dq, dv)
 }
 
@@ -164,14 +157,8 @@ pub fn difference_jacobians_blocks<T: Real, const NQ: usize, const NV: usize>(
     q1: &[T; NQ],
     free: &[(usize, usize)],
 ) -> ([[T; NV]; NV], [[T; NV]; NV]) {
-    let (mut d0, mut d1) = identities_with(-T::one(), T::one(), None);
-    walk_blocks::<NQ, NV>(free, |block| {
-        if let Block::Flyer(a, b) = block {
-            let (b0, b1) = se3::difference_jacobians(&q0[a..a + 7], &q1[a..a + 7]);
-            put_block(&mut d0, b, &b0);
-            put_block(&mut d1, b, &b1);
-        }
-    });
+    let (mut d0, mut d1) = ([[T::zero(); NV]; NV], [[T::zero(); NV]; NV]);
+    difference_jacobians_blocks_into(q0, q1, free, &mut d0, &mut d1);
     (d0, d1)
 }
 
