@@ -81,8 +81,13 @@ fn only_the_selected_functions_and_their_helpers_are_generated() {
         functions(&source),
         ["joint_transform", "link_frame", "link_jacobian", "name"]
     );
-    // Link kinematics takes `Real` (the runtime's chain kernels), so it has no batch version.
-    assert!(batch_functions(&source).is_empty());
+    // Link kinematics takes `Real` (the runtime's chain kernels): its batch runs the scalar
+    // method state by state.
+    assert_eq!(batch_functions(&source), ["link_jacobian_batch"]);
+    assert!(
+        source.contains("link: "),
+        "the link is passed once, for every state"
+    );
 }
 
 #[test]

@@ -1387,4 +1387,179 @@ impl<T: ::eomgen_runtime::batch::Batch> DoublePendulum<T> {
         );
         Ok(())
     }
+    /// `link_pose` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, the shared arguments the same for all. The scalar method state by state (its code branches on values: no SIMD lanes), over threads with `eomgen_runtime`'s `rayon` feature. An error, with nothing written, when a slice holds another number of states than `out`.
+    pub fn link_pose_batch(
+        &self,
+        link: DoublePendulumLink,
+        q: &[[T; 2]],
+        out: &mut [::eomgen_runtime::Pose<T>],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
+        ::eomgen_runtime::batch::run(
+            1,
+            out,
+            &|start: usize, out: &mut [::eomgen_runtime::Pose<T>]| {
+                let r = Self::link_pose(self, link, &q[start]);
+                out[0] = r;
+            },
+        );
+        Ok(())
+    }
+    /// `link_jacobian` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, the shared arguments the same for all. The scalar method state by state (its code branches on values: no SIMD lanes), over threads with `eomgen_runtime`'s `rayon` feature. An error, with nothing written, when a slice holds another number of states than `out`.
+    pub fn link_jacobian_batch(
+        &self,
+        link: DoublePendulumLink,
+        q: &[[T; 2]],
+        out: &mut [[[T; 2]; 6]],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
+        ::eomgen_runtime::batch::run(
+            1,
+            out,
+            &|start: usize, out: &mut [[[T; 2]; 6]]| {
+                let r = Self::link_jacobian(self, link, &q[start]);
+                out[0] = r;
+            },
+        );
+        Ok(())
+    }
+    /// `link_velocity` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, the shared arguments the same for all. The scalar method state by state (its code branches on values: no SIMD lanes), over threads with `eomgen_runtime`'s `rayon` feature. An error, with nothing written, when a slice holds another number of states than `out`.
+    pub fn link_velocity_batch(
+        &self,
+        link: DoublePendulumLink,
+        q: &[[T; 2]],
+        qd: &[[T; 2]],
+        out: &mut [[T; 6]],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
+        ::eomgen_runtime::batch::run(
+            1,
+            out,
+            &|start: usize, out: &mut [[T; 6]]| {
+                let r = Self::link_velocity(self, link, &q[start], &qd[start]);
+                out[0] = r;
+            },
+        );
+        Ok(())
+    }
+    /// `link_acceleration` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, the shared arguments the same for all. The scalar method state by state (its code branches on values: no SIMD lanes), over threads with `eomgen_runtime`'s `rayon` feature. An error, with nothing written, when a slice holds another number of states than `out`.
+    pub fn link_acceleration_batch(
+        &self,
+        link: DoublePendulumLink,
+        q: &[[T; 2]],
+        qd: &[[T; 2]],
+        qdd: &[[T; 2]],
+        out: &mut [[T; 6]],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(
+            out.len(),
+            &[("q", q.len()), ("qd", qd.len()), ("qdd", qdd.len())],
+        )?;
+        ::eomgen_runtime::batch::run(
+            1,
+            out,
+            &|start: usize, out: &mut [[T; 6]]| {
+                let r = Self::link_acceleration(
+                    self,
+                    link,
+                    &q[start],
+                    &qd[start],
+                    &qdd[start],
+                );
+                out[0] = r;
+            },
+        );
+        Ok(())
+    }
+    /// `link_jacobian_time_variation` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, the shared arguments the same for all. The scalar method state by state (its code branches on values: no SIMD lanes), over threads with `eomgen_runtime`'s `rayon` feature. An error, with nothing written, when a slice holds another number of states than `out`.
+    pub fn link_jacobian_time_variation_batch(
+        &self,
+        link: DoublePendulumLink,
+        q: &[[T; 2]],
+        qd: &[[T; 2]],
+        out: &mut [[[T; 2]; 6]],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
+        ::eomgen_runtime::batch::run(
+            1,
+            out,
+            &|start: usize, out: &mut [[[T; 2]; 6]]| {
+                let r = Self::link_jacobian_time_variation(
+                    self,
+                    link,
+                    &q[start],
+                    &qd[start],
+                );
+                out[0] = r;
+            },
+        );
+        Ok(())
+    }
+    /// `difference` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, the shared arguments the same for all. The scalar method state by state (its code branches on values: no SIMD lanes), over threads with `eomgen_runtime`'s `rayon` feature. An error, with nothing written, when a slice holds another number of states than `out`.
+    pub fn difference_batch(
+        &self,
+        q0: &[[T; 2]],
+        q1: &[[T; 2]],
+        out: &mut [[T; 2]],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(
+            out.len(),
+            &[("q0", q0.len()), ("q1", q1.len())],
+        )?;
+        ::eomgen_runtime::batch::run(
+            1,
+            out,
+            &|start: usize, out: &mut [[T; 2]]| {
+                let r = Self::difference(self, &q0[start], &q1[start]);
+                out[0] = r;
+            },
+        );
+        Ok(())
+    }
+    /// `integrate_jacobians` at every state: `out_0[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, the shared arguments the same for all. The scalar method state by state (its code branches on values: no SIMD lanes), over threads with `eomgen_runtime`'s `rayon` feature. An error, with nothing written, when a slice holds another number of states than `out_0`.
+    pub fn integrate_jacobians_batch(
+        &self,
+        q: &[[T; 2]],
+        v: &[[T; 2]],
+        out_0: &mut [[[T; 2]; 2]],
+        out_1: &mut [[[T; 2]; 2]],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(
+            out_0.len(),
+            &[("q", q.len()), ("v", v.len()), ("out_1", out_1.len())],
+        )?;
+        ::eomgen_runtime::batch::run(
+            1,
+            (out_0, out_1),
+            &|start: usize, (out_0, out_1): (&mut [[[T; 2]; 2]], &mut [[[T; 2]; 2]])| {
+                let r = Self::integrate_jacobians(self, &q[start], &v[start]);
+                out_0[0] = r.0;
+                out_1[0] = r.1;
+            },
+        );
+        Ok(())
+    }
+    /// `difference_jacobians` at every state: `out_0[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, the shared arguments the same for all. The scalar method state by state (its code branches on values: no SIMD lanes), over threads with `eomgen_runtime`'s `rayon` feature. An error, with nothing written, when a slice holds another number of states than `out_0`.
+    pub fn difference_jacobians_batch(
+        &self,
+        q0: &[[T; 2]],
+        q1: &[[T; 2]],
+        out_0: &mut [[[T; 2]; 2]],
+        out_1: &mut [[[T; 2]; 2]],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(
+            out_0.len(),
+            &[("q0", q0.len()), ("q1", q1.len()), ("out_1", out_1.len())],
+        )?;
+        ::eomgen_runtime::batch::run(
+            1,
+            (out_0, out_1),
+            &|start: usize, (out_0, out_1): (&mut [[[T; 2]; 2]], &mut [[[T; 2]; 2]])| {
+                let r = Self::difference_jacobians(self, &q0[start], &q1[start]);
+                out_0[0] = r.0;
+                out_1[0] = r.1;
+            },
+        );
+        Ok(())
+    }
 }

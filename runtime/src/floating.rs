@@ -83,7 +83,12 @@ pub trait FloatingDynamics<T: Lane, const NQ: usize, const NV: usize> {
 
 /// Point contacts of a floating-base (or fixed-base) robot generated with
 /// `Builder::contact_points`: `K3 = 3 x` the number of contact points.
-pub trait Contacts<T: Real, const NQ: usize, const NV: usize, const K3: usize> {
+///
+/// Implemented for every [`Real`], and for every [`Lane`] (vectors of states, one per lane)
+/// where the generated contact forward dynamics is one straight-line program; on a vector,
+/// `try_contact_forward_dynamics` returns the error of the lowest failed lane, and the
+/// generated `try_contact_forward_dynamics_lanes` says which lane failed and keeps the others.
+pub trait Contacts<T: Lane, const NQ: usize, const NV: usize, const K3: usize> {
     /// The contact points' Jacobian (linear velocity of each point, world axes), K3 x NV.
     fn contact_jacobian(&self, q: &[T; NQ]) -> [[T; NV]; K3];
     /// `Jdot v`: the points' acceleration at zero generalized acceleration, world axes.

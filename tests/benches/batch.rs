@@ -1,7 +1,9 @@
 //! States per second of the generated dynamics three ways: the scalar code state by state on
 //! one core (`scalar`), the `_batch` methods on the target's widest SIMD lanes on one core
 //! (`batch`: `f64x4` and `f32x8` with AVX), and the same over every core (`threads`), for the
-//! panda (9 coordinates) and anymal (floating base, 18), in `f64` and `f32`. Named
+//! panda (9 coordinates) and anymal (floating base, 18), in `f64` and `f32`, and anymal's
+//! contact forward dynamics and impulse dynamics on its four feet (and their derivatives, whose
+//! batch runs state by state: `batch` is then the scalar code through it). Named
 //! `batch-<robot>-<scalar>/<function>/<way>`; criterion prints states per second
 //! (`thrpt`). Needs the `rayon` feature:
 //!
@@ -18,7 +20,9 @@ use criterion::{criterion_group, criterion_main, BenchmarkGroup, Criterion, Thro
 use eomgen_generated::panda::Panda;
 use eomgen_runtime::batch::Batch;
 use eomgen_runtime::prelude::*;
+use eomgen_tests::robots::anymal::Anymal;
 use eomgen_tests::robots::anymal_derivatives::AnymalDerivatives;
+use eomgen_tests::robots::anymal_mpc::AnymalMpc;
 use eomgen_tests::robots::panda_derivatives::PandaDerivatives;
 use rayon::{ThreadPool, ThreadPoolBuilder};
 
@@ -150,6 +154,43 @@ fn anymal<S: Batch>(c: &mut Criterion, pools: &Pools, label: &str) {
     });
 }
 
+/// anymal standing on its four feet: contact forward dynamics and impulse dynamics (each one
+/// straight-line program, on lanes).
+fn anymal_contacts<S: Batch>(c: &mut Criterion, pools: &Pools, label: &str) {
+    let robot = Anymal::<S>::default();
+    let q = configurations::<S, 19>(7);
+    let (v, tau) = (states::<S, 18>(8, 1.0), states::<S, 18>(9, 10.0));
+    let e = S::from_f64(0.2);
+    let (z, f) = ([S::zero(); 18], [S::zero(); 12]);
+    let mut g = group(c, &format!("batch-anymal-contacts-{label}"));
+    three_ways!(g, pools, "contact_forward_dynamics", (a: z, b: f), |i| {
+        (a[i], b[i]) = robot.contact_forward_dynamics(black_box(&q[i]), &v[i], &tau[i]);
+    }, {
+        robot.contact_forward_dynamics_batch(black_box(&q), &v, &tau, &mut a, &mut b).unwrap()
+    });
+    three_ways!(g, pools, "impulse_dynamics", (a: z, b: f), |i| {
+        (a[i], b[i]) = robot.impulse_dynamics(black_box(&q[i]), &v[i], e);
+    }, {
+        robot.impulse_dynamics_batch(black_box(&q), &v, e, &mut a, &mut b).unwrap()
+    });
+}
+
+/// anymal's contact forward dynamics derivatives (four feet), whose batch runs the scalar
+/// method state by state: `batch` is the scalar code through the batch method, `threads` the
+/// same over every core.
+fn anymal_contact_derivatives(c: &mut Criterion, pools: &Pools) {
+    let robot = AnymalMpc::<f64>::default();
+    let q = configurations::<f64, 19>(10);
+    let (v, tau) = (states::<f64, 18>(11, 1.0), states::<f64, 18>(12, 10.0));
+    let zero = robot.contact_forward_dynamics_derivatives(&[0.0; 19], &[0.0; 18], &[0.0; 18]);
+    let mut g = group(c, "batch-anymal-contact-derivatives-f64");
+    three_ways!(g, pools, "contact_forward_dynamics_derivatives", (d: zero), |i| {
+        d[i] = robot.contact_forward_dynamics_derivatives(black_box(&q[i]), &v[i], &tau[i]);
+    }, {
+        robot.contact_forward_dynamics_derivatives_batch(black_box(&q), &v, &tau, &mut d).unwrap()
+    });
+}
+
 fn batch(c: &mut Criterion) {
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     let pools = Pools {
@@ -160,6 +201,9 @@ fn batch(c: &mut Criterion) {
     anymal::<f64>(c, &pools, "f64");
     panda::<f32>(c, &pools, "f32");
     anymal::<f32>(c, &pools, "f32");
+    anymal_contacts::<f64>(c, &pools, "f64");
+    anymal_contacts::<f32>(c, &pools, "f32");
+    anymal_contact_derivatives(c, &pools);
 }
 
 criterion_group!(benches, batch);

@@ -40,6 +40,11 @@ impl Flat for f64 {
         vec![*self]
     }
 }
+impl Flat for Vec<f64> {
+    fn flat(&self) -> Vec<f64> {
+        self.clone()
+    }
+}
 impl<const N: usize> Flat for [f64; N] {
     fn flat(&self) -> Vec<f64> {
         self.to_vec()
@@ -436,4 +441,248 @@ fn gather_and_scatter_of_four_doubles_partial_last_vector() {
             }
         }
     }
+}
+
+/// `count` floating-base states of anymal: unit quaternions, joints within a radian.
+fn anymal_states(n: &mut Numbers, count: usize) -> (Vec<[f64; 19]>, Vec<[f64; 18]>) {
+    let (mut q, v) = (n.states::<19>(count, 1.0), n.states::<18>(count, 1.0));
+    for s in &mut q {
+        let norm = s[3..7].iter().map(|x| x * x).sum::<f64>().sqrt();
+        s[3..7].iter_mut().for_each(|x| *x /= norm);
+    }
+    (q, v)
+}
+
+#[test]
+fn contact_and_impulse_dynamics_in_batches_equal_the_scalar_code() {
+    use eomgen_tests::robots::anymal::Anymal;
+    let robot = Anymal::<f64>::default();
+    let mut n = Numbers(10);
+    let (mut q, mut v) = anymal_states(&mut n, STATES);
+    spoil(&mut q, &mut v);
+    let tau = n.states::<18>(STATES, 20.0);
+    let (mut a, mut f) = (vec![[0.0; 18]; STATES], vec![[0.0; 12]; STATES]);
+    robot
+        .contact_forward_dynamics_batch(&q, &v, &tau, &mut a, &mut f)
+        .unwrap();
+    let (mut after, mut p) = (vec![[0.0; 18]; STATES], vec![[0.0; 12]; STATES]);
+    robot
+        .impulse_dynamics_batch(&q, &v, 0.3, &mut after, &mut p)
+        .unwrap();
+    let mut j = vec![[[0.0; 18]; 12]; STATES];
+    robot.contact_jacobian_batch(&q, &mut j).unwrap();
+    let mut drift = vec![[0.0; 12]; STATES];
+    robot.contact_drift_batch(&q, &v, &mut drift).unwrap();
+    for i in 0..STATES {
+        let (want_a, want_f) = robot.contact_forward_dynamics(&q[i], &v[i], &tau[i]);
+        assert_close("contact accelerations", i, &a[i], &want_a, 0.0);
+        assert_close("contact forces", i, &f[i], &want_f, 0.0);
+        assert!(want_a.iter().all(|x| x.is_finite()) == (i != 2 && i != 5));
+        let (want_v, want_p) = robot.impulse_dynamics(&q[i], &v[i], 0.3);
+        assert_close("velocity after the impact", i, &after[i], &want_v, 0.0);
+        assert_close("impulses", i, &p[i], &want_p, 0.0);
+        assert_close(
+            "contact_jacobian",
+            i,
+            &j[i],
+            &robot.contact_jacobian(&q[i]),
+            0.0,
+        );
+        let want = robot.contact_drift(&q[i], &v[i]);
+        assert_close("contact_drift", i, &drift[i], &want, 0.0);
+    }
+}
+
+#[test]
+fn a_failed_contact_lane_is_named_and_the_others_are_unaffected() {
+    use eomgen_tests::robots::anymal::Anymal;
+    let robot = Anymal::<f64>::default();
+    let wide = robot.in_lanes::<f64x4>();
+    let mut n = Numbers(11);
+    let (mut q, v) = anymal_states(&mut n, 4);
+    let tau = n.states::<18>(4, 20.0);
+    q[1][9] = f64::NAN;
+    let (ql, vl, tl): ([f64x4; 19], [f64x4; 18], [f64x4; 18]) =
+        (gather(&q, 0), gather(&v, 0), gather(&tau, 0));
+    let err = wide
+        .try_contact_forward_dynamics_lanes(&ql, &vl, &tl)
+        .unwrap_err();
+    let scalar = robot
+        .try_contact_forward_dynamics(&q[1], &v[1], &tau[1])
+        .unwrap_err();
+    assert_eq!(
+        err,
+        LaneError {
+            lane: 1,
+            error: scalar
+        }
+    );
+    // The trait's `try_` reports the same lane's error.
+    assert_eq!(
+        wide.try_contact_forward_dynamics(&ql, &vl, &tl),
+        Err(scalar)
+    );
+    let err = wide
+        .try_impulse_dynamics_lanes(&ql, &vl, f64x4::splat(0.0))
+        .unwrap_err();
+    let scalar = robot.try_impulse_dynamics(&q[1], &v[1], 0.0).unwrap_err();
+    assert_eq!(
+        err,
+        LaneError {
+            lane: 1,
+            error: scalar
+        }
+    );
+    let (a, f) = wide.contact_forward_dynamics(&ql, &vl, &tl);
+    for l in 0..4 {
+        let one: Vec<f64> = a.iter().chain(&f).map(|x| x.lane(l)).collect();
+        assert_eq!(one.iter().all(|x| x.is_nan()), l == 1, "lane {l}");
+        let (want_a, want_f) = robot.contact_forward_dynamics(&q[l], &v[l], &tau[l]);
+        let want: Vec<f64> = want_a.iter().chain(&want_f).copied().collect();
+        assert_close("f64x4 contact forward dynamics", l, &one, &want, 0.0);
+    }
+}
+
+impl<const N: usize, const K: usize> Flat
+    for eomgen_runtime::ContactDynamicsDerivatives<f64, N, K>
+{
+    fn flat(&self) -> Vec<f64> {
+        [self.da_dq, self.da_dv, self.da_dtau]
+            .iter()
+            .flat_map(Flat::flat)
+            .chain(
+                [self.df_dq, self.df_dv, self.df_dtau]
+                    .iter()
+                    .flat_map(Flat::flat),
+            )
+            .collect()
+    }
+}
+
+impl<const N: usize, const K: usize> Flat
+    for eomgen_runtime::ImpulseDynamicsDerivatives<f64, N, K>
+{
+    fn flat(&self) -> Vec<f64> {
+        [self.dv_dq, self.dv_dv]
+            .iter()
+            .flat_map(Flat::flat)
+            .chain(
+                [self.dimpulse_dq, self.dimpulse_dv]
+                    .iter()
+                    .flat_map(Flat::flat),
+            )
+            .collect()
+    }
+}
+
+impl Flat for eomgen_runtime::Pose<f64> {
+    fn flat(&self) -> Vec<f64> {
+        self.translation
+            .iter()
+            .chain(self.rotation.as_flattened())
+            .copied()
+            .collect()
+    }
+}
+
+/// `got[i]` equals `want(i)` bit for bit at every state.
+fn each_state<X: Flat>(what: &str, got: &[X], want: impl Fn(usize) -> X) {
+    for (i, g) in got.iter().enumerate() {
+        assert_close(what, i, g, &want(i), 0.0);
+    }
+}
+
+#[test]
+fn methods_off_the_lanes_in_batches_equal_the_scalar_code() {
+    use eomgen_runtime::{Baumgarte, ContactDynamicsDerivatives, ImpulseDynamicsDerivatives};
+    use eomgen_tests::robots::anymal_mpc::{AnymalMpc, AnymalMpcLink};
+    let robot = AnymalMpc::<f64>::default();
+    let mut n = Numbers(12);
+    let (mut q, mut v) = anymal_states(&mut n, STATES);
+    let (a, q1) = (n.states::<18>(STATES, 1.0), anymal_states(&mut n, STATES).0);
+    spoil(&mut q, &mut v);
+    let link = AnymalMpcLink::LfFoot;
+    let (z6, zm) = ([0.0; 6], [[0.0; 18]; 18]);
+    let mut six = vec![z6; STATES];
+    robot
+        .link_acceleration_batch(link, &q, &v, &a, &mut six)
+        .unwrap();
+    each_state("link_acceleration", &six, |i| {
+        robot.link_acceleration(link, &q[i], &v[i], &a[i])
+    });
+    let mut poses = vec![eomgen_runtime::Pose::identity(); STATES];
+    robot.link_pose_batch(link, &q, &mut poses).unwrap();
+    each_state("link_pose", &poses, |i| robot.link_pose(link, &q[i]));
+    let mut dv = vec![[0.0; 18]; STATES];
+    robot.difference_batch(&q, &q1, &mut dv).unwrap();
+    each_state("difference", &dv, |i| robot.difference(&q[i], &q1[i]));
+    let (mut ja, mut jb) = (vec![zm; STATES], vec![zm; STATES]);
+    robot
+        .integrate_jacobians_batch(&q, &v, &mut ja, &mut jb)
+        .unwrap();
+    each_state("integrate_jacobians in q", &ja, |i| {
+        robot.integrate_jacobians(&q[i], &v[i]).0
+    });
+    each_state("integrate_jacobians in v", &jb, |i| {
+        robot.integrate_jacobians(&q[i], &v[i]).1
+    });
+
+    let tau = n.states::<18>(STATES, 20.0);
+    let zk = [[0.0; 18]; 12];
+    let cdd = ContactDynamicsDerivatives {
+        da_dq: zm,
+        da_dv: zm,
+        da_dtau: zm,
+        df_dq: zk,
+        df_dv: zk,
+        df_dtau: zk,
+    };
+    let mut d = vec![cdd; STATES];
+    robot
+        .contact_forward_dynamics_derivatives_batch(&q, &v, &tau, &mut d)
+        .unwrap();
+    each_state("contact derivatives", &d, |i| {
+        robot.contact_forward_dynamics_derivatives(&q[i], &v[i], &tau[i])
+    });
+    let idd = ImpulseDynamicsDerivatives {
+        dv_dq: zm,
+        dv_dv: zm,
+        dimpulse_dq: zk,
+        dimpulse_dv: zk,
+    };
+    let mut d = vec![idd; STATES];
+    robot
+        .impulse_dynamics_derivatives_batch(&q, &v, 0.2, &mut d)
+        .unwrap();
+    each_state("impulse derivatives", &d, |i| {
+        robot.impulse_dynamics_derivatives(&q[i], &v[i], 0.2)
+    });
+    // Two feet of four, shared by every state.
+    let active = [true, false, false, true];
+    let (mut acc, mut f) = (vec![[0.0; 18]; STATES], vec![[0.0; 12]; STATES]);
+    robot
+        .contact_forward_dynamics_active_batch(&q, &v, &tau, &active, &mut acc, &mut f)
+        .unwrap();
+    each_state("active accelerations", &acc, |i| {
+        robot
+            .contact_forward_dynamics_active(&q[i], &v[i], &tau[i], &active)
+            .0
+    });
+    each_state("active forces", &f, |i| {
+        robot
+            .contact_forward_dynamics_active(&q[i], &v[i], &tau[i], &active)
+            .1
+    });
+    let reference = [eomgen_runtime::Pose::from_translation([0.3, -0.2, 0.0]); 4];
+    let gains = Baumgarte::new(100.0, 20.0, reference);
+    robot
+        .contact_forward_dynamics_stabilized_batch(&q, &v, &tau, &active, &gains, &mut acc, &mut f)
+        .unwrap();
+    each_state("stabilized forces", &f, |i| {
+        robot
+            .contact_forward_dynamics_stabilized(&q[i], &v[i], &tau[i], &active, &gains)
+            .1
+    });
+    let e = robot.difference_batch(&q, &q1[1..], &mut dv).unwrap_err();
+    assert_eq!((e.argument, e.len, e.expected), ("q1", STATES - 1, STATES));
 }

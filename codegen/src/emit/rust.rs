@@ -6,6 +6,7 @@
 //! parameter fields, the link enum, each kind of [`Evaluation`], the trait implementation.
 
 mod batch;
+mod batch_states;
 mod contact;
 mod items;
 mod lanes;

@@ -37,12 +37,8 @@ struct Outs {
     scatters: Vec<TokenStream>,
 }
 
-/// The output slices of a quantity of `shape`.
-fn outputs(shape: Shape) -> Outs {
-    let shapes: Vec<Shape> = match shape {
-        Shape::Matrices(k, r, c) => vec![Shape::Matrix(r, c); k],
-        s => vec![s],
-    };
+/// The output slices of a quantity whose value holds one element of each of `shapes`.
+fn outputs(shapes: Vec<Shape>) -> Outs {
     let names: Vec<Ident> = match shapes.len() {
         1 => vec![format_ident!("out")],
         k => (0..k).map(|i| format_ident!("out_{}", i)).collect(),
@@ -72,7 +68,38 @@ fn outputs(shape: Shape) -> Outs {
     }
 }
 
+/// The element shapes of a value of `shape`: the matrices of a tuple, or the value itself.
+pub(super) fn elements(shape: Shape) -> Vec<Shape> {
+    match shape {
+        Shape::Matrices(k, r, c) => vec![Shape::Matrix(r, c); k],
+        s => vec![s],
+    }
+}
+
+/// The number shared by every state that a method of this evaluation takes besides its inputs:
+/// `integrate`'s time step, impulse dynamics' restitution.
+fn shared_scalar(eval: &Evaluation) -> Option<Ident> {
+    match eval {
+        Evaluation::Integrate => Some(format_ident!("dt")),
+        Evaluation::ImpulseDynamicsFlat { .. } => Some(format_ident!("restitution")),
+        _ => None,
+    }
+}
+
 impl Emitter<'_> {
+    /// The element shapes of `q`'s value: contact forward dynamics and impulse dynamics give
+    /// a pair of vectors (`N` velocity coordinates, `K` contact rows).
+    fn result_shapes(&self, q: &Quantity) -> Vec<Shape> {
+        match q.eval {
+            Evaluation::ContactForwardDynamicsFlat { .. }
+            | Evaluation::ImpulseDynamicsFlat { .. } => {
+                let n = self.parents.len();
+                vec![Shape::Vector(n), Shape::Vector(q.shape.len() - n)]
+            }
+            _ => elements(q.shape),
+        }
+    }
+
     /// `impl<T: Batch>` with `in_lanes` and one `_batch` method per quantity on lanes.
     pub(super) fn batch_impl(&self, fields: &Fields) -> TokenStream {
         let (ty, allow) = (&self.ty, allow_lints());
@@ -81,7 +108,8 @@ impl Emitter<'_> {
             .quantities
             .iter()
             .filter(|q| self.lanes.contains(q.name))
-            .map(|q| self.batch_fn(q));
+            .map(|q| self.batch_fn(q))
+            .chain(self.state_batch_fns());
         let unpacked: Vec<TokenStream> = self
             .quantities
             .iter()
@@ -146,7 +174,7 @@ impl Emitter<'_> {
         };
         let f = format_ident!("{}_unpacked", q.name);
         let params = self.args(q.inputs);
-        let outs = outputs(q.shape).names;
+        let outs = outputs(elements(q.shape)).names;
         let (r, c) = match q.shape {
             Shape::Matrix(r, c) | Shape::Matrices(_, r, c) => (usize_lit(r), usize_lit(c)),
             _ => return TokenStream::new(),
@@ -173,6 +201,10 @@ impl Emitter<'_> {
             Some(Trait::Floating) => {
                 quote!(<#ty<#l> as ::eomgen_runtime::FloatingDynamics<#l, #nq, #n>>::#f)
             }
+            Some(Trait::Contacts) => {
+                let k = &self.k;
+                quote!(<#ty<#l> as ::eomgen_runtime::Contacts<#l, #nq, #n, #k>>::#f)
+            }
             _ => quote!(#ty::<#l>::#f),
         }
     }
@@ -190,22 +222,22 @@ impl Emitter<'_> {
             names: outs,
             types: out_types,
             scatters,
-        } = outputs(q.shape);
-        let integrate = matches!(q.eval, Evaluation::Integrate);
-        let (dt, dt_arg, dt_lanes) = if integrate {
-            let l = lanes();
-            (
-                quote!(dt: T,),
-                quote!(dt),
-                quote!(let dt = <#l as ::eomgen_runtime::Lane>::from_f64(::eomgen_runtime::Real::to_f64(dt));),
-            )
-        } else {
-            (TokenStream::new(), TokenStream::new(), TokenStream::new())
+        } = outputs(self.result_shapes(q));
+        let shared = shared_scalar(&q.eval);
+        let (dt, dt_lanes) = match &shared {
+            Some(x) => {
+                let l = lanes();
+                (
+                    quote!(#x: T,),
+                    quote!(let #x = <#l as ::eomgen_runtime::Lane>::from_f64(::eomgen_runtime::Real::to_f64(#x));),
+                )
+            }
+            None => (TokenStream::new(), TokenStream::new()),
         };
         let call_args = inputs
             .iter()
             .map(|i| quote!(&::eomgen_runtime::batch::gather(#i, start)))
-            .chain(integrate.then(|| dt_arg.clone()));
+            .chain(shared.iter().map(|x| quote!(#x)));
         let path = self.lane_path(q.name);
         let first = &outs[0];
         let checked = inputs.iter().chain(&outs[1..]).map(|a| {

@@ -363,43 +363,51 @@ impl Emitter<'_> {
     }
 
     /// `try_impulse_dynamics` and `impulse_dynamics` from one straight-line program at
-    /// restitution zero (`Evaluation::ImpulseDynamicsFlat`), scaled by `1 + e`.
+    /// restitution zero (`Evaluation::ImpulseDynamicsFlat`), scaled by `1 + e`, generated for
+    /// every `T: Lane` as contact forward dynamics' (`impulse_dynamics_checked` records each
+    /// lane's failure; `impulse_dynamics` gives NaN in the failed lanes alone).
     pub(super) fn impulse_flat_fns(
         &mut self,
         q: &Quantity,
         outputs: &[Id],
         pivots: &[Id],
     ) -> TokenStream {
-        let super::solve::FlatProgram {
-            program,
-            first: dv,
-            rows: p,
-            ops,
-        } = self.flat_program(q, outputs, pivots);
-        let docs = Self::quantity_doc(q, Some(ops));
+        let flat = self.flat_program(q, outputs, pivots);
+        let (program, piv, dv, p) = (&flat.program, &flat.pivots, &flat.first, &flat.rows);
         let (n, nq, k) = (self.n.clone(), self.nq.clone(), self.k.clone());
+        let (docs, lane) = (
+            Self::quantity_doc(q, Some(flat.ops)),
+            quote!(::eomgen_runtime::lane),
+        );
+        let failures = quote!(<T as ::eomgen_runtime::Lane>::Failures);
+        let params = quote!(q: &[T; #nq], qd: &[T; #n], restitution: T);
+        let args = quote!(q, qd, restitution);
+        let wrappers = self.lane_pair_fns("impulse_dynamics", params, args, docs);
         quote! {
             /// The velocity after the impact and the impulses of `impulse_dynamics`, or why
             /// they do not exist: a pivot of M(q) (`pivot` < N) or of `J_c M^-1 J_c^T`
             /// (`pivot` - N, a rank-deficient contact Jacobian) that is not positive, or a
-            /// non-finite result.
+            /// non-finite result. On a vector of states, the lowest failed lane's error.
             pub fn try_impulse_dynamics(&self, q: &[T; #nq], qd: &[T; #n], restitution: T) -> ::core::result::Result<([T; #n], [T; #k]), ::eomgen_runtime::FactorError> {
-                #program
-                let s = T::one() + restitution;
-                let jump = [#(s * #dv,)* #(s * #p),*];
-                ::eomgen_runtime::lane::check_finite(&jump, &mut ())?;
-                let after: [T; #n] = ::core::array::from_fn(|i| qd[i] + jump[i]);
-                let p: [T; #k] = ::core::array::from_fn(|i| jump[#n + i]);
-                Ok((after, p))
+                let (x, failures) = self.impulse_dynamics_checked(q, qd, restitution)?;
+                #lane::lanes_ok::<_, T>(x, &failures).map_err(|e| e.error)
             }
 
-            #docs
-            pub fn impulse_dynamics(&self, q: &[T; #nq], qd: &[T; #n], restitution: T) -> ([T; #n], [T; #k]) {
-                match self.try_impulse_dynamics(q, qd, restitution) {
-                    Ok(x) => x,
-                    Err(_) => ([T::nan(); #n], [T::nan(); #k]),
-                }
+            /// The velocity and impulses, and each lane's failure (a scalar returns its first
+            /// at once).
+            fn impulse_dynamics_checked(&self, q: &[T; #nq], qd: &[T; #n], restitution: T) -> ::core::result::Result<(([T; #n], [T; #k]), #failures), ::eomgen_runtime::FactorError> {
+                let mut failures: #failures = ::core::default::Default::default();
+                #program
+                #lane::check_pivots(&[#(#piv),*], &mut failures)?;
+                let s = T::one() + restitution;
+                let jump = [#(s * #dv,)* #(s * #p),*];
+                #lane::check_finite(&jump, &mut failures)?;
+                let after: [T; #n] = ::core::array::from_fn(|i| qd[i] + jump[i]);
+                let p: [T; #k] = ::core::array::from_fn(|i| jump[#n + i]);
+                Ok(((after, p), failures))
             }
+
+            #wrappers
         }
     }
 

@@ -1,7 +1,8 @@
 //! Which generated methods run on vectors of states (`eomgen_runtime::Lane`): those whose
 //! code is arithmetic, pivot checks and the runtime kernels that take a `Lane`, and whose
-//! callees do too. They live in the `impl<T: Lane>` blocks; the rest (link kinematics, the
-//! manifold, contacts) in `impl<T: Real>`.
+//! callees do too (contact forward dynamics and impulse dynamics when each is one straight-line
+//! program). They live in the `impl<T: Lane>` blocks; the rest (link kinematics, the manifold,
+//! the contact solves at run time and the contact derivatives) in `impl<T: Real>`.
 
 use std::collections::BTreeSet;
 
@@ -21,6 +22,8 @@ fn evaluation_on_lanes(q: &Quantity) -> bool {
             | Evaluation::Factored { .. }
             | Evaluation::ForwardDynamicsDerivatives { .. }
             | Evaluation::Integrate
+            | Evaluation::ContactForwardDynamicsFlat { .. }
+            | Evaluation::ImpulseDynamicsFlat { .. }
     )
 }
 

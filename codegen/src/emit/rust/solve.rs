@@ -443,31 +443,17 @@ impl Emitter<'_> {
         let (body, ops) = match &q.eval {
             Evaluation::ContactForwardDynamics { h } => self.contact_runtime_body(q, h),
             Evaluation::ContactForwardDynamicsFlat { outputs, pivots } => {
-                self.contact_flat_body(q, outputs, pivots)
+                return self.contact_flat_fns(q, outputs, pivots);
             }
             _ => unreachable!("contact_forward_dynamics_fns on another evaluation"),
         };
         let docs = Self::quantity_doc(q, Some(ops));
-        let (n, nq) = (&self.n, &self.nq);
+        let (n, nq) = (self.n.clone(), self.nq.clone());
         let k3 = usize_lit(q.shape.len() - self.parents.len());
-        let try_vis = self.vis("try_contact_forward_dynamics");
         let try_cfd = self.path("try_contact_forward_dynamics");
-        let try_fn = quote! {
-            /// The accelerations and contact forces of `contact_forward_dynamics`, or why they
-            /// do not exist: a pivot of M(q) (`pivot` < N) or of `J_c M^-1 J_c^T` (`pivot` - N,
-            /// a rank-deficient contact Jacobian) that is not positive, or non-finite input.
-            #try_vis fn try_contact_forward_dynamics(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n]) -> ::core::result::Result<([T; #n], [T; #k3]), ::eomgen_runtime::FactorError> {
-                #body
-            }
-        };
-        let inherent_try = if self.trait_of("try_contact_forward_dynamics").is_some() {
-            self.try_contact_forward_dynamics = try_fn;
-            TokenStream::new()
-        } else {
-            try_fn
-        };
+        let try_fn = self.try_contact_forward_dynamics_fn(body);
         quote! {
-            #inherent_try
+            #try_fn
 
             #docs
             pub fn contact_forward_dynamics(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n]) -> ([T; #n], [T; #k3]) {
@@ -476,6 +462,70 @@ impl Emitter<'_> {
                     Err(_) => ([T::nan(); #n], [T::nan(); #k3]),
                 }
             }
+        }
+    }
+
+    /// `try_contact_forward_dynamics` with `body`: kept for the `Contacts` impl when the trait
+    /// holds it (an empty stream returned), else returned as an inherent method.
+    fn try_contact_forward_dynamics_fn(&mut self, body: TokenStream) -> TokenStream {
+        let (n, nq, k) = (&self.n, &self.nq, &self.k);
+        let try_vis = self.vis("try_contact_forward_dynamics");
+        let try_fn = quote! {
+            /// The accelerations and contact forces of `contact_forward_dynamics`, or why they
+            /// do not exist: a pivot of M(q) (`pivot` < N) or of `J_c M^-1 J_c^T` (`pivot` - N,
+            /// a rank-deficient contact Jacobian) that is not positive, or non-finite input.
+            #try_vis fn try_contact_forward_dynamics(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n]) -> ::core::result::Result<([T; #n], [T; #k]), ::eomgen_runtime::FactorError> {
+                #body
+            }
+        };
+        if self.trait_of("try_contact_forward_dynamics").is_some() {
+            self.try_contact_forward_dynamics = try_fn;
+            TokenStream::new()
+        } else {
+            try_fn
+        }
+    }
+
+    /// The methods of a straight-line contact forward dynamics, generated for every
+    /// `T: Lane` (one state per lane): `contact_forward_dynamics_checked`, which records each
+    /// lane's failure, `try_contact_forward_dynamics_lanes`, `contact_forward_dynamics` (NaN in
+    /// the failed lanes alone) and `try_contact_forward_dynamics` (the lowest failed lane's
+    /// error). The pivots are checked before the results, as the run-time route does: a
+    /// non-finite acceleration `i` is `NonFinite { pivot: i }`, a force `k`
+    /// `NonFinite { pivot: N + k }`.
+    fn contact_flat_fns(&mut self, q: &Quantity, outputs: &[Id], pivots: &[Id]) -> TokenStream {
+        let FlatProgram {
+            program,
+            pivots: piv,
+            first: a,
+            rows: f,
+            ops,
+        } = self.flat_program(q, outputs, pivots);
+        let docs = Self::quantity_doc(q, Some(ops));
+        let (n, nq, k) = (self.n.clone(), self.nq.clone(), self.k.clone());
+        let failures = quote!(<T as ::eomgen_runtime::Lane>::Failures);
+        let lane = quote!(::eomgen_runtime::lane);
+        let try_fn = self.try_contact_forward_dynamics_fn(quote! {
+            let (x, failures) = self.contact_forward_dynamics_checked(q, qd, tau)?;
+            #lane::lanes_ok::<_, T>(x, &failures).map_err(|e| e.error)
+        });
+        let params = quote!(q: &[T; #nq], qd: &[T; #n], tau: &[T; #n]);
+        let wrappers =
+            self.lane_pair_fns("contact_forward_dynamics", params, quote!(q, qd, tau), docs);
+        quote! {
+            #try_fn
+
+            /// The accelerations and forces, and each lane's failure (a scalar returns its
+            /// first at once).
+            fn contact_forward_dynamics_checked(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n]) -> ::core::result::Result<(([T; #n], [T; #k]), #failures), ::eomgen_runtime::FactorError> {
+                let mut failures: #failures = ::core::default::Default::default();
+                #program
+                #lane::check_pivots(&[#(#piv),*], &mut failures)?;
+                #lane::check_finite(&[#(#a,)* #(#f),*], &mut failures)?;
+                Ok((([#(#a),*], [#(#f),*]), failures))
+            }
+
+            #wrappers
         }
     }
 }
@@ -499,33 +549,49 @@ impl Emitter<'_> {
         (body, ops)
     }
 
-    /// The body of a straight-line `try_contact_forward_dynamics`: the accelerations, forces
-    /// and pivots of one program, the pivots checked, then every result (as the run-time
-    /// route: a non-finite acceleration `i` is `NonFinite { pivot: i }`, a force `k`
-    /// `NonFinite { pivot: N + k }`).
-    fn contact_flat_body(
-        &mut self,
-        q: &Quantity,
-        outputs: &[Id],
-        pivots: &[Id],
-    ) -> (TokenStream, OpCount) {
-        let FlatProgram {
-            program,
-            first: a,
-            rows: f,
-            ops,
-        } = self.flat_program(q, outputs, pivots);
-        let body = quote! {
-            #program
-            ::eomgen_runtime::lane::check_finite(&[#(#a,)* #(#f),*], &mut ())?;
-            Ok(([#(#a),*], [#(#f),*]))
-        };
-        (body, ops)
+    /// `try_{name}_lanes` (the lowest failed lane, `LaneError`) and `{name}` (NaN in the failed
+    /// lanes alone, documented by `docs`), both over `{name}_checked(args)`, which gives a pair
+    /// of vectors (`N` velocity coordinates, `K` contact rows) and each lane's failures.
+    pub(super) fn lane_pair_fns(
+        &self,
+        name: &str,
+        params: TokenStream,
+        args: TokenStream,
+        docs: TokenStream,
+    ) -> TokenStream {
+        let (n, k, lane) = (&self.n, &self.k, quote!(::eomgen_runtime::lane));
+        let f = quote::format_ident!("{}", name);
+        let (try_lanes, checked) = (
+            quote::format_ident!("try_{}_lanes", name),
+            quote::format_ident!("{}_checked", name),
+        );
+        let doc = format!(
+            " `try_{name}` on a vector of states (`eomgen_runtime::Lane`, one state per lane; a \
+             scalar is lane 0): the results of every lane, or the lowest lane whose \
+             factorization or result failed, with that lane's own error."
+        );
+        let result = quote!(([T; #n], [T; #k]));
+        quote! {
+            #[doc = #doc]
+            pub fn #try_lanes(&self, #params) -> ::core::result::Result<#result, ::eomgen_runtime::LaneError> {
+                match self.#checked(#args) {
+                    Ok((x, failures)) => #lane::lanes_ok::<_, T>(x, &failures),
+                    Err(error) => Err(::eomgen_runtime::LaneError { lane: 0, error }),
+                }
+            }
+
+            #docs
+            pub fn #f(&self, #params) -> #result {
+                match self.#checked(#args) {
+                    Ok(((x, y), failures)) => (#lane::nan_failed(x, &failures), #lane::nan_failed(y, &failures)),
+                    Err(_) => ([T::nan(); #n], [T::nan(); #k]),
+                }
+            }
+        }
     }
 
     /// The straight-line program of a contact or impulse dynamics (`contact_flat`): `let o`
-    /// holding its pivots then its results, the pivots checked (a scalar's first failure
-    /// returned), and the entries of `o` that hold each result.
+    /// holding its pivots then its results, and the entries of `o` that hold each.
     pub(super) fn flat_program(
         &mut self,
         q: &Quantity,
@@ -551,12 +617,9 @@ impl Emitter<'_> {
             outputs.len() - self.parents.len(),
             pivots.len(),
         );
-        let piv = at(0..p);
         FlatProgram {
-            program: quote! {
-                let o: [T; #len] = { #b };
-                ::eomgen_runtime::lane::check_pivots(&[#(#piv),*], &mut ())?;
-            },
+            program: quote!(let o: [T; #len] = { #b };),
+            pivots: at(0..p),
             first: at(p..p + n),
             rows: at(p + n..p + n + k),
             ops,
@@ -566,8 +629,10 @@ impl Emitter<'_> {
 
 /// A straight-line contact or impulse dynamics ([`Emitter::flat_program`]).
 pub(super) struct FlatProgram {
-    /// `let o = ...;` and its pivots checked.
+    /// `let o = ...;`.
     pub program: TokenStream,
+    /// The entries of `o` that hold the factorizations' pivots, for `check_pivots`.
+    pub pivots: Vec<TokenStream>,
     /// The entries of `o` per velocity coordinate (accelerations, or velocity changes).
     pub first: Vec<TokenStream>,
     /// The entries per contact row (forces, or impulses).

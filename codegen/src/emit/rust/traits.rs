@@ -129,9 +129,10 @@ impl Emitter<'_> {
             });
         }
         if let Some(k3) = &self.contacts_trait {
+            let bound = Self::bound(self.trait_lanes(Trait::Contacts));
             out.extend(quote! {
                 #allow
-                impl<T: ::eomgen_runtime::Real> ::eomgen_runtime::Contacts<T, #nq, #n, #k3> for #ty<T> {
+                impl<T: #bound> ::eomgen_runtime::Contacts<T, #nq, #n, #k3> for #ty<T> {
                     #(#contacts)*
                 }
             });

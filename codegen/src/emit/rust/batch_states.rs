@@ -1,0 +1,207 @@
+//! The `NAME_batch` methods of the quantities that do not run on lanes (link kinematics, the
+//! manifold, contact dynamics solved at run time, the contact and impulse derivatives,
+//! contacts switched at run time): the scalar method at each state in turn, the states spread
+//! over rayon's threads with the runtime's `rayon` feature (`eomgen_runtime::batch::run` of one
+//! state per vector). Their code branches on values, so a state per lane is not possible; the
+//! batch form still gives every catalogue method the same calling convention and the threads.
+
+use proc_macro2::{Ident, Literal, TokenStream};
+use quote::{format_ident, quote};
+
+use super::{usize_lit, Emitter};
+use crate::dynamics::{ActiveContacts, Evaluation, FrameMotion, Manifold, Quantity};
+use crate::emit::body::shape_type;
+
+/// One parameter of a scalar method, in its place in the signature.
+enum Param {
+    /// A value every state shares (a link, a restitution, a set of active contacts), passed
+    /// once to the batch method.
+    Shared(Ident, TokenStream),
+    /// An array of this length per state: a slice of them in the batch method.
+    State(Ident, Literal),
+}
+
+/// A scalar method's parameters, and the types of its result's elements (one, or a tuple's).
+struct StateSignature {
+    params: Vec<Param>,
+    outputs: Vec<TokenStream>,
+}
+
+fn state(name: &str, len: &Literal) -> Param {
+    Param::State(format_ident!("{}", name), len.clone())
+}
+
+fn shared(name: &str, ty: TokenStream) -> Param {
+    Param::Shared(format_ident!("{}", name), ty)
+}
+
+impl Emitter<'_> {
+    /// The `NAME_batch` of every method generated for `T: Real` alone.
+    pub(super) fn state_batch_fns(&self) -> Vec<TokenStream> {
+        self.quantities
+            .iter()
+            .filter(|q| !self.lanes.contains(q.name))
+            .map(|q| self.state_batch_fn(q, &self.state_signature(q)))
+            .collect()
+    }
+
+    /// The parameters and result elements of `q`'s scalar method, as its emitter writes them.
+    fn state_signature(&self, q: &Quantity) -> StateSignature {
+        let (n, nq, k) = (&self.n, &self.nq, &self.k);
+        let c = usize_lit(self.contact_rows.len());
+        let link = || {
+            shared("link", {
+                let t = &self.link_ty;
+                quote!(#t)
+            })
+        };
+        let [qs, qd, qdd, tau] =
+            [("q", nq), ("qd", n), ("qdd", n), ("tau", n)].map(|(a, l)| state(a, l));
+        let restitution = || shared("restitution", quote!(T));
+        let active = || shared("active", quote!(&[bool; #c]));
+        let (vector, matrix) = (
+            |l: Literal| quote!([T; #l]),
+            |r: Literal| quote!([[T; #n]; #r]),
+        );
+        let pair = vec![vector(n.clone()), vector(k.clone())];
+        let six = usize_lit(6);
+        let cdd = vec![quote!(::eomgen_runtime::ContactDynamicsDerivatives<T, #n, #k>)];
+        let idd = vec![quote!(::eomgen_runtime::ImpulseDynamicsDerivatives<T, #n, #k>)];
+        let (params, outputs) = match &q.eval {
+            Evaluation::LinkPose => (vec![link(), qs], vec![quote!(::eomgen_runtime::Pose<T>)]),
+            Evaluation::LinkJacobian => (vec![link(), qs], vec![matrix(six)]),
+            Evaluation::FrameMotion(FrameMotion::Velocity) => {
+                (vec![link(), qs, qd], vec![vector(six)])
+            }
+            Evaluation::FrameMotion(FrameMotion::Acceleration) => {
+                (vec![link(), qs, qd, qdd], vec![vector(six)])
+            }
+            Evaluation::FrameMotion(FrameMotion::JacobianTimeVariation) => {
+                (vec![link(), qs, qd], vec![matrix(six)])
+            }
+            Evaluation::Manifold(m) => {
+                let (a, b) = match m {
+                    Manifold::IntegrateJacobians => (state("q", nq), state("v", n)),
+                    _ => (state("q0", nq), state("q1", nq)),
+                };
+                let out = match m {
+                    Manifold::Difference => vec![vector(n.clone())],
+                    _ => vec![matrix(n.clone()); 2],
+                };
+                (vec![a, b], out)
+            }
+            Evaluation::ContactForwardDynamics { .. }
+            | Evaluation::ContactForwardDynamicsFlat { .. } => (vec![qs, qd, tau], pair),
+            Evaluation::ImpulseDynamics | Evaluation::ImpulseDynamicsFlat { .. } => {
+                (vec![qs, qd, restitution()], pair)
+            }
+            Evaluation::ContactDynamicsDerivatives { .. } => (vec![qs, qd, tau], cdd),
+            Evaluation::ImpulseDynamicsDerivatives => (vec![qs, qd, restitution()], idd),
+            Evaluation::Integrate => (
+                vec![qs, qd, shared("dt", quote!(T))],
+                vec![vector(nq.clone())],
+            ),
+            Evaluation::ActiveContacts(a) => match a {
+                ActiveContacts::Dynamics { .. } => (vec![qs, qd, tau, active()], pair),
+                ActiveContacts::Stabilized { .. } => {
+                    let gains = shared("baumgarte", quote!(&::eomgen_runtime::Baumgarte<T, #c>));
+                    (vec![qs, qd, tau, active(), gains], pair)
+                }
+                ActiveContacts::Derivatives { .. } => (vec![qs, qd, tau, active()], cdd),
+                ActiveContacts::Impulse => (vec![qs, qd, restitution(), active()], pair),
+                ActiveContacts::ImpulseDerivatives => (vec![qs, qd, restitution(), active()], idd),
+            },
+            _ => {
+                let inputs = q.inputs.iter().zip(Self::arg_names(q.inputs));
+                let params = inputs
+                    .map(|(i, name)| {
+                        let len = match i {
+                            crate::dynamics::Input::Q => nq,
+                            crate::dynamics::Input::Forces => k,
+                            _ => n,
+                        };
+                        Param::State(name, len.clone())
+                    })
+                    .collect();
+                let outputs = super::batch::elements(q.shape)
+                    .into_iter()
+                    .map(shape_type)
+                    .collect();
+                (params, outputs)
+            }
+        };
+        StateSignature { params, outputs }
+    }
+
+    /// `NAME_batch`: `q`'s scalar method at every state, one output slice per element of its
+    /// result, the shared parameters passed once.
+    fn state_batch_fn(&self, q: &Quantity, sig: &StateSignature) -> TokenStream {
+        let f = format_ident!("{}_batch", q.name);
+        let path = self.path(q.name);
+        let outs: Vec<Ident> = match sig.outputs.len() {
+            1 => vec![format_ident!("out")],
+            m => (0..m).map(|i| format_ident!("out_{}", i)).collect(),
+        };
+        let types = &sig.outputs;
+        let decls = sig.params.iter().map(|p| match p {
+            Param::Shared(name, ty) => quote!(#name: #ty),
+            Param::State(name, len) => quote!(#name: &[[T; #len]]),
+        });
+        let args = sig.params.iter().map(|p| match p {
+            Param::Shared(name, _) => quote!(#name),
+            Param::State(name, _) => quote!(&#name[start]),
+        });
+        let states: Vec<&Ident> = sig
+            .params
+            .iter()
+            .filter_map(|p| match p {
+                Param::State(name, _) => Some(name),
+                Param::Shared(..) => None,
+            })
+            .collect();
+        let first = &outs[0];
+        let checked = states
+            .iter()
+            .map(|a| a.to_string())
+            .zip(&states)
+            .map(|(s, a)| quote!((#s, #a.len())));
+        let checked = checked.chain(outs[1..].iter().map(|o| {
+            let s = o.to_string();
+            quote!((#s, #o.len()))
+        }));
+        let (pattern, passed, store) = if outs.len() == 1 {
+            let t = &types[0];
+            (
+                quote!(#first: &mut [#t]),
+                quote!(#first),
+                quote!(#first[0] = r;),
+            )
+        } else {
+            let fields = (0..outs.len()).map(usize_lit);
+            (
+                quote!((#(#outs),*): (#(&mut [#types]),*)),
+                quote!((#(#outs),*)),
+                quote!(#(#outs[0] = r.#fields;)*),
+            )
+        };
+        let doc = format!(
+            " `{}` at every state: `{first}[i]` (or each `out_k[i]` of a tuple) from the inputs' \
+             element `i`, the shared arguments the same for all. The scalar method state by \
+             state (its code branches on values: no SIMD lanes), over threads with \
+             `eomgen_runtime`'s `rayon` feature. An error, with nothing written, when a slice \
+             holds another number of states than `{first}`.",
+            q.name
+        );
+        quote! {
+            #[doc = #doc]
+            pub fn #f(&self, #(#decls,)* #(#outs: &mut [#types]),*) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+                ::eomgen_runtime::batch::check(#first.len(), &[#(#checked),*])?;
+                ::eomgen_runtime::batch::run(1, #passed, &|start: usize, #pattern| {
+                    let r = #path(self, #(#args),*);
+                    #store
+                });
+                Ok(())
+            }
+        }
+    }
+}
