@@ -11,8 +11,10 @@
 //!     RUSTFLAGS="-C target-cpu=native" cargo run --release --example mppi_rollout
 //!     RUSTFLAGS="-C target-cpu=native" cargo run --release --example mppi_rollout --features rayon
 
-use std::time::Instant;
+#[path = "mppi/common.rs"]
+mod common;
 
+use common::{iterate, noise, update};
 use eomgen_examples::{PandaArm, READY};
 use eomgen_runtime::prelude::*;
 
@@ -20,21 +22,6 @@ const SAMPLES: usize = 512;
 const HORIZON: usize = 50;
 const DT: f64 = 0.01;
 const TARGET: [f64; 7] = [0.5, 0.2, -0.3, -1.8, 0.4, 1.6, 0.0];
-
-/// Deterministic noise in [-1, 1) (splitmix64).
-fn noise(seed: u64, len: usize) -> Vec<f64> {
-    let mut x = seed;
-    (0..len)
-        .map(|_| {
-            x = x.wrapping_add(0x9e37_79b9_7f4a_7c15);
-            let mut z = x;
-            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-            z ^= z >> 31;
-            (z >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        })
-        .collect()
-}
 
 /// Sample `k`'s torques at step `t`: the nominal torques plus noise (N m).
 fn torque(nominal: &[[f64; 7]], eps: &[f64], k: usize, t: usize) -> [f64; 7] {
@@ -97,23 +84,6 @@ fn batch(robot: &PandaArm<f64>, nominal: &[[f64; 7]], eps: &[f64]) -> Vec<f64> {
     total
 }
 
-/// The cost-weighted mean of the samples' torques: MPPI's update of the nominal sequence.
-fn update(nominal: &[[f64; 7]], eps: &[f64], costs: &[f64]) -> Vec<[f64; 7]> {
-    let best = costs.iter().fold(f64::INFINITY, |m, c| m.min(*c));
-    let weights: Vec<f64> = costs.iter().map(|c| (-(c - best) / 10.0).exp()).collect();
-    let sum: f64 = weights.iter().sum();
-    (0..HORIZON)
-        .map(|t| {
-            core::array::from_fn(|j| {
-                (0..SAMPLES)
-                    .map(|k| weights[k] * torque(nominal, eps, k, t)[j])
-                    .sum::<f64>()
-                    / sum
-            })
-        })
-        .collect()
-}
-
 fn main() {
     let robot = PandaArm::<f64>::default();
     // Start from gravity compensation at the start configuration.
@@ -122,30 +92,14 @@ fn main() {
         "{SAMPLES} samples x {HORIZON} steps of forward dynamics ({} states per iteration)",
         SAMPLES * HORIZON
     );
-    println!("iteration   mean cost   scalar (ms)   batch (ms)   speed-up   max |difference|");
     for iteration in 0..5 {
         let eps = noise(iteration + 1, SAMPLES * HORIZON * 7);
-        let start = Instant::now();
-        let a = scalar(&robot, &nominal, &eps);
-        let scalar_time = start.elapsed().as_secs_f64();
-        let start = Instant::now();
-        let b = batch(&robot, &nominal, &eps);
-        let batch_time = start.elapsed().as_secs_f64();
-        let difference = a
-            .iter()
-            .zip(&b)
-            .fold(0.0_f64, |m, (x, y)| m.max((x - y).abs() / x.abs().max(1.0)));
-        assert!(
-            difference < 1e-9,
-            "scalar and batch rollouts differ: {difference}"
+        let (costs, _) = iterate(
+            iteration,
+            1e-9,
+            || scalar(&robot, &nominal, &eps),
+            || batch(&robot, &nominal, &eps),
         );
-        let mean = b.iter().sum::<f64>() / SAMPLES as f64;
-        println!(
-            "{iteration:9}   {mean:9.3}   {:11.1}   {:10.1}   {:8.2}   {difference:.1e}",
-            1e3 * scalar_time,
-            1e3 * batch_time,
-            scalar_time / batch_time
-        );
-        nominal = update(&nominal, &eps, &b);
+        nominal = update(HORIZON, &costs, 10.0, |k, t| torque(&nominal, &eps, k, t));
     }
 }

@@ -11,6 +11,7 @@
 //! cargo run --example quadruped_mpc         # an MPC step (iLQR) lifting a foot of the quadruped
 //! cargo run --example identify              # base inertial parameters of a UR5 from noisy torques
 //! cargo run --release --example mppi_rollout  # MPPI rollouts: scalar vs batch (SIMD lanes, threads)
+//! cargo run --release --example mppi_quadruped  # MPPI of the quadruped on its feet, in batches
 //! ```
 //!
 //! `Ur5` (6 joints, `robots/ur5.urdf`) is generated with identification: `regressor`,

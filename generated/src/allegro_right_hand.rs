@@ -26713,8 +26713,9 @@ impl<T: ::eomgen_runtime::batch::Batch> AllegroRightHand<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            574,
             out,
             &|start: usize, out: &mut [[[T; 16]; 16]]| {
                 robot
@@ -26734,8 +26735,9 @@ impl<T: ::eomgen_runtime::batch::Batch> AllegroRightHand<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            211,
             out,
             &|start: usize, out: &mut [[T; 16]]| {
                 let r = <AllegroRightHand<
@@ -26758,8 +26760,9 @@ impl<T: ::eomgen_runtime::batch::Batch> AllegroRightHand<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            1137,
             out,
             &|start: usize, out: &mut [[T; 16]]| {
                 let r = <AllegroRightHand<
@@ -26786,8 +26789,9 @@ impl<T: ::eomgen_runtime::batch::Batch> AllegroRightHand<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            1571,
             out,
             &|start: usize, out: &mut [[[T; 16]; 16]]| {
                 robot
@@ -26813,8 +26817,9 @@ impl<T: ::eomgen_runtime::batch::Batch> AllegroRightHand<T> {
             &[("q", q.len()), ("qd", qd.len()), ("qdd", qdd.len())],
         )?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            1254,
             out,
             &|start: usize, out: &mut [[T; 16]]| {
                 let r = <AllegroRightHand<
@@ -26846,8 +26851,9 @@ impl<T: ::eomgen_runtime::batch::Batch> AllegroRightHand<T> {
             &[("q", q.len()), ("qd", qd.len()), ("tau", tau.len())],
         )?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            1966,
             out,
             &|start: usize, out: &mut [[T; 16]]| {
                 let r = <AllegroRightHand<
@@ -26875,8 +26881,9 @@ impl<T: ::eomgen_runtime::batch::Batch> AllegroRightHand<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            551,
             out,
             &|start: usize, out: &mut [T]| {
                 let r = <AllegroRightHand<
@@ -26903,8 +26910,9 @@ impl<T: ::eomgen_runtime::batch::Batch> AllegroRightHand<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            607,
             out,
             &|start: usize, out: &mut [[T; 16]]| {
                 let r = AllegroRightHand::<
@@ -26927,8 +26935,9 @@ impl<T: ::eomgen_runtime::batch::Batch> AllegroRightHand<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            112,
             out,
             &|start: usize, out: &mut [T]| {
                 let r = <AllegroRightHand<
@@ -26950,8 +26959,9 @@ impl<T: ::eomgen_runtime::batch::Batch> AllegroRightHand<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            1132,
             out,
             &|start: usize, out: &mut [[[T; 16]; 16]]| {
                 robot
@@ -26971,8 +26981,9 @@ impl<T: ::eomgen_runtime::batch::Batch> AllegroRightHand<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            1174,
             out,
             &|start: usize, out: &mut [[[T; 120]; 16]]| {
                 let r = AllegroRightHand::<
@@ -26991,8 +27002,9 @@ impl<T: ::eomgen_runtime::batch::Batch> AllegroRightHand<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            271,
             out,
             &|start: usize, out: &mut [[T; 3]]| {
                 let r = AllegroRightHand::<
@@ -27011,8 +27023,9 @@ impl<T: ::eomgen_runtime::batch::Batch> AllegroRightHand<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            389,
             out,
             &|start: usize, out: &mut [[[T; 16]; 3]]| {
                 let r = AllegroRightHand::<
@@ -27034,8 +27047,9 @@ impl<T: ::eomgen_runtime::batch::Batch> AllegroRightHand<T> {
         out: &mut [::eomgen_runtime::Pose<T>],
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             out,
             &|start: usize, out: &mut [::eomgen_runtime::Pose<T>]| {
                 let r = Self::link_pose(self, link, &q[start]);
@@ -27052,8 +27066,9 @@ impl<T: ::eomgen_runtime::batch::Batch> AllegroRightHand<T> {
         out: &mut [[[T; 16]; 6]],
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             out,
             &|start: usize, out: &mut [[[T; 16]; 6]]| {
                 let r = Self::link_jacobian(self, link, &q[start]);
@@ -27071,8 +27086,9 @@ impl<T: ::eomgen_runtime::batch::Batch> AllegroRightHand<T> {
         out: &mut [[T; 6]],
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             out,
             &|start: usize, out: &mut [[T; 6]]| {
                 let r = Self::link_velocity(self, link, &q[start], &qd[start]);
@@ -27094,8 +27110,9 @@ impl<T: ::eomgen_runtime::batch::Batch> AllegroRightHand<T> {
             out.len(),
             &[("q", q.len()), ("qd", qd.len()), ("qdd", qdd.len())],
         )?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             out,
             &|start: usize, out: &mut [[T; 6]]| {
                 let r = Self::link_acceleration(
@@ -27119,8 +27136,9 @@ impl<T: ::eomgen_runtime::batch::Batch> AllegroRightHand<T> {
         out: &mut [[[T; 16]; 6]],
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             out,
             &|start: usize, out: &mut [[[T; 16]; 6]]| {
                 let r = Self::link_jacobian_time_variation(
@@ -27145,8 +27163,9 @@ impl<T: ::eomgen_runtime::batch::Batch> AllegroRightHand<T> {
             out.len(),
             &[("q0", q0.len()), ("q1", q1.len())],
         )?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             out,
             &|start: usize, out: &mut [[T; 16]]| {
                 let r = Self::difference(self, &q0[start], &q1[start]);
@@ -27167,8 +27186,9 @@ impl<T: ::eomgen_runtime::batch::Batch> AllegroRightHand<T> {
             out_0.len(),
             &[("q", q.len()), ("v", v.len()), ("out_1", out_1.len())],
         )?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             (out_0, out_1),
             &|
                 start: usize,
@@ -27193,8 +27213,9 @@ impl<T: ::eomgen_runtime::batch::Batch> AllegroRightHand<T> {
             out_0.len(),
             &[("q0", q0.len()), ("q1", q1.len()), ("out_1", out_1.len())],
         )?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             (out_0, out_1),
             &|
                 start: usize,

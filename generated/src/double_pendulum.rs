@@ -1073,8 +1073,9 @@ impl<T: ::eomgen_runtime::batch::Batch> DoublePendulum<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            9,
             out,
             &|start: usize, out: &mut [[[T; 2]; 2]]| {
                 robot
@@ -1094,8 +1095,9 @@ impl<T: ::eomgen_runtime::batch::Batch> DoublePendulum<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            22,
             out,
             &|start: usize, out: &mut [[T; 2]]| {
                 let r = <DoublePendulum<
@@ -1118,8 +1120,9 @@ impl<T: ::eomgen_runtime::batch::Batch> DoublePendulum<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            22,
             out,
             &|start: usize, out: &mut [[T; 2]]| {
                 let r = <DoublePendulum<
@@ -1146,8 +1149,9 @@ impl<T: ::eomgen_runtime::batch::Batch> DoublePendulum<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            20,
             out,
             &|start: usize, out: &mut [[[T; 2]; 2]]| {
                 robot
@@ -1173,8 +1177,9 @@ impl<T: ::eomgen_runtime::batch::Batch> DoublePendulum<T> {
             &[("q", q.len()), ("qd", qd.len()), ("qdd", qdd.len())],
         )?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            46,
             out,
             &|start: usize, out: &mut [[T; 2]]| {
                 let r = <DoublePendulum<
@@ -1206,8 +1211,9 @@ impl<T: ::eomgen_runtime::batch::Batch> DoublePendulum<T> {
             &[("q", q.len()), ("qd", qd.len()), ("tau", tau.len())],
         )?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            56,
             out,
             &|start: usize, out: &mut [[T; 2]]| {
                 let r = <DoublePendulum<
@@ -1235,8 +1241,9 @@ impl<T: ::eomgen_runtime::batch::Batch> DoublePendulum<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            19,
             out,
             &|start: usize, out: &mut [T]| {
                 let r = <DoublePendulum<
@@ -1263,8 +1270,9 @@ impl<T: ::eomgen_runtime::batch::Batch> DoublePendulum<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            23,
             out,
             &|start: usize, out: &mut [[T; 2]]| {
                 let r = DoublePendulum::<
@@ -1287,8 +1295,9 @@ impl<T: ::eomgen_runtime::batch::Batch> DoublePendulum<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            18,
             out,
             &|start: usize, out: &mut [T]| {
                 let r = <DoublePendulum<
@@ -1310,8 +1319,9 @@ impl<T: ::eomgen_runtime::batch::Batch> DoublePendulum<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            13,
             out,
             &|start: usize, out: &mut [[[T; 2]; 2]]| {
                 robot
@@ -1331,8 +1341,9 @@ impl<T: ::eomgen_runtime::batch::Batch> DoublePendulum<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            6,
             out,
             &|start: usize, out: &mut [[[T; 1]; 2]]| {
                 robot
@@ -1352,8 +1363,9 @@ impl<T: ::eomgen_runtime::batch::Batch> DoublePendulum<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            27,
             out,
             &|start: usize, out: &mut [[T; 3]]| {
                 let r = DoublePendulum::<
@@ -1372,8 +1384,9 @@ impl<T: ::eomgen_runtime::batch::Batch> DoublePendulum<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            34,
             out,
             &|start: usize, out: &mut [[[T; 2]; 3]]| {
                 let r = DoublePendulum::<
@@ -1395,8 +1408,9 @@ impl<T: ::eomgen_runtime::batch::Batch> DoublePendulum<T> {
         out: &mut [::eomgen_runtime::Pose<T>],
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             out,
             &|start: usize, out: &mut [::eomgen_runtime::Pose<T>]| {
                 let r = Self::link_pose(self, link, &q[start]);
@@ -1413,8 +1427,9 @@ impl<T: ::eomgen_runtime::batch::Batch> DoublePendulum<T> {
         out: &mut [[[T; 2]; 6]],
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             out,
             &|start: usize, out: &mut [[[T; 2]; 6]]| {
                 let r = Self::link_jacobian(self, link, &q[start]);
@@ -1432,8 +1447,9 @@ impl<T: ::eomgen_runtime::batch::Batch> DoublePendulum<T> {
         out: &mut [[T; 6]],
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             out,
             &|start: usize, out: &mut [[T; 6]]| {
                 let r = Self::link_velocity(self, link, &q[start], &qd[start]);
@@ -1455,8 +1471,9 @@ impl<T: ::eomgen_runtime::batch::Batch> DoublePendulum<T> {
             out.len(),
             &[("q", q.len()), ("qd", qd.len()), ("qdd", qdd.len())],
         )?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             out,
             &|start: usize, out: &mut [[T; 6]]| {
                 let r = Self::link_acceleration(
@@ -1480,8 +1497,9 @@ impl<T: ::eomgen_runtime::batch::Batch> DoublePendulum<T> {
         out: &mut [[[T; 2]; 6]],
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             out,
             &|start: usize, out: &mut [[[T; 2]; 6]]| {
                 let r = Self::link_jacobian_time_variation(
@@ -1506,8 +1524,9 @@ impl<T: ::eomgen_runtime::batch::Batch> DoublePendulum<T> {
             out.len(),
             &[("q0", q0.len()), ("q1", q1.len())],
         )?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             out,
             &|start: usize, out: &mut [[T; 2]]| {
                 let r = Self::difference(self, &q0[start], &q1[start]);
@@ -1528,8 +1547,9 @@ impl<T: ::eomgen_runtime::batch::Batch> DoublePendulum<T> {
             out_0.len(),
             &[("q", q.len()), ("v", v.len()), ("out_1", out_1.len())],
         )?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             (out_0, out_1),
             &|start: usize, (out_0, out_1): (&mut [[[T; 2]; 2]], &mut [[[T; 2]; 2]])| {
                 let r = Self::integrate_jacobians(self, &q[start], &v[start]);
@@ -1551,8 +1571,9 @@ impl<T: ::eomgen_runtime::batch::Batch> DoublePendulum<T> {
             out_0.len(),
             &[("q0", q0.len()), ("q1", q1.len()), ("out_1", out_1.len())],
         )?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             (out_0, out_1),
             &|start: usize, (out_0, out_1): (&mut [[[T; 2]; 2]], &mut [[[T; 2]; 2]])| {
                 let r = Self::difference_jacobians(self, &q0[start], &q1[start]);

@@ -2047,8 +2047,9 @@ impl<T: ::eomgen_runtime::batch::Batch> IrisSimple<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            0,
             out,
             &|start: usize, out: &mut [[[T; 6]; 6]]| {
                 robot
@@ -2068,8 +2069,9 @@ impl<T: ::eomgen_runtime::batch::Batch> IrisSimple<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            18,
             out,
             &|start: usize, out: &mut [[T; 6]]| {
                 let r = <IrisSimple<
@@ -2093,8 +2095,9 @@ impl<T: ::eomgen_runtime::batch::Batch> IrisSimple<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            47,
             out,
             &|start: usize, out: &mut [[T; 6]]| {
                 let r = <IrisSimple<
@@ -2122,8 +2125,9 @@ impl<T: ::eomgen_runtime::batch::Batch> IrisSimple<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            85,
             out,
             &|start: usize, out: &mut [[[T; 6]; 6]]| {
                 robot
@@ -2149,8 +2153,9 @@ impl<T: ::eomgen_runtime::batch::Batch> IrisSimple<T> {
             &[("q", q.len()), ("qd", qd.len()), ("qdd", qdd.len())],
         )?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            85,
             out,
             &|start: usize, out: &mut [[T; 6]]| {
                 let r = <IrisSimple<
@@ -2183,8 +2188,9 @@ impl<T: ::eomgen_runtime::batch::Batch> IrisSimple<T> {
             &[("q", q.len()), ("qd", qd.len()), ("tau", tau.len())],
         )?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            106,
             out,
             &|start: usize, out: &mut [[T; 6]]| {
                 let r = <IrisSimple<
@@ -2213,8 +2219,9 @@ impl<T: ::eomgen_runtime::batch::Batch> IrisSimple<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            29,
             out,
             &|start: usize, out: &mut [T]| {
                 let r = IrisSimple::<
@@ -2238,8 +2245,9 @@ impl<T: ::eomgen_runtime::batch::Batch> IrisSimple<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            22,
             out,
             &|start: usize, out: &mut [[T; 6]]| {
                 let r = IrisSimple::<
@@ -2262,8 +2270,9 @@ impl<T: ::eomgen_runtime::batch::Batch> IrisSimple<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            8,
             out,
             &|start: usize, out: &mut [T]| {
                 let r = IrisSimple::<
@@ -2282,8 +2291,9 @@ impl<T: ::eomgen_runtime::batch::Batch> IrisSimple<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            19,
             out,
             &|start: usize, out: &mut [[T; 3]]| {
                 let r = IrisSimple::<
@@ -2302,8 +2312,9 @@ impl<T: ::eomgen_runtime::batch::Batch> IrisSimple<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            44,
             out,
             &|start: usize, out: &mut [[[T; 6]; 3]]| {
                 robot
@@ -2323,8 +2334,9 @@ impl<T: ::eomgen_runtime::batch::Batch> IrisSimple<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            119,
             out,
             &|start: usize, out: &mut [[[T; 6]; 6]]| {
                 robot
@@ -2349,8 +2361,9 @@ impl<T: ::eomgen_runtime::batch::Batch> IrisSimple<T> {
         let dt = <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::from_f64(
             ::eomgen_runtime::Real::to_f64(dt),
         );
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            ::core::primitive::usize::MAX,
             out,
             &|start: usize, out: &mut [[T; 7]]| {
                 let r = <IrisSimple<
@@ -2383,8 +2396,9 @@ impl<T: ::eomgen_runtime::batch::Batch> IrisSimple<T> {
             &[("q", q.len()), ("qd", qd.len()), ("qdd", qdd.len())],
         )?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            151,
             out,
             &|start: usize, out: &mut [[T; 6]]| {
                 let r = IrisSimple::<
@@ -2408,8 +2422,9 @@ impl<T: ::eomgen_runtime::batch::Batch> IrisSimple<T> {
         out: &mut [::eomgen_runtime::Pose<T>],
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             out,
             &|start: usize, out: &mut [::eomgen_runtime::Pose<T>]| {
                 let r = Self::link_pose(self, link, &q[start]);
@@ -2426,8 +2441,9 @@ impl<T: ::eomgen_runtime::batch::Batch> IrisSimple<T> {
         out: &mut [[[T; 6]; 6]],
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             out,
             &|start: usize, out: &mut [[[T; 6]; 6]]| {
                 let r = Self::link_jacobian(self, link, &q[start]);
@@ -2445,8 +2461,9 @@ impl<T: ::eomgen_runtime::batch::Batch> IrisSimple<T> {
         out: &mut [[T; 6]],
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             out,
             &|start: usize, out: &mut [[T; 6]]| {
                 let r = Self::link_velocity(self, link, &q[start], &qd[start]);
@@ -2468,8 +2485,9 @@ impl<T: ::eomgen_runtime::batch::Batch> IrisSimple<T> {
             out.len(),
             &[("q", q.len()), ("qd", qd.len()), ("qdd", qdd.len())],
         )?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             out,
             &|start: usize, out: &mut [[T; 6]]| {
                 let r = Self::link_acceleration(
@@ -2493,8 +2511,9 @@ impl<T: ::eomgen_runtime::batch::Batch> IrisSimple<T> {
         out: &mut [[[T; 6]; 6]],
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             out,
             &|start: usize, out: &mut [[[T; 6]; 6]]| {
                 let r = Self::link_jacobian_time_variation(
@@ -2519,8 +2538,9 @@ impl<T: ::eomgen_runtime::batch::Batch> IrisSimple<T> {
             out.len(),
             &[("q0", q0.len()), ("q1", q1.len())],
         )?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             out,
             &|start: usize, out: &mut [[T; 6]]| {
                 let r = Self::difference(self, &q0[start], &q1[start]);
@@ -2541,8 +2561,9 @@ impl<T: ::eomgen_runtime::batch::Batch> IrisSimple<T> {
             out_0.len(),
             &[("q", q.len()), ("v", v.len()), ("out_1", out_1.len())],
         )?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             (out_0, out_1),
             &|start: usize, (out_0, out_1): (&mut [[[T; 6]; 6]], &mut [[[T; 6]; 6]])| {
                 let r = Self::integrate_jacobians(self, &q[start], &v[start]);
@@ -2564,8 +2585,9 @@ impl<T: ::eomgen_runtime::batch::Batch> IrisSimple<T> {
             out_0.len(),
             &[("q0", q0.len()), ("q1", q1.len()), ("out_1", out_1.len())],
         )?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             (out_0, out_1),
             &|start: usize, (out_0, out_1): (&mut [[[T; 6]; 6]], &mut [[[T; 6]; 6]])| {
                 let r = Self::difference_jacobians(self, &q0[start], &q1[start]);

@@ -14198,8 +14198,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Kinova<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            391,
             out,
             &|start: usize, out: &mut [[[T; 6]; 6]]| {
                 let r = <Kinova<
@@ -14221,8 +14222,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Kinova<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            104,
             out,
             &|start: usize, out: &mut [[T; 6]]| {
                 let r = <Kinova<
@@ -14245,8 +14247,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Kinova<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            595,
             out,
             &|start: usize, out: &mut [[T; 6]]| {
                 let r = <Kinova<
@@ -14273,8 +14276,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Kinova<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            1559,
             out,
             &|start: usize, out: &mut [[[T; 6]; 6]]| {
                 let r = <Kinova<
@@ -14305,8 +14309,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Kinova<T> {
             &[("q", q.len()), ("qd", qd.len()), ("qdd", qdd.len())],
         )?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            630,
             out,
             &|start: usize, out: &mut [[T; 6]]| {
                 let r = <Kinova<
@@ -14338,8 +14343,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Kinova<T> {
             &[("q", q.len()), ("qd", qd.len()), ("tau", tau.len())],
         )?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            1153,
             out,
             &|start: usize, out: &mut [[T; 6]]| {
                 let r = <Kinova<
@@ -14367,8 +14373,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Kinova<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            262,
             out,
             &|start: usize, out: &mut [T]| {
                 let r = <Kinova<
@@ -14395,8 +14402,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Kinova<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            330,
             out,
             &|start: usize, out: &mut [[T; 6]]| {
                 let r = Kinova::<
@@ -14419,8 +14427,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Kinova<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            45,
             out,
             &|start: usize, out: &mut [T]| {
                 let r = <Kinova<
@@ -14442,8 +14451,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Kinova<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            1284,
             out,
             &|start: usize, out: &mut [[[T; 6]; 6]]| {
                 let r = Kinova::<
@@ -14462,8 +14472,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Kinova<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            2925,
             out,
             &|start: usize, out: &mut [[[T; 15]; 6]]| {
                 let r = Kinova::<
@@ -14482,8 +14493,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Kinova<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            131,
             out,
             &|start: usize, out: &mut [[T; 3]]| {
                 let r = Kinova::<
@@ -14502,8 +14514,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Kinova<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            189,
             out,
             &|start: usize, out: &mut [[[T; 6]; 3]]| {
                 let r = Kinova::<
@@ -14525,8 +14538,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Kinova<T> {
         out: &mut [::eomgen_runtime::Pose<T>],
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             out,
             &|start: usize, out: &mut [::eomgen_runtime::Pose<T>]| {
                 let r = Self::link_pose(self, link, &q[start]);
@@ -14543,8 +14557,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Kinova<T> {
         out: &mut [[[T; 6]; 6]],
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             out,
             &|start: usize, out: &mut [[[T; 6]; 6]]| {
                 let r = Self::link_jacobian(self, link, &q[start]);
@@ -14562,8 +14577,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Kinova<T> {
         out: &mut [[T; 6]],
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             out,
             &|start: usize, out: &mut [[T; 6]]| {
                 let r = Self::link_velocity(self, link, &q[start], &qd[start]);
@@ -14585,8 +14601,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Kinova<T> {
             out.len(),
             &[("q", q.len()), ("qd", qd.len()), ("qdd", qdd.len())],
         )?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             out,
             &|start: usize, out: &mut [[T; 6]]| {
                 let r = Self::link_acceleration(
@@ -14610,8 +14627,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Kinova<T> {
         out: &mut [[[T; 6]; 6]],
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             out,
             &|start: usize, out: &mut [[[T; 6]; 6]]| {
                 let r = Self::link_jacobian_time_variation(
@@ -14636,8 +14654,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Kinova<T> {
             out.len(),
             &[("q0", q0.len()), ("q1", q1.len())],
         )?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             out,
             &|start: usize, out: &mut [[T; 6]]| {
                 let r = Self::difference(self, &q0[start], &q1[start]);
@@ -14658,8 +14677,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Kinova<T> {
             out_0.len(),
             &[("q", q.len()), ("v", v.len()), ("out_1", out_1.len())],
         )?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             (out_0, out_1),
             &|start: usize, (out_0, out_1): (&mut [[[T; 6]; 6]], &mut [[[T; 6]; 6]])| {
                 let r = Self::integrate_jacobians(self, &q[start], &v[start]);
@@ -14681,8 +14701,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Kinova<T> {
             out_0.len(),
             &[("q0", q0.len()), ("q1", q1.len()), ("out_1", out_1.len())],
         )?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             (out_0, out_1),
             &|start: usize, (out_0, out_1): (&mut [[[T; 6]; 6]], &mut [[[T; 6]; 6]])| {
                 let r = Self::difference_jacobians(self, &q0[start], &q1[start]);

@@ -7275,8 +7275,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Ur5<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            229,
             out,
             &|start: usize, out: &mut [[[T; 6]; 6]]| {
                 robot
@@ -7296,8 +7297,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Ur5<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            26,
             out,
             &|start: usize, out: &mut [[T; 6]]| {
                 let r = <Ur5<
@@ -7320,8 +7322,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Ur5<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            345,
             out,
             &|start: usize, out: &mut [[T; 6]]| {
                 let r = <Ur5<
@@ -7348,8 +7351,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Ur5<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            1001,
             out,
             &|start: usize, out: &mut [[[T; 6]; 6]]| {
                 let r = <Ur5<
@@ -7380,8 +7384,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Ur5<T> {
             &[("q", q.len()), ("qd", qd.len()), ("qdd", qdd.len())],
         )?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            394,
             out,
             &|start: usize, out: &mut [[T; 6]]| {
                 let r = <Ur5<
@@ -7413,8 +7418,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Ur5<T> {
             &[("q", q.len()), ("qd", qd.len()), ("tau", tau.len())],
         )?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            721,
             out,
             &|start: usize, out: &mut [[T; 6]]| {
                 let r = <Ur5<
@@ -7442,8 +7448,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Ur5<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            175,
             out,
             &|start: usize, out: &mut [T]| {
                 let r = <Ur5<
@@ -7470,8 +7477,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Ur5<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            233,
             out,
             &|start: usize, out: &mut [[T; 6]]| {
                 let r = Ur5::<
@@ -7494,8 +7502,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Ur5<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            21,
             out,
             &|start: usize, out: &mut [T]| {
                 let r = <Ur5<
@@ -7517,8 +7526,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Ur5<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            573,
             out,
             &|start: usize, out: &mut [[[T; 6]; 6]]| {
                 let r = Ur5::<
@@ -7537,8 +7547,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Ur5<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            696,
             out,
             &|start: usize, out: &mut [[[T; 15]; 6]]| {
                 let r = Ur5::<
@@ -7557,8 +7568,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Ur5<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            65,
             out,
             &|start: usize, out: &mut [[T; 3]]| {
                 let r = Ur5::<
@@ -7577,8 +7589,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Ur5<T> {
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
         let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            93,
             out,
             &|start: usize, out: &mut [[[T; 6]; 3]]| {
                 robot
@@ -7598,8 +7611,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Ur5<T> {
         out: &mut [::eomgen_runtime::Pose<T>],
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             out,
             &|start: usize, out: &mut [::eomgen_runtime::Pose<T>]| {
                 let r = Self::link_pose(self, link, &q[start]);
@@ -7616,8 +7630,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Ur5<T> {
         out: &mut [[[T; 6]; 6]],
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             out,
             &|start: usize, out: &mut [[[T; 6]; 6]]| {
                 let r = Self::link_jacobian(self, link, &q[start]);
@@ -7635,8 +7650,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Ur5<T> {
         out: &mut [[T; 6]],
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             out,
             &|start: usize, out: &mut [[T; 6]]| {
                 let r = Self::link_velocity(self, link, &q[start], &qd[start]);
@@ -7658,8 +7674,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Ur5<T> {
             out.len(),
             &[("q", q.len()), ("qd", qd.len()), ("qdd", qdd.len())],
         )?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             out,
             &|start: usize, out: &mut [[T; 6]]| {
                 let r = Self::link_acceleration(
@@ -7683,8 +7700,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Ur5<T> {
         out: &mut [[[T; 6]; 6]],
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             out,
             &|start: usize, out: &mut [[[T; 6]; 6]]| {
                 let r = Self::link_jacobian_time_variation(
@@ -7709,8 +7727,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Ur5<T> {
             out.len(),
             &[("q0", q0.len()), ("q1", q1.len())],
         )?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             out,
             &|start: usize, out: &mut [[T; 6]]| {
                 let r = Self::difference(self, &q0[start], &q1[start]);
@@ -7731,8 +7750,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Ur5<T> {
             out_0.len(),
             &[("q", q.len()), ("v", v.len()), ("out_1", out_1.len())],
         )?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             (out_0, out_1),
             &|start: usize, (out_0, out_1): (&mut [[[T; 6]; 6]], &mut [[[T; 6]; 6]])| {
                 let r = Self::integrate_jacobians(self, &q[start], &v[start]);
@@ -7754,8 +7774,9 @@ impl<T: ::eomgen_runtime::batch::Batch> Ur5<T> {
             out_0.len(),
             &[("q0", q0.len()), ("q1", q1.len()), ("out_1", out_1.len())],
         )?;
-        ::eomgen_runtime::batch::run(
+        ::eomgen_runtime::batch::run_costed(
             1,
+            ::core::primitive::usize::MAX,
             (out_0, out_1),
             &|start: usize, (out_0, out_1): (&mut [[[T; 6]; 6]], &mut [[[T; 6]; 6]])| {
                 let r = Self::difference_jacobians(self, &q0[start], &q1[start]);

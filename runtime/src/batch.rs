@@ -252,10 +252,77 @@ mod tuples {
 /// ```
 #[inline]
 pub fn run<O: Outputs>(lanes: usize, out: O, f: &(impl Fn(usize, O) + Sync)) {
+    run_costed(lanes, usize::MAX, out, f);
+}
+
+/// The arithmetic (states times operations per state) below which a call from outside
+/// rayon's pools stays on the calling thread: waking a pool thread from there costs some
+/// 20 us (anymal's contact forward dynamics, `examples/mppi_quadruped.rs`: 64 states, 25 us on
+/// one thread, took 30 to 47 us on two), a million operations about 50 us on lanes.
+#[cfg(feature = "rayon")]
+const OUTSIDE_MIN_OPS: usize = 1_000_000;
+
+/// [`run`] for a method of `ops` operations per state (generated code passes its operation
+/// count; `usize::MAX` when unknown): called from outside rayon's pools, a call of less
+/// arithmetic than a thread's wake-up is worth runs on the calling thread.
+#[inline]
+pub fn run_costed<O: Outputs>(lanes: usize, ops: usize, out: O, f: &(impl Fn(usize, O) + Sync)) {
+    let lanes = lanes.max(1);
     #[cfg(feature = "rayon")]
-    parallel(0, lanes.max(1), out, f);
+    if rayon::current_thread_index().is_some() {
+        parallel(0, lanes, out, f);
+    } else if out.states().saturating_mul(ops) < OUTSIDE_MIN_OPS {
+        sequential(0, lanes, out, f);
+    } else {
+        from_outside(lanes, out, f);
+    }
     #[cfg(not(feature = "rayon"))]
-    sequential(0, lanes.max(1), out, f);
+    {
+        let _ = ops;
+        sequential(0, lanes, out, f);
+    }
+}
+
+/// [`run`] called from a thread outside rayon's pools (a program's main thread). `join` there
+/// hands the whole call to a pool thread and blocks until it is done, and that thread wakes a
+/// second one to take half: a quadruped's 256-sample rollout (`examples/mppi_quadruped.rs`) was
+/// slower on two threads than on one. Instead the calling thread and `current_num_threads - 1`
+/// pool threads take runs of `GRAIN` vectors from the front in turn, so that the calling thread
+/// starts at once and a pool thread that wakes late takes less. (Fixed parts, one per thread,
+/// waited for the late one: anymal's contact forward dynamics, 256 states 20 us apart, 107 us
+/// a call against 70 us.)
+#[cfg(feature = "rayon")]
+fn from_outside<O: Outputs>(lanes: usize, out: O, f: &(impl Fn(usize, O) + Sync)) {
+    let vectors = out.states().div_ceil(lanes);
+    let threads = rayon::current_num_threads();
+    if vectors <= GRAIN || threads < 2 {
+        return sequential(0, lanes, out, f);
+    }
+    let rest = std::sync::Mutex::new((0usize, Some(out)));
+    let take = || {
+        let mut guard = rest.lock().unwrap_or_else(|e| e.into_inner());
+        let (start, left) = &mut *guard;
+        let o = left.take()?;
+        if o.states() == 0 {
+            return None;
+        }
+        let (part, more) = o.split_at(GRAIN * lanes);
+        let at = *start;
+        *start += GRAIN * lanes;
+        *left = Some(more);
+        Some((at, part))
+    };
+    let work = || {
+        while let Some((at, part)) = take() {
+            sequential(at, lanes, part, f);
+        }
+    };
+    rayon::in_place_scope(|scope| {
+        for _ in 1..threads {
+            scope.spawn(|_| work());
+        }
+        work();
+    });
 }
 
 /// [`run`] on the calling thread.
@@ -303,6 +370,31 @@ mod tests {
             });
             assert!(out[..n].iter().enumerate().all(|(i, v)| *v == i + 1));
             assert!(out[n..].iter().all(|v| *v == 0));
+        }
+    }
+
+    /// From a thread outside rayon's pools and from inside one, every state once, with its
+    /// own index.
+    #[cfg(feature = "rayon")]
+    #[test]
+    fn threads_cover_every_state_once_from_outside_and_inside_the_pool() {
+        let fill = |n: usize| {
+            let mut out = std::vec![0usize; n];
+            run(4, &mut out[..], &|start, chunk: &mut [usize]| {
+                for (k, c) in chunk.iter_mut().enumerate() {
+                    *c += start + k + 1;
+                }
+            });
+            out
+        };
+        for n in [0, 5, 32, 33, 100, 1001] {
+            let want: std::vec::Vec<usize> = (1..=n).collect();
+            assert_eq!(std::thread::spawn(move || fill(n)).join().unwrap(), want);
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(3)
+                .build()
+                .unwrap();
+            assert_eq!(pool.install(|| fill(n)), want);
         }
     }
 

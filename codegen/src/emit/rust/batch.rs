@@ -1,7 +1,7 @@
 //! The `NAME_batch` methods: each method generated for every `T: Lane` evaluated at many
 //! states per call, packed into the target's widest lanes (`eomgen_runtime::batch`).
 
-use proc_macro2::{Ident, TokenStream};
+use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote};
 
 use super::items::Fields;
@@ -187,6 +187,29 @@ impl Emitter<'_> {
         }
     }
 
+    /// `q`'s operations per state for `eomgen_runtime::batch::run_costed`: the count of a
+    /// straight-line program, else `usize::MAX` (a solve or kinematics at run time, whose
+    /// count, if any, is only its straight-line part: no call of it is taken as too cheap to
+    /// spread over threads).
+    pub(super) fn ops_per_state(&self, q: &Quantity) -> TokenStream {
+        let straight = matches!(
+            q.eval,
+            Evaluation::Exprs(_)
+                | Evaluation::ForwardDynamics { .. }
+                | Evaluation::ContactForwardDynamicsFlat { .. }
+                | Evaluation::ImpulseDynamicsFlat { .. }
+                | Evaluation::Factored { .. }
+        );
+        let count = self.counts.iter().find(|(name, _)| name == q.name);
+        match count {
+            Some((_, ops)) if straight => {
+                let ops = Literal::usize_unsuffixed(ops.total());
+                quote!(#ops)
+            }
+            _ => quote!(::core::primitive::usize::MAX),
+        }
+    }
+
     /// The path of method `name` on the robot of lanes.
     fn lane_path(&self, name: &str) -> TokenStream {
         let (ty, f, n, nq, l) = (
@@ -260,7 +283,7 @@ impl Emitter<'_> {
              nothing written, when a slice holds another number of states than `{}`.",
             q.name, first
         );
-        let l = lanes();
+        let (l, ops) = (lanes(), self.ops_per_state(q));
         let evaluate = if self.unpacks(q) {
             let f = format_ident!("{}_unpacked", q.name);
             quote! {
@@ -278,7 +301,7 @@ impl Emitter<'_> {
                 ::eomgen_runtime::batch::check(#first.len(), &[#(#checked),*])?;
                 let robot = self.in_lanes::<#l>();
                 #dt_lanes
-                ::eomgen_runtime::batch::run(<#l as ::eomgen_runtime::Lane>::LANES, #passed, &|start: usize, #pattern| {
+                ::eomgen_runtime::batch::run_costed(<#l as ::eomgen_runtime::Lane>::LANES, #ops, #passed, &|start: usize, #pattern| {
                     #evaluate
                 });
                 Ok(())

@@ -137,7 +137,7 @@ impl Emitter<'_> {
     /// result, the shared parameters passed once.
     fn state_batch_fn(&self, q: &Quantity, sig: &StateSignature) -> TokenStream {
         let f = format_ident!("{}_batch", q.name);
-        let path = self.path(q.name);
+        let (path, ops) = (self.path(q.name), self.ops_per_state(q));
         let outs: Vec<Ident> = match sig.outputs.len() {
             1 => vec![format_ident!("out")],
             m => (0..m).map(|i| format_ident!("out_{}", i)).collect(),
@@ -196,7 +196,7 @@ impl Emitter<'_> {
             #[doc = #doc]
             pub fn #f(&self, #(#decls,)* #(#outs: &mut [#types]),*) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
                 ::eomgen_runtime::batch::check(#first.len(), &[#(#checked),*])?;
-                ::eomgen_runtime::batch::run(1, #passed, &|start: usize, #pattern| {
+                ::eomgen_runtime::batch::run_costed(1, #ops, #passed, &|start: usize, #pattern| {
                     let r = #path(self, #(#args),*);
                     #store
                 });
