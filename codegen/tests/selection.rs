@@ -81,8 +81,8 @@ fn only_the_selected_functions_and_their_helpers_are_generated() {
         functions(&source),
         ["joint_transform", "link_frame", "link_jacobian", "name"]
     );
-    // Link kinematics takes `Real` (the runtime's chain kernels): its batch runs the scalar
-    // method state by state.
+    // Link kinematics runs on lanes (the runtime's chain kernels are arithmetic), the link the
+    // same for every state.
     assert_eq!(batch_functions(&source), ["link_jacobian_batch"]);
     assert!(
         source.contains("link: "),

@@ -257,6 +257,30 @@ impl<T: ::eomgen_runtime::Lane> DoublePendulum<T> {
             ));
         [[t0], [T::zero()]]
     }
+    /// Pose of a link frame in the world (root) frame.
+    ///
+    /// Route: each joint's transform composed along the link's chain from the root.
+    pub fn link_pose(
+        &self,
+        link: DoublePendulumLink,
+        q: &[T; 2],
+    ) -> ::eomgen_runtime::Pose<T> {
+        let (path, placement) = Self::link_frame(link);
+        ::eomgen_runtime::tree::chain_pose(path, |j| self.joint_transform(j, q))
+            .compose(&placement)
+    }
+    /// The 6 x N Jacobian of a link frame: rows vx, vy, vz, wx, wy, wz in world axes, at the link origin.
+    ///
+    /// Route: joint axes and origins along the link's chain, from the same transforms as `link_pose`.
+    pub fn link_jacobian(&self, link: DoublePendulumLink, q: &[T; 2]) -> [[T; 2]; 6] {
+        let (path, placement) = Self::link_frame(link);
+        ::eomgen_runtime::tree::chain_jacobian(
+            path,
+            &Self::TREE_JOINTS,
+            |j| self.joint_transform(j, q),
+            &placement,
+        )
+    }
     /// The centre of mass of the moving bodies in world coordinates (a fixed root link, welded to the world, is not counted).
     ///
     /// Route: the bodies' centres of mass by forward kinematics.
@@ -363,59 +387,6 @@ impl<T: ::eomgen_runtime::Lane> DoublePendulum<T> {
             ],
         ]
     }
-}
-#[allow(
-    unused_variables,
-    clippy::approx_constant,
-    clippy::excessive_precision,
-    clippy::unreadable_literal,
-    clippy::neg_multiply,
-    clippy::double_parens,
-    clippy::identity_op,
-    clippy::needless_range_loop,
-    clippy::let_and_return,
-    clippy::type_complexity,
-    clippy::too_many_arguments
-)]
-impl<T: ::eomgen_runtime::Real> DoublePendulum<T> {
-    /// Forward dynamics `qdd = M(q)^-1 (tau - b(q, qd) - G(q))`, or which pivot of the
-    /// `L^T D L` factorization of M(q) was not positive (a non-physical model or
-    /// non-finite input); see `forward_dynamics` for the route and operation count.
-    /// `Ok` holds only finite numbers: a non-finite component `i` of the solution (from
-    /// a non-finite `qd` or `tau`, or a `q` that leaves M(q) finite) is reported as
-    /// `FactorError::NonFinite { pivot: i }`.
-    pub fn try_forward_dynamics(
-        &self,
-        q: &[T; 2],
-        qd: &[T; 2],
-        tau: &[T; 2],
-    ) -> ::core::result::Result<[T; 2], ::eomgen_runtime::FactorError> {
-        self.forward_dynamics_checked(q, qd, tau).map(|(qdd, _)| qdd)
-    }
-    /// Pose of a link frame in the world (root) frame.
-    ///
-    /// Route: each joint's transform composed along the link's chain from the root.
-    pub fn link_pose(
-        &self,
-        link: DoublePendulumLink,
-        q: &[T; 2],
-    ) -> ::eomgen_runtime::Pose<T> {
-        let (path, placement) = Self::link_frame(link);
-        ::eomgen_runtime::tree::chain_pose(path, |j| self.joint_transform(j, q))
-            .compose(&placement)
-    }
-    /// The 6 x N Jacobian of a link frame: rows vx, vy, vz, wx, wy, wz in world axes, at the link origin.
-    ///
-    /// Route: joint axes and origins along the link's chain, from the same transforms as `link_pose`.
-    pub fn link_jacobian(&self, link: DoublePendulumLink, q: &[T; 2]) -> [[T; 2]; 6] {
-        let (path, placement) = Self::link_frame(link);
-        ::eomgen_runtime::tree::chain_jacobian(
-            path,
-            &Self::TREE_JOINTS,
-            |j| self.joint_transform(j, q),
-            &placement,
-        )
-    }
     /// The spatial velocity of a link frame: the velocity of its origin, then its angular velocity,
     /// world axes (Pinocchio's `getFrameVelocity`, LOCAL_WORLD_ALIGNED); `link_jacobian` times `qd`.
     ///
@@ -477,78 +448,6 @@ impl<T: ::eomgen_runtime::Real> DoublePendulum<T> {
             placement,
         };
         ::eomgen_runtime::frame::jacobian_time_variation(&chain, qd)
-    }
-    /// `difference(q0, q1)`: the velocity that moves `q0` to `q1` in unit time, so that
-    /// `integrate(q0, difference(q0, q1), 1) = q1` (Pinocchio's `difference`). A floating base's
-    /// quaternions may have either sign.
-    ///
-    /// The configurations of a fixed base form a vector space.
-    ///
-    /// Route: the vector space's (eomgen_runtime::manifold).
-    pub fn difference(&self, q0: &[T; 2], q1: &[T; 2]) -> [T; 2] {
-        ::eomgen_runtime::manifold::vector_difference(q0, q1)
-    }
-    /// The Jacobians of `integrate(q, v, 1)` in `q` and in `v`, q perturbed in its tangent space
-    /// (Pinocchio's `dIntegrate`, ARG0 and ARG1); element `[i][j]` = d out_i / d in_j.
-    ///
-    /// The configurations of a fixed base form a vector space.
-    ///
-    /// Route: the vector space's (eomgen_runtime::manifold).
-    pub fn integrate_jacobians(
-        &self,
-        q: &[T; 2],
-        v: &[T; 2],
-    ) -> ([[T; 2]; 2], [[T; 2]; 2]) {
-        ::eomgen_runtime::manifold::vector_integrate_jacobians()
-    }
-    /// `integrate_jacobians` written into `a` and `b`, their diagonal blocks only (a free flyer's
-    /// 6 x 6 blocks and each other coordinate's entry), as Pinocchio's `dIntegrate` and
-    /// `dDifference` write each joint's block of the matrix they are given. The entries
-    /// off those blocks are zero in the Jacobians and are left as they are: `a` and `b`
-    /// must hold zeros there (zeroed once, or written by an earlier call). The values are
-    /// `integrate_jacobians`'s to the bit, without writing its `2 NV^2` entries.
-    pub fn integrate_jacobians_into(
-        &self,
-        q: &[T; 2],
-        v: &[T; 2],
-        a: &mut [[T; 2]; 2],
-        b: &mut [[T; 2]; 2],
-    ) {
-        {
-            let _ = (q, v);
-            ::eomgen_runtime::manifold::vector_integrate_jacobians_into(a, b)
-        }
-    }
-    /// The Jacobians of `difference(q0, q1)` in `q0` and in `q1`, both perturbed in their tangent
-    /// spaces (Pinocchio's `dDifference`, ARG0 and ARG1); element `[i][j]` = d out_i / d in_j.
-    ///
-    /// The configurations of a fixed base form a vector space.
-    ///
-    /// Route: the vector space's (eomgen_runtime::manifold).
-    pub fn difference_jacobians(
-        &self,
-        q0: &[T; 2],
-        q1: &[T; 2],
-    ) -> ([[T; 2]; 2], [[T; 2]; 2]) {
-        ::eomgen_runtime::manifold::vector_difference_jacobians()
-    }
-    /// `difference_jacobians` written into `a` and `b`, their diagonal blocks only (a free flyer's
-    /// 6 x 6 blocks and each other coordinate's entry), as Pinocchio's `dIntegrate` and
-    /// `dDifference` write each joint's block of the matrix they are given. The entries
-    /// off those blocks are zero in the Jacobians and are left as they are: `a` and `b`
-    /// must hold zeros there (zeroed once, or written by an earlier call). The values are
-    /// `difference_jacobians`'s to the bit, without writing its `2 NV^2` entries.
-    pub fn difference_jacobians_into(
-        &self,
-        q0: &[T; 2],
-        q1: &[T; 2],
-        a: &mut [[T; 2]; 2],
-        b: &mut [[T; 2]; 2],
-    ) {
-        {
-            let _ = (q0, q1);
-            ::eomgen_runtime::manifold::vector_difference_jacobians_into(a, b)
-        }
     }
     /// Each joint's axis (in the frame of the body it moves) and motion.
     const TREE_JOINTS: [::eomgen_runtime::tree::TreeJoint; 2] = [
@@ -677,6 +576,107 @@ impl<T: ::eomgen_runtime::Real> DoublePendulum<T> {
                     },
                 )
             }
+        }
+    }
+}
+#[allow(
+    unused_variables,
+    clippy::approx_constant,
+    clippy::excessive_precision,
+    clippy::unreadable_literal,
+    clippy::neg_multiply,
+    clippy::double_parens,
+    clippy::identity_op,
+    clippy::needless_range_loop,
+    clippy::let_and_return,
+    clippy::type_complexity,
+    clippy::too_many_arguments
+)]
+impl<T: ::eomgen_runtime::Real> DoublePendulum<T> {
+    /// Forward dynamics `qdd = M(q)^-1 (tau - b(q, qd) - G(q))`, or which pivot of the
+    /// `L^T D L` factorization of M(q) was not positive (a non-physical model or
+    /// non-finite input); see `forward_dynamics` for the route and operation count.
+    /// `Ok` holds only finite numbers: a non-finite component `i` of the solution (from
+    /// a non-finite `qd` or `tau`, or a `q` that leaves M(q) finite) is reported as
+    /// `FactorError::NonFinite { pivot: i }`.
+    pub fn try_forward_dynamics(
+        &self,
+        q: &[T; 2],
+        qd: &[T; 2],
+        tau: &[T; 2],
+    ) -> ::core::result::Result<[T; 2], ::eomgen_runtime::FactorError> {
+        self.forward_dynamics_checked(q, qd, tau).map(|(qdd, _)| qdd)
+    }
+    /// `difference(q0, q1)`: the velocity that moves `q0` to `q1` in unit time, so that
+    /// `integrate(q0, difference(q0, q1), 1) = q1` (Pinocchio's `difference`). A floating base's
+    /// quaternions may have either sign.
+    ///
+    /// The configurations of a fixed base form a vector space.
+    ///
+    /// Route: the vector space's (eomgen_runtime::manifold).
+    pub fn difference(&self, q0: &[T; 2], q1: &[T; 2]) -> [T; 2] {
+        ::eomgen_runtime::manifold::vector_difference(q0, q1)
+    }
+    /// The Jacobians of `integrate(q, v, 1)` in `q` and in `v`, q perturbed in its tangent space
+    /// (Pinocchio's `dIntegrate`, ARG0 and ARG1); element `[i][j]` = d out_i / d in_j.
+    ///
+    /// The configurations of a fixed base form a vector space.
+    ///
+    /// Route: the vector space's (eomgen_runtime::manifold).
+    pub fn integrate_jacobians(
+        &self,
+        q: &[T; 2],
+        v: &[T; 2],
+    ) -> ([[T; 2]; 2], [[T; 2]; 2]) {
+        ::eomgen_runtime::manifold::vector_integrate_jacobians()
+    }
+    /// `integrate_jacobians` written into `a` and `b`, their diagonal blocks only (a free flyer's
+    /// 6 x 6 blocks and each other coordinate's entry), as Pinocchio's `dIntegrate` and
+    /// `dDifference` write each joint's block of the matrix they are given. The entries
+    /// off those blocks are zero in the Jacobians and are left as they are: `a` and `b`
+    /// must hold zeros there (zeroed once, or written by an earlier call). The values are
+    /// `integrate_jacobians`'s to the bit, without writing its `2 NV^2` entries.
+    pub fn integrate_jacobians_into(
+        &self,
+        q: &[T; 2],
+        v: &[T; 2],
+        a: &mut [[T; 2]; 2],
+        b: &mut [[T; 2]; 2],
+    ) {
+        {
+            let _ = (q, v);
+            ::eomgen_runtime::manifold::vector_integrate_jacobians_into(a, b)
+        }
+    }
+    /// The Jacobians of `difference(q0, q1)` in `q0` and in `q1`, both perturbed in their tangent
+    /// spaces (Pinocchio's `dDifference`, ARG0 and ARG1); element `[i][j]` = d out_i / d in_j.
+    ///
+    /// The configurations of a fixed base form a vector space.
+    ///
+    /// Route: the vector space's (eomgen_runtime::manifold).
+    pub fn difference_jacobians(
+        &self,
+        q0: &[T; 2],
+        q1: &[T; 2],
+    ) -> ([[T; 2]; 2], [[T; 2]; 2]) {
+        ::eomgen_runtime::manifold::vector_difference_jacobians()
+    }
+    /// `difference_jacobians` written into `a` and `b`, their diagonal blocks only (a free flyer's
+    /// 6 x 6 blocks and each other coordinate's entry), as Pinocchio's `dIntegrate` and
+    /// `dDifference` write each joint's block of the matrix they are given. The entries
+    /// off those blocks are zero in the Jacobians and are left as they are: `a` and `b`
+    /// must hold zeros there (zeroed once, or written by an earlier call). The values are
+    /// `difference_jacobians`'s to the bit, without writing its `2 NV^2` entries.
+    pub fn difference_jacobians_into(
+        &self,
+        q0: &[T; 2],
+        q1: &[T; 2],
+        a: &mut [[T; 2]; 2],
+        b: &mut [[T; 2]; 2],
+    ) {
+        {
+            let _ = (q0, q1);
+            ::eomgen_runtime::manifold::vector_difference_jacobians_into(a, b)
         }
     }
 }
@@ -1355,6 +1355,54 @@ impl<T: ::eomgen_runtime::batch::Batch> DoublePendulum<T> {
         );
         Ok(())
     }
+    /// `link_pose` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out`.
+    pub fn link_pose_batch(
+        &self,
+        link: DoublePendulumLink,
+        q: &[[T; 2]],
+        out: &mut [::eomgen_runtime::Pose<T>],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
+        let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
+        ::eomgen_runtime::batch::run_costed(
+            <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            ::core::primitive::usize::MAX,
+            out,
+            &|start: usize, out: &mut [::eomgen_runtime::Pose<T>]| {
+                let r = DoublePendulum::<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                >::link_pose(&robot, link, &::eomgen_runtime::batch::gather(q, start));
+                ::eomgen_runtime::batch::scatter_pose(&r, out);
+            },
+        );
+        Ok(())
+    }
+    /// `link_jacobian` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out`.
+    pub fn link_jacobian_batch(
+        &self,
+        link: DoublePendulumLink,
+        q: &[[T; 2]],
+        out: &mut [[[T; 2]; 6]],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
+        let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
+        ::eomgen_runtime::batch::run_costed(
+            <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            ::core::primitive::usize::MAX,
+            out,
+            &|start: usize, out: &mut [[[T; 2]; 6]]| {
+                let r = DoublePendulum::<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                >::link_jacobian(
+                    &robot,
+                    link,
+                    &::eomgen_runtime::batch::gather(q, start),
+                );
+                ::eomgen_runtime::batch::scatter_matrix(&r, out);
+            },
+        );
+        Ok(())
+    }
     /// `center_of_mass` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out`.
     pub fn center_of_mass_batch(
         &self,
@@ -1400,45 +1448,7 @@ impl<T: ::eomgen_runtime::batch::Batch> DoublePendulum<T> {
         );
         Ok(())
     }
-    /// `link_pose` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, the shared arguments the same for all. The scalar method state by state (its code branches on values: no SIMD lanes), over threads with `eomgen_runtime`'s `rayon` feature. An error, with nothing written, when a slice holds another number of states than `out`.
-    pub fn link_pose_batch(
-        &self,
-        link: DoublePendulumLink,
-        q: &[[T; 2]],
-        out: &mut [::eomgen_runtime::Pose<T>],
-    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
-        ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
-        ::eomgen_runtime::batch::run_costed(
-            1,
-            ::core::primitive::usize::MAX,
-            out,
-            &|start: usize, out: &mut [::eomgen_runtime::Pose<T>]| {
-                let r = Self::link_pose(self, link, &q[start]);
-                out[0] = r;
-            },
-        );
-        Ok(())
-    }
-    /// `link_jacobian` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, the shared arguments the same for all. The scalar method state by state (its code branches on values: no SIMD lanes), over threads with `eomgen_runtime`'s `rayon` feature. An error, with nothing written, when a slice holds another number of states than `out`.
-    pub fn link_jacobian_batch(
-        &self,
-        link: DoublePendulumLink,
-        q: &[[T; 2]],
-        out: &mut [[[T; 2]; 6]],
-    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
-        ::eomgen_runtime::batch::check(out.len(), &[("q", q.len())])?;
-        ::eomgen_runtime::batch::run_costed(
-            1,
-            ::core::primitive::usize::MAX,
-            out,
-            &|start: usize, out: &mut [[[T; 2]; 6]]| {
-                let r = Self::link_jacobian(self, link, &q[start]);
-                out[0] = r;
-            },
-        );
-        Ok(())
-    }
-    /// `link_velocity` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, the shared arguments the same for all. The scalar method state by state (its code branches on values: no SIMD lanes), over threads with `eomgen_runtime`'s `rayon` feature. An error, with nothing written, when a slice holds another number of states than `out`.
+    /// `link_velocity` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out`.
     pub fn link_velocity_batch(
         &self,
         link: DoublePendulumLink,
@@ -1447,18 +1457,26 @@ impl<T: ::eomgen_runtime::batch::Batch> DoublePendulum<T> {
         out: &mut [[T; 6]],
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
+        let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
         ::eomgen_runtime::batch::run_costed(
-            1,
+            <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
             ::core::primitive::usize::MAX,
             out,
             &|start: usize, out: &mut [[T; 6]]| {
-                let r = Self::link_velocity(self, link, &q[start], &qd[start]);
-                out[0] = r;
+                let r = DoublePendulum::<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                >::link_velocity(
+                    &robot,
+                    link,
+                    &::eomgen_runtime::batch::gather(q, start),
+                    &::eomgen_runtime::batch::gather(qd, start),
+                );
+                ::eomgen_runtime::batch::scatter(&r, out);
             },
         );
         Ok(())
     }
-    /// `link_acceleration` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, the shared arguments the same for all. The scalar method state by state (its code branches on values: no SIMD lanes), over threads with `eomgen_runtime`'s `rayon` feature. An error, with nothing written, when a slice holds another number of states than `out`.
+    /// `link_acceleration` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out`.
     pub fn link_acceleration_batch(
         &self,
         link: DoublePendulumLink,
@@ -1471,24 +1489,27 @@ impl<T: ::eomgen_runtime::batch::Batch> DoublePendulum<T> {
             out.len(),
             &[("q", q.len()), ("qd", qd.len()), ("qdd", qdd.len())],
         )?;
+        let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
         ::eomgen_runtime::batch::run_costed(
-            1,
+            <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
             ::core::primitive::usize::MAX,
             out,
             &|start: usize, out: &mut [[T; 6]]| {
-                let r = Self::link_acceleration(
-                    self,
+                let r = DoublePendulum::<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                >::link_acceleration(
+                    &robot,
                     link,
-                    &q[start],
-                    &qd[start],
-                    &qdd[start],
+                    &::eomgen_runtime::batch::gather(q, start),
+                    &::eomgen_runtime::batch::gather(qd, start),
+                    &::eomgen_runtime::batch::gather(qdd, start),
                 );
-                out[0] = r;
+                ::eomgen_runtime::batch::scatter(&r, out);
             },
         );
         Ok(())
     }
-    /// `link_jacobian_time_variation` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, the shared arguments the same for all. The scalar method state by state (its code branches on values: no SIMD lanes), over threads with `eomgen_runtime`'s `rayon` feature. An error, with nothing written, when a slice holds another number of states than `out`.
+    /// `link_jacobian_time_variation` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out`.
     pub fn link_jacobian_time_variation_batch(
         &self,
         link: DoublePendulumLink,
@@ -1497,18 +1518,21 @@ impl<T: ::eomgen_runtime::batch::Batch> DoublePendulum<T> {
         out: &mut [[[T; 2]; 6]],
     ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
         ::eomgen_runtime::batch::check(out.len(), &[("q", q.len()), ("qd", qd.len())])?;
+        let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
         ::eomgen_runtime::batch::run_costed(
-            1,
+            <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
             ::core::primitive::usize::MAX,
             out,
             &|start: usize, out: &mut [[[T; 2]; 6]]| {
-                let r = Self::link_jacobian_time_variation(
-                    self,
+                let r = DoublePendulum::<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                >::link_jacobian_time_variation(
+                    &robot,
                     link,
-                    &q[start],
-                    &qd[start],
+                    &::eomgen_runtime::batch::gather(q, start),
+                    &::eomgen_runtime::batch::gather(qd, start),
                 );
-                out[0] = r;
+                ::eomgen_runtime::batch::scatter_matrix(&r, out);
             },
         );
         Ok(())

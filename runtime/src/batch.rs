@@ -27,7 +27,7 @@
 use core::fmt;
 
 use crate::lane::Pack;
-use crate::Real;
+use crate::{Pose, Real};
 
 /// A scalar whose generated methods have `_batch` versions: `f64` and `f32`.
 pub trait Batch: Real + Send + Sync {
@@ -170,6 +170,24 @@ pub fn scatter_matrix<L: Pack, const R: usize, const C: usize>(
     out: &mut [[[L::Scalar; C]; R]],
 ) {
     L::unpack(v.as_flattened(), out.as_flattened_mut().as_flattened_mut());
+}
+
+/// Lane `l` of the pose `p` into element `l` of `out` (at most `L::LANES` elements).
+///
+/// ```
+/// use eomgen_runtime::{batch::scatter_pose, Pose};
+/// let mut out = [Pose::identity(); 1];
+/// scatter_pose(&Pose::from_translation([1.0_f64, 2.0, 3.0]), &mut out);
+/// assert_eq!(out[0].translation, [1.0, 2.0, 3.0]);
+/// ```
+#[inline(always)]
+pub fn scatter_pose<L: Pack>(p: &Pose<L>, out: &mut [Pose<L::Scalar>]) {
+    for (l, o) in out.iter_mut().enumerate() {
+        *o = Pose {
+            translation: p.translation.map(|x| x.lane(l)),
+            rotation: p.rotation.map(|row| row.map(|x| x.lane(l))),
+        };
+    }
 }
 
 /// Lanes `0..out.len()` of one number of lanes.

@@ -10,7 +10,7 @@
 //! in its own axes), in joint order.
 
 use crate::tree::{cross, Motion, TreeJoint};
-use crate::{Pose, Real};
+use crate::{Lane, Pose};
 
 /// A frame on a kinematic chain, as generated code describes it.
 ///
@@ -43,7 +43,7 @@ struct State<T> {
     a: [T; 3],
 }
 
-impl<T: Real> State<T> {
+impl<T: Lane> State<T> {
     /// The world (or a fixed root): at rest.
     fn rest() -> State<T> {
         let z = [T::zero(); 3];
@@ -57,20 +57,20 @@ impl<T: Real> State<T> {
     }
 }
 
-fn add<T: Real>(a: &[T; 3], b: &[T; 3]) -> [T; 3] {
+fn add<T: Lane>(a: &[T; 3], b: &[T; 3]) -> [T; 3] {
     [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
 }
 
-fn sub<T: Real>(a: &[T; 3], b: &[T; 3]) -> [T; 3] {
+fn sub<T: Lane>(a: &[T; 3], b: &[T; 3]) -> [T; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
-fn scale<T: Real>(a: &[T; 3], k: T) -> [T; 3] {
+fn scale<T: Lane>(a: &[T; 3], k: T) -> [T; 3] {
     [a[0] * k, a[1] * k, a[2] * k]
 }
 
 /// Entry `i` of `x`, zero beyond its end.
-fn at<T: Real>(x: &[T], i: usize) -> T {
+fn at<T: Lane>(x: &[T], i: usize) -> T {
     x.get(i).copied().unwrap_or_else(T::zero)
 }
 
@@ -80,7 +80,7 @@ fn at<T: Real>(x: &[T], i: usize) -> T {
 /// `R lin` and accelerates at `R (dlin + ang x lin)`, the body turns at `R ang` and
 /// accelerates at `R dang`; the parent's rotation `w_p` adds `2 w_p x R lin` (Coriolis) and
 /// `w_p x R ang` (`pw`, the parent's angular velocity).
-fn free_step<T: Real>(s: &mut State<T>, pw: &[T; 3], col: usize, qd: &[T], qdd: Option<&[T]>) {
+fn free_step<T: Lane>(s: &mut State<T>, pw: &[T; 3], col: usize, qd: &[T], qdd: Option<&[T]>) {
     let part = |x: &[T], k: usize| [at(x, col + k), at(x, col + k + 1), at(x, col + k + 2)];
     let (lin, ang) = (part(qd, 0), part(qd, 3));
     let (v_rel, w_rel) = (s.pose.transform_vector(&lin), s.pose.transform_vector(&ang));
@@ -96,7 +96,7 @@ fn free_step<T: Real>(s: &mut State<T>, pw: &[T; 3], col: usize, qd: &[T], qdd: 
     }
 }
 
-impl<T: Real, F: Fn(usize) -> Pose<T>> Chain<'_, T, F> {
+impl<T: Lane, F: Fn(usize) -> Pose<T>> Chain<'_, T, F> {
     /// The first velocity column and joint of body `b`, unless it is a floating base.
     fn joint(&self, b: usize) -> Option<(usize, TreeJoint)> {
         let j = if self.floating { b.checked_sub(1)? } else { b };
@@ -179,7 +179,7 @@ impl<T: Real, F: Fn(usize) -> Pose<T>> Chain<'_, T, F> {
 /// A revolute or prismatic joint's body state `s` (its pose, and its parent's motion carried
 /// to its origin) with the joint's own motion added: rate `x` and, with accelerations, `y`
 /// (`pw`, the parent's angular velocity).
-fn joint_step<T: Real>(s: &mut State<T>, pw: &[T; 3], joint: TreeJoint, x: T, y: Option<T>) {
+fn joint_step<T: Lane>(s: &mut State<T>, pw: &[T; 3], joint: TreeJoint, x: T, y: Option<T>) {
     let z = s.pose.transform_vector(&joint.axis.map(T::from_f64));
     let (rotates, zx) = (joint.motion == Motion::Rotation, scale(&z, x));
     if rotates {
@@ -210,7 +210,7 @@ fn joint_step<T: Real>(s: &mut State<T>, pw: &[T; 3], joint: TreeJoint, x: T, y:
 /// let chain = Chain { path: &[0], joints: &joints, floating: false, transform: |_| Pose::identity(), placement: Pose::from_translation([1.0_f64, 0.0, 0.0]) };
 /// assert_eq!(velocity(&chain, &[2.0]), [0.0, 2.0, 0.0, 0.0, 0.0, 2.0]);
 /// ```
-pub fn velocity<T: Real, F: Fn(usize) -> Pose<T>>(chain: &Chain<'_, T, F>, qd: &[T]) -> [T; 6] {
+pub fn velocity<T: Lane, F: Fn(usize) -> Pose<T>>(chain: &Chain<'_, T, F>, qd: &[T]) -> [T; 6] {
     let s = chain.walk(qd, None, |_, _| {});
     let v = add(&s.v, &cross(&s.w, &chain.lever(&s)));
     [v[0], v[1], v[2], s.w[0], s.w[1], s.w[2]]
@@ -229,7 +229,7 @@ pub fn velocity<T: Real, F: Fn(usize) -> Pose<T>>(chain: &Chain<'_, T, F>, qd: &
 /// let chain = Chain { path: &[0], joints: &joints, floating: false, transform: |_| Pose::identity(), placement: Pose::from_translation([1.0_f64, 0.0, 0.0]) };
 /// assert_eq!(acceleration(&chain, &[2.0], &[0.0]), [-4.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
 /// ```
-pub fn acceleration<T: Real, F: Fn(usize) -> Pose<T>>(
+pub fn acceleration<T: Lane, F: Fn(usize) -> Pose<T>>(
     chain: &Chain<'_, T, F>,
     qd: &[T],
     qdd: &[T],
@@ -257,7 +257,7 @@ pub fn acceleration<T: Real, F: Fn(usize) -> Pose<T>>(
 /// let dj: [[f64; 1]; 6] = jacobian_time_variation(&chain, &[2.0]);
 /// assert_eq!(dj, [[-2.0], [0.0], [0.0], [0.0], [0.0], [0.0]]);
 /// ```
-pub fn jacobian_time_variation<T: Real, F: Fn(usize) -> Pose<T>, const N: usize>(
+pub fn jacobian_time_variation<T: Lane, F: Fn(usize) -> Pose<T>, const N: usize>(
     chain: &Chain<'_, T, F>,
     qd: &[T; N],
 ) -> [[T; N]; 6] {
@@ -329,6 +329,6 @@ pub fn jacobian_time_variation<T: Real, F: Fn(usize) -> Pose<T>, const N: usize>
 /// let rates: [f64; 3] = tree_rates(&[1.0, 5.0], &[(0, 1.0), (1, 1.0), (0, 2.0)]);
 /// assert_eq!(rates, [1.0, 5.0, 2.0]);
 /// ```
-pub fn tree_rates<T: Real, const N: usize>(qd: &[T], coupling: &[(usize, f64); N]) -> [T; N] {
+pub fn tree_rates<T: Lane, const N: usize>(qd: &[T], coupling: &[(usize, f64); N]) -> [T; N] {
     coupling.map(|(c, k)| T::from_f64(k) * at(qd, c))
 }

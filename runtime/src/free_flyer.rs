@@ -3,7 +3,7 @@
 //! joints], as Pinocchio's free flyer.
 
 use crate::tree::{cross, Motion, TreeJoint};
-use crate::{Lane, Pose, Real};
+use crate::{Lane, Pose};
 
 /// `q (+) v dt`: the base moved along the SE(3) exponential of its body-frame velocity for
 /// `dt` (exact for a constant twist; the quaternion stays unit up to rounding and is
@@ -198,7 +198,7 @@ fn mul<T: Lane>(m: &[[T; 3]; 3], v: &[T; 3]) -> [T; 3] {
 /// body `b`, `transform(b)` is body `b`'s pose in its parent's (the base's in the world), and
 /// `placement` the frame's pose in the last body. The base's six columns come first, then one
 /// per joint.
-pub fn chain_jacobian<T: Real, const NJ: usize, const NV: usize>(
+pub fn chain_jacobian<T: Lane, const NJ: usize, const NV: usize>(
     path: &[usize],
     joints: &[TreeJoint; NJ],
     transform: impl Fn(usize) -> Pose<T>,

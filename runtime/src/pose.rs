@@ -1,6 +1,6 @@
 //! Rigid transforms.
 
-use crate::Real;
+use crate::Lane;
 
 /// A rigid transform: the pose of a frame (typically a link) expressed in a reference frame
 /// (typically the world), "world from link".
@@ -34,7 +34,7 @@ pub struct Pose<T> {
 }
 
 #[inline(always)]
-fn mat_vec<T: Real>(r: &[[T; 3]; 3], v: &[T; 3]) -> [T; 3] {
+fn mat_vec<T: Lane>(r: &[[T; 3]; 3], v: &[T; 3]) -> [T; 3] {
     [
         r[0][0] * v[0] + r[0][1] * v[1] + r[0][2] * v[2],
         r[1][0] * v[0] + r[1][1] * v[1] + r[1][2] * v[2],
@@ -43,7 +43,7 @@ fn mat_vec<T: Real>(r: &[[T; 3]; 3], v: &[T; 3]) -> [T; 3] {
 }
 
 #[inline(always)]
-fn mat_t_vec<T: Real>(r: &[[T; 3]; 3], v: &[T; 3]) -> [T; 3] {
+fn mat_t_vec<T: Lane>(r: &[[T; 3]; 3], v: &[T; 3]) -> [T; 3] {
     [
         r[0][0] * v[0] + r[1][0] * v[1] + r[2][0] * v[2],
         r[0][1] * v[0] + r[1][1] * v[1] + r[2][1] * v[2],
@@ -62,7 +62,7 @@ impl<T> Pose<T> {
     }
 }
 
-impl<T: Real> Pose<T> {
+impl<T: Lane> Pose<T> {
     /// The identity transform (no translation, no rotation).
     #[inline]
     pub fn identity() -> Self {
@@ -190,7 +190,7 @@ impl<T: Real> Pose<T> {
     }
 }
 
-impl<T: Real> core::ops::Mul for Pose<T> {
+impl<T: Lane> core::ops::Mul for Pose<T> {
     type Output = Pose<T>;
     /// `a * b` is [`a.compose(&b)`](Pose::compose).
     #[inline]

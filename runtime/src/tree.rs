@@ -58,7 +58,7 @@ pub struct TreeJoint {
 /// assert_eq!(chain_pose(&[0, 1], step).translation, [2.0, 0.0, 0.0]);
 /// ```
 #[inline]
-pub fn chain_pose<T: Real>(path: &[usize], transform: impl Fn(usize) -> Pose<T>) -> Pose<T> {
+pub fn chain_pose<T: Lane>(path: &[usize], transform: impl Fn(usize) -> Pose<T>) -> Pose<T> {
     let mut pose = Pose::identity();
     for &j in path {
         pose = pose.compose(&transform(j));
@@ -69,7 +69,7 @@ pub fn chain_pose<T: Real>(path: &[usize], transform: impl Fn(usize) -> Pose<T>)
 /// The world pose of each body along `path` (at most `N`), and the world position of a frame at
 /// `placement` in the last one.
 #[inline]
-fn chain_poses<T: Real, const N: usize>(
+fn chain_poses<T: Lane, const N: usize>(
     path: &[usize],
     transform: impl Fn(usize) -> Pose<T>,
     placement: &Pose<T>,
@@ -84,7 +84,7 @@ fn chain_poses<T: Real, const N: usize>(
 }
 
 /// `a x b`.
-pub(crate) fn cross<T: Real>(a: &[T; 3], b: &[T; 3]) -> [T; 3] {
+pub(crate) fn cross<T: Lane>(a: &[T; 3], b: &[T; 3]) -> [T; 3] {
     [
         a[1] * b[2] - a[2] * b[1],
         a[2] * b[0] - a[0] * b[2],
@@ -105,7 +105,7 @@ pub(crate) fn cross<T: Real>(a: &[T; 3], b: &[T; 3]) -> [T; 3] {
 /// let j = chain_jacobian(&[0], &joints, |_| Pose::identity(), &tip);
 /// assert_eq!(j, [[0.0], [1.0], [0.0], [0.0], [0.0], [1.0]]);
 /// ```
-pub fn chain_jacobian<T: Real, const N: usize>(
+pub fn chain_jacobian<T: Lane, const N: usize>(
     path: &[usize],
     joints: &[TreeJoint; N],
     transform: impl Fn(usize) -> Pose<T>,
@@ -154,7 +154,7 @@ pub fn chain_jacobian<T: Real, const N: usize>(
 /// assert_eq!(j[0][1], 1.0); // the flyer's linear x column
 /// assert_eq!(j[5][6], 1.0); // its angular z column
 /// ```
-pub fn chain_jacobian_columns<T: Real, const NJ: usize, const NV: usize>(
+pub fn chain_jacobian_columns<T: Lane, const NJ: usize, const NV: usize>(
     path: &[usize],
     joints: &[TreeJoint; NJ],
     columns: &[usize; NJ],
@@ -213,7 +213,7 @@ pub fn chain_jacobian_columns<T: Real, const NJ: usize, const NV: usize>(
 /// let reduced: [[f64; 2]; 1] = couple_columns(&j, &[(0, 1.0), (1, 1.0), (0, 2.0)]);
 /// assert_eq!(reduced, [[7.0, 2.0]]);
 /// ```
-pub fn couple_columns<T: Real, const R: usize, const NJ: usize, const N: usize>(
+pub fn couple_columns<T: Lane, const R: usize, const NJ: usize, const N: usize>(
     joints: &[[T; NJ]; R],
     coupling: &[(usize, f64); NJ],
 ) -> [[T; N]; R] {

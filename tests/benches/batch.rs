@@ -20,7 +20,7 @@ use criterion::{criterion_group, criterion_main, BenchmarkGroup, Criterion, Thro
 use eomgen_generated::panda::Panda;
 use eomgen_runtime::batch::Batch;
 use eomgen_runtime::prelude::*;
-use eomgen_tests::robots::anymal::Anymal;
+use eomgen_tests::robots::anymal::{Anymal, AnymalLink};
 use eomgen_tests::robots::anymal_derivatives::AnymalDerivatives;
 use eomgen_tests::robots::anymal_mpc::AnymalMpc;
 use eomgen_tests::robots::panda_derivatives::PandaDerivatives;
@@ -155,7 +155,7 @@ fn anymal<S: Batch>(c: &mut Criterion, pools: &Pools, label: &str) {
 }
 
 /// anymal standing on its four feet: contact forward dynamics and impulse dynamics (each one
-/// straight-line program, on lanes).
+/// straight-line program, on lanes), and a foot's pose.
 fn anymal_contacts<S: Batch>(c: &mut Criterion, pools: &Pools, label: &str) {
     let robot = Anymal::<S>::default();
     let q = configurations::<S, 19>(7);
@@ -167,6 +167,12 @@ fn anymal_contacts<S: Batch>(c: &mut Criterion, pools: &Pools, label: &str) {
         (a[i], b[i]) = robot.contact_forward_dynamics(black_box(&q[i]), &v[i], &tau[i]);
     }, {
         robot.contact_forward_dynamics_batch(black_box(&q), &v, &tau, &mut a, &mut b).unwrap()
+    });
+    let foot = AnymalLink::RhFoot;
+    three_ways!(g, pools, "link_pose", (p: Pose::identity()), |i| {
+        p[i] = robot.link_pose(foot, black_box(&q[i]));
+    }, {
+        robot.link_pose_batch(foot, black_box(&q), &mut p).unwrap()
     });
     three_ways!(g, pools, "impulse_dynamics", (a: z, b: f), |i| {
         (a[i], b[i]) = robot.impulse_dynamics(black_box(&q[i]), &v[i], e);

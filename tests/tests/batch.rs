@@ -686,3 +686,35 @@ fn methods_off_the_lanes_in_batches_equal_the_scalar_code() {
     let e = robot.difference_batch(&q, &q1[1..], &mut dv).unwrap_err();
     assert_eq!((e.argument, e.len, e.expected), ("q1", STATES - 1, STATES));
 }
+
+#[test]
+fn link_kinematics_on_four_lanes_equals_the_scalar_code() {
+    use eomgen_tests::robots::anymal_mpc::{AnymalMpc, AnymalMpcLink};
+    let robot = AnymalMpc::<f64>::default();
+    let wide = robot.in_lanes::<f64x4>();
+    let mut n = Numbers(13);
+    let (q, v) = anymal_states(&mut n, 4);
+    let a = n.states::<18>(4, 1.0);
+    let (ql, vl, al): ([f64x4; 19], [f64x4; 18], [f64x4; 18]) =
+        (gather(&q, 0), gather(&v, 0), gather(&a, 0));
+    for link in [AnymalMpcLink::Base, AnymalMpcLink::RhFoot] {
+        let pose = wide.link_pose(link, &ql);
+        let jac = wide.link_jacobian(link, &ql);
+        let vel = wide.link_velocity(link, &ql, &vl);
+        let acc = wide.link_acceleration(link, &ql, &vl, &al);
+        let jdot = wide.link_jacobian_time_variation(link, &ql, &vl);
+        for l in 0..4 {
+            let lane6 = |x: &[f64x4; 6]| x.map(|e| e.lane(l));
+            let lane_m = |m: &[[f64x4; 18]; 6]| m.map(|r| r.map(|e| e.lane(l)));
+            let want = robot.link_pose(link, &q[l]);
+            assert_eq!(pose.translation.map(|e| e.lane(l)), want.translation);
+            assert_eq!(pose.rotation.map(|r| r.map(|e| e.lane(l))), want.rotation);
+            assert_eq!(lane_m(&jac), robot.link_jacobian(link, &q[l]), "lane {l}");
+            assert_eq!(lane6(&vel), robot.link_velocity(link, &q[l], &v[l]));
+            let want = robot.link_acceleration(link, &q[l], &v[l], &a[l]);
+            assert_eq!(lane6(&acc), want, "lane {l}");
+            let want = robot.link_jacobian_time_variation(link, &q[l], &v[l]);
+            assert_eq!(lane_m(&jdot), want, "lane {l}");
+        }
+    }
+}

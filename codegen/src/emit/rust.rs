@@ -288,13 +288,13 @@ impl Emitter<'_> {
                 #lane_actuation
                 #(#lane_items)*
                 #(#blocks)*
+                #frames
             }
             #allow
             impl<T: ::eomgen_runtime::Real> #ty<T> {
                 #real_actuation
                 #try_fd
                 #(#real_items)*
-                #frames
             }
             #trait_impl
             #floating_impls

@@ -245,7 +245,25 @@ impl Emitter<'_> {
             names: outs,
             types: out_types,
             scatters,
-        } = outputs(self.result_shapes(q));
+        } = match q.eval {
+            Evaluation::LinkPose => Outs {
+                names: vec![format_ident!("out")],
+                types: vec![quote!(::eomgen_runtime::Pose<T>)],
+                scatters: vec![quote!(::eomgen_runtime::batch::scatter_pose(&r, out);)],
+            },
+            _ => outputs(self.result_shapes(q)),
+        };
+        // Link kinematics takes its link first, the same for every state.
+        let link = matches!(
+            q.eval,
+            Evaluation::LinkPose | Evaluation::LinkJacobian | Evaluation::FrameMotion(_)
+        );
+        let (link_param, link_arg) = if link {
+            let t = &self.link_ty;
+            (quote!(link: #t,), Some(quote!(link)))
+        } else {
+            (TokenStream::new(), None)
+        };
         let shared = shared_scalar(&q.eval);
         let (dt, dt_lanes) = match &shared {
             Some(x) => {
@@ -257,9 +275,13 @@ impl Emitter<'_> {
             }
             None => (TokenStream::new(), TokenStream::new()),
         };
-        let call_args = inputs
-            .iter()
-            .map(|i| quote!(&::eomgen_runtime::batch::gather(#i, start)))
+        let call_args = link_arg
+            .into_iter()
+            .chain(
+                inputs
+                    .iter()
+                    .map(|i| quote!(&::eomgen_runtime::batch::gather(#i, start))),
+            )
             .chain(shared.iter().map(|x| quote!(#x)));
         let path = self.lane_path(q.name);
         let first = &outs[0];
@@ -297,7 +319,7 @@ impl Emitter<'_> {
         };
         quote! {
             #[doc = #doc]
-            pub fn #f(&self, #(#inputs: &[[T; #input_types]],)* #dt #(#outs: &mut [#out_types]),*) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+            pub fn #f(&self, #link_param #(#inputs: &[[T; #input_types]],)* #dt #(#outs: &mut [#out_types]),*) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
                 ::eomgen_runtime::batch::check(#first.len(), &[#(#checked),*])?;
                 let robot = self.in_lanes::<#l>();
                 #dt_lanes

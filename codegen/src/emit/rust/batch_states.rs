@@ -1,20 +1,20 @@
-//! The `NAME_batch` methods of the quantities that do not run on lanes (link kinematics, the
-//! manifold, contact dynamics solved at run time, the contact and impulse derivatives,
-//! contacts switched at run time): the scalar method at each state in turn, the states spread
-//! over rayon's threads with the runtime's `rayon` feature (`eomgen_runtime::batch::run` of one
-//! state per vector). Their code branches on values, so a state per lane is not possible; the
-//! batch form still gives every catalogue method the same calling convention and the threads.
+//! The `NAME_batch` methods of the quantities that do not run on lanes (the manifold, contact
+//! dynamics solved at run time, the contact and impulse derivatives, contacts switched at run
+//! time): the scalar method at each state in turn, the states spread over rayon's threads with
+//! the runtime's `rayon` feature (`eomgen_runtime::batch::run_costed` of one state per vector).
+//! Their code branches on values, so a state per lane is not possible; the batch form still
+//! gives every catalogue method the same calling convention and the threads.
 
 use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote};
 
 use super::{usize_lit, Emitter};
-use crate::dynamics::{ActiveContacts, Evaluation, FrameMotion, Manifold, Quantity};
+use crate::dynamics::{ActiveContacts, Evaluation, Manifold, Quantity};
 use crate::emit::body::shape_type;
 
 /// One parameter of a scalar method, in its place in the signature.
 enum Param {
-    /// A value every state shares (a link, a restitution, a set of active contacts), passed
+    /// A value every state shares (a restitution, a set of active contacts, gains), passed
     /// once to the batch method.
     Shared(Ident, TokenStream),
     /// An array of this length per state: a slice of them in the batch method.
@@ -49,14 +49,7 @@ impl Emitter<'_> {
     fn state_signature(&self, q: &Quantity) -> StateSignature {
         let (n, nq, k) = (&self.n, &self.nq, &self.k);
         let c = usize_lit(self.contact_rows.len());
-        let link = || {
-            shared("link", {
-                let t = &self.link_ty;
-                quote!(#t)
-            })
-        };
-        let [qs, qd, qdd, tau] =
-            [("q", nq), ("qd", n), ("qdd", n), ("tau", n)].map(|(a, l)| state(a, l));
+        let [qs, qd, tau] = [("q", nq), ("qd", n), ("tau", n)].map(|(a, l)| state(a, l));
         let restitution = || shared("restitution", quote!(T));
         let active = || shared("active", quote!(&[bool; #c]));
         let (vector, matrix) = (
@@ -64,21 +57,9 @@ impl Emitter<'_> {
             |r: Literal| quote!([[T; #n]; #r]),
         );
         let pair = vec![vector(n.clone()), vector(k.clone())];
-        let six = usize_lit(6);
         let cdd = vec![quote!(::eomgen_runtime::ContactDynamicsDerivatives<T, #n, #k>)];
         let idd = vec![quote!(::eomgen_runtime::ImpulseDynamicsDerivatives<T, #n, #k>)];
         let (params, outputs) = match &q.eval {
-            Evaluation::LinkPose => (vec![link(), qs], vec![quote!(::eomgen_runtime::Pose<T>)]),
-            Evaluation::LinkJacobian => (vec![link(), qs], vec![matrix(six)]),
-            Evaluation::FrameMotion(FrameMotion::Velocity) => {
-                (vec![link(), qs, qd], vec![vector(six)])
-            }
-            Evaluation::FrameMotion(FrameMotion::Acceleration) => {
-                (vec![link(), qs, qd, qdd], vec![vector(six)])
-            }
-            Evaluation::FrameMotion(FrameMotion::JacobianTimeVariation) => {
-                (vec![link(), qs, qd], vec![matrix(six)])
-            }
             Evaluation::Manifold(m) => {
                 let (a, b) = match m {
                     Manifold::IntegrateJacobians => (state("q", nq), state("v", n)),

@@ -1,8 +1,9 @@
 //! Which generated methods run on vectors of states (`eomgen_runtime::Lane`): those whose
 //! code is arithmetic, pivot checks and the runtime kernels that take a `Lane`, and whose
 //! callees do too (contact forward dynamics and impulse dynamics when each is one straight-line
-//! program). They live in the `impl<T: Lane>` blocks; the rest (link kinematics, the manifold,
-//! the contact solves at run time and the contact derivatives) in `impl<T: Real>`.
+//! program; link kinematics, whose runtime kernels walk chains of poses). They live in the
+//! `impl<T: Lane>` blocks; the rest (the manifold, the contact solves at run time and the
+//! contact derivatives) in `impl<T: Real>`.
 
 use std::collections::BTreeSet;
 
@@ -24,6 +25,9 @@ fn evaluation_on_lanes(q: &Quantity) -> bool {
             | Evaluation::Integrate
             | Evaluation::ContactForwardDynamicsFlat { .. }
             | Evaluation::ImpulseDynamicsFlat { .. }
+            | Evaluation::LinkPose
+            | Evaluation::LinkJacobian
+            | Evaluation::FrameMotion(_)
     )
 }
 
