@@ -23,17 +23,23 @@ fn pack_blocks<V: Copy, S: Copy + Default, const W: usize>(
     transpose: impl Fn(&[[S; W]; W]) -> [V; W],
     new: impl Fn([S; W]) -> V,
 ) {
+    // Plain loops, not `core::array::from_fn`: it is inlined or not as the optimizer's budget
+    // falls, and where it was not, each block was built on the stack by 32-byte stores that
+    // the transposition's 64-byte loads could not take from the store buffer (the panda's
+    // `f32x8` inverse dynamics batch 1.56 times as long).
     let n = v.len();
-    let rows: [&[S]; W] =
-        core::array::from_fn(|l| states.get(l * n..(l + 1) * n).unwrap_or_default());
+    let mut rows: [&[S]; W] = [&[]; W];
+    for (l, row) in rows.iter_mut().enumerate() {
+        *row = states.get(l * n..(l + 1) * n).unwrap_or_default();
+    }
     let mut blocks = v.chunks_exact_mut(W);
     for (k, block) in (&mut blocks).enumerate() {
-        let m: [[S; W]; W] = core::array::from_fn(|l| {
-            match rows[l].get(k * W..(k + 1) * W).map(<&[S; W]>::try_from) {
-                Some(Ok(run)) => *run,
-                _ => [S::default(); W],
+        let mut m = [[S::default(); W]; W];
+        for (run, row) in m.iter_mut().zip(&rows) {
+            if let Some(Ok(r)) = row.get(k * W..(k + 1) * W).map(<&[S; W]>::try_from) {
+                *run = *r;
             }
-        });
+        }
         for (o, x) in block.iter_mut().zip(transpose(&m)) {
             *o = x;
         }
@@ -41,9 +47,11 @@ fn pack_blocks<V: Copy, S: Copy + Default, const W: usize>(
     let rest = blocks.into_remainder();
     let k = n - rest.len();
     for (j, o) in rest.iter_mut().enumerate() {
-        *o = new(core::array::from_fn(|l| {
-            rows[l].get(k + j).copied().unwrap_or_default()
-        }));
+        let mut lanes = [S::default(); W];
+        for (x, row) in lanes.iter_mut().zip(&rows) {
+            *x = row.get(k + j).copied().unwrap_or_default();
+        }
+        *o = new(lanes);
     }
 }
 
