@@ -12,6 +12,17 @@
 
 use wide::{f32x8, f64x4};
 
+/// `f` of each element of `a`, by a plain loop that is always inlined (array `map` is inlined
+/// or not as the optimizer's budget falls: see [`pack_blocks`]).
+#[inline(always)]
+fn each_of<A: Copy, B: Copy + Default, const W: usize>(a: [A; W], f: impl Fn(A) -> B) -> [B; W] {
+    let mut out = [B::default(); W];
+    for (o, x) in out.iter_mut().zip(a) {
+        *o = f(x);
+    }
+    out
+}
+
 /// Packs `states` (the whole runs of `v.len()` scalars it holds, up to `W`) into `v`: `W`
 /// entries at a time by `transpose` (of `W` rows of `W` scalars, one per state, into the `W`
 /// vectors of those entries), the rest by `new` (one vector from its `W` lanes). Lanes of
@@ -181,17 +192,17 @@ fn unpack_run_lanes<V: Copy, S: Copy, const W: usize, const R: usize, const C: u
 #[inline(always)]
 fn transpose4(v: &[f64x4; 4]) -> [f64x4; 4] {
     use safe_arch::{m256d, permute2z_m256d, unpack_hi_m256d, unpack_lo_m256d};
-    let m = v.map(|x| m256d::from_array(x.to_array()));
+    let m = each_of(*v, |x| m256d::from_array(x.to_array()));
     // [a0 b0 a2 b2], [a1 b1 a3 b3], [c0 d0 c2 d2], [c1 d1 c3 d3]
     let (ab0, ab1) = (unpack_lo_m256d(m[0], m[1]), unpack_hi_m256d(m[0], m[1]));
     let (cd0, cd1) = (unpack_lo_m256d(m[2], m[3]), unpack_hi_m256d(m[2], m[3]));
-    [
+    let t = [
         permute2z_m256d::<0x20>(ab0, cd0),
         permute2z_m256d::<0x20>(ab1, cd1),
         permute2z_m256d::<0x31>(ab0, cd0),
         permute2z_m256d::<0x31>(ab1, cd1),
-    ]
-    .map(|x| f64x4::new(x.to_array()))
+    ];
+    each_of(t, |x| f64x4::new(x.to_array()))
 }
 
 /// The 4 x 4 transposition, lane by lane (no AVX: `f64x4` is two halves or an array).
@@ -205,7 +216,12 @@ fn transpose4(v: &[f64x4; 4]) -> [f64x4; 4] {
 /// [`Pack::pack`](super::Pack::pack) of `f64x4`.
 #[inline(always)]
 pub(super) fn pack_f64x4(states: &[f64], v: &mut [f64x4]) {
-    pack_blocks(states, v, |m| transpose4(&m.map(f64x4::new)), f64x4::new);
+    pack_blocks(
+        states,
+        v,
+        |m| transpose4(&each_of(*m, f64x4::new)),
+        f64x4::new,
+    );
 }
 
 /// [`Pack::unpack`](super::Pack::unpack) of `f64x4`.
@@ -214,7 +230,7 @@ pub(super) fn unpack_f64x4(v: &[f64x4], states: &mut [f64]) {
     unpack_blocks(
         v,
         states,
-        |b| transpose4(b).map(f64x4::to_array),
+        |b| each_of(transpose4(b), f64x4::to_array),
         f64x4::to_array,
     );
 }
@@ -228,7 +244,7 @@ pub(super) fn unpack_run_f64x4<const R: usize, const C: usize>(
 ) {
     unpack_run_blocks(
         (v, states, at),
-        |b| transpose4(b).map(f64x4::to_array),
+        |b| each_of(transpose4(b), f64x4::to_array),
         f64x4::to_array,
     );
 }
@@ -240,7 +256,7 @@ pub(super) fn pack_f32x8(states: &[f32], v: &mut [f32x8]) {
     pack_blocks(
         states,
         v,
-        |m| f32x8::transpose(m.map(f32x8::new)),
+        |m| f32x8::transpose(each_of(*m, f32x8::new)),
         f32x8::new,
     );
 }
@@ -251,7 +267,7 @@ pub(super) fn unpack_f32x8(v: &[f32x8], states: &mut [f32]) {
     unpack_blocks(
         v,
         states,
-        |b| f32x8::transpose(*b).map(f32x8::to_array),
+        |b| each_of(f32x8::transpose(*b), f32x8::to_array),
         f32x8::to_array,
     );
 }
@@ -265,7 +281,7 @@ pub(super) fn unpack_run_f32x8<const R: usize, const C: usize>(
 ) {
     unpack_run_blocks(
         (v, states, at),
-        |b| f32x8::transpose(*b).map(f32x8::to_array),
+        |b| each_of(f32x8::transpose(*b), f32x8::to_array),
         f32x8::to_array,
     );
 }
