@@ -30,9 +30,7 @@ pub fn integrate_jacobians_into<T: Real, const NQ: usize, const NV: usize>(
     let _ = q;
     diagonal(dq, dv, T::one(), T::one());
     if NV >= 6 {
-        let (bq, bv) = se3::integrate_jacobians(&v[..6]);
-        put_block(dq, 0, &bq);
-        put_block(dv, 0, &bv);
+        se3::integrate_jacobians_at(&v[..6], (dq, dv), 0);
     }
 }
 
