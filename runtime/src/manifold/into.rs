@@ -70,8 +70,10 @@ pub fn integrate_jacobians_blocks_into<T: Real, const NQ: usize, const NV: usize
 ) {
     let _ = q;
     diagonal(dq, dv, T::one(), T::one());
-    flyers_into::<NQ, NV, T>(free, (dq, dv), |_, b| {
-        se3::integrate_jacobians(&v[b..b + 6])
+    walk_blocks::<NQ, NV>(free, |block| {
+        if let Block::Flyer(_, b) = block {
+            se3::integrate_jacobians_at(&v[b..b + 6], (&mut *dq, &mut *dv), b);
+        }
     });
 }
 
@@ -91,7 +93,8 @@ pub fn difference_jacobians_blocks_into<T: Real, const NQ: usize, const NV: usiz
 }
 
 /// Each free flyer's blocks `blocks(q index, v index)` of `free` on the diagonals of `x`
-/// and `y`.
+/// and `y` (`dDifference`'s: written whole, its 3 x 3 parts written in place made its dense
+/// form slower, `se3::integrate_jacobians_at`).
 fn flyers_into<const NQ: usize, const NV: usize, T: Real>(
     free: &[(usize, usize)],
     (x, y): (&mut [[T; NV]; NV], &mut [[T; NV]; NV]),
