@@ -8,7 +8,7 @@ use super::items::Fields;
 use super::traits::Trait;
 use super::{allow_lints, usize_lit, Emitter};
 use crate::cas::OpCount;
-use crate::dynamics::{Evaluation, Input, Quantity, Shape};
+use crate::dynamics::{ActiveContacts, Evaluation, Quantity, Shape};
 use crate::emit::body::shape_type;
 
 /// The most operations per entry of its result for which a quantity's batch method writes the
@@ -76,23 +76,35 @@ pub(super) fn elements(shape: Shape) -> Vec<Shape> {
     }
 }
 
-/// The number shared by every state that a method of this evaluation takes besides its inputs:
-/// `integrate`'s time step, impulse dynamics' restitution.
-fn shared_scalar(eval: &Evaluation) -> Option<Ident> {
+/// The number shared by every state that a method of this evaluation takes after its inputs:
+/// `integrate`'s time step, the impulse methods' restitution.
+pub(super) fn shared_scalar(eval: &Evaluation) -> Option<Ident> {
     match eval {
         Evaluation::Integrate => Some(format_ident!("dt")),
-        Evaluation::ImpulseDynamicsFlat { .. } => Some(format_ident!("restitution")),
+        Evaluation::ImpulseDynamics
+        | Evaluation::ImpulseDynamicsFlat { .. }
+        | Evaluation::ImpulseDynamicsDerivatives
+        | Evaluation::ActiveContacts(
+            ActiveContacts::Impulse | ActiveContacts::ImpulseDerivatives,
+        ) => Some(format_ident!("restitution")),
         _ => None,
     }
 }
 
 impl Emitter<'_> {
-    /// The element shapes of `q`'s value: contact forward dynamics and impulse dynamics give
-    /// a pair of vectors (`N` velocity coordinates, `K` contact rows).
-    fn result_shapes(&self, q: &Quantity) -> Vec<Shape> {
+    /// The element shapes of `q`'s value: contact forward dynamics and impulse dynamics (all
+    /// their forms) give a pair of vectors (`N` velocity coordinates, `K` contact rows).
+    pub(super) fn result_shapes(&self, q: &Quantity) -> Vec<Shape> {
         match q.eval {
-            Evaluation::ContactForwardDynamicsFlat { .. }
-            | Evaluation::ImpulseDynamicsFlat { .. } => {
+            Evaluation::ContactForwardDynamics { .. }
+            | Evaluation::ContactForwardDynamicsFlat { .. }
+            | Evaluation::ImpulseDynamics
+            | Evaluation::ImpulseDynamicsFlat { .. }
+            | Evaluation::ActiveContacts(
+                ActiveContacts::Dynamics { .. }
+                | ActiveContacts::Stabilized { .. }
+                | ActiveContacts::Impulse,
+            ) => {
                 let n = self.parents.len();
                 vec![Shape::Vector(n), Shape::Vector(q.shape.len() - n)]
             }
@@ -236,11 +248,7 @@ impl Emitter<'_> {
     fn batch_fn(&self, q: &Quantity) -> TokenStream {
         let f = format_ident!("{}_batch", q.name);
         let inputs = Self::arg_names(q.inputs);
-        let input_types = q.inputs.iter().map(|i| match i {
-            Input::Q => &self.nq,
-            Input::Forces => &self.k,
-            _ => &self.n,
-        });
+        let input_types = q.inputs.iter().map(|i| self.input_len(*i));
         let Outs {
             names: outs,
             types: out_types,

@@ -8,6 +8,7 @@
 use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote};
 
+use super::batch::shared_scalar;
 use super::{usize_lit, Emitter};
 use crate::dynamics::{ActiveContacts, Evaluation, Manifold, Quantity};
 use crate::emit::body::shape_type;
@@ -27,10 +28,6 @@ struct StateSignature {
     outputs: Vec<TokenStream>,
 }
 
-fn state(name: &str, len: &Literal) -> Param {
-    Param::State(format_ident!("{}", name), len.clone())
-}
-
 fn shared(name: &str, ty: TokenStream) -> Param {
     Param::Shared(format_ident!("{}", name), ty)
 }
@@ -45,73 +42,51 @@ impl Emitter<'_> {
             .collect()
     }
 
-    /// The parameters and result elements of `q`'s scalar method, as its emitter writes them.
+    /// The parameters and result elements of `q`'s scalar method, as its emitter writes them:
+    /// its inputs, then what every state shares in the order the method takes it (a
+    /// restitution, the active contacts, Baumgarte gains).
     fn state_signature(&self, q: &Quantity) -> StateSignature {
-        let (n, nq, k) = (&self.n, &self.nq, &self.k);
+        let (n, k) = (&self.n, &self.k);
         let c = usize_lit(self.contact_rows.len());
-        let [qs, qd, tau] = [("q", nq), ("qd", n), ("tau", n)].map(|(a, l)| state(a, l));
-        let restitution = || shared("restitution", quote!(T));
-        let active = || shared("active", quote!(&[bool; #c]));
-        let (vector, matrix) = (
-            |l: Literal| quote!([T; #l]),
-            |r: Literal| quote!([[T; #n]; #r]),
-        );
-        let pair = vec![vector(n.clone()), vector(k.clone())];
-        let cdd = vec![quote!(::eomgen_runtime::ContactDynamicsDerivatives<T, #n, #k>)];
-        let idd = vec![quote!(::eomgen_runtime::ImpulseDynamicsDerivatives<T, #n, #k>)];
-        let (params, outputs) = match &q.eval {
-            Evaluation::Manifold(m) => {
-                let (a, b) = match m {
-                    Manifold::IntegrateJacobians => (state("q", nq), state("v", n)),
-                    _ => (state("q0", nq), state("q1", nq)),
-                };
-                let out = match m {
-                    Manifold::Difference => vec![vector(n.clone())],
-                    _ => vec![matrix(n.clone()); 2],
-                };
-                (vec![a, b], out)
+        let active = matches!(q.eval, Evaluation::ActiveContacts(_))
+            .then(|| shared("active", quote!(&[bool; #c])));
+        let gains = matches!(
+            q.eval,
+            Evaluation::ActiveContacts(ActiveContacts::Stabilized { .. })
+        )
+        .then(|| shared("baumgarte", quote!(&::eomgen_runtime::Baumgarte<T, #c>)));
+        let params = q
+            .inputs
+            .iter()
+            .zip(self.state_names(q))
+            .map(|(i, name)| Param::State(name, self.input_len(*i).clone()))
+            .chain(shared_scalar(&q.eval).map(|x| Param::Shared(x, quote!(T))))
+            .chain(active)
+            .chain(gains)
+            .collect();
+        let outputs = match q.eval {
+            Evaluation::ContactDynamicsDerivatives { .. }
+            | Evaluation::ActiveContacts(ActiveContacts::Derivatives { .. }) => {
+                vec![quote!(::eomgen_runtime::ContactDynamicsDerivatives<T, #n, #k>)]
             }
-            Evaluation::ContactForwardDynamics { .. }
-            | Evaluation::ContactForwardDynamicsFlat { .. } => (vec![qs, qd, tau], pair),
-            Evaluation::ImpulseDynamics | Evaluation::ImpulseDynamicsFlat { .. } => {
-                (vec![qs, qd, restitution()], pair)
+            Evaluation::ImpulseDynamicsDerivatives
+            | Evaluation::ActiveContacts(ActiveContacts::ImpulseDerivatives) => {
+                vec![quote!(::eomgen_runtime::ImpulseDynamicsDerivatives<T, #n, #k>)]
             }
-            Evaluation::ContactDynamicsDerivatives { .. } => (vec![qs, qd, tau], cdd),
-            Evaluation::ImpulseDynamicsDerivatives => (vec![qs, qd, restitution()], idd),
-            Evaluation::Integrate => (
-                vec![qs, qd, shared("dt", quote!(T))],
-                vec![vector(nq.clone())],
-            ),
-            Evaluation::ActiveContacts(a) => match a {
-                ActiveContacts::Dynamics { .. } => (vec![qs, qd, tau, active()], pair),
-                ActiveContacts::Stabilized { .. } => {
-                    let gains = shared("baumgarte", quote!(&::eomgen_runtime::Baumgarte<T, #c>));
-                    (vec![qs, qd, tau, active(), gains], pair)
-                }
-                ActiveContacts::Derivatives { .. } => (vec![qs, qd, tau, active()], cdd),
-                ActiveContacts::Impulse => (vec![qs, qd, restitution(), active()], pair),
-                ActiveContacts::ImpulseDerivatives => (vec![qs, qd, restitution(), active()], idd),
-            },
-            _ => {
-                let inputs = q.inputs.iter().zip(Self::arg_names(q.inputs));
-                let params = inputs
-                    .map(|(i, name)| {
-                        let len = match i {
-                            crate::dynamics::Input::Q => nq,
-                            crate::dynamics::Input::Forces => k,
-                            _ => n,
-                        };
-                        Param::State(name, len.clone())
-                    })
-                    .collect();
-                let outputs = super::batch::elements(q.shape)
-                    .into_iter()
-                    .map(shape_type)
-                    .collect();
-                (params, outputs)
-            }
+            _ => self.result_shapes(q).into_iter().map(shape_type).collect(),
         };
         StateSignature { params, outputs }
+    }
+
+    /// The names of `q`'s per-state arguments: the manifold's own (`q0, q1`; `q, v`), else
+    /// those of its inputs.
+    fn state_names(&self, q: &Quantity) -> Vec<Ident> {
+        let names: &[&str] = match q.eval {
+            Evaluation::Manifold(Manifold::IntegrateJacobians) => &["q", "v"],
+            Evaluation::Manifold(_) => &["q0", "q1"],
+            _ => return Self::arg_names(q.inputs),
+        };
+        names.iter().map(|x| format_ident!("{}", x)).collect()
     }
 
     /// `NAME_batch`: `q`'s scalar method at every state, one output slice per element of its

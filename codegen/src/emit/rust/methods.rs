@@ -71,15 +71,19 @@ impl Emitter<'_> {
         inputs
             .iter()
             .map(|i| {
-                let name = format_ident!("{}", i.name());
-                let len = match i {
-                    Input::Q => &self.nq,
-                    Input::Forces => &self.k,
-                    _ => &self.n,
-                };
+                let (name, len) = (format_ident!("{}", i.name()), self.input_len(*i));
                 quote!(#name: &[T; #len])
             })
             .collect()
+    }
+
+    /// The length of an argument's array: `NQ` for `q`, `K` for the contact forces, else `N`.
+    pub(super) fn input_len(&self, i: Input) -> &proc_macro2::Literal {
+        match i {
+            Input::Q => &self.nq,
+            Input::Forces => &self.k,
+            _ => &self.n,
+        }
     }
 
     /// The names `q, qd, ...` of a quantity's arguments.
