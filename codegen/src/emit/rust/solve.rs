@@ -124,136 +124,76 @@ impl Emitter<'_> {
     /// `mass_matrix`, for users' own solves), `CONTACT_ROWS` (with `contact_jacobian`), and
     /// the robot's unrolled factorization and substitution (`emit/tree_solve.rs`).
     pub(super) fn parents_const(&self) -> TokenStream {
-        use Evaluation as E;
-        let n = &self.n;
-        let table = self.has("mass_matrix")
-            || self.any_eval(|e| {
-                matches!(
-                    e,
-                    E::MassMatrixInverse
-                        | E::ForwardDynamicsDerivatives { .. }
-                        | E::ContactForwardDynamics { .. }
-                        | E::ContactDynamicsDerivatives { .. }
-                        | E::ImpulseDynamics
-                        | E::ImpulseDynamicsDerivatives
-                        | E::ActiveContacts(_)
-                )
-            });
-        let table = if table {
-            let parents = self.parents.iter().map(|p| match p {
-                Some(p) => {
-                    let p = usize_lit(*p);
-                    quote!(Some(#p))
-                }
-                None => quote!(None),
-            });
-            quote! {
-                /// Each coordinate's parent coordinate (`None`: the root), parents first: the
-                /// joints' parents (a floating base's six coordinates form a chain). The sparsity
-                /// of `mass_matrix` that the runtime's tree solves take (`eomgen_runtime::tree`,
-                /// `eomgen_runtime::contact::solve`, `eomgen_runtime::ContactKkt`).
-                pub const PARENTS: [Option<usize>; #n] = [#(#parents),*];
-            }
-        } else {
-            TokenStream::new()
-        };
-        let rows = if self.has("contact_jacobian") {
-            let c = usize_lit(self.contact_rows.len());
-            let rows = self.contact_rows.iter().map(|r| usize_lit(*r));
-            quote! {
-                /// Each contact's number of rows in `contact_jacobian`, `contact_drift` and the
-                /// forces (3: a point, 6: a frame), in the contacts' order: points, then frames.
-                /// The `active` flags of the `_active` methods follow this order
-                /// (`eomgen_runtime::contact::row_mask` turns them into rows).
-                pub const CONTACT_ROWS: [usize; #c] = [#(#rows),*];
-            }
-        } else {
-            TokenStream::new()
-        };
-        // What substitutes through M's unrolled factors: forward dynamics, and contact dynamics,
-        // impulse dynamics, the contact derivatives for their one `M^-1 b` each, and the
-        // forward-dynamics derivatives that do not take M's factors from
-        // `forward_dynamics_partials`.
-        let solves = |e: &Evaluation| {
-            matches!(
-                e,
-                E::ForwardDynamicsSolve { .. }
-                    | E::ContactForwardDynamics { .. }
-                    | E::ForwardDynamicsDerivatives { partials: false }
-                    | E::ImpulseDynamics
-                    | E::ContactDynamicsDerivatives { .. }
-                    | E::ActiveContacts(
-                        ActiveContacts::Dynamics { .. }
-                            | ActiveContacts::Stabilized { .. }
-                            | ActiveContacts::Impulse
-                            | ActiveContacts::Derivatives { .. }
-                    )
-            )
-        };
-        // Every KKT system (`ContactKkt::set_up_factored`) takes M's factors from it too.
-        let kkt = |e: &Evaluation| {
-            matches!(
-                e,
-                E::MassMatrixInverse
-                    | E::ContactDynamicsDerivatives { .. }
-                    | E::ImpulseDynamics
-                    | E::ImpulseDynamicsDerivatives
-                    | E::ActiveContacts(_)
-            )
-        };
-        let factor = if self.any_eval(|e| solves(e) || kkt(e)) {
-            crate::emit::tree_factor::factor_fn(&self.parents, n)
-        } else {
-            TokenStream::new()
-        };
-        let substitute = if self.any_eval(solves) {
-            crate::emit::tree_solve::substitute_fn(&self.parents, n)
-        } else {
-            TokenStream::new()
-        };
-        // The KKT systems of the contact and impulse derivatives take every pass over many
-        // columns from the robot's `TreePasses` (`tree_passes_impl`).
-        let passes = self.any_eval(kkt_derivatives);
-        let inverts = |e: &Evaluation| {
-            matches!(
-                e,
-                E::MassMatrixInverse | E::ForwardDynamicsDerivatives { .. }
-            )
-        };
-        let inverse = if passes || self.any_eval(inverts) {
-            crate::emit::tree_solve::inverse_fn(&self.parents, n)
-        } else {
-            TokenStream::new()
-        };
-        // What forms `W = L^-T J^T` for `J M^-1 J^T`: contact and impulse dynamics.
-        let lowers = |e: &Evaluation| {
-            matches!(
-                e,
-                E::ContactForwardDynamics { .. }
-                    | E::ImpulseDynamics
-                    | E::ActiveContacts(
-                        ActiveContacts::Dynamics { .. }
-                            | ActiveContacts::Stabilized { .. }
-                            | ActiveContacts::Impulse
-                    )
-            )
-        };
-        // `forward_dynamics_derivatives` solves for the 2 N columns of d tau/dq and d tau/dqd.
-        let fd_derivatives = |e: &Evaluation| matches!(e, E::ForwardDynamicsDerivatives { .. });
-        let columns = passes || self.any_eval(fd_derivatives);
-        let lower_rows = if columns || self.any_eval(lowers) {
-            crate::emit::tree_solve::lower_rows_fn(&self.parents, n)
-        } else {
-            TokenStream::new()
-        };
-        let upper_rows = if columns {
-            crate::emit::tree_solve::upper_rows_fn(&self.parents, n)
-        } else {
-            TokenStream::new()
-        };
+        let table = self.parents_table();
+        let rows = self.contact_rows_const();
+        let helpers = self.tree_helpers();
         quote! {
             #table
             #rows
+            #helpers
+        }
+    }
+
+    /// `PARENTS`, with `mass_matrix` or a quantity whose run-time solve walks the tree.
+    fn parents_table(&self) -> TokenStream {
+        if !(self.has("mass_matrix") || self.any_eval(reads_parents)) {
+            return TokenStream::new();
+        }
+        let n = &self.n;
+        let parents = self.parents.iter().map(|p| match p {
+            Some(p) => {
+                let p = usize_lit(*p);
+                quote!(Some(#p))
+            }
+            None => quote!(None),
+        });
+        quote! {
+            /// Each coordinate's parent coordinate (`None`: the root), parents first: the
+            /// joints' parents (a floating base's six coordinates form a chain). The sparsity
+            /// of `mass_matrix` that the runtime's tree solves take (`eomgen_runtime::tree`,
+            /// `eomgen_runtime::contact::solve`, `eomgen_runtime::ContactKkt`).
+            pub const PARENTS: [Option<usize>; #n] = [#(#parents),*];
+        }
+    }
+
+    /// `CONTACT_ROWS`, with `contact_jacobian`.
+    fn contact_rows_const(&self) -> TokenStream {
+        if !self.has("contact_jacobian") {
+            return TokenStream::new();
+        }
+        let c = usize_lit(self.contact_rows.len());
+        let rows = self.contact_rows.iter().map(|r| usize_lit(*r));
+        quote! {
+            /// Each contact's number of rows in `contact_jacobian`, `contact_drift` and the
+            /// forces (3: a point, 6: a frame), in the contacts' order: points, then frames.
+            /// The `active` flags of the `_active` methods follow this order
+            /// (`eomgen_runtime::contact::row_mask` turns them into rows).
+            pub const CONTACT_ROWS: [usize; #c] = [#(#rows),*];
+        }
+    }
+
+    /// The unrolled passes over `M`'s tree factors (`emit/tree_solve.rs`), each where a
+    /// quantity calls it: the factorization, one substitution, `M^-1`, and the two halves of
+    /// a substitution of many columns.
+    fn tree_helpers(&self) -> TokenStream {
+        use crate::emit::{tree_factor, tree_solve};
+        let (parents, n) = (&self.parents, &self.n);
+        // The KKT systems of the contact and impulse derivatives take every pass over many
+        // columns from the robot's `TreePasses` (`tree_passes_impl`); the forward-dynamics
+        // derivatives solve for the 2 N columns of d tau/dq and d tau/dqd.
+        let passes = self.any_eval(kkt_derivatives);
+        let columns =
+            passes || self.any_eval(|e| matches!(e, Evaluation::ForwardDynamicsDerivatives { .. }));
+        let factor = self.any_eval(|e| substitutes(e) || sets_up_kkt(e));
+        let factor = factor.then(|| tree_factor::factor_fn(parents, n));
+        let substitute = self.any_eval(substitutes);
+        let substitute = substitute.then(|| tree_solve::substitute_fn(parents, n));
+        let inverse = passes || self.any_eval(inverts);
+        let inverse = inverse.then(|| tree_solve::inverse_fn(parents, n));
+        let lower_rows = columns || self.any_eval(lowers);
+        let lower_rows = lower_rows.then(|| tree_solve::lower_rows_fn(parents, n));
+        let upper_rows = columns.then(|| tree_solve::upper_rows_fn(parents, n));
+        quote! {
             #factor
             #substitute
             #inverse
@@ -648,6 +588,80 @@ fn kkt_derivatives(e: &Evaluation) -> bool {
             | Evaluation::ImpulseDynamicsDerivatives
             | Evaluation::ActiveContacts(
                 ActiveContacts::Derivatives { .. } | ActiveContacts::ImpulseDerivatives
+            )
+    )
+}
+
+/// Whether an evaluation's run-time solve reads `PARENTS` (the runtime's tree kernels or
+/// `ContactKkt`).
+fn reads_parents(e: &Evaluation) -> bool {
+    use Evaluation as E;
+    matches!(
+        e,
+        E::MassMatrixInverse
+            | E::ForwardDynamicsDerivatives { .. }
+            | E::ContactForwardDynamics { .. }
+            | E::ContactDynamicsDerivatives { .. }
+            | E::ImpulseDynamics
+            | E::ImpulseDynamicsDerivatives
+            | E::ActiveContacts(_)
+    )
+}
+
+/// Whether an evaluation substitutes through `M`'s unrolled factors: forward dynamics, and
+/// contact dynamics, impulse dynamics, the contact derivatives for their one `M^-1 b` each,
+/// and the forward-dynamics derivatives that do not take `M`'s factors from
+/// `forward_dynamics_partials`.
+fn substitutes(e: &Evaluation) -> bool {
+    use Evaluation as E;
+    matches!(
+        e,
+        E::ForwardDynamicsSolve { .. }
+            | E::ContactForwardDynamics { .. }
+            | E::ForwardDynamicsDerivatives { partials: false }
+            | E::ImpulseDynamics
+            | E::ContactDynamicsDerivatives { .. }
+            | E::ActiveContacts(
+                ActiveContacts::Dynamics { .. }
+                    | ActiveContacts::Stabilized { .. }
+                    | ActiveContacts::Impulse
+                    | ActiveContacts::Derivatives { .. }
+            )
+    )
+}
+
+/// Whether an evaluation sets up a KKT system (`ContactKkt::set_up_factored`), which takes
+/// `M`'s factors from the unrolled factorization.
+fn sets_up_kkt(e: &Evaluation) -> bool {
+    use Evaluation as E;
+    matches!(
+        e,
+        E::MassMatrixInverse
+            | E::ContactDynamicsDerivatives { .. }
+            | E::ImpulseDynamics
+            | E::ImpulseDynamicsDerivatives
+            | E::ActiveContacts(_)
+    )
+}
+
+/// Whether an evaluation forms `M^-1` from the factors.
+fn inverts(e: &Evaluation) -> bool {
+    matches!(
+        e,
+        Evaluation::MassMatrixInverse | Evaluation::ForwardDynamicsDerivatives { .. }
+    )
+}
+
+/// Whether an evaluation forms `W = L^-T J^T` for `J M^-1 J^T`: contact and impulse dynamics.
+fn lowers(e: &Evaluation) -> bool {
+    matches!(
+        e,
+        Evaluation::ContactForwardDynamics { .. }
+            | Evaluation::ImpulseDynamics
+            | Evaluation::ActiveContacts(
+                ActiveContacts::Dynamics { .. }
+                    | ActiveContacts::Stabilized { .. }
+                    | ActiveContacts::Impulse
             )
     )
 }
