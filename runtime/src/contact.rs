@@ -9,10 +9,11 @@
 //! of `M^-1 J^T`. Everything is in fixed-size arrays on the stack.
 
 pub use crate::baumgarte::{log3, placement, Baumgarte};
-use crate::kkt::{axpy, dot, finite_solution, shift};
+use crate::kkt::{axpy, dot};
+use crate::lane::check_finite;
 use crate::linalg::{Cholesky, FactorError};
 use crate::tree::{ltdl_factor, ltdl_lower_rows, ltdl_substitute};
-use crate::Real;
+use crate::{Lane, Real};
 
 /// Solves the contact forward dynamics for `rhs = tau - h` (`h = b + G`, friction included),
 /// the contact Jacobian `j` (K rows, world axes) and its drift `Jdot v`. `m` (the mass matrix)
@@ -153,7 +154,37 @@ pub fn solve_factored_active_by<T: Real, const N: usize, const K: usize>(
     substitute: impl Fn(&[T; N]) -> [T; N],
     lower: impl FnOnce(&mut [[T; K]; N]),
 ) -> Result<([T; N], [T; K]), FactorError> {
-    let chol = contact_space(m, j, active, lower)?;
+    let system = (j, drift, active);
+    solve_factored_active_lanes(m, free, system, substitute, lower, &mut ())
+}
+
+/// [`solve_factored_active_by`] on a vector of states ([`Lane`], one state per lane), with
+/// the contact Jacobian, its drift and the active rows as one argument: a lane whose pivot of
+/// `J M^-1 J^T` fails, or whose solution is not finite, records its error in `failures` and
+/// holds garbage (a scalar returns the error at once, as [`solve_factored_active_by`]).
+/// `active` is every lane's.
+///
+/// ```
+/// use eomgen_runtime::contact::solve_factored_active_lanes;
+/// use eomgen_runtime::tree::{ltdl_lower_rows, ltdl_substitute};
+/// // The point mass of `solve`, M = I already factorized, with its contact switched off.
+/// let (m, parent) = ([[1.0_f64, 0.0], [0.0, 1.0]], [None, None]);
+/// let substitute = |b: &[f64; 2]| ltdl_substitute(&m, &parent, b);
+/// let lower = |w: &mut [[f64; 1]; 2]| ltdl_lower_rows(&m, &parent, w);
+/// let system = (&[[0.0, 1.0]], &[0.0], &[false]);
+/// let (a, f) =
+///     solve_factored_active_lanes(&m, &[0.0, -9.81], system, substitute, lower, &mut ()).unwrap();
+/// assert_eq!((a, f), ([0.0, -9.81], [0.0]));
+/// ```
+pub fn solve_factored_active_lanes<T: Lane, const N: usize, const K: usize>(
+    m: &[[T; N]; N],
+    free: &[T; N],
+    (j, drift, active): (&[[T; N]; K], &[T; K], &[bool; K]),
+    substitute: impl Fn(&[T; N]) -> [T; N],
+    lower: impl FnOnce(&mut [[T; K]; N]),
+    failures: &mut T::Failures,
+) -> Result<([T; N], [T; K]), FactorError> {
+    let chol = contact_space(m, j, active, lower, failures)?;
     let mut b = [T::zero(); K];
     for k in 0..K {
         if active[k] {
@@ -166,19 +197,25 @@ pub fn solve_factored_active_by<T: Real, const N: usize, const K: usize>(
     for (ai, fi) in a.iter_mut().zip(free) {
         *ai += *fi;
     }
-    finite_solution(a, f)
+    check_finite(&a, failures)?;
+    for (k, fk) in f.iter().enumerate() {
+        T::check_finite(*fk, N + k, failures)?;
+    }
+    Ok((a, f))
 }
 
 /// The Cholesky factor of `J M^-1 J^T = W^T D^-1 W` with `W = L^-T J^T` (the inactive rows of
 /// `J` as zero; the identity's rows and columns for them), from `M`'s factors `m` and `lower`
 /// (`x <- L^-T x`, [`ltdl_lower_rows`]): half the substitution that `M^-1 J^T` would take.
 ///
-/// Errors: a pivot of `J M^-1 J^T` that is not positive or not finite (pivot `N + k`).
-pub(crate) fn contact_space<T: Real, const N: usize, const K: usize>(
+/// Errors: a pivot of `J M^-1 J^T` that is not positive or not finite (pivot `N + k`; on a
+/// vector, recorded in `failures`).
+pub(crate) fn contact_space<T: Lane, const N: usize, const K: usize>(
     m: &[[T; N]; N],
     j: &[[T; N]; K],
     active: &[bool; K],
     lower: impl FnOnce(&mut [[T; K]; N]),
+    failures: &mut T::Failures,
 ) -> Result<Cholesky<T, K>, FactorError> {
     let mut w = [[T::zero(); K]; N];
     for (i, wi) in w.iter_mut().enumerate() {
@@ -193,13 +230,14 @@ pub(crate) fn contact_space<T: Real, const N: usize, const K: usize>(
     // chains the processor overlaps (gathered row by row, each row was a chain of N dependent
     // multiply-adds, and they were a sixth of a quadruped's contact dynamics).
     // A coordinate's row of `W` is zero in the contact rows outside its subtree (a leg joint
-    // moves its own foot only): those rows of the update are skipped. (A non-finite entry
-    // still reaches `lambda`: through its own row, onto the diagonal.)
+    // moves its own foot only): those rows of the update are skipped, on a vector where every
+    // lane's entry is zero. (A non-finite entry still reaches `lambda`: through its own row,
+    // onto the diagonal.)
     let mut lambda = [[T::zero(); K]; K];
     for (i, wi) in w.iter().enumerate() {
         let d = T::one() / m[i][i];
         for (lr, wir) in lambda.iter_mut().zip(wi) {
-            if *wir == T::zero() {
+            if wir.zero_in_every_lane() {
                 continue;
             }
             let s = *wir * d;
@@ -213,11 +251,11 @@ pub(crate) fn contact_space<T: Real, const N: usize, const K: usize>(
             lr[r] = T::one();
         }
     }
-    Cholesky::new(lambda).map_err(shift::<N>)
+    Cholesky::factor(lambda, N, failures)
 }
 
 /// `J^T f` over the rows of `active` only.
-pub(crate) fn transpose_times<T: Real, const N: usize, const K: usize>(
+pub(crate) fn transpose_times<T: Lane, const N: usize, const K: usize>(
     j: &[[T; N]; K],
     f: &[T; K],
     active: &[bool; K],

@@ -7,11 +7,11 @@
 
 use crate::contact::{contact_space, transpose_times};
 use crate::kkt::{
-    column_support, combination_into, dot, finite_rows, finite_solution, ContactKkt,
-    ImpulseDynamicsDerivatives,
+    column_support, combination_into, dot, finite_rows, ContactKkt, ImpulseDynamicsDerivatives,
 };
+use crate::lane::check_finite;
 use crate::tree::{ltdl_lower_rows, TreePasses, Walked};
-use crate::{FactorError, Real};
+use crate::{FactorError, Lane, Real};
 
 impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
     /// The velocity after the impact and the impulses, from the velocity before `v` and the
@@ -152,7 +152,37 @@ pub fn solve_factored_active_by<T: Real, const N: usize, const K: usize>(
     substitute: impl Fn(&[T; N]) -> [T; N],
     lower: impl FnOnce(&mut [[T; K]; N]),
 ) -> Result<([T; N], [T; K]), FactorError> {
-    let chol = contact_space(m, j, active, lower)?;
+    solve_factored_active_lanes(m, (j, active), (v, e), substitute, lower, &mut ())
+}
+
+/// [`solve_factored_active_by`] on a vector of states ([`Lane`], one state per lane), with
+/// the contact Jacobian and the active rows, then the velocity and the restitution, as one
+/// argument each: a lane whose pivot of `J M^-1 J^T` fails, or whose result is not finite,
+/// records its error in `failures` and holds garbage (a scalar returns the error at once, as
+/// [`solve_factored_active_by`]). `active` is every lane's.
+///
+/// ```
+/// use eomgen_runtime::impulse::solve_factored_active_lanes;
+/// use eomgen_runtime::tree::{ltdl_lower_rows, ltdl_substitute};
+/// // The point mass of `solve_factored_active_with`, bouncing back at half its speed.
+/// let (m, parent) = ([[1.0_f64, 0.0], [0.0, 1.0]], [None, None]);
+/// let substitute = |b: &[f64; 2]| ltdl_substitute(&m, &parent, b);
+/// let lower = |w: &mut [[f64; 1]; 2]| ltdl_lower_rows(&m, &parent, w);
+/// let contact = (&[[0.0, 1.0]], &[true]);
+/// let (after, p) =
+///     solve_factored_active_lanes(&m, contact, (&[1.0, -2.0], 0.5), substitute, lower, &mut ())
+///         .unwrap();
+/// assert_eq!((after, p), ([1.0, 1.0], [3.0]));
+/// ```
+pub fn solve_factored_active_lanes<T: Lane, const N: usize, const K: usize>(
+    m: &[[T; N]; N],
+    (j, active): (&[[T; N]; K], &[bool; K]),
+    (v, e): (&[T; N], T),
+    substitute: impl Fn(&[T; N]) -> [T; N],
+    lower: impl FnOnce(&mut [[T; K]; N]),
+    failures: &mut T::Failures,
+) -> Result<([T; N], [T; K]), FactorError> {
+    let chol = contact_space(m, j, active, lower, failures)?;
     let k = -(T::one() + e);
     let mut bottom = [T::zero(); K];
     for ((b, jr), on) in bottom.iter_mut().zip(j).zip(active) {
@@ -161,7 +191,11 @@ pub fn solve_factored_active_by<T: Real, const N: usize, const K: usize>(
         }
     }
     let p = chol.solve(&bottom);
-    let (mut after, p) = finite_solution(substitute(&transpose_times(j, &p, active)), p)?;
+    let mut after = substitute(&transpose_times(j, &p, active));
+    check_finite(&after, failures)?;
+    for (r, pr) in p.iter().enumerate() {
+        T::check_finite(*pr, N + r, failures)?;
+    }
     for (x, vi) in after.iter_mut().zip(v) {
         *x += *vi;
     }

@@ -843,7 +843,7 @@ pub(crate) fn column_support<T: Real, const N: usize, const K: usize>(
     lo..hi
 }
 
-pub(crate) fn dot<T: Real, const N: usize>(a: &[T; N], b: &[T; N]) -> T {
+pub(crate) fn dot<T: crate::Lane, const N: usize>(a: &[T; N], b: &[T; N]) -> T {
     // Eight partial sums, one per lane of a vector: one long chain of dependent additions was
     // a twentieth of a humanoid's impulse dynamics (twelve of them, 35 terms each).
     let mut part = [T::zero(); 8];

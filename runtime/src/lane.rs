@@ -111,6 +111,18 @@ pub trait Lane: Copy + Debug + Default + Arithmetic + 'static {
     fn all(mask: Self::Mask) -> bool;
     /// The lowest lane that recorded a failure, with its error.
     fn first_failure(failures: &Self::Failures) -> Option<LaneError>;
+    /// Whether `self` is zero in every lane (no lane NaN, infinite or anything but zero): a
+    /// multiply-add by it changes no lane of a sum, so sparse kernels skip it. A scalar
+    /// compares once.
+    ///
+    /// ```
+    /// use eomgen_runtime::Lane;
+    /// assert!(0.0_f64.zero_in_every_lane() && !f64::NAN.zero_in_every_lane());
+    /// ```
+    #[inline(always)]
+    fn zero_in_every_lane(self) -> bool {
+        !Self::any(self.abs().gt(Self::zero())) && Self::all(self.finite())
+    }
 }
 
 /// The operators of [`Real`] and [`Lane`]: `+ - * /`, their assignments and negation, all
@@ -342,6 +354,10 @@ impl<T: Real> Lane for T {
     #[inline(always)]
     fn failed(_: &()) -> bool {
         false
+    }
+    #[inline(always)]
+    fn zero_in_every_lane(self) -> bool {
+        self == T::zero()
     }
     #[inline(always)]
     fn any(mask: bool) -> bool {

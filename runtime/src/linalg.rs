@@ -309,11 +309,24 @@ impl<T: Real, const N: usize> Cholesky<T, N> {
     /// Factorizes `m` (lower triangle read). Errors on the first pivot `L_jj²` that is not
     /// finite or not strictly positive.
     pub fn new(m: [[T; N]; N]) -> Result<Self, FactorError> {
+        Self::factor(m, 0, &mut ())
+    }
+}
+
+impl<T: Lane, const N: usize> Cholesky<T, N> {
+    /// [`Cholesky::new`] on a vector of states: pivot `j` is checked as pivot `offset + j`
+    /// ([`Lane::check_pivot`]: a scalar returns its error at once, a vector records it in
+    /// `failures` and goes on, NaN then filling that lane).
+    pub(crate) fn factor(
+        m: [[T; N]; N],
+        offset: usize,
+        failures: &mut T::Failures,
+    ) -> Result<Self, FactorError> {
         let mut l = [[T::zero(); N]; N];
         let mut diag_inv = [T::zero(); N];
         for j in 0..N {
             let d = m[j][j] - dot_prefix(&l[j], &l[j], j);
-            <T as Lane>::check_pivot(d, j, &mut ())?;
+            T::check_pivot(d, offset + j, failures)?;
             // `1 / L_jj = L_jj / d`: the division starts with the square root instead of after
             // it, which takes a division's latency off each column's critical path.
             let (ljj, r) = (d.sqrt(), T::one() / d);
