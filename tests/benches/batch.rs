@@ -2,8 +2,9 @@
 //! one core (`scalar`), the `_batch` methods on the target's widest SIMD lanes on one core
 //! (`batch`: `f64x4` and `f32x8` with AVX), and the same over every core (`threads`), for the
 //! panda (9 coordinates) and anymal (floating base, 18), in `f64` and `f32`, and anymal's
-//! contact forward dynamics and impulse dynamics on its four feet (and their derivatives, whose
-//! batch runs state by state: `batch` is then the scalar code through it). Named
+//! contact forward dynamics and impulse dynamics on its four feet, with two of them switched on
+//! at run time (`_active`), and the derivatives on four feet, whose batch runs state by state
+//! (`batch` is then the scalar code through it). Named
 //! `batch-<robot>-<scalar>/<function>/<way>`; criterion prints states per second
 //! (`thrpt`). Needs the `rayon` feature:
 //!
@@ -181,6 +182,29 @@ fn anymal_contacts<S: Batch>(c: &mut Criterion, pools: &Pools, label: &str) {
     });
 }
 
+/// anymal trotting: contact forward dynamics and impulse dynamics with two diagonal feet of
+/// four, the set passed at run time (`_active`, on lanes: the runtime's solves over every lane
+/// at once).
+fn anymal_active<S: Batch>(c: &mut Criterion, pools: &Pools, label: &str) {
+    let robot = AnymalMpc::<S>::default();
+    let q = configurations::<S, 19>(13);
+    let (v, tau) = (states::<S, 18>(14, 1.0), states::<S, 18>(15, 10.0));
+    let (z, f) = ([S::zero(); 18], [S::zero(); 12]);
+    let trot = [true, false, false, true];
+    let mut g = group(c, &format!("batch-anymal-contacts-{label}"));
+    three_ways!(g, pools, "contact_forward_dynamics_active", (a: z, b: f), |i| {
+        (a[i], b[i]) = robot.contact_forward_dynamics_active(black_box(&q[i]), &v[i], &tau[i], &trot);
+    }, {
+        robot.contact_forward_dynamics_active_batch(black_box(&q), &v, &tau, &trot, &mut a, &mut b).unwrap()
+    });
+    let e = S::from_f64(0.2);
+    three_ways!(g, pools, "impulse_dynamics_active", (a: z, b: f), |i| {
+        (a[i], b[i]) = robot.impulse_dynamics_active(black_box(&q[i]), &v[i], e, &trot);
+    }, {
+        robot.impulse_dynamics_active_batch(black_box(&q), &v, e, &trot, &mut a, &mut b).unwrap()
+    });
+}
+
 /// anymal's contact forward dynamics derivatives (four feet), whose batch runs the scalar
 /// method state by state: `batch` is the scalar code through the batch method, `threads` the
 /// same over every core.
@@ -209,6 +233,8 @@ fn batch(c: &mut Criterion) {
     anymal::<f32>(c, &pools, "f32");
     anymal_contacts::<f64>(c, &pools, "f64");
     anymal_contacts::<f32>(c, &pools, "f32");
+    anymal_active::<f64>(c, &pools, "f64");
+    anymal_active::<f32>(c, &pools, "f32");
     anymal_contact_derivatives(c, &pools);
 }
 

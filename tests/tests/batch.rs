@@ -543,6 +543,114 @@ fn a_failed_contact_lane_is_named_and_the_others_are_unaffected() {
     }
 }
 
+#[test]
+fn active_contacts_on_four_lanes_name_the_failed_lane() {
+    use eomgen_tests::robots::anymal_mpc::AnymalMpc;
+    let robot = AnymalMpc::<f64>::default();
+    let wide = robot.in_lanes::<f64x4>();
+    let mut n = Numbers(14);
+    let (mut q, mut v) = anymal_states(&mut n, 4);
+    let tau = n.states::<18>(4, 20.0);
+    // Lane 1 fails in M's factorization, lane 3 in its result (an infinite velocity).
+    q[1][9] = f64::NAN;
+    v[3][10] = f64::INFINITY;
+    let active = [true, false, true, true];
+    let (ql, vl, tl): ([f64x4; 19], [f64x4; 18], [f64x4; 18]) =
+        (gather(&q, 0), gather(&v, 0), gather(&tau, 0));
+    let err = wide
+        .try_contact_forward_dynamics_active_lanes(&ql, &vl, &tl, &active)
+        .unwrap_err();
+    let scalar =
+        |l: usize| robot.try_contact_forward_dynamics_active(&q[l], &v[l], &tau[l], &active);
+    let first = scalar(1).unwrap_err();
+    assert_eq!(
+        err,
+        LaneError {
+            lane: 1,
+            error: first
+        }
+    );
+    assert_eq!(
+        wide.try_contact_forward_dynamics_active(&ql, &vl, &tl, &active),
+        Err(first)
+    );
+    assert!(scalar(3).is_err() && scalar(0).is_ok() && scalar(2).is_ok());
+    let (a, f) = wide.contact_forward_dynamics_active(&ql, &vl, &tl, &active);
+    for l in 0..4 {
+        let one: Vec<f64> = a.iter().chain(&f).map(|x| x.lane(l)).collect();
+        assert_eq!(one.iter().all(|x| x.is_nan()), l == 1 || l == 3, "lane {l}");
+        let (want_a, want_f) =
+            robot.contact_forward_dynamics_active(&q[l], &v[l], &tau[l], &active);
+        let want: Vec<f64> = want_a.iter().chain(&want_f).copied().collect();
+        assert_close(
+            "f64x4 contact forward dynamics, two feet",
+            l,
+            &one,
+            &want,
+            0.0,
+        );
+        // The inactive foot's forces are zero where the lane did not fail.
+        if l % 2 == 0 {
+            assert!(want_f[3..6].iter().all(|x| *x == 0.0), "lane {l}");
+        }
+    }
+    // Impulse dynamics at the same feet: lane 1 fails in M, lane 3 (its velocity infinite) in
+    // its result.
+    let e = 0.4;
+    let err = wide
+        .try_impulse_dynamics_active_lanes(&ql, &vl, f64x4::splat(e), &active)
+        .unwrap_err();
+    let scalar = |l: usize| robot.try_impulse_dynamics_active(&q[l], &v[l], e, &active);
+    assert_eq!(
+        err,
+        LaneError {
+            lane: 1,
+            error: scalar(1).unwrap_err()
+        }
+    );
+    assert!(scalar(3).is_err() && scalar(0).is_ok() && scalar(2).is_ok());
+    let (after, p) = wide.impulse_dynamics_active(&ql, &vl, f64x4::splat(e), &active);
+    for l in 0..4 {
+        let one: Vec<f64> = after.iter().chain(&p).map(|x| x.lane(l)).collect();
+        assert_eq!(one.iter().all(|x| x.is_nan()), l == 1 || l == 3, "lane {l}");
+        let (want_v, want_p) = robot.impulse_dynamics_active(&q[l], &v[l], e, &active);
+        let want: Vec<f64> = want_v.iter().chain(&want_p).copied().collect();
+        assert_close("f64x4 impulse dynamics, two feet", l, &one, &want, 0.0);
+    }
+}
+
+/// Both `_active` batches on lanes equal the scalar methods, with NaN and infinite states
+/// between finite ones, and a set of contacts other than the one-contact-off sets above.
+#[test]
+fn active_contact_batches_equal_the_scalar_code() {
+    use eomgen_tests::robots::anymal_mpc::AnymalMpc;
+    let robot = AnymalMpc::<f64>::default();
+    let mut n = Numbers(15);
+    let (mut q, mut v) = anymal_states(&mut n, STATES);
+    spoil(&mut q, &mut v);
+    let tau = n.states::<18>(STATES, 20.0);
+    for active in [[false, true, true, false], [true; 4], [false; 4]] {
+        let (mut a, mut f) = (vec![[0.0; 18]; STATES], vec![[0.0; 12]; STATES]);
+        robot
+            .contact_forward_dynamics_active_batch(&q, &v, &tau, &active, &mut a, &mut f)
+            .unwrap();
+        let (mut after, mut p) = (vec![[0.0; 18]; STATES], vec![[0.0; 12]; STATES]);
+        robot
+            .impulse_dynamics_active_batch(&q, &v, 0.2, &active, &mut after, &mut p)
+            .unwrap();
+        for i in 0..STATES {
+            let (want_a, want_f) =
+                robot.contact_forward_dynamics_active(&q[i], &v[i], &tau[i], &active);
+            assert_close("active accelerations", i, &a[i], &want_a, 0.0);
+            assert_close("active forces", i, &f[i], &want_f, 0.0);
+            let (want_v, want_p) = robot.impulse_dynamics_active(&q[i], &v[i], 0.2, &active);
+            assert_close("velocity after an impact", i, &after[i], &want_v, 0.0);
+            assert_close("active impulses", i, &p[i], &want_p, 0.0);
+            assert!(want_a.iter().all(|x| x.is_finite()) == (i != 2 && i != 5));
+        }
+    }
+}
+
 impl<const N: usize, const K: usize> Flat
     for eomgen_runtime::ContactDynamicsDerivatives<f64, N, K>
 {
@@ -592,6 +700,8 @@ fn each_state<X: Flat>(what: &str, got: &[X], want: impl Fn(usize) -> X) {
     }
 }
 
+/// The state-by-state batches, and beside them contact forward dynamics with active
+/// contacts (on lanes on this robot), with NaN and infinite states between finite ones.
 #[test]
 fn methods_off_the_lanes_in_batches_equal_the_scalar_code() {
     use eomgen_runtime::{Baumgarte, ContactDynamicsDerivatives, ImpulseDynamicsDerivatives};

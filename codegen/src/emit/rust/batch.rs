@@ -261,36 +261,18 @@ impl Emitter<'_> {
             },
             _ => outputs(self.result_shapes(q)),
         };
-        // Link kinematics takes its link first, the same for every state.
-        let link = matches!(
-            q.eval,
-            Evaluation::LinkPose | Evaluation::LinkJacobian | Evaluation::FrameMotion(_)
+        let Shared {
+            link_param,
+            params: shared_params,
+            to_lanes,
+            args: shared_args,
+        } = self.shared_params(q);
+        let call_args = shared_args.0.into_iter().chain(
+            inputs
+                .iter()
+                .map(|i| quote!(&::eomgen_runtime::batch::gather(#i, start)))
+                .chain(shared_args.1),
         );
-        let (link_param, link_arg) = if link {
-            let t = &self.link_ty;
-            (quote!(link: #t,), Some(quote!(link)))
-        } else {
-            (TokenStream::new(), None)
-        };
-        let shared = shared_scalar(&q.eval);
-        let (dt, dt_lanes) = match &shared {
-            Some(x) => {
-                let l = lanes();
-                (
-                    quote!(#x: T,),
-                    quote!(let #x = <#l as ::eomgen_runtime::Lane>::from_f64(::eomgen_runtime::Real::to_f64(#x));),
-                )
-            }
-            None => (TokenStream::new(), TokenStream::new()),
-        };
-        let call_args = link_arg
-            .into_iter()
-            .chain(
-                inputs
-                    .iter()
-                    .map(|i| quote!(&::eomgen_runtime::batch::gather(#i, start))),
-            )
-            .chain(shared.iter().map(|x| quote!(#x)));
         let path = self.lane_path(q.name);
         let first = &outs[0];
         let checked = inputs.iter().chain(&outs[1..]).map(|a| {
@@ -327,10 +309,10 @@ impl Emitter<'_> {
         };
         quote! {
             #[doc = #doc]
-            pub fn #f(&self, #link_param #(#inputs: &[[T; #input_types]],)* #dt #(#outs: &mut [#out_types]),*) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+            pub fn #f(&self, #link_param #(#inputs: &[[T; #input_types]],)* #shared_params #(#outs: &mut [#out_types]),*) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
                 ::eomgen_runtime::batch::check(#first.len(), &[#(#checked),*])?;
                 let robot = self.in_lanes::<#l>();
-                #dt_lanes
+                #to_lanes
                 ::eomgen_runtime::batch::run_costed(<#l as ::eomgen_runtime::Lane>::LANES, #ops, #passed, &|start: usize, #pattern| {
                     #evaluate
                 });
@@ -338,4 +320,51 @@ impl Emitter<'_> {
             }
         }
     }
+
+    /// What every state of `q`'s batch shares, passed once: link kinematics' link (first),
+    /// and after the inputs a restitution or time step (turned into lanes once) and the active
+    /// contacts, in the order the scalar method takes them.
+    fn shared_params(&self, q: &Quantity) -> Shared {
+        let link = matches!(
+            q.eval,
+            Evaluation::LinkPose | Evaluation::LinkJacobian | Evaluation::FrameMotion(_)
+        );
+        let (link_param, link_arg) = if link {
+            let t = &self.link_ty;
+            (quote!(link: #t,), Some(quote!(link)))
+        } else {
+            (TokenStream::new(), None)
+        };
+        let scalar = shared_scalar(&q.eval);
+        let (mut params, mut to_lanes) = (TokenStream::new(), TokenStream::new());
+        if let Some(x) = &scalar {
+            let l = lanes();
+            params = quote!(#x: T,);
+            to_lanes = quote!(let #x = <#l as ::eomgen_runtime::Lane>::from_f64(::eomgen_runtime::Real::to_f64(#x)););
+        }
+        let mut after: Vec<TokenStream> = scalar.iter().map(|x| quote!(#x)).collect();
+        if matches!(q.eval, Evaluation::ActiveContacts(_)) {
+            let c = usize_lit(self.contact_rows.len());
+            params = quote!(#params active: &[bool; #c],);
+            after.push(quote!(active));
+        }
+        Shared {
+            link_param,
+            params,
+            to_lanes,
+            args: (link_arg, after),
+        }
+    }
+}
+
+/// [`Emitter::shared_params`]' parameters, statements and arguments.
+struct Shared {
+    /// The link parameter, before the inputs.
+    link_param: TokenStream,
+    /// The parameters after the inputs.
+    params: TokenStream,
+    /// What turns them into lanes.
+    to_lanes: TokenStream,
+    /// The arguments before the inputs, and after them.
+    args: (Option<TokenStream>, Vec<TokenStream>),
 }

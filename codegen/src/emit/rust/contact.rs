@@ -5,6 +5,12 @@
 use proc_macro2::{Ident, TokenStream};
 use quote::{format_ident, quote};
 
+/// The `try_` doc of contact forward dynamics with active contacts, around its name.
+const ACTIVE_WHY: (&str, &str) = (
+    "The accelerations and contact forces of",
+    ", or why they do not exist: a pivot of M(q) (`pivot` < N) or of the active rows' `J_c M^-1 J_c^T` (`pivot` - N) that is not positive, or non-finite input.",
+);
+
 use super::{usize_lit, Emitter};
 use crate::cas::{Id, OpCount};
 use crate::dynamics::{Quantity, Shape};
@@ -144,42 +150,26 @@ impl Emitter<'_> {
         h: &[Id],
         stabilized: bool,
     ) -> TokenStream {
+        if !stabilized {
+            return self.contact_active_checked_fns(q, h);
+        }
         let (hb, ops) = self.active_bias(q, h);
         let docs = Self::quantity_doc(q, Some(ops));
         let (n, nq, k) = (&self.n, &self.nq, &self.k);
         let c = usize_lit(self.contact_rows.len());
-        let s = self.signature(
-            q,
-            true,
-            (
-                "The accelerations and contact forces of",
-                ", or why they do not exist: a pivot of M(q) (`pivot` < N) or of the active rows' `J_c M^-1 J_c^T` (`pivot` - N) that is not positive, or non-finite input.",
-            ),
-        );
+        let s = self.signature(q, true, ACTIVE_WHY);
         let free = self.free_accelerations(&hb);
         let (j, drift) = (self.call("contact_jacobian"), self.call("contact_drift"));
-        let (param, arg, drift) = if stabilized {
-            let placements = self.call("contact_placements");
-            (
-                quote!(, baumgarte: &::eomgen_runtime::Baumgarte<T, #c>),
-                quote!(, baumgarte),
-                quote! {
-                    let mut drift = #drift(self, q, qd);
-                    baumgarte.correct_drift(&Self::CONTACT_ROWS, &#placements(self, q), &j, qd, &mut drift);
-                },
-            )
-        } else {
-            let drift = quote!(let drift = #drift(self, q, qd););
-            (TokenStream::new(), TokenStream::new(), drift)
-        };
+        let placements = self.call("contact_placements");
         let (name, try_name, active, active_arg, why) =
             (&s.name, &s.try_name, &s.param, &s.arg, &s.why);
         quote! {
             #[doc = #why]
-            pub fn #try_name(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n] #active #param) -> ::core::result::Result<([T; #n], [T; #k]), ::eomgen_runtime::FactorError> {
+            pub fn #try_name(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n] #active, baumgarte: &::eomgen_runtime::Baumgarte<T, #c>) -> ::core::result::Result<([T; #n], [T; #k]), ::eomgen_runtime::FactorError> {
                 #free
                 let j = #j(self, q);
-                #drift
+                let mut drift = #drift(self, q, qd);
+                baumgarte.correct_drift(&Self::CONTACT_ROWS, &#placements(self, q), &j, qd, &mut drift);
                 let rows = ::eomgen_runtime::contact::row_mask(&Self::CONTACT_ROWS, active);
                 let substitute = |b: &[T; #n]| Self::ltdl_substitute_unrolled(&m, b);
                 let lower = |w: &mut [[T; #k]; #n]| Self::ltdl_lower_rows_unrolled(&m, w);
@@ -187,13 +177,45 @@ impl Emitter<'_> {
             }
 
             #docs
-            pub fn #name(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n] #active #param) -> ([T; #n], [T; #k]) {
-                match self.#try_name(q, qd, tau #active_arg #arg) {
+            pub fn #name(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n] #active, baumgarte: &::eomgen_runtime::Baumgarte<T, #c>) -> ([T; #n], [T; #k]) {
+                match self.#try_name(q, qd, tau #active_arg, baumgarte) {
                     Ok(x) => x,
                     Err(_) => ([T::nan(); #n], [T::nan(); #k]),
                 }
             }
         }
+    }
+
+    /// `contact_forward_dynamics_active` for every `T: Lane` where its callees are (one state
+    /// per lane; `active` every lane's): `contact_forward_dynamics_active_checked` records
+    /// each lane's failed pivot or non-finite result
+    /// (`eomgen_runtime::contact::solve_factored_active_lanes`), `try_` gives the lowest
+    /// failed lane's error, `try_contact_forward_dynamics_active_lanes` says which lane, and
+    /// the plain method gives NaN in the failed lanes alone. On a scalar, the same as the
+    /// stabilized form's route.
+    fn contact_active_checked_fns(&mut self, q: &Quantity, h: &[Id]) -> TokenStream {
+        let (hb, ops) = self.active_bias(q, h);
+        let docs = Self::quantity_doc(q, Some(ops));
+        let (n, nq, k) = (&self.n, &self.nq, &self.k);
+        let c = usize_lit(self.contact_rows.len());
+        let why = self.signature(q, true, ACTIVE_WHY).why;
+        let free = self.free_accelerations_recording(&hb, quote!(&mut failures));
+        let (j, drift) = (self.call("contact_jacobian"), self.call("contact_drift"));
+        let params = quote!(q: &[T; #nq], qd: &[T; #n], tau: &[T; #n], active: &[bool; #c]);
+        let body = quote! {
+            #free
+            let j = #j(self, q);
+            let drift = #drift(self, q, qd);
+            let rows = ::eomgen_runtime::contact::row_mask(&Self::CONTACT_ROWS, active);
+            let substitute = |b: &[T; #n]| Self::ltdl_substitute_unrolled(&m, b);
+            let lower = |w: &mut [[T; #k]; #n]| Self::ltdl_lower_rows_unrolled(&m, w);
+            let system = (&j, &drift, &rows);
+            let x = ::eomgen_runtime::contact::solve_factored_active_lanes(&m, &free, system, substitute, lower, &mut failures)?;
+            Ok((x, failures))
+        };
+        let args = quote!(q, qd, tau, active);
+        let what = "accelerations and forces";
+        self.lane_checked_fns(q.name, (params, args), (why, what, docs), body)
     }
 
     /// `try_contact_forward_dynamics_derivatives` and `contact_forward_dynamics_derivatives`
@@ -324,6 +346,9 @@ impl Emitter<'_> {
     /// `try_impulse_dynamics` and `impulse_dynamics` (NaN on failure), or their `_active`
     /// variants.
     pub(super) fn impulse_dynamics_fns(&mut self, q: &Quantity, active: bool) -> TokenStream {
+        if active {
+            return self.impulse_active_checked_fns(q);
+        }
         let docs = Self::quantity_doc(q, None);
         let (n, nq, k) = (self.n.clone(), self.nq.clone(), self.k.clone());
         let (m, j) = (self.call("mass_matrix"), self.call("contact_jacobian"));
@@ -360,6 +385,39 @@ impl Emitter<'_> {
                 }
             }
         }
+    }
+
+    /// `impulse_dynamics_active` for every `T: Lane` where its callees are, as
+    /// `contact_forward_dynamics_active` (`Emitter::contact_active_checked_fns`): its
+    /// `_checked` method records each lane's failure
+    /// (`eomgen_runtime::impulse::solve_factored_active_lanes`).
+    fn impulse_active_checked_fns(&mut self, q: &Quantity) -> TokenStream {
+        let docs = Self::quantity_doc(q, None);
+        let (n, nq, k) = (&self.n, &self.nq, &self.k);
+        let c = usize_lit(self.contact_rows.len());
+        let (m, j) = (self.call("mass_matrix"), self.call("contact_jacobian"));
+        let params = quote!(q: &[T; #nq], qd: &[T; #n], restitution: T, active: &[bool; #c]);
+        let why = format!(
+            " The velocity after the impact and the impulses of `{}`, or why they do not exist: \
+             a pivot of M(q) (`pivot` < N) or of the active rows' `J_c M^-1 J_c^T` (`pivot` - \
+             N) that is not positive, or a non-finite result. On a vector of states, the lowest \
+             failed lane's error.",
+            q.name
+        );
+        let body = quote! {
+            // M's factors and J_c, no KKT system: M^-1 meets the one vector J_c^T p.
+            let mut m = #m(self, q);
+            let j = #j(self, q);
+            Self::ltdl_factor_unrolled(&mut m, &mut failures)?;
+            let substitute = |b: &[T; #n]| Self::ltdl_substitute_unrolled(&m, b);
+            let lower = |w: &mut [[T; #k]; #n]| Self::ltdl_lower_rows_unrolled(&m, w);
+            let rows = ::eomgen_runtime::contact::row_mask(&Self::CONTACT_ROWS, active);
+            let x = ::eomgen_runtime::impulse::solve_factored_active_lanes(&m, (&j, &rows), (qd, restitution), substitute, lower, &mut failures)?;
+            Ok((x, failures))
+        };
+        let args = quote!(q, qd, restitution, active);
+        let what = "velocity and impulses";
+        self.lane_checked_fns(q.name, (params, args), (why, what, docs), body)
     }
 
     /// `try_impulse_dynamics` and `impulse_dynamics` from one straight-line program at

@@ -1,15 +1,16 @@
 //! Which generated methods run on vectors of states (`eomgen_runtime::Lane`): those whose
 //! code is arithmetic, pivot checks and the runtime kernels that take a `Lane`, and whose
 //! callees do too (contact forward dynamics and impulse dynamics when each is one straight-line
-//! program; link kinematics, whose runtime kernels walk chains of poses). They live in the
-//! `impl<T: Lane>` blocks; the rest (the manifold, the contact solves at run time and the
+//! program, and then contact forward dynamics and impulse dynamics with active contacts, whose
+//! runtime solves take a `Lane`; link kinematics, whose runtime kernels walk chains of poses). They live in the
+//! `impl<T: Lane>` blocks; the rest (the manifold, the other contact solves at run time and the
 //! contact derivatives) in `impl<T: Real>`.
 
 use std::collections::BTreeSet;
 
 use super::traits::Trait;
 use super::Emitter;
-use crate::dynamics::{Evaluation, Quantity};
+use crate::dynamics::{ActiveContacts, Evaluation, Quantity};
 
 /// Whether a quantity's own evaluation runs on lanes (its callees aside).
 fn evaluation_on_lanes(q: &Quantity) -> bool {
@@ -28,6 +29,7 @@ fn evaluation_on_lanes(q: &Quantity) -> bool {
             | Evaluation::LinkPose
             | Evaluation::LinkJacobian
             | Evaluation::FrameMotion(_)
+            | Evaluation::ActiveContacts(ActiveContacts::Dynamics { .. } | ActiveContacts::Impulse)
     )
 }
 

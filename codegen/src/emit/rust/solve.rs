@@ -350,6 +350,17 @@ impl Emitter<'_> {
     /// (returning its error) and the accelerations without contacts `M^-1 (tau - h)`, `h` by
     /// the straight-line block `hb`.
     pub(super) fn free_accelerations(&self, hb: &TokenStream) -> TokenStream {
+        self.free_accelerations_recording(hb, quote!(&mut ::core::default::Default::default()))
+    }
+
+    /// [`Emitter::free_accelerations`] with `M`'s pivots checked into `failures` (an
+    /// expression of type `&mut <T as Lane>::Failures`), so that a vector's failed lanes are
+    /// known.
+    pub(super) fn free_accelerations_recording(
+        &self,
+        hb: &TokenStream,
+        failures: TokenStream,
+    ) -> TokenStream {
         let (n, m) = (&self.n, self.call("mass_matrix"));
         quote! {
             let mut m = #m(self, q);
@@ -358,7 +369,7 @@ impl Emitter<'_> {
             for (r, h) in rhs.iter_mut().zip(h) {
                 *r -= h;
             }
-            Self::ltdl_factor_unrolled(&mut m, &mut ::core::default::Default::default())?;
+            Self::ltdl_factor_unrolled(&mut m, #failures)?;
             let free = Self::ltdl_substitute_unrolled(&m, &rhs);
         }
     }
@@ -527,6 +538,41 @@ impl Emitter<'_> {
                     Err(_) => ([T::nan(); #n], [T::nan(); #k]),
                 }
             }
+        }
+    }
+
+    /// A pair-valued method on every `T: Lane` from the body of its `{name}_checked(params)`
+    /// (which declares `failures`, fills it and ends in `Ok(((x, y), failures))`): `try_{name}`
+    /// (the lowest failed lane's error, documented by `why`), the checked method itself (its
+    /// `what` in the doc), and [`Emitter::lane_pair_fns`]' `try_{name}_lanes` and `{name}`.
+    pub(super) fn lane_checked_fns(
+        &self,
+        name: &str,
+        (params, args): (TokenStream, TokenStream),
+        (why, what, docs): (String, &str, TokenStream),
+        body: TokenStream,
+    ) -> TokenStream {
+        let (n, k, lane) = (&self.n, &self.k, quote!(::eomgen_runtime::lane));
+        let failures = quote!(<T as ::eomgen_runtime::Lane>::Failures);
+        let try_name = quote::format_ident!("try_{}", name);
+        let checked = quote::format_ident!("{}_checked", name);
+        let doc =
+            format!(" The {what}, and each lane's failure (a scalar returns its first at once).");
+        let wrappers = self.lane_pair_fns(name, params.clone(), args.clone(), docs);
+        quote! {
+            #[doc = #why]
+            pub fn #try_name(&self, #params) -> ::core::result::Result<([T; #n], [T; #k]), ::eomgen_runtime::FactorError> {
+                let (x, failures) = self.#checked(#args)?;
+                #lane::lanes_ok::<_, T>(x, &failures).map_err(|e| e.error)
+            }
+
+            #[doc = #doc]
+            fn #checked(&self, #params) -> ::core::result::Result<(([T; #n], [T; #k]), #failures), ::eomgen_runtime::FactorError> {
+                let mut failures: #failures = ::core::default::Default::default();
+                #body
+            }
+
+            #wrappers
         }
     }
 
