@@ -5,15 +5,15 @@
 use proc_macro2::{Ident, TokenStream};
 use quote::{format_ident, quote};
 
+use super::{usize_lit, Emitter};
+use crate::cas::{Id, OpCount};
+use crate::dynamics::{Quantity, Shape};
+
 /// The `try_` doc of contact forward dynamics with active contacts, around its name.
 const ACTIVE_WHY: (&str, &str) = (
     "The accelerations and contact forces of",
     ", or why they do not exist: a pivot of M(q) (`pivot` < N) or of the active rows' `J_c M^-1 J_c^T` (`pivot` - N) that is not positive, or non-finite input.",
 );
-
-use super::{usize_lit, Emitter};
-use crate::cas::{Id, OpCount};
-use crate::dynamics::{Quantity, Shape};
 
 /// The names and extra argument of a method with or without a set of active contacts.
 struct Signature {
@@ -141,9 +141,9 @@ impl Emitter<'_> {
         (call, ops)
     }
 
-    /// `try_contact_forward_dynamics_active` and `contact_forward_dynamics_active` (NaN on
-    /// failure), or with `stabilized` the same of `contact_forward_dynamics_stabilized`, which
-    /// takes an `eomgen_runtime::Baumgarte` after `active`.
+    /// `try_contact_forward_dynamics_stabilized` and `contact_forward_dynamics_stabilized` (NaN
+    /// on failure), which take an `eomgen_runtime::Baumgarte` after `active`; without
+    /// `stabilized`, [`Emitter::contact_active_checked_fns`].
     pub(super) fn contact_active_fns(
         &mut self,
         q: &Quantity,
@@ -191,14 +191,15 @@ impl Emitter<'_> {
     /// each lane's failed pivot or non-finite result
     /// (`eomgen_runtime::contact::solve_factored_active_lanes`), `try_` gives the lowest
     /// failed lane's error, `try_contact_forward_dynamics_active_lanes` says which lane, and
-    /// the plain method gives NaN in the failed lanes alone. On a scalar, the same as the
-    /// stabilized form's route.
+    /// the plain method gives NaN in the failed lanes alone. On a scalar, the stabilized
+    /// form's route without its drift correction.
     fn contact_active_checked_fns(&mut self, q: &Quantity, h: &[Id]) -> TokenStream {
         let (hb, ops) = self.active_bias(q, h);
         let docs = Self::quantity_doc(q, Some(ops));
         let (n, nq, k) = (&self.n, &self.nq, &self.k);
         let c = usize_lit(self.contact_rows.len());
         let why = self.signature(q, true, ACTIVE_WHY).why;
+        let why = format!("{why} On a vector of states, the lowest failed lane's error.");
         let free = self.free_accelerations_recording(&hb, quote!(&mut failures));
         let (j, drift) = (self.call("contact_jacobian"), self.call("contact_drift"));
         let params = quote!(q: &[T; #nq], qd: &[T; #n], tau: &[T; #n], active: &[bool; #c]);
