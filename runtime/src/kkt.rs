@@ -843,6 +843,9 @@ pub(crate) fn column_support<T: Real, const N: usize, const K: usize>(
     lo..hi
 }
 
+/// `a . b`. Inlined where it is called: bounded by `Lane`, the optimizer had stopped inlining
+/// it (96 calls in the batch bench's binary, none before), in the contact solves' loops too.
+#[inline]
 pub(crate) fn dot<T: crate::Lane, const N: usize>(a: &[T; N], b: &[T; N]) -> T {
     // Eight partial sums, one per lane of a vector: one long chain of dependent additions was
     // a twentieth of a humanoid's impulse dynamics (twelve of them, 35 terms each).
