@@ -335,25 +335,42 @@ impl Emitter<'_> {
         } else {
             (TokenStream::new(), None)
         };
-        let scalar = shared_scalar(&q.eval);
-        let (mut params, mut to_lanes) = (TokenStream::new(), TokenStream::new());
-        if let Some(x) = &scalar {
+        let (names, types): (Vec<Ident>, Vec<TokenStream>) =
+            self.shared_values(q).into_iter().unzip();
+        let params = quote!(#(#names: #types,)*);
+        let to_lanes = shared_scalar(&q.eval).map(|x| {
             let l = lanes();
-            params = quote!(#x: T,);
-            to_lanes = quote!(let #x = <#l as ::eomgen_runtime::Lane>::from_f64(::eomgen_runtime::Real::to_f64(#x)););
-        }
-        let mut after: Vec<TokenStream> = scalar.iter().map(|x| quote!(#x)).collect();
-        if matches!(q.eval, Evaluation::ActiveContacts(_)) {
-            let c = usize_lit(self.contact_rows.len());
-            params = quote!(#params active: &[bool; #c],);
-            after.push(quote!(active));
-        }
+            quote!(let #x = <#l as ::eomgen_runtime::Lane>::from_f64(::eomgen_runtime::Real::to_f64(#x));)
+        });
+        let after = names.iter().map(|x| quote!(#x)).collect();
         Shared {
             link_param,
             params,
-            to_lanes,
+            to_lanes: to_lanes.unwrap_or_default(),
             args: (link_arg, after),
         }
+    }
+
+    /// What every state of `q` shares after its inputs, in the order its scalar method takes
+    /// them, with their types: a time step or restitution, the active contacts, Baumgarte's
+    /// gains. Both kinds of batch pass them once.
+    pub(super) fn shared_values(&self, q: &Quantity) -> Vec<(Ident, TokenStream)> {
+        let c = usize_lit(self.contact_rows.len());
+        let mut out: Vec<(Ident, TokenStream)> = shared_scalar(&q.eval)
+            .map(|x| (x, quote!(T)))
+            .into_iter()
+            .collect();
+        if matches!(q.eval, Evaluation::ActiveContacts(_)) {
+            out.push((format_ident!("active"), quote!(&[bool; #c])));
+        }
+        if matches!(
+            q.eval,
+            Evaluation::ActiveContacts(ActiveContacts::Stabilized { .. })
+        ) {
+            let gains = quote!(&::eomgen_runtime::Baumgarte<T, #c>);
+            out.push((format_ident!("baumgarte"), gains));
+        }
+        out
     }
 }
 

@@ -8,7 +8,6 @@
 use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote};
 
-use super::batch::shared_scalar;
 use super::{usize_lit, Emitter};
 use crate::dynamics::{ActiveContacts, Evaluation, Manifold, Quantity};
 use crate::emit::body::shape_type;
@@ -28,10 +27,6 @@ struct StateSignature {
     outputs: Vec<TokenStream>,
 }
 
-fn shared(name: &str, ty: TokenStream) -> Param {
-    Param::Shared(format_ident!("{}", name), ty)
-}
-
 impl Emitter<'_> {
     /// The `NAME_batch` of every method generated for `T: Real` alone.
     pub(super) fn state_batch_fns(&self) -> Vec<TokenStream> {
@@ -47,22 +42,16 @@ impl Emitter<'_> {
     /// restitution, the active contacts, Baumgarte gains).
     fn state_signature(&self, q: &Quantity) -> StateSignature {
         let (n, k) = (&self.n, &self.k);
-        let c = usize_lit(self.contact_rows.len());
-        let active = matches!(q.eval, Evaluation::ActiveContacts(_))
-            .then(|| shared("active", quote!(&[bool; #c])));
-        let gains = matches!(
-            q.eval,
-            Evaluation::ActiveContacts(ActiveContacts::Stabilized { .. })
-        )
-        .then(|| shared("baumgarte", quote!(&::eomgen_runtime::Baumgarte<T, #c>)));
         let params = q
             .inputs
             .iter()
             .zip(self.state_names(q))
             .map(|(i, name)| Param::State(name, self.input_len(*i).clone()))
-            .chain(shared_scalar(&q.eval).map(|x| Param::Shared(x, quote!(T))))
-            .chain(active)
-            .chain(gains)
+            .chain(
+                self.shared_values(q)
+                    .into_iter()
+                    .map(|(x, t)| Param::Shared(x, t)),
+            )
             .collect();
         let outputs = match q.eval {
             Evaluation::ContactDynamicsDerivatives { .. }
