@@ -7,7 +7,7 @@ use support::{eomgen, listing, mtime, one_line_error, robot, scratch, workspace}
 
 #[test]
 fn the_cli_leaves_the_previous_output_untouched_on_error() {
-    let dir = scratch("atomic");
+    let (_guard, dir) = scratch("atomic");
     let output = dir.join("robot.rs");
     let bad_file = dir.join("bad.urdf");
     // A URDF refused by the parser.

@@ -8,6 +8,8 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+use crate::support::scratch;
+
 /// Reference robots in `tests/robots/` of the workspace.
 const ROBOTS: [&str; 5] = [
     "double_pendulum",
@@ -92,13 +94,6 @@ fn bad_usage(args: &[&str]) {
         !stderr.is_empty() && !stderr.contains("panicked"),
         "{stderr}"
     );
-}
-
-/// A scratch directory for this test process.
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("eomgen-cli-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir
 }
 
 fn path_str(p: &Path) -> &str {
@@ -305,7 +300,7 @@ fn generate_matches_the_builder_and_writes_files() {
             "{name}: CLI and Builder differ"
         );
     }
-    let dir = scratch("generate");
+    let (_guard, dir) = scratch("generate");
     let file = dir.join("pendulum.rs");
     let path = robot("double_pendulum");
     let stdout = ok(&[
@@ -330,7 +325,6 @@ fn generate_matches_the_builder_and_writes_files() {
     let e = bad_input(&["generate", &path, "--type-name", "not a type"]);
     assert!(e.contains("not a type"), "{e}");
     bad_input(&["generate", &path, "-o", path_str(&dir.join("missing/x.rs"))]);
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// `generate --regressor` is `Builder::regressor`, and `show --base-parameters` prints each
@@ -593,7 +587,7 @@ fn eval_matches_the_reference_dynamics() {
 
 #[test]
 fn bad_input_gives_one_line_and_status_1() {
-    let dir = scratch("bad-input");
+    let (_guard, dir) = scratch("bad-input");
     let write = |name: &str, text: &str| -> String {
         let p = dir.join(name);
         std::fs::write(&p, text).expect("write");
@@ -630,7 +624,6 @@ fn bad_input_gives_one_line_and_status_1() {
     }
     let e = bad_input(&["show", &dangling]);
     assert!(e.contains('c'), "{e}");
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
@@ -935,7 +928,7 @@ fn textbook_planar_two_link_arm() {
     }
 
     // The printed equations show the textbook structure.
-    let dir = scratch("planar");
+    let (_guard, dir) = scratch("planar");
     let file = dir.join("planar.urdf");
     std::fs::write(&file, PLANAR).expect("write");
     let out = ok(&[
@@ -976,7 +969,6 @@ fn textbook_planar_two_link_arm() {
     );
     assert!(out.contains("  c2 = cos(q2)\n") && out.contains("  c12 = cos(q1 + q2)\n"));
     assert!(out.contains("  x_joint2: origin of joint joint2 in its parent's frame, x coordinate"));
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// The README's quick start: exactly two commands, the first runs eomgen on a bundled robot
@@ -1111,7 +1103,8 @@ fn show_other_forms() {
         ));
     }
     urdf.push_str("</robot>");
-    let chain = scratch("chain14").join("chain14.urdf");
+    let (_guard, dir) = scratch("chain14");
+    let chain = dir.join("chain14.urdf");
     std::fs::write(&chain, urdf).expect("write");
     let err = bad_input(&["show", path_str(&chain), "--form", "projected-newton-euler"]);
     assert_eq!(err.lines().count(), 1, "{err}");

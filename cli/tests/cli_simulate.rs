@@ -4,6 +4,8 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+use crate::support::scratch;
+
 fn workspace() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .parent()
@@ -62,8 +64,7 @@ fn passive_double_pendulum_csv_and_energy() {
     assert_eq!(r[0], vec![0.0, 1.8, 1.2, 1.0, 2.0, 0.0, 0.0]);
     assert!((r[500][0] - 0.5).abs() < 1e-12);
     // The summary reports the energy change; RK4 at 1 ms keeps it tiny.
-    let dir = std::env::temp_dir().join(format!("eomgen-sim-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let (_guard, dir) = scratch("sim");
     let file = dir.join("dp.csv");
     let summary = ok(&[
         "simulate",
@@ -86,7 +87,6 @@ fn passive_double_pendulum_csv_and_energy() {
         .parse()
         .unwrap();
     assert!(change.abs() < 1e-7, "{summary}");
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// Every CSV field is the shortest text that reads back to its number, in exponent form when
@@ -181,12 +181,7 @@ fn gravity_compensation_holds_still_and_bad_input_fails() {
 #[test]
 fn friction_dissipates_and_computed_torque_compensates_it() {
     let change = |extra: &[&str]| -> f64 {
-        let dir = std::env::temp_dir().join(format!(
-            "eomgen-fric-{}-{}",
-            std::process::id(),
-            extra.len()
-        ));
-        std::fs::create_dir_all(&dir).unwrap();
+        let (_guard, dir) = scratch("fric");
         let file = dir.join("dp.csv");
         let mut args = vec![
             "simulate",
@@ -202,7 +197,6 @@ fn friction_dissipates_and_computed_torque_compensates_it() {
         ];
         args.extend_from_slice(extra);
         let summary = ok(&args);
-        std::fs::remove_dir_all(&dir).unwrap();
         summary
             .split("(change ")
             .nth(1)
@@ -266,7 +260,8 @@ fn energy_change(summary: &str) -> f64 {
 /// the undamped double pendulum (the runtime's test measures the long runs).
 #[test]
 fn integrators() {
-    let out = std::env::temp_dir().join(format!("eomgen-integrators-{}.csv", std::process::id()));
+    let (_guard, dir) = scratch("integrators");
+    let out = dir.join("integrators.csv");
     let mut finals = Vec::new();
     for (integrator, name, tolerance) in [
         ("rk4", "RK4", 1e-7),
@@ -300,7 +295,6 @@ fn integrators() {
         let csv = std::fs::read_to_string(&out).unwrap();
         finals.push(rows(&csv).last().unwrap()[1..3].to_vec());
     }
-    let _ = std::fs::remove_file(&out);
     // Second and fourth order methods end where RK4 does, to their accuracy.
     for (k, tol) in [(2, 1e-2), (3, 1e-4)] {
         for j in 0..2 {
@@ -333,7 +327,8 @@ fn acrobot_collocated_pfl() {
     let last = r.last().unwrap();
     let want = 0.8 - 0.8 * (1.0 + 4.0 * 3.0) * (-12.0f64).exp();
     assert!((last[1] - want).abs() < 1e-6, "{last:?}");
-    let out = std::env::temp_dir().join(format!("eomgen-pfl-{}.csv", std::process::id()));
+    let (_guard, dir) = scratch("pfl");
+    let out = dir.join("pfl.csv");
     let summary = ok(&[
         "simulate",
         "tests/fixtures/acrobot.urdf",
@@ -352,7 +347,6 @@ fn acrobot_collocated_pfl() {
         "--csv",
         out.to_str().unwrap(),
     ]);
-    let _ = std::fs::remove_file(&out);
     assert!(energy_change(&summary) > 10.0, "{summary}");
 
     let err = eomgen(&[

@@ -47,7 +47,7 @@ fn show_prints_the_floating_equations_of_a_drone() {
 
 #[test]
 fn a_floating_joint_from_a_world_link_floats() {
-    let dir = scratch("floating-joint");
+    let (_guard, dir) = scratch("floating-joint");
     let path = dir.join("two_links.urdf");
     std::fs::write(&path, TWO_LINKS).unwrap();
     let path = path.to_str().unwrap();
@@ -220,7 +220,7 @@ fn numbers_after(text: &str, label: &str) -> Vec<f64> {
 
 #[test]
 fn a_drone_hovers_to_its_target() {
-    let dir = scratch("hover");
+    let (_guard, dir) = scratch("hover");
     let csv = dir.join("iris.csv");
     let plot = dir.join("iris.svg");
     let urdf = robot("floating/iris_simple");
@@ -277,7 +277,7 @@ fn a_drone_hovers_to_its_target() {
 
 #[test]
 fn a_quadruped_stands_on_its_four_feet() {
-    let dir = scratch("stand");
+    let (_guard, dir) = scratch("stand");
     let plot = dir.join("anymal.svg");
     let csv = dir.join("anymal.csv");
     let urdf = robot("floating/anymal");

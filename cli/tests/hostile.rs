@@ -71,7 +71,7 @@ fn is_terminal_control(c: char) -> bool {
 
 #[test]
 fn bad_input_gives_one_line_naming_the_file() {
-    let dir = scratch("hostile");
+    let (_guard, dir) = scratch("hostile");
     for (name, text) in cases() {
         let path = dir.join(format!("{name}.urdf"));
         std::fs::write(&path, text).unwrap();
@@ -95,7 +95,7 @@ fn bad_input_gives_one_line_naming_the_file() {
 
 #[test]
 fn names_printed_on_stdout_cannot_drive_the_terminal() {
-    let dir = scratch("escapes");
+    let (_guard, dir) = scratch("escapes");
     let path = dir.join("escapes.urdf");
     let name = "tip\u{9b}2J\u{85}\u{202e}x";
     std::fs::write(

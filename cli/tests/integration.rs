@@ -17,6 +17,8 @@ mod show_derivatives;
 mod simulate_divergence;
 mod urdf_reader;
 
+#[path = "../../codegen/tests/support/scratch.rs"]
+mod scratch;
 #[path = "../../codegen/tests/support/test_files.rs"]
 mod test_files;
 

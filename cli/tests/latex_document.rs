@@ -4,7 +4,7 @@
 
 use crate::support;
 
-use support::{eomgen, robot, stdout_of};
+use support::{eomgen, robot, scratch, stdout_of};
 
 fn standalone(name: &str, extra: &[&str]) -> String {
     let urdf = robot(name);
@@ -53,8 +53,7 @@ fn pdflatex_compiles_it_where_installed() {
         return;
     };
     assert!(status.status.success());
-    let dir = std::env::temp_dir().join(format!("eomgen-latex-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let (_guard, dir) = scratch("latex");
     std::fs::write(dir.join("ur5.tex"), standalone("ur5", &[])).unwrap();
     // The base parameters' document too (long formulas, names with underscores).
     let base = standalone("ur5", &["--base-parameters"]);
@@ -72,7 +71,6 @@ fn pdflatex_compiles_it_where_installed() {
             &log[log.len().saturating_sub(2000)..]
         );
     }
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]

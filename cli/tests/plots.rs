@@ -50,7 +50,7 @@ fn is_number(text: &str) -> bool {
 
 #[test]
 fn svg_plots_have_titles_axes_with_units_ticks_and_a_legend() {
-    let dir = scratch("plots-svg");
+    let (_guard, dir) = scratch("plots-svg");
     let plot = dir.join("ur5.svg");
     ur5_run(
         &plot,
@@ -125,7 +125,7 @@ fn svg_plots_have_titles_axes_with_units_ticks_and_a_legend() {
 
 #[test]
 fn a_free_run_plots_the_drift_of_the_integrator_and_mixed_joints_say_rad_or_m() {
-    let dir = scratch("plots-free");
+    let (_guard, dir) = scratch("plots-free");
     let plot = dir.join("panda.svg");
     stdout_of(&[
         "simulate",
@@ -150,7 +150,7 @@ fn a_free_run_plots_the_drift_of_the_integrator_and_mixed_joints_say_rad_or_m() 
 
 #[test]
 fn the_same_run_gives_the_same_bytes() {
-    let dir = scratch("plots-same");
+    let (_guard, dir) = scratch("plots-same");
     let (a, b) = (dir.join("a.svg"), dir.join("b.svg"));
     ur5_run(&a, &[]);
     ur5_run(&b, &[]);
@@ -166,7 +166,7 @@ fn the_same_run_gives_the_same_bytes() {
 
 #[test]
 fn png_plots_are_pngs_of_960_by_540() {
-    let dir = scratch("plots-png");
+    let (_guard, dir) = scratch("plots-png");
     let plot = dir.join("ur5.PNG");
     ur5_run(&plot, &[]);
     assert_eq!(
@@ -197,7 +197,7 @@ fn png_plots_are_pngs_of_960_by_540() {
 
 #[test]
 fn another_extension_is_a_one_line_error_before_the_run() {
-    let dir = scratch("plots-bad");
+    let (_guard, dir) = scratch("plots-bad");
     for name in ["ur5.pdf", "ur5", "ur5.svg.txt"] {
         let plot = dir.join(name);
         let err = one_line_error(&eomgen(&[
@@ -214,7 +214,7 @@ fn another_extension_is_a_one_line_error_before_the_run() {
 
 #[test]
 fn every_sample_of_every_joint_is_a_point_of_its_line() {
-    let dir = scratch("plots-lines");
+    let (_guard, dir) = scratch("plots-lines");
     let file = dir.join("ur5.svg");
     ur5_run(&file, &[]);
     let svg = std::fs::read_to_string(&file).unwrap();
@@ -254,7 +254,7 @@ fn every_sample_of_every_joint_is_a_point_of_its_line() {
 
 #[test]
 fn a_damped_run_says_energy_is_not_conserved() {
-    let dir = scratch("plots-damped");
+    let (_guard, dir) = scratch("plots-damped");
     let plot = dir.join("dp.svg");
     stdout_of(&[
         "simulate",

@@ -16,8 +16,9 @@ const STIFF: &str = r#"<robot name="stiff">
 </robot>"#;
 
 fn simulate(dt: &str) -> std::process::Output {
-    // One directory per step: the two tests run in parallel, and `scratch` empties its directory.
-    let path = scratch(&format!("divergence-{dt}")).join("stiff.urdf");
+    // A directory of its own for each call (the two tests run in parallel), removed on return.
+    let (_guard, dir) = scratch(&format!("divergence-{dt}"));
+    let path = dir.join("stiff.urdf");
     std::fs::write(&path, STIFF).unwrap();
     let path = path.to_str().unwrap().to_string();
     eomgen(&[

@@ -22,10 +22,10 @@ fn arm(tip_extra: &str, joint_extra: &str, top: &str) -> String {
     )
 }
 
-/// Runs `eomgen ARGS FILE` on `text` written to a scratch file named `name`.
+/// Runs `eomgen ARGS FILE` on `text` written to a scratch file named `name` (in a scratch
+/// directory removed on return).
 fn cli(name: &str, text: &str, args: &[&str]) -> std::process::Output {
-    let dir = std::env::temp_dir().join(format!("eomgen-reader-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let (_guard, dir) = crate::support::scratch("reader");
     let path = dir.join(name);
     std::fs::write(&path, text).unwrap();
     std::process::Command::new(env!("CARGO_BIN_EXE_eomgen"))

@@ -29,9 +29,8 @@ use crate::Error;
 /// [`Builder::generate`] returns the source instead of writing it:
 ///
 /// ```
-/// # let dir = std::env::temp_dir().join(format!("eomgen-doc-{}", std::process::id()));
-/// # std::fs::create_dir_all(&dir).unwrap();
-/// # let path = dir.join("pendulum.urdf");
+/// # let dir = tempfile::Builder::new().prefix("eomgen-doc-").tempdir().unwrap(); // removed on drop
+/// # let path = dir.path().join("pendulum.urdf");
 /// # std::fs::write(&path, r#"<robot name="pendulum"><link name="base"/>
 /// #   <link name="arm"><inertial><origin xyz="0 0 -0.5"/><mass value="1"/>
 /// #   <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.001"/></inertial></link>

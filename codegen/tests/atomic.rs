@@ -11,12 +11,10 @@ fn robot(name: &str) -> PathBuf {
         .join(format!("{name}.urdf"))
 }
 
-/// A fresh scratch directory for one test.
-fn scratch(test: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("eomgen-atomic-{}-{test}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh scratch directory for one test, `eomgen-atomic-TEST-XXXXXX`, and its path: the
+/// directory is removed when the guard is dropped (see `scratch::dir`).
+fn scratch(test: &str) -> (tempfile::TempDir, PathBuf) {
+    crate::scratch::dir(&format!("eomgen-atomic-{test}"))
 }
 
 /// The names of the files in `dir`, sorted.
@@ -42,8 +40,8 @@ const BAD_URDF: &str = r#"<robot name="pendulum"><link name="base"/>
 
 #[test]
 fn a_failing_compile_leaves_the_previous_output_untouched() {
-    let out = scratch("compile");
-    let inputs = scratch("compile-inputs");
+    let (_out_guard, out) = scratch("compile");
+    let (_inputs_guard, inputs) = scratch("compile-inputs");
     let good = eomgen::Builder::new(robot("double_pendulum"))
         .module_name("robot")
         .out_dir(&out);
@@ -111,7 +109,7 @@ fn a_failing_compile_leaves_the_previous_output_untouched() {
 
 #[test]
 fn an_unchanged_regeneration_keeps_the_file_and_its_time() {
-    let out = scratch("unchanged");
+    let (_guard, out) = scratch("unchanged");
     let builder = eomgen::Builder::new(robot("double_pendulum"))
         .module_name("robot")
         .out_dir(&out);
@@ -136,7 +134,7 @@ fn an_unchanged_regeneration_keeps_the_file_and_its_time() {
 
 #[test]
 fn write_failures_leave_no_temporary_file() {
-    let dir = scratch("write");
+    let (_guard, dir) = scratch("write");
     // A directory where the file should go: the rename fails.
     std::fs::create_dir(dir.join("robot.rs")).unwrap();
     let err = eomgen::write_if_changed(&dir.join("robot.rs"), b"fn main() {}").unwrap_err();

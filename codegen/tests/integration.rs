@@ -22,6 +22,8 @@ mod scaling;
 mod selection;
 mod urdf_reader;
 
+#[path = "support/scratch.rs"]
+mod scratch;
 #[path = "support/test_files.rs"]
 mod test_files;
 

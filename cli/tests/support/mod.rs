@@ -40,12 +40,10 @@ pub fn stdout_of<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> String {
     String::from_utf8(out.stdout).unwrap()
 }
 
-/// A fresh scratch directory for one test.
-pub fn scratch(test: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("eomgen-cli-{}-{test}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh scratch directory for one test, `eomgen-cli-TEST-XXXXXX`, and its path: the directory
+/// is removed when the guard is dropped, pass or fail (see `scratch::dir`).
+pub fn scratch(test: &str) -> (tempfile::TempDir, PathBuf) {
+    crate::scratch::dir(&format!("eomgen-cli-{test}"))
 }
 
 /// The names of the files in `dir`, sorted.
