@@ -10775,15 +10775,7 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
         q: &[T; 16],
         qd: &[T; 16],
     ) -> [T; 6] {
-        let (path, placement) = Self::link_frame(link);
-        let chain = ::eomgen_runtime::frame::Chain {
-            path,
-            joints: &Self::TREE_JOINTS,
-            floating: false,
-            transform: |j| self.joint_transform(j, q),
-            placement,
-        };
-        ::eomgen_runtime::frame::velocity(&chain, qd)
+        ::eomgen_runtime::frame::velocity(&self.link_chain(link, q), qd)
     }
     /// The classical acceleration of a link frame: the acceleration of its origin, then its angular
     /// acceleration, world axes (Pinocchio's `getFrameClassicalAcceleration`, LOCAL_WORLD_ALIGNED);
@@ -10797,15 +10789,7 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
         qd: &[T; 16],
         qdd: &[T; 16],
     ) -> [T; 6] {
-        let (path, placement) = Self::link_frame(link);
-        let chain = ::eomgen_runtime::frame::Chain {
-            path,
-            joints: &Self::TREE_JOINTS,
-            floating: false,
-            transform: |j| self.joint_transform(j, q),
-            placement,
-        };
-        ::eomgen_runtime::frame::acceleration(&chain, qd, qdd)
+        ::eomgen_runtime::frame::acceleration(&self.link_chain(link, q), qd, qdd)
     }
     /// The time derivative of `link_jacobian` at velocity `qd`, 6 x N, rows as `link_jacobian`
     /// (Pinocchio's `getFrameJacobianTimeVariation`, LOCAL_WORLD_ALIGNED).
@@ -10817,15 +10801,7 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
         q: &[T; 16],
         qd: &[T; 16],
     ) -> [[T; 16]; 6] {
-        let (path, placement) = Self::link_frame(link);
-        let chain = ::eomgen_runtime::frame::Chain {
-            path,
-            joints: &Self::TREE_JOINTS,
-            floating: false,
-            transform: |j| self.joint_transform(j, q),
-            placement,
-        };
-        ::eomgen_runtime::frame::jacobian_time_variation(&chain, qd)
+        ::eomgen_runtime::frame::jacobian_time_variation(&self.link_chain(link, q), qd)
     }
     /// Each joint's axis (in the frame of the body it moves) and motion.
     const TREE_JOINTS: [::eomgen_runtime::tree::TreeJoint; 16] = [
@@ -11678,6 +11654,27 @@ impl<T: ::eomgen_runtime::Lane> AllegroRightHand<T> {
                     },
                 )
             }
+        }
+    }
+    /// The chain from the root to a link's frame that `link_velocity`, `link_acceleration`
+    /// and `link_jacobian_time_variation` walk, its joints' transforms at `q`.
+    #[inline]
+    fn link_chain<'a>(
+        &'a self,
+        link: AllegroRightHandLink,
+        q: &'a [T; 16],
+    ) -> ::eomgen_runtime::frame::Chain<
+        'static,
+        T,
+        impl Fn(usize) -> ::eomgen_runtime::Pose<T> + 'a,
+    > {
+        let (path, placement) = Self::link_frame(link);
+        ::eomgen_runtime::frame::Chain {
+            path,
+            joints: &Self::TREE_JOINTS,
+            floating: false,
+            transform: move |j| self.joint_transform(j, q),
+            placement,
         }
     }
 }

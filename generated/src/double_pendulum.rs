@@ -397,15 +397,7 @@ impl<T: ::eomgen_runtime::Lane> DoublePendulum<T> {
         q: &[T; 2],
         qd: &[T; 2],
     ) -> [T; 6] {
-        let (path, placement) = Self::link_frame(link);
-        let chain = ::eomgen_runtime::frame::Chain {
-            path,
-            joints: &Self::TREE_JOINTS,
-            floating: false,
-            transform: |j| self.joint_transform(j, q),
-            placement,
-        };
-        ::eomgen_runtime::frame::velocity(&chain, qd)
+        ::eomgen_runtime::frame::velocity(&self.link_chain(link, q), qd)
     }
     /// The classical acceleration of a link frame: the acceleration of its origin, then its angular
     /// acceleration, world axes (Pinocchio's `getFrameClassicalAcceleration`, LOCAL_WORLD_ALIGNED);
@@ -419,15 +411,7 @@ impl<T: ::eomgen_runtime::Lane> DoublePendulum<T> {
         qd: &[T; 2],
         qdd: &[T; 2],
     ) -> [T; 6] {
-        let (path, placement) = Self::link_frame(link);
-        let chain = ::eomgen_runtime::frame::Chain {
-            path,
-            joints: &Self::TREE_JOINTS,
-            floating: false,
-            transform: |j| self.joint_transform(j, q),
-            placement,
-        };
-        ::eomgen_runtime::frame::acceleration(&chain, qd, qdd)
+        ::eomgen_runtime::frame::acceleration(&self.link_chain(link, q), qd, qdd)
     }
     /// The time derivative of `link_jacobian` at velocity `qd`, 6 x N, rows as `link_jacobian`
     /// (Pinocchio's `getFrameJacobianTimeVariation`, LOCAL_WORLD_ALIGNED).
@@ -439,15 +423,7 @@ impl<T: ::eomgen_runtime::Lane> DoublePendulum<T> {
         q: &[T; 2],
         qd: &[T; 2],
     ) -> [[T; 2]; 6] {
-        let (path, placement) = Self::link_frame(link);
-        let chain = ::eomgen_runtime::frame::Chain {
-            path,
-            joints: &Self::TREE_JOINTS,
-            floating: false,
-            transform: |j| self.joint_transform(j, q),
-            placement,
-        };
-        ::eomgen_runtime::frame::jacobian_time_variation(&chain, qd)
+        ::eomgen_runtime::frame::jacobian_time_variation(&self.link_chain(link, q), qd)
     }
     /// Each joint's axis (in the frame of the body it moves) and motion.
     const TREE_JOINTS: [::eomgen_runtime::tree::TreeJoint; 2] = [
@@ -576,6 +552,27 @@ impl<T: ::eomgen_runtime::Lane> DoublePendulum<T> {
                     },
                 )
             }
+        }
+    }
+    /// The chain from the root to a link's frame that `link_velocity`, `link_acceleration`
+    /// and `link_jacobian_time_variation` walk, its joints' transforms at `q`.
+    #[inline]
+    fn link_chain<'a>(
+        &'a self,
+        link: DoublePendulumLink,
+        q: &'a [T; 2],
+    ) -> ::eomgen_runtime::frame::Chain<
+        'static,
+        T,
+        impl Fn(usize) -> ::eomgen_runtime::Pose<T> + 'a,
+    > {
+        let (path, placement) = Self::link_frame(link);
+        ::eomgen_runtime::frame::Chain {
+            path,
+            joints: &Self::TREE_JOINTS,
+            floating: false,
+            transform: move |j| self.joint_transform(j, q),
+            placement,
         }
     }
 }

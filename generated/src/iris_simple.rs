@@ -826,15 +826,7 @@ impl<T: ::eomgen_runtime::Lane> IrisSimple<T> {
         q: &[T; 7],
         qd: &[T; 6],
     ) -> [T; 6] {
-        let (path, placement) = Self::link_frame(link);
-        let chain = ::eomgen_runtime::frame::Chain {
-            path,
-            joints: &Self::TREE_JOINTS,
-            floating: true,
-            transform: |j| self.joint_transform(j, q),
-            placement,
-        };
-        ::eomgen_runtime::frame::velocity(&chain, qd)
+        ::eomgen_runtime::frame::velocity(&self.link_chain(link, q), qd)
     }
     /// The classical acceleration of a link frame: the acceleration of its origin, then its angular
     /// acceleration, world axes (Pinocchio's `getFrameClassicalAcceleration`, LOCAL_WORLD_ALIGNED);
@@ -848,15 +840,7 @@ impl<T: ::eomgen_runtime::Lane> IrisSimple<T> {
         qd: &[T; 6],
         qdd: &[T; 6],
     ) -> [T; 6] {
-        let (path, placement) = Self::link_frame(link);
-        let chain = ::eomgen_runtime::frame::Chain {
-            path,
-            joints: &Self::TREE_JOINTS,
-            floating: true,
-            transform: |j| self.joint_transform(j, q),
-            placement,
-        };
-        ::eomgen_runtime::frame::acceleration(&chain, qd, qdd)
+        ::eomgen_runtime::frame::acceleration(&self.link_chain(link, q), qd, qdd)
     }
     /// The time derivative of `link_jacobian` at velocity `qd`, 6 x N, rows as `link_jacobian`
     /// (Pinocchio's `getFrameJacobianTimeVariation`, LOCAL_WORLD_ALIGNED).
@@ -868,15 +852,7 @@ impl<T: ::eomgen_runtime::Lane> IrisSimple<T> {
         q: &[T; 7],
         qd: &[T; 6],
     ) -> [[T; 6]; 6] {
-        let (path, placement) = Self::link_frame(link);
-        let chain = ::eomgen_runtime::frame::Chain {
-            path,
-            joints: &Self::TREE_JOINTS,
-            floating: true,
-            transform: |j| self.joint_transform(j, q),
-            placement,
-        };
-        ::eomgen_runtime::frame::jacobian_time_variation(&chain, qd)
+        ::eomgen_runtime::frame::jacobian_time_variation(&self.link_chain(link, q), qd)
     }
     /// The rate of the centroidal momentum, `dh/dt = A_g qdd + dA_g/dt qd`: the rate of the linear
     /// momentum, then of the angular momentum about the centre of mass, world axes (Pinocchio's
@@ -1153,6 +1129,27 @@ impl<T: ::eomgen_runtime::Lane> IrisSimple<T> {
                     },
                 )
             }
+        }
+    }
+    /// The chain from the root to a link's frame that `link_velocity`, `link_acceleration`
+    /// and `link_jacobian_time_variation` walk, its joints' transforms at `q`.
+    #[inline]
+    fn link_chain<'a>(
+        &'a self,
+        link: IrisSimpleLink,
+        q: &'a [T; 7],
+    ) -> ::eomgen_runtime::frame::Chain<
+        'static,
+        T,
+        impl Fn(usize) -> ::eomgen_runtime::Pose<T> + 'a,
+    > {
+        let (path, placement) = Self::link_frame(link);
+        ::eomgen_runtime::frame::Chain {
+            path,
+            joints: &Self::TREE_JOINTS,
+            floating: true,
+            transform: move |j| self.joint_transform(j, q),
+            placement,
         }
     }
 }

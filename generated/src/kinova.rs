@@ -8551,15 +8551,7 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
     ///
     /// Route: each body's pose, velocity and acceleration walked along the link's chain from the same transforms as `link_pose` (eomgen_runtime::frame).
     pub fn link_velocity(&self, link: KinovaLink, q: &[T; 6], qd: &[T; 6]) -> [T; 6] {
-        let (path, placement) = Self::link_frame(link);
-        let chain = ::eomgen_runtime::frame::Chain {
-            path,
-            joints: &Self::TREE_JOINTS,
-            floating: false,
-            transform: |j| self.joint_transform(j, q),
-            placement,
-        };
-        ::eomgen_runtime::frame::velocity(&chain, qd)
+        ::eomgen_runtime::frame::velocity(&self.link_chain(link, q), qd)
     }
     /// The classical acceleration of a link frame: the acceleration of its origin, then its angular
     /// acceleration, world axes (Pinocchio's `getFrameClassicalAcceleration`, LOCAL_WORLD_ALIGNED);
@@ -8573,15 +8565,7 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
         qd: &[T; 6],
         qdd: &[T; 6],
     ) -> [T; 6] {
-        let (path, placement) = Self::link_frame(link);
-        let chain = ::eomgen_runtime::frame::Chain {
-            path,
-            joints: &Self::TREE_JOINTS,
-            floating: false,
-            transform: |j| self.joint_transform(j, q),
-            placement,
-        };
-        ::eomgen_runtime::frame::acceleration(&chain, qd, qdd)
+        ::eomgen_runtime::frame::acceleration(&self.link_chain(link, q), qd, qdd)
     }
     /// The time derivative of `link_jacobian` at velocity `qd`, 6 x N, rows as `link_jacobian`
     /// (Pinocchio's `getFrameJacobianTimeVariation`, LOCAL_WORLD_ALIGNED).
@@ -8593,15 +8577,7 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
         q: &[T; 6],
         qd: &[T; 6],
     ) -> [[T; 6]; 6] {
-        let (path, placement) = Self::link_frame(link);
-        let chain = ::eomgen_runtime::frame::Chain {
-            path,
-            joints: &Self::TREE_JOINTS,
-            floating: false,
-            transform: |j| self.joint_transform(j, q),
-            placement,
-        };
-        ::eomgen_runtime::frame::jacobian_time_variation(&chain, qd)
+        ::eomgen_runtime::frame::jacobian_time_variation(&self.link_chain(link, q), qd)
     }
     /// Each joint's axis (in the frame of the body it moves) and motion.
     const TREE_JOINTS: [::eomgen_runtime::tree::TreeJoint; 6] = [
@@ -9046,6 +9022,27 @@ impl<T: ::eomgen_runtime::Lane> Kinova<T> {
                     },
                 )
             }
+        }
+    }
+    /// The chain from the root to a link's frame that `link_velocity`, `link_acceleration`
+    /// and `link_jacobian_time_variation` walk, its joints' transforms at `q`.
+    #[inline]
+    fn link_chain<'a>(
+        &'a self,
+        link: KinovaLink,
+        q: &'a [T; 6],
+    ) -> ::eomgen_runtime::frame::Chain<
+        'static,
+        T,
+        impl Fn(usize) -> ::eomgen_runtime::Pose<T> + 'a,
+    > {
+        let (path, placement) = Self::link_frame(link);
+        ::eomgen_runtime::frame::Chain {
+            path,
+            joints: &Self::TREE_JOINTS,
+            floating: false,
+            transform: move |j| self.joint_transform(j, q),
+            placement,
         }
     }
 }

@@ -70,7 +70,8 @@ impl Emitter<'_> {
     }
 
     /// What link kinematics walks: each joint's transform as straight-line code, the joint
-    /// axes, and per link its chain from the root and its placement in its body.
+    /// axes, per link its chain from the root and its placement in its body, and the frames'
+    /// motion's `link_chain`.
     pub(super) fn frame_support(&mut self, d: &Derivation) -> TokenStream {
         let nq = &self.nq;
         let arms: Vec<TokenStream> = d
@@ -88,6 +89,7 @@ impl Emitter<'_> {
         let link_arms = self.link_frame_arms();
         let link_ty = &self.link_ty;
         let tables = self.jacobian_tables();
+        let chain = self.link_chain_fn();
         quote! {
             #tables
 
@@ -107,6 +109,8 @@ impl Emitter<'_> {
             fn link_frame(link: #link_ty) -> (&'static [usize], ::eomgen_runtime::Pose<T>) {
                 match link { #(#link_arms)* }
             }
+
+            #chain
         }
     }
 

@@ -5,17 +5,17 @@ use proc_macro2::TokenStream;
 use quote::{format_ident, quote};
 
 use super::{usize_lit, Emitter};
-use crate::dynamics::{FrameMotion, Manifold, Quantity};
+use crate::dynamics::{Evaluation, FrameMotion, Manifold, Quantity};
 use crate::model::{Joint, JointKind, Limits, Model};
 
 impl Emitter<'_> {
     /// `link_velocity`, `link_acceleration` or `link_jacobian_time_variation`: the link's chain
-    /// from `link_frame`, walked by the runtime. With mimic joints the coordinates' rates are
-    /// first spread over the joint tree's columns (`COUPLING`), and a Jacobian's columns summed
-    /// back (`J G`).
+    /// from `link_chain` (`link_chain_fn`), walked by the runtime. With mimic joints the
+    /// coordinates' rates are first spread over the joint tree's columns (`COUPLING`), and a
+    /// Jacobian's columns summed back (`J G`).
     pub(super) fn frame_motion_fn(&mut self, q: &Quantity, motion: FrameMotion) -> TokenStream {
         let docs = Self::quantity_doc(q, None);
-        let (link_ty, n, nq, floating) = (&self.link_ty, &self.n, &self.nq, self.floating);
+        let (link_ty, n, nq) = (&self.link_ty, &self.n, &self.nq);
         let coupled = self.model.is_coupled();
         let nj = usize_lit(self.model.nv());
         let spread = |x: TokenStream| {
@@ -26,45 +26,60 @@ impl Emitter<'_> {
             }
         };
         let (qd_rates, qdd_rates) = (spread(quote!(qd)), spread(quote!(qdd)));
-        let chain = quote! {
-            let (path, placement) = Self::link_frame(link);
-            let chain = ::eomgen_runtime::frame::Chain { path, joints: &Self::TREE_JOINTS, floating: #floating, transform: |j| self.joint_transform(j, q), placement };
-        };
+        let chain = quote!(&self.link_chain(link, q));
         match motion {
             FrameMotion::Velocity => quote! {
                 #docs
                 pub fn link_velocity(&self, link: #link_ty, q: &[T; #nq], qd: &[T; #n]) -> [T; 6] {
-                    #chain
                     #qd_rates
-                    ::eomgen_runtime::frame::velocity(&chain, qd)
+                    ::eomgen_runtime::frame::velocity(#chain, qd)
                 }
             },
             FrameMotion::Acceleration => quote! {
                 #docs
                 pub fn link_acceleration(&self, link: #link_ty, q: &[T; #nq], qd: &[T; #n], qdd: &[T; #n]) -> [T; 6] {
-                    #chain
                     #qd_rates
                     #qdd_rates
-                    ::eomgen_runtime::frame::acceleration(&chain, qd, qdd)
+                    ::eomgen_runtime::frame::acceleration(#chain, qd, qdd)
                 }
             },
             FrameMotion::JacobianTimeVariation => {
                 let body = if coupled {
                     quote! {
-                        let joints: [[T; #nj]; 6] = ::eomgen_runtime::frame::jacobian_time_variation(&chain, qd);
+                        let joints: [[T; #nj]; 6] = ::eomgen_runtime::frame::jacobian_time_variation(#chain, qd);
                         ::eomgen_runtime::tree::couple_columns(&joints, &Self::COUPLING)
                     }
                 } else {
-                    quote!(::eomgen_runtime::frame::jacobian_time_variation(&chain, qd))
+                    quote!(::eomgen_runtime::frame::jacobian_time_variation(#chain, qd))
                 };
                 quote! {
                     #docs
                     pub fn link_jacobian_time_variation(&self, link: #link_ty, q: &[T; #nq], qd: &[T; #n]) -> [[T; #n]; 6] {
-                        #chain
                         #qd_rates
                         #body
                     }
                 }
+            }
+        }
+    }
+
+    /// The private `link_chain` that `link_velocity`, `link_acceleration` and
+    /// `link_jacobian_time_variation` walk (`eomgen_runtime::frame::Chain`): the link's bodies
+    /// and placement from `link_frame`, `TREE_JOINTS` and the joints' transforms at `q`. Nothing
+    /// without those methods (rustc's `dead_code` warning).
+    pub(super) fn link_chain_fn(&self) -> TokenStream {
+        let motion = |q: &Quantity| matches!(q.eval, Evaluation::FrameMotion(_));
+        if !self.quantities.iter().any(motion) {
+            return TokenStream::new();
+        }
+        let (link_ty, nq, floating) = (&self.link_ty, &self.nq, self.floating);
+        quote! {
+            /// The chain from the root to a link's frame that `link_velocity`, `link_acceleration`
+            /// and `link_jacobian_time_variation` walk, its joints' transforms at `q`.
+            #[inline]
+            fn link_chain<'a>(&'a self, link: #link_ty, q: &'a [T; #nq]) -> ::eomgen_runtime::frame::Chain<'static, T, impl Fn(usize) -> ::eomgen_runtime::Pose<T> + 'a> {
+                let (path, placement) = Self::link_frame(link);
+                ::eomgen_runtime::frame::Chain { path, joints: &Self::TREE_JOINTS, floating: #floating, transform: move |j| self.joint_transform(j, q), placement }
             }
         }
     }
