@@ -79,11 +79,17 @@ pub const DEFAULT_MAX_DOF: usize = 64;
 /// the worst; a 40-joint chain needs a few million.
 pub const DEFAULT_MAX_GRAPH_NODES: usize = crate::cas::graph::DEFAULT_MAX_NODES;
 
-/// The default of [`Builder::max_function_ops`]: the panda's inverse-dynamics derivatives
-/// (about 7,000 operations) stay whole, and the memory of a build stays bounded (talos_full_v2,
-/// 50 joints, with derivatives: 0.9 GiB, against 2.2 GiB unsplit). Splitting costs about 5 to
-/// 10 % of a function's run time at 3,000 operations a block on the panda's derivatives.
-pub const DEFAULT_MAX_FUNCTION_OPS: usize = 8000;
+/// The default of [`Builder::max_function_ops`], the same as the derivatives' budget: the
+/// straight-line contact and impulse dynamics of a legged robot stay whole (blocks of 8,000
+/// operations, the default until November 2026, cost anymal's contact forward dynamics 6 %,
+/// g1_29dof's 11 % and its impulse dynamics 8 %), and the memory of a build stays bounded by
+/// its longest block (talos_full_v2, 50 joints, with derivatives: 0.9 GiB in blocks of 8,000,
+/// 2.2 GiB unsplit). Against blocks of 8,000, native builds in a user's crate took the same
+/// time and memory (anymal with contacts and derivatives 13.3 -> 12.8 s, 659 -> 590 MiB;
+/// talos with two soles 26.6 -> 25.6 s, 1,221 -> 1,370 MiB; with derivatives too 55.1 -> 53.3
+/// s, 1,875 -> 1,881 MiB), builds for the baseline CPU up to a tenth longer (talos with
+/// derivatives 63 -> 71 s, g1_29dof with two contacts 19.2 -> 20.6 s).
+pub const DEFAULT_MAX_FUNCTION_OPS: usize = 24_000;
 
 /// The default of [`Builder::max_derivative_function_ops`]. The derivatives' bodies are where
 /// the blocks cost run time: on talos_full_v2 (50 joints, floating, two soles, native CPU) its
@@ -293,10 +299,11 @@ impl Builder {
     /// The budget of [`Builder::max_function_ops`] for the bodies of the derivatives
     /// [`Builder::derivatives`] adds (`inverse_dynamics_derivatives`, straight-line
     /// `forward_dynamics_derivatives` and `mass_matrix_inverse`, the contact and impulse
-    /// partials; default [`DEFAULT_MAX_DERIVATIVE_FUNCTION_OPS`], 24,000). There the blocks'
-    /// boundaries cost run time (about a sixth of a humanoid's inverse-dynamics derivatives at
-    /// 8,000 operations a block), so they get longer blocks than the dynamics, at some compile
-    /// memory. Set it after `max_function_ops`, which sets both.
+    /// partials; default [`DEFAULT_MAX_DERIVATIVE_FUNCTION_OPS`], 24,000, as the dynamics').
+    /// There the blocks' boundaries cost the most run time (about a sixth of a humanoid's
+    /// inverse-dynamics derivatives at 8,000 operations a block): this keeps them long where
+    /// the dynamics are cut shorter to save compile memory. Set it after `max_function_ops`,
+    /// which sets both.
     ///
     /// ```
     /// let b = eomgen::Builder::new("robots/anymal.urdf")

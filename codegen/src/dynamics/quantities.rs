@@ -327,7 +327,7 @@ fn inverse_dynamics(d: &Derivation, notes: &Notes) -> Quantity {
 }
 
 /// Forward dynamics unrolled into straight-line code when that is at most this many
-/// operations (one block of the default `max_function_ops`); beyond, `M` from `mass_matrix`
+/// operations (one block of `max_function_ops`'s default until November 2026); beyond, `M` from `mass_matrix`
 /// and the tree's factorization unrolled for the robot, at run time. A 48-joint chain's
 /// unrolled solve and second copy of `M` were 49k lines of its 172k, and g1_29dof's
 /// straight-line forward dynamics (15,963 operations, two blocks) took 2.49 us against
