@@ -47,6 +47,9 @@ pub struct Centroidal {
     pub contact_jacobian: Vec<Vec<Id>>,
     /// `Jdot v`, 3K, world axes.
     pub contact_drift: Vec<Id>,
+    /// The same drift from the forward pass of `b + G`
+    /// ([`GravityDrift`](super::gravity_drift::GravityDrift)), contact by contact.
+    pub gravity_drift: Vec<super::gravity_drift::GravityDrift>,
     /// Each contact's world placement (points, then frames), 12 entries each: the position,
     /// then the row-major rotation.
     pub contact_placements: Vec<Id>,
@@ -83,6 +86,7 @@ impl Centroidal {
         };
         let (contact_jacobian, contact_drift, contact_placements) =
             contacts(g, model, lm, wk, &poses, v);
+        let gravity_drift = super::gravity_drift::gravity_drift(g, model, lm, wk, &poses, v);
         Centroidal {
             mass,
             first_moment,
@@ -91,6 +95,7 @@ impl Centroidal {
             map,
             contact_jacobian,
             contact_drift,
+            gravity_drift,
             contact_placements,
         }
     }
@@ -210,12 +215,8 @@ fn contacts(
         },
         |_, _, _| {},
     );
-    let origin = [0.0; 3];
-    let points = model.contacts.iter().map(|&f| (f, origin, false));
-    let at = model.contact_points_at.iter().map(|&(f, p)| (f, p, false));
-    let frames = model.contact_frames.iter().map(|&f| (f, origin, true));
     let (mut jac, mut drift, mut placements) = (Vec::new(), Vec::new(), Vec::new());
-    for (f, offset, six) in points.chain(at).chain(frames) {
+    for (f, offset, six) in contact_list(model) {
         let rows = if six { 6 } else { 3 };
         let frame = &model.frames[f];
         let placement = Transform {
@@ -370,6 +371,16 @@ fn contact_order(model: &Model) -> String {
     order
 }
 
+/// Every contact in the contact rows' order: its frame, the point's offset in the frame, and
+/// whether it is a 6D frame (points at frame origins, points at an offset, then 6D frames).
+pub(super) fn contact_list(model: &Model) -> impl Iterator<Item = (usize, [f64; 3], bool)> + '_ {
+    let origin = [0.0; 3];
+    let points = model.contacts.iter().map(move |&f| (f, origin, false));
+    let at = model.contact_points_at.iter().map(|&(f, p)| (f, p, false));
+    let frames = model.contact_frames.iter().map(move |&f| (f, origin, true));
+    points.chain(at).chain(frames)
+}
+
 /// `contact_jacobian`, `contact_drift` and `contact_forward_dynamics` (robots with contacts).
 fn contact_quantities(model: &Model, d: &mut Derivation) -> [Quantity; 3] {
     let (route, forward) =
@@ -434,19 +445,20 @@ pub(super) fn contacts_in_base_axes(
         .copied()
         .collect();
     let g = &mut d.graph;
-    let (zero, one) = (g.zero(), g.one());
-    let at_identity: HashMap<Id, Id> = [
-        (d.q[3], zero),
-        (d.q[4], zero),
-        (d.q[5], zero),
-        (d.q[6], one),
-    ]
-    .into_iter()
-    .collect();
+    let at_identity = base_at_identity(g, &d.q);
     let based = g.substitute(&all, &at_identity);
     let j = based[..k * n].chunks(n).map(<[Id]>::to_vec).collect();
     let drift = based[k * n..].to_vec();
     Some((j, drift, free_flyer_placement(g, &d.q[..7]).rotation))
+}
+
+/// The floating base's quaternion (x, y, z, w) of `q` at the identity, as a substitution: what
+/// turns an expression in world axes of a point moving with the base into base axes.
+pub(super) fn base_at_identity(g: &mut Graph, q: &[Id]) -> HashMap<Id, Id> {
+    let (zero, one) = (g.zero(), g.one());
+    [(q[3], zero), (q[4], zero), (q[5], zero), (q[6], one)]
+        .into_iter()
+        .collect()
 }
 
 /// The contact Jacobian and drift in the axes they are solved in, and the rotation that turns
@@ -501,7 +513,9 @@ pub(super) fn contact_forward_dynamics(
     if flat_max_ops == 0 {
         return run_time;
     }
-    let (j, drift, axes) = contacts_in_solving_axes(model, d);
+    let (j, _, axes) = contacts_in_solving_axes(model, d);
+    // The drift from `b + G`'s forward pass, which the program computes anyway.
+    let drift = super::gravity_drift::in_solving_axes(model, d);
     let flat = super::contact_flat::contact_forward_dynamics(
         &mut d.graph,
         &d.coordinate_parents,

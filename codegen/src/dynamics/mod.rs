@@ -22,6 +22,7 @@ mod contact_flat;
 pub mod coupling;
 mod derivatives;
 mod fast;
+mod gravity_drift;
 pub mod identification;
 mod lagrangian;
 pub(crate) mod ltdl;
