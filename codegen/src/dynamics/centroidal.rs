@@ -49,7 +49,7 @@ pub struct Centroidal {
     pub contact_drift: Vec<Id>,
     /// The same drift from the forward pass of `b + G`
     /// ([`GravityDrift`](super::gravity_drift::GravityDrift)), contact by contact.
-    pub gravity_drift: Vec<super::gravity_drift::GravityDrift>,
+    pub(crate) gravity_drift: Vec<super::gravity_drift::GravityDrift>,
     /// Each contact's world placement (points, then frames), 12 entries each: the position,
     /// then the row-major rotation.
     pub contact_placements: Vec<Id>,
