@@ -25,8 +25,9 @@ use crate::model::{Model, Transform};
 /// plus gravity's upward acceleration in body axes, `R^T (-g)`, so that in world axes the
 /// point's drift is `R accel + g` (and in a floating base's axes `R_b^T (R accel + g)`). Built
 /// from that pass's own expressions, the drift shares its kinematics with `b + G` in a program
-/// that computes both (straight-line contact forward dynamics), where [`Centroidal::contact_drift`]
-/// repeats the pass without gravity.
+/// that computes both (straight-line contact forward dynamics), where
+/// [`Centroidal::contact_drift`](super::centroidal::Centroidal::contact_drift) repeats the pass
+/// without gravity.
 #[derive(Clone, Debug)]
 pub struct GravityDrift {
     /// The body's world rotation `R` (a floating base's included); `None` for a contact on a
@@ -109,12 +110,15 @@ pub(super) fn gravity_drift(
     out
 }
 
-/// The contact drift in the axes [`contacts_in_solving_axes`](super::centroidal::contacts_in_solving_axes) solves in, built from
+/// The contact drift in the axes that [`contacts_in_solving_axes`] solves in, built from
 /// [`GravityDrift`] (the same values as its drift, to rounding): in a floating base's axes each
-/// point's is `R_bi accel + R_b^T g`, with `R_bi` the body's rotation in base axes (the world's at
-/// the identity quaternion, as [`contacts_in_base_axes`](super::centroidal::contacts_in_base_axes) takes `J`) and `R_b` the base's; in
-/// world axes `R accel + g`. A 6D frame's linear rows subtract `w x v` (its angular velocity and
-/// origin velocity in those axes), its angular rows are `R dw`.
+/// point's is `R_bi accel + R_b^T g`, with `R_bi` the body's rotation in base axes (the world's
+/// at the identity quaternion, as [`contacts_in_base_axes`] takes `J`) and `R_b` the base's; in
+/// world axes `R accel + g`. A 6D frame's linear rows subtract `w x v` (its angular velocity
+/// and origin velocity in those axes), its angular rows are `R dw`.
+///
+/// [`contacts_in_solving_axes`]: super::centroidal::contacts_in_solving_axes
+/// [`contacts_in_base_axes`]: super::centroidal::contacts_in_base_axes
 pub(super) fn in_solving_axes(model: &Model, d: &mut Derivation) -> Vec<Id> {
     let g = &mut d.graph;
     let gv = const_v3(g, &model.gravity);
