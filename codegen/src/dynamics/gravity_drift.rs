@@ -213,11 +213,14 @@ mod tests {
 
     #[test]
     fn a_fixed_base_drift_from_the_gravity_pass_is_the_drift() {
-        check(
+        let panda = || {
             crate::Builder::new("../tests/robots/panda.urdf")
-                .contact_points(&["panda_hand"])
+                .contact_points(&["panda_hand", "panda_rightfinger"])
                 .contact_point_at("panda_link5", [0.05, 0.0, -0.1])
-                .contact_frames(&["panda_leftfinger"]),
-        );
+                .contact_frames(&["panda_leftfinger"])
+        };
+        check(panda());
+        // The second finger coupled to the first: `b + G` projected, the drift in joint rates.
+        check(panda().mimic_joints());
     }
 }
