@@ -9,8 +9,7 @@
 //! of `M^-1 J^T`. Everything is in fixed-size arrays on the stack.
 
 pub use crate::baumgarte::{log3, placement, Baumgarte};
-use crate::kkt::{axpy, dot};
-use crate::lane::check_finite;
+use crate::kkt::{axpy, dot, finite_solution};
 use crate::linalg::{Cholesky, FactorError};
 use crate::tree::{ltdl_factor, ltdl_lower_rows, ltdl_substitute};
 use crate::{Lane, Real};
@@ -197,11 +196,7 @@ pub fn solve_factored_active_lanes<T: Lane, const N: usize, const K: usize>(
     for (ai, fi) in a.iter_mut().zip(free) {
         *ai += *fi;
     }
-    check_finite(&a, failures)?;
-    for (k, fk) in f.iter().enumerate() {
-        T::check_finite(*fk, N + k, failures)?;
-    }
-    Ok((a, f))
+    finite_solution(a, f, failures)
 }
 
 /// The Cholesky factor of `J M^-1 J^T = W^T D^-1 W` with `W = L^-T J^T` (the inactive rows of

@@ -7,9 +7,9 @@
 
 use crate::contact::{contact_space, transpose_times};
 use crate::kkt::{
-    column_support, combination_into, dot, finite_rows, ContactKkt, ImpulseDynamicsDerivatives,
+    column_support, combination_into, dot, finite_rows, finite_solution, ContactKkt,
+    ImpulseDynamicsDerivatives,
 };
-use crate::lane::check_finite;
 use crate::tree::{ltdl_lower_rows, TreePasses, Walked};
 use crate::{FactorError, Lane, Real};
 
@@ -191,11 +191,7 @@ pub fn solve_factored_active_lanes<T: Lane, const N: usize, const K: usize>(
         }
     }
     let p = chol.solve(&bottom);
-    let mut after = substitute(&transpose_times(j, &p, active));
-    check_finite(&after, failures)?;
-    for (r, pr) in p.iter().enumerate() {
-        T::check_finite(*pr, N + r, failures)?;
-    }
+    let (mut after, p) = finite_solution(substitute(&transpose_times(j, &p, active)), p, failures)?;
     for (x, vi) in after.iter_mut().zip(v) {
         *x += *vi;
     }

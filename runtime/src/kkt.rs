@@ -247,7 +247,7 @@ impl<T: Real, const N: usize, const K: usize> Parts<'_, T, N, K> {
                 *xi += *yi * *fk;
             }
         }
-        finite_solution(x, f)
+        finite_solution(x, f, &mut ())
     }
 
     /// The solution for `(sign top, sign bottom)`, `sign` one or minus one: with
@@ -888,16 +888,16 @@ fn scale<T: Real, const C: usize>(y: &mut [T; C], a: T) {
 }
 
 /// `(x, f)` if every entry is finite; else `NonFinite` at the first bad one of `x` (`pivot <
-/// N`) or of `f` (`N + k`): how the system's solvers report a non-finite solution.
-pub(crate) fn finite_solution<T: Real, const N: usize, const K: usize>(
+/// N`) or of `f` (`N + k`): how the system's solvers report a non-finite solution. On a vector
+/// of states ([`crate::Lane`]) each lane's is recorded in `failures` instead.
+pub(crate) fn finite_solution<T: crate::Lane, const N: usize, const K: usize>(
     x: [T; N],
     f: [T; K],
+    failures: &mut T::Failures,
 ) -> Result<([T; N], [T; K]), FactorError> {
-    if let Some(pivot) = x.iter().position(|v| !v.is_finite()) {
-        return Err(FactorError::NonFinite { pivot });
-    }
-    if let Some(k) = f.iter().position(|v| !v.is_finite()) {
-        return Err(FactorError::NonFinite { pivot: N + k });
+    crate::lane::check_finite(&x, failures)?;
+    for (k, fk) in f.iter().enumerate() {
+        T::check_finite(*fk, N + k, failures)?;
     }
     Ok((x, f))
 }
