@@ -8,6 +8,7 @@
 //! centroidal momentum map `A_g`, and `P_w / m` is the centre of mass Jacobian.
 
 use super::catalogue::{Evaluation, Home, Input, Quantity, Shape};
+use super::gravity_drift::{self, GravityDrift};
 use super::newton_euler::{self, LocalModel, Terms};
 use super::{flat, Derivation};
 use crate::cas::{Graph, Id};
@@ -48,8 +49,8 @@ pub struct Centroidal {
     /// `Jdot v`, 3K, world axes.
     pub contact_drift: Vec<Id>,
     /// The same drift from the forward pass of `b + G`
-    /// ([`GravityDrift`](super::gravity_drift::GravityDrift)), contact by contact.
-    pub(crate) gravity_drift: Vec<super::gravity_drift::GravityDrift>,
+    /// ([`GravityDrift`]), contact by contact.
+    pub(crate) gravity_drift: Vec<GravityDrift>,
     /// Each contact's world placement (points, then frames), 12 entries each: the position,
     /// then the row-major rotation.
     pub contact_placements: Vec<Id>,
@@ -84,9 +85,12 @@ impl Centroidal {
             let (map, com_jacobian) = centroidal_map(g, lm, &poses, &com, inv);
             (mass, first_moment, com, map, com_jacobian)
         };
-        let (contact_jacobian, contact_drift, contact_placements) =
-            contacts(g, model, lm, wk, &poses, v);
-        let gravity_drift = super::gravity_drift::gravity_drift(g, model, lm, wk, &poses, v);
+        let Contacts {
+            jacobian: contact_jacobian,
+            drift: contact_drift,
+            placements: contact_placements,
+            gravity_drift,
+        } = contacts(g, model, lm, wk, &poses, v);
         Centroidal {
             mass,
             first_moment,
@@ -189,13 +193,24 @@ fn centroidal_map(
     (ag, jcom)
 }
 
-/// The contacts' Jacobian (K x nv, world axes: the linear rows of each contact point's link
-/// Jacobian, then all six of each 6D contact frame's) and drift, the constrained acceleration at
-/// zero generalized acceleration: a point's classical acceleration (`Jdot v`), a frame's spatial
-/// acceleration (linear part: the origin's classical acceleration minus `omega x` its
-/// velocity, as Pinocchio's `getFrameAcceleration`), with `q`, `v` the coordinate symbols;
-/// and each contact's world placement (position, then row-major rotation).
-#[allow(clippy::type_complexity)]
+/// What [`contacts`] derives for every contact, in the contact rows' order.
+struct Contacts {
+    /// K x nv, world axes: the linear rows of each contact point's link Jacobian, then all six
+    /// of each 6D contact frame's.
+    jacobian: Vec<Vec<Id>>,
+    /// The constrained acceleration at zero generalized acceleration: a point's classical
+    /// acceleration (`Jdot v`), a frame's spatial acceleration (linear part: the origin's
+    /// classical acceleration minus `omega x` its velocity, as Pinocchio's
+    /// `getFrameAcceleration`), from Newton-Euler's forward pass without gravity.
+    drift: Vec<Id>,
+    /// Each contact's world placement (position, then row-major rotation).
+    placements: Vec<Id>,
+    /// The drift's parts from the forward pass with gravity (`b + G`'s).
+    gravity_drift: Vec<GravityDrift>,
+}
+
+/// The contacts' Jacobian, drift, placements and drift from `b + G`'s pass ([`Contacts`]), with
+/// `q`, `v` the coordinate symbols.
 fn contacts(
     g: &mut Graph,
     model: &Model,
@@ -203,19 +218,21 @@ fn contacts(
     wk: &WorldKinematics,
     poses: &[(M3, V3)],
     v: &[Id],
-) -> (Vec<Vec<Id>>, Vec<Id>, Vec<Id>) {
+) -> Contacts {
     let shift = usize::from(model.is_floating());
-    let motions = newton_euler::forward_pass(
-        g,
-        lm,
-        Terms {
-            qd: Some(v),
-            qdd: None,
-            gravity: None,
-        },
-        |_, _, _| {},
-    );
-    let (mut jac, mut drift, mut placements) = (Vec::new(), Vec::new(), Vec::new());
+    let terms = Terms {
+        qd: Some(v),
+        qdd: None,
+        gravity: None,
+    };
+    let motions = newton_euler::forward_pass(g, lm, terms, |_, _, _| {});
+    let with_gravity = gravity_drift::forward_pass(g, model, lm, v);
+    let mut out = Contacts {
+        jacobian: Vec::new(),
+        drift: Vec::new(),
+        placements: Vec::new(),
+        gravity_drift: Vec::new(),
+    };
     for (f, offset, six) in contact_list(model) {
         let rows = if six { 6 } else { 3 };
         let frame = &model.frames[f];
@@ -225,35 +242,50 @@ fn contacts(
                 + frame.placement.rotation * nalgebra::Vector3::from(offset),
         };
         let (rotation, position) = wk.frame_pose(g, frame.body, &placement);
-        placements.extend(position);
-        placements.extend(rotation.iter().flatten());
+        out.placements.extend(position);
+        out.placements.extend(rotation.iter().flatten());
         let full = wk.point_jacobian(g, model, frame.body, &position);
         let Some(body) = frame.body.map(|b| b + shift).or((shift == 1).then_some(0)) else {
             // On a fixed root: the frame never moves.
-            jac.extend(full.into_iter().take(rows));
-            drift.extend(vec![g.zero(); rows]);
+            out.jacobian.extend(full.into_iter().take(rows));
+            out.drift.extend(vec![g.zero(); rows]);
+            out.gravity_drift.push(GravityDrift::still(g));
             continue;
         };
-        let m = &motions[body];
         let t = [0, 1, 2].map(|k| g.constant(placement.translation[k]));
-        let dwt = cross(g, &m.dw, &t);
-        let wt = cross(g, &m.w, &t);
-        let wwt = cross(g, &m.w, &wt);
-        let a = [0, 1, 2].map(|k| g.add_all([m.acc[k], dwt[k], wwt[k]]));
-        let r = &poses[body].0;
+        let (m, r) = (&motions[body], &poses[body].0);
+        let a = point_acceleration(g, m, &t);
         let classical = mat_vec(g, r, &a);
-        if six {
+        // A frame's origin velocity, which its drift and its gravity drift's parts take.
+        let velocity = if six {
             let w = mat_vec(g, r, &m.w);
             let velocity = [0, 1, 2].map(|k| g.dot(&full[k], v));
             let wv = cross(g, &w, &velocity);
-            drift.extend(vec_sub(g, &classical, &wv));
-            drift.extend(mat_vec(g, r, &m.dw));
+            out.drift.extend(vec_sub(g, &classical, &wv));
+            out.drift.extend(mat_vec(g, r, &m.dw));
+            Some(velocity)
         } else {
-            drift.extend(classical);
-        }
-        jac.extend(full.into_iter().take(rows));
+            out.drift.extend(classical);
+            None
+        };
+        let mg = &with_gravity[body];
+        out.gravity_drift.push(GravityDrift {
+            rotation: Some(*r),
+            accel: point_acceleration(g, mg, &t),
+            frame: velocity.map(|velocity| (mg.w, mg.dw, velocity)),
+        });
+        out.jacobian.extend(full.into_iter().take(rows));
     }
-    (jac, drift, placements)
+    out
+}
+
+/// The classical acceleration of the point `t` of a body (body axes) from the body's motion:
+/// its origin's plus `dw x t + w x (w x t)`.
+fn point_acceleration(g: &mut Graph, m: &newton_euler::BodyMotion, t: &V3) -> V3 {
+    let dwt = cross(g, &m.dw, t);
+    let wt = cross(g, &m.w, t);
+    let wwt = cross(g, &m.w, &wt);
+    [0, 1, 2].map(|k| g.add_all([m.acc[k], dwt[k], wwt[k]]))
 }
 
 const Q: &[Input] = &[Input::Q];

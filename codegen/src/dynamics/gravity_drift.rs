@@ -10,18 +10,17 @@
 //! values equal `contact_drift`'s to rounding (the gravity terms cancel), which is why the
 //! contact drift itself and everything differentiated from it keep the pass without gravity.
 
-use super::centroidal::{base_at_identity, contact_list};
-use super::newton_euler::{self, LocalModel, Terms};
+use super::centroidal::base_at_identity;
+use super::newton_euler::{self, BodyMotion, LocalModel, Terms};
 use super::Derivation;
 use crate::cas::{Graph, Id, SumFlattening};
 use crate::kinematics::joint::free_flyer_placement;
-use crate::kinematics::{
-    const_v3, cross, mat_t_vec, mat_vec, vec_add, vec_sub, WorldKinematics, M3, V3,
-};
-use crate::model::{Model, Transform};
+use crate::kinematics::{const_v3, cross, mat_t_vec, mat_vec, vec_add, vec_sub, M3, V3};
+use crate::model::Model;
 
-/// A contact's drift as Newton-Euler's forward pass with gravity sees it, the pass that `b + G`
-/// runs (`Recursive::bias_and_gravity`): the body's classical acceleration there is the drift's
+/// A contact's drift as Newton-Euler's forward pass with gravity sees it ([`forward_pass`]; the
+/// contacts' derivation in `centroidal.rs` builds one per contact), the pass that `b + G` runs
+/// (`Recursive::bias_and_gravity`): the body's classical acceleration there is the drift's
 /// plus gravity's upward acceleration in body axes, `R^T (-g)`, so that in world axes the
 /// point's drift is `R accel + g` (and in a floating base's axes `R_b^T (R accel + g)`). Built
 /// from that pass's own expressions, the drift shares its kinematics with `b + G` in a program
@@ -40,74 +39,35 @@ pub struct GravityDrift {
     pub frame: Option<(V3, V3, V3)>,
 }
 
-/// [`GravityDrift`] of each contact, in the contact rows' order ([`contact_list`]).
-pub(super) fn gravity_drift(
+impl GravityDrift {
+    /// A contact on a fixed root: it never moves.
+    pub fn still(g: &mut Graph) -> GravityDrift {
+        GravityDrift {
+            rotation: None,
+            accel: [g.zero(); 3],
+            frame: None,
+        }
+    }
+}
+
+/// Newton-Euler's forward pass with gravity at the velocities `v`, built as `recursive` builds
+/// `b + G`'s (shared sums), so that its nodes are that pass's.
+pub(super) fn forward_pass(
     g: &mut Graph,
     model: &Model,
     lm: &LocalModel,
-    wk: &WorldKinematics,
-    poses: &[(M3, V3)],
     v: &[Id],
-) -> Vec<GravityDrift> {
-    if model.contacts.is_empty()
-        && model.contact_points_at.is_empty()
-        && model.contact_frames.is_empty()
-    {
-        return Vec::new();
-    }
-    let shift = usize::from(model.is_floating());
+) -> Vec<BodyMotion> {
     let gravity = Some(const_v3(g, &model.gravity));
-    // As `recursive` runs it, so that the nodes are the same.
     let old = g.set_flattening(SumFlattening::Shared);
-    let motions = newton_euler::forward_pass(
-        g,
-        lm,
-        Terms {
-            qd: Some(v),
-            qdd: None,
-            gravity,
-        },
-        |_, _, _| {},
-    );
+    let terms = Terms {
+        qd: Some(v),
+        qdd: None,
+        gravity,
+    };
+    let motions = newton_euler::forward_pass(g, lm, terms, |_, _, _| {});
     g.set_flattening(old);
-    let mut out = Vec::new();
-    for (f, offset, six) in contact_list(model) {
-        let frame = &model.frames[f];
-        let Some(body) = frame.body.map(|b| b + shift).or((shift == 1).then_some(0)) else {
-            out.push(GravityDrift {
-                rotation: None,
-                accel: [g.zero(); 3],
-                frame: None,
-            });
-            continue;
-        };
-        let t_local = frame.placement.translation
-            + frame.placement.rotation * nalgebra::Vector3::from(offset);
-        let m = &motions[body];
-        let t = [0, 1, 2].map(|k| g.constant(t_local[k]));
-        let dwt = cross(g, &m.dw, &t);
-        let wt = cross(g, &m.w, &t);
-        let wwt = cross(g, &m.w, &wt);
-        let accel = [0, 1, 2].map(|k| g.add_all([m.acc[k], dwt[k], wwt[k]]));
-        let rotation = poses[body].0;
-        let frame = six.then(|| {
-            // The frame origin's velocity, world axes, as `contacts` computes it.
-            let placement = Transform {
-                rotation: frame.placement.rotation,
-                translation: t_local,
-            };
-            let (_, position) = wk.frame_pose(g, frame.body, &placement);
-            let full = wk.point_jacobian(g, model, frame.body, &position);
-            let velocity = [0, 1, 2].map(|k| g.dot(&full[k], v));
-            (m.w, m.dw, velocity)
-        });
-        out.push(GravityDrift {
-            rotation: Some(rotation),
-            accel,
-            frame,
-        });
-    }
-    out
+    motions
 }
 
 /// The contact drift in the axes that [`contacts_in_solving_axes`] solves in, built from
