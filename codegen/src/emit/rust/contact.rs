@@ -142,17 +142,8 @@ impl Emitter<'_> {
     }
 
     /// `try_contact_forward_dynamics_stabilized` and `contact_forward_dynamics_stabilized` (NaN
-    /// on failure), which take an `eomgen_runtime::Baumgarte` after `active`; without
-    /// `stabilized`, [`Emitter::contact_active_checked_fns`].
-    pub(super) fn contact_active_fns(
-        &mut self,
-        q: &Quantity,
-        h: &[Id],
-        stabilized: bool,
-    ) -> TokenStream {
-        if !stabilized {
-            return self.contact_active_checked_fns(q, h);
-        }
+    /// on failure), which take an `eomgen_runtime::Baumgarte` after `active`.
+    pub(super) fn contact_stabilized_fns(&mut self, q: &Quantity, h: &[Id]) -> TokenStream {
         let (hb, ops) = self.active_bias(q, h);
         let docs = Self::quantity_doc(q, Some(ops));
         let (n, nq, k) = (&self.n, &self.nq, &self.k);
@@ -193,7 +184,7 @@ impl Emitter<'_> {
     /// failed lane's error, `try_contact_forward_dynamics_active_lanes` says which lane, and
     /// the plain method gives NaN in the failed lanes alone. On a scalar, the stabilized
     /// form's route without its drift correction.
-    fn contact_active_checked_fns(&mut self, q: &Quantity, h: &[Id]) -> TokenStream {
+    pub(super) fn contact_active_checked_fns(&mut self, q: &Quantity, h: &[Id]) -> TokenStream {
         let (hb, ops) = self.active_bias(q, h);
         let docs = Self::quantity_doc(q, Some(ops));
         let (n, nq, k) = (&self.n, &self.nq, &self.k);
@@ -344,19 +335,16 @@ impl Emitter<'_> {
         (build(quote!(&mut err)), build(quote!(&mut None)))
     }
 
-    /// `try_impulse_dynamics` and `impulse_dynamics` (NaN on failure), or their `_active`
-    /// variants.
-    pub(super) fn impulse_dynamics_fns(&mut self, q: &Quantity, active: bool) -> TokenStream {
-        if active {
-            return self.impulse_active_checked_fns(q);
-        }
+    /// `try_impulse_dynamics` and `impulse_dynamics` (NaN on failure) solved at run time (the
+    /// `_active` variants: [`Emitter::impulse_active_checked_fns`]).
+    pub(super) fn impulse_dynamics_fns(&mut self, q: &Quantity) -> TokenStream {
         let docs = Self::quantity_doc(q, None);
         let (n, nq, k) = (self.n.clone(), self.nq.clone(), self.k.clone());
         let (m, j) = (self.call("mass_matrix"), self.call("contact_jacobian"));
-        let rows = self.active_rows(active);
+        let rows = self.active_rows(false);
         let s = self.signature(
             q,
-            active,
+            false,
             (
                 "The velocity after the impact and the impulses of",
                 ", or why",
@@ -392,7 +380,7 @@ impl Emitter<'_> {
     /// `contact_forward_dynamics_active` (`Emitter::contact_active_checked_fns`): its
     /// `_checked` method records each lane's failure
     /// (`eomgen_runtime::impulse::solve_factored_active_lanes`).
-    fn impulse_active_checked_fns(&mut self, q: &Quantity) -> TokenStream {
+    pub(super) fn impulse_active_checked_fns(&mut self, q: &Quantity) -> TokenStream {
         let docs = Self::quantity_doc(q, None);
         let (n, nq, k) = (&self.n, &self.nq, &self.k);
         let c = usize_lit(self.contact_rows.len());

@@ -43,7 +43,7 @@ impl Emitter<'_> {
             Evaluation::ContactDynamicsDerivatives { h } => {
                 self.contact_dynamics_derivatives_fns(q, h, false)
             }
-            Evaluation::ImpulseDynamics => self.impulse_dynamics_fns(q, false),
+            Evaluation::ImpulseDynamics => self.impulse_dynamics_fns(q),
             Evaluation::ImpulseDynamicsFlat { outputs, pivots } => {
                 self.impulse_flat_fns(q, outputs, pivots)
             }
@@ -58,10 +58,10 @@ impl Emitter<'_> {
     /// The methods of a set of active contacts ([`ActiveContacts`]).
     pub(super) fn active_contacts_fns(&mut self, q: &Quantity, a: &ActiveContacts) -> TokenStream {
         match a {
-            ActiveContacts::Dynamics { h } => self.contact_active_fns(q, h, false),
-            ActiveContacts::Stabilized { h } => self.contact_active_fns(q, h, true),
+            ActiveContacts::Dynamics { h } => self.contact_active_checked_fns(q, h),
+            ActiveContacts::Stabilized { h } => self.contact_stabilized_fns(q, h),
             ActiveContacts::Derivatives { h } => self.contact_dynamics_derivatives_fns(q, h, true),
-            ActiveContacts::Impulse => self.impulse_dynamics_fns(q, true),
+            ActiveContacts::Impulse => self.impulse_active_checked_fns(q),
             ActiveContacts::ImpulseDerivatives => self.impulse_dynamics_derivatives_fns(q, true),
         }
     }
