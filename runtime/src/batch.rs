@@ -26,8 +26,9 @@
 
 use core::fmt;
 
+use crate::entries;
 use crate::lane::Pack;
-use crate::{Pose, Real};
+use crate::{ContactDynamicsDerivatives, ImpulseDynamicsDerivatives, Pose, Real};
 
 /// A scalar whose generated methods have `_batch` versions: `f64` and `f32`.
 pub trait Batch: Real + Send + Sync {
@@ -170,6 +171,34 @@ pub fn scatter_matrix<L: Pack, const R: usize, const C: usize>(
     out: &mut [[[L::Scalar; C]; R]],
 ) {
     L::unpack(v.as_flattened(), out.as_flattened_mut().as_flattened_mut());
+}
+
+/// Lanes `0..out.len()` of contact-dynamics derivatives, one result per state: the six
+/// matrices unpacked as one run of entries, as [`scatter_matrix`] unpacks a matrix.
+///
+/// ```
+/// use eomgen_runtime::{batch::scatter_contact_derivatives, ContactDynamicsDerivatives};
+/// let d = ContactDynamicsDerivatives::<f64, 1, 1>::nan();
+/// let mut out = [ContactDynamicsDerivatives { da_dq: [[0.5]], ..d }];
+/// scatter_contact_derivatives(&d, &mut out);
+/// assert!(out[0].da_dq[0][0].is_nan());
+/// ```
+#[inline(always)]
+pub fn scatter_contact_derivatives<L: Pack, const N: usize, const K: usize>(
+    d: &ContactDynamicsDerivatives<L, N, K>,
+    out: &mut [ContactDynamicsDerivatives<L::Scalar, N, K>],
+) {
+    L::unpack(entries::of(d), entries::of_each_mut(out));
+}
+
+/// Lanes `0..out.len()` of impulse-dynamics derivatives, one result per state (as
+/// [`scatter_contact_derivatives`]).
+#[inline(always)]
+pub fn scatter_impulse_derivatives<L: Pack, const N: usize, const K: usize>(
+    d: &ImpulseDynamicsDerivatives<L, N, K>,
+    out: &mut [ImpulseDynamicsDerivatives<L::Scalar, N, K>],
+) {
+    L::unpack(entries::of(d), entries::of_each_mut(out));
 }
 
 /// Lane `l` of the pose `p` into element `l` of `out` (at most `L::LANES` elements).

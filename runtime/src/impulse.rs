@@ -17,13 +17,7 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
     /// The velocity after the impact and the impulses, from the velocity before `v` and the
     /// restitution `e` (0: the contacts stop, 1: they bounce back at full speed).
     pub fn impulse(&self, v: &[T; N], e: T) -> Result<([T; N], [T; K]), FactorError> {
-        let k = -(T::one() + e);
-        let bottom: [T; K] = core::array::from_fn(|r| k * dot(&self.jacobian()[r], v));
-        let (mut dv, p) = self.solve_bottom(&bottom)?;
-        for (x, vi) in dv.iter_mut().zip(v) {
-            *x += *vi;
-        }
-        Ok((dv, p))
+        self.impulse_lanes(v, e, &mut ())
     }
 
     /// The derivatives of [`ContactKkt::impulse`] at its solution, from the generated
@@ -67,6 +61,37 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
         e: T,
         d: &mut ImpulseDynamicsDerivatives<T, N, K>,
     ) -> Result<(), FactorError> {
+        self.impulse_derivatives_lanes::<P>(e, d, &mut ())
+    }
+}
+
+impl<T: Lane, const N: usize, const K: usize> ContactKkt<T, N, K> {
+    /// [`ContactKkt::impulse`] on a vector of states ([`Lane`], one state per lane, `e` each
+    /// lane's restitution): a lane whose result is not finite records its error in `failures`
+    /// (a scalar returns it).
+    pub fn impulse_lanes(
+        &self,
+        v: &[T; N],
+        e: T,
+        failures: &mut T::Failures,
+    ) -> Result<([T; N], [T; K]), FactorError> {
+        let k = -(T::one() + e);
+        let bottom: [T; K] = core::array::from_fn(|r| k * dot(&self.jacobian()[r], v));
+        let (mut dv, p) = self.solve_bottom_lanes(&bottom, failures)?;
+        for (x, vi) in dv.iter_mut().zip(v) {
+            *x += *vi;
+        }
+        Ok((dv, p))
+    }
+
+    /// [`ContactKkt::impulse_derivatives_in_place_by`] on a vector of states: a lane with a
+    /// non-finite derivative records its error in `failures` (a scalar returns it).
+    pub fn impulse_derivatives_lanes<P: TreePasses<T, N>>(
+        &self,
+        e: T,
+        d: &mut ImpulseDynamicsDerivatives<T, N, K>,
+        failures: &mut T::Failures,
+    ) -> Result<(), FactorError> {
         let inverse = self.lambda_inverse();
         let (dv_dq, dp_dq) = (&mut d.dv_dq, &mut d.dimpulse_dq);
         self.solve_signed_columns_in_place::<P, N>(Some(&inverse), dv_dq, dp_dq, -T::one());
@@ -85,10 +110,10 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
             combination_into(row, |k| y[k][i], &d.dimpulse_dv, cols.clone());
             row[i] += T::one();
         }
-        finite_rows(&d.dv_dq, 0)?;
-        finite_rows(&d.dv_dv, 0)?;
-        finite_rows(&d.dimpulse_dq, N)?;
-        finite_rows(&d.dimpulse_dv, N)?;
+        finite_rows(&d.dv_dq, 0, failures)?;
+        finite_rows(&d.dv_dv, 0, failures)?;
+        finite_rows(&d.dimpulse_dq, N, failures)?;
+        finite_rows(&d.dimpulse_dv, N, failures)?;
         Ok(())
     }
 }

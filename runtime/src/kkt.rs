@@ -19,12 +19,13 @@
 pub(crate) use crate::linalg::{axpy, combination_into, scaled};
 use crate::linalg::{Cholesky, FactorError};
 use crate::tree::{ltdl_factor, ltdl_substitute, TreePasses, Walked};
-use crate::Real;
+use crate::{Lane, Real};
 
 /// The derivatives of contact forward dynamics (`contact_forward_dynamics_derivatives`), as
 /// Pinocchio's `computeConstraintDynamicsDerivatives`: element `[i][j]` = d out_i / d in_j,
 /// `q` perturbed in the tangent space (as `integrate`), forces on the robot in world axes.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
 pub struct ContactDynamicsDerivatives<T, const NV: usize, const K: usize> {
     /// d a / d q, NV x NV.
     pub da_dq: [[T; NV]; NV],
@@ -40,7 +41,7 @@ pub struct ContactDynamicsDerivatives<T, const NV: usize, const K: usize> {
     pub df_dtau: [[T; NV]; K],
 }
 
-impl<T: Real, const NV: usize, const K: usize> ContactDynamicsDerivatives<T, NV, K> {
+impl<T: Lane, const NV: usize, const K: usize> ContactDynamicsDerivatives<T, NV, K> {
     /// Sets every entry to NaN, in place.
     pub fn fill_nan(&mut self) {
         let (a, f) = (T::nan(), T::nan());
@@ -49,6 +50,18 @@ impl<T: Real, const NV: usize, const K: usize> ContactDynamicsDerivatives<T, NV,
         }
         for m in [&mut self.df_dq, &mut self.df_dv, &mut self.df_dtau] {
             m.iter_mut().flatten().for_each(|x| *x = f);
+        }
+    }
+
+    /// NaN in every entry of the lanes that recorded a failure (nothing for a scalar, whose
+    /// failure stops the computation before): what the methods without `try_` give a failed
+    /// lane of a vector of states.
+    pub fn nan_failed(&mut self, failures: &T::Failures) {
+        for m in [&mut self.da_dq, &mut self.da_dv, &mut self.da_dtau] {
+            crate::lane::nan_failed_in(m.as_flattened_mut(), failures);
+        }
+        for m in [&mut self.df_dq, &mut self.df_dv, &mut self.df_dtau] {
+            crate::lane::nan_failed_in(m.as_flattened_mut(), failures);
         }
     }
 
@@ -91,6 +104,7 @@ impl<T: Real, const NV: usize, const K: usize> ContactDynamicsDerivatives<T, NV,
 /// d v_after / d v_before (Pinocchio's derivative of the jump plus the identity). Element
 /// `[i][j]` = d out_i / d in_j, `q` perturbed in the tangent space.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
 pub struct ImpulseDynamicsDerivatives<T, const NV: usize, const K: usize> {
     /// d v_after / d q, NV x NV.
     pub dv_dq: [[T; NV]; NV],
@@ -102,7 +116,7 @@ pub struct ImpulseDynamicsDerivatives<T, const NV: usize, const K: usize> {
     pub dimpulse_dv: [[T; NV]; K],
 }
 
-impl<T: Real, const NV: usize, const K: usize> ImpulseDynamicsDerivatives<T, NV, K> {
+impl<T: Lane, const NV: usize, const K: usize> ImpulseDynamicsDerivatives<T, NV, K> {
     /// Sets every entry to NaN, in place.
     pub fn fill_nan(&mut self) {
         for m in [&mut self.dv_dq, &mut self.dv_dv] {
@@ -110,6 +124,17 @@ impl<T: Real, const NV: usize, const K: usize> ImpulseDynamicsDerivatives<T, NV,
         }
         for m in [&mut self.dimpulse_dq, &mut self.dimpulse_dv] {
             m.iter_mut().flatten().for_each(|x| *x = T::nan());
+        }
+    }
+
+    /// NaN in every entry of the lanes that recorded a failure, as
+    /// [`ContactDynamicsDerivatives::nan_failed`].
+    pub fn nan_failed(&mut self, failures: &T::Failures) {
+        for m in [&mut self.dv_dq, &mut self.dv_dv] {
+            crate::lane::nan_failed_in(m.as_flattened_mut(), failures);
+        }
+        for m in [&mut self.dimpulse_dq, &mut self.dimpulse_dv] {
+            crate::lane::nan_failed_in(m.as_flattened_mut(), failures);
         }
     }
 
@@ -144,13 +169,15 @@ impl<T: Real, const NV: usize, const K: usize> ImpulseDynamicsDerivatives<T, NV,
 /// Completes the system whose `M`'s `L^T D L` factors and contact Jacobian are in `factors`
 /// and `j`: zeroes the inactive rows of `J`, writes `Y = M^-1 J^T` into `y` (row `k` a column)
 /// and returns the Cholesky factor of `J M^-1 J^T` (the identity's rows and columns for
-/// inactive rows). `P` substitutes through the factors.
-fn factorize<P: TreePasses<T, N>, T: Real, const N: usize, const K: usize>(
+/// inactive rows). `P` substitutes through the factors. A pivot of `J M^-1 J^T` that fails is
+/// pivot `N + k` ([`Lane::check_pivot`]: a scalar returns it, a vector records it in
+/// `failures`).
+fn factorize<P: TreePasses<T, N>, T: Lane, const N: usize, const K: usize>(
     factors: &[[T; N]; N],
     j: &mut [[T; N]; K],
     y: &mut [[T; N]; K],
-    parent: &[Option<usize>; N],
-    active: &[bool; K],
+    (parent, active): (&[Option<usize>; N], &[bool; K]),
+    failures: &mut T::Failures,
 ) -> Result<Cholesky<T, K>, FactorError> {
     for (jk, on) in j.iter_mut().zip(active) {
         if !*on {
@@ -195,7 +222,7 @@ fn factorize<P: TreePasses<T, N>, T: Real, const N: usize, const K: usize>(
             above[c] = lower[0][r];
         }
     }
-    Cholesky::new(lambda).map_err(shift::<N>)
+    Cholesky::factor(lambda, N, failures)
 }
 
 /// The arrays of a factorized system, wherever they lie ([`ContactKkt`], or a result and a
@@ -211,7 +238,7 @@ struct Parts<'a, T, const N: usize, const K: usize> {
     active: &'a [bool; K],
 }
 
-impl<T: Real, const N: usize, const K: usize> Parts<'_, T, N, K> {
+impl<T: Lane, const N: usize, const K: usize> Parts<'_, T, N, K> {
     /// [`ContactKkt::solve`] with the contact Jacobian `j`; `top = None` stands for zeros
     /// (impulse dynamics), whose substitution through `M` is skipped.
     fn solve(
@@ -219,10 +246,10 @@ impl<T: Real, const N: usize, const K: usize> Parts<'_, T, N, K> {
         j: &[[T; N]; K],
         top: Option<&[T; N]>,
         bottom: &[T; K],
+        failures: &mut T::Failures,
     ) -> Result<([T; N], [T; K]), FactorError> {
-        self.solve_with(j, top, bottom, |b| {
-            ltdl_substitute(self.factors, self.parent, b)
-        })
+        let substitute = |b: &[T; N]| ltdl_substitute(self.factors, self.parent, b);
+        self.solve_with(j, top, bottom, substitute, failures)
     }
 
     /// [`Parts::solve`] with the caller's `M^-1 b` from the factors (`substitute`).
@@ -232,6 +259,7 @@ impl<T: Real, const N: usize, const K: usize> Parts<'_, T, N, K> {
         top: Option<&[T; N]>,
         bottom: &[T; K],
         substitute: impl Fn(&[T; N]) -> [T; N],
+        failures: &mut T::Failures,
     ) -> Result<([T; N], [T; K]), FactorError> {
         let mut x = match top {
             Some(top) => substitute(top),
@@ -247,7 +275,7 @@ impl<T: Real, const N: usize, const K: usize> Parts<'_, T, N, K> {
                 *xi += *yi * *fk;
             }
         }
-        finite_solution(x, f, &mut ())
+        finite_solution(x, f, failures)
     }
 
     /// The solution for `(sign top, sign bottom)`, `sign` one or minus one: with
@@ -269,10 +297,11 @@ impl<T: Real, const N: usize, const K: usize> Parts<'_, T, N, K> {
             }
             // Each row gathered in a local accumulator (kept in registers), not updated in
             // memory once per term: that form was vectorized across rows, with gathers.
-            // The zeros of `J` (a contact's row is zero outside its chain) are skipped.
+            // The zeros of `J` (a contact's row is zero outside its chain) are skipped; on a
+            // vector, where every lane's entry is zero.
             let mut acc = scaled(fk, sign);
             for (jki, xi) in jk.iter().zip(x.iter()) {
-                if *jki != T::zero() {
+                if !jki.zero_in_every_lane() {
                     axpy(&mut acc, -sign * *jki, xi);
                 }
             }
@@ -356,7 +385,7 @@ pub struct KktStash<T, const N: usize, const K: usize> {
     active: [bool; K],
 }
 
-impl<T: Real, const N: usize, const K: usize> KktStash<T, N, K> {
+impl<T: Lane, const N: usize, const K: usize> KktStash<T, N, K> {
     /// A stash for the system of the coordinate tree `parent` and the contact rows `active`,
     /// before [`ContactKkt::set_up_in_stash_by`] sets it up (`Y` zero, `J M^-1 J^T` the
     /// identity).
@@ -369,27 +398,17 @@ impl<T: Real, const N: usize, const K: usize> KktStash<T, N, K> {
         }
     }
 
-    /// [`ContactKkt::solve`] of the system set up in `d` by [`ContactKkt::set_up_in`].
-    pub fn solve(
+    /// [`KktStash::solve_with`] on a vector of states ([`Lane`], one state per lane): a lane
+    /// whose solution is not finite records its error in `failures` (a scalar returns it).
+    pub fn solve_with_lanes(
         &self,
         d: &ContactDynamicsDerivatives<T, N, K>,
-        top: &[T; N],
-        bottom: &[T; K],
-    ) -> Result<([T; N], [T; K]), FactorError> {
-        self.parts(d).solve(&d.df_dtau, Some(top), bottom)
-    }
-
-    /// [`KktStash::solve`] with the caller's own `M^-1 b` from the factors in `d.da_dtau`
-    /// (`substitute`): generated code passes its unrolled substitution.
-    pub fn solve_with(
-        &self,
-        d: &ContactDynamicsDerivatives<T, N, K>,
-        top: &[T; N],
-        bottom: &[T; K],
+        (top, bottom): (&[T; N], &[T; K]),
         substitute: impl Fn(&[T; N]) -> [T; N],
+        failures: &mut T::Failures,
     ) -> Result<([T; N], [T; K]), FactorError> {
         self.parts(d)
-            .solve_with(&d.df_dtau, Some(top), bottom, substitute)
+            .solve_with(&d.df_dtau, Some(top), bottom, substitute, failures)
     }
 
     /// The arrays of the system stashed in `d`, for [`Parts`]' methods.
@@ -408,26 +427,13 @@ impl<T: Real, const N: usize, const K: usize> KktStash<T, N, K> {
         }
     }
 
-    /// [`ContactKkt::contact_dynamics_derivatives_in_place`] of the system stashed in `d`,
-    /// whose `da_dq`, `da_dv`, `df_dq` and `df_dv` hold the right-hand sides by then. The
-    /// system is set up again in this function's own frame, so that it is never on the stack
-    /// while the caller computes them.
+    /// [`KktStash::contact_dynamics_derivatives_in_place_by`] on a vector of states: a lane
+    /// with a non-finite derivative records its error in `failures` (a scalar returns it).
     #[inline(never)]
-    pub fn contact_dynamics_derivatives_in_place(
+    pub fn contact_dynamics_derivatives_lanes<P: TreePasses<T, N>>(
         &self,
         d: &mut ContactDynamicsDerivatives<T, N, K>,
-    ) -> Result<(), FactorError> {
-        self.contact_dynamics_derivatives_in_place_by::<Walked>(d)
-    }
-
-    /// [`KktStash::contact_dynamics_derivatives_in_place`] with the passes `P`, as
-    /// [`ContactKkt::contact_dynamics_derivatives_in_place_by`]. The system's arrays in `d`
-    /// are read where they lie; only `M`'s factors are copied, before the solve for `tau`
-    /// writes `M^-1` over them.
-    #[inline(never)]
-    pub fn contact_dynamics_derivatives_in_place_by<P: TreePasses<T, N>>(
-        &self,
-        d: &mut ContactDynamicsDerivatives<T, N, K>,
+        failures: &mut T::Failures,
     ) -> Result<(), FactorError> {
         let ContactDynamicsDerivatives {
             da_dq,
@@ -445,7 +451,54 @@ impl<T: Real, const N: usize, const K: usize> KktStash<T, N, K> {
         let factors = *da_dtau;
         self.over(&factors)
             .solve_identity_in_place_by::<P>(Some(&inverse), da_dtau, df_dtau);
-        finite_derivatives(d)
+        finite_derivatives(d, failures)
+    }
+}
+
+impl<T: Real, const N: usize, const K: usize> KktStash<T, N, K> {
+    /// [`ContactKkt::solve`] of the system set up in `d` by [`ContactKkt::set_up_in`].
+    pub fn solve(
+        &self,
+        d: &ContactDynamicsDerivatives<T, N, K>,
+        top: &[T; N],
+        bottom: &[T; K],
+    ) -> Result<([T; N], [T; K]), FactorError> {
+        self.parts(d).solve(&d.df_dtau, Some(top), bottom, &mut ())
+    }
+
+    /// [`KktStash::solve`] with the caller's own `M^-1 b` from the factors in `d.da_dtau`
+    /// (`substitute`): generated code passes its unrolled substitution.
+    pub fn solve_with(
+        &self,
+        d: &ContactDynamicsDerivatives<T, N, K>,
+        top: &[T; N],
+        bottom: &[T; K],
+        substitute: impl Fn(&[T; N]) -> [T; N],
+    ) -> Result<([T; N], [T; K]), FactorError> {
+        self.solve_with_lanes(d, (top, bottom), substitute, &mut ())
+    }
+
+    /// [`ContactKkt::contact_dynamics_derivatives_in_place`] of the system stashed in `d`,
+    /// whose `da_dq`, `da_dv`, `df_dq` and `df_dv` hold the right-hand sides by then. The
+    /// system is set up again in this function's own frame, so that it is never on the stack
+    /// while the caller computes them.
+    #[inline(never)]
+    pub fn contact_dynamics_derivatives_in_place(
+        &self,
+        d: &mut ContactDynamicsDerivatives<T, N, K>,
+    ) -> Result<(), FactorError> {
+        self.contact_dynamics_derivatives_in_place_by::<Walked>(d)
+    }
+
+    /// [`KktStash::contact_dynamics_derivatives_in_place`] with the passes `P`, as
+    /// [`ContactKkt::contact_dynamics_derivatives_in_place_by`]. The system's arrays in `d`
+    /// are read where they lie; only `M`'s factors are copied, before the solve for `tau`
+    /// writes `M^-1` over them.
+    pub fn contact_dynamics_derivatives_in_place_by<P: TreePasses<T, N>>(
+        &self,
+        d: &mut ContactDynamicsDerivatives<T, N, K>,
+    ) -> Result<(), FactorError> {
+        self.contact_dynamics_derivatives_lanes::<P>(d, &mut ())
     }
 }
 
@@ -512,18 +565,6 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
             active,
         )?;
         Ok(kkt)
-    }
-
-    /// A system of zeros, for [`ContactKkt::set_up`] to set up where it lies.
-    pub fn zeroed() -> Self {
-        ContactKkt {
-            factors: [[T::zero(); N]; N],
-            parent: [None; N],
-            j: [[T::zero(); N]; K],
-            y: [[T::zero(); N]; K],
-            lambda: Cholesky::identity(),
-            active: [true; K],
-        }
     }
 
     /// [`ContactKkt::new_active`] in place, so that a caller keeps one copy of the system
@@ -597,12 +638,7 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
         parent: &[Option<usize>; N],
         active: &[bool; K],
     ) -> Result<(), FactorError> {
-        fill(&mut self.factors, &mut self.j)?;
-        self.parent = *parent;
-        self.active = *active;
-        let (factors, j, y) = (&mut self.factors, &mut self.j, &mut self.y);
-        self.lambda = factorize::<P, T, N, K>(factors, j, y, parent, active)?;
-        Ok(())
+        self.set_up_factored_lanes::<P>(|m, j, _| fill(m, j), (parent, active), &mut ())
     }
 
     /// [`ContactKkt::set_up`] with the system's two largest arrays in the parts of `d` that
@@ -693,10 +729,7 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
         stash: &mut KktStash<T, N, K>,
         fill: impl FnOnce(&mut [[T; N]; N], &mut [[T; N]; K]) -> Result<(), FactorError>,
     ) -> Result<(), FactorError> {
-        fill(&mut d.da_dtau, &mut d.df_dtau)?;
-        let (m, j, y) = (&mut d.da_dtau, &mut d.df_dtau, &mut stash.y);
-        stash.lambda = factorize::<P, T, N, K>(m, j, y, &stash.parent, &stash.active)?;
-        Ok(())
+        Self::set_up_in_stash_lanes::<P>(d, stash, |m, j, _| fill(m, j), &mut ())
     }
 
     /// The system that [`ContactKkt::set_up_in`] left in `d` and `stash`.
@@ -711,6 +744,74 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
         }
     }
 
+    /// Solves the system for one right-hand side `(top, bottom)`: `(x, f)`. Contact forward
+    /// dynamics is `solve(tau - h, -drift)`; a non-finite component of `x` (`pivot < N`) or
+    /// `f` (`N + k`) is an error.
+    pub fn solve(&self, top: &[T; N], bottom: &[T; K]) -> Result<([T; N], [T; K]), FactorError> {
+        self.parts().solve(&self.j, Some(top), bottom, &mut ())
+    }
+
+    /// [`ContactKkt::solve`] with `top = 0`: `x = M^-1 J^T f`, with no substitution of the
+    /// zeros through `M` (impulse dynamics' system).
+    pub fn solve_bottom(&self, bottom: &[T; K]) -> Result<([T; N], [T; K]), FactorError> {
+        self.solve_bottom_lanes(bottom, &mut ())
+    }
+}
+
+impl<T: Lane, const N: usize, const K: usize> ContactKkt<T, N, K> {
+    /// A system of zeros, for [`ContactKkt::set_up`] to set up where it lies.
+    pub fn zeroed() -> Self {
+        ContactKkt {
+            factors: [[T::zero(); N]; N],
+            parent: [None; N],
+            j: [[T::zero(); N]; K],
+            y: [[T::zero(); N]; K],
+            lambda: Cholesky::identity(),
+            active: [true; K],
+        }
+    }
+
+    /// [`ContactKkt::set_up_factored_by`] on a vector of states ([`Lane`], one state per lane):
+    /// `fill` writes `M`'s factors and `J` and checks `M`'s pivots with the `failures` it is
+    /// given; a lane whose pivot of `J M^-1 J^T` fails records it there (pivot `N + k`; a
+    /// scalar returns it) and holds garbage.
+    pub fn set_up_factored_lanes<P: TreePasses<T, N>>(
+        &mut self,
+        fill: impl FnOnce(
+            &mut [[T; N]; N],
+            &mut [[T; N]; K],
+            &mut T::Failures,
+        ) -> Result<(), FactorError>,
+        (parent, active): (&[Option<usize>; N], &[bool; K]),
+        failures: &mut T::Failures,
+    ) -> Result<(), FactorError> {
+        fill(&mut self.factors, &mut self.j, failures)?;
+        self.parent = *parent;
+        self.active = *active;
+        let (factors, j, y) = (&mut self.factors, &mut self.j, &mut self.y);
+        self.lambda = factorize::<P, T, N, K>(factors, j, y, (parent, active), failures)?;
+        Ok(())
+    }
+
+    /// [`ContactKkt::set_up_in_stash_by`] on a vector of states, as
+    /// [`ContactKkt::set_up_factored_lanes`].
+    pub fn set_up_in_stash_lanes<P: TreePasses<T, N>>(
+        d: &mut ContactDynamicsDerivatives<T, N, K>,
+        stash: &mut KktStash<T, N, K>,
+        fill: impl FnOnce(
+            &mut [[T; N]; N],
+            &mut [[T; N]; K],
+            &mut T::Failures,
+        ) -> Result<(), FactorError>,
+        failures: &mut T::Failures,
+    ) -> Result<(), FactorError> {
+        fill(&mut d.da_dtau, &mut d.df_dtau, failures)?;
+        let (m, j, y) = (&mut d.da_dtau, &mut d.df_dtau, &mut stash.y);
+        let tree = (&stash.parent, &stash.active);
+        stash.lambda = factorize::<P, T, N, K>(m, j, y, tree, failures)?;
+        Ok(())
+    }
+
     /// Which contact rows take part (all of them for [`ContactKkt::new`]).
     pub fn active(&self) -> &[bool; K] {
         &self.active
@@ -721,17 +822,14 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
         &self.j
     }
 
-    /// Solves the system for one right-hand side `(top, bottom)`: `(x, f)`. Contact forward
-    /// dynamics is `solve(tau - h, -drift)`; a non-finite component of `x` (`pivot < N`) or
-    /// `f` (`N + k`) is an error.
-    pub fn solve(&self, top: &[T; N], bottom: &[T; K]) -> Result<([T; N], [T; K]), FactorError> {
-        self.parts().solve(&self.j, Some(top), bottom)
-    }
-
-    /// [`ContactKkt::solve`] with `top = 0`: `x = M^-1 J^T f`, with no substitution of the
-    /// zeros through `M` (impulse dynamics' system).
-    pub fn solve_bottom(&self, bottom: &[T; K]) -> Result<([T; N], [T; K]), FactorError> {
-        self.parts().solve(&self.j, None, bottom)
+    /// [`ContactKkt::solve_bottom`] on a vector of states: a lane whose solution is not finite
+    /// records its error in `failures` (a scalar returns it).
+    pub(crate) fn solve_bottom_lanes(
+        &self,
+        bottom: &[T; K],
+        failures: &mut T::Failures,
+    ) -> Result<([T; N], [T; K]), FactorError> {
+        self.parts().solve(&self.j, None, bottom, failures)
     }
 
     /// The system's arrays, for [`Parts`]' methods.
@@ -820,24 +918,14 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
     }
 }
 
-/// Pivot `k` of `J M^-1 J^T` is pivot `N + k` of the system.
-pub(crate) fn shift<const N: usize>(e: FactorError) -> FactorError {
-    match e {
-        FactorError::NotPositiveDefinite { pivot } => {
-            FactorError::NotPositiveDefinite { pivot: N + pivot }
-        }
-        FactorError::NonFinite { pivot } => FactorError::NonFinite { pivot: N + pivot },
-    }
-}
-
 /// The columns `lo..hi` outside which every row of `j` is zero (an empty range for a zero
 /// `j`). A contact Jacobian is zero in the columns of the joints that move no contact (a
 /// humanoid's arms and waist for its soles: 17 of its 35 columns), and the products with it
 /// skip them. Found from the ends inwards, so a typical Jacobian costs a few compares.
-pub(crate) fn column_support<T: Real, const N: usize, const K: usize>(
+pub(crate) fn column_support<T: Lane, const N: usize, const K: usize>(
     j: &[[T; N]; K],
 ) -> core::ops::Range<usize> {
-    let nonzero = |c: &usize| j.iter().any(|row| row[*c] != T::zero());
+    let nonzero = |c: &usize| j.iter().any(|row| !row[*c].zero_in_every_lane());
     let lo = (0..N).find(nonzero).unwrap_or(N);
     let hi = (lo..N).rev().find(nonzero).map_or(lo, |c| c + 1);
     lo..hi
@@ -867,7 +955,7 @@ pub(crate) fn dot<T: crate::Lane, const N: usize>(a: &[T; N], b: &[T; N]) -> T {
 
 /// `B <- A B` for the K x K matrix `A` and the K x C matrix `B`: each row of the product
 /// gathered in a local accumulator, the rows independent of each other.
-pub(crate) fn times_columns<T: Real, const K: usize, const C: usize>(
+pub(crate) fn times_columns<T: Lane, const K: usize, const C: usize>(
     a: &[[T; K]; K],
     b: &mut [[T; C]; K],
 ) {
@@ -881,7 +969,7 @@ pub(crate) fn times_columns<T: Real, const K: usize, const C: usize>(
     }
 }
 
-fn scale<T: Real, const C: usize>(y: &mut [T; C], a: T) {
+fn scale<T: Lane, const C: usize>(y: &mut [T; C], a: T) {
     for yi in y.iter_mut() {
         *yi *= a;
     }
@@ -904,40 +992,44 @@ pub(crate) fn finite_solution<T: crate::Lane, const N: usize, const K: usize>(
 
 /// `NonFinite` at the first row of `d`'s matrices with a non-finite entry: of `da_*` (`pivot
 /// < N`) or `df_*` (`N + k`), in the order `dq`, `dv`, `tau`.
-fn finite_derivatives<T: Real, const N: usize, const K: usize>(
+fn finite_derivatives<T: Lane, const N: usize, const K: usize>(
     d: &ContactDynamicsDerivatives<T, N, K>,
+    failures: &mut T::Failures,
 ) -> Result<(), FactorError> {
     for m in [&d.da_dq, &d.da_dv, &d.da_dtau] {
-        finite_rows(m, 0)?;
+        finite_rows(m, 0, failures)?;
     }
     for m in [&d.df_dq, &d.df_dv, &d.df_dtau] {
-        finite_rows(m, N)?;
+        finite_rows(m, N, failures)?;
     }
     Ok(())
 }
 
 /// `NonFinite` at `offset` plus the first row of `m` with a non-finite entry.
-pub(crate) fn finite_rows<T: Real, const C: usize, const R: usize>(
+pub(crate) fn finite_rows<T: Lane, const C: usize, const R: usize>(
     m: &[[T; C]; R],
     offset: usize,
+    failures: &mut T::Failures,
 ) -> Result<(), FactorError> {
     // `0 x` is zero for a finite `x` and NaN otherwise, and NaN stays in a sum: one pass of
     // multiply-adds the compiler vectorizes, without a branch per entry (a fortieth of a
-    // quadruped's contact derivatives went to the comparisons). The row is looked for only
-    // when the sum says there is one.
+    // quadruped's contact derivatives went to the comparisons). The rows are checked one by
+    // one only when the sum says one is not finite (on a vector, in some lane).
     let (zero, mut sum) = (T::zero(), [T::zero(); C]);
     for row in m {
         for (s, x) in sum.iter_mut().zip(row) {
             *s = zero.mul_add(*x, *s);
         }
     }
-    if sum.iter().all(|s| *s == T::zero()) {
+    if sum.iter().all(|s| s.zero_in_every_lane()) {
         return Ok(());
     }
-    match m.iter().position(|row| row.iter().any(|x| !x.is_finite())) {
-        Some(i) => Err(FactorError::NonFinite { pivot: offset + i }),
-        None => Ok(()),
+    for (i, row) in m.iter().enumerate() {
+        for x in row {
+            T::check_finite(*x, offset + i, failures)?;
+        }
     }
+    Ok(())
 }
 
 impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
@@ -991,7 +1083,7 @@ impl<T: Real, const N: usize, const K: usize> ContactKkt<T, N, K> {
         parts.solve_signed_columns_in_place::<P, N>(system, &mut d.da_dq, &mut d.df_dq, minus);
         parts.solve_signed_columns_in_place::<P, N>(system, &mut d.da_dv, &mut d.df_dv, minus);
         parts.solve_identity_in_place_by::<P>(Some(&inverse), &mut d.da_dtau, &mut d.df_dtau);
-        finite_derivatives(d)
+        finite_derivatives(d, &mut ())
     }
 }
 
@@ -1009,16 +1101,16 @@ mod tests {
     #[test]
     fn finite_rows_finds_the_first_row_with_a_non_finite_entry() {
         let mut m = [[1.0, -2.0, 3.5], [0.0, -0.0, 1e300], [4.0, 5.0, 6.0]];
-        assert_eq!(finite_rows(&m, 7), Ok(()));
+        assert_eq!(finite_rows(&m, 7, &mut ()), Ok(()));
         for (bad, row) in [(f64::INFINITY, 2), (f64::NEG_INFINITY, 1), (f64::NAN, 0)] {
             m[row][1] = bad;
             assert_eq!(
-                finite_rows(&m, 7),
+                finite_rows(&m, 7, &mut ()),
                 Err(FactorError::NonFinite { pivot: 7 + row })
             );
         }
         // Entries that overflow only when summed are finite.
-        assert_eq!(finite_rows(&[[f64::MAX], [f64::MAX]], 0), Ok(()));
+        assert_eq!(finite_rows(&[[f64::MAX], [f64::MAX]], 0, &mut ()), Ok(()));
     }
 
     /// The derivatives solved where a stash left the system (`d`) equal those of the system
@@ -1057,17 +1149,17 @@ mod tests {
                 let mx: f64 = (0..3).map(|k| m[i][k] * d.da_dtau[k][c]).sum();
                 let jf: f64 = (0..2).map(|k| j[k][i] * d.df_dtau[k][c]).sum();
                 let want = if i == c { 1.0 } else { 0.0 };
-                assert!((mx - jf - want).abs() < 1e-14, "tau ({i}, {c})");
+                assert!(Real::abs(mx - jf - want) < 1e-14, "tau ({i}, {c})");
                 let mx: f64 = (0..3).map(|k| m[i][k] * d.da_dq[k][c]).sum();
                 let jf: f64 = (0..2).map(|k| j[k][i] * d.df_dq[k][c]).sum();
                 let rhs = -(did_dq[i][c] + partials[i][c]);
-                assert!((mx - jf - rhs).abs() < 1e-13, "q ({i}, {c})");
+                assert!(Real::abs(mx - jf - rhs) < 1e-13, "q ({i}, {c})");
             }
             for r in 0..2 {
                 let ja: f64 = (0..3).map(|k| j[r][k] * d.da_dtau[k][c]).sum();
-                assert!(ja.abs() < 1e-14, "tau row {r}, column {c}");
+                assert!(Real::abs(ja) < 1e-14, "tau row {r}, column {c}");
                 let ja: f64 = (0..3).map(|k| j[r][k] * d.da_dq[k][c]).sum();
-                assert!((ja + partials[3 + r][c]).abs() < 1e-13, "q row {r}");
+                assert!(Real::abs(ja + partials[3 + r][c]) < 1e-13, "q row {r}");
             }
         }
     }
@@ -1083,10 +1175,10 @@ mod tests {
                 .solve(&top.map(|r| r[c]), &bottom.map(|r| r[c]))
                 .unwrap();
             for i in 0..3 {
-                assert!((x[i][c] - xc[i]).abs() < 1e-14);
+                assert!(Real::abs(x[i][c] - xc[i]) < 1e-14);
             }
             for k in 0..2 {
-                assert!((f[k][c] - fc[k]).abs() < 1e-14);
+                assert!(Real::abs(f[k][c] - fc[k]) < 1e-14);
             }
         }
     }
@@ -1104,22 +1196,22 @@ mod tests {
         let (x, f) = masked.solve(&top, &[7.0, 2.0]).unwrap();
         let (xa, fa) = alone.solve(&top, &[2.0]).unwrap();
         assert_eq!(f[0], 0.0);
-        assert!((f[1] - fa[0]).abs() < 1e-14);
-        assert!(x.iter().zip(&xa).all(|(a, b)| (a - b).abs() < 1e-14));
+        assert!(Real::abs(f[1] - fa[0]) < 1e-14);
+        assert!(x.iter().zip(&xa).all(|(a, b)| Real::abs(a - b) < 1e-14));
         let (xc, fc) = masked.solve_columns(&top.map(|t| [t, -t]), &[[3.0, 1.0], [2.0, -2.0]]);
         assert_eq!(fc[0], [0.0, 0.0]);
-        assert!((0..3).all(|i| (xc[i][0] - x[i]).abs() < 1e-14));
+        assert!((0..3).all(|i| Real::abs(xc[i][0] - x[i]) < 1e-14));
         let v = [0.3, -0.2, 0.5];
         let ((after, p), (after_a, pa)) = (
             masked.impulse(&v, 0.5).unwrap(),
             alone.impulse(&v, 0.5).unwrap(),
         );
         assert_eq!(p[0], 0.0);
-        assert!((p[1] - pa[0]).abs() < 1e-14);
+        assert!(Real::abs(p[1] - pa[0]) < 1e-14);
         assert!(after
             .iter()
             .zip(&after_a)
-            .all(|(a, b)| (a - b).abs() < 1e-14));
+            .all(|(a, b)| Real::abs(a - b) < 1e-14));
         // All rows inactive: the free solution.
         let none = ContactKkt::new_active(m, &parent, j, &[false; 2]).unwrap();
         let (free, zero) = none.solve(&top, &[1.0, 1.0]).unwrap();
@@ -1247,14 +1339,17 @@ mod tests {
         for r in 0..2 {
             for c in 0..N {
                 let dp: f64 = -(1.0 + e) * (0..2).map(|k| li[r][k] * j[k][c]).sum::<f64>();
-                assert!((d.dimpulse_dv[r][c] - dp).abs() < 1e-12, "dp/dv[{r}][{c}]");
+                assert!(
+                    Real::abs(d.dimpulse_dv[r][c] - dp) < 1e-12,
+                    "dp/dv[{r}][{c}]"
+                );
             }
         }
         for i in 0..N {
             for c in 0..N {
                 let id = if i == c { 1.0 } else { 0.0 };
                 let dv = id + (0..2).map(|k| y[k][i] * d.dimpulse_dv[k][c]).sum::<f64>();
-                assert!((d.dv_dv[i][c] - dv).abs() < 1e-12, "dv+/dv[{i}][{c}]");
+                assert!(Real::abs(d.dv_dv[i][c] - dv) < 1e-12, "dv+/dv[{i}][{c}]");
             }
         }
         // Outside the contact's columns: dp/dv zero, dv+/dv the identity's columns.

@@ -92,6 +92,7 @@ pub mod contact;
 pub mod control;
 mod dimensions;
 mod dynamics;
+mod entries;
 mod floating;
 pub mod frame;
 pub mod free_flyer;

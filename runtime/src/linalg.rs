@@ -294,6 +294,14 @@ pub struct Cholesky<T, const N: usize> {
 }
 
 impl<T: Real, const N: usize> Cholesky<T, N> {
+    /// Factorizes `m` (lower triangle read). Errors on the first pivot `L_jj²` that is not
+    /// finite or not strictly positive.
+    pub fn new(m: [[T; N]; N]) -> Result<Self, FactorError> {
+        Self::factor(m, 0, &mut ())
+    }
+}
+
+impl<T: Lane, const N: usize> Cholesky<T, N> {
     /// The factorization of the identity.
     pub(crate) fn identity() -> Self {
         let mut l = [[T::zero(); N]; N];
@@ -306,14 +314,6 @@ impl<T: Real, const N: usize> Cholesky<T, N> {
         }
     }
 
-    /// Factorizes `m` (lower triangle read). Errors on the first pivot `L_jj²` that is not
-    /// finite or not strictly positive.
-    pub fn new(m: [[T; N]; N]) -> Result<Self, FactorError> {
-        Self::factor(m, 0, &mut ())
-    }
-}
-
-impl<T: Lane, const N: usize> Cholesky<T, N> {
     /// [`Cholesky::new`] on a vector of states: pivot `j` is checked as pivot `offset + j`
     /// ([`Lane::check_pivot`]: a scalar returns its error at once, a vector records it in
     /// `failures` and goes on, NaN then filling that lane).

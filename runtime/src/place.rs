@@ -43,7 +43,7 @@ use core::mem::MaybeUninit;
 use core::ptr::addr_of_mut;
 
 use crate::kkt::{ContactDynamicsDerivatives, ImpulseDynamicsDerivatives};
-use crate::{Lane, Real};
+use crate::Lane;
 
 /// An invariant lifetime: `'b` names one call of [`build`] and no other.
 type Brand<'b> = PhantomData<fn(&'b ()) -> &'b ()>;
@@ -315,8 +315,8 @@ impl<A: Zeroed, B: Zeroed, C: Zeroed> Zeroed for (A, B, C) {
 /// `Zeroed` for a struct of `Zeroed` fields, field by field.
 macro_rules! zeroed_struct {
     ($name:ident { $($field:ident),* }) => {
-        impl<T: Real, const NV: usize, const K: usize> sealed::Sealed for $name<T, NV, K> {}
-        impl<T: Real, const NV: usize, const K: usize> Zeroed for $name<T, NV, K> {
+        impl<T: Lane, const NV: usize, const K: usize> sealed::Sealed for $name<T, NV, K> {}
+        impl<T: Lane, const NV: usize, const K: usize> Zeroed for $name<T, NV, K> {
             #[inline]
             fn zero_in(slot: &mut MaybeUninit<Self>) -> &mut Self {
                 let p = slot.as_mut_ptr();

@@ -351,7 +351,7 @@ pub fn ltdl_factor<T: Real, const N: usize>(
 }
 
 /// Solves `M x = b` with the factors of [`ltdl_factor`] (`m` as it left it).
-pub fn ltdl_substitute<T: Real, const N: usize>(
+pub fn ltdl_substitute<T: Lane, const N: usize>(
     m: &[[T; N]; N],
     parent: &[Option<usize>; N],
     b: &[T; N],

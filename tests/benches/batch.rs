@@ -3,8 +3,7 @@
 //! (`batch`: `f64x4` and `f32x8` with AVX), and the same over every core (`threads`), for the
 //! panda (9 coordinates) and anymal (floating base, 18), in `f64` and `f32`, and anymal's
 //! contact forward dynamics and impulse dynamics on its four feet, with two of them switched on
-//! at run time (`_active`), and the derivatives on four feet, whose batch runs state by state
-//! (`batch` is then the scalar code through it). Named
+//! at run time (`_active`), and the contact and impulse derivatives on four feet. Named
 //! `batch-<robot>-<scalar>/<function>/<way>`; criterion prints states per second
 //! (`thrpt`). Needs the `rayon` feature:
 //!
@@ -205,19 +204,26 @@ fn anymal_active<S: Batch>(c: &mut Criterion, pools: &Pools, label: &str) {
     });
 }
 
-/// anymal's contact forward dynamics derivatives (four feet), whose batch runs the scalar
-/// method state by state: `batch` is the scalar code through the batch method, `threads` the
-/// same over every core.
-fn anymal_contact_derivatives(c: &mut Criterion, pools: &Pools) {
-    let robot = AnymalMpc::<f64>::default();
-    let q = configurations::<f64, 19>(10);
-    let (v, tau) = (states::<f64, 18>(11, 1.0), states::<f64, 18>(12, 10.0));
-    let zero = robot.contact_forward_dynamics_derivatives(&[0.0; 19], &[0.0; 18], &[0.0; 18]);
-    let mut g = group(c, "batch-anymal-contact-derivatives-f64");
+/// anymal's contact forward dynamics and impulse dynamics derivatives (four feet), on lanes
+/// like the rest (the runtime's KKT solves over every lane at once).
+fn anymal_contact_derivatives<S: Batch>(c: &mut Criterion, pools: &Pools, label: &str) {
+    let robot = AnymalMpc::<S>::default();
+    let q = configurations::<S, 19>(10);
+    let (v, tau) = (states::<S, 18>(11, 1.0), states::<S, 18>(12, 10.0));
+    let (q0, v0) = (configurations::<S, 19>(10)[0], [S::zero(); 18]);
+    let zero = robot.contact_forward_dynamics_derivatives(&q0, &v0, &v0);
+    let mut g = group(c, &format!("batch-anymal-contact-derivatives-{label}"));
     three_ways!(g, pools, "contact_forward_dynamics_derivatives", (d: zero), |i| {
         d[i] = robot.contact_forward_dynamics_derivatives(black_box(&q[i]), &v[i], &tau[i]);
     }, {
         robot.contact_forward_dynamics_derivatives_batch(black_box(&q), &v, &tau, &mut d).unwrap()
+    });
+    let e = S::from_f64(0.2);
+    let zero = robot.impulse_dynamics_derivatives(&q0, &v0, e);
+    three_ways!(g, pools, "impulse_dynamics_derivatives", (d: zero), |i| {
+        d[i] = robot.impulse_dynamics_derivatives(black_box(&q[i]), &v[i], e);
+    }, {
+        robot.impulse_dynamics_derivatives_batch(black_box(&q), &v, e, &mut d).unwrap()
     });
 }
 
@@ -235,7 +241,8 @@ fn batch(c: &mut Criterion) {
     anymal_contacts::<f32>(c, &pools, "f32");
     anymal_active::<f64>(c, &pools, "f64");
     anymal_active::<f32>(c, &pools, "f32");
-    anymal_contact_derivatives(c, &pools);
+    anymal_contact_derivatives::<f64>(c, &pools, "f64");
+    anymal_contact_derivatives::<f32>(c, &pools, "f32");
 }
 
 criterion_group!(benches, batch);

@@ -543,20 +543,46 @@ fn a_failed_contact_lane_is_named_and_the_others_are_unaffected() {
     }
 }
 
+/// Four anymal states from `seed` of which lane 1 fails in M's factorization (NaN in `q`)
+/// and lane 3 in its result (an infinite velocity): `(q, v, tau)` per state, and the same
+/// on four `f64` lanes.
+#[allow(clippy::type_complexity)]
+fn four_lanes_two_failing(
+    seed: u64,
+) -> (
+    (Vec<[f64; 19]>, Vec<[f64; 18]>, Vec<[f64; 18]>),
+    ([f64x4; 19], [f64x4; 18], [f64x4; 18]),
+) {
+    let mut n = Numbers(seed);
+    let (mut q, mut v) = anymal_states(&mut n, 4);
+    let tau = n.states::<18>(4, 20.0);
+    q[1][9] = f64::NAN;
+    v[3][10] = f64::INFINITY;
+    let lanes = (gather(&q, 0), gather(&v, 0), gather(&tau, 0));
+    ((q, v, tau), lanes)
+}
+
+/// `err` is lane 1's own error (`scalar(1)`'s), and of the scalar calls only lanes 1 and 3
+/// fail ([`four_lanes_two_failing`]).
+fn lane_one_named<X>(err: LaneError, scalar: impl Fn(usize) -> Result<X, FactorError>) {
+    let first = scalar(1).err().expect("lane 1 fails");
+    assert_eq!(
+        err,
+        LaneError {
+            lane: 1,
+            error: first
+        }
+    );
+    assert!(scalar(3).is_err() && scalar(0).is_ok() && scalar(2).is_ok());
+}
+
 #[test]
 fn active_contacts_on_four_lanes_name_the_failed_lane() {
     use eomgen_tests::robots::anymal_mpc::AnymalMpc;
     let robot = AnymalMpc::<f64>::default();
     let wide = robot.in_lanes::<f64x4>();
-    let mut n = Numbers(14);
-    let (mut q, mut v) = anymal_states(&mut n, 4);
-    let tau = n.states::<18>(4, 20.0);
-    // Lane 1 fails in M's factorization, lane 3 in its result (an infinite velocity).
-    q[1][9] = f64::NAN;
-    v[3][10] = f64::INFINITY;
+    let ((q, v, tau), (ql, vl, tl)) = four_lanes_two_failing(14);
     let active = [true, false, true, true];
-    let (ql, vl, tl): ([f64x4; 19], [f64x4; 18], [f64x4; 18]) =
-        (gather(&q, 0), gather(&v, 0), gather(&tau, 0));
     let err = wide
         .try_contact_forward_dynamics_active_lanes(&ql, &vl, &tl, &active)
         .unwrap_err();
@@ -601,14 +627,7 @@ fn active_contacts_on_four_lanes_name_the_failed_lane() {
         .try_impulse_dynamics_active_lanes(&ql, &vl, f64x4::splat(e), &active)
         .unwrap_err();
     let scalar = |l: usize| robot.try_impulse_dynamics_active(&q[l], &v[l], e, &active);
-    assert_eq!(
-        err,
-        LaneError {
-            lane: 1,
-            error: scalar(1).unwrap_err()
-        }
-    );
-    assert!(scalar(3).is_err() && scalar(0).is_ok() && scalar(2).is_ok());
+    lane_one_named(err, scalar);
     let (after, p) = wide.impulse_dynamics_active(&ql, &vl, f64x4::splat(e), &active);
     for l in 0..4 {
         let one: Vec<f64> = after.iter().chain(&p).map(|x| x.lane(l)).collect();
@@ -616,6 +635,79 @@ fn active_contacts_on_four_lanes_name_the_failed_lane() {
         let (want_v, want_p) = robot.impulse_dynamics_active(&q[l], &v[l], e, &active);
         let want: Vec<f64> = want_v.iter().chain(&want_p).copied().collect();
         assert_close("f64x4 impulse dynamics, two feet", l, &one, &want, 0.0);
+    }
+}
+
+/// The contact and impulse derivatives (every contact, and a set of active ones) on four
+/// lanes: a lane failing in `M`'s factorization and one failing in its result (an infinite
+/// velocity) are NaN and named, the others equal the scalar code bit for bit.
+#[test]
+fn derivatives_on_four_lanes_name_the_failed_lane() {
+    use eomgen_runtime::batch::{scatter_contact_derivatives, scatter_impulse_derivatives};
+    use eomgen_tests::robots::anymal_mpc::AnymalMpc;
+    let robot = AnymalMpc::<f64>::default();
+    let wide = robot.in_lanes::<f64x4>();
+    let ((q, v, tau), (ql, vl, tl)) = four_lanes_two_failing(16);
+    let (active, e) = ([true, false, true, true], 0.3);
+    let failed = |l: usize, all_nan: bool| {
+        assert_eq!(all_nan, l == 1 || l == 3, "lane {l}");
+    };
+    let nan = |x: &[f64]| x.iter().all(|y| y.is_nan());
+
+    let err = wide
+        .try_contact_forward_dynamics_derivatives_lanes(&ql, &vl, &tl)
+        .unwrap_err();
+    let scalar = |l: usize| robot.try_contact_forward_dynamics_derivatives(&q[l], &v[l], &tau[l]);
+    lane_one_named(err, scalar);
+    let mut got = vec![robot.contact_forward_dynamics_derivatives(&q[0], &v[0], &tau[0]); 4];
+    scatter_contact_derivatives(
+        &wide.contact_forward_dynamics_derivatives(&ql, &vl, &tl),
+        &mut got,
+    );
+    for (l, d) in got.iter().enumerate() {
+        failed(l, nan(&d.flat()));
+        let want = robot.contact_forward_dynamics_derivatives(&q[l], &v[l], &tau[l]);
+        assert_close("f64x4 contact derivatives", l, d, &want, 0.0);
+    }
+    let d = wide.contact_forward_dynamics_derivatives_active(&ql, &vl, &tl, &active);
+    scatter_contact_derivatives(&d, &mut got);
+    for (l, d) in got.iter().enumerate() {
+        failed(l, nan(&d.flat()));
+        let want =
+            robot.contact_forward_dynamics_derivatives_active(&q[l], &v[l], &tau[l], &active);
+        assert_close("f64x4 contact derivatives, three feet", l, d, &want, 0.0);
+    }
+
+    let el = f64x4::splat(e);
+    let err = wide
+        .try_impulse_dynamics_derivatives_lanes(&ql, &vl, el)
+        .unwrap_err();
+    let scalar = |l: usize| robot.try_impulse_dynamics_derivatives(&q[l], &v[l], e);
+    assert_eq!(
+        err,
+        LaneError {
+            lane: 1,
+            error: scalar(1).unwrap_err()
+        }
+    );
+    assert_eq!(
+        wide.try_impulse_dynamics_derivatives(&ql, &vl, el)
+            .unwrap_err(),
+        scalar(1).unwrap_err()
+    );
+    let mut got = vec![robot.impulse_dynamics_derivatives(&q[0], &v[0], e); 4];
+    scatter_impulse_derivatives(&wide.impulse_dynamics_derivatives(&ql, &vl, el), &mut got);
+    for (l, d) in got.iter().enumerate() {
+        failed(l, nan(&d.flat()));
+        let want = robot.impulse_dynamics_derivatives(&q[l], &v[l], e);
+        assert_close("f64x4 impulse derivatives", l, d, &want, 0.0);
+    }
+    let d = wide.impulse_dynamics_derivatives_active(&ql, &vl, el, &active);
+    scatter_impulse_derivatives(&d, &mut got);
+    for (l, d) in got.iter().enumerate() {
+        failed(l, nan(&d.flat()));
+        let want = robot.impulse_dynamics_derivatives_active(&q[l], &v[l], e, &active);
+        assert_close("f64x4 impulse derivatives, three feet", l, d, &want, 0.0);
     }
 }
 
@@ -701,7 +793,8 @@ fn each_state<X: Flat>(what: &str, got: &[X], want: impl Fn(usize) -> X) {
 }
 
 /// The state-by-state batches, and beside them contact forward dynamics with active
-/// contacts (on lanes on this robot), with NaN and infinite states between finite ones.
+/// contacts and the contact and impulse derivatives (on lanes on this robot), with NaN and
+/// infinite states between finite ones.
 #[test]
 fn methods_off_the_lanes_in_batches_equal_the_scalar_code() {
     use eomgen_runtime::{Baumgarte, ContactDynamicsDerivatives, ImpulseDynamicsDerivatives};

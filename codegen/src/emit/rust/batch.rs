@@ -253,14 +253,21 @@ impl Emitter<'_> {
             names: outs,
             types: out_types,
             scatters,
-        } = match q.eval {
-            Evaluation::LinkPose => Outs {
-                names: vec![format_ident!("out")],
-                types: vec![quote!(::eomgen_runtime::Pose<T>)],
-                scatters: vec![quote!(::eomgen_runtime::batch::scatter_pose(&r, out);)],
-            },
-            _ => outputs(self.result_shapes(q)),
-        };
+        } =
+            match q.eval {
+                Evaluation::LinkPose => Outs {
+                    names: vec![format_ident!("out")],
+                    types: vec![quote!(::eomgen_runtime::Pose<T>)],
+                    scatters: vec![quote!(::eomgen_runtime::batch::scatter_pose(&r, out);)],
+                },
+                Evaluation::ContactDynamicsDerivatives { .. }
+                | Evaluation::ActiveContacts(ActiveContacts::Derivatives { .. }) => self
+                    .derivatives_out("ContactDynamicsDerivatives", "scatter_contact_derivatives"),
+                Evaluation::ImpulseDynamicsDerivatives
+                | Evaluation::ActiveContacts(ActiveContacts::ImpulseDerivatives) => self
+                    .derivatives_out("ImpulseDynamicsDerivatives", "scatter_impulse_derivatives"),
+                _ => outputs(self.result_shapes(q)),
+            };
         let Shared {
             link_param,
             params: shared_params,
@@ -318,6 +325,18 @@ impl Emitter<'_> {
                 });
                 Ok(())
             }
+        }
+    }
+
+    /// The output slice of a result struct of the runtime (`ty`, of `N` velocity coordinates
+    /// and `K` contact rows), with the runtime's function `scatter` unpacking its lanes.
+    fn derivatives_out(&self, ty: &str, scatter: &str) -> Outs {
+        let (n, k) = (&self.n, &self.k);
+        let (ty, scatter) = (format_ident!("{}", ty), format_ident!("{}", scatter));
+        Outs {
+            names: vec![format_ident!("out")],
+            types: vec![quote!(::eomgen_runtime::#ty<T, #n, #k>)],
+            scatters: vec![quote!(::eomgen_runtime::batch::#scatter(&r, out);)],
         }
     }
 

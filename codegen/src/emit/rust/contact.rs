@@ -48,37 +48,39 @@ impl Emitter<'_> {
 
     /// `let kkt = ...;`, a reference to the KKT system at `q` from `mass_matrix` and
     /// `contact_jacobian` (of the contacts of `active` when `active`), returning the error
-    /// from the enclosing function when it cannot be factorized. The system lies in the
+    /// from the enclosing function when it cannot be factorized (on a vector of states, each
+    /// lane's recorded in the enclosing function's `failures`). The system lies in the
     /// caller's frame, set up there by a non-inlined `contact_kkt` (or `contact_kkt_active`)
-    /// with `ContactKkt::set_up`, so that it is neither moved nor held next to the mass matrix
-    /// it is made of.
+    /// with `ContactKkt::set_up_factored_lanes`, so that it is neither moved nor held next to
+    /// the mass matrix it is made of.
     fn kkt(&mut self, active: bool) -> TokenStream {
         let (n, nq, k) = (self.n.clone(), self.nq.clone(), self.k.clone());
         let kkt_ty = quote!(::eomgen_runtime::ContactKkt<T, #n, #k>);
         let (fill, rows) = self.kkt_inputs(active);
         let result = quote!(::core::result::Result<(), ::eomgen_runtime::FactorError>);
+        let failures = quote!(failures: &mut <T as ::eomgen_runtime::Lane>::Failures);
         let (helper, call, item) = if active {
             let c = usize_lit(self.contact_rows.len());
             (
                 "contact_kkt_active",
-                quote!(self.contact_kkt_active(q, active, &mut kkt)),
+                quote!(self.contact_kkt_active(q, active, &mut kkt, failures)),
                 quote! {
                     /// Sets `kkt` up for the contacts of `active` at `q`.
                     #[inline(never)]
-                    fn contact_kkt_active(&self, q: &[T; #nq], active: &[bool; #c], kkt: &mut #kkt_ty) -> #result {
-                        kkt.set_up_factored_by::<Self>(#fill, &Self::PARENTS, &#rows)
+                    fn contact_kkt_active(&self, q: &[T; #nq], active: &[bool; #c], kkt: &mut #kkt_ty, #failures) -> #result {
+                        kkt.set_up_factored_lanes::<Self>(#fill, (&Self::PARENTS, &#rows), failures)
                     }
                 },
             )
         } else {
             (
                 "contact_kkt",
-                quote!(self.contact_kkt(q, &mut kkt)),
+                quote!(self.contact_kkt(q, &mut kkt, failures)),
                 quote! {
                     /// Sets `kkt` up for every contact at `q`.
                     #[inline(never)]
-                    fn contact_kkt(&self, q: &[T; #nq], kkt: &mut #kkt_ty) -> #result {
-                        kkt.set_up_factored_by::<Self>(#fill, &Self::PARENTS, &#rows)
+                    fn contact_kkt(&self, q: &[T; #nq], kkt: &mut #kkt_ty, #failures) -> #result {
+                        kkt.set_up_factored_lanes::<Self>(#fill, (&Self::PARENTS, &#rows), failures)
                     }
                 },
             )
@@ -94,16 +96,17 @@ impl Emitter<'_> {
     }
 
     /// The closure that writes `M`'s factors and `J_c` at `q` into a KKT system's storage
-    /// (`ContactKkt::set_up_factored`), and the contact rows that take part: every one, or
-    /// those of the contacts of `active`.
+    /// (`ContactKkt::set_up_factored_lanes`: `M`'s pivots checked with the failures it is
+    /// given), and the contact rows that take part: every one, or those of the contacts of
+    /// `active`.
     fn kkt_inputs(&self, active: bool) -> (TokenStream, TokenStream) {
         let (m, j) = (self.call("mass_matrix"), self.call("contact_jacobian"));
         // M factorized by the robot's unrolled L^T D L (`emit/tree_solve.rs`), not by the
         // runtime's loops over the tree.
-        let fill = quote!(|m, j| {
+        let fill = quote!(|m, j, failures| {
             *m = #m(self, q);
             *j = #j(self, q);
-            Self::ltdl_factor_unrolled(m, &mut ::core::default::Default::default())
+            Self::ltdl_factor_unrolled(m, failures)
         });
         (fill, self.active_rows(active))
     }
@@ -226,7 +229,7 @@ impl Emitter<'_> {
         let docs = Self::quantity_doc(q, Some(ops));
         let (n, nq, k) = (self.n.clone(), self.nq.clone(), self.k.clone());
         let s = self.signature(q, active, ("The derivatives of", ", or why they do not"));
-        let (name, try_name, param, arg, why) = (&s.name, &s.try_name, &s.param, &s.arg, &s.why);
+        let (name, param) = (&s.name, &s.param);
         let (fill, rows) = self.kkt_inputs(active);
         let drift = self.call("contact_drift");
         let id_derivatives = self.id_derivatives_into(quote!(d.da_dq), quote!(d.da_dv), quote!(a));
@@ -240,11 +243,12 @@ impl Emitter<'_> {
             ["into", "solve", "partials"].map(|s| format_ident!("{}_{}", name, s));
         let stash = quote!(::eomgen_runtime::KktStash<T, #n, #k>);
         let err = quote!(::eomgen_runtime::FactorError);
+        let failures = quote!(<T as ::eomgen_runtime::Lane>::Failures);
         // The KKT system's arrays lie in `d` (`ContactKkt::set_up_in`) until their last use,
         // never in a frame that the inverse-dynamics derivatives or the partials run below.
         self.blocks.push(quote! {
             /// The derivatives written into `d` (which holds garbage on failure).
-            fn #into(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n] #param, d: &mut #ty) -> ::core::result::Result<(), #err> {
+            fn #into(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n] #param, d: &mut #ty, failures: &mut #failures) -> ::core::result::Result<(), #err> {
                 let h: [T; #n] = { #hb };
                 let mut rhs = *tau;
                 for (r, h) in rhs.iter_mut().zip(h) {
@@ -252,18 +256,18 @@ impl Emitter<'_> {
                 }
                 let drift = #drift(self, q, qd);
                 let mut stash = <#stash>::new(&Self::PARENTS, &#rows);
-                let (a, f) = self.#solve(q, &rhs, &drift, d, &mut stash)?;
+                let (a, f) = self.#solve(q, &rhs, &drift, d, &mut stash, failures)?;
                 #id_derivatives
                 self.#stage(q, qd, &a, &f, d)?;
-                stash.contact_dynamics_derivatives_in_place_by::<Self>(d)
+                stash.contact_dynamics_derivatives_lanes::<Self>(d, failures)
             }
 
             /// The accelerations and forces, with the KKT system set up in `d` and `stash`.
             #[inline(never)]
-            fn #solve(&self, q: &[T; #nq], rhs: &[T; #n], drift: &[T; #k], d: &mut #ty, stash: &mut #stash) -> ::core::result::Result<([T; #n], [T; #k]), #err> {
-                ::eomgen_runtime::ContactKkt::set_up_in_stash_by::<Self>(d, stash, #fill)?;
+            fn #solve(&self, q: &[T; #nq], rhs: &[T; #n], drift: &[T; #k], d: &mut #ty, stash: &mut #stash, failures: &mut #failures) -> ::core::result::Result<([T; #n], [T; #k]), #err> {
+                ::eomgen_runtime::ContactKkt::set_up_in_stash_lanes::<Self>(d, stash, #fill, failures)?;
                 let substitute = |b: &[T; #n]| Self::ltdl_substitute_unrolled(&d.da_dtau, b);
-                stash.solve_with(d, rhs, &drift.map(|x| -x), substitute)
+                stash.solve_with_lanes(d, (rhs, &drift.map(|x| -x)), substitute, failures)
             }
 
             /// The partials added to `d` in a frame of their own.
@@ -273,22 +277,70 @@ impl Emitter<'_> {
                 Ok(())
             }
         });
-        let (with_err, without) = self.fill_in_place(
-            name,
-            &into,
-            &ty,
-            &[
-                ("q", quote!(&[T; #nq])),
-                ("qd", quote!(&[T; #n])),
-                ("tau", quote!(&[T; #n])),
-            ],
-            (param, arg),
-        );
+        let params = [
+            ("q", quote!(&[T; #nq])),
+            ("qd", quote!(&[T; #n])),
+            ("tau", quote!(&[T; #n])),
+        ];
+        let why_more = " exist: a pivot of M(q) (`pivot` < N) or of `J_c M^-1 J_c^T` (`pivot` - N, a rank-deficient contact Jacobian) that is not positive, or a non-finite result.";
+        self.derivative_fns(&s, (&into, &ty), &params, (docs, why_more))
+    }
+
+    /// `{name}_in_slot` (not `_in_place`: a split body of `name` has that one), for the
+    /// inherent impl, which fills the caller's storage for the result of `into` (a fallible
+    /// `fn(&self, params..., extra, d: &mut ty, failures)`) through `eomgen_runtime::place`:
+    /// NaN, and the error in `err`, on failure (on a vector of states, in the failed lanes, and
+    /// the lowest one's error). `params` are `(name, type)`. Returns the `try_` method (the
+    /// lowest failed lane's error), `try_{name}_lanes` (which lane) and the plain one (NaN),
+    /// `why` and `why_more` starting the `try_` method's documentation.
+    fn derivative_fns(
+        &mut self,
+        s: &Signature,
+        (into, ty): (&Ident, &TokenStream),
+        params: &[(&str, TokenStream)],
+        (docs, why_more): (TokenStream, &str),
+    ) -> TokenStream {
+        let (name, try_name, param, arg, why) = (&s.name, &s.try_name, &s.param, &s.arg, &s.why);
+        let in_place = format_ident!("{}_in_slot", name);
+        let try_lanes = format_ident!("{}_lanes", try_name);
+        let args: Vec<Ident> = params.iter().map(|(n, _)| format_ident!("{}", n)).collect();
+        let decls: Vec<TokenStream> = params
+            .iter()
+            .zip(&args)
+            .map(|((_, t), a)| quote!(#a: #t))
+            .collect();
+        let lane_err = quote!(::eomgen_runtime::LaneError);
+        self.blocks.push(quote! {
+            #[inline(never)]
+            fn #in_place<'b>(&self, #(#decls,)* err: &mut ::core::option::Option<#lane_err> #param, slot: ::eomgen_runtime::place::Slot<'b, #ty>) -> ::eomgen_runtime::place::Filled<'b> {
+                let (d, filled) = slot.fill();
+                let mut failures = ::core::default::Default::default();
+                match self.#into(#(#args),* #arg, d, &mut failures) {
+                    Err(error) => {
+                        d.fill_nan();
+                        *err = Some(#lane_err { lane: 0, error });
+                    }
+                    Ok(()) => {
+                        d.nan_failed(&failures);
+                        *err = <T as ::eomgen_runtime::Lane>::first_failure(&failures);
+                    }
+                }
+                filled
+            }
+        });
+        let build = |err: TokenStream| quote!(::eomgen_runtime::place::build(|slot| self.#in_place(#(#args,)* #err #arg, slot)));
+        let (with_err, without) = (build(quote!(&mut err)), build(quote!(&mut None)));
+        let lanes_doc = format!(" `{try_name}` on a vector of states (`eomgen_runtime::Lane`, one state per lane; a scalar is lane 0): the derivatives of every lane, or the lowest lane that failed, with that lane's own error.");
         quote! {
             #[doc = #why]
-            /// exist: a pivot of M(q) (`pivot` < N) or of `J_c M^-1 J_c^T` (`pivot` - N, a
-            /// rank-deficient contact Jacobian) that is not positive, or a non-finite result.
-            pub fn #try_name(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n] #param) -> ::core::result::Result<#ty, ::eomgen_runtime::FactorError> {
+            #[doc = #why_more]
+            /// On a vector of states, the lowest failed lane's error.
+            pub fn #try_name(&self, #(#decls),* #param) -> ::core::result::Result<#ty, ::eomgen_runtime::FactorError> {
+                self.#try_lanes(#(#args),* #arg).map_err(|e| e.error)
+            }
+
+            #[doc = #lanes_doc]
+            pub fn #try_lanes(&self, #(#decls),* #param) -> ::core::result::Result<#ty, #lane_err> {
                 let mut err = None;
                 let d = #with_err;
                 match err {
@@ -298,41 +350,10 @@ impl Emitter<'_> {
             }
 
             #docs
-            pub fn #name(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n] #param) -> #ty {
+            pub fn #name(&self, #(#decls),* #param) -> #ty {
                 #without
             }
         }
-    }
-
-    /// `{name}_in_slot` (not `_in_place`: a split body of `name` has that one), for the
-    /// inherent impl, which fills the caller's storage for the result of `into` (a fallible
-    /// `fn(&self, params..., extra, d: &mut ty)`) through `eomgen_runtime::place`: NaN, and the
-    /// error in `err`, on failure. `params` are `(name, type)`. Returns the calls of it for the
-    /// `try_` method (the error in a local `err`) and for the plain one.
-    fn fill_in_place(
-        &mut self,
-        name: &Ident,
-        into: &Ident,
-        ty: &TokenStream,
-        params: &[(&str, TokenStream)],
-        (param, arg): (&TokenStream, &TokenStream),
-    ) -> (TokenStream, TokenStream) {
-        let in_place = format_ident!("{}_in_slot", name);
-        let args: Vec<Ident> = params.iter().map(|(n, _)| format_ident!("{}", n)).collect();
-        let decls = params.iter().zip(&args).map(|((_, t), a)| quote!(#a: #t));
-        self.blocks.push(quote! {
-            #[inline(never)]
-            fn #in_place<'b>(&self, #(#decls,)* err: &mut ::core::option::Option<::eomgen_runtime::FactorError> #param, slot: ::eomgen_runtime::place::Slot<'b, #ty>) -> ::eomgen_runtime::place::Filled<'b> {
-                let (d, filled) = slot.fill();
-                if let Err(e) = self.#into(#(#args),* #arg, d) {
-                    d.fill_nan();
-                    *err = Some(e);
-                }
-                filled
-            }
-        });
-        let build = |err: TokenStream| quote!(::eomgen_runtime::place::build(|slot| self.#in_place(#(#args,)* #err #arg, slot)));
-        (build(quote!(&mut err)), build(quote!(&mut None)))
     }
 
     /// `try_impulse_dynamics` and `impulse_dynamics` (NaN on failure) solved at run time (the
@@ -473,7 +494,7 @@ impl Emitter<'_> {
             active,
             ("The derivatives of", ", or why they do not exist (as"),
         );
-        let (name, try_name, param, arg, why) = (&s.name, &s.try_name, &s.param, &s.arg, &s.why);
+        let (name, param) = (&s.name, &s.param);
         let ty = quote!(::eomgen_runtime::ImpulseDynamicsDerivatives<T, #n, #k>);
         // The partials' blocks write their two row groups straight into `d` (a body that its
         // callers fill is always written in blocks: `methods.rs`, `FILLED`).
@@ -489,13 +510,13 @@ impl Emitter<'_> {
         );
         self.blocks.push(quote! {
             /// The derivatives written into `d` (which holds garbage on failure).
-            fn #into(&self, q: &[T; #nq], qd: &[T; #n], restitution: T #param, d: &mut #ty) -> ::core::result::Result<(), ::eomgen_runtime::FactorError> {
+            fn #into(&self, q: &[T; #nq], qd: &[T; #n], restitution: T #param, d: &mut #ty, failures: &mut <T as ::eomgen_runtime::Lane>::Failures) -> ::core::result::Result<(), ::eomgen_runtime::FactorError> {
                 #kkt
-                let (after, p) = kkt.impulse(qd, restitution)?;
+                let (after, p) = kkt.impulse_lanes(qd, restitution, failures)?;
                 let jump: [T; #n] = ::core::array::from_fn(|i| after[i] - qd[i]);
                 let w: [T; #n] = ::core::array::from_fn(|i| after[i] + restitution * qd[i]);
                 self.#stage(q, &w, &jump, &p, d)?;
-                kkt.impulse_derivatives_in_place_by::<Self>(restitution, d)
+                kkt.impulse_derivatives_lanes::<Self>(restitution, d, failures)
             }
 
             /// The partials set in `d` in a frame of their own.
@@ -504,33 +525,12 @@ impl Emitter<'_> {
                 #set_partials
             }
         });
-        let (with_err, without) = self.fill_in_place(
-            name,
-            &into,
-            &ty,
-            &[
-                ("q", quote!(&[T; #nq])),
-                ("qd", quote!(&[T; #n])),
-                ("restitution", quote!(T)),
-            ],
-            (param, arg),
-        );
-        quote! {
-            #[doc = #why]
-            /// `try_impulse_dynamics`).
-            pub fn #try_name(&self, q: &[T; #nq], qd: &[T; #n], restitution: T #param) -> ::core::result::Result<#ty, ::eomgen_runtime::FactorError> {
-                let mut err = None;
-                let d = #with_err;
-                match err {
-                    None => Ok(d),
-                    Some(e) => Err(e),
-                }
-            }
-
-            #docs
-            pub fn #name(&self, q: &[T; #nq], qd: &[T; #n], restitution: T #param) -> #ty {
-                #without
-            }
-        }
+        let params = [
+            ("q", quote!(&[T; #nq])),
+            ("qd", quote!(&[T; #n])),
+            ("restitution", quote!(T)),
+        ];
+        let why_more = " `try_impulse_dynamics`).";
+        self.derivative_fns(&s, (&into, &ty), &params, (docs, why_more))
     }
 }

@@ -29,7 +29,14 @@ fn evaluation_on_lanes(q: &Quantity) -> bool {
             | Evaluation::LinkPose
             | Evaluation::LinkJacobian
             | Evaluation::FrameMotion(_)
-            | Evaluation::ActiveContacts(ActiveContacts::Dynamics { .. } | ActiveContacts::Impulse)
+            | Evaluation::ContactDynamicsDerivatives { .. }
+            | Evaluation::ImpulseDynamicsDerivatives
+            | Evaluation::ActiveContacts(
+                ActiveContacts::Dynamics { .. }
+                    | ActiveContacts::Impulse
+                    | ActiveContacts::Derivatives { .. }
+                    | ActiveContacts::ImpulseDerivatives
+            )
     )
 }
 
