@@ -58,7 +58,7 @@ impl<T: Lane> Relative<T> {
         );
         // The same rotation with w >= 0: its angle is in [0, pi].
         let flip = T::zero().gt(quat[3]);
-        let quat = quat.map(|x| T::select(flip, x.neg_exact(), x));
+        let quat = branch::<T, _>(flip, || quat.map(|x| x.neg_exact()), || quat);
         let w = quat[3];
         let s2 = quat[0] * quat[0] + quat[1] * quat[1] + quat[2] * quat[2];
         let n2 = s2 + w * w;
