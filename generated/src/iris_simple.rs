@@ -854,6 +854,72 @@ impl<T: ::eomgen_runtime::Lane> IrisSimple<T> {
     ) -> [[T; 6]; 6] {
         ::eomgen_runtime::frame::jacobian_time_variation(&self.link_chain(link, q), qd)
     }
+    /// `difference(q0, q1)`: the velocity that moves `q0` to `q1` in unit time, so that
+    /// `integrate(q0, difference(q0, q1), 1) = q1` (Pinocchio's `difference`). A floating base's
+    /// quaternions may have either sign.
+    ///
+    /// The base moves along the SE(3) exponential (`integrate(q, v, 1) = q exp6(v)`), the joints as a vector space.
+    ///
+    /// Route: the base's block in closed form (SE(3) logarithm, adjoint, right Jacobian of exp6 and its inverse), identity for the joints (eomgen_runtime::manifold).
+    pub fn difference(&self, q0: &[T; 7], q1: &[T; 7]) -> [T; 6] {
+        ::eomgen_runtime::manifold::difference(q0, q1)
+    }
+    /// The Jacobians of `integrate(q, v, 1)` in `q` and in `v`, q perturbed in its tangent space
+    /// (Pinocchio's `dIntegrate`, ARG0 and ARG1); element `[i][j]` = d out_i / d in_j.
+    ///
+    /// The base moves along the SE(3) exponential (`integrate(q, v, 1) = q exp6(v)`), the joints as a vector space.
+    ///
+    /// Route: the base's block in closed form (SE(3) logarithm, adjoint, right Jacobian of exp6 and its inverse), identity for the joints (eomgen_runtime::manifold).
+    pub fn integrate_jacobians(
+        &self,
+        q: &[T; 7],
+        v: &[T; 6],
+    ) -> ([[T; 6]; 6], [[T; 6]; 6]) {
+        ::eomgen_runtime::manifold::integrate_jacobians(q, v)
+    }
+    /// `integrate_jacobians` written into `a` and `b`, their diagonal blocks only (a free flyer's
+    /// 6 x 6 blocks and each other coordinate's entry), as Pinocchio's `dIntegrate` and
+    /// `dDifference` write each joint's block of the matrix they are given. The entries
+    /// off those blocks are zero in the Jacobians and are left as they are: `a` and `b`
+    /// must hold zeros there (zeroed once, or written by an earlier call). The values are
+    /// `integrate_jacobians`'s to the bit, without writing its `2 NV^2` entries.
+    pub fn integrate_jacobians_into(
+        &self,
+        q: &[T; 7],
+        v: &[T; 6],
+        a: &mut [[T; 6]; 6],
+        b: &mut [[T; 6]; 6],
+    ) {
+        ::eomgen_runtime::manifold::integrate_jacobians_into(q, v, a, b)
+    }
+    /// The Jacobians of `difference(q0, q1)` in `q0` and in `q1`, both perturbed in their tangent
+    /// spaces (Pinocchio's `dDifference`, ARG0 and ARG1); element `[i][j]` = d out_i / d in_j.
+    ///
+    /// The base moves along the SE(3) exponential (`integrate(q, v, 1) = q exp6(v)`), the joints as a vector space.
+    ///
+    /// Route: the base's block in closed form (SE(3) logarithm, adjoint, right Jacobian of exp6 and its inverse), identity for the joints (eomgen_runtime::manifold).
+    pub fn difference_jacobians(
+        &self,
+        q0: &[T; 7],
+        q1: &[T; 7],
+    ) -> ([[T; 6]; 6], [[T; 6]; 6]) {
+        ::eomgen_runtime::manifold::difference_jacobians(q0, q1)
+    }
+    /// `difference_jacobians` written into `a` and `b`, their diagonal blocks only (a free flyer's
+    /// 6 x 6 blocks and each other coordinate's entry), as Pinocchio's `dIntegrate` and
+    /// `dDifference` write each joint's block of the matrix they are given. The entries
+    /// off those blocks are zero in the Jacobians and are left as they are: `a` and `b`
+    /// must hold zeros there (zeroed once, or written by an earlier call). The values are
+    /// `difference_jacobians`'s to the bit, without writing its `2 NV^2` entries.
+    pub fn difference_jacobians_into(
+        &self,
+        q0: &[T; 7],
+        q1: &[T; 7],
+        a: &mut [[T; 6]; 6],
+        b: &mut [[T; 6]; 6],
+    ) {
+        ::eomgen_runtime::manifold::difference_jacobians_into(q0, q1, a, b)
+    }
     /// The rate of the centroidal momentum, `dh/dt = A_g qdd + dA_g/dt qd`: the rate of the linear
     /// momentum, then of the angular momentum about the centre of mass, world axes (Pinocchio's
     /// `computeCentroidalMomentumTimeVariation`, its `dhg`).
@@ -1180,72 +1246,6 @@ impl<T: ::eomgen_runtime::Real> IrisSimple<T> {
         tau: &[T; 6],
     ) -> ::core::result::Result<[T; 6], ::eomgen_runtime::FactorError> {
         self.forward_dynamics_checked(q, qd, tau).map(|(qdd, _)| qdd)
-    }
-    /// `difference(q0, q1)`: the velocity that moves `q0` to `q1` in unit time, so that
-    /// `integrate(q0, difference(q0, q1), 1) = q1` (Pinocchio's `difference`). A floating base's
-    /// quaternions may have either sign.
-    ///
-    /// The base moves along the SE(3) exponential (`integrate(q, v, 1) = q exp6(v)`), the joints as a vector space.
-    ///
-    /// Route: the base's block in closed form (SE(3) logarithm, adjoint, right Jacobian of exp6 and its inverse), identity for the joints (eomgen_runtime::manifold).
-    pub fn difference(&self, q0: &[T; 7], q1: &[T; 7]) -> [T; 6] {
-        ::eomgen_runtime::manifold::difference(q0, q1)
-    }
-    /// The Jacobians of `integrate(q, v, 1)` in `q` and in `v`, q perturbed in its tangent space
-    /// (Pinocchio's `dIntegrate`, ARG0 and ARG1); element `[i][j]` = d out_i / d in_j.
-    ///
-    /// The base moves along the SE(3) exponential (`integrate(q, v, 1) = q exp6(v)`), the joints as a vector space.
-    ///
-    /// Route: the base's block in closed form (SE(3) logarithm, adjoint, right Jacobian of exp6 and its inverse), identity for the joints (eomgen_runtime::manifold).
-    pub fn integrate_jacobians(
-        &self,
-        q: &[T; 7],
-        v: &[T; 6],
-    ) -> ([[T; 6]; 6], [[T; 6]; 6]) {
-        ::eomgen_runtime::manifold::integrate_jacobians(q, v)
-    }
-    /// `integrate_jacobians` written into `a` and `b`, their diagonal blocks only (a free flyer's
-    /// 6 x 6 blocks and each other coordinate's entry), as Pinocchio's `dIntegrate` and
-    /// `dDifference` write each joint's block of the matrix they are given. The entries
-    /// off those blocks are zero in the Jacobians and are left as they are: `a` and `b`
-    /// must hold zeros there (zeroed once, or written by an earlier call). The values are
-    /// `integrate_jacobians`'s to the bit, without writing its `2 NV^2` entries.
-    pub fn integrate_jacobians_into(
-        &self,
-        q: &[T; 7],
-        v: &[T; 6],
-        a: &mut [[T; 6]; 6],
-        b: &mut [[T; 6]; 6],
-    ) {
-        ::eomgen_runtime::manifold::integrate_jacobians_into(q, v, a, b)
-    }
-    /// The Jacobians of `difference(q0, q1)` in `q0` and in `q1`, both perturbed in their tangent
-    /// spaces (Pinocchio's `dDifference`, ARG0 and ARG1); element `[i][j]` = d out_i / d in_j.
-    ///
-    /// The base moves along the SE(3) exponential (`integrate(q, v, 1) = q exp6(v)`), the joints as a vector space.
-    ///
-    /// Route: the base's block in closed form (SE(3) logarithm, adjoint, right Jacobian of exp6 and its inverse), identity for the joints (eomgen_runtime::manifold).
-    pub fn difference_jacobians(
-        &self,
-        q0: &[T; 7],
-        q1: &[T; 7],
-    ) -> ([[T; 6]; 6], [[T; 6]; 6]) {
-        ::eomgen_runtime::manifold::difference_jacobians(q0, q1)
-    }
-    /// `difference_jacobians` written into `a` and `b`, their diagonal blocks only (a free flyer's
-    /// 6 x 6 blocks and each other coordinate's entry), as Pinocchio's `dIntegrate` and
-    /// `dDifference` write each joint's block of the matrix they are given. The entries
-    /// off those blocks are zero in the Jacobians and are left as they are: `a` and `b`
-    /// must hold zeros there (zeroed once, or written by an earlier call). The values are
-    /// `difference_jacobians`'s to the bit, without writing its `2 NV^2` entries.
-    pub fn difference_jacobians_into(
-        &self,
-        q0: &[T; 7],
-        q1: &[T; 7],
-        a: &mut [[T; 6]; 6],
-        b: &mut [[T; 6]; 6],
-    ) {
-        ::eomgen_runtime::manifold::difference_jacobians_into(q0, q1, a, b)
     }
 }
 #[allow(
@@ -2517,6 +2517,97 @@ impl<T: ::eomgen_runtime::batch::Batch> IrisSimple<T> {
         );
         Ok(())
     }
+    /// `difference` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out`.
+    pub fn difference_batch(
+        &self,
+        q0: &[[T; 7]],
+        q1: &[[T; 7]],
+        out: &mut [[T; 6]],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(
+            out.len(),
+            &[("q0", q0.len()), ("q1", q1.len())],
+        )?;
+        let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
+        ::eomgen_runtime::batch::run_costed(
+            <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            ::core::primitive::usize::MAX,
+            out,
+            &|start: usize, out: &mut [[T; 6]]| {
+                let r = IrisSimple::<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                >::difference(
+                    &robot,
+                    &::eomgen_runtime::batch::gather(q0, start),
+                    &::eomgen_runtime::batch::gather(q1, start),
+                );
+                ::eomgen_runtime::batch::scatter(&r, out);
+            },
+        );
+        Ok(())
+    }
+    /// `integrate_jacobians` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out_0`.
+    pub fn integrate_jacobians_batch(
+        &self,
+        q: &[[T; 7]],
+        v: &[[T; 6]],
+        out_0: &mut [[[T; 6]; 6]],
+        out_1: &mut [[[T; 6]; 6]],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(
+            out_0.len(),
+            &[("q", q.len()), ("v", v.len()), ("out_1", out_1.len())],
+        )?;
+        let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
+        ::eomgen_runtime::batch::run_costed(
+            <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            ::core::primitive::usize::MAX,
+            (out_0, out_1),
+            &|start: usize, (out_0, out_1): (&mut [[[T; 6]; 6]], &mut [[[T; 6]; 6]])| {
+                let r = IrisSimple::<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                >::integrate_jacobians(
+                    &robot,
+                    &::eomgen_runtime::batch::gather(q, start),
+                    &::eomgen_runtime::batch::gather(v, start),
+                );
+                ::eomgen_runtime::batch::scatter_matrix(&r.0, out_0);
+                ::eomgen_runtime::batch::scatter_matrix(&r.1, out_1);
+            },
+        );
+        Ok(())
+    }
+    /// `difference_jacobians` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out_0`.
+    pub fn difference_jacobians_batch(
+        &self,
+        q0: &[[T; 7]],
+        q1: &[[T; 7]],
+        out_0: &mut [[[T; 6]; 6]],
+        out_1: &mut [[[T; 6]; 6]],
+    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
+        ::eomgen_runtime::batch::check(
+            out_0.len(),
+            &[("q0", q0.len()), ("q1", q1.len()), ("out_1", out_1.len())],
+        )?;
+        let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
+        ::eomgen_runtime::batch::run_costed(
+            <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
+            ::core::primitive::usize::MAX,
+            (out_0, out_1),
+            &|start: usize, (out_0, out_1): (&mut [[[T; 6]; 6]], &mut [[[T; 6]; 6]])| {
+                let r = IrisSimple::<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                >::difference_jacobians(
+                    &robot,
+                    &::eomgen_runtime::batch::gather(q0, start),
+                    &::eomgen_runtime::batch::gather(q1, start),
+                );
+                ::eomgen_runtime::batch::scatter_matrix(&r.0, out_0);
+                ::eomgen_runtime::batch::scatter_matrix(&r.1, out_1);
+            },
+        );
+        Ok(())
+    }
     /// `centroidal_momentum_rate` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out`.
     pub fn centroidal_momentum_rate_batch(
         &self,
@@ -2544,76 +2635,6 @@ impl<T: ::eomgen_runtime::batch::Batch> IrisSimple<T> {
                     &::eomgen_runtime::batch::gather(qdd, start),
                 );
                 ::eomgen_runtime::batch::scatter(&r, out);
-            },
-        );
-        Ok(())
-    }
-    /// `difference` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, the shared arguments the same for all. The scalar method state by state (its code branches on values: no SIMD lanes), over threads with `eomgen_runtime`'s `rayon` feature. An error, with nothing written, when a slice holds another number of states than `out`.
-    pub fn difference_batch(
-        &self,
-        q0: &[[T; 7]],
-        q1: &[[T; 7]],
-        out: &mut [[T; 6]],
-    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
-        ::eomgen_runtime::batch::check(
-            out.len(),
-            &[("q0", q0.len()), ("q1", q1.len())],
-        )?;
-        ::eomgen_runtime::batch::run_costed(
-            1,
-            ::core::primitive::usize::MAX,
-            out,
-            &|start: usize, out: &mut [[T; 6]]| {
-                let r = Self::difference(self, &q0[start], &q1[start]);
-                out[0] = r;
-            },
-        );
-        Ok(())
-    }
-    /// `integrate_jacobians` at every state: `out_0[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, the shared arguments the same for all. The scalar method state by state (its code branches on values: no SIMD lanes), over threads with `eomgen_runtime`'s `rayon` feature. An error, with nothing written, when a slice holds another number of states than `out_0`.
-    pub fn integrate_jacobians_batch(
-        &self,
-        q: &[[T; 7]],
-        v: &[[T; 6]],
-        out_0: &mut [[[T; 6]; 6]],
-        out_1: &mut [[[T; 6]; 6]],
-    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
-        ::eomgen_runtime::batch::check(
-            out_0.len(),
-            &[("q", q.len()), ("v", v.len()), ("out_1", out_1.len())],
-        )?;
-        ::eomgen_runtime::batch::run_costed(
-            1,
-            ::core::primitive::usize::MAX,
-            (out_0, out_1),
-            &|start: usize, (out_0, out_1): (&mut [[[T; 6]; 6]], &mut [[[T; 6]; 6]])| {
-                let r = Self::integrate_jacobians(self, &q[start], &v[start]);
-                out_0[0] = r.0;
-                out_1[0] = r.1;
-            },
-        );
-        Ok(())
-    }
-    /// `difference_jacobians` at every state: `out_0[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, the shared arguments the same for all. The scalar method state by state (its code branches on values: no SIMD lanes), over threads with `eomgen_runtime`'s `rayon` feature. An error, with nothing written, when a slice holds another number of states than `out_0`.
-    pub fn difference_jacobians_batch(
-        &self,
-        q0: &[[T; 7]],
-        q1: &[[T; 7]],
-        out_0: &mut [[[T; 6]; 6]],
-        out_1: &mut [[[T; 6]; 6]],
-    ) -> ::core::result::Result<(), ::eomgen_runtime::batch::BatchError> {
-        ::eomgen_runtime::batch::check(
-            out_0.len(),
-            &[("q0", q0.len()), ("q1", q1.len()), ("out_1", out_1.len())],
-        )?;
-        ::eomgen_runtime::batch::run_costed(
-            1,
-            ::core::primitive::usize::MAX,
-            (out_0, out_1),
-            &|start: usize, (out_0, out_1): (&mut [[[T; 6]; 6]], &mut [[[T; 6]; 6]])| {
-                let r = Self::difference_jacobians(self, &q0[start], &q1[start]);
-                out_0[0] = r.0;
-                out_1[0] = r.1;
             },
         );
         Ok(())

@@ -3425,6 +3425,78 @@ impl<T: ::eomgen_runtime::Lane> Ur5<T> {
     ) -> [[T; 6]; 6] {
         ::eomgen_runtime::frame::jacobian_time_variation(&self.link_chain(link, q), qd)
     }
+    /// `difference(q0, q1)`: the velocity that moves `q0` to `q1` in unit time, so that
+    /// `integrate(q0, difference(q0, q1), 1) = q1` (Pinocchio's `difference`). A floating base's
+    /// quaternions may have either sign.
+    ///
+    /// The configurations of a fixed base form a vector space.
+    ///
+    /// Route: the vector space's (eomgen_runtime::manifold).
+    pub fn difference(&self, q0: &[T; 6], q1: &[T; 6]) -> [T; 6] {
+        ::eomgen_runtime::manifold::vector_difference(q0, q1)
+    }
+    /// The Jacobians of `integrate(q, v, 1)` in `q` and in `v`, q perturbed in its tangent space
+    /// (Pinocchio's `dIntegrate`, ARG0 and ARG1); element `[i][j]` = d out_i / d in_j.
+    ///
+    /// The configurations of a fixed base form a vector space.
+    ///
+    /// Route: the vector space's (eomgen_runtime::manifold).
+    pub fn integrate_jacobians(
+        &self,
+        q: &[T; 6],
+        v: &[T; 6],
+    ) -> ([[T; 6]; 6], [[T; 6]; 6]) {
+        ::eomgen_runtime::manifold::vector_integrate_jacobians()
+    }
+    /// `integrate_jacobians` written into `a` and `b`, their diagonal blocks only (a free flyer's
+    /// 6 x 6 blocks and each other coordinate's entry), as Pinocchio's `dIntegrate` and
+    /// `dDifference` write each joint's block of the matrix they are given. The entries
+    /// off those blocks are zero in the Jacobians and are left as they are: `a` and `b`
+    /// must hold zeros there (zeroed once, or written by an earlier call). The values are
+    /// `integrate_jacobians`'s to the bit, without writing its `2 NV^2` entries.
+    pub fn integrate_jacobians_into(
+        &self,
+        q: &[T; 6],
+        v: &[T; 6],
+        a: &mut [[T; 6]; 6],
+        b: &mut [[T; 6]; 6],
+    ) {
+        {
+            let _ = (q, v);
+            ::eomgen_runtime::manifold::vector_integrate_jacobians_into(a, b)
+        }
+    }
+    /// The Jacobians of `difference(q0, q1)` in `q0` and in `q1`, both perturbed in their tangent
+    /// spaces (Pinocchio's `dDifference`, ARG0 and ARG1); element `[i][j]` = d out_i / d in_j.
+    ///
+    /// The configurations of a fixed base form a vector space.
+    ///
+    /// Route: the vector space's (eomgen_runtime::manifold).
+    pub fn difference_jacobians(
+        &self,
+        q0: &[T; 6],
+        q1: &[T; 6],
+    ) -> ([[T; 6]; 6], [[T; 6]; 6]) {
+        ::eomgen_runtime::manifold::vector_difference_jacobians()
+    }
+    /// `difference_jacobians` written into `a` and `b`, their diagonal blocks only (a free flyer's
+    /// 6 x 6 blocks and each other coordinate's entry), as Pinocchio's `dIntegrate` and
+    /// `dDifference` write each joint's block of the matrix they are given. The entries
+    /// off those blocks are zero in the Jacobians and are left as they are: `a` and `b`
+    /// must hold zeros there (zeroed once, or written by an earlier call). The values are
+    /// `difference_jacobians`'s to the bit, without writing its `2 NV^2` entries.
+    pub fn difference_jacobians_into(
+        &self,
+        q0: &[T; 6],
+        q1: &[T; 6],
+        a: &mut [[T; 6]; 6],
+        b: &mut [[T; 6]; 6],
+    ) {
+        {
+            let _ = (q0, q1);
+            ::eomgen_runtime::manifold::vector_difference_jacobians_into(a, b)
+        }
+    }
     /// Each joint's axis (in the frame of the body it moves) and motion.
     const TREE_JOINTS: [::eomgen_runtime::tree::TreeJoint; 6] = [
         ::eomgen_runtime::tree::TreeJoint {
@@ -3845,78 +3917,6 @@ impl<T: ::eomgen_runtime::Real> Ur5<T> {
         tau: &[T; 6],
     ) -> ::core::result::Result<[T; 6], ::eomgen_runtime::FactorError> {
         self.forward_dynamics_checked(q, qd, tau).map(|(qdd, _)| qdd)
-    }
-    /// `difference(q0, q1)`: the velocity that moves `q0` to `q1` in unit time, so that
-    /// `integrate(q0, difference(q0, q1), 1) = q1` (Pinocchio's `difference`). A floating base's
-    /// quaternions may have either sign.
-    ///
-    /// The configurations of a fixed base form a vector space.
-    ///
-    /// Route: the vector space's (eomgen_runtime::manifold).
-    pub fn difference(&self, q0: &[T; 6], q1: &[T; 6]) -> [T; 6] {
-        ::eomgen_runtime::manifold::vector_difference(q0, q1)
-    }
-    /// The Jacobians of `integrate(q, v, 1)` in `q` and in `v`, q perturbed in its tangent space
-    /// (Pinocchio's `dIntegrate`, ARG0 and ARG1); element `[i][j]` = d out_i / d in_j.
-    ///
-    /// The configurations of a fixed base form a vector space.
-    ///
-    /// Route: the vector space's (eomgen_runtime::manifold).
-    pub fn integrate_jacobians(
-        &self,
-        q: &[T; 6],
-        v: &[T; 6],
-    ) -> ([[T; 6]; 6], [[T; 6]; 6]) {
-        ::eomgen_runtime::manifold::vector_integrate_jacobians()
-    }
-    /// `integrate_jacobians` written into `a` and `b`, their diagonal blocks only (a free flyer's
-    /// 6 x 6 blocks and each other coordinate's entry), as Pinocchio's `dIntegrate` and
-    /// `dDifference` write each joint's block of the matrix they are given. The entries
-    /// off those blocks are zero in the Jacobians and are left as they are: `a` and `b`
-    /// must hold zeros there (zeroed once, or written by an earlier call). The values are
-    /// `integrate_jacobians`'s to the bit, without writing its `2 NV^2` entries.
-    pub fn integrate_jacobians_into(
-        &self,
-        q: &[T; 6],
-        v: &[T; 6],
-        a: &mut [[T; 6]; 6],
-        b: &mut [[T; 6]; 6],
-    ) {
-        {
-            let _ = (q, v);
-            ::eomgen_runtime::manifold::vector_integrate_jacobians_into(a, b)
-        }
-    }
-    /// The Jacobians of `difference(q0, q1)` in `q0` and in `q1`, both perturbed in their tangent
-    /// spaces (Pinocchio's `dDifference`, ARG0 and ARG1); element `[i][j]` = d out_i / d in_j.
-    ///
-    /// The configurations of a fixed base form a vector space.
-    ///
-    /// Route: the vector space's (eomgen_runtime::manifold).
-    pub fn difference_jacobians(
-        &self,
-        q0: &[T; 6],
-        q1: &[T; 6],
-    ) -> ([[T; 6]; 6], [[T; 6]; 6]) {
-        ::eomgen_runtime::manifold::vector_difference_jacobians()
-    }
-    /// `difference_jacobians` written into `a` and `b`, their diagonal blocks only (a free flyer's
-    /// 6 x 6 blocks and each other coordinate's entry), as Pinocchio's `dIntegrate` and
-    /// `dDifference` write each joint's block of the matrix they are given. The entries
-    /// off those blocks are zero in the Jacobians and are left as they are: `a` and `b`
-    /// must hold zeros there (zeroed once, or written by an earlier call). The values are
-    /// `difference_jacobians`'s to the bit, without writing its `2 NV^2` entries.
-    pub fn difference_jacobians_into(
-        &self,
-        q0: &[T; 6],
-        q1: &[T; 6],
-        a: &mut [[T; 6]; 6],
-        b: &mut [[T; 6]; 6],
-    ) {
-        {
-            let _ = (q0, q1);
-            ::eomgen_runtime::manifold::vector_difference_jacobians_into(a, b)
-        }
     }
 }
 #[allow(
@@ -7737,7 +7737,7 @@ impl<T: ::eomgen_runtime::batch::Batch> Ur5<T> {
         );
         Ok(())
     }
-    /// `difference` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, the shared arguments the same for all. The scalar method state by state (its code branches on values: no SIMD lanes), over threads with `eomgen_runtime`'s `rayon` feature. An error, with nothing written, when a slice holds another number of states than `out`.
+    /// `difference` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out`.
     pub fn difference_batch(
         &self,
         q0: &[[T; 6]],
@@ -7748,18 +7748,25 @@ impl<T: ::eomgen_runtime::batch::Batch> Ur5<T> {
             out.len(),
             &[("q0", q0.len()), ("q1", q1.len())],
         )?;
+        let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
         ::eomgen_runtime::batch::run_costed(
-            1,
+            <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
             ::core::primitive::usize::MAX,
             out,
             &|start: usize, out: &mut [[T; 6]]| {
-                let r = Self::difference(self, &q0[start], &q1[start]);
-                out[0] = r;
+                let r = Ur5::<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                >::difference(
+                    &robot,
+                    &::eomgen_runtime::batch::gather(q0, start),
+                    &::eomgen_runtime::batch::gather(q1, start),
+                );
+                ::eomgen_runtime::batch::scatter(&r, out);
             },
         );
         Ok(())
     }
-    /// `integrate_jacobians` at every state: `out_0[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, the shared arguments the same for all. The scalar method state by state (its code branches on values: no SIMD lanes), over threads with `eomgen_runtime`'s `rayon` feature. An error, with nothing written, when a slice holds another number of states than `out_0`.
+    /// `integrate_jacobians` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out_0`.
     pub fn integrate_jacobians_batch(
         &self,
         q: &[[T; 6]],
@@ -7771,19 +7778,26 @@ impl<T: ::eomgen_runtime::batch::Batch> Ur5<T> {
             out_0.len(),
             &[("q", q.len()), ("v", v.len()), ("out_1", out_1.len())],
         )?;
+        let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
         ::eomgen_runtime::batch::run_costed(
-            1,
+            <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
             ::core::primitive::usize::MAX,
             (out_0, out_1),
             &|start: usize, (out_0, out_1): (&mut [[[T; 6]; 6]], &mut [[[T; 6]; 6]])| {
-                let r = Self::integrate_jacobians(self, &q[start], &v[start]);
-                out_0[0] = r.0;
-                out_1[0] = r.1;
+                let r = Ur5::<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                >::integrate_jacobians(
+                    &robot,
+                    &::eomgen_runtime::batch::gather(q, start),
+                    &::eomgen_runtime::batch::gather(v, start),
+                );
+                ::eomgen_runtime::batch::scatter_matrix(&r.0, out_0);
+                ::eomgen_runtime::batch::scatter_matrix(&r.1, out_1);
             },
         );
         Ok(())
     }
-    /// `difference_jacobians` at every state: `out_0[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, the shared arguments the same for all. The scalar method state by state (its code branches on values: no SIMD lanes), over threads with `eomgen_runtime`'s `rayon` feature. An error, with nothing written, when a slice holds another number of states than `out_0`.
+    /// `difference_jacobians` at every state: `out[i]` (or each `out_k[i]` of a tuple) from the inputs' element `i`, several states per vector of the target's widest SIMD lanes (`eomgen_runtime::batch`; over threads with its `rayon` feature). An error, with nothing written, when a slice holds another number of states than `out_0`.
     pub fn difference_jacobians_batch(
         &self,
         q0: &[[T; 6]],
@@ -7795,14 +7809,21 @@ impl<T: ::eomgen_runtime::batch::Batch> Ur5<T> {
             out_0.len(),
             &[("q0", q0.len()), ("q1", q1.len()), ("out_1", out_1.len())],
         )?;
+        let robot = self.in_lanes::<<T as ::eomgen_runtime::batch::Batch>::Lanes>();
         ::eomgen_runtime::batch::run_costed(
-            1,
+            <<T as ::eomgen_runtime::batch::Batch>::Lanes as ::eomgen_runtime::Lane>::LANES,
             ::core::primitive::usize::MAX,
             (out_0, out_1),
             &|start: usize, (out_0, out_1): (&mut [[[T; 6]; 6]], &mut [[[T; 6]; 6]])| {
-                let r = Self::difference_jacobians(self, &q0[start], &q1[start]);
-                out_0[0] = r.0;
-                out_1[0] = r.1;
+                let r = Ur5::<
+                    <T as ::eomgen_runtime::batch::Batch>::Lanes,
+                >::difference_jacobians(
+                    &robot,
+                    &::eomgen_runtime::batch::gather(q0, start),
+                    &::eomgen_runtime::batch::gather(q1, start),
+                );
+                ::eomgen_runtime::batch::scatter_matrix(&r.0, out_0);
+                ::eomgen_runtime::batch::scatter_matrix(&r.1, out_1);
             },
         );
         Ok(())

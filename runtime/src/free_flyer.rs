@@ -2,6 +2,7 @@
 //! x, y, z, w (4), joints], velocities `v` = [linear (3), angular (3), both in base axes,
 //! joints], as Pinocchio's free flyer.
 
+use crate::lane::branch;
 use crate::tree::{cross, Motion, TreeJoint};
 use crate::{Lane, Pose};
 
@@ -135,32 +136,20 @@ pub(crate) fn exp_so3<T: Lane>(w: &[T; 3]) -> ([T; 4], [[T; 3]; 3]) {
     // sin(t/2)/t, (1 - cos t)/t^2, (t - sin t)/t^3: the series where t^2 < 1e-8 (lane-wise
     // for a vector of states, each lane from its own branch).
     let series = || {
-        (
+        [
             half - t2 / T::from_f64(48.0),
             half - t2 / T::from_f64(24.0),
             T::from_f64(1.0 / 6.0) - t2 / T::from_f64(120.0),
-        )
+        ]
     };
     // sin t = 2 sin(t/2) cos(t/2) and 1 - cos t = 2 sin(t/2)^2: no second sine and cosine
     // (and no cancellation in 1 - cos t).
     let exact = || {
         let two = T::from_f64(2.0);
         let st = two * s * c;
-        (s / t, two * s * s / t2, (t - st) / (t2 * t))
+        [s / t, two * s * s / t2, (t - st) / (t2 * t)]
     };
-    let small = T::from_f64(1e-8).gt(t2);
-    let (k, a, b) = if T::all(small) {
-        series()
-    } else if !T::any(small) {
-        exact()
-    } else {
-        let (x, y) = (series(), exact());
-        (
-            T::select(small, x.0, y.0),
-            T::select(small, x.1, y.1),
-            T::select(small, x.2, y.2),
-        )
-    };
+    let [k, a, b] = branch::<T, _>(T::from_f64(1e-8).gt(t2), series, exact);
     let quat = [w[0] * k, w[1] * k, w[2] * k, c];
     let kx = [
         [T::zero(), -w[2], w[1]],

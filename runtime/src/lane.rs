@@ -84,6 +84,19 @@ pub trait Lane: Copy + Debug + Default + Arithmetic + 'static {
     fn recip(self) -> Self;
     /// `self * a + b`, fused where [`Real::mul_add`] is (an FMA instruction at compile time).
     fn mul_add(self, a: Self, b: Self) -> Self;
+    /// `-self`, lane-wise, with its sign bit flipped in every lane as a scalar's `-` flips it:
+    /// `-0` for `+0`. `wide`'s vectors implement `-x` as `0 - x`, which gives `+0` for `+0`
+    /// (and keeps a NaN's sign); code that must match the scalar's signed zeros in every lane
+    /// negates through here. A scalar's is its `-`.
+    ///
+    /// ```
+    /// use eomgen_runtime::Lane;
+    /// assert!(0.0_f64.neg_exact().is_sign_negative());
+    /// ```
+    #[inline(always)]
+    fn neg_exact(self) -> Self {
+        -self
+    }
     /// Lanes that are neither infinite nor NaN.
     fn finite(self) -> Self::Mask;
     /// Lanes where `self > other` (false where either is NaN).
@@ -510,5 +523,8 @@ impl<T: Real> Pack for T {
     }
 }
 
+mod branch;
 #[cfg(feature = "simd")]
 mod simd;
+
+pub(crate) use branch::{branch, Select};

@@ -55,6 +55,16 @@ impl<const R: usize, const C: usize> Flat for [[f64; C]; R] {
         self.iter().flatten().copied().collect()
     }
 }
+impl<const N: usize> Flat for [f32; N] {
+    fn flat(&self) -> Vec<f64> {
+        self.iter().map(|x| f64::from(*x)).collect()
+    }
+}
+impl<const R: usize, const C: usize> Flat for [[f32; C]; R] {
+    fn flat(&self) -> Vec<f64> {
+        self.iter().flatten().map(|x| f64::from(*x)).collect()
+    }
+}
 
 /// `got` equals `want` entry by entry: the same NaNs and infinities, and finite entries bit for
 /// bit (`tol` 0) or within `tol` times the largest finite entry of `want` (at least 1).
@@ -787,8 +797,13 @@ impl Flat for eomgen_runtime::Pose<f64> {
 
 /// `got[i]` equals `want(i)` bit for bit at every state.
 fn each_state<X: Flat>(what: &str, got: &[X], want: impl Fn(usize) -> X) {
+    each_state_within(what, got, want, 0.0);
+}
+
+/// `got[i]` equals `want(i)` at every state, as [`assert_close`] with `tol`.
+fn each_state_within<X: Flat>(what: &str, got: &[X], want: impl Fn(usize) -> X, tol: f64) {
     for (i, g) in got.iter().enumerate() {
-        assert_close(what, i, g, &want(i), 0.0);
+        assert_close(what, i, g, &want(i), tol);
     }
 }
 
@@ -802,7 +817,7 @@ fn methods_off_the_lanes_in_batches_equal_the_scalar_code() {
     let robot = AnymalMpc::<f64>::default();
     let mut n = Numbers(12);
     let (mut q, mut v) = anymal_states(&mut n, STATES);
-    let (a, q1) = (n.states::<18>(STATES, 1.0), anymal_states(&mut n, STATES).0);
+    let a = n.states::<18>(STATES, 1.0);
     spoil(&mut q, &mut v);
     let link = AnymalMpcLink::LfFoot;
     let (z6, zm) = ([0.0; 6], [[0.0; 18]; 18]);
@@ -816,19 +831,6 @@ fn methods_off_the_lanes_in_batches_equal_the_scalar_code() {
     let mut poses = vec![eomgen_runtime::Pose::identity(); STATES];
     robot.link_pose_batch(link, &q, &mut poses).unwrap();
     each_state("link_pose", &poses, |i| robot.link_pose(link, &q[i]));
-    let mut dv = vec![[0.0; 18]; STATES];
-    robot.difference_batch(&q, &q1, &mut dv).unwrap();
-    each_state("difference", &dv, |i| robot.difference(&q[i], &q1[i]));
-    let (mut ja, mut jb) = (vec![zm; STATES], vec![zm; STATES]);
-    robot
-        .integrate_jacobians_batch(&q, &v, &mut ja, &mut jb)
-        .unwrap();
-    each_state("integrate_jacobians in q", &ja, |i| {
-        robot.integrate_jacobians(&q[i], &v[i]).0
-    });
-    each_state("integrate_jacobians in v", &jb, |i| {
-        robot.integrate_jacobians(&q[i], &v[i]).1
-    });
 
     let tau = n.states::<18>(STATES, 20.0);
     let zk = [[0.0; 18]; 12];
@@ -886,8 +888,6 @@ fn methods_off_the_lanes_in_batches_equal_the_scalar_code() {
             .contact_forward_dynamics_stabilized(&q[i], &v[i], &tau[i], &active, &gains)
             .1
     });
-    let e = robot.difference_batch(&q, &q1[1..], &mut dv).unwrap_err();
-    assert_eq!((e.argument, e.len, e.expected), ("q1", STATES - 1, STATES));
 }
 
 #[test]
@@ -920,4 +920,113 @@ fn link_kinematics_on_four_lanes_equals_the_scalar_code() {
             assert_eq!(lane_m(&jdot), want, "lane {l}");
         }
     }
+}
+
+/// `q0`, `q1` and `v` of every state of a manifold batch.
+type ManifoldStates<const NQ: usize, const NV: usize> =
+    (Vec<[f64; NQ]>, Vec<[f64; NQ]>, Vec<[f64; NV]>);
+
+/// Manifold states around `q` and `v` (states of `STATES`), each special one next to ordinary
+/// ones in its vector of lanes: `q1` is `integrate(q0, v)` with its quaternions (those starting
+/// at `quats`) negated in every other state, and in state 1 `q0` itself (the zero rotation:
+/// series, signed zeros), in 2 `q0` negated, in 3 a rotation of about 1e-7 rad away (the
+/// series of the rotation vector), in 5 one of about 3e-3 rad (the series of `V^-1` and of the
+/// Jacobians) next to a NaN in `q0` of state 4 and an infinite velocity and `q1` in state 6;
+/// velocities of zero angle in state 8 and of about 1e-3 rad (series) in state 9.
+fn manifold_states<const NQ: usize, const NV: usize>(
+    (mut q0, mut v): (Vec<[f64; NQ]>, Vec<[f64; NV]>),
+    quats: &[usize],
+    integrate: impl Fn(&[f64; NQ], &[f64; NV], f64) -> [f64; NQ],
+) -> ManifoldStates<NQ, NV> {
+    let negated = |mut q: [f64; NQ]| {
+        for &w in quats {
+            q[w..w + 4].iter_mut().for_each(|x| *x = -*x);
+        }
+        q
+    };
+    v[8] = [0.0; NV];
+    v[9] = v[9].map(|x| 1e-3 * x);
+    let mut q1: Vec<[f64; NQ]> = (0..STATES)
+        .map(|i| integrate(&q0[i], &v[i], 1.0))
+        .enumerate()
+        .map(|(i, q)| if i % 2 == 1 { negated(q) } else { q })
+        .collect();
+    (q1[1], q1[2]) = (q0[1], negated(q0[2]));
+    q1[3] = integrate(&q0[3], &v[3].map(|x| 1e-7 * x), 1.0);
+    q1[5] = integrate(&q0[5], &v[5].map(|x| 3e-3 * x), 1.0);
+    q0[4][quats.first().map_or(0, |w| w + 1)] = f64::NAN;
+    (v[6][NV - 1], q1[6][NQ - 1]) = (f64::INFINITY, f64::INFINITY);
+    (q0, q1, v)
+}
+
+/// The three manifold batches of `$robot` (`difference`, `integrate_jacobians`,
+/// `difference_jacobians`) in `$t` against its scalar methods state by state: bit for bit,
+/// `integrate_jacobians` within `$tol` (its sine and cosine: `wide`'s in `f32`). The outputs
+/// start marked, so that an entry a batch leaves alone shows.
+macro_rules! manifold_batches_equal_the_scalar_code {
+    ($robot:expr, $t:ty, $states:expr, $tol:expr) => {{
+        let robot = &$robot;
+        let what = |name: &str| format!("{name} ({})", stringify!($t));
+        let (q0, q1, v) = &$states;
+        let (q0, q1, v) = (q0.iter(), q1.iter(), v.iter());
+        let q0: Vec<_> = q0.map(|s| s.map(|x| x as $t)).collect();
+        let q1: Vec<_> = q1.map(|s| s.map(|x| x as $t)).collect();
+        let v: Vec<_> = v.map(|s| s.map(|x| x as $t)).collect();
+        let mut d = vec![v[0].map(|_| 7.25); STATES];
+        robot.difference_batch(&q0, &q1, &mut d).unwrap();
+        each_state(&what("difference"), &d, |i| {
+            robot.difference(&q0[i], &q1[i])
+        });
+        let mark = robot
+            .integrate_jacobians(&q0[0], &v[0])
+            .0
+            .map(|r| r.map(|_| 7.25));
+        let (mut a, mut b) = (vec![mark; STATES], vec![mark; STATES]);
+        robot
+            .integrate_jacobians_batch(&q0, &v, &mut a, &mut b)
+            .unwrap();
+        let want = |i: usize| robot.integrate_jacobians(&q0[i], &v[i]);
+        each_state_within(&what("integrate_jacobians q"), &a, |i| want(i).0, $tol);
+        each_state_within(&what("integrate_jacobians v"), &b, |i| want(i).1, $tol);
+        let (mut a, mut b) = (vec![mark; STATES], vec![mark; STATES]);
+        robot
+            .difference_jacobians_batch(&q0, &q1, &mut a, &mut b)
+            .unwrap();
+        let want = |i: usize| robot.difference_jacobians(&q0[i], &q1[i]);
+        each_state(&what("difference_jacobians q0"), &a, |i| want(i).0);
+        each_state(&what("difference_jacobians q1"), &b, |i| want(i).1);
+        let e = robot.difference_batch(&q0, &q1[1..], &mut d).unwrap_err();
+        assert_eq!((e.argument, e.len, e.expected), ("q1", STATES - 1, STATES));
+    }};
+}
+
+/// The manifold's batches on lanes, in `f64` and `f32`: a fixed base (the panda), a floating
+/// base (anymal) and floating joints below the root (`rover_pods`), with the special states
+/// of [`manifold_states`].
+#[test]
+fn manifold_batches_on_lanes_equal_the_scalar_code() {
+    use super::joints::{quaternion_starts, rover_pods::RoverPods, rover_state};
+    use eomgen_tests::robots::anymal_mpc::AnymalMpc;
+    let mut n = Numbers(14);
+    let vector = |q: &[f64; 9], v: &[f64; 9], t: f64| -> [f64; 9] {
+        core::array::from_fn(|i| q[i] + t * v[i])
+    };
+    let panda = (n.states::<9>(STATES, 1.0), n.states::<9>(STATES, 1.0));
+    let panda = manifold_states(panda, &[], vector);
+    manifold_batches_equal_the_scalar_code!(Panda::<f64>::default(), f64, panda, 0.0);
+    manifold_batches_equal_the_scalar_code!(Panda::<f32>::default(), f32, panda, 0.0);
+    let anymal = AnymalMpc::<f64>::default();
+    let along = |q: &[f64; 19], v: &[f64; 18], t: f64| anymal.integrate(q, v, t);
+    let states = manifold_states(anymal_states(&mut n, STATES), &[3], along);
+    manifold_batches_equal_the_scalar_code!(anymal, f64, states, 0.0);
+    let anymal32 = AnymalMpc::<f32>::default();
+    manifold_batches_equal_the_scalar_code!(anymal32, f32, states, 1e-5);
+    let rover = RoverPods::<f64>::default();
+    let rovers: (Vec<_>, Vec<_>) = (0..STATES as u64)
+        .map(|seed| rover_state(seed + 40))
+        .map(|(q, v, _)| (q, v))
+        .unzip();
+    let along = |q: &[f64; 21], v: &[f64; 19], t: f64| rover.integrate(q, v, t);
+    let states = manifold_states(rovers, &quaternion_starts(), along);
+    manifold_batches_equal_the_scalar_code!(rover, f64, states, 0.0);
 }

@@ -30,7 +30,7 @@ mod crane_payload {
     include!(concat!(env!("OUT_DIR"), "/crane_payload.rs"));
 }
 #[allow(dead_code)]
-mod rover_pods {
+pub(crate) mod rover_pods {
     include!(concat!(env!("OUT_DIR"), "/rover_pods.rs"));
 }
 
@@ -206,7 +206,7 @@ fn joint_names_have_one_entry_per_velocity_coordinate() {
 }
 
 /// A reproducible state of `rover_pods`: coordinates in [-0.8, 0.8], unit quaternions.
-fn rover_state(seed: u64) -> ([f64; 21], [f64; 19], [f64; 19]) {
+pub(crate) fn rover_state(seed: u64) -> ([f64; 21], [f64; 19], [f64; 19]) {
     let mut lcg = eomgen_tests::Lcg(seed);
     let mut q: [f64; 21] = core::array::from_fn(|_| lcg.uniform(-0.8, 0.8));
     let qd: [f64; 19] = core::array::from_fn(|_| lcg.uniform(-1.0, 1.0));
@@ -223,7 +223,7 @@ fn rover_state(seed: u64) -> ([f64; 21], [f64; 19], [f64; 19]) {
 }
 
 /// Where each floating joint's quaternion starts in `rover_pods`'s `q`, from `JOINT_NAMES`.
-fn quaternion_starts() -> Vec<usize> {
+pub(crate) fn quaternion_starts() -> Vec<usize> {
     let names = rover_pods::RoverPods::<f64>::JOINT_NAMES;
     let (mut q, mut out) = (0, Vec::new());
     let mut i = 0;

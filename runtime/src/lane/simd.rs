@@ -5,10 +5,12 @@
 //! `f64x2` and `f32x4`, and plain arrays elsewhere. Its `mul_add` fuses exactly when
 //! [`Real::mul_add`](crate::Real::mul_add) does on x86-64 (the `fma` feature), its arithmetic
 //! and square root are IEEE's, so a lane computes what the scalar code computes, bit for bit.
-//! Sines and cosines: the `f64` vectors' [`Lane::sin_cos_many`] (every joint angle of
-//! generated code) runs the scalar `f64` kernel, [`crate::trig::sin_cos_f64_in`], on all lanes
-//! at once, bit for bit again; single sines and cosines, and the `f32` vectors', are `wide`'s
-//! polynomial approximations, which differ from `libm`'s in the last bits.
+//! `-x` is `wide`'s `0 - x`, which differs from a scalar's negation in the sign of a zero (and
+//! of a NaN); [`Lane::neg_exact`] flips the sign bit as the scalar does. Sines and cosines:
+//! the `f64` vectors' [`Lane::sin_cos_many`] (every joint angle of generated code) runs the
+//! scalar `f64` kernel, [`crate::trig::sin_cos_f64_in`], on all lanes at once, bit for bit
+//! again; single sines and cosines, and the `f32` vectors', are `wide`'s polynomial
+//! approximations, which differ from `libm`'s in the last bits.
 
 use super::{pack_each, scalar_check, unpack_each, unpack_run_each, Lane, LaneError, Pack};
 use crate::FactorError;
@@ -75,6 +77,10 @@ macro_rules! impl_lane {
             #[inline(always)]
             fn mul_add(self, a: Self, b: Self) -> Self {
                 $v::mul_add(self, a, b)
+            }
+            #[inline(always)]
+            fn neg_exact(self) -> Self {
+                self ^ $v::splat(-0.0)
             }
             #[inline(always)]
             fn finite(self) -> $v {

@@ -5,13 +5,14 @@
 //! arguments are known non-negative, so one comparison swaps them into `lo <= hi`, a second
 //! picks the reduced argument (`lo / hi`, or `(lo - hi) / (lo + hi)` around `pi/4`: one
 //! division either way, `|z| <= tan(pi/8)`), and fdlibm's odd polynomial of `atan` on
-//! `|z| < 7/16` finishes. Accuracy: within a few units in the last place of `libm::atan2`
+//! `|z| < 7/16` finishes. Both choices are lane-wise selections, not branches, so that a
+//! vector of states ([`crate::Lane`]) takes each lane's own. Accuracy: within a few units in the last place of `libm::atan2`
 //! (the unit test sweeps the quadrant).
 
 // fdlibm's coefficients, digit for digit as published (more digits than an f64 holds).
 #![allow(clippy::excessive_precision)]
 
-use crate::Real;
+use crate::Lane;
 
 /// fdlibm's `atan` coefficients `aT[0..11]`, valid for `|z| < 7/16`.
 const AT: [f64; 11] = [
@@ -31,32 +32,27 @@ const AT: [f64; 11] = [
 /// `tan(pi/8)`: above it, the argument is reduced around `pi/4`.
 const TAN_PI_8: f64 = 0.414_213_562_373_095_048_80;
 
-/// `atan2(y, x)` for `y >= 0` and `x >= 0`, not both zero: the angle in `[0, pi/2]`.
+/// `atan2(y, x)` for `y >= 0` and `x >= 0`, not both zero: the angle in `[0, pi/2]`, lane by
+/// lane (the swap and the reduction selected per lane, no branch on a value).
 #[inline]
-pub(super) fn atan2_quadrant<T: Real>(y: T, x: T) -> T {
+pub(super) fn atan2_quadrant<T: Lane>(y: T, x: T) -> T {
     let f = T::from_f64;
-    let swap = y > x;
-    let (lo, hi) = if swap { (x, y) } else { (y, x) };
+    let swap = y.gt(x);
+    let (lo, hi) = (T::select(swap, x, y), T::select(swap, y, x));
     // atan(lo / hi) in [0, pi/4], around 0 or around pi/4.
-    let near = lo > f(TAN_PI_8) * hi;
-    let (num, den, base) = if near {
-        (lo - hi, lo + hi, f(core::f64::consts::FRAC_PI_4))
-    } else {
-        (lo, hi, T::zero())
-    };
+    let near = lo.gt(f(TAN_PI_8) * hi);
+    let num = T::select(near, lo - hi, lo);
+    let den = T::select(near, lo + hi, hi);
+    let base = T::select(near, f(core::f64::consts::FRAC_PI_4), T::zero());
     let z = num / den;
     let a = base + atan_small(z);
-    if swap {
-        f(core::f64::consts::FRAC_PI_2) - a
-    } else {
-        a
-    }
+    T::select(swap, f(core::f64::consts::FRAC_PI_2) - a, a)
 }
 
 /// `atan(z)` for `|z| < 7/16`: `z - z (z^2 P(z^4) + z^4 Q(z^4))`, the odd and even halves of
 /// the polynomial in parallel (Estrin's scheme on `w = z^4`).
 #[inline(always)]
-fn atan_small<T: Real>(z: T) -> T {
+fn atan_small<T: Lane>(z: T) -> T {
     let c = |i: usize| T::from_f64(AT[i]);
     let z2 = z * z;
     let w = z2 * z2;

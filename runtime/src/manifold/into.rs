@@ -8,7 +8,7 @@
 //! humanoid's 19.6 kB).
 
 use super::{put_block, se3, walk_blocks, Block, M6};
-use crate::Real;
+use crate::Lane;
 
 /// [`super::integrate_jacobians`] into `dq` and `dv`, their diagonal blocks only (module
 /// documentation): the entries off the blocks must be zero.
@@ -21,7 +21,7 @@ use crate::Real;
 /// integrate_jacobians_into(&q, &v, &mut dq, &mut dv);
 /// assert_eq!((dq, dv), integrate_jacobians(&q, &v));
 /// ```
-pub fn integrate_jacobians_into<T: Real, const NQ: usize, const NV: usize>(
+pub fn integrate_jacobians_into<T: Lane, const NQ: usize, const NV: usize>(
     q: &[T; NQ],
     v: &[T; NV],
     dq: &mut [[T; NV]; NV],
@@ -45,7 +45,7 @@ pub fn integrate_jacobians_into<T: Real, const NQ: usize, const NV: usize>(
 /// difference_jacobians_into(&q0, &q1, &mut d0, &mut d1);
 /// assert_eq!((d0, d1), difference_jacobians(&q0, &q1));
 /// ```
-pub fn difference_jacobians_into<T: Real, const NQ: usize, const NV: usize>(
+pub fn difference_jacobians_into<T: Lane, const NQ: usize, const NV: usize>(
     q0: &[T; NQ],
     q1: &[T; NQ],
     d0: &mut [[T; NV]; NV],
@@ -61,7 +61,7 @@ pub fn difference_jacobians_into<T: Real, const NQ: usize, const NV: usize>(
 
 /// [`super::integrate_jacobians_blocks`] into `dq` and `dv`, their diagonal blocks only
 /// (module documentation), `free` as there.
-pub fn integrate_jacobians_blocks_into<T: Real, const NQ: usize, const NV: usize>(
+pub fn integrate_jacobians_blocks_into<T: Lane, const NQ: usize, const NV: usize>(
     q: &[T; NQ],
     v: &[T; NV],
     free: &[(usize, usize)],
@@ -79,7 +79,7 @@ pub fn integrate_jacobians_blocks_into<T: Real, const NQ: usize, const NV: usize
 
 /// [`super::difference_jacobians_blocks`] into `d0` and `d1`, their diagonal blocks only
 /// (module documentation), `free` as there.
-pub fn difference_jacobians_blocks_into<T: Real, const NQ: usize, const NV: usize>(
+pub fn difference_jacobians_blocks_into<T: Lane, const NQ: usize, const NV: usize>(
     q0: &[T; NQ],
     q1: &[T; NQ],
     free: &[(usize, usize)],
@@ -95,7 +95,7 @@ pub fn difference_jacobians_blocks_into<T: Real, const NQ: usize, const NV: usiz
 /// Each free flyer's blocks `blocks(q index, v index)` of `free` on the diagonals of `x`
 /// and `y` (`dDifference`'s: written whole, its 3 x 3 parts written in place made its dense
 /// form slower, `se3::integrate_jacobians_at`).
-fn flyers_into<const NQ: usize, const NV: usize, T: Real>(
+fn flyers_into<const NQ: usize, const NV: usize, T: Lane>(
     free: &[(usize, usize)],
     (x, y): (&mut [[T; NV]; NV], &mut [[T; NV]; NV]),
     blocks: impl Fn(usize, usize) -> (M6<T>, M6<T>),
@@ -111,7 +111,7 @@ fn flyers_into<const NQ: usize, const NV: usize, T: Real>(
 
 /// A fixed base's [`super::vector_integrate_jacobians`] into `dq` and `dv`: ones on their
 /// diagonals, the rest left as it is (zero).
-pub fn vector_integrate_jacobians_into<T: Real, const N: usize>(
+pub fn vector_integrate_jacobians_into<T: Lane, const N: usize>(
     dq: &mut [[T; N]; N],
     dv: &mut [[T; N]; N],
 ) {
@@ -120,7 +120,7 @@ pub fn vector_integrate_jacobians_into<T: Real, const N: usize>(
 
 /// A fixed base's [`super::vector_difference_jacobians`] into `d0` and `d1`: minus one and
 /// one on their diagonals, the rest left as it is (zero).
-pub fn vector_difference_jacobians_into<T: Real, const N: usize>(
+pub fn vector_difference_jacobians_into<T: Lane, const N: usize>(
     d0: &mut [[T; N]; N],
     d1: &mut [[T; N]; N],
 ) {
@@ -128,7 +128,7 @@ pub fn vector_difference_jacobians_into<T: Real, const N: usize>(
 }
 
 /// `a` and `b` on the diagonals of `x` and `y`.
-fn diagonal<T: Real, const N: usize>(x: &mut [[T; N]; N], y: &mut [[T; N]; N], a: T, b: T) {
+fn diagonal<T: Lane, const N: usize>(x: &mut [[T; N]; N], y: &mut [[T; N]; N], a: T, b: T) {
     for (i, (rx, ry)) in x.iter_mut().zip(y.iter_mut()).enumerate() {
         rx[i] = a;
         ry[i] = b;

@@ -7,6 +7,11 @@
 //! [linear (3), angular (3), both in base axes, joints], `NQ = NV + 1`. Tangent vectors of the
 //! base are [translation (3), rotation (3)] in base axes; Jacobians are `[i][j]` = d out_i /
 //! d in_j, block diagonal with the base's 6 x 6 block and the joints' identity.
+//!
+//! Every function takes a [`Lane`]: a scalar ([`crate::Real`]), or a vector of states, one
+//! per lane. Where the closed forms need a case (the quaternion's sign, a series near the
+//! zero rotation, the arctangent's reduction) each lane takes its own by [`Lane::select`]; a
+//! scalar evaluates only its case, so its values are those of plain branches, bit for bit.
 
 mod atan;
 mod into;
@@ -18,7 +23,7 @@ pub use into::{
 };
 
 use crate::place::{self, Filled, Slot};
-use crate::Real;
+use crate::Lane;
 use se3::{Relative, M6};
 
 /// Two N x N matrices: the Jacobians in both arguments.
@@ -36,7 +41,7 @@ type Pair<T, const N: usize> = ([[T; N]; N], [[T; N]; N]);
 /// let d: [f64; 7] = difference(&q, &integrate(&q, &v, 1.0));
 /// assert!(d.iter().zip(&v).all(|(a, b)| (a - b).abs() < 1e-12));
 /// ```
-pub fn difference<T: Real, const NQ: usize, const NV: usize>(
+pub fn difference<T: Lane, const NQ: usize, const NV: usize>(
     q0: &[T; NQ],
     q1: &[T; NQ],
 ) -> [T; NV] {
@@ -64,7 +69,7 @@ pub fn difference<T: Real, const NQ: usize, const NV: usize>(
 /// let (dq, dv) = integrate_jacobians::<f64, 8, 7>(&q, &[0.0; 7]);
 /// assert!((0..7).all(|i| dq[i][i] == 1.0 && dv[i][i] == 1.0));
 /// ```
-pub fn integrate_jacobians<T: Real, const NQ: usize, const NV: usize>(
+pub fn integrate_jacobians<T: Lane, const NQ: usize, const NV: usize>(
     q: &[T; NQ],
     v: &[T; NV],
 ) -> ([[T; NV]; NV], [[T; NV]; NV]) {
@@ -83,7 +88,7 @@ pub fn integrate_jacobians<T: Real, const NQ: usize, const NV: usize>(
 /// let (d0, d1) = difference_jacobians::<f64, 8, 7>(&q, &q);
 /// assert!((0..7).all(|i| d0[i][i] == -1.0 && d1[i][i] == 1.0));
 /// ```
-pub fn difference_jacobians<T: Real, const NQ: usize, const NV: usize>(
+pub fn difference_jacobians<T: Lane, const NQ: usize, const NV: usize>(
     q0: &[T; NQ],
     q1: &[T; NQ],
 ) -> ([[T; NV]; NV], [[T; NV]; NV]) {
@@ -105,7 +110,7 @@ pub fn difference_jacobians<T: Real, const NQ: usize, const NV: usize>(
 /// let d: [f64; 7] = difference_blocks(&q, &integrate_blocks(&q, &v, 1.0, &[(1, 1)]), &[(1, 1)]);
 /// assert!(d.iter().zip(&v).all(|(a, b)| (a - b).abs() < 1e-12));
 /// ```
-pub fn difference_blocks<T: Real, const NQ: usize, const NV: usize>(
+pub fn difference_blocks<T: Lane, const NQ: usize, const NV: usize>(
     q0: &[T; NQ],
     q1: &[T; NQ],
     free: &[(usize, usize)],
@@ -132,7 +137,7 @@ pub fn difference_blocks<T: Real, const NQ: usize, const NV: usize>(
 /// let (dq, dv) = integrate_jacobians_blocks::<f64, 8, 7>(&q, &[0.0; 7], &[(1, 1)]);
 /// assert!((0..7).all(|i| dq[i][i] == 1.0 && dv[i][i] == 1.0));
 /// ```
-pub fn integrate_jacobians_blocks<T: Real, const NQ: usize, const NV: usize>(
+pub fn integrate_jacobians_blocks<T: Lane, const NQ: usize, const NV: usize>(
     q: &[T; NQ],
     v: &[T; NV],
     free: &[(usize, usize)],
@@ -152,7 +157,7 @@ pub fn integrate_jacobians_blocks<T: Real, const NQ: usize, const NV: usize>(
 /// let (d0, d1) = difference_jacobians_blocks::<f64, 8, 7>(&q, &q, &[(1, 1)]);
 /// assert!((0..7).all(|i| d0[i][i] == -1.0 && d1[i][i] == 1.0));
 /// ```
-pub fn difference_jacobians_blocks<T: Real, const NQ: usize, const NV: usize>(
+pub fn difference_jacobians_blocks<T: Lane, const NQ: usize, const NV: usize>(
     q0: &[T; NQ],
     q1: &[T; NQ],
     free: &[(usize, usize)],
@@ -196,24 +201,24 @@ fn walk_blocks<const NQ: usize, const NV: usize>(
 }
 
 /// `block` on the diagonal of `m`, from row and column `at`.
-fn put_block<T: Real, const N: usize>(m: &mut [[T; N]; N], at: usize, block: &M6<T>) {
+fn put_block<T: Lane, const N: usize>(m: &mut [[T; N]; N], at: usize, block: &M6<T>) {
     for (row, b) in m[at..at + 6].iter_mut().zip(block) {
         row[at..at + 6].copy_from_slice(b);
     }
 }
 
 /// A fixed base's `difference`: `q1 - q0`.
-pub fn vector_difference<T: Real, const N: usize>(q0: &[T; N], q1: &[T; N]) -> [T; N] {
+pub fn vector_difference<T: Lane, const N: usize>(q0: &[T; N], q1: &[T; N]) -> [T; N] {
     core::array::from_fn(|i| q1[i] - q0[i])
 }
 
 /// A fixed base's `dIntegrate` in `q` and `v`: `(I, I)`.
-pub fn vector_integrate_jacobians<T: Real, const N: usize>() -> ([[T; N]; N], [[T; N]; N]) {
+pub fn vector_integrate_jacobians<T: Lane, const N: usize>() -> ([[T; N]; N], [[T; N]; N]) {
     identities_with(T::one(), T::one(), None)
 }
 
 /// A fixed base's `dDifference` in `q0` and `q1`: `(-I, I)`.
-pub fn vector_difference_jacobians<T: Real, const N: usize>() -> ([[T; N]; N], [[T; N]; N]) {
+pub fn vector_difference_jacobians<T: Lane, const N: usize>() -> ([[T; N]; N], [[T; N]; N]) {
     identities_with(-T::one(), T::one(), None)
 }
 
@@ -222,7 +227,7 @@ pub fn vector_difference_jacobians<T: Real, const N: usize>() -> ([[T; N]; N], [
 /// and moved there, the matrices were copied, which cost more than the free flyer's
 /// arithmetic.
 #[inline(always)]
-fn identities_with<T: Real, const N: usize>(
+fn identities_with<T: Lane, const N: usize>(
     a: T,
     b: T,
     base: Option<&(M6<T>, M6<T>)>,
@@ -232,7 +237,7 @@ fn identities_with<T: Real, const N: usize>(
 
 /// [`identities_with`]'s filling, not inlined so that the slot stays the caller's storage.
 #[inline(never)]
-fn write_identities<'s, T: Real, const N: usize>(
+fn write_identities<'s, T: Lane, const N: usize>(
     slot: Slot<'s, Pair<T, N>>,
     a: T,
     b: T,
@@ -354,6 +359,144 @@ mod tests {
                 let by_q1 = central(|h| difference(&q0, &integrate(&q1, &step(j, h), 1.0)));
                 close(&column(&d1, j), &by_q1, 1e-7, "d/dq1");
             }
+        }
+    }
+}
+
+/// The functions on vectors of states against the scalar code, lane by lane.
+#[cfg(all(test, feature = "simd"))]
+mod lanes {
+    use super::*;
+    use crate::free_flyer::integrate;
+    use crate::lane::Pack;
+    use wide::f64x4;
+
+    /// `q0`, `q1` and `v` of a root free flyer and a joint.
+    type State = ([f64; 8], [f64; 8], [f64; 7]);
+
+    /// A root free flyer and a joint (8, 7) per lane: the same rotation in `q0` and `q1`
+    /// (the zero rotation, series; signed zeros), a tiny and a moderate one, `q1`'s
+    /// quaternion negated in all three, and a NaN state; the velocities' angles zero, small
+    /// and moderate.
+    fn states() -> [State; 4] {
+        let q0 = [0.3, -0.2, 0.5, 0.1, -0.7, 0.2, 0.67, 0.4];
+        let v = |angle: f64| {
+            [
+                0.4,
+                -0.3,
+                0.2,
+                0.48 * angle,
+                -0.6 * angle,
+                0.64 * angle,
+                0.9,
+            ]
+        };
+        let negated = |mut q: [f64; 8]| {
+            q[3..7].iter_mut().for_each(|x| *x = -*x);
+            q
+        };
+        let mut nan = q0;
+        nan[4] = f64::NAN;
+        [
+            (q0, negated(q0), v(0.0)),
+            (q0, negated(integrate(&q0, &v(1e-7), 1.0)), v(1e-3)),
+            (q0, negated(integrate(&q0, &v(0.8), 1.0)), v(0.8)),
+            (nan, q0, v(f64::NAN)),
+        ]
+    }
+
+    /// Entries equal bit for bit, any NaN equal to any NaN (Rust fixes no NaN's sign).
+    fn same(lanes: &[f64x4], scalar: &[f64], l: usize, what: &str) {
+        for (k, (x, y)) in lanes.iter().zip(scalar).enumerate() {
+            let x = x.lane(l);
+            let ok = x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan());
+            assert!(ok, "{what}, lane {l}, entry {k}: {x} vs {y}");
+        }
+    }
+
+    #[test]
+    fn each_lane_is_the_scalar_code() {
+        let s = states();
+        let gather = |f: fn(&State) -> &[f64]| -> [f64x4; 8] {
+            core::array::from_fn(|j| f64x4::gather(|l| f(&s[l]).get(j).copied().unwrap_or(0.0)))
+        };
+        let (q0, q1, v8) = (gather(|x| &x.0), gather(|x| &x.1), gather(|x| &x.2));
+        let v: [f64x4; 7] = core::array::from_fn(|j| v8[j]);
+        let d: [f64x4; 7] = difference(&q0, &q1);
+        let ij = integrate_jacobians::<f64x4, 8, 7>(&q0, &v);
+        let dj = difference_jacobians::<f64x4, 8, 7>(&q0, &q1);
+        // The same flyer below a joint, on the `_blocks` path.
+        let shift = |x: &[f64x4]| -> [f64x4; 9] {
+            core::array::from_fn(|i| if i == 0 { f64x4::ONE } else { x[i - 1] })
+        };
+        let (p0, p1) = (shift(&q0), shift(&q1));
+        let w: [f64x4; 8] = core::array::from_fn(|i| shift(&v8)[i]);
+        let db: [f64x4; 8] = difference_blocks(&p0, &p1, &[(1, 1)]);
+        let djb = difference_jacobians_blocks::<f64x4, 9, 8>(&p0, &p1, &[(1, 1)]);
+        let ijb = integrate_jacobians_blocks::<f64x4, 9, 8>(&p0, &w, &[(1, 1)]);
+        for (l, (a, b, u)) in s.iter().enumerate() {
+            same(&d, &difference::<f64, 8, 7>(a, b), l, "difference");
+            let (x, y) = integrate_jacobians::<f64, 8, 7>(a, u);
+            same(
+                ij.0.as_flattened(),
+                x.as_flattened(),
+                l,
+                "integrate_jacobians q",
+            );
+            same(
+                ij.1.as_flattened(),
+                y.as_flattened(),
+                l,
+                "integrate_jacobians v",
+            );
+            let (x, y) = difference_jacobians::<f64, 8, 7>(a, b);
+            same(
+                dj.0.as_flattened(),
+                x.as_flattened(),
+                l,
+                "difference_jacobians q0",
+            );
+            same(
+                dj.1.as_flattened(),
+                y.as_flattened(),
+                l,
+                "difference_jacobians q1",
+            );
+            let lane = |x: &[f64x4]| -> [f64; 9] { core::array::from_fn(|i| x[i].lane(l)) };
+            let (a, b) = (lane(&p0), lane(&p1));
+            let u: [f64; 8] = core::array::from_fn(|i| w[i].lane(l));
+            same(
+                &db,
+                &difference_blocks::<f64, 9, 8>(&a, &b, &[(1, 1)]),
+                l,
+                "blocks",
+            );
+            let (x, y) = difference_jacobians_blocks::<f64, 9, 8>(&a, &b, &[(1, 1)]);
+            same(
+                djb.0.as_flattened(),
+                x.as_flattened(),
+                l,
+                "difference_jacobians_blocks",
+            );
+            same(
+                djb.1.as_flattened(),
+                y.as_flattened(),
+                l,
+                "difference_jacobians_blocks",
+            );
+            let (x, y) = integrate_jacobians_blocks::<f64, 9, 8>(&a, &u, &[(1, 1)]);
+            same(
+                ijb.0.as_flattened(),
+                x.as_flattened(),
+                l,
+                "integrate_jacobians_blocks",
+            );
+            same(
+                ijb.1.as_flattened(),
+                y.as_flattened(),
+                l,
+                "integrate_jacobians_blocks",
+            );
         }
     }
 }

@@ -8,11 +8,15 @@
 //! and cosine of `M0^-1 M1`'s angle are scaled by `2 / |q|^2` instead. No rotation matrix is
 //! formed where an identity spares it: `R^T v` from the quaternion, `J R^T` as the inverse of
 //! the left Jacobian, `R^T t` as `Jr rho`.
+//!
+//! Values are negated by [`Lane::neg_exact`], not `-`, so that a vector of states has the
+//! scalar's signed zeros in every lane.
 
 use super::atan::atan2_quadrant;
 use crate::free_flyer::quat_mul;
+use crate::lane::{branch, Select};
 use crate::tree::cross;
-use crate::Real;
+use crate::Lane;
 
 pub(super) type M3<T> = [[T; 3]; 3];
 pub(super) type M6<T> = [[T; 6]; 6];
@@ -40,7 +44,7 @@ pub(super) struct Relative<T> {
     t: [T; 3],
 }
 
-impl<T: Real> Relative<T> {
+impl<T: Lane> Relative<T> {
     /// The relative pose of the bases whose coordinates (position, quaternion x, y, z, w)
     /// start `q0` and `q1`; `q1`'s quaternion may have either sign.
     #[inline]
@@ -48,30 +52,32 @@ impl<T: Real> Relative<T> {
         let f = T::from_f64;
         let a = [q0[3], q0[4], q0[5], q0[6]];
         let b = [q1[3], q1[4], q1[5], q1[6]];
-        let mut quat = quat_mul(&[-a[0], -a[1], -a[2], a[3]], &b);
+        let quat = quat_mul(
+            &[a[0].neg_exact(), a[1].neg_exact(), a[2].neg_exact(), a[3]],
+            &b,
+        );
         // The same rotation with w >= 0: its angle is in [0, pi].
-        if quat[3] < T::zero() {
-            quat = [-quat[0], -quat[1], -quat[2], -quat[3]];
-        }
+        let flip = T::zero().gt(quat[3]);
+        let quat = branch::<T, _>(flip, || quat.map(|x| x.neg_exact()), || quat);
         let w = quat[3];
         let s2 = quat[0] * quat[0] + quat[1] * quat[1] + quat[2] * quat[2];
         let n2 = s2 + w * w;
         let s = s2.sqrt();
         let theta = f(2.0) * atan2_quadrant(s, w);
         // phi = (x, y, z) theta / s, free of the norm; its series near the zero rotation.
-        let k = if s2 < f(1e-12) * n2 {
-            f(2.0) / w * (T::one() - s2 / (f(3.0) * w * w))
-        } else {
-            theta / s
-        };
+        let k = branch::<T, _>(
+            (f(1e-12) * n2).gt(s2),
+            || f(2.0) / w * (T::one() - s2 / (f(3.0) * w * w)),
+            || theta / s,
+        );
         let phi = [quat[0] * k, quat[1] * k, quat[2] * k];
         let t2 = theta * theta;
         // c = 1/theta^2 - (1 + cos)/(2 theta sin) = 1/theta^2 - w/(2 theta s).
-        let c = if t2 < f(1e-4) {
-            f(1.0 / 12.0) + t2 / f(720.0) + t2 * t2 / f(30240.0)
-        } else {
-            T::one() / t2 - w / (f(2.0) * theta * s)
-        };
+        let c = branch::<T, _>(
+            f(1e-4).gt(t2),
+            || f(1.0 / 12.0) + t2 / f(720.0) + t2 * t2 / f(30240.0),
+            || T::one() / t2 - w / (f(2.0) * theta * s),
+        );
         let dp = [q1[0] - q0[0], q1[1] - q0[1], q1[2] - q0[2]];
         let t = unrotated(&a, &dp);
         let pt = cross(&phi, &t);
@@ -95,7 +101,7 @@ impl<T: Real> Relative<T> {
 
 /// `R^T v` for the rotation `R` of the unit quaternion `q` (x, y, z, w):
 /// `v - 2 w (u x v) + 2 u x (u x v)`, `u = (x, y, z)`, without forming `R`.
-fn unrotated<T: Real>(q: &[T; 4], v: &[T; 3]) -> [T; 3] {
+fn unrotated<T: Lane>(q: &[T; 4], v: &[T; 3]) -> [T; 3] {
     let u = [q[0], q[1], q[2]];
     let uv = cross(&u, v);
     let uuv = cross(&u, &uv);
@@ -118,18 +124,32 @@ struct Coefficients<T> {
 }
 
 /// [`Coefficients`] from `theta^2`, `theta`, `sin theta` and `1 - cos theta`; their series
-/// where `theta^2 < 1e-4`.
+/// where `theta^2 < 1e-4` (lane by lane).
 #[inline]
-fn coefficients<T: Real>(t2: T, theta: T, sin: T, vers: T) -> Coefficients<T> {
-    if t2 < T::from_f64(1e-4) {
-        series(t2)
-    } else {
-        exact(t2, theta, sin, vers)
+fn coefficients<T: Lane>(t2: T, theta: T, sin: T, vers: T) -> Coefficients<T> {
+    branch::<T, _>(
+        T::from_f64(1e-4).gt(t2),
+        || series(t2),
+        || exact(t2, theta, sin, vers),
+    )
+}
+
+impl<T: Lane> Select<T> for Coefficients<T> {
+    #[inline(always)]
+    fn select(mask: T::Mask, yes: Self, no: Self) -> Self {
+        let pick = |a: T, b: T| T::select(mask, a, b);
+        Coefficients {
+            sinc: pick(yes.sinc, no.sinc),
+            a: pick(yes.a, no.a),
+            b: pick(yes.b, no.b),
+            da: pick(yes.da, no.da),
+            db: pick(yes.db, no.db),
+        }
     }
 }
 
 /// [`Coefficients`] by their Taylor series in `theta^2`, to `theta^4`.
-fn series<T: Real>(t2: T) -> Coefficients<T> {
+fn series<T: Lane>(t2: T) -> Coefficients<T> {
     let f = T::from_f64;
     let t4 = t2 * t2;
     Coefficients {
@@ -142,7 +162,7 @@ fn series<T: Real>(t2: T) -> Coefficients<T> {
 }
 
 /// [`Coefficients`] by their closed forms.
-fn exact<T: Real>(t2: T, theta: T, sin: T, vers: T) -> Coefficients<T> {
+fn exact<T: Lane>(t2: T, theta: T, sin: T, vers: T) -> Coefficients<T> {
     let f = T::from_f64;
     let (r1, r2) = (T::one() / theta, T::one() / t2);
     let r4 = r2 * r2;
@@ -160,7 +180,7 @@ fn exact<T: Real>(t2: T, theta: T, sin: T, vers: T) -> Coefficients<T> {
 /// `Ad(exp6(v))^-1` and the right Jacobian of `exp6` at `v`,
 /// `[[Jr3, R^T D], [0, Jr3]]` with `Jr3 = I - a phi^ + b phi^2` and `D` the derivative of
 /// `V(phi) rho` in `phi`.
-pub(super) fn integrate_jacobians<T: Real>(v: &[T]) -> (M6<T>, M6<T>) {
+pub(super) fn integrate_jacobians<T: Lane>(v: &[T]) -> (M6<T>, M6<T>) {
     let [rt, top, jr, q] = integrate_parts(v);
     (blocks(&rt, &top, &rt), blocks(&jr, &q, &jr))
 }
@@ -169,7 +189,7 @@ pub(super) fn integrate_jacobians<T: Real>(v: &[T]) -> (M6<T>, M6<T>) {
 /// `dv` (the same values): the two 6 x 6 blocks are neither built nor copied, which took a
 /// fifth of `integrate_jacobians_into` (anymal 84 -> 66 ns, a 35-coordinate humanoid 101 ->
 /// 72 ns).
-pub(super) fn integrate_jacobians_at<T: Real, const N: usize>(
+pub(super) fn integrate_jacobians_at<T: Lane, const N: usize>(
     v: &[T],
     (dq, dv): (&mut [[T; N]; N], &mut [[T; N]; N]),
     at: usize,
@@ -181,7 +201,7 @@ pub(super) fn integrate_jacobians_at<T: Real, const N: usize>(
 
 /// `[[a, b], [0, a]]` into rows and columns `at..at + 6` of `m`.
 #[inline(always)]
-fn put<T: Real, const N: usize>(m: &mut [[T; N]; N], at: usize, a: &M3<T>, b: &M3<T>) {
+fn put<T: Lane, const N: usize>(m: &mut [[T; N]; N], at: usize, a: &M3<T>, b: &M3<T>) {
     let Some(rows) = m.get_mut(at..at + 6) else {
         return;
     };
@@ -201,7 +221,7 @@ fn put<T: Real, const N: usize>(m: &mut [[T; N]; N], at: usize, a: &M3<T>, b: &M
 /// The 3 x 3 blocks of [`integrate_jacobians`]: `R^T`, the inverse action's corner, `Jr3` and
 /// `R^T D`.
 #[inline(always)]
-fn integrate_parts<T: Real>(v: &[T]) -> [M3<T>; 4] {
+fn integrate_parts<T: Lane>(v: &[T]) -> [M3<T>; 4] {
     let f = T::from_f64;
     let rho = [v[0], v[1], v[2]];
     let phi = [v[3], v[4], v[5]];
@@ -213,8 +233,8 @@ fn integrate_parts<T: Real>(v: &[T]) -> [M3<T>; 4] {
     let h2 = hat_squared(&phi, t2);
     // R^T = I - sinc phi^ + a phi^2, and the inverse action's corner -R^T t^ = -(R^T t)^ R^T
     // with R^T t = R^T Jl rho = Jr rho (Jl = R Jr): t itself is never formed.
-    let rt = combine(&h, &h2, -k.sinc, k.a);
-    let jr = combine(&h, &h2, -k.a, k.b);
+    let rt = combine(&h, &h2, k.sinc.neg_exact(), k.a);
+    let jr = combine(&h, &h2, k.a.neg_exact(), k.b);
     let top = negated(&hat_times(&mat_vec(&jr, &rho), &rt));
     let q = mat_mul(&rt, &dv_dphi(&rho, &phi, &k));
     [rt, top, jr, q]
@@ -227,7 +247,7 @@ fn integrate_parts<T: Real>(v: &[T]) -> [M3<T>; 4] {
 ///
 /// `P` is the inverse of the left Jacobian (`Jl = R Jr`), `I - phi^/2 + c phi^2`, so that
 /// `J Q = P D` and `J Q J R^T = (P D) P`: the relative rotation `R` is never formed.
-pub(super) fn difference_jacobians<T: Real>(q0: &[T], q1: &[T]) -> (M6<T>, M6<T>) {
+pub(super) fn difference_jacobians<T: Lane>(q0: &[T], q1: &[T]) -> (M6<T>, M6<T>) {
     let rel = Relative::new(q0, q1);
     let two_n2 = T::from_f64(2.0) / rel.n2;
     let (s, w) = (rel.s, rel.quat[3]);
@@ -252,7 +272,7 @@ pub(super) fn difference_jacobians<T: Real>(q0: &[T], q1: &[T]) -> (M6<T>, M6<T>
 /// `d (V(phi) rho) / d phi` with `V = I + a phi^ + b phi^2`:
 /// `-a rho^ + (a'/theta) (phi x rho) phi^T + b ((phi.rho) I + phi rho^T - 2 rho phi^T)
 /// + (b'/theta) (phi x (phi x rho)) phi^T`.
-fn dv_dphi<T: Real>(rho: &[T; 3], phi: &[T; 3], k: &Coefficients<T>) -> M3<T> {
+fn dv_dphi<T: Lane>(rho: &[T; 3], phi: &[T; 3], k: &Coefficients<T>) -> M3<T> {
     let pr = cross(phi, rho);
     let ppr = cross(phi, &pr);
     let dot = phi[0] * rho[0] + phi[1] * rho[1] + phi[2] * rho[2];
@@ -261,12 +281,12 @@ fn dv_dphi<T: Real>(rho: &[T; 3], phi: &[T; 3], k: &Coefficients<T>) -> M3<T> {
     each(|i, j| {
         let id = if i == j { dot } else { T::zero() };
         let sym = id + phi[i] * rho[j] - two * rho[i] * phi[j];
-        -k.a * rh[i][j] + (k.da * pr[i] + k.db * ppr[i]) * phi[j] + k.b * sym
+        k.a.neg_exact() * rh[i][j] + (k.da * pr[i] + k.db * ppr[i]) * phi[j] + k.b * sym
     })
 }
 
 /// `[[a, b], [0, c]]`.
-fn blocks<T: Real>(a: &M3<T>, b: &M3<T>, c: &M3<T>) -> M6<T> {
+fn blocks<T: Lane>(a: &M3<T>, b: &M3<T>, c: &M3<T>) -> M6<T> {
     let mut m = [[T::zero(); 6]; 6];
     for i in 0..3 {
         for j in 0..3 {
@@ -279,7 +299,7 @@ fn blocks<T: Real>(a: &M3<T>, b: &M3<T>, c: &M3<T>) -> M6<T> {
 }
 
 /// `I + x h + y h2`.
-fn combine<T: Real>(h: &M3<T>, h2: &M3<T>, x: T, y: T) -> M3<T> {
+fn combine<T: Lane>(h: &M3<T>, h2: &M3<T>, x: T, y: T) -> M3<T> {
     each(|i, j| {
         let id = if i == j { T::one() } else { T::zero() };
         id + x * h[i][j] + y * h2[i][j]
@@ -289,7 +309,7 @@ fn combine<T: Real>(h: &M3<T>, h2: &M3<T>, x: T, y: T) -> M3<T> {
 /// The 3 x 3 matrix of `entry(i, j)`, written out (no closure calls left for the optimizer to
 /// inline, as `core::array::from_fn`'s were not).
 #[inline(always)]
-fn each<T: Real>(entry: impl Fn(usize, usize) -> T) -> M3<T> {
+fn each<T: Lane>(entry: impl Fn(usize, usize) -> T) -> M3<T> {
     let mut m = [[T::zero(); 3]; 3];
     for (i, row) in m.iter_mut().enumerate() {
         for (j, x) in row.iter_mut().enumerate() {
@@ -299,42 +319,43 @@ fn each<T: Real>(entry: impl Fn(usize, usize) -> T) -> M3<T> {
     m
 }
 
-fn hat<T: Real>(w: &[T; 3]) -> M3<T> {
+fn hat<T: Lane>(w: &[T; 3]) -> M3<T> {
     let z = T::zero();
-    [[z, -w[2], w[1]], [w[2], z, -w[0]], [-w[1], w[0], z]]
+    let m = |x: T| x.neg_exact();
+    [[z, m(w[2]), w[1]], [w[2], z, m(w[0])], [m(w[1]), w[0], z]]
 }
 
 /// `hat(w)^2 = w w^T - |w|^2 I`, given `t2 = |w|^2`.
-fn hat_squared<T: Real>(w: &[T; 3], t2: T) -> M3<T> {
+fn hat_squared<T: Lane>(w: &[T; 3], t2: T) -> M3<T> {
     each(|i, j| {
         let d = if i == j { t2 } else { T::zero() };
         w[i] * w[j] - d
     })
 }
 
-fn negated<T: Real>(m: &M3<T>) -> M3<T> {
-    each(|i, j| -m[i][j])
+fn negated<T: Lane>(m: &M3<T>) -> M3<T> {
+    each(|i, j| m[i][j].neg_exact())
 }
 
-fn mat_mul<T: Real>(a: &M3<T>, b: &M3<T>) -> M3<T> {
+fn mat_mul<T: Lane>(a: &M3<T>, b: &M3<T>) -> M3<T> {
     each(|i, j| a[i][0] * b[0][j] + a[i][1] * b[1][j] + a[i][2] * b[2][j])
 }
 
 /// `m t^`: each row of `m` crossed with `t` (`x^T t^ = (x cross t)^T`), without the products
 /// by the zeros of `t^`.
-fn times_hat<T: Real>(m: &M3<T>, t: &[T; 3]) -> M3<T> {
+fn times_hat<T: Lane>(m: &M3<T>, t: &[T; 3]) -> M3<T> {
     let rows = [cross(&m[0], t), cross(&m[1], t), cross(&m[2], t)];
     each(|i, j| rows[i][j])
 }
 
 /// `u^ m`: each column of `m` crossed by `u`.
-fn hat_times<T: Real>(u: &[T; 3], m: &M3<T>) -> M3<T> {
+fn hat_times<T: Lane>(u: &[T; 3], m: &M3<T>) -> M3<T> {
     let column = |j: usize| cross(u, &[m[0][j], m[1][j], m[2][j]]);
     let cols = [column(0), column(1), column(2)];
     each(|i, j| cols[j][i])
 }
 
-fn mat_vec<T: Real>(m: &M3<T>, v: &[T; 3]) -> [T; 3] {
+fn mat_vec<T: Lane>(m: &M3<T>, v: &[T; 3]) -> [T; 3] {
     let row = |i: usize| m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2];
     [row(0), row(1), row(2)]
 }

@@ -247,7 +247,7 @@ impl Emitter<'_> {
     /// `NAME_batch(&self, inputs: &[[T; _]]..., outputs: &mut [_]...)`.
     fn batch_fn(&self, q: &Quantity) -> TokenStream {
         let f = format_ident!("{}_batch", q.name);
-        let inputs = Self::arg_names(q.inputs);
+        let inputs = Self::state_names(q);
         let input_types = q.inputs.iter().map(|i| self.input_len(*i));
         let Outs {
             names: outs,

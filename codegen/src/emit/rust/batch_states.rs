@@ -1,7 +1,7 @@
-//! The `NAME_batch` methods of the quantities that do not run on lanes (the manifold, contact
-//! dynamics solved at run time, the contact and impulse derivatives, contacts switched at run
-//! time): the scalar method at each state in turn, the states spread over rayon's threads with
-//! the runtime's `rayon` feature (`eomgen_runtime::batch::run_costed` of one state per vector).
+//! The `NAME_batch` methods of the quantities that do not run on lanes (contact dynamics
+//! solved at run time, the contact and impulse derivatives, contacts switched at run time):
+//! the scalar method at each state in turn, the states spread over rayon's threads with the
+//! runtime's `rayon` feature (`eomgen_runtime::batch::run_costed` of one state per vector).
 //! Their code branches on values, so a state per lane is not possible; the batch form still
 //! gives every catalogue method the same calling convention and the threads.
 
@@ -9,7 +9,7 @@ use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote};
 
 use super::{usize_lit, Emitter};
-use crate::dynamics::{ActiveContacts, Evaluation, Manifold, Quantity};
+use crate::dynamics::{ActiveContacts, Evaluation, Quantity};
 use crate::emit::body::shape_type;
 
 /// One parameter of a scalar method, in its place in the signature.
@@ -45,7 +45,7 @@ impl Emitter<'_> {
         let params = q
             .inputs
             .iter()
-            .zip(self.state_names(q))
+            .zip(Self::state_names(q))
             .map(|(i, name)| Param::State(name, self.input_len(*i).clone()))
             .chain(
                 self.shared_values(q)
@@ -65,17 +65,6 @@ impl Emitter<'_> {
             _ => self.result_shapes(q).into_iter().map(shape_type).collect(),
         };
         StateSignature { params, outputs }
-    }
-
-    /// The names of `q`'s per-state arguments: the manifold's own (`q0, q1`; `q, v`), else
-    /// those of its inputs.
-    fn state_names(&self, q: &Quantity) -> Vec<Ident> {
-        let names: &[&str] = match q.eval {
-            Evaluation::Manifold(Manifold::IntegrateJacobians) => &["q", "v"],
-            Evaluation::Manifold(_) => &["q0", "q1"],
-            _ => return Self::arg_names(q.inputs),
-        };
-        names.iter().map(|x| format_ident!("{}", x)).collect()
     }
 
     /// `NAME_batch`: `q`'s scalar method at every state, one output slice per element of its

@@ -2,9 +2,10 @@
 //! code is arithmetic, pivot checks and the runtime kernels that take a `Lane`, and whose
 //! callees do too (contact forward dynamics and impulse dynamics when each is one straight-line
 //! program, and then contact forward dynamics and impulse dynamics with active contacts, whose
-//! runtime solves take a `Lane`; link kinematics, whose runtime kernels walk chains of poses). They live in the
-//! `impl<T: Lane>` blocks; the rest (the manifold, the other contact solves at run time and the
-//! contact derivatives) in `impl<T: Real>`.
+//! runtime solves take a `Lane`; link kinematics, whose runtime kernels walk chains of poses;
+//! the configuration manifold, whose kernels select each lane's case). They live in the
+//! `impl<T: Lane>` blocks; the rest (the other contact solves at run time and the contact
+//! derivatives) in `impl<T: Real>`.
 
 use std::collections::BTreeSet;
 
@@ -24,6 +25,7 @@ fn evaluation_on_lanes(q: &Quantity) -> bool {
             | Evaluation::Factored { .. }
             | Evaluation::ForwardDynamicsDerivatives { .. }
             | Evaluation::Integrate
+            | Evaluation::Manifold(_)
             | Evaluation::ContactForwardDynamicsFlat { .. }
             | Evaluation::ImpulseDynamicsFlat { .. }
             | Evaluation::LinkPose

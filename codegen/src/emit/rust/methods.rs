@@ -6,7 +6,7 @@ use quote::{format_ident, quote};
 
 use super::{doc, usize_lit, Emitter};
 use crate::cas::{Id, OpCount};
-use crate::dynamics::{ActiveContacts, Craig, Evaluation, Input, Quantity, Shape};
+use crate::dynamics::{ActiveContacts, Craig, Evaluation, Input, Manifold, Quantity, Shape};
 use crate::emit::body::{body, factored_body, shape_type, Body};
 use crate::emit::split::Split;
 
@@ -92,6 +92,18 @@ impl Emitter<'_> {
             .iter()
             .map(|i| format_ident!("{}", i.name()))
             .collect()
+    }
+
+    /// The names of `q`'s per-state arguments, as its method's signature has them: the
+    /// manifold's own (`q0, q1`; `q, v`), else those of its inputs. Both kinds of batch
+    /// method take their slices under these names.
+    pub(super) fn state_names(q: &Quantity) -> Vec<Ident> {
+        let names: &[&str] = match q.eval {
+            Evaluation::Manifold(Manifold::IntegrateJacobians) => &["q", "v"],
+            Evaluation::Manifold(_) => &["q0", "q1"],
+            _ => return Self::arg_names(q.inputs),
+        };
+        names.iter().map(|x| format_ident!("{}", x)).collect()
     }
 
     pub(super) fn quantity_doc(q: &Quantity, ops: Option<OpCount>) -> TokenStream {
