@@ -3,9 +3,9 @@
 //! callees do too (contact forward dynamics and impulse dynamics when each is one straight-line
 //! program, and then contact forward dynamics and impulse dynamics with active contacts, whose
 //! runtime solves take a `Lane`; link kinematics, whose runtime kernels walk chains of poses;
-//! the configuration manifold, whose kernels select each lane's case). They live in the
-//! `impl<T: Lane>` blocks; the rest (the other contact solves at run time and the contact
-//! derivatives) in `impl<T: Real>`.
+//! the configuration manifold, whose kernels select each lane's case; the contact and impulse
+//! derivatives, whose KKT solves take a `Lane`). They live in the `impl<T: Lane>` blocks; the
+//! rest (contact dynamics solved at run time, the stabilized form) in `impl<T: Real>`.
 
 use std::collections::BTreeSet;
 
