@@ -241,6 +241,17 @@ fn contact_dynamics() {
         ])
         .compile()
         .unwrap();
+    // Contact and impulse dynamics solved at run time (the route of robots over the
+    // straight-line budget), on the same four feet (`tests/batch.rs`).
+    eomgen::Builder::new("robots/floating/anymal.urdf")
+        .floating_base()
+        .contact_points(&["LF_FOOT", "RF_FOOT", "LH_FOOT", "RH_FOOT"])
+        .contact_forward_dynamics_flat_max_ops(0)
+        .module_name("anymal_solved")
+        .type_name("AnymalSolved")
+        .quantities(["contact_forward_dynamics", "impulse_dynamics"])
+        .compile()
+        .unwrap();
     // Contact points away from a link's origin: the last foot's 5 cm off.
     eomgen::Builder::new("robots/floating/anymal.urdf")
         .floating_base()

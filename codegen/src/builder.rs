@@ -342,9 +342,9 @@ impl Builder {
     /// measured, from a quadruped to a 50-joint humanoid with 6D soles, where contact forward
     /// dynamics was a fifth faster than the run-time route); beyond, `mass_matrix`,
     /// `contact_jacobian` (and `contact_drift`) are called and the contact problem is solved
-    /// at run time (`eomgen_runtime::contact::solve_factored_active_by`,
-    /// `impulse::solve_factored_active_by`: the route of the `_active` variants). `0` always
-    /// solves at run time: less generated code for a very large robot.
+    /// at run time (`eomgen_runtime::contact::solve_factored_active_lanes`,
+    /// `impulse::solve_factored_active_lanes`: the route of the `_active` variants, on SIMD
+    /// lanes too). `0` always solves at run time: less generated code for a very large robot.
     ///
     /// ```
     /// let b = eomgen::Builder::new("robots/anymal.urdf")

@@ -256,6 +256,11 @@ pub mod robots {
     pub mod anymal_two_feet {
         include!(concat!(env!("OUT_DIR"), "/anymal_two_feet.rs"));
     }
+    /// anymal on its four feet with contact and impulse dynamics solved at run time (the
+    /// route of robots over the straight-line budget).
+    pub mod anymal_solved {
+        include!(concat!(env!("OUT_DIR"), "/anymal_solved.rs"));
+    }
     /// anymal with contact points at positions in its feet's frames.
     pub mod anymal_at {
         include!(concat!(env!("OUT_DIR"), "/anymal_at.rs"));

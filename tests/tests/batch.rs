@@ -463,41 +463,49 @@ fn anymal_states(n: &mut Numbers, count: usize) -> (Vec<[f64; 19]>, Vec<[f64; 18
     (q, v)
 }
 
+/// `$robot`'s contact forward dynamics and impulse dynamics (restitution `$e`) in batches
+/// equal its scalar methods bit for bit, at `STATES` anymal states from `$seed` with NaN and
+/// infinite ones ([`spoil`]); gives the states `(q, v, tau)`.
+macro_rules! contact_batches_equal_the_scalar_code {
+    ($robot:expr, $seed:expr, $e:expr) => {{
+        let (robot, e) = (&$robot, $e);
+        let mut n = Numbers($seed);
+        let (mut q, mut v) = anymal_states(&mut n, STATES);
+        spoil(&mut q, &mut v);
+        let tau = n.states::<18>(STATES, 20.0);
+        let (mut a, mut f) = (vec![[0.0; 18]; STATES], vec![[0.0; 12]; STATES]);
+        robot
+            .contact_forward_dynamics_batch(&q, &v, &tau, &mut a, &mut f)
+            .unwrap();
+        let (mut after, mut p) = (vec![[0.0; 18]; STATES], vec![[0.0; 12]; STATES]);
+        robot
+            .impulse_dynamics_batch(&q, &v, e, &mut after, &mut p)
+            .unwrap();
+        for i in 0..STATES {
+            let (want_a, want_f) = robot.contact_forward_dynamics(&q[i], &v[i], &tau[i]);
+            assert_close("contact accelerations", i, &a[i], &want_a, 0.0);
+            assert_close("contact forces", i, &f[i], &want_f, 0.0);
+            assert!(want_a.iter().all(|x| x.is_finite()) == (i != 2 && i != 5));
+            let (want_v, want_p) = robot.impulse_dynamics(&q[i], &v[i], e);
+            assert_close("velocity after the impact", i, &after[i], &want_v, 0.0);
+            assert_close("impulses", i, &p[i], &want_p, 0.0);
+        }
+        (q, v, tau)
+    }};
+}
+
 #[test]
 fn contact_and_impulse_dynamics_in_batches_equal_the_scalar_code() {
     use eomgen_tests::robots::anymal::Anymal;
     let robot = Anymal::<f64>::default();
-    let mut n = Numbers(10);
-    let (mut q, mut v) = anymal_states(&mut n, STATES);
-    spoil(&mut q, &mut v);
-    let tau = n.states::<18>(STATES, 20.0);
-    let (mut a, mut f) = (vec![[0.0; 18]; STATES], vec![[0.0; 12]; STATES]);
-    robot
-        .contact_forward_dynamics_batch(&q, &v, &tau, &mut a, &mut f)
-        .unwrap();
-    let (mut after, mut p) = (vec![[0.0; 18]; STATES], vec![[0.0; 12]; STATES]);
-    robot
-        .impulse_dynamics_batch(&q, &v, 0.3, &mut after, &mut p)
-        .unwrap();
+    let (q, v, _) = contact_batches_equal_the_scalar_code!(robot, 10, 0.3);
     let mut j = vec![[[0.0; 18]; 12]; STATES];
     robot.contact_jacobian_batch(&q, &mut j).unwrap();
     let mut drift = vec![[0.0; 12]; STATES];
     robot.contact_drift_batch(&q, &v, &mut drift).unwrap();
     for i in 0..STATES {
-        let (want_a, want_f) = robot.contact_forward_dynamics(&q[i], &v[i], &tau[i]);
-        assert_close("contact accelerations", i, &a[i], &want_a, 0.0);
-        assert_close("contact forces", i, &f[i], &want_f, 0.0);
-        assert!(want_a.iter().all(|x| x.is_finite()) == (i != 2 && i != 5));
-        let (want_v, want_p) = robot.impulse_dynamics(&q[i], &v[i], 0.3);
-        assert_close("velocity after the impact", i, &after[i], &want_v, 0.0);
-        assert_close("impulses", i, &p[i], &want_p, 0.0);
-        assert_close(
-            "contact_jacobian",
-            i,
-            &j[i],
-            &robot.contact_jacobian(&q[i]),
-            0.0,
-        );
+        let want = robot.contact_jacobian(&q[i]);
+        assert_close("contact_jacobian", i, &j[i], &want, 0.0);
         let want = robot.contact_drift(&q[i], &v[i]);
         assert_close("contact_drift", i, &drift[i], &want, 0.0);
     }
@@ -718,6 +726,46 @@ fn derivatives_on_four_lanes_name_the_failed_lane() {
         failed(l, nan(&d.flat()));
         let want = robot.impulse_dynamics_derivatives_active(&q[l], &v[l], e, &active);
         assert_close("f64x4 impulse derivatives, three feet", l, d, &want, 0.0);
+    }
+}
+
+/// Contact forward dynamics and impulse dynamics solved at run time (the route of robots over
+/// the straight-line budget) on lanes: their batches equal the scalar code bit for bit with
+/// NaN and infinite states between finite ones, four lanes name their failed lane, and the
+/// values are the straight-line programs' to rounding.
+#[test]
+fn contact_dynamics_solved_at_run_time_on_lanes() {
+    use eomgen_tests::robots::{anymal_mpc::AnymalMpc, anymal_solved::AnymalSolved};
+    let source = include_str!(concat!(env!("OUT_DIR"), "/anymal_solved.rs"));
+    assert!(source.contains("contact::solve_factored_active_lanes"));
+    assert!(source.contains("impulse::solve_factored_active_lanes"));
+    let (robot, flat) = (AnymalSolved::<f64>::default(), AnymalMpc::<f64>::default());
+    let (q, v, tau) = contact_batches_equal_the_scalar_code!(robot, 17, 0.2);
+    for i in 0..STATES {
+        let (want_a, want_f) = robot.contact_forward_dynamics(&q[i], &v[i], &tau[i]);
+        let (flat_a, flat_f) = flat.contact_forward_dynamics(&q[i], &v[i], &tau[i]);
+        assert_close("solved against flat", i, &want_a, &flat_a, 1e-9);
+        assert_close("solved against flat", i, &want_f, &flat_f, 1e-9);
+    }
+    let wide = robot.in_lanes::<f64x4>();
+    let ((q, v, tau), (ql, vl, tl)) = four_lanes_two_failing(18);
+    let err = wide
+        .try_contact_forward_dynamics_lanes(&ql, &vl, &tl)
+        .unwrap_err();
+    lane_one_named(err, |l| {
+        robot.try_contact_forward_dynamics(&q[l], &v[l], &tau[l])
+    });
+    let err = wide
+        .try_impulse_dynamics_lanes(&ql, &vl, f64x4::splat(0.2))
+        .unwrap_err();
+    lane_one_named(err, |l| robot.try_impulse_dynamics(&q[l], &v[l], 0.2));
+    let (a, f) = wide.contact_forward_dynamics(&ql, &vl, &tl);
+    for l in 0..4 {
+        let one: Vec<f64> = a.iter().chain(&f).map(|x| x.lane(l)).collect();
+        assert_eq!(one.iter().all(|x| x.is_nan()), l == 1 || l == 3, "lane {l}");
+        let (want_a, want_f) = robot.contact_forward_dynamics(&q[l], &v[l], &tau[l]);
+        let want: Vec<f64> = want_a.iter().chain(&want_f).copied().collect();
+        assert_close("f64x4 solved contact dynamics", l, &one, &want, 0.0);
     }
 }
 

@@ -1,5 +1,5 @@
-//! The `NAME_batch` methods of the quantities that do not run on lanes (contact dynamics
-//! solved at run time, the stabilized form of contacts switched at run time):
+//! The `NAME_batch` methods of the quantities that do not run on lanes (the stabilized form of
+//! contacts switched at run time, whose Baumgarte correction branches on values):
 //! the scalar method at each state in turn, the states spread over rayon's threads with the
 //! runtime's `rayon` feature (`eomgen_runtime::batch::run_costed` of one state per vector).
 //! Their code branches on values, so a state per lane is not possible; the batch form still

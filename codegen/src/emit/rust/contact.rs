@@ -356,45 +356,11 @@ impl Emitter<'_> {
         }
     }
 
-    /// `try_impulse_dynamics` and `impulse_dynamics` (NaN on failure) solved at run time (the
-    /// `_active` variants: [`Emitter::impulse_active_checked_fns`]).
+    /// `try_impulse_dynamics` and `impulse_dynamics` solved at run time, for every `T: Lane`
+    /// as their `_active` variants ([`Emitter::impulse_active_checked_fns`]), every row
+    /// active.
     pub(super) fn impulse_dynamics_fns(&mut self, q: &Quantity) -> TokenStream {
-        let docs = Self::quantity_doc(q, None);
-        let (n, nq, k) = (self.n.clone(), self.nq.clone(), self.k.clone());
-        let (m, j) = (self.call("mass_matrix"), self.call("contact_jacobian"));
-        let rows = self.active_rows(false);
-        let s = self.signature(
-            q,
-            false,
-            (
-                "The velocity after the impact and the impulses of",
-                ", or why",
-            ),
-        );
-        let (name, try_name, param, arg, why) = (&s.name, &s.try_name, &s.param, &s.arg, &s.why);
-        quote! {
-            #[doc = #why]
-            /// they do not exist: a pivot of M(q) (`pivot` < N) or of `J_c M^-1 J_c^T`
-            /// (`pivot` - N, a rank-deficient contact Jacobian) that is not positive, or a
-            /// non-finite result.
-            pub fn #try_name(&self, q: &[T; #nq], qd: &[T; #n], restitution: T #param) -> ::core::result::Result<([T; #n], [T; #k]), ::eomgen_runtime::FactorError> {
-                // M's factors and J_c, no KKT system: M^-1 meets the one vector J_c^T p.
-                let mut m = #m(self, q);
-                let j = #j(self, q);
-                Self::ltdl_factor_unrolled(&mut m, &mut ::core::default::Default::default())?;
-                let substitute = |b: &[T; #n]| Self::ltdl_substitute_unrolled(&m, b);
-                let lower = |w: &mut [[T; #k]; #n]| Self::ltdl_lower_rows_unrolled(&m, w);
-                ::eomgen_runtime::impulse::solve_factored_active_by(&m, &j, qd, restitution, &#rows, substitute, lower)
-            }
-
-            #docs
-            pub fn #name(&self, q: &[T; #nq], qd: &[T; #n], restitution: T #param) -> ([T; #n], [T; #k]) {
-                match self.#try_name(q, qd, restitution #arg) {
-                    Ok(x) => x,
-                    Err(_) => ([T::nan(); #n], [T::nan(); #k]),
-                }
-            }
-        }
+        self.impulse_checked_fns(q, false)
     }
 
     /// `impulse_dynamics_active` for every `T: Lane` where its callees are, as
@@ -402,18 +368,26 @@ impl Emitter<'_> {
     /// `_checked` method records each lane's failure
     /// (`eomgen_runtime::impulse::solve_factored_active_lanes`).
     pub(super) fn impulse_active_checked_fns(&mut self, q: &Quantity) -> TokenStream {
+        self.impulse_checked_fns(q, true)
+    }
+
+    /// Impulse dynamics solved at run time with every contact, or with those of `active`.
+    fn impulse_checked_fns(&mut self, q: &Quantity, active: bool) -> TokenStream {
         let docs = Self::quantity_doc(q, None);
         let (n, nq, k) = (&self.n, &self.nq, &self.k);
-        let c = usize_lit(self.contact_rows.len());
         let (m, j) = (self.call("mass_matrix"), self.call("contact_jacobian"));
-        let params = quote!(q: &[T; #nq], qd: &[T; #n], restitution: T, active: &[bool; #c]);
+        let s = self.signature(q, active, (" ", ""));
+        let (param, arg) = (&s.param, &s.arg);
+        let params = quote!(q: &[T; #nq], qd: &[T; #n], restitution: T #param);
+        let which = if active { "the active rows' " } else { "" };
         let why = format!(
             " The velocity after the impact and the impulses of `{}`, or why they do not exist: \
-             a pivot of M(q) (`pivot` < N) or of the active rows' `J_c M^-1 J_c^T` (`pivot` - \
+             a pivot of M(q) (`pivot` < N) or of {which}`J_c M^-1 J_c^T` (`pivot` - \
              N) that is not positive, or a non-finite result. On a vector of states, the lowest \
              failed lane's error.",
             q.name
         );
+        let rows = self.active_rows(active);
         let body = quote! {
             // M's factors and J_c, no KKT system: M^-1 meets the one vector J_c^T p.
             let mut m = #m(self, q);
@@ -421,11 +395,11 @@ impl Emitter<'_> {
             Self::ltdl_factor_unrolled(&mut m, &mut failures)?;
             let substitute = |b: &[T; #n]| Self::ltdl_substitute_unrolled(&m, b);
             let lower = |w: &mut [[T; #k]; #n]| Self::ltdl_lower_rows_unrolled(&m, w);
-            let rows = ::eomgen_runtime::contact::row_mask(&Self::CONTACT_ROWS, active);
+            let rows = #rows;
             let x = ::eomgen_runtime::impulse::solve_factored_active_lanes(&m, (&j, &rows), (qd, restitution), substitute, lower, &mut failures)?;
             Ok((x, failures))
         };
-        let args = quote!(q, qd, restitution, active);
+        let args = quote!(q, qd, restitution #arg);
         let what = "velocity and impulses";
         self.lane_checked_fns(q.name, (params, args), (why, what, docs), body)
     }

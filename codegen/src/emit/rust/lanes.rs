@@ -4,8 +4,9 @@
 //! program, and then contact forward dynamics and impulse dynamics with active contacts, whose
 //! runtime solves take a `Lane`; link kinematics, whose runtime kernels walk chains of poses;
 //! the configuration manifold, whose kernels select each lane's case; the contact and impulse
-//! derivatives, whose KKT solves take a `Lane`). They live in the `impl<T: Lane>` blocks; the
-//! rest (contact dynamics solved at run time, the stabilized form) in `impl<T: Real>`.
+//! derivatives, whose KKT solves take a `Lane`; contact and impulse dynamics solved at run
+//! time, as their `_active` forms). They live in the `impl<T: Lane>` blocks; the rest (the
+//! stabilized form) in `impl<T: Real>`.
 
 use std::collections::BTreeSet;
 
@@ -26,7 +27,9 @@ fn evaluation_on_lanes(q: &Quantity) -> bool {
             | Evaluation::ForwardDynamicsDerivatives { .. }
             | Evaluation::Integrate
             | Evaluation::Manifold(_)
+            | Evaluation::ContactForwardDynamics { .. }
             | Evaluation::ContactForwardDynamicsFlat { .. }
+            | Evaluation::ImpulseDynamics
             | Evaluation::ImpulseDynamicsFlat { .. }
             | Evaluation::LinkPose
             | Evaluation::LinkJacobian

@@ -391,28 +391,12 @@ impl Emitter<'_> {
 
     /// `try_contact_forward_dynamics` and `contact_forward_dynamics` (NaN on failure).
     pub(super) fn contact_forward_dynamics_fns(&mut self, q: &Quantity) -> TokenStream {
-        let (body, ops) = match &q.eval {
-            Evaluation::ContactForwardDynamics { h } => self.contact_runtime_body(q, h),
+        match &q.eval {
+            Evaluation::ContactForwardDynamics { h } => self.contact_runtime_fns(q, h),
             Evaluation::ContactForwardDynamicsFlat { outputs, pivots } => {
-                return self.contact_flat_fns(q, outputs, pivots);
+                self.contact_flat_fns(q, outputs, pivots)
             }
             _ => unreachable!("contact_forward_dynamics_fns on another evaluation"),
-        };
-        let docs = Self::quantity_doc(q, Some(ops));
-        let (n, nq) = (self.n.clone(), self.nq.clone());
-        let k3 = usize_lit(q.shape.len() - self.parents.len());
-        let try_cfd = self.path("try_contact_forward_dynamics");
-        let try_fn = self.try_contact_forward_dynamics_fn(body);
-        quote! {
-            #try_fn
-
-            #docs
-            pub fn contact_forward_dynamics(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n]) -> ([T; #n], [T; #k3]) {
-                match #try_cfd(self, q, qd, tau) {
-                    Ok(x) => x,
-                    Err(_) => ([T::nan(); #n], [T::nan(); #k3]),
-                }
-            }
         }
     }
 
@@ -438,12 +422,9 @@ impl Emitter<'_> {
     }
 
     /// The methods of a straight-line contact forward dynamics, generated for every
-    /// `T: Lane` (one state per lane): `contact_forward_dynamics_checked`, which records each
-    /// lane's failure, `try_contact_forward_dynamics_lanes`, `contact_forward_dynamics` (NaN in
-    /// the failed lanes alone) and `try_contact_forward_dynamics` (the lowest failed lane's
-    /// error). The pivots are checked before the results, as the run-time route does: a
-    /// non-finite acceleration `i` is `NonFinite { pivot: i }`, a force `k`
-    /// `NonFinite { pivot: N + k }`.
+    /// `T: Lane` (one state per lane) by [`Emitter::contact_checked_fns`]. The pivots are
+    /// checked before the results, as the run-time route does: a non-finite acceleration `i`
+    /// is `NonFinite { pivot: i }`, a force `k` `NonFinite { pivot: N + k }`.
     fn contact_flat_fns(&mut self, q: &Quantity, outputs: &[Id], pivots: &[Id]) -> TokenStream {
         let FlatProgram {
             program,
@@ -452,6 +433,47 @@ impl Emitter<'_> {
             rows: f,
             ops,
         } = self.flat_program(q, outputs, pivots);
+        let lane = quote!(::eomgen_runtime::lane);
+        let body = quote! {
+            #program
+            #lane::check_pivots(&[#(#piv),*], &mut failures)?;
+            #lane::check_finite(&[#(#a,)* #(#f),*], &mut failures)?;
+            Ok((([#(#a),*], [#(#f),*]), failures))
+        };
+        self.contact_checked_fns(q, ops, body)
+    }
+
+    /// Contact forward dynamics solved at run time, for every `T: Lane` as the straight-line
+    /// program's ([`Emitter::contact_checked_fns`]): `M` factorized by the unrolled tree
+    /// `L^T D L`, `h` straight-line, `J_c` and its drift from their functions, then every
+    /// lane's contact problem at once (`eomgen_runtime::contact::solve_factored_active_lanes`,
+    /// every row active).
+    fn contact_runtime_fns(&mut self, q: &Quantity, h: &[Id]) -> TokenStream {
+        let (hb, ops) = self.straight(q, h, Shape::Vector(h.len()));
+        let (n, k) = (&self.n, &self.k);
+        let free = self.free_accelerations_recording(&hb, quote!(&mut failures));
+        let (j, drift) = (self.call("contact_jacobian"), self.call("contact_drift"));
+        let body = quote! {
+            #free
+            let substitute = |b: &[T; #n]| Self::ltdl_substitute_unrolled(&m, b);
+            let lower = |w: &mut [[T; #k]; #n]| Self::ltdl_lower_rows_unrolled(&m, w);
+            let system = (&#j(self, q), &#drift(self, q, qd), &[true; #k]);
+            let x = ::eomgen_runtime::contact::solve_factored_active_lanes(&m, &free, system, substitute, lower, &mut failures)?;
+            Ok((x, failures))
+        };
+        self.contact_checked_fns(q, ops, body)
+    }
+
+    /// `contact_forward_dynamics_checked` with `body` (which records each lane's failure in
+    /// `failures` and ends with `Ok((result, failures))`),
+    /// `try_contact_forward_dynamics_lanes`, `contact_forward_dynamics` (NaN in the failed
+    /// lanes alone) and `try_contact_forward_dynamics` (the lowest failed lane's error).
+    fn contact_checked_fns(
+        &mut self,
+        q: &Quantity,
+        ops: OpCount,
+        body: TokenStream,
+    ) -> TokenStream {
         let docs = Self::quantity_doc(q, Some(ops));
         let (n, nq, k) = (self.n.clone(), self.nq.clone(), self.k.clone());
         let failures = quote!(<T as ::eomgen_runtime::Lane>::Failures);
@@ -470,10 +492,7 @@ impl Emitter<'_> {
             /// first at once).
             fn contact_forward_dynamics_checked(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n]) -> ::core::result::Result<(([T; #n], [T; #k]), #failures), ::eomgen_runtime::FactorError> {
                 let mut failures: #failures = ::core::default::Default::default();
-                #program
-                #lane::check_pivots(&[#(#piv),*], &mut failures)?;
-                #lane::check_finite(&[#(#a,)* #(#f),*], &mut failures)?;
-                Ok((([#(#a),*], [#(#f),*]), failures))
+                #body
             }
 
             #wrappers
@@ -482,24 +501,6 @@ impl Emitter<'_> {
 }
 
 impl Emitter<'_> {
-    /// The body of a `try_contact_forward_dynamics` solved at run time: `M` factorized by the
-    /// unrolled tree `L^T D L`, `h` straight-line, `J_c` and its drift from their functions,
-    /// then `eomgen_runtime::contact::solve_factored_active_by`.
-    fn contact_runtime_body(&mut self, q: &Quantity, h: &[Id]) -> (TokenStream, OpCount) {
-        let (hb, ops) = self.straight(q, h, Shape::Vector(h.len()));
-        let n = &self.n;
-        let k3 = usize_lit(q.shape.len() - h.len());
-        let free = self.free_accelerations(&hb);
-        let (j, drift) = (self.call("contact_jacobian"), self.call("contact_drift"));
-        let body = quote! {
-            #free
-            let substitute = |b: &[T; #n]| Self::ltdl_substitute_unrolled(&m, b);
-            let lower = |w: &mut [[T; #k3]; #n]| Self::ltdl_lower_rows_unrolled(&m, w);
-            ::eomgen_runtime::contact::solve_factored_active_by(&m, &free, &#j(self, q), &#drift(self, q, qd), &[true; #k3], substitute, lower)
-        };
-        (body, ops)
-    }
-
     /// `try_{name}_lanes` (the lowest failed lane, `LaneError`) and `{name}` (NaN in the failed
     /// lanes alone, documented by `docs`), both over `{name}_checked(args)`, which gives a pair
     /// of vectors (`N` velocity coordinates, `K` contact rows) and each lane's failures.
