@@ -4,7 +4,9 @@
 //! that drifted from its reference (integration error) is pulled back instead of kept
 //! accelerating at zero.
 
-use crate::{Pose, Real};
+use crate::lane::{branch, Pack};
+use crate::manifold::atan2_quadrant;
+use crate::{Lane, Pose, Real};
 
 /// The gains and each contact's reference placement (world) of Baumgarte stabilization, for a
 /// robot of `C` contacts (points, then frames, as its `CONTACT_ROWS`), given to the generated
@@ -41,6 +43,27 @@ pub struct Baumgarte<T, const C: usize> {
 }
 
 impl<T: Real, const C: usize> Baumgarte<T, C> {
+    /// The same gains and references in every lane of `L` (what a batch of states shares).
+    ///
+    /// ```
+    /// use eomgen_runtime::{Baumgarte, Pose};
+    /// let b = Baumgarte::new(100.0_f64, 20.0, [Pose::identity()]);
+    /// assert_eq!(b.in_lanes::<f64>(), b);
+    /// ```
+    pub fn in_lanes<L: Pack<Scalar = T>>(&self) -> Baumgarte<L, C> {
+        let splat = |x: T| L::gather(|_| x);
+        Baumgarte {
+            kp: splat(self.kp),
+            kd: splat(self.kd),
+            reference: self.reference.map(|r| Pose {
+                translation: r.translation.map(splat),
+                rotation: r.rotation.map(|row| row.map(splat)),
+            }),
+        }
+    }
+}
+
+impl<T: Lane, const C: usize> Baumgarte<T, C> {
     /// The gains and references.
     pub fn new(kp: T, kd: T, reference: [Pose<T>; C]) -> Self {
         Baumgarte { kp, kd, reference }
@@ -92,7 +115,7 @@ impl<T: Real, const C: usize> Baumgarte<T, C> {
         v: &[T; N],
         drift: &mut [T; K],
     ) {
-        if self.kp == T::zero() && self.kd == T::zero() {
+        if self.kp.zero_in_every_lane() && self.kd.zero_in_every_lane() {
             return;
         }
         let e: [T; K] = self.position_error(rows, placements);
@@ -108,7 +131,7 @@ impl<T: Real, const C: usize> Baumgarte<T, C> {
 
 /// The [`Pose`] of one row of the generated `contact_placements(q)`: the world position (3),
 /// then the row-major world rotation (9).
-pub fn placement<T: Real>(row: &[T; 12]) -> Pose<T> {
+pub fn placement<T: Lane>(row: &[T; 12]) -> Pose<T> {
     Pose {
         translation: [row[0], row[1], row[2]],
         rotation: core::array::from_fn(|i| core::array::from_fn(|k| row[3 + 3 * i + k])),
@@ -116,14 +139,15 @@ pub fn placement<T: Real>(row: &[T; 12]) -> Pose<T> {
 }
 
 /// `a b^T`.
-fn mul_transposed<T: Real>(a: &[[T; 3]; 3], b: &[[T; 3]; 3]) -> [[T; 3]; 3] {
+fn mul_transposed<T: Lane>(a: &[[T; 3]; 3], b: &[[T; 3]; 3]) -> [[T; 3]; 3] {
     core::array::from_fn(|i| {
         core::array::from_fn(|k| a[i][0] * b[k][0] + a[i][1] * b[k][1] + a[i][2] * b[k][2])
     })
 }
 
 /// The rotation vector of `r` (SO(3)'s logarithm), through its unit quaternion (Shepperd's
-/// method: accurate at every angle, up to pi).
+/// method: accurate at every angle, up to pi). On a vector of states ([`Lane`]) each lane
+/// takes its own case.
 ///
 /// ```
 /// use eomgen_runtime::contact::log3;
@@ -131,32 +155,55 @@ fn mul_transposed<T: Real>(a: &[[T; 3]; 3], b: &[[T; 3]; 3]) -> [[T; 3]; 3] {
 /// let w = log3(&[[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]);
 /// assert!((w[2] - 0.3).abs() < 1e-15 && w[0] == 0.0 && w[1] == 0.0);
 /// ```
-pub fn log3<T: Real>(r: &[[T; 3]; 3]) -> [T; 3] {
+pub fn log3<T: Lane>(r: &[[T; 3]; 3]) -> [T; 3] {
+    let q = shepperd(r);
+    let one = T::one();
+    let sign = T::select(T::zero().gt(q[3]), -one, one);
+    let (x, y, z, w) = (q[0] * sign, q[1] * sign, q[2] * sign, q[3] * sign);
+    let s = (x * x + y * y + z * z).sqrt();
+    // theta = 2 atan2(s, w), s and w >= 0; the vector is (x, y, z) theta / s (2 / w as s -> 0).
+    let two = T::from_f64(2.0);
+    let k = branch(
+        s.gt(T::epsilon() * (s + w)),
+        || two * atan2_quadrant(s, w) / s,
+        || two / w,
+    );
+    [x * k, y * k, z * k]
+}
+
+/// The quaternion (x, y, z, w) of `r`, up to a nonzero factor, from the largest of its
+/// squares: the trace's when it is at least every diagonal entry, else the largest diagonal
+/// entry's (`a >= b` is `!(b > a)`, which differs only where a NaN makes every case NaN).
+fn shepperd<T: Lane>(r: &[[T; 3]; 3]) -> [T; 4] {
     let one = T::one();
     let trace = r[0][0] + r[1][1] + r[2][2];
-    // (x, y, z, w), up to a positive factor, from the largest of its squares.
-    let q = if trace >= r[0][0] && trace >= r[1][1] && trace >= r[2][2] {
+    let at_least =
+        |a: T, b: T, yes: &dyn Fn() -> [T; 4], no: &dyn Fn() -> [T; 4]| branch(b.gt(a), no, yes);
+    let by_trace = || {
         [
             r[2][1] - r[1][2],
             r[0][2] - r[2][0],
             r[1][0] - r[0][1],
             one + trace,
         ]
-    } else if r[0][0] >= r[1][1] && r[0][0] >= r[2][2] {
+    };
+    let by_x = || {
         [
             one + r[0][0] - r[1][1] - r[2][2],
             r[0][1] + r[1][0],
             r[0][2] + r[2][0],
             r[2][1] - r[1][2],
         ]
-    } else if r[1][1] >= r[2][2] {
+    };
+    let by_y = || {
         [
             r[0][1] + r[1][0],
             one + r[1][1] - r[0][0] - r[2][2],
             r[1][2] + r[2][1],
             r[0][2] - r[2][0],
         ]
-    } else {
+    };
+    let by_z = || {
         [
             r[0][2] + r[2][0],
             r[1][2] + r[2][1],
@@ -164,16 +211,14 @@ pub fn log3<T: Real>(r: &[[T; 3]; 3]) -> [T; 3] {
             r[1][0] - r[0][1],
         ]
     };
-    let sign = if q[3] < T::zero() { -one } else { one };
-    let (x, y, z, w) = (q[0] * sign, q[1] * sign, q[2] * sign, q[3] * sign);
-    let s = (x * x + y * y + z * z).sqrt();
-    // theta = 2 atan2(s, w); the vector is (x, y, z) theta / s (2 / w as s -> 0).
-    let k = if s > T::epsilon() * (s + w) {
-        T::from_f64(2.0) * s.atan2(w) / s
-    } else {
-        T::from_f64(2.0) / w
+    let by_y_or_z = || at_least(r[1][1], r[2][2], &by_y, &by_z);
+    let by_diagonal = || {
+        let x_first = || at_least(r[0][0], r[2][2], &by_x, &by_y_or_z);
+        at_least(r[0][0], r[1][1], &x_first, &by_y_or_z)
     };
-    [x * k, y * k, z * k]
+    let by_trace_third = || at_least(trace, r[2][2], &by_trace, &by_diagonal);
+    let by_trace_second = || at_least(trace, r[1][1], &by_trace_third, &by_diagonal);
+    at_least(trace, r[0][0], &by_trace_second, &by_diagonal)
 }
 
 #[cfg(test)]
@@ -195,6 +240,44 @@ mod tests {
             for k in 0..3 {
                 assert!((w[k] - axis[k] * angle).abs() < 1e-12, "{angle}: {w:?}");
             }
+        }
+    }
+
+    /// Four rotations taking each of Shepperd's cases (the trace's, then the largest diagonal
+    /// entry's: x, y, z) and the series near zero, on four lanes at once: each lane's is the
+    /// scalar's, bit for bit.
+    #[cfg(feature = "simd")]
+    #[test]
+    fn log3_on_lanes_takes_each_lanes_case() {
+        use wide::f64x4;
+        let cases = [
+            ([0.6, 0.0, 0.8], 1e-9),
+            ([1.0, 0.0, 0.0], 3.0),
+            ([0.0, 0.8, -0.6], 3.1),
+            ([0.0, 0.6, -0.8], 3.1),
+        ];
+        let rs = cases.map(|(axis, angle)| {
+            let (s, c) = (0.5_f64 * angle).sin_cos();
+            rotation(&[axis[0] * s, axis[1] * s, axis[2] * s, c])
+        });
+        let case = |r: &[[f64; 3]; 3]| {
+            let (d, t) = ([r[0][0], r[1][1], r[2][2]], r[0][0] + r[1][1] + r[2][2]);
+            if d.iter().all(|x| t >= *x) {
+                0
+            } else {
+                1 + (0..3)
+                    .find(|&i| d[i + 1..].iter().all(|x| d[i] >= *x))
+                    .unwrap()
+            }
+        };
+        assert_eq!(rs.map(|r| case(&r)), [0, 1, 2, 3]);
+        let lanes: [[f64x4; 3]; 3] =
+            core::array::from_fn(|i| core::array::from_fn(|k| f64x4::from(rs.map(|r| r[i][k]))));
+        let w = log3(&lanes);
+        for (l, r) in rs.iter().enumerate() {
+            let want = log3(r);
+            let got = w.map(|x| x.to_array()[l]);
+            assert_eq!(got.map(f64::to_bits), want.map(f64::to_bits), "lane {l}");
         }
     }
 

@@ -97,6 +97,17 @@ pub trait Lane: Copy + Debug + Default + Arithmetic + 'static {
     fn neg_exact(self) -> Self {
         -self
     }
+    /// The machine epsilon of a lane's scalar (`f64::EPSILON`, or `f32::EPSILON` for the
+    /// vectors of `f32`), in every lane.
+    ///
+    /// ```
+    /// use eomgen_runtime::Lane;
+    /// assert_eq!(<f32 as Lane>::epsilon(), f32::EPSILON);
+    /// ```
+    #[inline(always)]
+    fn epsilon() -> Self {
+        Self::from_f64(f64::EPSILON)
+    }
     /// Lanes that are neither infinite nor NaN.
     fn finite(self) -> Self::Mask;
     /// Lanes where `self > other` (false where either is NaN).
@@ -302,6 +313,10 @@ impl<T: Real> Lane for T {
     #[inline(always)]
     fn nan() -> Self {
         <T as Real>::nan()
+    }
+    #[inline(always)]
+    fn epsilon() -> Self {
+        <T as Real>::epsilon()
     }
     #[inline(always)]
     fn sin(self) -> Self {

@@ -654,6 +654,25 @@ fn active_contacts_on_four_lanes_name_the_failed_lane() {
         let want: Vec<f64> = want_v.iter().chain(&want_p).copied().collect();
         assert_close("f64x4 impulse dynamics, two feet", l, &one, &want, 0.0);
     }
+    // Baumgarte-stabilized, each foot's reference off its position: the same lanes fail.
+    let reference = [eomgen_runtime::Pose::from_translation([0.3, -0.2, 0.0]); 4];
+    let gains = eomgen_runtime::Baumgarte::new(100.0, 20.0, reference);
+    let wide_gains = gains.in_lanes::<f64x4>();
+    let err = wide
+        .try_contact_forward_dynamics_stabilized_lanes(&ql, &vl, &tl, &active, &wide_gains)
+        .unwrap_err();
+    lane_one_named(err, |l| {
+        robot.try_contact_forward_dynamics_stabilized(&q[l], &v[l], &tau[l], &active, &gains)
+    });
+    let (a, f) = wide.contact_forward_dynamics_stabilized(&ql, &vl, &tl, &active, &wide_gains);
+    for l in 0..4 {
+        let one: Vec<f64> = a.iter().chain(&f).map(|x| x.lane(l)).collect();
+        assert_eq!(one.iter().all(|x| x.is_nan()), l == 1 || l == 3, "lane {l}");
+        let (want_a, want_f) =
+            robot.contact_forward_dynamics_stabilized(&q[l], &v[l], &tau[l], &active, &gains);
+        let want: Vec<f64> = want_a.iter().chain(&want_f).copied().collect();
+        assert_close("f64x4 stabilized contact dynamics", l, &one, &want, 0.0);
+    }
 }
 
 /// The contact and impulse derivatives (every contact, and a set of active ones) on four

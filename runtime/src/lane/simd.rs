@@ -83,6 +83,10 @@ macro_rules! impl_lane {
                 self ^ $v::splat(-0.0)
             }
             #[inline(always)]
+            fn epsilon() -> Self {
+                $v::splat($s::EPSILON)
+            }
+            #[inline(always)]
             fn finite(self) -> $v {
                 $v::is_finite(self)
             }

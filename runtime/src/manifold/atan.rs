@@ -35,7 +35,7 @@ const TAN_PI_8: f64 = 0.414_213_562_373_095_048_80;
 /// `atan2(y, x)` for `y >= 0` and `x >= 0`, not both zero: the angle in `[0, pi/2]`, lane by
 /// lane (the swap and the reduction selected per lane, no branch on a value).
 #[inline]
-pub(super) fn atan2_quadrant<T: Lane>(y: T, x: T) -> T {
+pub(crate) fn atan2_quadrant<T: Lane>(y: T, x: T) -> T {
     let f = T::from_f64;
     let swap = y.gt(x);
     let (lo, hi) = (T::select(swap, x, y), T::select(swap, y, x));

@@ -14,6 +14,8 @@
 //! scalar evaluates only its case, so its values are those of plain branches, bit for bit.
 
 mod atan;
+
+pub(crate) use atan::atan2_quadrant;
 mod into;
 mod se3;
 

@@ -357,15 +357,21 @@ impl Emitter<'_> {
         let (names, types): (Vec<Ident>, Vec<TokenStream>) =
             self.shared_values(q).into_iter().unzip();
         let params = quote!(#(#names: #types,)*);
+        let l = lanes();
         let to_lanes = shared_scalar(&q.eval).map(|x| {
-            let l = lanes();
             quote!(let #x = <#l as ::eomgen_runtime::Lane>::from_f64(::eomgen_runtime::Real::to_f64(#x));)
         });
+        // Baumgarte's gains and references, the same in every lane.
+        let gains = names
+            .iter()
+            .any(|x| x == "baumgarte")
+            .then(|| quote!(let baumgarte = &baumgarte.in_lanes::<#l>();));
+        let to_lanes = to_lanes.into_iter().chain(gains).collect();
         let after = names.iter().map(|x| quote!(#x)).collect();
         Shared {
             link_param,
             params,
-            to_lanes: to_lanes.unwrap_or_default(),
+            to_lanes,
             args: (link_arg, after),
         }
     }

@@ -144,40 +144,11 @@ impl Emitter<'_> {
         (call, ops)
     }
 
-    /// `try_contact_forward_dynamics_stabilized` and `contact_forward_dynamics_stabilized` (NaN
-    /// on failure), which take an `eomgen_runtime::Baumgarte` after `active`.
+    /// `contact_forward_dynamics_stabilized`, which takes an `eomgen_runtime::Baumgarte` after
+    /// `active`, for every `T: Lane` as `contact_forward_dynamics_active`, with the drift
+    /// corrected first.
     pub(super) fn contact_stabilized_fns(&mut self, q: &Quantity, h: &[Id]) -> TokenStream {
-        let (hb, ops) = self.active_bias(q, h);
-        let docs = Self::quantity_doc(q, Some(ops));
-        let (n, nq, k) = (&self.n, &self.nq, &self.k);
-        let c = usize_lit(self.contact_rows.len());
-        let s = self.signature(q, true, ACTIVE_WHY);
-        let free = self.free_accelerations(&hb);
-        let (j, drift) = (self.call("contact_jacobian"), self.call("contact_drift"));
-        let placements = self.call("contact_placements");
-        let (name, try_name, active, active_arg, why) =
-            (&s.name, &s.try_name, &s.param, &s.arg, &s.why);
-        quote! {
-            #[doc = #why]
-            pub fn #try_name(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n] #active, baumgarte: &::eomgen_runtime::Baumgarte<T, #c>) -> ::core::result::Result<([T; #n], [T; #k]), ::eomgen_runtime::FactorError> {
-                #free
-                let j = #j(self, q);
-                let mut drift = #drift(self, q, qd);
-                baumgarte.correct_drift(&Self::CONTACT_ROWS, &#placements(self, q), &j, qd, &mut drift);
-                let rows = ::eomgen_runtime::contact::row_mask(&Self::CONTACT_ROWS, active);
-                let substitute = |b: &[T; #n]| Self::ltdl_substitute_unrolled(&m, b);
-                let lower = |w: &mut [[T; #k]; #n]| Self::ltdl_lower_rows_unrolled(&m, w);
-                ::eomgen_runtime::contact::solve_factored_active_by(&m, &free, &j, &drift, &rows, substitute, lower)
-            }
-
-            #docs
-            pub fn #name(&self, q: &[T; #nq], qd: &[T; #n], tau: &[T; #n] #active, baumgarte: &::eomgen_runtime::Baumgarte<T, #c>) -> ([T; #n], [T; #k]) {
-                match self.#try_name(q, qd, tau #active_arg, baumgarte) {
-                    Ok(x) => x,
-                    Err(_) => ([T::nan(); #n], [T::nan(); #k]),
-                }
-            }
-        }
+        self.contact_active_lanes_fns(q, h, true)
     }
 
     /// `contact_forward_dynamics_active` for every `T: Lane` where its callees are (one state
@@ -185,9 +156,19 @@ impl Emitter<'_> {
     /// each lane's failed pivot or non-finite result
     /// (`eomgen_runtime::contact::solve_factored_active_lanes`), `try_` gives the lowest
     /// failed lane's error, `try_contact_forward_dynamics_active_lanes` says which lane, and
-    /// the plain method gives NaN in the failed lanes alone. On a scalar, the stabilized
-    /// form's route without its drift correction.
+    /// the plain method gives NaN in the failed lanes alone.
     pub(super) fn contact_active_checked_fns(&mut self, q: &Quantity, h: &[Id]) -> TokenStream {
+        self.contact_active_lanes_fns(q, h, false)
+    }
+
+    /// Contact forward dynamics with active contacts, Baumgarte-stabilized when `stabilized`
+    /// (an `eomgen_runtime::Baumgarte` after `active`, which corrects the drift).
+    fn contact_active_lanes_fns(
+        &mut self,
+        q: &Quantity,
+        h: &[Id],
+        stabilized: bool,
+    ) -> TokenStream {
         let (hb, ops) = self.active_bias(q, h);
         let docs = Self::quantity_doc(q, Some(ops));
         let (n, nq, k) = (&self.n, &self.nq, &self.k);
@@ -196,11 +177,27 @@ impl Emitter<'_> {
         let why = format!("{why} On a vector of states, the lowest failed lane's error.");
         let free = self.free_accelerations_recording(&hb, quote!(&mut failures));
         let (j, drift) = (self.call("contact_jacobian"), self.call("contact_drift"));
-        let params = quote!(q: &[T; #nq], qd: &[T; #n], tau: &[T; #n], active: &[bool; #c]);
+        let (gains, gains_arg, correct) = if stabilized {
+            let placements = self.call("contact_placements");
+            (
+                quote!(, baumgarte: &::eomgen_runtime::Baumgarte<T, #c>),
+                quote!(, baumgarte),
+                quote!(baumgarte.correct_drift(&Self::CONTACT_ROWS, &#placements(self, q), &j, qd, &mut drift);),
+            )
+        } else {
+            Default::default()
+        };
+        let drift_let = if stabilized {
+            quote!(let mut drift)
+        } else {
+            quote!(let drift)
+        };
+        let params = quote!(q: &[T; #nq], qd: &[T; #n], tau: &[T; #n], active: &[bool; #c] #gains);
         let body = quote! {
             #free
             let j = #j(self, q);
-            let drift = #drift(self, q, qd);
+            #drift_let = #drift(self, q, qd);
+            #correct
             let rows = ::eomgen_runtime::contact::row_mask(&Self::CONTACT_ROWS, active);
             let substitute = |b: &[T; #n]| Self::ltdl_substitute_unrolled(&m, b);
             let lower = |w: &mut [[T; #k]; #n]| Self::ltdl_lower_rows_unrolled(&m, w);
@@ -208,7 +205,7 @@ impl Emitter<'_> {
             let x = ::eomgen_runtime::contact::solve_factored_active_lanes(&m, &free, system, substitute, lower, &mut failures)?;
             Ok((x, failures))
         };
-        let args = quote!(q, qd, tau, active);
+        let args = quote!(q, qd, tau, active #gains_arg);
         let what = "accelerations and forces";
         self.lane_checked_fns(q.name, (params, args), (why, what, docs), body)
     }

@@ -5,8 +5,8 @@
 //! runtime solves take a `Lane`; link kinematics, whose runtime kernels walk chains of poses;
 //! the configuration manifold, whose kernels select each lane's case; the contact and impulse
 //! derivatives, whose KKT solves take a `Lane`; contact and impulse dynamics solved at run
-//! time, as their `_active` forms). They live in the `impl<T: Lane>` blocks; the rest (the
-//! stabilized form) in `impl<T: Real>`.
+//! time, as their `_active` forms, and the stabilized form). They live in the `impl<T: Lane>`
+//! blocks.
 
 use std::collections::BTreeSet;
 
@@ -38,6 +38,7 @@ fn evaluation_on_lanes(q: &Quantity) -> bool {
             | Evaluation::ImpulseDynamicsDerivatives
             | Evaluation::ActiveContacts(
                 ActiveContacts::Dynamics { .. }
+                    | ActiveContacts::Stabilized { .. }
                     | ActiveContacts::Impulse
                     | ActiveContacts::Derivatives { .. }
                     | ActiveContacts::ImpulseDerivatives

@@ -347,15 +347,9 @@ impl Emitter<'_> {
     }
 
     /// `let mut m = ...; let free = ...;`: `M(q)` factorized by the unrolled tree `L^T D L`
-    /// (returning its error) and the accelerations without contacts `M^-1 (tau - h)`, `h` by
-    /// the straight-line block `hb`.
-    pub(super) fn free_accelerations(&self, hb: &TokenStream) -> TokenStream {
-        self.free_accelerations_recording(hb, quote!(&mut ::core::default::Default::default()))
-    }
-
-    /// [`Emitter::free_accelerations`] with `M`'s pivots checked into `failures` (an
-    /// expression of type `&mut <T as Lane>::Failures`), so that a vector's failed lanes are
-    /// known.
+    /// and the accelerations without contacts `M^-1 (tau - h)`, `h` by the straight-line block
+    /// `hb`; `M`'s pivots checked into `failures` (an expression of type
+    /// `&mut <T as Lane>::Failures`: a scalar returns its error, a vector records its lanes').
     pub(super) fn free_accelerations_recording(
         &self,
         hb: &TokenStream,
