@@ -6,10 +6,8 @@
 //! parameter fields, the link enum, each kind of [`Evaluation`], the trait implementation.
 
 mod batch;
-mod batch_states;
 mod contact;
 mod items;
-mod lanes;
 mod links;
 mod methods;
 mod mpc;
@@ -94,8 +92,6 @@ struct Emitter<'a> {
     try_forward_dynamics: TokenStream,
     /// `try_forward_dynamics_lanes` and the checked solve behind both, with `forward_dynamics`.
     forward_dynamics_lanes: TokenStream,
-    /// The quantities generated for every `T: Lane` (`rust/lanes.rs`).
-    lanes: BTreeSet<&'static str>,
     /// Whether a floating base's six `FloatingDynamics` methods are all generated, so that the
     /// trait is implemented (and its methods live there rather than in the inherent impl).
     floating_trait: bool,
@@ -118,12 +114,11 @@ struct Emitter<'a> {
     helpers: BTreeSet<&'static str>,
 }
 
-/// The generated methods by where they go: the inherent impls for every `T: Lane` and for
-/// `T: Real` (with the blocks of their split bodies), and the trait impls.
+/// The generated methods by where they go: the inherent impl for every `T: Lane` (with the
+/// blocks of their split bodies), and the trait impls.
 #[derive(Default)]
 struct Methods {
-    lane_items: Vec<TokenStream>,
-    real_items: Vec<TokenStream>,
+    items: Vec<TokenStream>,
     trait_methods: Vec<TokenStream>,
     floating_methods: Vec<TokenStream>,
     contact_methods: Vec<TokenStream>,
@@ -168,7 +163,6 @@ pub fn emit_tokens(
         in_trait: d.quantities.iter().any(|q| q.home == Home::Dynamics),
         try_forward_dynamics: TokenStream::new(),
         forward_dynamics_lanes: TokenStream::new(),
-        lanes: BTreeSet::new(),
         floating_trait: d
             .quantities
             .iter()
@@ -187,7 +181,6 @@ pub fn emit_tokens(
         split: BTreeSet::new(),
         helpers: BTreeSet::new(),
     };
-    e.lanes = e.lane_quantities();
     let tokens = e.file(&fields, d);
     (tokens, e.counts)
 }
@@ -209,11 +202,7 @@ impl Emitter<'_> {
         for q in self.quantities {
             let before = self.blocks.len();
             let tokens = self.quantity_fn(q);
-            let items = if self.lanes.contains(q.name) {
-                &mut m.lane_items
-            } else {
-                &mut m.real_items
-            };
+            let items = &mut m.items;
             items.extend(self.blocks.drain(before..));
             match self.trait_of(q.name) {
                 Some(Trait::Dynamics) => m.trait_methods.push(tokens),
@@ -240,8 +229,7 @@ impl Emitter<'_> {
             TokenStream::new()
         };
         let Methods {
-            lane_items,
-            real_items,
+            items,
             trait_methods,
             floating_methods,
             contact_methods,
@@ -266,35 +254,28 @@ impl Emitter<'_> {
         let joint_names = self.joint_names_const();
         let sizes = self.sizes();
         let limits = mpc::limit_constants(self.model);
-        let (blocks, lane) = (&self.blocks, Self::bound(true));
+        let blocks = &self.blocks;
         let batch = self.batch_impl(fields);
-        let actuation_lanes =
-            !self.has("forward_dynamics") || self.lanes.contains("forward_dynamics");
-        let (lane_actuation, real_actuation) = if actuation_lanes {
-            (actuation, TokenStream::new())
-        } else {
-            (TokenStream::new(), actuation)
-        };
         quote! {
             #strukt
             #links
             #sizes
             #allow
-            impl<T: #lane> #ty<T> {
+            impl<T: ::eomgen_runtime::Lane> #ty<T> {
                 #parents
                 #joint_names
                 #limits
                 #identification
-                #lane_actuation
-                #(#lane_items)*
+                #actuation
+                #(#items)*
                 #(#blocks)*
                 #frames
             }
+            // `try_forward_dynamics` returns the first failure at once, which a vector of
+            // states cannot (`try_forward_dynamics_lanes` says which lane failed).
             #allow
             impl<T: ::eomgen_runtime::Real> #ty<T> {
-                #real_actuation
                 #try_fd
-                #(#real_items)*
             }
             #trait_impl
             #floating_impls

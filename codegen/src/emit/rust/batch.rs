@@ -116,12 +116,7 @@ impl Emitter<'_> {
     pub(super) fn batch_impl(&self, fields: &Fields) -> TokenStream {
         let (ty, allow) = (&self.ty, allow_lints());
         let names: Vec<&Ident> = fields.by_symbol.values().collect();
-        let methods = self
-            .quantities
-            .iter()
-            .filter(|q| self.lanes.contains(q.name))
-            .map(|q| self.batch_fn(q))
-            .chain(self.state_batch_fns());
+        let methods = self.quantities.iter().map(|q| self.batch_fn(q));
         let unpacked: Vec<TokenStream> = self
             .quantities
             .iter()
@@ -166,8 +161,7 @@ impl Emitter<'_> {
         let n = self.parents.len();
         let small =
             |ops: OpCount| entries <= n * n && ops.total() <= UNPACKED_MAX_OPS_PER_ENTRY * entries;
-        self.lanes.contains(q.name)
-            && matches!(q.eval, Evaluation::Exprs(_))
+        matches!(q.eval, Evaluation::Exprs(_))
             && matches!(q.shape, Shape::Matrix(..) | Shape::Matrices(..))
             && !self.split.contains(q.name)
             && !self.derivatives.contains(q.name)

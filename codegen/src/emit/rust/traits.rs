@@ -96,7 +96,7 @@ impl Emitter<'_> {
             .into_iter()
             .map(|name| Literal::string(&name));
         let (ty, n, allow) = (&self.ty, &self.n, allow_lints());
-        let bound = Self::bound(self.trait_lanes(Trait::Dynamics));
+        let bound = quote!(::eomgen_runtime::Lane);
         quote! {
             #allow
             impl<T: #bound> ::eomgen_runtime::Dynamics<T, #n> for #ty<T> {
@@ -120,7 +120,7 @@ impl Emitter<'_> {
         let (ty, n, nq, allow) = (&self.ty, &self.n, &self.nq, allow_lints());
         let mut out = TokenStream::new();
         if self.floating_trait {
-            let bound = Self::bound(self.trait_lanes(Trait::Floating));
+            let bound = quote!(::eomgen_runtime::Lane);
             out.extend(quote! {
                 #allow
                 impl<T: #bound> ::eomgen_runtime::FloatingDynamics<T, #nq, #n> for #ty<T> {
@@ -129,7 +129,7 @@ impl Emitter<'_> {
             });
         }
         if let Some(k3) = &self.contacts_trait {
-            let bound = Self::bound(self.trait_lanes(Trait::Contacts));
+            let bound = quote!(::eomgen_runtime::Lane);
             out.extend(quote! {
                 #allow
                 impl<T: #bound> ::eomgen_runtime::Contacts<T, #nq, #n, #k3> for #ty<T> {
