@@ -247,21 +247,7 @@ impl Emitter<'_> {
             names: outs,
             types: out_types,
             scatters,
-        } =
-            match q.eval {
-                Evaluation::LinkPose => Outs {
-                    names: vec![format_ident!("out")],
-                    types: vec![quote!(::eomgen_runtime::Pose<T>)],
-                    scatters: vec![quote!(::eomgen_runtime::batch::scatter_pose(&r, out);)],
-                },
-                Evaluation::ContactDynamicsDerivatives { .. }
-                | Evaluation::ActiveContacts(ActiveContacts::Derivatives { .. }) => self
-                    .derivatives_out("ContactDynamicsDerivatives", "scatter_contact_derivatives"),
-                Evaluation::ImpulseDynamicsDerivatives
-                | Evaluation::ActiveContacts(ActiveContacts::ImpulseDerivatives) => self
-                    .derivatives_out("ImpulseDynamicsDerivatives", "scatter_impulse_derivatives"),
-                _ => outputs(self.result_shapes(q)),
-            };
+        } = self.batch_outs(q);
         let Shared {
             link_param,
             params: shared_params,
@@ -319,6 +305,26 @@ impl Emitter<'_> {
                 });
                 Ok(())
             }
+        }
+    }
+
+    /// `q`'s output slices: a pose, a result struct of the runtime, or arrays and matrices.
+    fn batch_outs(&self, q: &Quantity) -> Outs {
+        match q.eval {
+            Evaluation::LinkPose => Outs {
+                names: vec![format_ident!("out")],
+                types: vec![quote!(::eomgen_runtime::Pose<T>)],
+                scatters: vec![quote!(::eomgen_runtime::batch::scatter_pose(&r, out);)],
+            },
+            Evaluation::ContactDynamicsDerivatives { .. }
+            | Evaluation::ActiveContacts(ActiveContacts::Derivatives { .. }) => {
+                self.derivatives_out("ContactDynamicsDerivatives", "scatter_contact_derivatives")
+            }
+            Evaluation::ImpulseDynamicsDerivatives
+            | Evaluation::ActiveContacts(ActiveContacts::ImpulseDerivatives) => {
+                self.derivatives_out("ImpulseDynamicsDerivatives", "scatter_impulse_derivatives")
+            }
+            _ => outputs(self.result_shapes(q)),
         }
     }
 
