@@ -69,6 +69,14 @@ impl<T: Lane, const N: usize, const K: usize> ContactKkt<T, N, K> {
     /// [`ContactKkt::impulse`] on a vector of states ([`Lane`], one state per lane, `e` each
     /// lane's restitution): a lane whose result is not finite records its error in `failures`
     /// (a scalar returns it).
+    ///
+    /// ```
+    /// use eomgen_runtime::ContactKkt;
+    /// // A unit point mass moving at (1, -2) hits the ground (its second coordinate) and stops.
+    /// let m = [[1.0_f64, 0.0], [0.0, 1.0]];
+    /// let kkt = ContactKkt::new(m, &[None, None], [[0.0, 1.0]]).unwrap();
+    /// assert_eq!(kkt.impulse_lanes(&[1.0, -2.0], 0.0, &mut ()), Ok(([1.0, 0.0], [2.0])));
+    /// ```
     pub fn impulse_lanes(
         &self,
         v: &[T; N],

@@ -775,6 +775,18 @@ impl<T: Lane, const N: usize, const K: usize> ContactKkt<T, N, K> {
     /// `fill` writes `M`'s factors and `J` and checks `M`'s pivots with the `failures` it is
     /// given; a lane whose pivot of `J M^-1 J^T` fails records it there (pivot `N + k`; a
     /// scalar returns it) and holds garbage.
+    ///
+    /// ```
+    /// use eomgen_runtime::{tree::{ltdl_factor, Walked}, ContactKkt, FactorError};
+    /// // A unit point mass in the plane, its second coordinate held (a scalar's failures: `()`).
+    /// let (parent, mut kkt) = ([None, None], ContactKkt::<f64, 2, 1>::zeroed());
+    /// let fill = |m: &mut [[f64; 2]; 2], j: &mut [[f64; 2]; 1], _: &mut ()| {
+    ///     (*m, *j) = ([[1.0, 0.0], [0.0, 1.0]], [[0.0, 1.0]]);
+    ///     ltdl_factor(m, &parent)
+    /// };
+    /// kkt.set_up_factored_lanes::<Walked>(fill, (&parent, &[true]), &mut ()).unwrap();
+    /// assert_eq!(kkt.solve(&[1.0, -9.81], &[0.0]), Ok(([1.0, 0.0], [9.81])));
+    /// ```
     pub fn set_up_factored_lanes<P: TreePasses<T, N>>(
         &mut self,
         fill: impl FnOnce(
