@@ -172,53 +172,59 @@ pub fn log3<T: Lane>(r: &[[T; 3]; 3]) -> [T; 3] {
 }
 
 /// The quaternion (x, y, z, w) of `r`, up to a nonzero factor, from the largest of its
-/// squares: the trace's when it is at least every diagonal entry, else the largest diagonal
-/// entry's (`a >= b` is `!(b > a)`, which differs only where a NaN makes every case NaN).
+/// squares: the case of the largest of the trace and the diagonal entries, the earlier one on a
+/// tie (the trace's when it is at least every diagonal entry, else the largest diagonal
+/// entry's). Lane by lane: from the last case, each earlier one is taken where its value is at
+/// least the best so far (`!(best > v)`, which differs from `v >= best` only where a NaN makes
+/// every case NaN). The four cases cost twelve additions.
 fn shepperd<T: Lane>(r: &[[T; 3]; 3]) -> [T; 4] {
     let one = T::one();
     let trace = r[0][0] + r[1][1] + r[2][2];
-    let at_least =
-        |a: T, b: T, yes: &dyn Fn() -> [T; 4], no: &dyn Fn() -> [T; 4]| branch(b.gt(a), no, yes);
-    let by_trace = || {
-        [
-            r[2][1] - r[1][2],
-            r[0][2] - r[2][0],
-            r[1][0] - r[0][1],
-            one + trace,
-        ]
-    };
-    let by_x = || {
-        [
-            one + r[0][0] - r[1][1] - r[2][2],
-            r[0][1] + r[1][0],
-            r[0][2] + r[2][0],
-            r[2][1] - r[1][2],
-        ]
-    };
-    let by_y = || {
-        [
-            r[0][1] + r[1][0],
-            one + r[1][1] - r[0][0] - r[2][2],
-            r[1][2] + r[2][1],
-            r[0][2] - r[2][0],
-        ]
-    };
-    let by_z = || {
-        [
-            r[0][2] + r[2][0],
-            r[1][2] + r[2][1],
-            one + r[2][2] - r[0][0] - r[1][1],
-            r[1][0] - r[0][1],
-        ]
-    };
-    let by_y_or_z = || at_least(r[1][1], r[2][2], &by_y, &by_z);
-    let by_diagonal = || {
-        let x_first = || at_least(r[0][0], r[2][2], &by_x, &by_y_or_z);
-        at_least(r[0][0], r[1][1], &x_first, &by_y_or_z)
-    };
-    let by_trace_third = || at_least(trace, r[2][2], &by_trace, &by_diagonal);
-    let by_trace_second = || at_least(trace, r[1][1], &by_trace_third, &by_diagonal);
-    at_least(trace, r[0][0], &by_trace_second, &by_diagonal)
+    let cases = [
+        (
+            trace,
+            [
+                r[2][1] - r[1][2],
+                r[0][2] - r[2][0],
+                r[1][0] - r[0][1],
+                one + trace,
+            ],
+        ),
+        (
+            r[0][0],
+            [
+                one + r[0][0] - r[1][1] - r[2][2],
+                r[0][1] + r[1][0],
+                r[0][2] + r[2][0],
+                r[2][1] - r[1][2],
+            ],
+        ),
+        (
+            r[1][1],
+            [
+                r[0][1] + r[1][0],
+                one + r[1][1] - r[0][0] - r[2][2],
+                r[1][2] + r[2][1],
+                r[0][2] - r[2][0],
+            ],
+        ),
+        (
+            r[2][2],
+            [
+                r[0][2] + r[2][0],
+                r[1][2] + r[2][1],
+                one + r[2][2] - r[0][0] - r[1][1],
+                r[1][0] - r[0][1],
+            ],
+        ),
+    ];
+    let (mut best, mut q) = cases[3];
+    for (v, case) in cases[..3].iter().rev() {
+        let keep = best.gt(*v);
+        q = core::array::from_fn(|i| T::select(keep, q[i], case[i]));
+        best = T::select(keep, best, *v);
+    }
+    q
 }
 
 #[cfg(test)]

@@ -171,7 +171,7 @@ impl Emitter<'_> {
     ) -> TokenStream {
         let (hb, ops) = self.active_bias(q, h);
         let docs = Self::quantity_doc(q, Some(ops));
-        let (n, nq, k) = (&self.n, &self.nq, &self.k);
+        let (n, nq) = (&self.n, &self.nq);
         let c = usize_lit(self.contact_rows.len());
         let why = self.signature(q, true, ACTIVE_WHY).why;
         let why = format!("{why} On a vector of states, the lowest failed lane's error.");
@@ -193,21 +193,37 @@ impl Emitter<'_> {
             quote!(let drift)
         };
         let params = quote!(q: &[T; #nq], qd: &[T; #n], tau: &[T; #n], active: &[bool; #c] #gains);
+        let solve = self.contact_solve_lanes(quote!(::eomgen_runtime::contact::row_mask(
+            &Self::CONTACT_ROWS,
+            active
+        )));
         let body = quote! {
             #free
             let j = #j(self, q);
             #drift_let = #drift(self, q, qd);
             #correct
-            let rows = ::eomgen_runtime::contact::row_mask(&Self::CONTACT_ROWS, active);
+            #solve
+        };
+        let args = quote!(q, qd, tau, active #gains_arg);
+        let what = "accelerations and forces";
+        self.lane_checked_fns(q.name, (params, args), (why, what, docs), body)
+    }
+
+    /// The statements that solve every lane's contact problem with `m` (`M`'s factors), `free`,
+    /// `j` and `drift` in scope, the contact rows `rows` taking part
+    /// (`eomgen_runtime::contact::solve_factored_active_lanes`), ending in
+    /// `Ok((result, failures))`: what contact forward dynamics solved at run time and its
+    /// `_active` and `_stabilized` forms share.
+    pub(super) fn contact_solve_lanes(&self, rows: TokenStream) -> TokenStream {
+        let (n, k) = (&self.n, &self.k);
+        quote! {
+            let rows = #rows;
             let substitute = |b: &[T; #n]| Self::ltdl_substitute_unrolled(&m, b);
             let lower = |w: &mut [[T; #k]; #n]| Self::ltdl_lower_rows_unrolled(&m, w);
             let system = (&j, &drift, &rows);
             let x = ::eomgen_runtime::contact::solve_factored_active_lanes(&m, &free, system, substitute, lower, &mut failures)?;
             Ok((x, failures))
-        };
-        let args = quote!(q, qd, tau, active #gains_arg);
-        let what = "accelerations and forces";
-        self.lane_checked_fns(q.name, (params, args), (why, what, docs), body)
+        }
     }
 
     /// `try_contact_forward_dynamics_derivatives` and `contact_forward_dynamics_derivatives`

@@ -444,16 +444,15 @@ impl Emitter<'_> {
     /// every row active).
     fn contact_runtime_fns(&mut self, q: &Quantity, h: &[Id]) -> TokenStream {
         let (hb, ops) = self.straight(q, h, Shape::Vector(h.len()));
-        let (n, k) = (&self.n, &self.k);
+        let k = &self.k;
         let free = self.free_accelerations_recording(&hb, quote!(&mut failures));
         let (j, drift) = (self.call("contact_jacobian"), self.call("contact_drift"));
+        let solve = self.contact_solve_lanes(quote!([true; #k]));
         let body = quote! {
             #free
-            let substitute = |b: &[T; #n]| Self::ltdl_substitute_unrolled(&m, b);
-            let lower = |w: &mut [[T; #k]; #n]| Self::ltdl_lower_rows_unrolled(&m, w);
-            let system = (&#j(self, q), &#drift(self, q, qd), &[true; #k]);
-            let x = ::eomgen_runtime::contact::solve_factored_active_lanes(&m, &free, system, substitute, lower, &mut failures)?;
-            Ok((x, failures))
+            let j = #j(self, q);
+            let drift = #drift(self, q, qd);
+            #solve
         };
         self.contact_checked_fns(q, ops, body)
     }
