@@ -49,38 +49,41 @@ impl Emitter<'_> {
     /// `let kkt = ...;`, a reference to the KKT system at `q` from `mass_matrix` and
     /// `contact_jacobian` (of the contacts of `active` when `active`), returning the error
     /// from the enclosing function when it cannot be factorized (on a vector of states, each
-    /// lane's recorded in the enclosing function's `failures`). The system lies in the
-    /// caller's frame, set up there by a non-inlined `contact_kkt` (or `contact_kkt_active`)
-    /// with `ContactKkt::set_up_factored_lanes`, so that it is neither moved nor held next to
-    /// the mass matrix it is made of.
+    /// lane's recorded in the enclosing function's `failures`). A non-inlined `contact_kkt`
+    /// (or `contact_kkt_active`) returns the system unfactored into the caller's frame, made
+    /// by `ContactKkt::unfactored` of the results of `mass_matrix` and `contact_jacobian`,
+    /// which are written where they stay; the caller factorizes it there
+    /// (`ContactKkt::factor_lanes`). Nothing of it is zeroed first or moved.
     fn kkt(&mut self, active: bool) -> TokenStream {
         let (n, nq, k) = (self.n.clone(), self.nq.clone(), self.k.clone());
         let kkt_ty = quote!(::eomgen_runtime::ContactKkt<T, #n, #k>);
-        let (fill, rows) = self.kkt_inputs(active);
-        let result = quote!(::core::result::Result<(), ::eomgen_runtime::FactorError>);
-        let failures = quote!(failures: &mut <T as ::eomgen_runtime::Lane>::Failures);
+        let (m, j) = (self.call("mass_matrix"), self.call("contact_jacobian"));
+        let rows = self.active_rows(active);
+        let body = quote! {
+            ::eomgen_runtime::ContactKkt::unfactored(#m(self, q), #j(self, q), (&Self::PARENTS, &#rows))
+        };
         let (helper, call, item) = if active {
             let c = usize_lit(self.contact_rows.len());
             (
                 "contact_kkt_active",
-                quote!(self.contact_kkt_active(q, active, &mut kkt, failures)),
+                quote!(self.contact_kkt_active(q, active)),
                 quote! {
-                    /// Sets `kkt` up for the contacts of `active` at `q`.
+                    /// The KKT system for the contacts of `active` at `q`, not factorized.
                     #[inline(never)]
-                    fn contact_kkt_active(&self, q: &[T; #nq], active: &[bool; #c], kkt: &mut #kkt_ty, #failures) -> #result {
-                        kkt.set_up_factored_lanes::<Self>(#fill, (&Self::PARENTS, &#rows), failures)
+                    fn contact_kkt_active(&self, q: &[T; #nq], active: &[bool; #c]) -> #kkt_ty {
+                        #body
                     }
                 },
             )
         } else {
             (
                 "contact_kkt",
-                quote!(self.contact_kkt(q, &mut kkt, failures)),
+                quote!(self.contact_kkt(q)),
                 quote! {
-                    /// Sets `kkt` up for every contact at `q`.
+                    /// The KKT system for every contact at `q`, not factorized.
                     #[inline(never)]
-                    fn contact_kkt(&self, q: &[T; #nq], kkt: &mut #kkt_ty, #failures) -> #result {
-                        kkt.set_up_factored_lanes::<Self>(#fill, (&Self::PARENTS, &#rows), failures)
+                    fn contact_kkt(&self, q: &[T; #nq]) -> #kkt_ty {
+                        #body
                     }
                 },
             )
@@ -88,21 +91,21 @@ impl Emitter<'_> {
         if self.helpers.insert(helper) {
             self.blocks.push(item);
         }
+        // M factorized by the robot's unrolled L^T D L (`emit/tree_solve.rs`), not by the
+        // runtime's loops over the tree.
         quote! {
-            let mut kkt = ::eomgen_runtime::ContactKkt::zeroed();
-            #call?;
+            let mut kkt = #call;
+            kkt.factor_lanes::<Self>(|m, failures| Self::ltdl_factor_unrolled(m, failures), failures)?;
             let kkt = &kkt;
         }
     }
 
     /// The closure that writes `M`'s factors and `J_c` at `q` into a KKT system's storage
-    /// (`ContactKkt::set_up_factored_lanes`: `M`'s pivots checked with the failures it is
+    /// (`ContactKkt::set_up_in_stash_lanes`: `M`'s pivots checked with the failures it is
     /// given), and the contact rows that take part: every one, or those of the contacts of
     /// `active`.
     fn kkt_inputs(&self, active: bool) -> (TokenStream, TokenStream) {
         let (m, j) = (self.call("mass_matrix"), self.call("contact_jacobian"));
-        // M factorized by the robot's unrolled L^T D L (`emit/tree_solve.rs`), not by the
-        // runtime's loops over the tree.
         let fill = quote!(|m, j, failures| {
             *m = #m(self, q);
             *j = #j(self, q);
