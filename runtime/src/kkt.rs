@@ -1232,6 +1232,37 @@ mod tests {
         }
     }
 
+    /// A system made unfactored and factorized where it lies is the one `new` makes, to the
+    /// bit, inactive rows included; a pivot of `M` or of `J M^-1 J^T` that fails is named.
+    #[test]
+    fn an_unfactored_system_factorizes_as_new_does() {
+        let (m, j, parent) = (
+            [[4.0, 1.0, 0.5], [1.0, 3.0, 0.25], [0.5, 0.25, 2.0]],
+            [[1.0, 0.0, 2.0], [0.0, 1.0, -1.0]],
+            [None, Some(0), Some(1)],
+        );
+        let factor = |m: &mut [[f64; 3]; 3], _: &mut ()| crate::tree::ltdl_factor(m, &parent);
+        for active in [[true, true], [false, true]] {
+            let mut kkt = ContactKkt::unfactored(m, j, (&parent, &active));
+            kkt.factor_lanes::<Walked>(factor, &mut ()).unwrap();
+            let want = ContactKkt::new_active(m, &parent, j, &active).unwrap();
+            assert_eq!(
+                kkt.solve(&[1.0, -2.0, 0.5], &[0.25, -1.0]),
+                want.solve(&[1.0, -2.0, 0.5], &[0.25, -1.0])
+            );
+            assert_eq!(kkt.inverse_inertia_rows(), want.inverse_inertia_rows());
+        }
+        // A zero row of `J`: pivot N + 1 of `J M^-1 J^T` is zero.
+        let mut singular = ContactKkt::unfactored(m, [j[0], [0.0; 3]], (&parent, &[true; 2]));
+        let err = singular.factor_lanes::<Walked>(factor, &mut ());
+        assert_eq!(err, Err(FactorError::NotPositiveDefinite { pivot: 4 }));
+        let mut not_positive = m;
+        not_positive[2][2] = -1.0;
+        let mut bad = ContactKkt::unfactored(not_positive, j, (&parent, &[true; 2]));
+        let err = bad.factor_lanes::<Walked>(factor, &mut ());
+        assert_eq!(err, Err(FactorError::NotPositiveDefinite { pivot: 2 }));
+    }
+
     #[test]
     fn solving_columns_equals_solving_each() {
         let kkt = system();
