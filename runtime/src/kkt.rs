@@ -812,7 +812,7 @@ impl<T: Lane, const N: usize, const K: usize> ContactKkt<T, N, K> {
     /// Made where it is returned to, with `m` and `j` the results of the calls that compute
     /// them, no array of the system is written twice: a system zeroed first and then filled
     /// ([`ContactKkt::zeroed`], [`ContactKkt::set_up_factored_lanes`]) wrote `M` and `J`
-    /// three times, a humanoid's 30 kB (4 % of g1's impulse derivatives).
+    /// three times, a humanoid's 30 kB (3 % of g1's impulse derivatives).
     ///
     /// ```
     /// use eomgen_runtime::{tree::{ltdl_factor, Walked}, ContactKkt};
