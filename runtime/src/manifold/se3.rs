@@ -38,6 +38,8 @@ pub(super) struct Relative<T> {
     t2: T,
     /// `theta`.
     theta: T,
+    /// `1 / theta` (infinite at the zero rotation, where the series are taken instead).
+    r1: T,
     /// `c` of `V(phi)^-1 = I - phi^/2 + c phi^2`.
     c: T,
     /// The relative translation, in the axes of `q0`'s base.
@@ -64,11 +66,13 @@ impl<T: Lane> Relative<T> {
         let n2 = s2 + w * w;
         let s = s2.sqrt();
         let theta = f(2.0) * atan2_quadrant(s, w);
+        // Two reciprocals, each taken once: a division's latency sits on this chain.
+        let (inv_s, r1) = (T::one() / s, T::one() / theta);
         // phi = (x, y, z) theta / s, free of the norm; its series near the zero rotation.
         let k = branch::<T, _>(
             (f(1e-12) * n2).gt(s2),
             || f(2.0) / w * (T::one() - s2 / (f(3.0) * w * w)),
-            || theta / s,
+            || theta * inv_s,
         );
         let phi = [quat[0] * k, quat[1] * k, quat[2] * k];
         let t2 = theta * theta;
@@ -76,7 +80,7 @@ impl<T: Lane> Relative<T> {
         let c = branch::<T, _>(
             f(1e-4).gt(t2),
             || f(1.0 / 12.0) + t2 / f(720.0) + t2 * t2 / f(30240.0),
-            || T::one() / t2 - w / (f(2.0) * theta * s),
+            || r1 * (r1 - f(0.5) * w * inv_s),
         );
         let dp = [q1[0] - q0[0], q1[1] - q0[1], q1[2] - q0[2]];
         let t = unrotated(&a, &dp);
@@ -93,6 +97,7 @@ impl<T: Lane> Relative<T> {
             s,
             t2,
             theta,
+            r1,
             c,
             t,
         }
@@ -123,14 +128,14 @@ struct Coefficients<T> {
     db: T,
 }
 
-/// [`Coefficients`] from `theta^2`, `theta`, `sin theta` and `1 - cos theta`; their series
-/// where `theta^2 < 1e-4` (lane by lane).
+/// [`Coefficients`] from `theta^2`, `theta` and its reciprocal `r1`, `sin theta` and
+/// `1 - cos theta`; their series where `theta^2 < 1e-4` (lane by lane).
 #[inline]
-fn coefficients<T: Lane>(t2: T, theta: T, sin: T, vers: T) -> Coefficients<T> {
+fn coefficients<T: Lane>((t2, theta, r1): (T, T, T), sin: T, vers: T) -> Coefficients<T> {
     branch::<T, _>(
         T::from_f64(1e-4).gt(t2),
         || series(t2),
-        || exact(t2, theta, sin, vers),
+        || exact((theta, r1), sin, vers),
     )
 }
 
@@ -161,10 +166,10 @@ fn series<T: Lane>(t2: T) -> Coefficients<T> {
     }
 }
 
-/// [`Coefficients`] by their closed forms.
-fn exact<T: Lane>(t2: T, theta: T, sin: T, vers: T) -> Coefficients<T> {
+/// [`Coefficients`] by their closed forms, from `theta` and `r1 = 1 / theta` (no division).
+fn exact<T: Lane>((theta, r1): (T, T), sin: T, vers: T) -> Coefficients<T> {
     let f = T::from_f64;
-    let (r1, r2) = (T::one() / theta, T::one() / t2);
+    let r2 = r1 * r1;
     let r4 = r2 * r2;
     let gap = theta - sin;
     Coefficients {
@@ -228,7 +233,8 @@ fn integrate_parts<T: Lane>(v: &[T]) -> [M3<T>; 4] {
     let t2 = phi[0] * phi[0] + phi[1] * phi[1] + phi[2] * phi[2];
     let theta = t2.sqrt();
     let ([sh], [ch]) = T::sin_cos_many([theta * f(0.5)]);
-    let k = coefficients(t2, theta, f(2.0) * sh * ch, f(2.0) * sh * sh);
+    let r1 = T::one() / theta;
+    let k = coefficients((t2, theta, r1), f(2.0) * sh * ch, f(2.0) * sh * sh);
     let h = hat(&phi);
     let h2 = hat_squared(&phi, t2);
     // R^T = I - sinc phi^ + a phi^2, and the inverse action's corner -R^T t^ = -(R^T t)^ R^T
@@ -251,7 +257,7 @@ pub(super) fn difference_jacobians<T: Lane>(q0: &[T], q1: &[T]) -> (M6<T>, M6<T>
     let rel = Relative::new(q0, q1);
     let two_n2 = T::from_f64(2.0) / rel.n2;
     let (s, w) = (rel.s, rel.quat[3]);
-    let k = coefficients(rel.t2, rel.theta, two_n2 * s * w, two_n2 * s * s);
+    let k = coefficients((rel.t2, rel.theta, rel.r1), two_n2 * s * w, two_n2 * s * s);
     let h = hat(&rel.phi);
     let h2 = hat_squared(&rel.phi, rel.t2);
     let half = T::from_f64(0.5);
@@ -370,7 +376,7 @@ mod tests {
         for t2 in [0.6e-4_f64, 1e-4] {
             let theta = t2.sqrt();
             let (s, c) = theta.sin_cos();
-            let (x, y) = (series(t2), exact(t2, theta, s, 1.0 - c));
+            let (x, y) = (series(t2), exact((theta, 1.0 / theta), s, 1.0 - c));
             for (a, b, tol) in [
                 (x.sinc, y.sinc, 1e-14),
                 (x.a, y.a, 1e-11),
