@@ -798,11 +798,8 @@ impl<T: Lane, const N: usize, const K: usize> ContactKkt<T, N, K> {
         failures: &mut T::Failures,
     ) -> Result<(), FactorError> {
         fill(&mut self.factors, &mut self.j, failures)?;
-        self.parent = *parent;
-        self.active = *active;
-        let (factors, j, y) = (&mut self.factors, &mut self.j, &mut self.y);
-        self.lambda = factorize::<P, T, N, K>(factors, j, y, (parent, active), failures)?;
-        Ok(())
+        (self.parent, self.active) = (*parent, *active);
+        self.complete::<P>(failures)
     }
 
     /// The system of the mass matrix `m` and the contact Jacobian `j`, not yet factorized
@@ -848,6 +845,17 @@ impl<T: Lane, const N: usize, const K: usize> ContactKkt<T, N, K> {
         factor: impl FnOnce(&mut [[T; N]; N], &mut T::Failures) -> Result<(), FactorError>,
         failures: &mut T::Failures,
     ) -> Result<(), FactorError> {
+        factor(&mut self.factors, failures)?;
+        self.complete::<P>(failures)
+    }
+
+    /// [`factorize`] where the system lies, `M`'s factors and `J` in place: `Y` and the
+    /// factor of `J M^-1 J^T` (what [`ContactKkt::set_up_factored_lanes`] and
+    /// [`ContactKkt::factor_lanes`] both finish with).
+    fn complete<P: TreePasses<T, N>>(
+        &mut self,
+        failures: &mut T::Failures,
+    ) -> Result<(), FactorError> {
         let ContactKkt {
             factors,
             parent,
@@ -856,7 +864,6 @@ impl<T: Lane, const N: usize, const K: usize> ContactKkt<T, N, K> {
             lambda,
             active,
         } = self;
-        factor(factors, failures)?;
         *lambda = factorize::<P, T, N, K>(factors, j, y, (parent, active), failures)?;
         Ok(())
     }
@@ -1242,15 +1249,33 @@ mod tests {
             [None, Some(0), Some(1)],
         );
         let factor = |m: &mut [[f64; 3]; 3], _: &mut ()| crate::tree::ltdl_factor(m, &parent);
+        let (top, bottom) = ([1.0, -2.0, 0.5], [0.25, -1.0]);
         for active in [[true, true], [false, true]] {
             let mut kkt = ContactKkt::unfactored(m, j, (&parent, &active));
             kkt.factor_lanes::<Walked>(factor, &mut ()).unwrap();
             let want = ContactKkt::new_active(m, &parent, j, &active).unwrap();
-            assert_eq!(
-                kkt.solve(&[1.0, -2.0, 0.5], &[0.25, -1.0]),
-                want.solve(&[1.0, -2.0, 0.5], &[0.25, -1.0])
-            );
+            let (x, f) = kkt.solve(&top, &bottom).unwrap();
+            assert_eq!(Ok((x, f)), want.solve(&top, &bottom));
             assert_eq!(kkt.inverse_inertia_rows(), want.inverse_inertia_rows());
+            // Independently: `M x - J^T f = top`, `J x = bottom` on the active rows, `f` zero
+            // on the others.
+            for i in 0..3 {
+                let mx: f64 = (0..3).map(|c| m[i][c] * x[c]).sum();
+                let jf: f64 = (0..2).map(|r| j[r][i] * f[r]).sum();
+                assert!(
+                    Real::abs(mx - jf - top[i]) < 1e-14,
+                    "row {i} of M x - J^T f"
+                );
+            }
+            for r in 0..2 {
+                let jx: f64 = (0..3).map(|c| j[r][c] * x[c]).sum();
+                let ok = if active[r] {
+                    Real::abs(jx - bottom[r]) < 1e-14
+                } else {
+                    f[r] == 0.0
+                };
+                assert!(ok, "contact row {r}");
+            }
         }
         // A zero row of `J`: pivot N + 1 of `J M^-1 J^T` is zero.
         let mut singular = ContactKkt::unfactored(m, [j[0], [0.0; 3]], (&parent, &[true; 2]));
