@@ -933,11 +933,11 @@ fn each_state_within<X: Flat>(what: &str, got: &[X], want: impl Fn(usize) -> X, 
     }
 }
 
-/// The state-by-state batches, and beside them contact forward dynamics with active
-/// contacts and the contact and impulse derivatives (on lanes on this robot), with NaN and
-/// infinite states between finite ones.
+/// The MPC kit's batches on anymal's four feet (link kinematics, contact forward dynamics
+/// with active contacts and stabilized, the contact and impulse derivatives) equal the scalar
+/// methods, with NaN and infinite states between finite ones.
 #[test]
-fn methods_off_the_lanes_in_batches_equal_the_scalar_code() {
+fn mpc_kit_batches_equal_the_scalar_code() {
     use eomgen_runtime::{Baumgarte, ContactDynamicsDerivatives, ImpulseDynamicsDerivatives};
     use eomgen_tests::robots::anymal_mpc::{AnymalMpc, AnymalMpcLink};
     let robot = AnymalMpc::<f64>::default();

@@ -202,16 +202,16 @@ impl Emitter<'_> {
         for q in self.quantities {
             let before = self.blocks.len();
             let tokens = self.quantity_fn(q);
-            let items = &mut m.items;
-            items.extend(self.blocks.drain(before..));
+            m.items.extend(self.blocks.drain(before..));
             match self.trait_of(q.name) {
                 Some(Trait::Dynamics) => m.trait_methods.push(tokens),
                 Some(Trait::Floating) => m.floating_methods.push(tokens),
                 Some(Trait::Contacts) => m.contact_methods.push(tokens),
-                None => items.push(tokens),
+                None => m.items.push(tokens),
             }
             if q.name == "forward_dynamics" {
-                items.push(std::mem::take(&mut self.forward_dynamics_lanes));
+                m.items
+                    .push(std::mem::take(&mut self.forward_dynamics_lanes));
             }
         }
         m.contact_methods

@@ -96,10 +96,9 @@ impl Emitter<'_> {
             .into_iter()
             .map(|name| Literal::string(&name));
         let (ty, n, allow) = (&self.ty, &self.n, allow_lints());
-        let bound = quote!(::eomgen_runtime::Lane);
         quote! {
             #allow
-            impl<T: #bound> ::eomgen_runtime::Dynamics<T, #n> for #ty<T> {
+            impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Dynamics<T, #n> for #ty<T> {
                 const JOINT_NAMES: [&'static str; #n] = [#(#names),*];
                 #(#methods)*
             }
@@ -120,19 +119,17 @@ impl Emitter<'_> {
         let (ty, n, nq, allow) = (&self.ty, &self.n, &self.nq, allow_lints());
         let mut out = TokenStream::new();
         if self.floating_trait {
-            let bound = quote!(::eomgen_runtime::Lane);
             out.extend(quote! {
                 #allow
-                impl<T: #bound> ::eomgen_runtime::FloatingDynamics<T, #nq, #n> for #ty<T> {
+                impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::FloatingDynamics<T, #nq, #n> for #ty<T> {
                     #(#floating)*
                 }
             });
         }
         if let Some(k3) = &self.contacts_trait {
-            let bound = quote!(::eomgen_runtime::Lane);
             out.extend(quote! {
                 #allow
-                impl<T: #bound> ::eomgen_runtime::Contacts<T, #nq, #n, #k3> for #ty<T> {
+                impl<T: ::eomgen_runtime::Lane> ::eomgen_runtime::Contacts<T, #nq, #n, #k3> for #ty<T> {
                     #(#contacts)*
                 }
             });
