@@ -135,42 +135,39 @@ fn max_abs(v: &[f32; N]) -> f32 {
     v.iter().fold(0.0, |m, x| m.max(x.abs()))
 }
 
-fn run() -> bool {
-    let mut core = Peripherals::take().expect("peripherals taken once");
-    core.SYST.set_clock_source(SystClkSource::Core);
-    core.SYST.set_reload(0x00ff_ffff);
-    core.SYST.clear_current();
-    core.SYST.enable_counter();
+/// What a closed-loop run of the UR5 leaves to check: its final state, the worst tracking error
+/// per joint after the transient, the worst `|qdd - u|`, and the SysTick counts of the
+/// controller and the plant (sums and maxima over the ticks).
+struct Tracking {
+    q: [f32; N],
+    qd: [f32; N],
+    worst: [f32; N],
+    worst_model: f32,
+    controller: (u64, u32),
+    plant: (u64, u32),
+}
 
-    let robot = Ur5::<f32>::default();
+/// Runs the computed-torque loop for `TICKS` ticks from the reference's start plus
+/// `INITIAL_OFFSET`, at rest, printing the tracking error every half second.
+fn track(robot: &Ur5<f32>) -> Tracking {
     let (r0, _, _) = reference(0.0);
-    let mut q: [f32; N] = core::array::from_fn(|i| r0[i] + INITIAL_OFFSET[i]);
-    let mut qd = [0.0_f32; N];
-
-    hprintln!(
-        "eomgen firmware: computed-torque control of Ur5<f32>, {} joints, dt = {} s, {} ticks, \
-         KP = {}, KD = {}",
-        N,
-        DT,
-        TICKS,
-        KP,
-        KD
-    );
-    let mut worst = [0.0_f32; N];
-    let mut worst_model = 0.0_f32;
-    let (mut controller_counts, mut plant_counts) = (0u64, 0u64);
-    let (mut controller_max, mut plant_max) = (0u32, 0u32);
-    let initial_error = max_abs(&INITIAL_OFFSET);
-
+    let mut run = Tracking {
+        q: core::array::from_fn(|i| r0[i] + INITIAL_OFFSET[i]),
+        qd: [0.0; N],
+        worst: [0.0; N],
+        worst_model: 0.0,
+        controller: (0, 0),
+        plant: (0, 0),
+    };
     for k in 0..TICKS {
         let t = k as f32 * DT;
         let (r, rd, rdd) = reference(t);
-        let e: [f32; N] = core::array::from_fn(|i| r[i] - q[i]);
-        let ed: [f32; N] = core::array::from_fn(|i| rd[i] - qd[i]);
+        let e: [f32; N] = core::array::from_fn(|i| r[i] - run.q[i]);
+        let ed: [f32; N] = core::array::from_fn(|i| rd[i] - run.qd[i]);
 
         if k >= CHECK_FROM {
-            for i in 0..N {
-                worst[i] = worst[i].max(e[i].abs());
+            for (w, ei) in run.worst.iter_mut().zip(&e) {
+                *w = w.max(ei.abs());
             }
         }
         if k % 500 == 0 {
@@ -184,36 +181,65 @@ fn run() -> bool {
 
         let start = SYST::get_current();
         let u: [f32; N] = core::array::from_fn(|i| rdd[i] + KP * e[i] + KD * ed[i]);
-        let tau = computed_torque(&robot, &q, &qd, &u);
+        let tau = computed_torque(robot, &run.q, &run.qd, &u);
         let controller = elapsed(start);
 
         let start = SYST::get_current();
-        let qdd = robot.forward_dynamics(&q, &qd, &tau);
+        let qdd = robot.forward_dynamics(&run.q, &run.qd, &tau);
         let plant = elapsed(start);
 
         for i in 0..N {
-            worst_model = worst_model.max((qdd[i] - u[i]).abs());
-            qd[i] += DT * qdd[i];
-            q[i] += DT * qd[i];
+            run.worst_model = run.worst_model.max((qdd[i] - u[i]).abs());
+            run.qd[i] += DT * qdd[i];
+            run.q[i] += DT * run.qd[i];
         }
-        controller_counts += controller as u64;
-        plant_counts += plant as u64;
-        controller_max = controller_max.max(controller);
-        plant_max = plant_max.max(plant);
+        run.controller = (
+            run.controller.0 + controller as u64,
+            run.controller.1.max(controller),
+        );
+        run.plant = (run.plant.0 + plant as u64, run.plant.1.max(plant));
     }
+    run
+}
 
+fn run() -> bool {
+    let mut core = Peripherals::take().expect("peripherals taken once");
+    core.SYST.set_clock_source(SystClkSource::Core);
+    core.SYST.set_reload(0x00ff_ffff);
+    core.SYST.clear_current();
+    core.SYST.enable_counter();
+
+    hprintln!(
+        "eomgen firmware: computed-torque control of Ur5<f32>, {} joints, dt = {} s, {} ticks, \
+         KP = {}, KD = {}",
+        N,
+        DT,
+        TICKS,
+        KP,
+        KD
+    );
+    let run = track(&Ur5::<f32>::default());
     let (r, _, _) = reference(TICKS as f32 * DT);
-    let final_error: [f32; N] = core::array::from_fn(|i| r[i] - q[i]);
+    let final_error: [f32; N] = core::array::from_fn(|i| r[i] - run.q[i]);
     hprintln!(
         "t = {:.3} s  max|e| = {:.3e} rad (final)",
         TICKS as f32 * DT,
         max_abs(&final_error)
     );
+    report(&run)
+}
 
+/// Prints the checks of a run (a finite state, each joint's error within its bound, the model
+/// round trip within its budget) and the instruction counts; whether every check held.
+fn report(run: &Tracking) -> bool {
     // A NaN anywhere propagates to the state for good (and `max` above skips NaNs).
-    let mut ok = q.iter().chain(qd.iter()).all(|x| x.is_finite());
+    let mut ok = run.q.iter().chain(run.qd.iter()).all(|x| x.is_finite());
     if !ok {
-        hprintln!("the state is not finite: q = {:?}, qd = {:?}", q, qd);
+        hprintln!(
+            "the state is not finite: q = {:?}, qd = {:?}",
+            run.q,
+            run.qd
+        );
     }
     hprintln!(
         "after the transient (t >= {} s), per joint: max|e| / bound",
@@ -221,7 +247,7 @@ fn run() -> bool {
     );
     for (i, (name, worst)) in <Ur5<f32> as Dynamics<f32, N>>::JOINT_NAMES
         .iter()
-        .zip(worst)
+        .zip(run.worst)
         .enumerate()
     {
         let bound = error_bound(i);
@@ -235,11 +261,11 @@ fn run() -> bool {
             if joint_ok { "ok" } else { "EXCEEDED" }
         );
     }
-    let model_ok = worst_model <= MODEL_BUDGET;
+    let model_ok = run.worst_model <= MODEL_BUDGET;
     ok &= model_ok;
     hprintln!(
         "max |qdd - u| (f32 model round trip) = {:.3e} rad/s^2, budget {:.1e}  {}",
-        worst_model,
+        run.worst_model,
         MODEL_BUDGET,
         if model_ok { "ok" } else { "EXCEEDED" }
     );
@@ -247,15 +273,15 @@ fn run() -> bool {
     hprintln!(
         "instructions per tick (QEMU icount): controller (M, b, g, M u) {} avg / {} max, \
          plant (forward_dynamics) {} avg / {} max",
-        per_tick(controller_counts),
-        controller_max * INSTRUCTIONS_PER_SYSTICK,
-        per_tick(plant_counts),
-        plant_max * INSTRUCTIONS_PER_SYSTICK
+        per_tick(run.controller.0),
+        run.controller.1 * INSTRUCTIONS_PER_SYSTICK,
+        per_tick(run.plant.0),
+        run.plant.1 * INSTRUCTIONS_PER_SYSTICK
     );
     hprintln!(
         "tracking error {:.3e} rad at start, {:.3e} rad worst after {} s: {}",
-        initial_error,
-        worst.iter().fold(0.0_f32, |m, x| m.max(*x)),
+        max_abs(&INITIAL_OFFSET),
+        run.worst.iter().fold(0.0_f32, |m, x| m.max(*x)),
         CHECK_FROM as f32 * DT,
         if ok { "PASS" } else { "FAIL" }
     );

@@ -234,7 +234,12 @@ fn run() -> bool {
         instr_baseline
     );
 
-    let baseline = (stack_baseline, instr_baseline);
+    measure_robots(per_count, (stack_baseline, instr_baseline))
+}
+
+/// Measures the robot this build was made for (its cargo feature), in f32 then f64; false if
+/// an entry overflowed the painted stack.
+fn measure_robots(per_count: f64, baseline: (usize, f64)) -> bool {
     let mut ok = true;
     // One robot per build (a cargo feature each; see Cargo.toml), f32 then f64.
     #[cfg(feature = "double_pendulum")]
