@@ -89,6 +89,14 @@ fn render(rows: &[Row], functions: &[String], stages: &[&'static str]) -> String
          16 joints or 8,000 operations; link poses and Jacobians always are). Times are from one run on a shared \
          2-core machine: read them for growth, not to a few percent.\n"
     );
+    render_times(&mut s, rows, stages);
+    render_ops(&mut s, rows, functions);
+    render_rare_ops(&mut s, rows, functions);
+    s
+}
+
+/// The table of generation times: the total, each stage of the derivation, the rest.
+fn render_times(s: &mut String, rows: &[Row], stages: &[&'static str]) {
     let _ = writeln!(s, "## Generation time (seconds)\n");
     let _ = write!(s, "| n | total |");
     for st in stages {
@@ -116,7 +124,10 @@ fn render(rows: &[Row], functions: &[String], stages: &[&'static str]) -> String
             r.source_bytes / 1024
         );
     }
+}
 
+/// The tables of multiplications and of additions per function, each with its growth exponent.
+fn render_ops(s: &mut String, rows: &[Row], functions: &[String]) {
     let kinds = [(0, "Multiplications"), (1, "Additions and subtractions")];
     for (k, title) in kinds {
         let _ = writeln!(s, "\n## {title}\n");
@@ -154,7 +165,10 @@ fn render(rows: &[Row], functions: &[String], stages: &[&'static str]) -> String
         "\nThe last row is the slope of log(count) against log(n) between the largest chain and \
          the one about half as long: 1 is linear growth, 2 quadratic."
     );
+}
 
+/// One table of the rarer operations (divisions, square roots, sines, cosines) per function.
+fn render_rare_ops(s: &mut String, rows: &[Row], functions: &[String]) {
     // Divisions, square roots, sines and cosines: few, so one cell per function.
     let _ = writeln!(s, "\n## Divisions, square roots, sines and cosines\n");
     let _ = writeln!(s, "Each cell is div / sqrt / sin / cos.\n");
@@ -176,7 +190,6 @@ fn render(rows: &[Row], functions: &[String], stages: &[&'static str]) -> String
         }
         let _ = writeln!(s);
     }
-    s
 }
 
 /// The command line.
