@@ -115,7 +115,7 @@ impl Emitter<'_> {
     }
 
     /// The contact rows that take part: every one, or those of the contacts of `active`.
-    fn active_rows(&self, active: bool) -> TokenStream {
+    pub(super) fn active_rows(&self, active: bool) -> TokenStream {
         let k = &self.k;
         if active {
             quote!(::eomgen_runtime::contact::row_mask(
@@ -196,10 +196,7 @@ impl Emitter<'_> {
             quote!(let drift)
         };
         let params = quote!(q: &[T; #nq], qd: &[T; #n], tau: &[T; #n], active: &[bool; #c] #gains);
-        let solve = self.contact_solve_lanes(quote!(::eomgen_runtime::contact::row_mask(
-            &Self::CONTACT_ROWS,
-            active
-        )));
+        let solve = self.contact_solve_lanes(self.active_rows(true));
         let body = quote! {
             #free
             let j = #j(self, q);

@@ -444,10 +444,9 @@ impl Emitter<'_> {
     /// every row active).
     fn contact_runtime_fns(&mut self, q: &Quantity, h: &[Id]) -> TokenStream {
         let (hb, ops) = self.straight(q, h, Shape::Vector(h.len()));
-        let k = &self.k;
         let free = self.free_accelerations_recording(&hb, quote!(&mut failures));
         let (j, drift) = (self.call("contact_jacobian"), self.call("contact_drift"));
-        let solve = self.contact_solve_lanes(quote!([true; #k]));
+        let solve = self.contact_solve_lanes(self.active_rows(false));
         let body = quote! {
             #free
             let j = #j(self, q);
