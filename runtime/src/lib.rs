@@ -66,9 +66,10 @@
 //! `use eomgen_runtime::prelude::*;` brings [`Dynamics`], [`Hamiltonian`], [`Real`], [`Pose`]
 //! and [`FactorError`] into scope (module [`prelude`]).
 //!
-//! The crate's `unsafe` code is confined to two places, each with its soundness argument: the
-//! fused multiply-add intrinsics of [`Real::mul_add`], and [`place`], which lets generated
-//! functions write a large result where the caller keeps it.
+//! The crate's `unsafe` code is confined to three places, each with its soundness argument:
+//! the fused multiply-add intrinsics of [`Real::mul_add`], [`place`], which lets generated
+//! functions write a large result where the caller keeps it, and the cache hints of the batch
+//! runner (a prefetch instruction, which never faults).
 //!
 //! # Cargo features
 //! - `nalgebra`: conversions to and from `nalgebra` (no_std compatible; uses nalgebra's `libm`).
@@ -105,6 +106,7 @@ mod linalg;
 pub mod manifold;
 pub mod place;
 mod pose;
+mod prefetch;
 pub mod prelude;
 mod real;
 pub mod sim;
