@@ -5,8 +5,9 @@
 //! core's L2 cache, every line written must first be fetched, and a burst of fetches waits on
 //! the processor's few outstanding misses: on an Intel Xeon (Emerald Rapids) the `f64x4` batch
 //! of 1024 anymal mass matrices ran slower than the scalar code, and fetching the next vector's
-//! lines while the current one computes took a third off it (`docs/performance-log.md`,
-//! 29 November, late evening). On other targets the hint is nothing.
+//! lines while the current one computes took 11 to 31 % off it in alternated rounds
+//! (`docs/performance-log.md`, 29 November, late evening). On other targets the hint is
+//! nothing.
 //!
 //! This module holds one of the crate's `unsafe` blocks: `_mm_prefetch` takes a raw pointer.
 //! A prefetch instruction never faults and changes no memory or register the program can
