@@ -5,8 +5,9 @@
 //! states into the widest SIMD lanes the target supports ([`Batch::Lanes`]: with the `simd`
 //! feature, `f64x4` and `f32x8` where AVX is enabled at compile time, `f64x2` and `f32x4` with
 //! SSE2, NEON or WebAssembly SIMD; one state at a time otherwise), fills the last, partial
-//! vector with copies of its last state, never allocates, and with the `rayon` feature (host
-//! only) spreads the vectors over rayon's threads. Slices of different lengths are an error
+//! vector with copies of its last state, never allocates, asks the processor for the next
+//! vector's result memory while the current one computes ([`Outputs::prefetch`]), and with the
+//! `rayon` feature (host only) spreads the vectors over rayon's threads. Slices of different lengths are an error
 //! ([`BatchError`]), checked before anything is written.
 //!
 //! ```
