@@ -7,8 +7,8 @@
 //! SSE2, NEON or WebAssembly SIMD; one state at a time otherwise), fills the last, partial
 //! vector with copies of its last state, never allocates, asks the processor for the next
 //! vector's result memory while the current one computes ([`Outputs::prefetch`]), and with the
-//! `rayon` feature (host only) spreads the vectors over rayon's threads. Slices of different lengths are an error
-//! ([`BatchError`]), checked before anything is written.
+//! `rayon` feature (host only) spreads the vectors over rayon's threads. Slices of different
+//! lengths are an error ([`BatchError`]), checked before anything is written.
 //!
 //! ```
 //! # mod generated { include!("../../generated/src/double_pendulum.rs"); }
@@ -391,7 +391,7 @@ fn from_outside<O: Outputs>(lanes: usize, out: O, f: &(impl Fn(usize, O) + Sync)
 /// [`run`] on the calling thread. The next chunk's results are fetched while the current one
 /// computes ([`Outputs::prefetch`]): a vector's results are written in one burst, and where
 /// they lie beyond the L2 cache the burst waited on its fetches (anymal's `f64x4` mass matrix
-/// batch, 1024 states, Intel Xeon: 300 us a call without, 200 us with).
+/// batch, 1024 states, Intel Xeon: 11 to 31 % less time a call in alternated rounds).
 fn sequential<O: Outputs>(mut start: usize, lanes: usize, mut out: O, f: &impl Fn(usize, O)) {
     while out.states() > 0 {
         let (chunk, rest) = out.split_at(lanes);

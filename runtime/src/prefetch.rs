@@ -15,20 +15,10 @@
 //! the lines of a slice the caller holds anyway.
 
 /// Bytes per cache line (x86-64).
-#[cfg(any(
-    test,
-    target_arch = "x86_64",
-    all(target_arch = "x86", target_feature = "sse")
-))]
 const LINE: usize = 64;
 
 /// The lines of `bytes` bytes from address `at`: how far the first line starts before `at`,
 /// and how many lines there are (none for no bytes).
-#[cfg(any(
-    test,
-    target_arch = "x86_64",
-    all(target_arch = "x86", target_feature = "sse")
-))]
 fn span(at: usize, bytes: usize) -> (usize, usize) {
     if bytes == 0 {
         return (0, 0);
@@ -37,36 +27,35 @@ fn span(at: usize, bytes: usize) -> (usize, usize) {
     (back, (back + bytes).div_ceil(LINE))
 }
 
-/// Asks the processor to bring every cache line of `items` into its L1 data cache.
+/// Asks the processor to bring every cache line of `items` into its L1 data cache (where
+/// [`hint`] is nothing, the loop compiles to nothing).
 #[inline(always)]
 pub(crate) fn lines_of<A>(items: &[A]) {
-    #[cfg(any(
-        target_arch = "x86_64",
-        all(target_arch = "x86", target_feature = "sse")
-    ))]
-    {
-        #[cfg(target_arch = "x86")]
-        use core::arch::x86::{_mm_prefetch, _MM_HINT_T0};
-        #[cfg(target_arch = "x86_64")]
-        use core::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
-        let start = items.as_ptr().cast::<i8>();
-        let (back, lines) = span(start as usize, core::mem::size_of_val(items));
-        let first = start.wrapping_sub(back);
-        for k in 0..lines {
-            // SAFETY: a prefetch never faults and has no effect the program can observe
-            // (module documentation); the address is only a hint.
-            #[allow(unsafe_code)]
-            unsafe {
-                _mm_prefetch::<_MM_HINT_T0>(first.wrapping_add(k * LINE));
-            }
-        }
+    let start = items.as_ptr().cast::<i8>();
+    let (back, lines) = span(start as usize, core::mem::size_of_val(items));
+    let first = start.wrapping_sub(back);
+    for k in 0..lines {
+        hint(first.wrapping_add(k * LINE));
     }
-    #[cfg(not(any(
-        target_arch = "x86_64",
-        all(target_arch = "x86", target_feature = "sse")
-    )))]
-    let _ = items;
 }
+
+/// One line's prefetch (`prefetcht0`, SSE: every x86-64 processor).
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn hint(line: *const i8) {
+    use core::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+    // SAFETY: a prefetch never faults and has no effect the program can observe (module
+    // documentation); the address is only a hint.
+    #[allow(unsafe_code)]
+    unsafe {
+        _mm_prefetch::<_MM_HINT_T0>(line);
+    }
+}
+
+/// Elsewhere no hint (stable Rust has no prefetch intrinsic for the other targets).
+#[cfg(not(target_arch = "x86_64"))]
+#[inline(always)]
+fn hint(_line: *const i8) {}
 
 #[cfg(test)]
 mod tests {
